@@ -1,0 +1,146 @@
+//! Pure-component data and property correlations.
+//!
+//! The forms follow the DIPPR equation numbers used by Perry's Chemical Engineers' Handbook
+//! (8th ed., section 2), so published coefficients can be entered as printed (after conversion to
+//! the SI units stated on each variant).
+
+use serde::{Deserialize, Serialize};
+
+use crate::Scalar;
+
+/// One pure component. Fields carry SI units; the library file stores exactly this structure.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Component {
+    /// Name used in flowsheets (lower case, e.g. `"ethanol"`).
+    pub name: String,
+    /// Chemical formula (informational), e.g. `"C2H6O"`.
+    #[serde(default)]
+    pub formula: String,
+    /// CAS registry number (informational).
+    #[serde(default)]
+    pub cas: String,
+    /// Molar mass [kg/mol].
+    pub mw: f64,
+    /// Normal boiling point at 101 325 Pa [K].
+    pub tb: f64,
+    /// Critical temperature [K] (None for hypothetical components).
+    #[serde(default)]
+    pub tc: Option<f64>,
+    /// Critical pressure [Pa].
+    #[serde(default)]
+    pub pc: Option<f64>,
+    /// Acentric factor [-].
+    #[serde(default)]
+    pub omega: Option<f64>,
+    /// Vapour pressure correlation.
+    pub psat: VapourPressure,
+    /// Ideal-gas heat capacity.
+    pub cp_ig: CpIdealGas,
+    /// Liquid heat capacity (reported and checked; the liquid enthalpy itself is built from the
+    /// ideal-gas enthalpy minus the heat of vaporization so that it is consistent with the VLE).
+    pub cp_liq: CpLiquid,
+    /// Heat of vaporization.
+    pub hvap: HeatOfVaporization,
+    /// Liquid molar volume.
+    pub vliq: LiquidVolume,
+    /// Where the numbers come from (book, table, page).
+    #[serde(default)]
+    pub source: String,
+}
+
+/// Vapour pressure `P_sat(T)` [Pa], `T` in K.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "form", rename_all = "snake_case", deny_unknown_fields)]
+pub enum VapourPressure {
+    /// DIPPR 101: `ln P = c[0] + c[1]/T + c[2] ln T + c[3] T^c[4]`, P in Pa.
+    Dippr101 { c: [f64; 5], tmin: f64, tmax: f64 },
+    /// Extended Antoine (Aspen PLXANT form): `ln P = c[0] + c[1]/(T + c[2]) + c[3] T + c[4] ln T + c[5] T^c[6]`, P in Pa.
+    ExtendedAntoine { c: [f64; 7], tmin: f64, tmax: f64 },
+    /// Classic Antoine: `log10 P = a − b/(T + c)`, P in Pa, T in K.
+    Antoine { a: f64, b: f64, c: f64, tmin: f64, tmax: f64 },
+    /// Clausius–Clapeyron with constant heat of vaporization, for hypothetical components:
+    /// `P = p_ref · exp(−hvap/R · (1/T − 1/t_ref))`. Components sharing `hvap` and `t_ref` have a
+    /// constant relative volatility equal to the ratio of their `p_ref`.
+    ClausiusClapeyron { p_ref: f64, t_ref: f64, hvap: f64 },
+}
+
+/// Ideal-gas heat capacity [J/(mol·K)].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "form", rename_all = "snake_case", deny_unknown_fields)]
+pub enum CpIdealGas {
+    /// DIPPR 107 (Aly–Lee): `cp = c[0] + c[1]·((c[2]/T)/sinh(c[2]/T))² + c[3]·((c[4]/T)/cosh(c[4]/T))²`, J/(mol·K).
+    Dippr107 { c: [f64; 5] },
+    /// Polynomial `cp = c[0] + c[1] T + c[2] T² + c[3] T³`, J/(mol·K).
+    Polynomial { c: [f64; 4] },
+    /// Constant, J/(mol·K).
+    Constant { cp: f64 },
+}
+
+/// Liquid heat capacity [J/(mol·K)].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "form", rename_all = "snake_case", deny_unknown_fields)]
+pub enum CpLiquid {
+    /// DIPPR 100: `cp = c[0] + c[1] T + c[2] T² + c[3] T³ + c[4] T⁴`, J/(mol·K).
+    Dippr100 { c: [f64; 5] },
+    /// Constant, J/(mol·K).
+    Constant { cp: f64 },
+}
+
+/// Heat of vaporization `ΔH_vap(T)` [J/mol].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "form", rename_all = "snake_case", deny_unknown_fields)]
+pub enum HeatOfVaporization {
+    /// Watson: `ΔH = h_ref · ((tc − T)/(tc − t_ref))^n`, usually `n = 0.38` and `t_ref = tb`; 0 above tc.
+    Watson { h_ref: f64, t_ref: f64, tc: f64, n: f64 },
+    /// DIPPR 106: `ΔH = c[0] (1 − Tr)^(c[1] + c[2] Tr + c[3] Tr² + c[4] Tr³)`, `Tr = T/tc`, J/mol.
+    Dippr106 { c: [f64; 5], tc: f64 },
+    /// Constant, J/mol (hypothetical components).
+    Constant { h: f64 },
+}
+
+/// Liquid molar volume [m³/mol].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "form", rename_all = "snake_case", deny_unknown_fields)]
+pub enum LiquidVolume {
+    /// DIPPR 105 density: `ρ = c[0] / c[1]^(1 + (1 − T/c[2])^c[3])` in mol/m³; volume = 1/ρ.
+    Dippr105 { c: [f64; 4] },
+    /// Rackett: `V = (R tc / pc) · zra^(1 + (1 − T/tc)^(2/7))`.
+    Rackett { tc: f64, pc: f64, zra: f64 },
+    /// Constant, m³/mol.
+    Constant { v: f64 },
+}
+
+impl Component {
+    /// Vapour pressure [Pa] at `t` [K].
+    pub fn psat<S: Scalar>(&self, t: S) -> S {
+        todo!("{t:?}")
+    }
+    /// Ideal-gas molar enthalpy relative to the ideal gas at 298.15 K [J/mol] (analytic integral of `cp_ig`).
+    pub fn h_ig<S: Scalar>(&self, t: S) -> S {
+        todo!("{t:?}")
+    }
+    /// Heat of vaporization [J/mol] at `t` [K].
+    pub fn dh_vap<S: Scalar>(&self, t: S) -> S {
+        todo!("{t:?}")
+    }
+    /// Liquid molar enthalpy [J/mol]: `h_ig(T) − ΔH_vap(T)`.
+    pub fn h_liq<S: Scalar>(&self, t: S) -> S {
+        self.h_ig(t) - self.dh_vap(t)
+    }
+    /// Liquid heat capacity from the `cp_liq` correlation [J/(mol·K)].
+    pub fn cp_liquid<S: Scalar>(&self, t: S) -> S {
+        todo!("{t:?}")
+    }
+    /// Liquid molar volume [m³/mol] at `t` [K].
+    pub fn v_liq<S: Scalar>(&self, t: S) -> S {
+        todo!("{t:?}")
+    }
+    /// A hypothetical component for constant-relative-volatility studies: vapour pressure by
+    /// Clausius–Clapeyron with `p_sat(t_ref) = alpha · 101 325 Pa`, constant `hvap` [J/mol],
+    /// constant liquid heat capacity `cp` [J/(mol·K)] (ideal-gas heat capacity set equal, so `hvap` is
+    /// temperature independent), molar mass `mw` [kg/mol] and liquid volume `v` [m³/mol].
+    pub fn hypothetical(name: &str, alpha: f64, mw: f64, hvap: f64, t_ref: f64, cp: f64, v: f64) -> Component {
+        todo!("{name}{alpha}{mw}{hvap}{t_ref}{cp}{v}")
+    }
+}

@@ -1,0 +1,1 @@
+//! plantwide-units
