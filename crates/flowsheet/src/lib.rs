@@ -1,1 +1,18 @@
-//! plantwide-flowsheet
+//! Flowsheet files (JSON) and their assembly into one plant DAE.
+//!
+//! Entry point: [`load_file`] → [`Plant`]. Loading collects every problem it finds and reports them
+//! together, each with the file, the JSON path and what would fix it.
+
+pub mod assemble;
+pub mod components;
+pub mod error;
+pub mod guess;
+pub mod parse;
+pub mod plant;
+pub mod spec;
+
+pub use assemble::{assemble, load_file, load_str};
+pub use error::{Diagnostic, LoadError};
+pub use parse::parse_spec;
+pub use plant::{Block, BlockKind, InputInfo, Plant, Read, StreamInfo, VarInfo};
+pub use spec::FlowsheetSpec;

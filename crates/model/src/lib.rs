@@ -1,1 +1,26 @@
-//! plantwide-model
+//! The unit library of plantwide: every unit and controller is written once, as equations, and that
+//! one model serves the whole-plant Newton steady state, dynamic integration and linearization.
+//!
+//! The plant is the semi-explicit DAE `M · dx/dt = f(x, u, t)`. A unit owns a block of variables
+//! (its outlet streams, then its internal variables) and writes a block of residuals: for a
+//! differential variable the residual *is* its time derivative; for an algebraic variable it is an
+//! equation that is zero at a solution.
+//!
+//! **Architecture Invariant:** a unit sees only its local read vector ([`UnitIo`]); global indices,
+//! other units and solvers never leak in. This crate knows nothing about files or solvers.
+
+pub mod build;
+pub mod controllers;
+pub mod registry;
+pub mod stream;
+pub mod unit;
+pub mod units;
+pub mod var;
+
+pub use build::{BuildCx, FieldError};
+pub use registry::{ControllerSpec, UnitSpec};
+pub use stream::{Stream, StreamLayout};
+pub use unit::{InputSpec, LocalLayout, SignalSpec, Unit, UnitIo, UnitModel};
+pub use var::{VarKind, VarSpec};
+
+pub use plantwide_thermo::Scalar;

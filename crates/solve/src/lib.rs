@@ -1,1 +1,15 @@
-//! plantwide-solve
+//! Numerical solvers over a time-unaware nonlinear system: Newton with faer sparse LU, scaled
+//! residuals, bounded backtracking line search and pseudo-transient continuation; structural
+//! analysis (maximum matching) for degrees-of-freedom diagnostics.
+//!
+//! **Architecture Invariant:** solvers see a [`System`] (residual, Jacobian triplets, bounds,
+//! nominal magnitudes, mass-matrix pattern), never a unit, a stream or a file.
+
+pub mod newton;
+pub mod sparse;
+pub mod structure;
+pub mod system;
+
+pub use newton::{solve_steady, IterationRecord, NewtonReport, NewtonSettings, NewtonStatus};
+pub use structure::{maximum_matching, Matching};
+pub use system::System;

@@ -1,0 +1,118 @@
+//! Resolving the flowsheet's components and thermodynamic model into a [`ThermoPackage`].
+
+use plantwide_thermo::{Component, Library, ThermoPackage, VleModel};
+use plantwide_units::{Dimension, QuantityValue};
+
+use crate::error::{did_you_mean, Diagnostic};
+use crate::spec::{ComponentSpec, ThermoSpec, VleChoice};
+
+/// Component names and the thermodynamic package, or diagnostics.
+pub fn thermo_package(components: &[ComponentSpec], thermo: &ThermoSpec, diags: &mut Vec<Diagnostic>) -> Option<(Vec<String>, ThermoPackage, Vec<Option<f64>>)> {
+    let library = match Library::builtin() {
+        Ok(l) => l,
+        Err(e) => {
+            diags.push(Diagnostic::new("components", e.to_string()));
+            return None;
+        }
+    };
+    let mut comps = Vec::new();
+    let mut alphas = Vec::new();
+    let n0 = diags.len();
+    for (i, spec) in components.iter().enumerate() {
+        let path = format!("components[{i}]");
+        match spec {
+            ComponentSpec::Library(name) => match library.component(name) {
+                Ok(c) => {
+                    comps.push(c.clone());
+                    alphas.push(None);
+                }
+                Err(_) => diags.push(Diagnostic::new(
+                    path,
+                    format!(
+                        "unknown component `{name}`{}; `plantwide components` lists the library, or define it inline with \"hypothetical\"",
+                        did_you_mean(name, library.components.iter().map(|c| c.name.as_str()))
+                    ),
+                )),
+            },
+            ComponentSpec::Hypothetical { name, hypothetical: h } => {
+                let mut q = |field: &str, v: Option<&QuantityValue>, dim: Dimension, default: f64| -> f64 {
+                    let Some(v) = v else { return default };
+                    match v.to_si(dim) {
+                        Ok(x) if x.is_finite() && x > 0.0 => x,
+                        Ok(x) => {
+                            diags.push(Diagnostic::new(format!("{path}.hypothetical.{field}"), format!("must be positive (got {x})")));
+                            default
+                        }
+                        Err(e) => {
+                            diags.push(Diagnostic::new(format!("{path}.hypothetical.{field}"), e.to_string()));
+                            default
+                        }
+                    }
+                };
+                let mw = q("mw", Some(&h.mw), Dimension::MOLAR_MASS, 0.05);
+                let hvap = q("hvap", Some(&h.hvap), Dimension::MOLAR_ENERGY, 3e4);
+                let t_ref = q("t_ref", h.t_ref.as_ref(), Dimension::TEMPERATURE, 350.0);
+                let cp = q("cp", h.cp.as_ref(), Dimension::MOLAR_HEAT_CAPACITY, 150.0);
+                let v = q("v_liq", h.v_liq.as_ref(), Dimension::MOLAR_VOLUME, 1e-4);
+                if !(h.alpha.is_finite() && h.alpha > 0.0) {
+                    diags.push(Diagnostic::new(format!("{path}.hypothetical.alpha"), format!("relative volatility must be positive (got {})", h.alpha)));
+                }
+                comps.push(Component::hypothetical(name, h.alpha, mw, hvap, t_ref, cp, v));
+                alphas.push(Some(h.alpha));
+            }
+            ComponentSpec::Inline(c) => {
+                comps.push((**c).clone());
+                alphas.push(None);
+            }
+        }
+    }
+    let names: Vec<String> = comps.iter().map(|c| c.name.clone()).collect();
+    for (i, n) in names.iter().enumerate() {
+        if names[..i].contains(n) {
+            diags.push(Diagnostic::new(format!("components[{i}]"), format!("component `{n}` is listed twice")));
+        }
+    }
+    if names.is_empty() && diags.len() == n0 {
+        diags.push(Diagnostic::new("components", "a flowsheet needs at least one component"));
+    }
+    if diags.len() > n0 {
+        return None;
+    }
+    let vle = match thermo.vle {
+        VleChoice::Ideal => VleModel::Ideal,
+        VleChoice::ConstantAlpha => {
+            let mut alpha = Vec::new();
+            for (i, name) in names.iter().enumerate() {
+                let a = thermo.alpha.as_ref().and_then(|m| m.get(name).copied()).or(alphas[i]);
+                match a {
+                    Some(a) if a.is_finite() && a > 0.0 => alpha.push(a),
+                    _ => diags.push(Diagnostic::new(
+                        format!("thermo.alpha.{name}"),
+                        "constant_alpha needs a positive relative volatility for every component (in thermo.alpha or as a hypothetical component's alpha)",
+                    )),
+                }
+            }
+            if let Some(m) = &thermo.alpha {
+                for k in m.keys().filter(|k| !names.contains(k)) {
+                    diags.push(Diagnostic::new(format!("thermo.alpha.{k}"), format!("`{k}` is not a component of this flowsheet")));
+                }
+            }
+            VleModel::ConstantAlpha { alpha }
+        }
+        VleChoice::Nrtl | VleChoice::Wilson => {
+            let kind = if thermo.vle == VleChoice::Nrtl { "nrtl" } else { "wilson" };
+            let refs: Vec<&str> = names.iter().map(String::as_str).collect();
+            match library.activity_model(kind, &refs, &thermo.binary_parameters) {
+                Ok(m) => VleModel::Activity(m),
+                Err(e) => {
+                    diags.push(Diagnostic::new("thermo.vle", e.to_string()));
+                    VleModel::Ideal
+                }
+            }
+        }
+    };
+    if diags.len() > n0 {
+        return None;
+    }
+    Some((names, ThermoPackage { components: comps, vle }, alphas))
+}

@@ -1,0 +1,93 @@
+//! Loading and validation errors. Every diagnostic names the file and the JSON path of the
+//! offending field, and says what would fix it; all problems found are reported together.
+
+/// One problem in a flowsheet file.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Diagnostic {
+    /// JSON path (`units.feed.F`, `streams.s3.to`); empty for the whole file.
+    pub path: String,
+    /// What is wrong and what would fix it.
+    pub message: String,
+}
+
+impl Diagnostic {
+    /// A diagnostic at `path`.
+    pub fn new(path: impl Into<String>, message: impl Into<String>) -> Diagnostic {
+        Diagnostic { path: path.into(), message: message.into() }
+    }
+}
+
+/// Why a flowsheet could not be loaded.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum LoadError {
+    /// The file could not be read.
+    #[error("{file}: cannot read the file: {reason}")]
+    Io {
+        /// File path.
+        file: String,
+        /// Operating-system reason.
+        reason: String,
+    },
+    /// The file is not valid JSON.
+    #[error("{file}:{line}:{column}: malformed JSON: {reason}")]
+    Syntax {
+        /// File path.
+        file: String,
+        /// 1-based line.
+        line: usize,
+        /// 1-based column.
+        column: usize,
+        /// Parser message.
+        reason: String,
+    },
+    /// The JSON is well formed but describes an invalid flowsheet.
+    #[error("{}", render(file, diagnostics))]
+    Invalid {
+        /// File path.
+        file: String,
+        /// Every problem found.
+        diagnostics: Vec<Diagnostic>,
+    },
+}
+
+fn render(file: &str, diagnostics: &[Diagnostic]) -> String {
+    let n = diagnostics.len();
+    let mut s = format!("{file}: {n} problem{} found", if n == 1 { "" } else { "s" });
+    for d in diagnostics {
+        if d.path.is_empty() {
+            s.push_str(&format!("\n  - {}", d.message));
+        } else {
+            s.push_str(&format!("\n  - {}: {}", d.path, d.message));
+        }
+    }
+    s
+}
+
+/// The closest of `candidates` to `word` by edit distance, if it is close enough to be a likely typo.
+pub fn suggest<'a>(word: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
+    let w = word.to_lowercase();
+    candidates
+        .into_iter()
+        .map(|c| (edit_distance(&w, &c.to_lowercase()), c))
+        .filter(|(d, c)| *d <= 2.max(c.len() / 3))
+        .min_by_key(|(d, _)| *d)
+        .map(|(_, c)| c)
+}
+
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut prev: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut cur = vec![i + 1; b.len() + 1];
+        for (j, cb) in b.iter().enumerate() {
+            cur[j + 1] = (prev[j] + usize::from(ca != *cb)).min(prev[j + 1] + 1).min(cur[j] + 1);
+        }
+        prev = cur;
+    }
+    prev[b.len()]
+}
+
+/// " Did you mean `x`?" or nothing.
+pub fn did_you_mean<'a>(word: &str, candidates: impl IntoIterator<Item = &'a str>) -> String {
+    suggest(word, candidates).map(|s| format!(" (did you mean `{s}`?)")).unwrap_or_default()
+}

@@ -1,0 +1,207 @@
+//! Assembly of a validated flowsheet into one plant DAE `M dx/dt = f(x, u)`: the global variable
+//! vector, the equation blocks of every unit and controller, the inputs `u`, and the paths that name
+//! every variable and input.
+
+use std::collections::HashMap;
+
+use plantwide_model::stream::StreamLayout;
+use plantwide_model::{LocalLayout, Unit, UnitIo, VarKind, VarSpec};
+use plantwide_thermo::ThermoPackage;
+use plantwide_units::Dimension;
+
+/// Where one entry of a unit's local vector (beyond its own variables) comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Read {
+    /// Global variable index.
+    Var(usize),
+    /// Free input index (not driven by a controller).
+    Input(usize),
+}
+
+/// Whether a block is a process unit or a controller.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BlockKind {
+    /// A process unit.
+    Unit,
+    /// A controller.
+    Controller,
+}
+
+/// One unit or controller in the assembled plant.
+#[derive(Debug)]
+pub struct Block {
+    /// Name in the flowsheet.
+    pub name: String,
+    /// Unit or controller.
+    pub kind: BlockKind,
+    /// The model.
+    pub unit: Box<dyn Unit>,
+    /// Its local layout.
+    pub layout: LocalLayout,
+    /// First global variable it owns.
+    pub own_offset: usize,
+    /// First global equation it writes.
+    pub eq_offset: usize,
+    /// Number of equations.
+    pub n_eq: usize,
+    /// Sources of the local entries after the own variables.
+    pub reads: Vec<Read>,
+    /// Global input indices of its declared inputs, in declaration order.
+    pub input_ids: Vec<usize>,
+}
+
+/// A global variable.
+#[derive(Debug, Clone, PartialEq)]
+pub struct VarInfo {
+    /// Path (`feed.F`, `tank.level`, `lc1.op`).
+    pub path: String,
+    /// Description from the owning unit.
+    pub spec: VarSpec,
+    /// Owning block.
+    pub block: usize,
+}
+
+/// A declared input of some unit: a manipulated variable or disturbance.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InputInfo {
+    /// Path (`valve.opening`, `fresh.F`).
+    pub path: String,
+    /// SI dimension.
+    pub dim: Dimension,
+    /// Value used when no controller drives it (SI).
+    pub value: f64,
+    /// The controller output variable that drives it, if any.
+    pub driven_by: Option<usize>,
+    /// Owning block.
+    pub block: usize,
+}
+
+/// A material stream of the plant.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StreamInfo {
+    /// Name.
+    pub name: String,
+    /// Source block and outlet port index.
+    pub from: (usize, usize),
+    /// Destination block and inlet port index.
+    pub to: (usize, usize),
+    /// First global variable (`F`) of its block.
+    pub offset: usize,
+    /// Marked as a preferred tear.
+    pub tear: bool,
+}
+
+/// The assembled plant.
+#[derive(Debug)]
+pub struct Plant {
+    /// File the plant came from (for messages).
+    pub file: String,
+    /// Name of the plant.
+    pub name: String,
+    /// Component names.
+    pub components: Vec<String>,
+    /// Thermodynamic package.
+    pub thermo: ThermoPackage,
+    /// Stream layout.
+    pub stream_layout: StreamLayout,
+    /// Units and controllers.
+    pub blocks: Vec<Block>,
+    /// Global variables.
+    pub vars: Vec<VarInfo>,
+    /// Declared inputs.
+    pub inputs: Vec<InputInfo>,
+    /// Streams.
+    pub streams: Vec<StreamInfo>,
+    /// Named inputs (`alias → input index`).
+    pub aliases: HashMap<String, usize>,
+    pub(crate) var_index: HashMap<String, usize>,
+    pub(crate) input_index: HashMap<String, usize>,
+}
+
+impl Plant {
+    /// Number of variables (= number of equations in a well-posed plant).
+    pub fn n_vars(&self) -> usize {
+        self.vars.len()
+    }
+    /// Number of equations.
+    pub fn n_eqs(&self) -> usize {
+        self.blocks.iter().map(|b| b.n_eq).sum()
+    }
+    /// Global index of the variable at `path` (`stream.x[comp]` and `stream.z[comp]` both work).
+    pub fn var(&self, path: &str) -> Option<usize> {
+        self.var_index.get(path).or_else(|| self.var_index.get(&path.replace(".z[", ".x["))).copied()
+    }
+    /// Index of the input at `path` or named by an alias.
+    pub fn input(&self, path: &str) -> Option<usize> {
+        self.input_index.get(path).or_else(|| self.aliases.get(path)).copied()
+    }
+    /// Current values of all inputs (SI).
+    pub fn input_values(&self) -> Vec<f64> {
+        self.inputs.iter().map(|i| i.value).collect()
+    }
+    /// Differential flags of the variables (the diagonal of M).
+    pub fn differential(&self) -> Vec<bool> {
+        self.vars.iter().map(|v| v.spec.kind == VarKind::Differential).collect()
+    }
+    /// Name of global equation `eq` for diagnostics: `unit: equation for <var>`.
+    pub fn equation_name(&self, eq: usize) -> String {
+        let Some(b) = self.blocks.iter().find(|b| eq >= b.eq_offset && eq < b.eq_offset + b.n_eq) else {
+            return format!("equation {eq}");
+        };
+        let own: Vec<String> = self.vars[b.own_offset..b.own_offset + b.layout.n_own()].iter().map(|v| v.path.clone()).collect();
+        format!("{}: {}", b.name, b.unit.equation_name(eq - b.eq_offset, &own))
+    }
+
+    /// Fill `local` with block `b`'s local vector from `x` and inputs `u`.
+    pub fn gather(&self, b: &Block, x: &[f64], u: &[f64], local: &mut Vec<f64>) {
+        local.clear();
+        local.extend_from_slice(&x[b.own_offset..b.own_offset + b.layout.n_own()]);
+        local.extend(b.reads.iter().map(|r| match *r {
+            Read::Var(i) => x[i],
+            Read::Input(j) => u[j],
+        }));
+    }
+
+    /// Residuals `f(x, u)` at time `t` into `r` (length `n_eqs`).
+    pub fn residual(&self, x: &[f64], u: &[f64], t: f64, r: &mut [f64]) {
+        let mut local = Vec::new();
+        for b in &self.blocks {
+            self.gather(b, x, u, &mut local);
+            let io = UnitIo { local: &local, layout: &b.layout, thermo: &self.thermo, time: t };
+            b.unit.residual(&io, &mut r[b.eq_offset..b.eq_offset + b.n_eq]);
+        }
+    }
+
+    /// Residuals and Jacobians: `∂f/∂x` as triplets `(row, col, value)` into `jx`, and `∂f/∂u`
+    /// (free inputs only) into `ju`. Structural entries are kept even when their value is zero, so
+    /// the pattern is the same at every point.
+    pub fn jacobian(&self, x: &[f64], u: &[f64], t: f64, r: &mut [f64], jx: &mut Vec<(usize, usize, f64)>, ju: &mut Vec<(usize, usize, f64)>) {
+        jx.clear();
+        ju.clear();
+        let mut local = Vec::new();
+        let mut jac = Vec::new();
+        for b in &self.blocks {
+            self.gather(b, x, u, &mut local);
+            let n = local.len();
+            jac.clear();
+            jac.resize(b.n_eq * n, 0.0);
+            let io = UnitIo { local: &local, layout: &b.layout, thermo: &self.thermo, time: t };
+            b.unit.jacobian(&io, &mut r[b.eq_offset..b.eq_offset + b.n_eq], &mut jac);
+            let n_own = b.layout.n_own();
+            for k in 0..b.n_eq {
+                let row = b.eq_offset + k;
+                for j in 0..n {
+                    let v = jac[k * n + j];
+                    if j < n_own {
+                        jx.push((row, b.own_offset + j, v));
+                    } else {
+                        match b.reads[j - n_own] {
+                            Read::Var(i) => jx.push((row, i, v)),
+                            Read::Input(i) => ju.push((row, i, v)),
+                        }
+                    }
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,127 @@
+//! The flowsheet file format (JSON). `flowsheets/plantwide.schema.json` is generated from these
+//! types (`plantwide schema`), so editors can validate and autocomplete.
+//!
+//! Quantities are strings with units (`"1 kmol/min"`, `"80 degC"`) or bare SI numbers
+//! (mol, s, K, Pa, J, m). The format carries `format_version: 1`.
+
+use std::collections::BTreeMap;
+
+use indexmap::IndexMap;
+use plantwide_model::{ControllerSpec, UnitSpec};
+use plantwide_thermo::{BinaryPair, Component};
+use plantwide_units::QuantityValue;
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+/// The format version this build reads and writes.
+pub const FORMAT_VERSION: u32 = 1;
+
+/// A whole flowsheet file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct FlowsheetSpec {
+    /// Format version; must be 1.
+    pub format_version: u32,
+    /// Short name of the plant.
+    #[serde(default)]
+    pub name: String,
+    /// What the plant is and where its data come from.
+    #[serde(default)]
+    pub description: String,
+    /// Components, in the order used by every composition: library names (`"water"`),
+    /// hypothetical components or full inline data.
+    pub components: Vec<ComponentSpec>,
+    /// Thermodynamic model.
+    pub thermo: ThermoSpec,
+    /// Process units by name.
+    pub units: IndexMap<String, UnitSpec>,
+    /// Material streams by name, each from an outlet port to an inlet port.
+    pub streams: IndexMap<String, StreamSpec>,
+    /// Controllers by name (they share the name space of units).
+    #[serde(default)]
+    pub controllers: IndexMap<String, ControllerSpec>,
+    /// Named inputs and disturbances: a short name for an input path (`"feed_rate": "fresh.F"`).
+    #[serde(default)]
+    pub inputs: IndexMap<String, String>,
+}
+
+/// A component of the flowsheet.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(untagged)]
+pub enum ComponentSpec {
+    /// A component of the built-in library, by name (`plantwide components` lists them).
+    Library(String),
+    /// A hypothetical component defined by its relative volatility.
+    Hypothetical {
+        /// Name used in compositions and paths.
+        name: String,
+        /// Its definition.
+        hypothetical: HypotheticalSpec,
+    },
+    /// A component with full property data (same fields as the library file).
+    Inline(Box<Component>),
+}
+
+/// A hypothetical component for constant-relative-volatility studies. Components that share `hvap`
+/// and `t_ref` have exactly the relative volatility given by the ratio of their `alpha`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct HypotheticalSpec {
+    /// Relative volatility against the reference scale (the heaviest component usually has 1).
+    pub alpha: f64,
+    /// Molar mass (e.g. `"50 kg/kmol"`; bare numbers in kg/mol).
+    pub mw: QuantityValue,
+    /// Heat of vaporization (e.g. `"30 kJ/mol"`).
+    pub hvap: QuantityValue,
+    /// Temperature at which a component of `alpha = 1` boils at 1 atm (default 350 K).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub t_ref: Option<QuantityValue>,
+    /// Liquid (and ideal-gas) heat capacity (default 150 J/(mol K)).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cp: Option<QuantityValue>,
+    /// Liquid molar volume (default 1e-4 m3/mol).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub v_liq: Option<QuantityValue>,
+}
+
+/// VLE model choice.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum VleChoice {
+    /// Constant relative volatility (from the hypothetical components' `alpha` or `thermo.alpha`).
+    ConstantAlpha,
+    /// Raoult's law with the components' vapour pressures.
+    Ideal,
+    /// NRTL activity coefficients with binary parameters.
+    Nrtl,
+    /// Wilson activity coefficients with binary parameters.
+    Wilson,
+}
+
+/// Thermodynamic model of the flowsheet.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ThermoSpec {
+    /// VLE model.
+    pub vle: VleChoice,
+    /// Relative volatilities by component for `constant_alpha` (default: the hypothetical
+    /// components' `alpha`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub alpha: Option<BTreeMap<String, f64>>,
+    /// Binary parameters that add to or override the library's (`nrtl`, `wilson`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub binary_parameters: Vec<BinaryPair>,
+}
+
+/// A material stream from an outlet port to an inlet port.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct StreamSpec {
+    /// Source `"unit.port"` (or `"unit"` when the unit has one outlet).
+    pub from: String,
+    /// Destination `"unit.port"` (or `"unit"` when the unit has one inlet).
+    pub to: String,
+    /// Prefer this stream as a tear stream in the sequential-modular pass.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub tear: bool,
+}

@@ -1,0 +1,114 @@
+//! Building units from their flowsheet descriptions: quantity conversion and error collection.
+
+use std::collections::BTreeMap;
+
+use plantwide_thermo::ThermoPackage;
+use plantwide_units::{Dimension, QuantityValue};
+
+/// A problem with one field of the flowsheet file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FieldError {
+    /// JSON path of the field (`units.feed.F`).
+    pub path: String,
+    /// What is wrong and what would fix it.
+    pub message: String,
+}
+
+impl std::fmt::Display for FieldError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}: {}", self.path, self.message)
+    }
+}
+
+/// Context for building one unit: the flowsheet's components and thermodynamics, the JSON path of
+/// the unit, and the errors found so far (all are reported, not only the first).
+#[derive(Debug)]
+pub struct BuildCx<'a> {
+    /// Component names in flowsheet order.
+    pub components: &'a [String],
+    /// Thermodynamic package.
+    pub thermo: &'a ThermoPackage,
+    /// JSON path of the unit being built (`units.tank1`).
+    pub path: String,
+    /// Errors collected while building.
+    pub errors: Vec<FieldError>,
+}
+
+impl<'a> BuildCx<'a> {
+    /// A context for the unit at JSON path `path`.
+    pub fn new(components: &'a [String], thermo: &'a ThermoPackage, path: impl Into<String>) -> BuildCx<'a> {
+        BuildCx { components, thermo, path: path.into(), errors: Vec::new() }
+    }
+    /// Record an error on `field` of the current unit.
+    pub fn error(&mut self, field: &str, message: impl Into<String>) {
+        let path = if field.is_empty() { self.path.clone() } else { format!("{}.{field}", self.path) };
+        self.errors.push(FieldError { path, message: message.into() });
+    }
+    /// Convert a quantity to SI, recording a dimension or parse error (returns NaN on error).
+    pub fn quantity(&mut self, field: &str, value: &QuantityValue, dim: Dimension) -> f64 {
+        match value.to_si(dim) {
+            Ok(v) if v.is_finite() => v,
+            Ok(v) => {
+                self.error(field, format!("value {v} is not finite"));
+                f64::NAN
+            }
+            Err(e) => {
+                self.error(field, e.to_string());
+                f64::NAN
+            }
+        }
+    }
+    /// A quantity that must be ≥ 0.
+    pub fn non_negative(&mut self, field: &str, value: &QuantityValue, dim: Dimension) -> f64 {
+        let v = self.quantity(field, value, dim);
+        if v < 0.0 {
+            self.error(field, format!("must not be negative (got {v} in SI units)"));
+        }
+        v
+    }
+    /// A quantity that must be > 0.
+    pub fn positive(&mut self, field: &str, value: &QuantityValue, dim: Dimension) -> f64 {
+        let v = self.quantity(field, value, dim);
+        if v <= 0.0 {
+            self.error(field, format!("must be positive (got {v} in SI units)"));
+        }
+        v
+    }
+    /// A plain fraction in `[lo, hi]`.
+    pub fn in_range(&mut self, field: &str, v: f64, lo: f64, hi: f64) -> f64 {
+        if !(v.is_finite() && v >= lo && v <= hi) {
+            self.error(field, format!("must lie in [{lo}, {hi}] (got {v})"));
+        }
+        v
+    }
+    /// A composition given as `{component: fraction}`; missing components are 0; the fractions must
+    /// be non-negative and sum to 1 within 1e-6 (they are then normalised exactly).
+    pub fn composition(&mut self, field: &str, map: &BTreeMap<String, f64>) -> Vec<f64> {
+        let mut z = vec![0.0; self.components.len()];
+        for (name, &v) in map {
+            match self.components.iter().position(|c| c == name) {
+                Some(i) => {
+                    if !(v.is_finite() && v >= 0.0) {
+                        self.error(&format!("{field}.{name}"), format!("mole fraction must be finite and ≥ 0 (got {v})"));
+                    }
+                    z[i] = v;
+                }
+                None => self.error(
+                    &format!("{field}.{name}"),
+                    format!("`{name}` is not a component of this flowsheet (components: {})", self.components.join(", ")),
+                ),
+            }
+        }
+        let sum: f64 = z.iter().sum();
+        if (sum - 1.0).abs() > 1e-6 {
+            self.error(field, format!("mole fractions sum to {sum}, not 1"));
+        } else {
+            z.iter_mut().for_each(|v| *v /= sum);
+        }
+        z
+    }
+    /// Finish: the built value or every error found.
+    pub fn finish<T>(self, value: T) -> Result<T, Vec<FieldError>> {
+        if self.errors.is_empty() { Ok(value) } else { Err(self.errors) }
+    }
+}

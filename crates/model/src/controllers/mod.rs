@@ -1,0 +1,79 @@
+//! Controllers are units: a PI controller's integral is a differential variable, so at steady state
+//! its residual forces the error to zero and a "design spec" is just a controller in the flowsheet.
+
+pub mod pid;
+
+use plantwide_units::{Dimension, QuantityValue};
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+/// What the flowsheet resolved for a controller before building it: the dimensions of the measured
+/// variable and of the driven input, and the driven input's value in the flowsheet.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ControllerLinks {
+    /// Dimension of the measurement (`pv`).
+    pub pv_dim: Dimension,
+    /// Dimension of the driven input.
+    pub op_dim: Dimension,
+    /// The driven input's value in the flowsheet (SI): the default bias, for a bumpless start.
+    pub op_value: f64,
+    /// Current value of the measurement at the initial guess (SI), used for scaling.
+    pub pv_nominal: f64,
+}
+
+/// A setpoint: a value (an input `sp` that analyses and scenarios may move) or another controller's
+/// output (cascade).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(untagged)]
+pub enum Setpoint {
+    /// A local setpoint, e.g. `"1.2 m"`.
+    Value(QuantityValue),
+    /// A remote setpoint: `{"from": "tc1.op"}`.
+    Remote {
+        /// Variable path of the master controller's output.
+        from: String,
+    },
+}
+
+/// Controller action.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum Action {
+    /// Output falls when the measurement rises (`e = sp − pv`): most flow-to-level-out loops are *not*
+    /// this; a heater duty on a temperature is.
+    #[default]
+    Reverse,
+    /// Output rises when the measurement rises (`e = pv − sp`), e.g. a level held by the outflow.
+    Direct,
+}
+
+/// Operating mode.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum Mode {
+    /// Closed loop.
+    #[default]
+    Auto,
+    /// Output held at `op_manual`; the integral tracks it for a bumpless return to auto.
+    Manual,
+}
+
+/// The variable paths a controller description names, resolved by the flowsheet before building.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ControllerPaths {
+    /// Measured variables (`pv`, remote setpoints, selector inputs), with their JSON field names.
+    pub measured: Vec<(String, String)>,
+    /// Driven inputs (`unit.input`), with their JSON field names.
+    pub driven: Vec<(String, String)>,
+}
+
+/// What every controller description offers.
+pub trait ControllerConfig: std::fmt::Debug {
+    /// The paths it reads and drives.
+    fn paths(&self) -> ControllerPaths;
+}
+
+/// The dimension a controller gain must have: output per unit of measurement.
+pub fn gain_dimension(links: &ControllerLinks) -> Dimension {
+    links.op_dim / links.pv_dim
+}

@@ -1,0 +1,67 @@
+//! The registries: flowsheet descriptions (`"type": "..."` in JSON) mapped to unit models.
+//! Adding a unit type is one line in `unit_registry!` below (plus its file and `pub mod` line).
+
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+use crate::controllers::{self, ControllerConfig, ControllerLinks};
+use crate::units;
+use crate::{BuildCx, FieldError, Unit};
+
+/// What every unit description offers (nothing beyond `Debug` for now).
+pub trait UnitConfig: std::fmt::Debug {}
+
+impl<T: std::fmt::Debug> UnitConfig for T {}
+
+macro_rules! registry {
+    ($(#[$meta:meta])* $name:ident, $cx:ty, $tr:path, [$($tag:literal => $variant:ident($cfg:ty, $unit:ty)),* $(,)?]) => {
+        $(#[$meta])*
+        #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+        #[serde(tag = "type")]
+        pub enum $name {
+            $(
+                #[doc = concat!("`\"type\": \"", $tag, "\"`")]
+                #[serde(rename = $tag)]
+                $variant($cfg),
+            )*
+        }
+
+        impl $name {
+            /// Every type name, as written in flowsheet files.
+            pub const TYPES: &'static [&'static str] = &[$($tag),*];
+
+            /// Type name as written in flowsheet files.
+            pub fn type_name(&self) -> &'static str {
+                match self { $($name::$variant(_) => $tag,)* }
+            }
+
+            /// The description as a trait object.
+            pub fn config(&self) -> &dyn $tr {
+                match self { $($name::$variant(c) => c,)* }
+            }
+
+            /// Build the unit model, or every error found in the description.
+            pub fn build(&self, cx: BuildCx<'_>, links: $cx) -> Result<Box<dyn Unit>, Vec<FieldError>> {
+                match self {
+                    $($name::$variant(c) => <$unit>::build(c, cx, links).map(|u| Box::new(u) as Box<dyn Unit>),)*
+                }
+            }
+        }
+    };
+}
+
+registry!(
+    /// A process unit's description in a flowsheet file.
+    UnitSpec, (), UnitConfig, [
+    "feed" => Feed(units::feed::FeedConfig, units::feed::Feed),
+    "product" => Product(units::product::ProductConfig, units::product::Product),
+    "mixer" => Mixer(units::mixer::MixerConfig, units::mixer::Mixer),
+    "splitter" => Splitter(units::splitter::SplitterConfig, units::splitter::Splitter),
+    "heater" => Heater(units::heater::HeaterConfig, units::heater::Heater),
+]);
+
+registry!(
+    /// A controller's description in a flowsheet file.
+    ControllerSpec, &ControllerLinks, ControllerConfig, [
+    "pid" => Pid(controllers::pid::PidConfig, controllers::pid::Pid),
+]);

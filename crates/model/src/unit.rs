@@ -1,0 +1,250 @@
+//! The unit interface.
+//!
+//! A unit reads one contiguous *local vector* laid out as
+//! `[own variables | inlet stream 0 | inlet stream 1 | … | inputs | signals]`, where
+//! - *own variables* are its outlet streams (in outlet-port order, `nc + 4` each) followed by its
+//!   internal variables ([`UnitModel::internal_vars`]);
+//! - *inputs* are its declared manipulable inputs (valve openings, flows, duties): constants from
+//!   the flowsheet or the output variable of a controller;
+//! - *signals* are measured variables (controllers only), resolved from variable paths.
+//!
+//! It writes [`UnitModel::n_equations`] residuals. Residual `k < n_own` belongs to own variable `k`;
+//! for a differential variable it is that variable's time derivative, so the mass matrix of the plant
+//! has a 1 at (equation of `k`, variable `k`). Units that share a flow with a neighbour (a vessel
+//! whose outflow a downstream valve sets) may own more variables than equations or the reverse; the
+//! plant as a whole is square.
+
+use num_dual::Dual64;
+use plantwide_thermo::ThermoPackage;
+use plantwide_units::Dimension;
+
+use crate::{Scalar, Stream, StreamLayout, VarSpec};
+
+/// A manipulable input declared by a unit.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InputSpec {
+    /// Local name (`"opening"`, `"duty"`, `"F"`); the path is `unit.name`.
+    pub name: String,
+    /// SI dimension.
+    pub dim: Dimension,
+    /// Value from the flowsheet (SI), used when no controller drives the input.
+    pub value: f64,
+}
+
+/// A measured variable a controller reads, by path.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SignalSpec {
+    /// Role in the controller (`"pv"`, `"sp"`, `"in1"`, …).
+    pub role: String,
+    /// Variable path to read (`"tank.level"`, `"distillate.x[light]"`).
+    pub path: String,
+}
+
+/// Offsets of the blocks of a unit's local vector.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct LocalLayout {
+    /// Stream block layout.
+    pub stream: StreamLayout,
+    /// Number of outlet streams.
+    pub n_outlets: usize,
+    /// Number of internal variables.
+    pub n_internal: usize,
+    /// Number of inlet streams.
+    pub n_inlets: usize,
+    /// Number of inputs.
+    pub n_inputs: usize,
+    /// Number of signals.
+    pub n_signals: usize,
+}
+
+impl LocalLayout {
+    /// Number of own variables.
+    pub fn n_own(&self) -> usize {
+        self.n_outlets * self.stream.len() + self.n_internal
+    }
+    /// Offset of the first inlet stream.
+    pub fn inlets_offset(&self) -> usize {
+        self.n_own()
+    }
+    /// Offset of the first input.
+    pub fn inputs_offset(&self) -> usize {
+        self.inlets_offset() + self.n_inlets * self.stream.len()
+    }
+    /// Offset of the first signal.
+    pub fn signals_offset(&self) -> usize {
+        self.inputs_offset() + self.n_inputs
+    }
+    /// Length of the local vector.
+    pub fn len(&self) -> usize {
+        self.signals_offset() + self.n_signals
+    }
+    /// True if the unit reads nothing and owns nothing.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+/// What a unit sees during evaluation.
+#[derive(Debug, Clone, Copy)]
+pub struct UnitIo<'a, S> {
+    /// The local vector (see the module documentation).
+    pub local: &'a [S],
+    /// Its layout.
+    pub layout: &'a LocalLayout,
+    /// Thermodynamic package of the flowsheet.
+    pub thermo: &'a ThermoPackage,
+    /// Simulation time [s] (0 at steady state).
+    pub time: f64,
+}
+
+impl<'a, S: Scalar> UnitIo<'a, S> {
+    /// Outlet stream `k` (own variables).
+    pub fn outlet(&self, k: usize) -> Stream<'a, S> {
+        let n = self.layout.stream.len();
+        Stream { v: &self.local[k * n..(k + 1) * n] }
+    }
+    /// Internal variable `i`.
+    pub fn var(&self, i: usize) -> S {
+        self.local[self.layout.n_outlets * self.layout.stream.len() + i]
+    }
+    /// Internal variables `i..i+len`.
+    pub fn vars(&self, i: usize, len: usize) -> &'a [S] {
+        let o = self.layout.n_outlets * self.layout.stream.len() + i;
+        &self.local[o..o + len]
+    }
+    /// Inlet stream `k`.
+    pub fn inlet(&self, k: usize) -> Stream<'a, S> {
+        let n = self.layout.stream.len();
+        let o = self.layout.inlets_offset() + k * n;
+        Stream { v: &self.local[o..o + n] }
+    }
+    /// Input `k`.
+    pub fn input(&self, k: usize) -> S {
+        self.local[self.layout.inputs_offset() + k]
+    }
+    /// Signal `k`.
+    pub fn signal(&self, k: usize) -> S {
+        self.local[self.layout.signals_offset() + k]
+    }
+    /// Number of components.
+    pub fn n_comp(&self) -> usize {
+        self.layout.stream.n_comp
+    }
+}
+
+/// A unit model, written once and generic over the scalar so that dual numbers give its exact
+/// Jacobian. Implement this; the object-safe [`Unit`] follows from a blanket implementation.
+pub trait UnitModel: Send + Sync + std::fmt::Debug {
+    /// Type name as in flowsheet files (`"mixer"`).
+    fn type_name(&self) -> &'static str;
+    /// Inlet port names, in local order.
+    fn inlet_ports(&self) -> Vec<String>;
+    /// Outlet port names, in local order.
+    fn outlet_ports(&self) -> Vec<String>;
+    /// Internal (non-stream) variables, after the outlet streams in the own block.
+    fn internal_vars(&self) -> Vec<VarSpec> {
+        Vec::new()
+    }
+    /// Declared manipulable inputs.
+    fn inputs(&self) -> Vec<InputSpec> {
+        Vec::new()
+    }
+    /// Measured signals (controllers).
+    fn signals(&self) -> Vec<SignalSpec> {
+        Vec::new()
+    }
+    /// Number of equations relative to the own variables (default 0: square).
+    fn extra_equations(&self) -> isize {
+        0
+    }
+    /// Name of equation `k` for diagnostics (default: balance of own variable `k`).
+    fn equation_name(&self, k: usize, own_names: &[String]) -> String {
+        own_names.get(k).map(|n| format!("equation for {n}")).unwrap_or_else(|| format!("equation {k}"))
+    }
+    /// Residuals at the local vector `io.local` into `r`.
+    fn eval<S: Scalar>(&self, io: &UnitIo<'_, S>, r: &mut [S]);
+    /// Initial guess of the own variables from the inlets and inputs in `local` (its own block holds
+    /// whatever was there before: defaults or a previous solution).
+    fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]);
+}
+
+/// Object-safe view of a [`UnitModel`], used by assembly and solvers.
+pub trait Unit: Send + Sync + std::fmt::Debug {
+    /// See [`UnitModel::type_name`].
+    fn type_name(&self) -> &'static str;
+    /// See [`UnitModel::inlet_ports`].
+    fn inlet_ports(&self) -> Vec<String>;
+    /// See [`UnitModel::outlet_ports`].
+    fn outlet_ports(&self) -> Vec<String>;
+    /// See [`UnitModel::internal_vars`].
+    fn internal_vars(&self) -> Vec<VarSpec>;
+    /// See [`UnitModel::inputs`].
+    fn inputs(&self) -> Vec<InputSpec>;
+    /// See [`UnitModel::signals`].
+    fn signals(&self) -> Vec<SignalSpec>;
+    /// See [`UnitModel::extra_equations`].
+    fn extra_equations(&self) -> isize;
+    /// See [`UnitModel::equation_name`].
+    fn equation_name(&self, k: usize, own_names: &[String]) -> String;
+    /// Residuals in `f64`.
+    fn residual(&self, io: &UnitIo<'_, f64>, r: &mut [f64]);
+    /// Residuals and the dense local Jacobian `jac[k][j] = ∂r_k/∂local_j` (row-major, `n_eq × len`),
+    /// exact by forward-mode dual numbers, one pass per local column.
+    fn jacobian(&self, io: &UnitIo<'_, f64>, r: &mut [f64], jac: &mut [f64]);
+    /// See [`UnitModel::guess`].
+    fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]);
+}
+
+impl<U: UnitModel> Unit for U {
+    fn type_name(&self) -> &'static str {
+        UnitModel::type_name(self)
+    }
+    fn inlet_ports(&self) -> Vec<String> {
+        UnitModel::inlet_ports(self)
+    }
+    fn outlet_ports(&self) -> Vec<String> {
+        UnitModel::outlet_ports(self)
+    }
+    fn internal_vars(&self) -> Vec<VarSpec> {
+        UnitModel::internal_vars(self)
+    }
+    fn inputs(&self) -> Vec<InputSpec> {
+        UnitModel::inputs(self)
+    }
+    fn signals(&self) -> Vec<SignalSpec> {
+        UnitModel::signals(self)
+    }
+    fn extra_equations(&self) -> isize {
+        UnitModel::extra_equations(self)
+    }
+    fn equation_name(&self, k: usize, own_names: &[String]) -> String {
+        UnitModel::equation_name(self, k, own_names)
+    }
+    fn residual(&self, io: &UnitIo<'_, f64>, r: &mut [f64]) {
+        self.eval(io, r);
+    }
+    fn jacobian(&self, io: &UnitIo<'_, f64>, r: &mut [f64], jac: &mut [f64]) {
+        let n = io.local.len();
+        let m = r.len();
+        let mut local: Vec<Dual64> = io.local.iter().map(|&v| Dual64::from_re(v)).collect();
+        let mut rd = vec![Dual64::from_re(0.0); m];
+        for j in 0..n {
+            local[j].eps = 1.0;
+            let dio = UnitIo { local: &local, layout: io.layout, thermo: io.thermo, time: io.time };
+            self.eval(&dio, &mut rd);
+            for k in 0..m {
+                jac[k * n + j] = rd[k].eps;
+            }
+            local[j].eps = 0.0;
+        }
+        for k in 0..m {
+            r[k] = rd[k].re;
+        }
+        if n == 0 {
+            self.eval(io, r);
+        }
+    }
+    fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]) {
+        UnitModel::guess(self, io, own);
+    }
+}

@@ -1,0 +1,150 @@
+//! Feed: a source stream of given flow, temperature (or saturated liquid), pressure and composition.
+//!
+//! Port: outlet `out`. Inputs (all may be moved by controllers or analyses):
+//! `F` [mol/s], `T` [K] (not for a saturated-liquid feed), `P` [Pa], and `z[c]` for every component
+//! but the last, which makes up the balance `z_n = 1 − Σ_{i<n} z_i`.
+//!
+//! Equations: `F = F_in`, `P = P_in`, `z_i = z_in,i`, and either `T = T_in` or, for a saturated
+//! liquid, the bubble-point condition `Σ K_i(T, P, z) z_i = 1`; `h = h_phase(T, z)`.
+
+use std::collections::BTreeMap;
+
+use plantwide_units::{Dimension, QuantityValue};
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+use super::Phase;
+use crate::stream::{F, H, P, T, Z0};
+use crate::{BuildCx, FieldError, InputSpec, Scalar, UnitIo, UnitModel};
+
+/// Thermal condition of a feed.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum FeedCondition {
+    /// Liquid at the given temperature.
+    #[default]
+    Liquid,
+    /// Vapour at the given temperature.
+    Vapour,
+    /// Saturated liquid at its bubble point (no temperature given).
+    SaturatedLiquid,
+}
+
+/// Flowsheet description of a feed.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct FeedConfig {
+    /// Molar flow (e.g. `"1 kmol/min"`; bare numbers in mol/s).
+    #[serde(rename = "F")]
+    pub flow: QuantityValue,
+    /// Temperature (e.g. `"350 K"`, `"80 degC"`); omit for a saturated liquid.
+    #[serde(rename = "T", default, skip_serializing_if = "Option::is_none")]
+    pub temperature: Option<QuantityValue>,
+    /// Pressure (e.g. `"1 atm"`; bare numbers in Pa).
+    #[serde(rename = "P")]
+    pub pressure: QuantityValue,
+    /// Mole fractions by component name; missing components are 0.
+    pub z: BTreeMap<String, f64>,
+    /// Thermal condition (default `liquid`).
+    #[serde(default)]
+    pub condition: FeedCondition,
+}
+
+/// A feed source.
+#[derive(Debug, Clone)]
+pub struct Feed {
+    flow: f64,
+    temperature: f64,
+    pressure: f64,
+    z: Vec<f64>,
+    condition: FeedCondition,
+    comp_names: Vec<String>,
+}
+
+impl Feed {
+    /// Build from the flowsheet description.
+    pub fn build(config: &FeedConfig, mut cx: BuildCx<'_>, _links: ()) -> Result<Feed, Vec<FieldError>> {
+        let flow = cx.non_negative("F", &config.flow, Dimension::MOLAR_FLOW);
+        let pressure = cx.positive("P", &config.pressure, Dimension::PRESSURE);
+        let temperature = match (&config.temperature, config.condition) {
+            (Some(t), FeedCondition::Liquid | FeedCondition::Vapour) => cx.positive("T", t, Dimension::TEMPERATURE),
+            (None, FeedCondition::SaturatedLiquid) => f64::NAN,
+            (Some(_), FeedCondition::SaturatedLiquid) => {
+                cx.error("T", "a saturated-liquid feed is at its bubble point: remove `T` or set `condition` to `liquid`");
+                f64::NAN
+            }
+            (None, _) => {
+                cx.error("T", "missing: give the feed temperature (e.g. \"350 K\") or set `condition` to `saturated_liquid`");
+                f64::NAN
+            }
+        };
+        let z = cx.composition("z", &config.z);
+        let comp_names = cx.components.to_vec();
+        cx.finish(Feed { flow, temperature, pressure, z, condition: config.condition, comp_names })
+    }
+
+    fn has_t_input(&self) -> bool {
+        self.condition != FeedCondition::SaturatedLiquid
+    }
+}
+
+impl UnitModel for Feed {
+    fn type_name(&self) -> &'static str {
+        "feed"
+    }
+    fn inlet_ports(&self) -> Vec<String> {
+        Vec::new()
+    }
+    fn outlet_ports(&self) -> Vec<String> {
+        vec!["out".into()]
+    }
+    fn inputs(&self) -> Vec<InputSpec> {
+        let mut v = vec![InputSpec { name: "F".into(), dim: Dimension::MOLAR_FLOW, value: self.flow }];
+        v.push(InputSpec { name: "P".into(), dim: Dimension::PRESSURE, value: self.pressure });
+        if self.has_t_input() {
+            v.push(InputSpec { name: "T".into(), dim: Dimension::TEMPERATURE, value: self.temperature });
+        }
+        let n = self.z.len();
+        for (name, &z) in self.comp_names.iter().zip(&self.z).take(n - 1) {
+            v.push(InputSpec { name: format!("z[{name}]"), dim: Dimension::DIMENSIONLESS, value: z });
+        }
+        v
+    }
+    fn eval<S: Scalar>(&self, io: &UnitIo<'_, S>, r: &mut [S]) {
+        let out = io.outlet(0);
+        let n = io.n_comp();
+        let z0 = if self.has_t_input() { 3 } else { 2 };
+        r[F] = out.f() - io.input(0);
+        r[P] = out.p() - io.input(1);
+        let mut rest = S::from(1.0);
+        for i in 0..n - 1 {
+            let zi = io.input(z0 + i);
+            r[Z0 + i] = out.z()[i] - zi;
+            rest -= zi;
+        }
+        r[Z0 + n - 1] = out.z()[n - 1] - rest;
+        let z = out.z();
+        r[T] = match self.condition {
+            FeedCondition::SaturatedLiquid => {
+                let mut k = vec![S::from(0.0); n];
+                io.thermo.k_values(out.t(), out.p(), z, &mut k);
+                k.iter().zip(z).fold(S::from(-1.0), |acc, (ki, zi)| acc + *ki * *zi)
+            }
+            _ => out.t() - io.input(2),
+        };
+        let phase = if self.condition == FeedCondition::Vapour { Phase::Vapour } else { Phase::Liquid };
+        r[H] = out.h() - phase.enthalpy(io.thermo, out.t(), z);
+    }
+    fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]) {
+        own[F] = self.flow;
+        own[P] = self.pressure;
+        own[Z0..].copy_from_slice(&self.z);
+        own[T] = if self.has_t_input() {
+            self.temperature
+        } else {
+            io.thermo.bubble_t(self.pressure, &self.z).map(|s| s.t).unwrap_or(350.0)
+        };
+        let phase = if self.condition == FeedCondition::Vapour { Phase::Vapour } else { Phase::Liquid };
+        own[H] = phase.enthalpy(io.thermo, own[T], &self.z);
+    }
+}

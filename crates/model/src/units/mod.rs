@@ -1,0 +1,51 @@
+//! The unit library: one file per unit type. Adding a unit touches its file, a `pub mod` line here
+//! and one line of the registry in `crate::registry`.
+
+pub mod feed;
+pub mod heater;
+pub mod mixer;
+pub mod product;
+pub mod splitter;
+
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+use crate::Scalar;
+use plantwide_thermo::ThermoPackage;
+
+/// The phase of an outlet stream whose state follows from an energy balance.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum Phase {
+    /// Liquid (subcooled or saturated): `h = h_L(T, z)`.
+    #[default]
+    Liquid,
+    /// Vapour (superheated or saturated): `h = h_V(T, z)`.
+    Vapour,
+}
+
+impl Phase {
+    /// Molar enthalpy [J/mol] of composition `z` at `t` [K] in this phase.
+    pub fn enthalpy<S: Scalar>(self, thermo: &ThermoPackage, t: S, z: &[S]) -> S {
+        match self {
+            Phase::Liquid => thermo.h_liq(t, z),
+            Phase::Vapour => thermo.h_vap(t, z),
+        }
+    }
+    /// Temperature [K] at which `h_phase(T, z) = h` (f64, for initial guesses), by Newton from `t0`.
+    pub fn temperature(self, thermo: &ThermoPackage, h: f64, z: &[f64], t0: f64) -> f64 {
+        let mut t = t0;
+        for _ in 0..50 {
+            let hd = self.enthalpy(thermo, num_dual::Dual64::new(t, 1.0), &z.iter().map(|&v| num_dual::Dual64::from_re(v)).collect::<Vec<_>>());
+            if !(hd.eps.is_finite() && hd.eps > 0.0) {
+                break;
+            }
+            let dt = (h - hd.re) / hd.eps;
+            t = (t + dt.clamp(-100.0, 100.0)).max(10.0);
+            if dt.abs() < 1e-10 * t {
+                break;
+            }
+        }
+        t
+    }
+}
