@@ -52,7 +52,7 @@ pub fn thermo_package(components: &[ComponentSpec], thermo: &ThermoSpec, diags: 
                 let mw = q("mw", Some(&h.mw), Dimension::MOLAR_MASS, 0.05);
                 let hvap = q("hvap", Some(&h.hvap), Dimension::MOLAR_ENERGY, 3e4);
                 let t_ref = q("t_ref", h.t_ref.as_ref(), Dimension::TEMPERATURE, 350.0);
-                let cp = q("cp", h.cp.as_ref(), Dimension::MOLAR_HEAT_CAPACITY, 150.0);
+                let cp = q("cp", h.cp.as_ref(), Dimension::HEAT_CAPACITY_MOLAR, 150.0);
                 let v = q("v_liq", h.v_liq.as_ref(), Dimension::MOLAR_VOLUME, 1e-4);
                 if !(h.alpha.is_finite() && h.alpha > 0.0) {
                     diags.push(Diagnostic::new(format!("{path}.hypothetical.alpha"), format!("relative volatility must be positive (got {})", h.alpha)));

@@ -37,9 +37,13 @@ impl Plant {
         order
     }
 
-    /// A cold-start guess of every variable, from the units' own guess rules.
+    /// A cold-start guess of every variable at the flowsheet's input values.
     pub fn initial_guess(&self) -> Vec<f64> {
-        let u = self.input_values();
+        self.initial_guess_at(&self.input_values())
+    }
+
+    /// A cold-start guess of every variable at inputs `u`, from the units' own guess rules.
+    pub fn initial_guess_at(&self, u: &[f64]) -> Vec<f64> {
         let mut x = vec![0.0; self.n_vars()];
         let nc = self.components.len();
         let z = vec![1.0 / nc as f64; nc];
@@ -57,7 +61,7 @@ impl Plant {
         for _sweep in 0..3 {
             for &bi in &order {
                 let b = &self.blocks[bi];
-                self.gather(b, &x, &u, &mut local);
+                self.gather(b, &x, u, &mut local);
                 let mut own = local[..b.layout.n_own()].to_vec();
                 let io = UnitIo { local: &local, layout: &b.layout, thermo: &self.thermo, time: 0.0 };
                 b.unit.guess(&io, &mut own);

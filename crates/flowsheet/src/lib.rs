@@ -6,7 +6,9 @@
 pub mod assemble;
 pub mod components;
 pub mod error;
+pub mod graph;
 pub mod guess;
+pub mod overrides;
 pub mod parse;
 pub mod plant;
 pub mod spec;

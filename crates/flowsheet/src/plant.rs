@@ -152,6 +152,13 @@ impl Plant {
         format!("{}: {}", b.name, b.unit.equation_name(eq - b.eq_offset, &own))
     }
 
+    /// The own variable that equation `eq` belongs to (for diagnostics).
+    pub fn equation_variable(&self, eq: usize) -> Option<usize> {
+        let b = self.blocks.iter().find(|b| eq >= b.eq_offset && eq < b.eq_offset + b.n_eq)?;
+        let k = eq - b.eq_offset;
+        (k < b.layout.n_own()).then_some(b.own_offset + k)
+    }
+
     /// Fill `local` with block `b`'s local vector from `x` and inputs `u`.
     pub fn gather(&self, b: &Block, x: &[f64], u: &[f64], local: &mut Vec<f64>) {
         local.clear();

@@ -13,6 +13,7 @@ pub mod build;
 pub mod controllers;
 pub mod registry;
 pub mod stream;
+pub mod testing;
 pub mod unit;
 pub mod units;
 pub mod var;

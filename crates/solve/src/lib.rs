@@ -7,9 +7,11 @@
 
 pub mod newton;
 pub mod sparse;
+pub mod steady;
 pub mod structure;
 pub mod system;
 
 pub use newton::{solve_steady, IterationRecord, NewtonReport, NewtonSettings, NewtonStatus};
 pub use structure::{maximum_matching, Matching};
+pub use steady::{dof_check, steady_state, DofError, PlantSystem, SteadyError, SteadyState};
 pub use system::System;

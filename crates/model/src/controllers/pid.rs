@@ -219,7 +219,7 @@ impl UnitModel for Pid {
         if let Some((i, ti)) = integral {
             r[k] = match self.mode {
                 Mode::Auto => e + (op - u) / self.kc,
-                Mode::Manual => ((op_manual - self.bias) / self.kc - e - i / ti),
+                Mode::Manual => (op_manual - self.bias) / self.kc - e - i / ti,
             };
             k += 1;
         }

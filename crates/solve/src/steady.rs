@@ -1,0 +1,229 @@
+//! Whole-plant steady state: the degrees-of-freedom check, then Newton on `f(x, u) = 0`.
+
+use faer::Mat;
+use plantwide_flowsheet::Plant;
+use plantwide_model::VarKind;
+
+use crate::{maximum_matching, solve_steady, NewtonReport, NewtonSettings, NewtonStatus, System};
+
+/// The plant at fixed inputs `u`, seen as a nonlinear system.
+pub struct PlantSystem<'a> {
+    /// The plant.
+    pub plant: &'a Plant,
+    /// Input values (SI).
+    pub u: &'a [f64],
+    mass: Vec<(usize, usize)>,
+}
+
+impl<'a> PlantSystem<'a> {
+    /// Wrap a plant at inputs `u`.
+    pub fn new(plant: &'a Plant, u: &'a [f64]) -> PlantSystem<'a> {
+        let mut mass = Vec::new();
+        for b in &plant.blocks {
+            for k in 0..b.layout.n_own().min(b.n_eq) {
+                if plant.vars[b.own_offset + k].spec.kind == VarKind::Differential {
+                    mass.push((b.eq_offset + k, b.own_offset + k));
+                }
+            }
+        }
+        PlantSystem { plant, u, mass }
+    }
+}
+
+impl System for PlantSystem<'_> {
+    fn n(&self) -> usize {
+        self.plant.n_vars()
+    }
+    fn residual(&self, x: &[f64], r: &mut [f64]) {
+        self.plant.residual(x, self.u, 0.0, r);
+    }
+    fn jacobian(&self, x: &[f64], r: &mut [f64], jac: &mut Vec<(usize, usize, f64)>) {
+        let mut ju = Vec::new();
+        self.plant.jacobian(x, self.u, 0.0, r, jac, &mut ju);
+    }
+    fn nominal(&self, i: usize) -> f64 {
+        self.plant.vars[i].spec.nominal
+    }
+    fn bounds(&self, i: usize) -> (f64, f64) {
+        let s = &self.plant.vars[i].spec;
+        (s.lower, s.upper)
+    }
+    fn mass(&self) -> Vec<(usize, usize)> {
+        self.mass.clone()
+    }
+}
+
+/// A well-posedness problem found before Newton is attempted.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum DofError {
+    /// Equations and variables do not match in number.
+    #[error("{file}: the plant has {n_eqs} equations for {n_vars} variables: {hint}")]
+    Count {
+        /// Flowsheet file.
+        file: String,
+        /// Number of equations.
+        n_eqs: usize,
+        /// Number of variables.
+        n_vars: usize,
+        /// What would fix it.
+        hint: String,
+    },
+    /// Some variables are not determined (structurally or numerically).
+    #[error("{file}: the steady state is not determined: {explanation}")]
+    Underdetermined {
+        /// Flowsheet file.
+        file: String,
+        /// Which variables are loose and what would fix it.
+        explanation: String,
+    },
+}
+
+/// Largest plant for which the numerical null-space probe (a dense SVD) is run.
+pub const DENSE_PROBE_LIMIT: usize = 1500;
+
+/// Degrees-of-freedom check at the point `x`: equation count, structural rank (maximum matching)
+/// and, for plants up to [`DENSE_PROBE_LIMIT`] variables, a numerical null-space probe that names
+/// the inventory or variable left free (an uncontrolled level, a flow fixed at both ends).
+pub fn dof_check(plant: &Plant, u: &[f64], x: &[f64]) -> Result<(), DofError> {
+    let file = plant.file.clone();
+    let (n_eqs, n_vars) = (plant.n_eqs(), plant.n_vars());
+    if n_eqs != n_vars {
+        let hint = if n_eqs > n_vars {
+            "a flow is set twice — e.g. a valve or pump in flow mode downstream of a vessel whose outflow is not `free`".to_string()
+        } else {
+            "a flow is set nowhere — e.g. a vessel with a `free` outflow but no valve or pump after it".to_string()
+        };
+        return Err(DofError::Count { file, n_eqs, n_vars, hint });
+    }
+    let mut r = vec![0.0; n_eqs];
+    let (mut jx, mut ju) = (Vec::new(), Vec::new());
+    plant.jacobian(x, u, 0.0, &mut r, &mut jx, &mut ju);
+    let entries: Vec<(usize, usize)> = jx.iter().map(|&(i, j, _)| (i, j)).collect();
+    let m = maximum_matching(n_eqs, n_vars, &entries);
+    let loose = m.unmatched_cols();
+    if !loose.is_empty() {
+        return Err(DofError::Underdetermined { file, explanation: explain_loose(plant, &loose, "no equation is left to determine") });
+    }
+    if n_vars <= DENSE_PROBE_LIMIT && n_vars > 0 {
+        // Scale columns by their nominal values and rows by their largest entry, then look for a
+        // (numerically) zero singular value.
+        let mut a = Mat::<f64>::zeros(n_eqs, n_vars);
+        for &(i, j, v) in &jx {
+            a[(i, j)] += v * plant.vars[j].spec.nominal;
+        }
+        for i in 0..n_eqs {
+            let s = (0..n_vars).map(|j| a[(i, j)].abs()).fold(0.0, f64::max);
+            if s > 0.0 {
+                for j in 0..n_vars {
+                    a[(i, j)] /= s;
+                }
+            }
+        }
+        if let Ok(svd) = a.svd() {
+            let s = svd.S().column_vector();
+            let (smax, smin) = (s[0], s[n_vars - 1]);
+            if smin <= 1e-12 * smax {
+                let v = svd.V();
+                let null: Vec<f64> = (0..n_vars).map(|j| v[(j, n_vars - 1)].abs()).collect();
+                let top = null.iter().cloned().fold(0.0, f64::max);
+                let mut idx: Vec<usize> = (0..n_vars).filter(|&j| null[j] > 0.05 * top).collect();
+                idx.sort_by(|&a, &b| null[b].total_cmp(&null[a]));
+                return Err(DofError::Underdetermined {
+                    file,
+                    explanation: explain_loose(plant, &idx, "these variables can move together without changing any equation"),
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+fn explain_loose(plant: &Plant, vars: &[usize], why: &str) -> String {
+    let paths: Vec<&str> = vars.iter().take(8).map(|&j| plant.vars[j].path.as_str()).collect();
+    let inventories: Vec<&str> = vars.iter().filter(|&&j| plant.vars[j].spec.kind == VarKind::Differential).map(|&j| plant.vars[j].path.as_str()).collect();
+    let mut s = format!("{why}: {}", paths.join(", "));
+    if vars.len() > 8 {
+        s.push_str(&format!(" and {} more", vars.len() - 8));
+    }
+    if !inventories.is_empty() {
+        let units: Vec<&str> = {
+            let mut u: Vec<&str> = inventories.iter().map(|p| p.split('.').next().unwrap_or(p)).collect();
+            u.dedup();
+            u
+        };
+        s.push_str(&format!(
+            ". The inventory of {} is uncontrolled at steady state: nothing ties its holdup to a steady value — add a level (or pressure) controller on it, or give it an outflow that depends on its level (a valve)",
+            units.iter().map(|u| format!("`{u}`")).collect::<Vec<_>>().join(", ")
+        ));
+    }
+    s
+}
+
+/// A converged (or failed) steady state.
+#[derive(Debug, Clone)]
+pub struct SteadyState {
+    /// Variable values (SI).
+    pub x: Vec<f64>,
+    /// Input values used (SI).
+    pub u: Vec<f64>,
+    /// Newton report.
+    pub report: NewtonReport,
+}
+
+/// Why a steady state could not be found.
+#[derive(Debug, Clone, thiserror::Error)]
+pub enum SteadyError {
+    /// The problem is ill-posed.
+    #[error(transparent)]
+    Dof(#[from] DofError),
+    /// Newton did not converge.
+    #[error("{file}: steady state not found ({status:?} after {iterations} iterations, scaled residual {residual:.3e}); worst equation: {equation} (variable {variable}, scaled residual {worst:.3e})")]
+    NotConverged {
+        /// Flowsheet file.
+        file: String,
+        /// Solver status.
+        status: NewtonStatus,
+        /// Iterations.
+        iterations: usize,
+        /// Final scaled residual.
+        residual: f64,
+        /// Name of the worst equation.
+        equation: String,
+        /// Path of the variable that equation belongs to.
+        variable: String,
+        /// Its scaled residual.
+        worst: f64,
+        /// The full report with the iteration history.
+        report: Box<NewtonReport>,
+        /// The last iterate.
+        x: Vec<f64>,
+    },
+}
+
+/// Solve the plant's steady state at inputs `u` from `x0` (or the cold-start guess).
+pub fn steady_state(plant: &Plant, u: &[f64], x0: Option<&[f64]>, settings: &NewtonSettings) -> Result<SteadyState, SteadyError> {
+    let mut x = match x0 {
+        Some(x0) => x0.to_vec(),
+        None => plant.initial_guess_at(u),
+    };
+    dof_check(plant, u, &x)?;
+    let sys = PlantSystem::new(plant, u);
+    let report = solve_steady(&sys, &mut x, settings);
+    if report.status == NewtonStatus::Converged {
+        return Ok(SteadyState { x, u: u.to_vec(), report });
+    }
+    let (eq, worst) = report.worst.unwrap_or((0, f64::NAN));
+    let equation = plant.equation_name(eq);
+    let variable = plant.equation_variable(eq).map(|j| plant.vars[j].path.clone()).unwrap_or_else(|| "-".into());
+    Err(SteadyError::NotConverged {
+        file: plant.file.clone(),
+        status: report.status,
+        iterations: report.iterations,
+        residual: report.residual,
+        equation,
+        variable,
+        worst,
+        report: Box::new(report),
+        x,
+    })
+}

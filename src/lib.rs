@@ -1,0 +1,12 @@
+//! plantwide: plantwide process-control studies from one model of the plant.
+//!
+//! This facade re-exports the layers: [`thermo`] ← [`model`] ← [`flowsheet`] ← [`solve`] ←
+//! [`analysis`]. The `plantwide` binary (src/main.rs) is the only code that touches files and the
+//! terminal.
+
+pub use plantwide_analysis as analysis;
+pub use plantwide_flowsheet as flowsheet;
+pub use plantwide_model as model;
+pub use plantwide_solve as solve;
+pub use plantwide_thermo as thermo;
+pub use plantwide_units as units;
