@@ -6,10 +6,12 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::Scalar;
+use num_dual::Dual64;
+
+use crate::{R_GAS, Scalar, ThermoError};
 
 /// One pure component. Fields carry SI units; the library file stores exactly this structure.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Component {
     /// Name used in flowsheets (lower case, e.g. `"ethanol"`).
@@ -50,7 +52,7 @@ pub struct Component {
 }
 
 /// Vapour pressure `P_sat(T)` [Pa], `T` in K.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(tag = "form", rename_all = "snake_case", deny_unknown_fields)]
 pub enum VapourPressure {
     /// DIPPR 101: `ln P = c[0] + c[1]/T + c[2] ln T + c[3] T^c[4]`, P in Pa.
@@ -66,7 +68,7 @@ pub enum VapourPressure {
 }
 
 /// Ideal-gas heat capacity [J/(mol·K)].
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(tag = "form", rename_all = "snake_case", deny_unknown_fields)]
 pub enum CpIdealGas {
     /// DIPPR 107 (Aly–Lee): `cp = c[0] + c[1]·((c[2]/T)/sinh(c[2]/T))² + c[3]·((c[4]/T)/cosh(c[4]/T))²`, J/(mol·K).
@@ -78,7 +80,7 @@ pub enum CpIdealGas {
 }
 
 /// Liquid heat capacity [J/(mol·K)].
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(tag = "form", rename_all = "snake_case", deny_unknown_fields)]
 pub enum CpLiquid {
     /// DIPPR 100: `cp = c[0] + c[1] T + c[2] T² + c[3] T³ + c[4] T⁴`, J/(mol·K).
@@ -88,7 +90,7 @@ pub enum CpLiquid {
 }
 
 /// Heat of vaporization `ΔH_vap(T)` [J/mol].
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(tag = "form", rename_all = "snake_case", deny_unknown_fields)]
 pub enum HeatOfVaporization {
     /// Watson: `ΔH = h_ref · ((tc − T)/(tc − t_ref))^n`, usually `n = 0.38` and `t_ref = tb`; 0 above tc.
@@ -100,7 +102,7 @@ pub enum HeatOfVaporization {
 }
 
 /// Liquid molar volume [m³/mol].
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(tag = "form", rename_all = "snake_case", deny_unknown_fields)]
 pub enum LiquidVolume {
     /// DIPPR 105 density: `ρ = c[0] / c[1]^(1 + (1 − T/c[2])^c[3])` in mol/m³; volume = 1/ρ.
@@ -112,17 +114,21 @@ pub enum LiquidVolume {
 }
 
 impl Component {
-    /// Vapour pressure [Pa] at `t` [K].
+    /// Vapour pressure [Pa] at `t` [K] (see [`VapourPressure`] for the forms).
     pub fn psat<S: Scalar>(&self, t: S) -> S {
-        todo!("{t:?}")
+        self.psat.eval(t)
     }
     /// Ideal-gas molar enthalpy relative to the ideal gas at 298.15 K [J/mol] (analytic integral of `cp_ig`).
     pub fn h_ig<S: Scalar>(&self, t: S) -> S {
-        todo!("{t:?}")
+        self.cp_ig.h(t)
+    }
+    /// Ideal-gas heat capacity [J/(mol·K)] at `t` [K].
+    pub fn cp_gas<S: Scalar>(&self, t: S) -> S {
+        self.cp_ig.cp(t)
     }
     /// Heat of vaporization [J/mol] at `t` [K].
     pub fn dh_vap<S: Scalar>(&self, t: S) -> S {
-        todo!("{t:?}")
+        self.hvap.eval(t)
     }
     /// Liquid molar enthalpy [J/mol]: `h_ig(T) − ΔH_vap(T)`.
     pub fn h_liq<S: Scalar>(&self, t: S) -> S {
@@ -130,17 +136,62 @@ impl Component {
     }
     /// Liquid heat capacity from the `cp_liq` correlation [J/(mol·K)].
     pub fn cp_liquid<S: Scalar>(&self, t: S) -> S {
-        todo!("{t:?}")
+        self.cp_liq.cp(t)
     }
     /// Liquid molar volume [m³/mol] at `t` [K].
     pub fn v_liq<S: Scalar>(&self, t: S) -> S {
-        todo!("{t:?}")
+        self.vliq.eval(t)
+    }
+    /// Saturation temperature [K] at pressure `p` [Pa]: the root of `P_sat(T) = p`, converged to
+    /// machine precision by bracketed Newton on `ln P_sat(T) − ln p`.
+    pub fn tsat(&self, p: f64) -> Result<f64, ThermoError> {
+        if !(p.is_finite() && p > 0.0) {
+            return Err(ThermoError::BadInput {
+                routine: "tsat",
+                reason: format!("pressure must be positive and finite, got {p} Pa"),
+            });
+        }
+        let ln_p = p.ln();
+        let t0 = if self.tb.is_finite() && self.tb > 0.0 { self.tb } else { 300.0 };
+        let f = |t: f64| {
+            let d = self.psat.ln_psat(Dual64::new(t, 1.0));
+            (d.re - ln_p, d.eps)
+        };
+        crate::solve1d::solve_increasing(f, t0, crate::solve1d::T_MIN, crate::solve1d::T_MAX).map(|(t, _)| t).map_err(
+            |it| ThermoError::NoConvergence {
+                routine: "tsat",
+                iterations: it,
+                residual: f64::NAN,
+                conditions: format!("component `{}`, P = {p} Pa", self.name),
+            },
+        )
     }
     /// A hypothetical component for constant-relative-volatility studies: vapour pressure by
     /// Clausius–Clapeyron with `p_sat(t_ref) = alpha · 101 325 Pa`, constant `hvap` [J/mol],
     /// constant liquid heat capacity `cp` [J/(mol·K)] (ideal-gas heat capacity set equal, so `hvap` is
     /// temperature independent), molar mass `mw` [kg/mol] and liquid volume `v` [m³/mol].
+    ///
+    /// The normal boiling point follows from Clausius–Clapeyron at 101 325 Pa:
+    /// `1/tb = 1/t_ref + R ln(alpha)/hvap`; it is `f64::INFINITY` when that is not positive (no
+    /// finite temperature reaches 1 atm).
     pub fn hypothetical(name: &str, alpha: f64, mw: f64, hvap: f64, t_ref: f64, cp: f64, v: f64) -> Component {
-        todo!("{name}{alpha}{mw}{hvap}{t_ref}{cp}{v}")
+        let inv_tb = t_ref.recip() + R_GAS * alpha.ln() / hvap;
+        let tb = if inv_tb > 0.0 && inv_tb.is_finite() { inv_tb.recip() } else { f64::INFINITY };
+        Component {
+            name: name.to_string(),
+            formula: String::new(),
+            cas: String::new(),
+            mw,
+            tb,
+            tc: None,
+            pc: None,
+            omega: None,
+            psat: VapourPressure::ClausiusClapeyron { p_ref: alpha * 101_325.0, t_ref, hvap },
+            cp_ig: CpIdealGas::Constant { cp },
+            cp_liq: CpLiquid::Constant { cp },
+            hvap: HeatOfVaporization::Constant { h: hvap },
+            vliq: LiquidVolume::Constant { v },
+            source: "hypothetical".to_string(),
+        }
     }
 }

@@ -7,7 +7,9 @@ pub enum ThermoError {
     #[error("unknown component `{name}` (not in the built-in library; define it inline or run `plantwide components`)")]
     UnknownComponent { name: String },
     /// Activity-model parameters are missing for a pair.
-    #[error("no {model} parameters for the pair `{i}`–`{j}`: give them under thermo.binary_parameters or choose another VLE model")]
+    #[error(
+        "no {model} parameters for the pair `{i}`–`{j}`: give them under thermo.binary_parameters or choose another VLE model"
+    )]
     MissingBinaryPair { model: String, i: String, j: String },
     /// A property is needed that the component's data do not provide.
     #[error("component `{component}` has no {property} data")]

@@ -1,5 +1,13 @@
 //! Bubble and dew points and flashes (f64, iterative, converged to machine precision).
 
+mod input;
+mod ph;
+pub mod rachford_rice;
+mod saturation;
+mod tp;
+
+pub use rachford_rice::{RachfordRice, rachford_rice};
+
 use crate::{ThermoError, ThermoPackage};
 
 /// A saturation point: the temperature or pressure and the incipient phase's composition.
@@ -48,29 +56,49 @@ pub struct FlashResult {
 }
 
 impl ThermoPackage {
-    /// Bubble temperature at pressure `p` [Pa] of liquid `x`.
+    /// Bubble temperature at pressure `p` [Pa] of liquid `x`: the root of `Σ x_i K_i(T, P, x) = 1`
+    /// (bracketed Newton on `ln Σ x_i Φ_i(T, x) − ln P`, to machine precision); `incipient` is the
+    /// vapour `y_i = K_i x_i`.
+    ///
+    /// For `ConstantAlpha` the K-values do not depend on T, so the temperature is the Raoult bubble
+    /// temperature of the liquid (`Σ x_i P_sat,i(T) = P`, as the `Ideal` model would give) and the
+    /// incipient vapour is `y_i = α_i x_i / Σ α_k x_k`.
     pub fn bubble_t(&self, p: f64, x: &[f64]) -> Result<SaturationPoint, ThermoError> {
-        todo!("{p}{}", x.len())
+        saturation::bubble_t(self, p, x)
     }
-    /// Bubble pressure at temperature `t` [K] of liquid `x`.
+    /// Bubble pressure at temperature `t` [K] of liquid `x`: `P = Σ x_i γ_i P_sat,i(T)` (direct);
+    /// `ConstantAlpha`: the Raoult bubble pressure `Σ x_i P_sat,i(T)`, `y_i = α_i x_i / Σ α_k x_k`.
     pub fn bubble_p(&self, t: f64, x: &[f64]) -> Result<SaturationPoint, ThermoError> {
-        todo!("{t}{}", x.len())
+        saturation::bubble_p(self, t, x)
     }
-    /// Dew temperature at pressure `p` [Pa] of vapour `y`.
+    /// Dew temperature at pressure `p` [Pa] of vapour `y`: `Σ y_i / K_i(T, P, x) = 1` with the
+    /// incipient liquid `x_i = y_i / K_i` (successive substitution, then Newton on `(ln K, ln T)`).
+    ///
+    /// For `ConstantAlpha` the incipient liquid is `x_i ∝ y_i / α_i` and the temperature is the
+    /// Raoult bubble temperature of that liquid, so `bubble_t` and `dew_t` are exact inverses. It
+    /// equals the Raoult dew temperature of `y` when the vapour pressures are proportional to the α
+    /// (hypothetical components with a common `hvap` and `t_ref`, see [`crate::Component::hypothetical`]).
     pub fn dew_t(&self, p: f64, y: &[f64]) -> Result<SaturationPoint, ThermoError> {
-        todo!("{p}{}", y.len())
+        saturation::dew_t(self, p, y)
     }
-    /// Dew pressure at temperature `t` [K] of vapour `y`.
+    /// Dew pressure at temperature `t` [K] of vapour `y`: `1/P = Σ y_i / (γ_i(x) P_sat,i(T))` with the
+    /// incipient liquid `x` (successive substitution, then Newton on `(ln K, ln P)`).
     pub fn dew_p(&self, t: f64, y: &[f64]) -> Result<SaturationPoint, ThermoError> {
-        todo!("{t}{}", y.len())
+        saturation::dew_p(self, t, y)
     }
     /// Isothermal flash of feed `z` at `t` [K], `p` [Pa] (Rachford–Rice with successive substitution
-    /// on the activity coefficients).
+    /// on the activity coefficients, polished by Newton's method to machine precision).
+    ///
+    /// Liquid when `P ≥ P_bubble(T, z)`, vapour when `P ≤ P_dew(T, z)`, else two phases. For
+    /// `ConstantAlpha` the two-phase state satisfies `y_i = α_i x_i / Σ α_k x_k` with `T` the
+    /// Raoult bubble temperature of the liquid `x`.
     pub fn flash_tp(&self, t: f64, p: f64, z: &[f64]) -> Result<FlashResult, ThermoError> {
-        todo!("{t}{p}{}", z.len())
+        tp::flash_tp(self, t, p, z)
     }
-    /// Adiabatic flash: feed `z` at pressure `p` [Pa] with molar enthalpy `h` [J/mol].
+    /// Adiabatic flash: feed `z` at pressure `p` [Pa] with molar enthalpy `h` [J/mol] (bracketed
+    /// between the bubble and dew temperatures; Newton in the single-phase regions, Brent on the
+    /// TP-flash enthalpy in the two-phase region).
     pub fn flash_ph(&self, p: f64, h: f64, z: &[f64]) -> Result<FlashResult, ThermoError> {
-        todo!("{p}{h}{}", z.len())
+        ph::flash_ph(self, p, h, z)
     }
 }

@@ -12,12 +12,16 @@
 //! **Architecture Invariant:** this crate depends on no other plantwide crate.
 
 pub mod component;
+mod correlations;
 pub mod error;
 pub mod flash;
 pub mod library;
 pub mod package;
 pub mod scalar;
 pub mod vle;
+
+mod newton;
+mod solve1d;
 
 pub use component::{Component, CpIdealGas, CpLiquid, HeatOfVaporization, LiquidVolume, VapourPressure};
 pub use error::ThermoError;
