@@ -9,31 +9,31 @@ use super::CliError;
 
 pub fn run(file: &Path) -> Result<(), CliError> {
     let plant = load_file(file).map_err(|e| CliError::user(e.to_string()))?;
-    println!("flowsheet `{}` ({})", plant.name, file.display());
-    println!("components ({}): {}", plant.components.len(), plant.components.join(", "));
+    outln!("flowsheet `{}` ({})", plant.name, file.display());
+    outln!("components ({}): {}", plant.components.len(), plant.components.join(", "));
     let units: Vec<_> = plant.blocks.iter().filter(|b| b.kind == BlockKind::Unit).collect();
-    println!("units ({}):", units.len());
+    outln!("units ({}):", units.len());
     for b in &units {
-        println!("  {:<16} {}", b.name, b.unit.type_name());
+        outln!("  {:<16} {}", b.name, b.unit.type_name());
     }
-    println!("streams ({}):", plant.streams.len());
+    outln!("streams ({}):", plant.streams.len());
     for s in &plant.streams {
         let (fb, fp) = s.from;
         let (tb, tp) = s.to;
         let from = &plant.blocks[fb];
         let to = &plant.blocks[tb];
-        println!("  {:<16} {}.{} -> {}.{}", s.name, from.name, from.unit.outlet_ports()[fp], to.name, to.unit.inlet_ports()[tp]);
+        outln!("  {:<16} {}.{} -> {}.{}", s.name, from.name, from.unit.outlet_ports()[fp], to.name, to.unit.inlet_ports()[tp]);
     }
     let ctrls: Vec<_> = plant.blocks.iter().filter(|b| b.kind == BlockKind::Controller).collect();
-    println!("controllers ({}):", ctrls.len());
+    outln!("controllers ({}):", ctrls.len());
     for b in &ctrls {
         let measured: Vec<String> = b.unit.signals().iter().map(|s| format!("{}={}", s.role, s.path)).collect();
         let driven: Vec<&str> = plant.inputs.iter().filter(|i| i.driven_by.is_some_and(|v| plant.vars[v].block == plant.blocks.iter().position(|x| std::ptr::eq(x, *b)).unwrap_or(usize::MAX))).map(|i| i.path.as_str()).collect();
-        println!("  {:<16} {:<12} reads {} drives {}", b.name, b.unit.type_name(), measured.join(", "), driven.join(", "));
+        outln!("  {:<16} {:<12} reads {} drives {}", b.name, b.unit.type_name(), measured.join(", "), driven.join(", "));
     }
     let n_diff = plant.differential().iter().filter(|d| **d).count();
     let free: Vec<&str> = plant.inputs.iter().filter(|i| i.driven_by.is_none()).map(|i| i.path.as_str()).collect();
-    println!(
+    outln!(
         "variables: {} ({} differential, {} algebraic); equations: {}; inputs: {} ({} driven by controllers)",
         plant.n_vars(),
         n_diff,
@@ -42,18 +42,18 @@ pub fn run(file: &Path) -> Result<(), CliError> {
         plant.inputs.len(),
         plant.inputs.len() - free.len()
     );
-    println!("free inputs (manipulated variables and disturbances): {}", free.join(", "));
+    outln!("free inputs (manipulated variables and disturbances): {}", free.join(", "));
     let recycles = plant.recycles();
     if recycles.is_empty() {
-        println!("recycles: none");
+        outln!("recycles: none");
     } else {
         for (k, r) in recycles.iter().enumerate() {
-            println!("recycle {}: {}", k + 1, r.join(" -> "));
+            outln!("recycle {}: {}", k + 1, r.join(" -> "));
         }
     }
     let u = plant.input_values();
     let x = plant.initial_guess();
     dof_check(&plant, &u, &x).map_err(|e| CliError::user(e.to_string()))?;
-    println!("degrees of freedom: 0 — square, structurally nonsingular{}", if plant.n_vars() <= plantwide::solve::steady::DENSE_PROBE_LIMIT { ", numerically nonsingular at the initial guess" } else { "" });
+    outln!("degrees of freedom: 0 — square, structurally nonsingular{}", if plant.n_vars() <= plantwide::solve::steady::DENSE_PROBE_LIMIT { ", numerically nonsingular at the initial guess" } else { "" });
     Ok(())
 }

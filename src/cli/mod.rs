@@ -1,5 +1,24 @@
 //! Subcommands of the `plantwide` binary.
 
+/// `print!` that ends the process quietly when stdout is closed (e.g. piped into `head`).
+macro_rules! out {
+    ($($t:tt)*) => { $crate::cli::write_out(format_args!($($t)*)) };
+}
+
+/// `println!` that ends the process quietly when stdout is closed.
+macro_rules! outln {
+    () => { $crate::cli::write_out(format_args!("\n")) };
+    ($($t:tt)*) => {{ $crate::cli::write_out(format_args!($($t)*)); $crate::cli::write_out(format_args!("\n")) }};
+}
+
+/// Write to stdout; a closed pipe ends the process with success (the reader has what it wanted).
+pub fn write_out(args: std::fmt::Arguments<'_>) {
+    use std::io::Write;
+    if std::io::stdout().lock().write_fmt(args).is_err() {
+        std::process::exit(0);
+    }
+}
+
 mod check;
 mod components;
 mod steady;
@@ -72,7 +91,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Schema => {
             let schema = schemars::schema_for!(plantwide::flowsheet::FlowsheetSpec);
             let text = serde_json::to_string_pretty(&schema).map_err(|e| CliError::user(e.to_string()))?;
-            println!("{text}");
+            outln!("{text}");
             Ok(())
         }
     }

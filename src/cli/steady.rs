@@ -64,25 +64,25 @@ pub fn run(file: &Path, json: bool, sets: &[String]) -> Result<(), CliError> {
             "residual": ss.report.residual,
             "values": values,
         });
-        println!("{}", serde_json::to_string_pretty(&out).map_err(|e| CliError::user(e.to_string()))?);
+        outln!("{}", serde_json::to_string_pretty(&out).map_err(|e| CliError::user(e.to_string()))?);
         return Ok(());
     }
-    println!("steady state of `{}`: converged in {} iterations, scaled residual {:.2e}\n", plant.name, ss.report.iterations, ss.report.residual);
+    outln!("steady state of `{}`: converged in {} iterations, scaled residual {:.2e}\n", plant.name, ss.report.iterations, ss.report.residual);
     let comps = &plant.components;
-    print!("{:<14} {:>12} {:>9} {:>10} {:>11}", "stream", "F kmol/h", "T K", "P kPa", "h kJ/mol");
+    out!("{:<14} {:>12} {:>9} {:>10} {:>11}", "stream", "F kmol/h", "T K", "P kPa", "h kJ/mol");
     for c in comps {
-        print!(" {:>10}", format!("x[{}]", truncate(c, 7)));
+        out!(" {:>10}", format!("x[{}]", truncate(c, 7)));
     }
-    println!();
+    outln!();
     for s in &plant.streams {
         let v = &ss.x[s.offset..s.offset + plant.stream_layout.len()];
-        print!("{:<14} {:>12.4} {:>9.3} {:>10.3} {:>11.4}", truncate(&s.name, 14), v[F] * 3.6, v[T], v[P] / 1e3, v[H] / 1e3);
+        out!("{:<14} {:>12.4} {:>9.3} {:>10.3} {:>11.4}", truncate(&s.name, 14), v[F] * 3.6, v[T], v[P] / 1e3, v[H] / 1e3);
         for z in &v[Z0..] {
-            print!(" {:>10.6}", z);
+            out!(" {:>10.6}", z);
         }
-        println!();
+        outln!();
     }
-    println!();
+    outln!();
     for (bi, b) in plant.blocks.iter().enumerate() {
         let internal: Vec<String> = plant
             .vars
@@ -92,8 +92,10 @@ pub fn run(file: &Path, json: bool, sets: &[String]) -> Result<(), CliError> {
             .map(|(v, x)| format!("{}={:.6}", v.path.trim_start_matches(&format!("{}.", b.name)), x))
             .collect();
         let kind = if b.kind == BlockKind::Controller { "controller" } else { "unit" };
-        if !internal.is_empty() {
-            println!("{kind} {:<14} {:<10} {}", b.name, b.unit.type_name(), internal.join("  "));
+        if internal.len() > 12 {
+            outln!("{kind} {:<14} {:<10} {} … ({} variables; `--json` lists them all)", b.name, b.unit.type_name(), internal[..6].join("  "), internal.len());
+        } else if !internal.is_empty() {
+            outln!("{kind} {:<14} {:<10} {}", b.name, b.unit.type_name(), internal.join("  "));
         }
     }
     Ok(())

@@ -170,7 +170,7 @@ pub fn assemble(spec: &FlowsheetSpec, file: &str) -> Result<Plant, LoadError> {
             n_signals: 0,
         };
         let n_eq = (layout.n_own() as isize + unit.extra_equations()).max(0) as usize;
-        blocks.push(Block { name, kind: BlockKind::Unit, unit, layout, own_offset, eq_offset: 0, n_eq, reads: Vec::new(), input_ids });
+        blocks.push(Block { name, kind: BlockKind::Unit, unit, layout, own_offset, eq_offset: 0, n_eq, reads: Vec::new(), input_ids, pattern: None });
     }
     let streams: Vec<StreamInfo> = links.iter().map(|(name, f, t, tear)| StreamInfo { name: name.clone(), from: *f, to: *t, offset: stream_offset[f], tear: *tear }).collect();
     let mut var_index: HashMap<String, usize> = vars.iter().enumerate().map(|(i, v)| (v.path.clone(), i)).collect();
@@ -255,7 +255,7 @@ pub fn assemble(spec: &FlowsheetSpec, file: &str) -> Result<Plant, LoadError> {
                     .collect();
                 let layout = LocalLayout { stream: stream_layout, n_outlets: 0, n_internal: unit.internal_vars().len(), n_inlets: 0, n_inputs: unit.inputs().len(), n_signals: unit.signals().len() };
                 let n_eq = (layout.n_own() as isize + unit.extra_equations()).max(0) as usize;
-                blocks.push(Block { name: cname.clone(), kind: BlockKind::Controller, unit, layout, own_offset, eq_offset: 0, n_eq, reads: Vec::new(), input_ids });
+                blocks.push(Block { name: cname.clone(), kind: BlockKind::Controller, unit, layout, own_offset, eq_offset: 0, n_eq, reads: Vec::new(), input_ids, pattern: None });
             }
             Err(errs) => diags.extend(errs.into_iter().map(|e| Diagnostic::new(e.path, e.message))),
         }
@@ -263,11 +263,12 @@ pub fn assemble(spec: &FlowsheetSpec, file: &str) -> Result<Plant, LoadError> {
     if !diags.is_empty() {
         return Err(invalid(diags));
     }
-    // Controller outputs drive inputs.
+    // Controller outputs drive inputs: driven input k takes `<ctrl>.op` (k = 0) or `<ctrl>.op<k+1>`
+    // (split range: `op`, `op2`).
     for (cname, _, _, driven) in &pending {
-        let op = var_index.get(&format!("{cname}.op")).copied();
-        for &i in driven {
-            inputs[i].driven_by = op;
+        for (k, &i) in driven.iter().enumerate() {
+            let op = if k == 0 { format!("{cname}.op") } else { format!("{cname}.op{}", k + 1) };
+            inputs[i].driven_by = var_index.get(&op).copied();
         }
     }
 
@@ -307,6 +308,7 @@ pub fn assemble(spec: &FlowsheetSpec, file: &str) -> Result<Plant, LoadError> {
         }
         let b = &mut blocks[bi];
         b.reads = reads;
+        b.pattern = b.unit.pattern(&b.layout);
         b.eq_offset = eq_offset;
         eq_offset += b.n_eq;
     }

@@ -48,6 +48,8 @@ pub struct Block {
     pub reads: Vec<Read>,
     /// Global input indices of its declared inputs, in declaration order.
     pub input_ids: Vec<usize>,
+    /// Declared local sparsity pattern (`None`: dense).
+    pub pattern: Option<Vec<(usize, usize)>>,
 }
 
 /// A global variable.
@@ -195,19 +197,20 @@ impl Plant {
             let io = UnitIo { local: &local, layout: &b.layout, thermo: &self.thermo, time: t };
             b.unit.jacobian(&io, &mut r[b.eq_offset..b.eq_offset + b.n_eq], &mut jac);
             let n_own = b.layout.n_own();
-            for k in 0..b.n_eq {
-                let row = b.eq_offset + k;
-                for j in 0..n {
-                    let v = jac[k * n + j];
-                    if j < n_own {
-                        jx.push((row, b.own_offset + j, v));
-                    } else {
-                        match b.reads[j - n_own] {
-                            Read::Var(i) => jx.push((row, i, v)),
-                            Read::Input(i) => ju.push((row, i, v)),
-                        }
+            let mut push = |k: usize, j: usize| {
+                let (row, v) = (b.eq_offset + k, jac[k * n + j]);
+                if j < n_own {
+                    jx.push((row, b.own_offset + j, v));
+                } else {
+                    match b.reads[j - n_own] {
+                        Read::Var(i) => jx.push((row, i, v)),
+                        Read::Input(i) => ju.push((row, i, v)),
                     }
                 }
+            };
+            match &b.pattern {
+                Some(p) => p.iter().for_each(|&(k, j)| push(k, j)),
+                None => (0..b.n_eq).for_each(|k| (0..n).for_each(|j| push(k, j))),
             }
         }
     }

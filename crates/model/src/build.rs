@@ -62,7 +62,7 @@ impl<'a> BuildCx<'a> {
     pub fn non_negative(&mut self, field: &str, value: &QuantityValue, dim: Dimension) -> f64 {
         let v = self.quantity(field, value, dim);
         if v < 0.0 {
-            self.error(field, format!("must not be negative (got {v} in SI units)"));
+            self.error(field, format!("must not be negative (got `{value}`)"));
         }
         v
     }
@@ -70,7 +70,7 @@ impl<'a> BuildCx<'a> {
     pub fn positive(&mut self, field: &str, value: &QuantityValue, dim: Dimension) -> f64 {
         let v = self.quantity(field, value, dim);
         if v <= 0.0 {
-            self.error(field, format!("must be positive (got {v} in SI units)"));
+            self.error(field, format!("must be positive (got `{value}`)"));
         }
         v
     }

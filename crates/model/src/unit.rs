@@ -161,6 +161,12 @@ pub trait UnitModel: Send + Sync + std::fmt::Debug {
     fn equation_name(&self, k: usize, own_names: &[String]) -> String {
         own_names.get(k).map(|n| format!("equation for {n}")).unwrap_or_else(|| format!("equation {k}"))
     }
+    /// Structural nonzeros `(equation, local column)` of the local Jacobian; `None` (the default)
+    /// means dense. A declared pattern must contain every entry that can ever be nonzero; the
+    /// Jacobian is then computed with one dual pass per column colour.
+    fn pattern(&self, _layout: &LocalLayout) -> Option<Vec<(usize, usize)>> {
+        None
+    }
     /// Residuals at the local vector `io.local` into `r`.
     fn eval<S: Scalar>(&self, io: &UnitIo<'_, S>, r: &mut [S]);
     /// Initial guess of the own variables from the inlets and inputs in `local` (its own block holds
@@ -186,10 +192,13 @@ pub trait Unit: Send + Sync + std::fmt::Debug {
     fn extra_equations(&self) -> isize;
     /// See [`UnitModel::equation_name`].
     fn equation_name(&self, k: usize, own_names: &[String]) -> String;
+    /// See [`UnitModel::pattern`].
+    fn pattern(&self, layout: &LocalLayout) -> Option<Vec<(usize, usize)>>;
     /// Residuals in `f64`.
     fn residual(&self, io: &UnitIo<'_, f64>, r: &mut [f64]);
-    /// Residuals and the dense local Jacobian `jac[k][j] = ∂r_k/∂local_j` (row-major, `n_eq × len`),
-    /// exact by forward-mode dual numbers, one pass per local column.
+    /// Residuals and the local Jacobian `jac[k][j] = ∂r_k/∂local_j` (row-major, `n_eq × len`; only
+    /// entries of the pattern are written, the rest stay as the caller set them), exact by
+    /// forward-mode dual numbers: one pass per column colour of the pattern.
     fn jacobian(&self, io: &UnitIo<'_, f64>, r: &mut [f64], jac: &mut [f64]);
     /// See [`UnitModel::guess`].
     fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]);
@@ -223,28 +232,94 @@ impl<U: UnitModel> Unit for U {
     fn residual(&self, io: &UnitIo<'_, f64>, r: &mut [f64]) {
         self.eval(io, r);
     }
+    fn pattern(&self, layout: &LocalLayout) -> Option<Vec<(usize, usize)>> {
+        UnitModel::pattern(self, layout)
+    }
     fn jacobian(&self, io: &UnitIo<'_, f64>, r: &mut [f64], jac: &mut [f64]) {
         let n = io.local.len();
         let m = r.len();
         let mut local: Vec<Dual64> = io.local.iter().map(|&v| Dual64::from_re(v)).collect();
         let mut rd = vec![Dual64::from_re(0.0); m];
-        for j in 0..n {
-            local[j].eps = 1.0;
-            let dio = UnitIo { local: &local, layout: io.layout, thermo: io.thermo, time: io.time };
-            self.eval(&dio, &mut rd);
-            for k in 0..m {
-                jac[k * n + j] = rd[k].eps;
+        let eval = |local: &[Dual64], rd: &mut [Dual64]| {
+            let dio = UnitIo { local, layout: io.layout, thermo: io.thermo, time: io.time };
+            self.eval(&dio, rd);
+        };
+        match UnitModel::pattern(self, io.layout) {
+            None => {
+                for j in 0..n {
+                    local[j].eps = 1.0;
+                    eval(&local, &mut rd);
+                    for k in 0..m {
+                        jac[k * n + j] = rd[k].eps;
+                    }
+                    local[j].eps = 0.0;
+                }
             }
-            local[j].eps = 0.0;
-        }
-        for k in 0..m {
-            r[k] = rd[k].re;
+            Some(pattern) => {
+                let (colors, n_colors) = color_columns(&pattern, m, n);
+                let mut rows_of_col: Vec<Vec<usize>> = vec![Vec::new(); n];
+                for &(k, j) in &pattern {
+                    rows_of_col[j].push(k);
+                }
+                for c in 0..n_colors {
+                    for j in 0..n {
+                        local[j].eps = if colors[j] == c { 1.0 } else { 0.0 };
+                    }
+                    eval(&local, &mut rd);
+                    for j in (0..n).filter(|&j| colors[j] == c) {
+                        for &k in &rows_of_col[j] {
+                            jac[k * n + j] = rd[k].eps;
+                        }
+                    }
+                }
+                if n_colors == 0 {
+                    local.iter_mut().for_each(|v| v.eps = 0.0);
+                    eval(&local, &mut rd);
+                }
+            }
         }
         if n == 0 {
             self.eval(io, r);
+        } else {
+            for k in 0..m {
+                r[k] = rd[k].re;
+            }
         }
     }
     fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]) {
         UnitModel::guess(self, io, own);
     }
+}
+
+/// Greedy distance-2 colouring of the columns of an `m × n` pattern: columns of one colour share
+/// no row, so one dual pass seeded on all of them yields each of their entries exactly.
+pub fn color_columns(pattern: &[(usize, usize)], m: usize, n: usize) -> (Vec<usize>, usize) {
+    let mut cols_of_row: Vec<Vec<usize>> = vec![Vec::new(); m];
+    let mut rows_of_col: Vec<Vec<usize>> = vec![Vec::new(); n];
+    for &(k, j) in pattern {
+        cols_of_row[k].push(j);
+        rows_of_col[j].push(k);
+    }
+    let mut color = vec![usize::MAX; n];
+    let mut n_colors = 0;
+    let mut forbidden: Vec<usize> = Vec::new();
+    for j in 0..n {
+        if rows_of_col[j].is_empty() {
+            continue;
+        }
+        forbidden.clear();
+        for &k in &rows_of_col[j] {
+            for &j2 in &cols_of_row[k] {
+                if color[j2] != usize::MAX {
+                    forbidden.push(color[j2]);
+                }
+            }
+        }
+        forbidden.sort_unstable();
+        forbidden.dedup();
+        let c = (0..).find(|c| forbidden.binary_search(c).is_err()).unwrap_or(0);
+        color[j] = c;
+        n_colors = n_colors.max(c + 1);
+    }
+    (color, n_colors)
 }

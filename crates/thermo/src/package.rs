@@ -139,4 +139,20 @@ impl ThermoPackage {
         }
         m
     }
+
+    /// Bubble-point residual of liquid `x` at `t` [K], `p` [Pa]: `Σ_i K_i x_i − 1`. For constant
+    /// relative volatility, where `Σ K x ≡ 1`, it is the vapour-pressure scale `Σ_i x_i P_sat,i(T)/P − 1`
+    /// (the temperature scale of the components), so that the bubble temperature stays defined.
+    pub fn bubble_residual<S: Scalar>(&self, t: S, p: S, x: &[S]) -> S {
+        match &self.vle {
+            VleModel::ConstantAlpha { .. } => {
+                self.components.iter().zip(x).fold(S::from(-1.0), |acc, (c, xi)| acc + c.psat(t) * *xi / p)
+            }
+            _ => {
+                let mut k = vec![S::from(0.0); x.len()];
+                self.k_values(t, p, x, &mut k);
+                k.iter().zip(x).fold(S::from(-1.0), |acc, (ki, xi)| acc + *ki * *xi)
+            }
+        }
+    }
 }

@@ -125,11 +125,7 @@ impl UnitModel for Feed {
         r[Z0 + n - 1] = out.z()[n - 1] - rest;
         let z = out.z();
         r[T] = match self.condition {
-            FeedCondition::SaturatedLiquid => {
-                let mut k = vec![S::from(0.0); n];
-                io.thermo.k_values(out.t(), out.p(), z, &mut k);
-                k.iter().zip(z).fold(S::from(-1.0), |acc, (ki, zi)| acc + *ki * *zi)
-            }
+            FeedCondition::SaturatedLiquid => io.thermo.bubble_residual(out.t(), out.p(), z),
             _ => out.t() - io.input(2),
         };
         let phase = if self.condition == FeedCondition::Vapour { Phase::Vapour } else { Phase::Liquid };

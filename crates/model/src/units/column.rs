@@ -1,0 +1,570 @@
+//! Tray-by-tray distillation column with its total condenser (reflux drum) and partial reboiler
+//! (sump) as stages of the same unit.
+//!
+//! **Stage numbering** (as Skogestad's column A): stage 1 is the reboiler, stages 2 … N−1 are the
+//! trays counted from the bottom, stage N is the total condenser. Paths use these numbers:
+//! `column.x[21][light]`, `column.T[1]`, `column.M[41]`.
+//!
+//! Ports: one inlet per feed (`feeds[k].port`, default `feed`), outlets `distillate`, `bottoms` and
+//! one per side draw. Inputs: `reflux` L [mol/s], `boilup` V [mol/s], `distillate` D [mol/s],
+//! `bottoms` B [mol/s], and each side draw's flow — so LV, DV, LB, (L/D)V … are controller wiring.
+//!
+//! # Simple model (constant molar overflow; Skogestad's column A)
+//! Variables per stage i: component holdups `n_ij` [mol] (differential), `x_ij`, `y_ij`, `T_i`,
+//! `M_i`, `L_i`, `V_i`. Equations:
+//! - component balances `dn_ij/dt = L_{i+1} x_{i+1,j} + V_{i−1} y_{i−1,j} − L_i x_ij − V_i y_ij
+//!   + Σ_feeds F z_j − draws`, where the condenser also loses `D x_Nj` and the reboiler's liquid
+//!   outflow is the bottoms;
+//! - `M_i = Σ_j n_ij`, `x_ij = n_ij / M_i`;
+//! - equilibrium `y_ij = K_ij(T_i, P, x_i) x_ij` (constant α: `y = α x / Σ α x`);
+//! - bubble point: `Σ_j K_ij x_ij = 1` (constant α: `Σ_j x_ij P_sat,j(T_i) = P`, the temperature
+//!   scale of the hypothetical components);
+//! - liquid flow: trays `L_i = L0_i + (M_i − M0_i)/τ_L + λ (V_{i−1} − V0)` (linearized Francis weir),
+//!   condenser `L_N = reflux`, reboiler `L_1 = B`;
+//! - vapour flow: `V_1 = boilup`, `V_i = V_{i−1} + Σ_feeds (1 − q) F` (CMO), condenser `V_N = 0`.
+//!
+//! `L0_i` is the nominal liquid flow leaving stage i: the nominal reflux above the feeds, plus
+//! `q·F_nominal` below each feed (`F_nominal` defaults to the nominal `D + B` for one feed).
+//! The feed quality `q` is given or, by default, computed from enthalpies at the feed stage:
+//! `q = (h_V − h_F)/(h_V − h_L)`.
+//!
+//! # References
+//! - S. Skogestad, I. Postlethwaite, *Multivariable Feedback Control*, Wiley 2005, §12.4 (column A).
+//! - W. L. Luyben (ed.), *Practical Distillation Control*, Van Nostrand Reinhold 1992, ch. 3–4.
+
+use plantwide_units::{Dimension, QuantityValue};
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+use crate::stream::{F, H, P, T, Z0};
+use crate::{BuildCx, FieldError, InputSpec, LocalLayout, Scalar, UnitIo, UnitModel, VarSpec};
+
+/// Fidelity of the column model.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum ColumnModel {
+    /// Constant molar overflow, linearized tray hydraulics, no energy balances.
+    #[default]
+    Simple,
+}
+
+/// A feed to the column.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ColumnFeed {
+    /// Inlet port name (default `feed`).
+    #[serde(default = "default_feed_port")]
+    pub port: String,
+    /// Stage the feed enters (1 = reboiler, N = condenser).
+    pub stage: usize,
+    /// Feed quality q (liquid fraction; 1 = saturated liquid); default from enthalpies.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub q: Option<f64>,
+    /// Nominal feed flow for the tray hydraulics (default: nominal D + B when there is one feed).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub nominal_flow: Option<QuantityValue>,
+}
+
+fn default_feed_port() -> String {
+    "feed".into()
+}
+
+/// A liquid side draw.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct SideDraw {
+    /// Outlet port name (also the name of its flow input).
+    pub port: String,
+    /// Stage it is drawn from.
+    pub stage: usize,
+    /// Draw flow (e.g. `"0.1 kmol/min"`).
+    pub flow: QuantityValue,
+}
+
+/// Flowsheet description of a column.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ColumnConfig {
+    /// Fidelity (default `simple`).
+    #[serde(default)]
+    pub model: ColumnModel,
+    /// Number of stages N including reboiler (stage 1) and condenser (stage N); ≥ 3.
+    pub stages: usize,
+    /// Feeds.
+    pub feeds: Vec<ColumnFeed>,
+    /// Liquid side draws (default none).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub side_draws: Vec<SideDraw>,
+    /// Column pressure (default 1 atm).
+    #[serde(rename = "P", default, skip_serializing_if = "Option::is_none")]
+    pub pressure: Option<QuantityValue>,
+    /// Nominal liquid holdup of a tray (e.g. `"0.5 kmol"`).
+    pub tray_holdup: QuantityValue,
+    /// Nominal liquid holdup of the condenser / reflux drum.
+    pub condenser_holdup: QuantityValue,
+    /// Nominal liquid holdup of the reboiler / sump.
+    pub reboiler_holdup: QuantityValue,
+    /// Liquid hydraulic time constant τ_L of a tray (e.g. `"0.063 min"`).
+    pub tau_l: QuantityValue,
+    /// Effect of vapour flow on liquid flow λ [-] (default 0).
+    #[serde(default)]
+    pub lambda: f64,
+    /// Reflux flow L.
+    pub reflux: QuantityValue,
+    /// Boilup V.
+    pub boilup: QuantityValue,
+    /// Distillate flow D.
+    pub distillate: QuantityValue,
+    /// Bottoms flow B.
+    pub bottoms: QuantityValue,
+}
+
+#[derive(Debug, Clone)]
+struct Feed {
+    stage: usize,
+    q: Option<f64>,
+}
+
+#[derive(Debug, Clone)]
+struct Draw {
+    stage: usize,
+    flow: f64,
+}
+
+/// A distillation column.
+#[derive(Debug, Clone)]
+pub struct Column {
+    n_stages: usize,
+    feeds: Vec<Feed>,
+    feed_ports: Vec<String>,
+    draws: Vec<Draw>,
+    draw_ports: Vec<String>,
+    pressure: f64,
+    m0: Vec<f64>,
+    l0: Vec<f64>,
+    tau_l: f64,
+    lambda: f64,
+    v0: f64,
+    reflux: f64,
+    boilup: f64,
+    distillate: f64,
+    bottoms: f64,
+    comp_names: Vec<String>,
+}
+
+// Inputs, in declaration order.
+const IN_REFLUX: usize = 0;
+const IN_BOILUP: usize = 1;
+const IN_DISTILLATE: usize = 2;
+const IN_BOTTOMS: usize = 3;
+
+impl Column {
+    /// Build from the flowsheet description.
+    pub fn build(c: &ColumnConfig, mut cx: BuildCx<'_>, _links: ()) -> Result<Column, Vec<FieldError>> {
+        let n = c.stages;
+        if n < 3 {
+            cx.error("stages", format!("a column needs at least 3 stages (reboiler, one tray, condenser); got {n}"));
+        }
+        let amount = Dimension::AMOUNT;
+        let flow = Dimension::MOLAR_FLOW;
+        let pressure = c.pressure.as_ref().map_or(101_325.0, |p| cx.positive("P", p, Dimension::PRESSURE));
+        let tray = cx.positive("tray_holdup", &c.tray_holdup, amount);
+        let cond = cx.positive("condenser_holdup", &c.condenser_holdup, amount);
+        let reb = cx.positive("reboiler_holdup", &c.reboiler_holdup, amount);
+        let tau_l = cx.positive("tau_l", &c.tau_l, Dimension::TIME);
+        let reflux = cx.non_negative("reflux", &c.reflux, flow);
+        let boilup = cx.non_negative("boilup", &c.boilup, flow);
+        let distillate = cx.non_negative("distillate", &c.distillate, flow);
+        let bottoms = cx.non_negative("bottoms", &c.bottoms, flow);
+        if c.feeds.is_empty() {
+            cx.error("feeds", "give at least one feed, e.g. [{\"port\": \"feed\", \"stage\": 21}]");
+        }
+        let mut feeds = Vec::new();
+        let mut feed_ports: Vec<String> = Vec::new();
+        let mut nominal_feed = Vec::new();
+        for (k, f) in c.feeds.iter().enumerate() {
+            if f.stage < 1 || f.stage > n {
+                cx.error(&format!("feeds[{k}].stage"), format!("must be between 1 (reboiler) and {n} (condenser); got {}", f.stage));
+            }
+            if let Some(q) = f.q {
+                if !q.is_finite() {
+                    cx.error(&format!("feeds[{k}].q"), "must be a finite number (1 = saturated liquid, 0 = saturated vapour)");
+                }
+            }
+            if feed_ports.contains(&f.port) {
+                cx.error(&format!("feeds[{k}].port"), format!("port `{}` is used twice", f.port));
+            }
+            feed_ports.push(f.port.clone());
+            let nom = match &f.nominal_flow {
+                Some(v) => cx.non_negative(&format!("feeds[{k}].nominal_flow"), v, flow),
+                None if c.feeds.len() == 1 => distillate + bottoms,
+                None => {
+                    cx.error(&format!("feeds[{k}].nominal_flow"), "with several feeds give each feed's nominal flow for the tray hydraulics");
+                    0.0
+                }
+            };
+            nominal_feed.push(nom);
+            feeds.push(Feed { stage: f.stage.saturating_sub(1), q: f.q });
+        }
+        let mut draws = Vec::new();
+        let mut draw_ports = Vec::new();
+        for (k, d) in c.side_draws.iter().enumerate() {
+            if d.stage < 2 || d.stage + 1 > n {
+                cx.error(&format!("side_draws[{k}].stage"), format!("side draws come from trays 2 … {}; got {}", n.saturating_sub(1), d.stage));
+            }
+            if ["distillate", "bottoms"].contains(&d.port.as_str()) || feed_ports.contains(&d.port) || draw_ports.contains(&d.port) {
+                cx.error(&format!("side_draws[{k}].port"), format!("port name `{}` is already used", d.port));
+            }
+            let f = cx.non_negative(&format!("side_draws[{k}].flow"), &d.flow, flow);
+            draws.push(Draw { stage: d.stage.saturating_sub(1), flow: f });
+            draw_ports.push(d.port.clone());
+        }
+        let mut m0 = vec![tray; n];
+        if n >= 1 {
+            m0[0] = reb;
+            m0[n - 1] = cond;
+        }
+        // Nominal liquid leaving each tray: reflux, plus q·F below each feed, minus side draws above.
+        let mut l0 = vec![0.0; n];
+        for i in (1..n.saturating_sub(1)).rev() {
+            let mut l = if i + 2 == n { reflux } else { l0[i + 1] };
+            for (f, nom) in feeds.iter().zip(&nominal_feed) {
+                if f.stage == i {
+                    l += f.q.unwrap_or(1.0) * nom;
+                }
+            }
+            for d in draws.iter().filter(|d| d.stage == i) {
+                l -= d.flow;
+            }
+            l0[i] = l;
+        }
+        let column = Column {
+            n_stages: n,
+            feeds,
+            feed_ports,
+            draws,
+            draw_ports,
+            pressure,
+            m0,
+            l0,
+            tau_l,
+            lambda: c.lambda,
+            v0: boilup,
+            reflux,
+            boilup,
+            distillate,
+            bottoms,
+            comp_names: cx.components.to_vec(),
+        };
+        cx.finish(column)
+    }
+
+    fn nc(&self) -> usize {
+        self.comp_names.len()
+    }
+    /// Variables per stage: n (nc), x (nc), y (nc), T, M, L, V.
+    fn per_stage(&self) -> usize {
+        3 * self.nc() + 4
+    }
+    fn n_outlets(&self) -> usize {
+        2 + self.draws.len()
+    }
+    /// Offset of stage `s` (0-based) in the internal variables.
+    fn stage(&self, s: usize) -> usize {
+        s * self.per_stage()
+    }
+}
+
+/// Offsets within a stage block.
+struct StageIdx {
+    nc: usize,
+}
+impl StageIdx {
+    fn n(&self, j: usize) -> usize {
+        j
+    }
+    fn x(&self, j: usize) -> usize {
+        self.nc + j
+    }
+    fn y(&self, j: usize) -> usize {
+        2 * self.nc + j
+    }
+    fn t(&self) -> usize {
+        3 * self.nc
+    }
+    fn m(&self) -> usize {
+        3 * self.nc + 1
+    }
+    fn l(&self) -> usize {
+        3 * self.nc + 2
+    }
+    fn v(&self) -> usize {
+        3 * self.nc + 3
+    }
+}
+
+impl UnitModel for Column {
+    fn type_name(&self) -> &'static str {
+        "column"
+    }
+    fn inlet_ports(&self) -> Vec<String> {
+        self.feed_ports.clone()
+    }
+    fn outlet_ports(&self) -> Vec<String> {
+        let mut v = vec!["distillate".to_string(), "bottoms".to_string()];
+        v.extend(self.draw_ports.iter().cloned());
+        v
+    }
+    fn internal_vars(&self) -> Vec<VarSpec> {
+        let mut v = Vec::with_capacity(self.n_stages * self.per_stage());
+        let flow_nom = self.reflux.max(self.boilup).max(1e-3);
+        for s in 0..self.n_stages {
+            let st = s + 1;
+            let m0 = self.m0[s];
+            for c in &self.comp_names {
+                v.push(VarSpec::differential(format!("n[{st}][{c}]"), Dimension::AMOUNT, m0).bounded(0.0, f64::INFINITY));
+            }
+            for c in &self.comp_names {
+                v.push(VarSpec::algebraic(format!("x[{st}][{c}]"), Dimension::DIMENSIONLESS, 1.0).bounded(0.0, 1.0));
+            }
+            for c in &self.comp_names {
+                v.push(VarSpec::algebraic(format!("y[{st}][{c}]"), Dimension::DIMENSIONLESS, 1.0).bounded(0.0, 1.0));
+            }
+            v.push(VarSpec::algebraic(format!("T[{st}]"), Dimension::TEMPERATURE, 350.0).bounded(1.0, 5000.0));
+            v.push(VarSpec::algebraic(format!("M[{st}]"), Dimension::AMOUNT, m0).bounded(1e-12 * m0, f64::INFINITY));
+            v.push(VarSpec::algebraic(format!("L[{st}]"), Dimension::MOLAR_FLOW, flow_nom).bounded(0.0, f64::INFINITY));
+            v.push(VarSpec::algebraic(format!("V[{st}]"), Dimension::MOLAR_FLOW, flow_nom).bounded(0.0, f64::INFINITY));
+        }
+        v
+    }
+    fn inputs(&self) -> Vec<InputSpec> {
+        let flow = Dimension::MOLAR_FLOW;
+        let mut v = vec![
+            InputSpec { name: "reflux".into(), dim: flow, value: self.reflux },
+            InputSpec { name: "boilup".into(), dim: flow, value: self.boilup },
+            InputSpec { name: "distillate".into(), dim: flow, value: self.distillate },
+            InputSpec { name: "bottoms".into(), dim: flow, value: self.bottoms },
+        ];
+        for (d, p) in self.draws.iter().zip(&self.draw_ports) {
+            v.push(InputSpec { name: p.clone(), dim: flow, value: d.flow });
+        }
+        v
+    }
+    fn pattern(&self, layout: &LocalLayout) -> Option<Vec<(usize, usize)>> {
+        let slen = layout.stream.len();
+        let internal0 = self.n_outlets() * slen;
+        let ps = self.per_stage();
+        let n_local = layout.len();
+        let shared: Vec<usize> = (layout.n_own()..n_local).collect();
+        let mut p = Vec::new();
+        let stage_cols = |s: usize| internal0 + self.stage(s)..internal0 + self.stage(s) + ps;
+        // Outlet streams: their own block, the stage they come from, inputs.
+        for k in 0..self.n_outlets() {
+            let s = match k {
+                0 => self.n_stages - 1,
+                1 => 0,
+                _ => self.draws[k - 2].stage,
+            };
+            for row in k * slen..(k + 1) * slen {
+                p.extend((k * slen..(k + 1) * slen).map(|c| (row, c)));
+                p.extend(stage_cols(s).map(|c| (row, c)));
+                p.extend(shared.iter().map(|&c| (row, c)));
+            }
+        }
+        for s in 0..self.n_stages {
+            let lo = s.saturating_sub(1);
+            let hi = (s + 1).min(self.n_stages - 1);
+            for row in internal0 + self.stage(s)..internal0 + self.stage(s) + ps {
+                for t in lo..=hi {
+                    p.extend(stage_cols(t).map(|c| (row, c)));
+                }
+                p.extend(shared.iter().map(|&c| (row, c)));
+            }
+        }
+        Some(p)
+    }
+    fn eval<S: Scalar>(&self, io: &UnitIo<'_, S>, r: &mut [S]) {
+        let nc = self.nc();
+        let slen = io.layout.stream.len();
+        let internal0 = self.n_outlets() * slen;
+        let ix = StageIdx { nc };
+        let p = S::from(self.pressure);
+        let st = |s: usize| io.vars(self.stage(s), self.per_stage());
+        let n = self.n_stages;
+        let (l_in, v_in, d_in, b_in) = (io.input(IN_REFLUX), io.input(IN_BOILUP), io.input(IN_DISTILLATE), io.input(IN_BOTTOMS));
+        let mut kbuf = vec![S::from(0.0); nc];
+
+        // Feed contributions and (1 − q) vapour per stage.
+        let mut feed_comp = vec![vec![S::from(0.0); nc]; n];
+        let mut feed_vap = vec![S::from(0.0); n];
+        for (k, f) in self.feeds.iter().enumerate() {
+            let s = io.inlet(k);
+            for j in 0..nc {
+                feed_comp[f.stage][j] += s.f() * s.z()[j];
+            }
+            let q = match f.q {
+                Some(q) => S::from(q),
+                None => {
+                    let v = st(f.stage);
+                    let hv = io.thermo.h_vap(v[ix.t()], &v[ix.y(0)..ix.y(0) + nc]);
+                    let hl = io.thermo.h_liq(v[ix.t()], &v[ix.x(0)..ix.x(0) + nc]);
+                    (hv - s.h()) / (hv - hl)
+                }
+            };
+            feed_vap[f.stage] += (S::from(1.0) - q) * s.f();
+        }
+        let draw_flow: Vec<S> = (0..self.draws.len()).map(|k| io.input(4 + k)).collect();
+
+        for s in 0..n {
+            let v = st(s);
+            let o = internal0 + self.stage(s);
+            let m = v[ix.m()];
+            // Component balances.
+            for j in 0..nc {
+                let mut acc = feed_comp[s][j] - v[ix.l()] * v[ix.x(j)] - v[ix.v()] * v[ix.y(j)];
+                if s + 1 < n {
+                    let up = st(s + 1);
+                    acc += up[ix.l()] * up[ix.x(j)];
+                }
+                if s > 0 {
+                    let dn = st(s - 1);
+                    acc += dn[ix.v()] * dn[ix.y(j)];
+                }
+                if s + 1 == n {
+                    acc -= d_in * v[ix.x(j)];
+                }
+                for (d, fl) in self.draws.iter().zip(&draw_flow) {
+                    if d.stage == s {
+                        acc -= *fl * v[ix.x(j)];
+                    }
+                }
+                r[o + ix.n(j)] = acc;
+                r[o + ix.x(j)] = v[ix.x(j)] - v[ix.n(j)] / m;
+            }
+            let x = &v[ix.x(0)..ix.x(0) + nc];
+            // Equilibrium and bubble point.
+            io.thermo.k_values(v[ix.t()], p, x, &mut kbuf);
+            for j in 0..nc {
+                r[o + ix.y(j)] = v[ix.y(j)] - kbuf[j] * x[j];
+            }
+            r[o + ix.t()] = io.thermo.bubble_residual(v[ix.t()], p, x);
+            r[o + ix.m()] = m - v[ix.n(0)..ix.n(0) + nc].iter().fold(S::from(0.0), |a, b| a + *b);
+            // Liquid flows.
+            r[o + ix.l()] = if s + 1 == n {
+                v[ix.l()] - l_in
+            } else if s == 0 {
+                v[ix.l()] - b_in
+            } else {
+                let mut l = S::from(self.l0[s]) + (m - self.m0[s]) / self.tau_l;
+                if self.lambda != 0.0 {
+                    l += (st(s - 1)[ix.v()] - self.v0) * self.lambda;
+                }
+                v[ix.l()] - l
+            };
+            // Vapour flows (CMO).
+            r[o + ix.v()] = if s == 0 {
+                v[ix.v()] - v_in - feed_vap[0]
+            } else if s + 1 == n {
+                v[ix.v()]
+            } else {
+                v[ix.v()] - st(s - 1)[ix.v()] - feed_vap[s]
+            };
+        }
+
+        // Outlet streams.
+        let outlet = |k: usize, s: usize, flow: S, r: &mut [S]| {
+            let out = io.outlet(k);
+            let v = st(s);
+            let rr = &mut r[k * slen..(k + 1) * slen];
+            rr[F] = out.f() - flow;
+            rr[T] = out.t() - v[ix.t()];
+            rr[P] = out.p() - p;
+            rr[H] = out.h() - io.thermo.h_liq(v[ix.t()], &v[ix.x(0)..ix.x(0) + nc]);
+            for j in 0..nc {
+                rr[Z0 + j] = out.z()[j] - v[ix.x(j)];
+            }
+        };
+        outlet(0, n - 1, d_in, r);
+        outlet(1, 0, st(0)[ix.l()], r);
+        for (k, d) in self.draws.iter().enumerate() {
+            outlet(2 + k, d.stage, draw_flow[k], r);
+        }
+    }
+    fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]) {
+        let nc = self.nc();
+        let n = self.n_stages;
+        let slen = io.layout.stream.len();
+        let internal0 = self.n_outlets() * slen;
+        let ix = StageIdx { nc };
+        // Overall feed composition.
+        let mut zf = vec![0.0; nc];
+        let mut ftot = 0.0;
+        for k in 0..self.feeds.len() {
+            let s = io.inlet(k);
+            ftot += s.f();
+            zf.iter_mut().zip(s.z()).for_each(|(a, z)| *a += s.f() * z);
+        }
+        if ftot > 0.0 {
+            zf.iter_mut().for_each(|a| *a /= ftot);
+        } else {
+            zf.iter_mut().for_each(|a| *a = 1.0 / nc as f64);
+        }
+        // Linear profile between a heavy-rich bottom (z/K) and a light-rich top (z·K).
+        let t_feed = io.thermo.bubble_t(self.pressure, &zf).map(|s| s.t).unwrap_or(350.0);
+        let mut k = vec![0.0; nc];
+        io.thermo.k_values(t_feed, self.pressure, &zf, &mut k);
+        let norm = |v: Vec<f64>| {
+            let s: f64 = v.iter().sum();
+            v.into_iter().map(|a| a / s).collect::<Vec<f64>>()
+        };
+        let top = norm(zf.iter().zip(&k).map(|(z, k)| z * k * k).collect());
+        let bot = norm(zf.iter().zip(&k).map(|(z, k)| z / (k * k)).collect());
+        let (l_in, v_in) = (io.input(IN_REFLUX), io.input(IN_BOILUP));
+        let mut vflow = v_in;
+        for s in 0..n {
+            let w = s as f64 / (n - 1) as f64;
+            let x: Vec<f64> = bot.iter().zip(&top).map(|(b, t)| (1.0 - w) * b + w * t).collect();
+            let t = io.thermo.bubble_t(self.pressure, &x).map(|s| s.t).unwrap_or(t_feed);
+            io.thermo.k_values(t, self.pressure, &x, &mut k);
+            let y: Vec<f64> = norm(x.iter().zip(&k).map(|(a, b)| a * b).collect());
+            let o = internal0 + self.stage(s);
+            let m = self.m0[s];
+            for j in 0..nc {
+                own[o + ix.n(j)] = m * x[j];
+                own[o + ix.x(j)] = x[j];
+                own[o + ix.y(j)] = y[j];
+            }
+            own[o + ix.t()] = t;
+            own[o + ix.m()] = m;
+            own[o + ix.l()] = if s + 1 == n {
+                l_in
+            } else if s == 0 {
+                io.input(IN_BOTTOMS)
+            } else {
+                self.l0[s]
+            };
+            if s > 0 {
+                for f in self.feeds.iter().filter(|f| f.stage == s) {
+                    vflow += (1.0 - f.q.unwrap_or(1.0)) * io.inlet(self.feeds.iter().position(|g| std::ptr::eq(g, f)).unwrap_or(0)).f();
+                }
+            }
+            own[o + ix.v()] = if s + 1 == n { 0.0 } else { vflow };
+        }
+        let mut outlet = |k: usize, s: usize, flow: f64| {
+            let o = internal0 + self.stage(s);
+            let x: Vec<f64> = own[o + ix.x(0)..o + ix.x(0) + nc].to_vec();
+            let t = own[o + ix.t()];
+            let rr = &mut own[k * slen..(k + 1) * slen];
+            rr[F] = flow;
+            rr[T] = t;
+            rr[P] = self.pressure;
+            rr[H] = io.thermo.h_liq(t, &x);
+            rr[Z0..].copy_from_slice(&x);
+        };
+        outlet(0, n - 1, io.input(IN_DISTILLATE));
+        outlet(1, 0, io.input(IN_BOTTOMS));
+        for (k, d) in self.draws.iter().enumerate() {
+            outlet(2 + k, d.stage, io.input(4 + k));
+        }
+    }
+}

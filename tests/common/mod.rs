@@ -1,0 +1,56 @@
+//! Shared helpers of the end-to-end tests: load a shipped flowsheet, converge it, read values by
+//! path, and check conservation around every unit.
+#![allow(dead_code)]
+
+use plantwide::flowsheet::{load_file, BlockKind, Plant};
+use plantwide::model::stream::{F, Z0};
+use plantwide::solve::{steady_state, NewtonSettings, SteadyState};
+
+/// Path of a shipped flowsheet.
+pub fn flowsheet(name: &str) -> String {
+    format!("{}/flowsheets/{name}", env!("CARGO_MANIFEST_DIR"))
+}
+
+/// Load and converge a shipped flowsheet from a cold start.
+pub fn converge(name: &str) -> (Plant, SteadyState) {
+    let plant = load_file(std::path::Path::new(&flowsheet(name))).unwrap_or_else(|e| panic!("{e}"));
+    let u = plant.input_values();
+    let ss = steady_state(&plant, &u, None, &NewtonSettings::default()).unwrap_or_else(|e| panic!("{e}"));
+    (plant, ss)
+}
+
+/// Value of the variable at `path`.
+pub fn value(plant: &Plant, x: &[f64], path: &str) -> f64 {
+    x[plant.var(path).unwrap_or_else(|| panic!("no variable {path}"))]
+}
+
+/// Largest relative component-balance error `|Σ in F z − Σ out F z| / Σ in F z` over all process
+/// units except those listed in `generating` (reactors), and over the plant as a whole.
+pub fn component_balance_error(plant: &Plant, x: &[f64], generating: &[&str]) -> f64 {
+    let nc = plant.components.len();
+    let mut worst: f64 = 0.0;
+    let flows = |s: &plantwide::flowsheet::StreamInfo| -> Vec<f64> {
+        let v = &x[s.offset..s.offset + plant.stream_layout.len()];
+        (0..nc).map(|j| v[F] * v[Z0 + j]).collect()
+    };
+    for (bi, b) in plant.blocks.iter().enumerate() {
+        if b.kind != BlockKind::Unit || b.layout.n_inlets == 0 || b.layout.n_outlets == 0 || generating.contains(&b.name.as_str()) {
+            continue;
+        }
+        let mut inn = vec![0.0; nc];
+        let mut out = vec![0.0; nc];
+        for s in &plant.streams {
+            if s.to.0 == bi {
+                inn.iter_mut().zip(flows(s)).for_each(|(a, b)| *a += b);
+            }
+            if s.from.0 == bi {
+                out.iter_mut().zip(flows(s)).for_each(|(a, b)| *a += b);
+            }
+        }
+        let total: f64 = inn.iter().sum();
+        for j in 0..nc {
+            worst = worst.max((inn[j] - out[j]).abs() / total.max(1e-300));
+        }
+    }
+    worst
+}
