@@ -41,7 +41,7 @@ pub fn load_with_overrides(file: &Path, sets: &[String]) -> Result<(Plant, Vec<f
 pub fn converge(plant: &Plant, u: &[f64]) -> Result<SteadyState, CliError> {
     steady_state(plant, u, None, &NewtonSettings::default()).map_err(|e| match e {
         SteadyError::Dof(d) => CliError::user(d.to_string()),
-        e @ SteadyError::NotConverged { .. } => CliError::numerical(e.to_string()),
+        SteadyError::NotConverged(f) => CliError::numerical(f.to_string()),
     })
 }
 

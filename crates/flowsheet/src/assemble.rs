@@ -104,15 +104,11 @@ pub fn assemble(spec: &FlowsheetSpec, file: &str) -> Result<Plant, LoadError> {
         };
         let from = resolve("from", &s.from, true);
         let to = resolve("to", &s.to, false);
-        if let Some(f) = from {
-            if let Some(prev) = outlet_of.insert(f, sname.clone()) {
-                diags.push(Diagnostic::new(format!("streams.{sname}.from"), format!("outlet `{}` is already the source of stream `{prev}`: a port takes one stream (use a splitter)", s.from)));
-            }
+        if let Some(prev) = from.and_then(|f| outlet_of.insert(f, sname.clone())) {
+            diags.push(Diagnostic::new(format!("streams.{sname}.from"), format!("outlet `{}` is already the source of stream `{prev}`: a port takes one stream (use a splitter)", s.from)));
         }
-        if let Some(t) = to {
-            if let Some(prev) = inlet_of.insert(t, sname.clone()) {
-                diags.push(Diagnostic::new(format!("streams.{sname}.to"), format!("inlet `{}` is already fed by stream `{prev}`: a port takes one stream (use a mixer)", s.to)));
-            }
+        if let Some(prev) = to.and_then(|t| inlet_of.insert(t, sname.clone())) {
+            diags.push(Diagnostic::new(format!("streams.{sname}.to"), format!("inlet `{}` is already fed by stream `{prev}`: a port takes one stream (use a mixer)", s.to)));
         }
         if let (Some(f), Some(t)) = (from, to) {
             links.push((sname.clone(), f, t, s.tear));
@@ -285,8 +281,7 @@ pub fn assemble(spec: &FlowsheetSpec, file: &str) -> Result<Plant, LoadError> {
 
     // Reads of every block, and equation offsets.
     let mut eq_offset = 0;
-    for bi in 0..blocks.len() {
-        let b = &blocks[bi];
+    for (bi, b) in blocks.iter_mut().enumerate() {
         let mut reads = Vec::new();
         if b.kind == BlockKind::Unit {
             for k in 0..b.layout.n_inlets {
@@ -306,7 +301,6 @@ pub fn assemble(spec: &FlowsheetSpec, file: &str) -> Result<Plant, LoadError> {
                 None => diags.push(Diagnostic::new(format!("controllers.{}.{}", b.name, s.role), format!("no variable `{}`", s.path))),
             }
         }
-        let b = &mut blocks[bi];
         b.reads = reads;
         b.pattern = b.unit.pattern(&b.layout);
         b.eq_offset = eq_offset;

@@ -13,5 +13,5 @@ pub mod system;
 
 pub use newton::{solve_steady, IterationRecord, NewtonReport, NewtonSettings, NewtonStatus};
 pub use structure::{maximum_matching, Matching};
-pub use steady::{dof_check, steady_state, DofError, PlantSystem, SteadyError, SteadyState};
+pub use steady::{dof_check, steady_state, ConvergenceFailure, DofError, PlantSystem, SteadyError, SteadyState};
 pub use system::System;

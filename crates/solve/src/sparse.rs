@@ -16,10 +16,13 @@ pub enum SparseError {
     Factor(String),
 }
 
+/// A pattern (as triplet positions) and its symbolic LU.
+type Symbolic = (Vec<(usize, usize)>, SymbolicLu<usize>);
+
 /// A sparse LU solver that reuses the symbolic factorization while the pattern is unchanged.
 #[derive(Debug, Default)]
 pub struct SparseLu {
-    symbolic: Option<(Vec<(usize, usize)>, SymbolicLu<usize>)>,
+    symbolic: Option<Symbolic>,
 }
 
 impl SparseLu {

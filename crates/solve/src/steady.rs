@@ -177,27 +177,32 @@ pub enum SteadyError {
     #[error(transparent)]
     Dof(#[from] DofError),
     /// Newton did not converge.
-    #[error("{file}: steady state not found ({status:?} after {iterations} iterations, scaled residual {residual:.3e}); worst equation: {equation} (variable {variable}, scaled residual {worst:.3e})")]
-    NotConverged {
-        /// Flowsheet file.
-        file: String,
-        /// Solver status.
-        status: NewtonStatus,
-        /// Iterations.
-        iterations: usize,
-        /// Final scaled residual.
-        residual: f64,
-        /// Name of the worst equation.
-        equation: String,
-        /// Path of the variable that equation belongs to.
-        variable: String,
-        /// Its scaled residual.
-        worst: f64,
-        /// The full report with the iteration history.
-        report: Box<NewtonReport>,
-        /// The last iterate.
-        x: Vec<f64>,
-    },
+    #[error(transparent)]
+    NotConverged(Box<ConvergenceFailure>),
+}
+
+/// A steady-state solve that did not converge: where and how it failed.
+#[derive(Debug, Clone, thiserror::Error)]
+#[error("{file}: steady state not found ({status:?} after {iterations} iterations, scaled residual {residual:.3e}); worst equation: {equation} (variable {variable}, scaled residual {worst:.3e})")]
+pub struct ConvergenceFailure {
+    /// Flowsheet file.
+    pub file: String,
+    /// Solver status.
+    pub status: NewtonStatus,
+    /// Iterations.
+    pub iterations: usize,
+    /// Final scaled residual.
+    pub residual: f64,
+    /// Name of the worst equation.
+    pub equation: String,
+    /// Path of the variable that equation belongs to.
+    pub variable: String,
+    /// Its scaled residual.
+    pub worst: f64,
+    /// The full report with the iteration history.
+    pub report: NewtonReport,
+    /// The last iterate.
+    pub x: Vec<f64>,
 }
 
 /// Solve the plant's steady state at inputs `u` from `x0` (or the cold-start guess).
@@ -215,7 +220,7 @@ pub fn steady_state(plant: &Plant, u: &[f64], x0: Option<&[f64]>, settings: &New
     let (eq, worst) = report.worst.unwrap_or((0, f64::NAN));
     let equation = plant.equation_name(eq);
     let variable = plant.equation_variable(eq).map(|j| plant.vars[j].path.clone()).unwrap_or_else(|| "-".into());
-    Err(SteadyError::NotConverged {
+    Err(SteadyError::NotConverged(Box::new(ConvergenceFailure {
         file: plant.file.clone(),
         status: report.status,
         iterations: report.iterations,
@@ -223,7 +228,7 @@ pub fn steady_state(plant: &Plant, u: &[f64], x0: Option<&[f64]>, settings: &New
         equation,
         variable,
         worst,
-        report: Box::new(report),
+        report,
         x,
-    })
+    })))
 }

@@ -39,8 +39,8 @@ pub fn maximum_matching(n_rows: usize, n_cols: usize, entries: &[(usize, usize)]
     }
     let mut m = Matching { row_to_col: vec![None; n_rows], col_to_row: vec![None; n_cols] };
     // Cheap greedy start, prefers the diagonal (own variable ↔ own equation).
-    for i in 0..n_rows {
-        if i < n_cols && adj[i].binary_search(&i).is_ok() && m.col_to_row[i].is_none() {
+    for (i, row) in adj.iter().enumerate() {
+        if i < n_cols && row.binary_search(&i).is_ok() && m.col_to_row[i].is_none() {
             m.row_to_col[i] = Some(i);
             m.col_to_row[i] = Some(i);
         }

@@ -12,8 +12,8 @@
 //! # Simple model (constant molar overflow; Skogestad's column A)
 //! Variables per stage i: component holdups `n_ij` [mol] (differential), `x_ij`, `y_ij`, `T_i`,
 //! `M_i`, `L_i`, `V_i`. Equations:
-//! - component balances `dn_ij/dt = L_{i+1} x_{i+1,j} + V_{i−1} y_{i−1,j} − L_i x_ij − V_i y_ij
-//!   + Σ_feeds F z_j − draws`, where the condenser also loses `D x_Nj` and the reboiler's liquid
+//! - component balances `dn_ij/dt = L_{i+1} x_{i+1,j} + V_{i−1} y_{i−1,j} − L_i x_ij − V_i y_ij + Σ_feeds F z_j − draws`,
+//!   where the condenser also loses `D x_Nj` and the reboiler's liquid
 //!   outflow is the bottoms;
 //! - `M_i = Σ_j n_ij`, `x_ij = n_ij / M_i`;
 //! - equilibrium `y_ij = K_ij(T_i, P, x_i) x_ij` (constant α: `y = α x / Σ α x`);
@@ -186,10 +186,8 @@ impl Column {
             if f.stage < 1 || f.stage > n {
                 cx.error(&format!("feeds[{k}].stage"), format!("must be between 1 (reboiler) and {n} (condenser); got {}", f.stage));
             }
-            if let Some(q) = f.q {
-                if !q.is_finite() {
-                    cx.error(&format!("feeds[{k}].q"), "must be a finite number (1 = saturated liquid, 0 = saturated vapour)");
-                }
+            if f.q.is_some_and(|q| !q.is_finite()) {
+                cx.error(&format!("feeds[{k}].q"), "must be a finite number (1 = saturated liquid, 0 = saturated vapour)");
             }
             if feed_ports.contains(&f.port) {
                 cx.error(&format!("feeds[{k}].port"), format!("port `{}` is used twice", f.port));
@@ -399,8 +397,8 @@ impl UnitModel for Column {
         let mut feed_vap = vec![S::from(0.0); n];
         for (k, f) in self.feeds.iter().enumerate() {
             let s = io.inlet(k);
-            for j in 0..nc {
-                feed_comp[f.stage][j] += s.f() * s.z()[j];
+            for (acc, z) in feed_comp[f.stage].iter_mut().zip(s.z()) {
+                *acc += s.f() * *z;
             }
             let q = match f.q {
                 Some(q) => S::from(q),

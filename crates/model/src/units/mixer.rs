@@ -111,6 +111,6 @@ impl UnitModel for Mixer {
             own[H] = s0.h();
             own[Z0..].copy_from_slice(s0.z());
         }
-        own[T] = self.phase.temperature(io.thermo, own[H], &own[Z0..].to_vec(), s0.t());
+        own[T] = self.phase.temperature(io.thermo, own[H], &own[Z0..], s0.t());
     }
 }
