@@ -58,10 +58,18 @@ registry!(
     "mixer" => Mixer(units::mixer::MixerConfig, units::mixer::Mixer),
     "splitter" => Splitter(units::splitter::SplitterConfig, units::splitter::Splitter),
     "heater" => Heater(units::heater::HeaterConfig, units::heater::Heater),
+    "column" => Column(units::column::ColumnConfig, units::column::Column),
+    "valve" => Valve(units::valve::ValveConfig, units::valve::Valve),
+    "pump" => Pump(units::pump::PumpConfig, units::pump::Pump),
+    "heat_exchanger" => HeatExchanger(units::hx::HeatExchangerConfig, units::hx::HeatExchanger),
 ]);
 
 registry!(
     /// A controller's description in a flowsheet file.
     ControllerSpec, &ControllerLinks, ControllerConfig, [
     "pid" => Pid(controllers::pid::PidConfig, controllers::pid::Pid),
+    "ratio" => Ratio(controllers::ratio::RatioConfig, controllers::ratio::Ratio),
+    "summer" => Summer(controllers::summer::SummerConfig, controllers::summer::Summer),
+    "split_range" => SplitRange(controllers::split_range::SplitRangeConfig, controllers::split_range::SplitRange),
+    "selector" => Selector(controllers::selector::SelectorConfig, controllers::selector::Selector),
 ]);

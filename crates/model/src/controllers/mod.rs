@@ -2,6 +2,10 @@
 //! its residual forces the error to zero and a "design spec" is just a controller in the flowsheet.
 
 pub mod pid;
+pub mod ratio;
+pub mod selector;
+pub mod split_range;
+pub mod summer;
 
 use plantwide_units::{Dimension, QuantityValue};
 use schemars::JsonSchema;

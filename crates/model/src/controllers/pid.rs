@@ -17,7 +17,7 @@ use plantwide_units::{Dimension, QuantityValue};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
-use super::{gain_dimension, Action, ControllerLinks, Mode, Setpoint};
+use super::{Action, ControllerLinks, Mode, Setpoint, gain_dimension};
 use crate::{BuildCx, FieldError, InputSpec, Scalar, SignalSpec, UnitIo, UnitModel, VarSpec};
 
 /// Flowsheet description of a PID controller.
@@ -246,5 +246,187 @@ impl UnitModel for Pid {
             Mode::Auto => clamp(self.bias + self.kc * e, self.op_min, self.op_max),
             Mode::Manual => self.op_manual,
         };
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use plantwide_units::Dimension;
+    use serde_json::json;
+
+    use super::*;
+    use crate::testing::{binary_package, jacobian_error};
+    use crate::{LocalLayout, StreamLayout};
+
+    /// A level (m) controller moving a molar flow (mol/s) whose flowsheet value is 5 mol/s.
+    fn links() -> ControllerLinks {
+        ControllerLinks { pv_dim: Dimension::LENGTH, op_dim: Dimension::MOLAR_FLOW, op_value: 5.0, pv_nominal: 1.2 }
+    }
+
+    fn build(extra: serde_json::Value) -> Pid {
+        let mut config = json!({"pv": "tank.level", "output": "drain.F", "sp": "1.2 m", "kc": "10 mol/s/m"});
+        if let (Some(c), Some(e)) = (config.as_object_mut(), extra.as_object()) {
+            c.extend(e.clone());
+        }
+        let c: PidConfig = serde_json::from_value(config).expect("valid PID description");
+        let thermo = binary_package();
+        let comps = vec!["light".to_string(), "heavy".to_string()];
+        Pid::build(&c, BuildCx::new(&comps, &thermo, "controllers.lc"), &links()).expect("PID builds")
+    }
+
+    fn layout(u: &dyn crate::Unit) -> LocalLayout {
+        LocalLayout {
+            stream: StreamLayout { n_comp: 2 },
+            n_outlets: 0,
+            n_internal: u.internal_vars().len(),
+            n_inlets: 0,
+            n_inputs: u.inputs().len(),
+            n_signals: u.signals().len(),
+        }
+    }
+
+    fn residual(u: &dyn crate::Unit, local: &[f64]) -> Vec<f64> {
+        let thermo = binary_package();
+        let layout = layout(u);
+        assert_eq!(layout.len(), local.len());
+        let mut r = vec![f64::NAN; layout.n_own()];
+        u.residual(&UnitIo { local, layout: &layout, thermo: &thermo, time: 0.0 }, &mut r);
+        r
+    }
+
+    fn jac_err(u: &dyn crate::Unit, local: &[f64]) -> f64 {
+        let layout = layout(u);
+        jacobian_error(u, &layout, &binary_package(), local, layout.n_own())
+    }
+
+    fn names(u: &dyn crate::Unit) -> (Vec<String>, Vec<String>, Vec<String>) {
+        (
+            u.internal_vars().into_iter().map(|v| v.name).collect(),
+            u.inputs().into_iter().map(|i| i.name).collect(),
+            u.signals().into_iter().map(|s| s.role).collect(),
+        )
+    }
+
+    #[test]
+    fn pi_at_steady_state_holds_zero_error() {
+        let u = build(json!({"tau_i": "100 s"}));
+        assert_eq!(
+            names(&u),
+            (vec!["I".into(), "op".into()], vec!["sp".into(), "op_manual".into()], vec!["pv".into()])
+        );
+        let (sp, bias, kc, ti) = (1.2, 5.0, 10.0, 100.0);
+        // local = [I, op | sp, op_manual | pv]; op = u (inside the limits).
+        let at = |i: f64, pv: f64| {
+            let op = bias + kc * (sp - pv + i / ti);
+            residual(&u, &[i, op, sp, bias, pv])
+        };
+        // On setpoint: a steady state for any integral (the integral carries the output's offset).
+        for i in [-30.0, 0.0, 42.0] {
+            let r = at(i, sp);
+            assert!(r[0].abs() < 1e-14 && r[1].abs() < 1e-12, "{r:?}");
+        }
+        // Off setpoint: dI/dt = e = sp − pv (reverse action), so no steady state.
+        let r = at(12.0, 1.0);
+        assert!((r[0] - 0.2).abs() < 1e-12 && r[1].abs() < 1e-12, "{r:?}");
+        let direct = build(json!({"tau_i": "100 s", "action": "direct"}));
+        let op = bias + kc * (1.0 - sp);
+        let r = residual(&direct, &[0.0, op, sp, bias, 1.0]);
+        assert!((r[0] + 0.2).abs() < 1e-12 && r[1].abs() < 1e-12, "{r:?}");
+    }
+
+    #[test]
+    fn p_only_leaves_the_offset_op_minus_bias_over_kc() {
+        let u = build(json!({}));
+        assert_eq!(names(&u), (vec!["op".into()], vec!["sp".into(), "op_manual".into()], vec!["pv".into()]));
+        let (sp, bias, kc) = (1.2, 5.0, 10.0);
+        // The process needs op = 7 mol/s: the loop settles with e = (op − bias)/Kc = 0.2 m.
+        let op = 7.0;
+        let e = (op - bias) / kc;
+        let r = residual(&u, &[op, sp, bias, sp - e]);
+        assert!(r[0].abs() < 1e-12, "{r:?}");
+        // Any other level leaves a residual Kc·Δe.
+        let r = residual(&u, &[op, sp, bias, sp]);
+        assert!((r[0] - 2.0).abs() < 1e-12, "{r:?}");
+        // The guess puts op on the P law.
+        let thermo = binary_package();
+        let layout = layout(&u);
+        let mut own = [0.0];
+        u.guess(&UnitIo { local: &[0.0, sp, bias, sp - e], layout: &layout, thermo: &thermo, time: 0.0 }, &mut own);
+        assert!((own[0] - op).abs() < 1e-12);
+    }
+
+    #[test]
+    fn saturated_output_with_back_calculation_stops_the_integral() {
+        let u = build(json!({"tau_i": "100 s", "op_max": "6 mol/s", "op_min": 0.0}));
+        let (sp, bias, kc, ti, op_max) = (1.2, 5.0, 10.0, 100.0, 6.0);
+        // At the upper limit the integral settles at I = τ_I (op_max − bias)/Kc whatever the error.
+        let i_sat = ti * (op_max - bias) / kc;
+        for e in [0.5, 2.0] {
+            let pv = sp - e;
+            let unclamped = bias + kc * (e + i_sat / ti);
+            assert!(unclamped > op_max);
+            let r = residual(&u, &[i_sat, op_max, sp, bias, pv]);
+            assert!(r[0].abs() < 1e-12 && r[1].abs() < 1e-12, "e = {e}: {r:?}");
+            // Away from that integral, it relaxes towards it: dI/dt = (op_max − bias)/Kc − I/τ_I.
+            let r = residual(&u, &[i_sat + 5.0, op_max, sp, bias, pv]);
+            assert!((r[0] + 5.0 / ti).abs() < 1e-12, "{r:?}");
+        }
+        // Inside the limits the back-calculation term vanishes: dI/dt = e.
+        let r = residual(&u, &[0.0, bias + kc * 0.05, sp, bias, sp - 0.05]);
+        assert!((r[0] - 0.05).abs() < 1e-12 && r[1].abs() < 1e-12, "{r:?}");
+    }
+
+    #[test]
+    fn manual_mode_holds_op_manual_and_tracks_it_with_the_integral() {
+        let u = build(json!({"tau_i": "100 s", "mode": "manual", "op_manual": "4 mol/s"}));
+        let (sp, bias, kc, ti) = (1.2, 5.0, 10.0, 100.0);
+        assert_eq!(u.inputs()[1].value, 4.0);
+        // At the tracking steady state the unclamped auto output equals op_manual (bumpless).
+        let pv = 1.0;
+        let i = ti * ((4.0 - bias) / kc - (sp - pv));
+        let r = residual(&u, &[i, 4.0, sp, 4.0, pv]);
+        assert!(r[0].abs() < 1e-12 && r[1].abs() < 1e-14, "{r:?}");
+        assert!((bias + kc * (sp - pv + i / ti) - 4.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn jacobians_match_finite_differences() {
+        // P: [op | sp, op_manual | pv]
+        let p = build(json!({}));
+        assert!(jac_err(&p, &[6.0, 1.2, 5.0, 1.1]) < 1e-7);
+        // PI: [I, op | sp, op_manual | pv]
+        let pi = build(json!({"tau_i": "5 min"}));
+        assert!(jac_err(&pi, &[3.0, 6.0, 1.2, 5.0, 1.1]) < 1e-7);
+        // PI saturated at op_max.
+        let sat = build(json!({"tau_i": "100 s", "op_max": 6.0}));
+        assert!(jac_err(&sat, &[10.0, 6.0, 1.2, 5.0, 0.7]) < 1e-7);
+        // PID: [I, xf, op | sp, op_manual | pv]
+        let pid = build(json!({"tau_i": "100 s", "tau_d": "20 s", "filter_ratio": 8.0, "action": "direct"}));
+        assert_eq!(names(&pid).0, ["I", "xf", "op"]);
+        assert!(jac_err(&pid, &[3.0, 0.05, 6.0, 1.2, 5.0, 1.1]) < 1e-7);
+        // Manual PI.
+        let manual = build(json!({"tau_i": "100 s", "mode": "manual"}));
+        assert!(jac_err(&manual, &[3.0, 6.0, 1.2, 5.5, 1.1]) < 1e-7);
+        // Remote setpoint: [I, op | op_manual | pv, sp]
+        let remote = build(json!({"tau_i": "100 s", "sp": {"from": "master.op"}}));
+        assert_eq!(
+            names(&remote),
+            (vec!["I".into(), "op".into()], vec!["op_manual".into()], vec!["pv".into(), "sp".into()])
+        );
+        assert!(jac_err(&remote, &[3.0, 6.0, 5.0, 1.1, 1.3]) < 1e-7);
+        let r = residual(&remote, &[0.0, 5.0 + 10.0 * 0.2, 5.0, 1.1, 1.3]);
+        assert!((r[0] - 0.2).abs() < 1e-12 && r[1].abs() < 1e-12, "remote sp is signal 1: {r:?}");
+    }
+
+    #[test]
+    fn gain_with_the_wrong_dimension_is_reported() {
+        let c: PidConfig =
+            serde_json::from_value(json!({"pv": "tank.level", "output": "drain.F", "sp": "1.2 m", "kc": "10 mol/s/K"}))
+                .unwrap();
+        let thermo = binary_package();
+        let comps = vec!["light".to_string(), "heavy".to_string()];
+        let errs = Pid::build(&c, BuildCx::new(&comps, &thermo, "controllers.lc"), &links()).unwrap_err();
+        assert_eq!(errs.len(), 1);
+        assert_eq!(errs[0].path, "controllers.lc.kc");
     }
 }

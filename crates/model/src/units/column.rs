@@ -184,10 +184,16 @@ impl Column {
         let mut nominal_feed = Vec::new();
         for (k, f) in c.feeds.iter().enumerate() {
             if f.stage < 1 || f.stage > n {
-                cx.error(&format!("feeds[{k}].stage"), format!("must be between 1 (reboiler) and {n} (condenser); got {}", f.stage));
+                cx.error(
+                    &format!("feeds[{k}].stage"),
+                    format!("must be between 1 (reboiler) and {n} (condenser); got {}", f.stage),
+                );
             }
             if f.q.is_some_and(|q| !q.is_finite()) {
-                cx.error(&format!("feeds[{k}].q"), "must be a finite number (1 = saturated liquid, 0 = saturated vapour)");
+                cx.error(
+                    &format!("feeds[{k}].q"),
+                    "must be a finite number (1 = saturated liquid, 0 = saturated vapour)",
+                );
             }
             if feed_ports.contains(&f.port) {
                 cx.error(&format!("feeds[{k}].port"), format!("port `{}` is used twice", f.port));
@@ -197,7 +203,10 @@ impl Column {
                 Some(v) => cx.non_negative(&format!("feeds[{k}].nominal_flow"), v, flow),
                 None if c.feeds.len() == 1 => distillate + bottoms,
                 None => {
-                    cx.error(&format!("feeds[{k}].nominal_flow"), "with several feeds give each feed's nominal flow for the tray hydraulics");
+                    cx.error(
+                        &format!("feeds[{k}].nominal_flow"),
+                        "with several feeds give each feed's nominal flow for the tray hydraulics",
+                    );
                     0.0
                 }
             };
@@ -208,9 +217,15 @@ impl Column {
         let mut draw_ports = Vec::new();
         for (k, d) in c.side_draws.iter().enumerate() {
             if d.stage < 2 || d.stage + 1 > n {
-                cx.error(&format!("side_draws[{k}].stage"), format!("side draws come from trays 2 … {}; got {}", n.saturating_sub(1), d.stage));
+                cx.error(
+                    &format!("side_draws[{k}].stage"),
+                    format!("side draws come from trays 2 … {}; got {}", n.saturating_sub(1), d.stage),
+                );
             }
-            if ["distillate", "bottoms"].contains(&d.port.as_str()) || feed_ports.contains(&d.port) || draw_ports.contains(&d.port) {
+            if ["distillate", "bottoms"].contains(&d.port.as_str())
+                || feed_ports.contains(&d.port)
+                || draw_ports.contains(&d.port)
+            {
                 cx.error(&format!("side_draws[{k}].port"), format!("port name `{}` is already used", d.port));
             }
             let f = cx.non_negative(&format!("side_draws[{k}].flow"), &d.flow, flow);
@@ -320,7 +335,9 @@ impl UnitModel for Column {
             let st = s + 1;
             let m0 = self.m0[s];
             for c in &self.comp_names {
-                v.push(VarSpec::differential(format!("n[{st}][{c}]"), Dimension::AMOUNT, m0).bounded(0.0, f64::INFINITY));
+                v.push(
+                    VarSpec::differential(format!("n[{st}][{c}]"), Dimension::AMOUNT, m0).bounded(0.0, f64::INFINITY),
+                );
             }
             for c in &self.comp_names {
                 v.push(VarSpec::algebraic(format!("x[{st}][{c}]"), Dimension::DIMENSIONLESS, 1.0).bounded(0.0, 1.0));
@@ -389,7 +406,8 @@ impl UnitModel for Column {
         let p = S::from(self.pressure);
         let st = |s: usize| io.vars(self.stage(s), self.per_stage());
         let n = self.n_stages;
-        let (l_in, v_in, d_in, b_in) = (io.input(IN_REFLUX), io.input(IN_BOILUP), io.input(IN_DISTILLATE), io.input(IN_BOTTOMS));
+        let (l_in, v_in, d_in, b_in) =
+            (io.input(IN_REFLUX), io.input(IN_BOILUP), io.input(IN_DISTILLATE), io.input(IN_BOTTOMS));
         let mut kbuf = vec![S::from(0.0); nc];
 
         // Feed contributions and (1 − q) vapour per stage.
@@ -543,7 +561,8 @@ impl UnitModel for Column {
             };
             if s > 0 {
                 for f in self.feeds.iter().filter(|f| f.stage == s) {
-                    vflow += (1.0 - f.q.unwrap_or(1.0)) * io.inlet(self.feeds.iter().position(|g| std::ptr::eq(g, f)).unwrap_or(0)).f();
+                    vflow += (1.0 - f.q.unwrap_or(1.0))
+                        * io.inlet(self.feeds.iter().position(|g| std::ptr::eq(g, f)).unwrap_or(0)).f();
                 }
             }
             own[o + ix.v()] = if s + 1 == n { 0.0 } else { vflow };

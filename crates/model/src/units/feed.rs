@@ -70,11 +70,17 @@ impl Feed {
             (Some(t), FeedCondition::Liquid | FeedCondition::Vapour) => cx.positive("T", t, Dimension::TEMPERATURE),
             (None, FeedCondition::SaturatedLiquid) => f64::NAN,
             (Some(_), FeedCondition::SaturatedLiquid) => {
-                cx.error("T", "a saturated-liquid feed is at its bubble point: remove `T` or set `condition` to `liquid`");
+                cx.error(
+                    "T",
+                    "a saturated-liquid feed is at its bubble point: remove `T` or set `condition` to `liquid`",
+                );
                 f64::NAN
             }
             (None, _) => {
-                cx.error("T", "missing: give the feed temperature (e.g. \"350 K\") or set `condition` to `saturated_liquid`");
+                cx.error(
+                    "T",
+                    "missing: give the feed temperature (e.g. \"350 K\") or set `condition` to `saturated_liquid`",
+                );
                 f64::NAN
             }
         };

@@ -1,11 +1,15 @@
 //! The unit library: one file per unit type. Adding a unit touches its file, a `pub mod` line here
 //! and one line of the registry in `crate::registry`.
 
+pub mod column;
 pub mod feed;
 pub mod heater;
+pub mod hx;
 pub mod mixer;
 pub mod product;
+pub mod pump;
 pub mod splitter;
+pub mod valve;
 
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -36,7 +40,11 @@ impl Phase {
     pub fn temperature(self, thermo: &ThermoPackage, h: f64, z: &[f64], t0: f64) -> f64 {
         let mut t = t0;
         for _ in 0..50 {
-            let hd = self.enthalpy(thermo, num_dual::Dual64::new(t, 1.0), &z.iter().map(|&v| num_dual::Dual64::from_re(v)).collect::<Vec<_>>());
+            let hd = self.enthalpy(
+                thermo,
+                num_dual::Dual64::new(t, 1.0),
+                &z.iter().map(|&v| num_dual::Dual64::from_re(v)).collect::<Vec<_>>(),
+            );
             if !(hd.eps.is_finite() && hd.eps > 0.0) {
                 break;
             }

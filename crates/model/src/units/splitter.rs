@@ -10,7 +10,7 @@ use serde::{Deserialize, Serialize};
 
 use plantwide_units::Dimension;
 
-use crate::stream::{copy_stream, F, H, P, T, Z0};
+use crate::stream::{F, H, P, T, Z0, copy_stream};
 use crate::{BuildCx, FieldError, InputSpec, Scalar, UnitIo, UnitModel};
 
 /// Flowsheet description of a splitter.
