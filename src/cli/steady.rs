@@ -5,7 +5,7 @@ use std::path::Path;
 use plantwide::flowsheet::overrides::{set_field, set_input, split_assignment};
 use plantwide::flowsheet::{assemble, parse_spec, BlockKind, Plant};
 use plantwide::model::stream::{F, H, P, T, Z0};
-use plantwide::solve::{steady_state, NewtonSettings, SteadyError, SteadyState};
+use plantwide::solve::{steady_state_observed, NewtonSettings, SteadyError, SteadyState};
 
 use super::CliError;
 
@@ -37,9 +37,18 @@ pub fn load_with_overrides(file: &Path, sets: &[String]) -> Result<(Plant, Vec<f
     Ok((plant, u))
 }
 
-/// Converge, mapping failures to exit codes.
+/// Converge with a progress spinner on stderr (hidden when stderr is not a terminal), mapping
+/// failures to exit codes.
 pub fn converge(plant: &Plant, u: &[f64]) -> Result<SteadyState, CliError> {
-    steady_state(plant, u, None, &NewtonSettings::default()).map_err(|e| match e {
+    let bar = indicatif::ProgressBar::new_spinner();
+    let mut observer = |r: &plantwide::solve::IterationRecord| {
+        let phase = if r.pseudo_dt.is_some() { "pseudo-transient" } else { "Newton" };
+        bar.set_message(format!("{phase} iteration {}: scaled residual {:.2e}", r.iter + 1, r.residual));
+        bar.tick();
+    };
+    let result = steady_state_observed(plant, u, None, &NewtonSettings::default(), &mut observer);
+    bar.finish_and_clear();
+    result.map_err(|e| match e {
         SteadyError::Dof(d) => CliError::user(d.to_string()),
         SteadyError::NotConverged(f) => CliError::numerical(f.to_string()),
     })

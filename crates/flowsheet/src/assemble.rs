@@ -226,9 +226,14 @@ pub fn assemble(spec: &FlowsheetSpec, file: &str) -> Result<Plant, LoadError> {
             pending.iter().find(|(n, ..)| n == head).and_then(|(_, _, _, d)| d.first().map(|&i| inputs[i].dim))
         }));
         let first = driven.first().copied();
+        let pv_dim = pv_dim.unwrap_or(plantwide_units::Dimension::DIMENSIONLESS);
+        let op_dim = match first {
+            Some(i) => inputs[i].dim,
+            None => c.config().op_dimension(pv_dim).unwrap_or(plantwide_units::Dimension::DIMENSIONLESS),
+        };
         let links = ControllerLinks {
-            pv_dim: pv_dim.unwrap_or(plantwide_units::Dimension::DIMENSIONLESS),
-            op_dim: first.map_or(plantwide_units::Dimension::DIMENSIONLESS, |i| inputs[i].dim),
+            pv_dim,
+            op_dim,
             op_value: first.map_or(0.0, |i| inputs[i].value),
             pv_nominal: 1.0,
         };

@@ -11,7 +11,7 @@ pub mod steady;
 pub mod structure;
 pub mod system;
 
-pub use newton::{solve_steady, IterationRecord, NewtonReport, NewtonSettings, NewtonStatus};
+pub use newton::{solve_steady, solve_steady_observed, IterationRecord, NewtonReport, NewtonSettings, NewtonStatus};
 pub use structure::{maximum_matching, Matching};
-pub use steady::{dof_check, steady_state, ConvergenceFailure, DofError, PlantSystem, SteadyError, SteadyState};
+pub use steady::{dof_check, steady_state, steady_state_observed, ConvergenceFailure, DofError, PlantSystem, SteadyError, SteadyState};
 pub use system::System;

@@ -168,9 +168,14 @@ fn line_search<S: System>(wk: &mut Work<'_, S>, x: &mut [f64], dx: &[f64], f0: f
 
 /// Solve `f(x) = 0` from the start `x` (overwritten with the result).
 pub fn solve_steady<S: System>(sys: &S, x: &mut [f64], settings: &NewtonSettings) -> NewtonReport {
+    solve_steady_observed(sys, x, settings, &mut |_| {})
+}
+
+/// [`solve_steady`] reporting every iteration to `observer` (progress display).
+pub fn solve_steady_observed<S: System>(sys: &S, x: &mut [f64], settings: &NewtonSettings, observer: &mut dyn FnMut(&IterationRecord)) -> NewtonReport {
     let n = sys.n();
     let mut wk = Work { sys, n, lu: SparseLu::default(), jac: Vec::new(), r: vec![0.0; n], w: vec![1.0; n], n_res: 0, n_jac: 0 };
-    let mut history = Vec::new();
+    let mut history = Observed { records: Vec::new(), observer };
     let mut status = newton_phase(&mut wk, x, settings, &mut history);
     if status != NewtonStatus::Converged && settings.pseudo_transient {
         status = ptc_phase(&mut wk, x, settings, &mut history);
@@ -179,6 +184,7 @@ pub fn solve_steady<S: System>(sys: &S, x: &mut [f64], settings: &NewtonSettings
             status = newton_phase(&mut wk, x, settings, &mut history);
         }
     }
+    let history = history.records;
     wk.linearize(x);
     let (residual, worst) = wk.scaled_norm(&wk.r.clone());
     NewtonReport {
@@ -192,7 +198,23 @@ pub fn solve_steady<S: System>(sys: &S, x: &mut [f64], settings: &NewtonSettings
     }
 }
 
-fn newton_phase<S: System>(wk: &mut Work<'_, S>, x: &mut [f64], st: &NewtonSettings, history: &mut Vec<IterationRecord>) -> NewtonStatus {
+/// The iteration history, shown to an observer as it grows.
+struct Observed<'a> {
+    records: Vec<IterationRecord>,
+    observer: &'a mut dyn FnMut(&IterationRecord),
+}
+
+impl Observed<'_> {
+    fn len(&self) -> usize {
+        self.records.len()
+    }
+    fn push(&mut self, r: IterationRecord) {
+        (self.observer)(&r);
+        self.records.push(r);
+    }
+}
+
+fn newton_phase<S: System>(wk: &mut Work<'_, S>, x: &mut [f64], st: &NewtonSettings, history: &mut Observed<'_>) -> NewtonStatus {
     for _ in 0..st.max_iter {
         wk.linearize(x);
         let (norm, _) = wk.scaled_norm(&wk.r);
@@ -216,7 +238,7 @@ fn newton_phase<S: System>(wk: &mut Work<'_, S>, x: &mut [f64], st: &NewtonSetti
     if wk.scaled_norm(&wk.r).0 <= st.tol { NewtonStatus::Converged } else { NewtonStatus::MaxIterations }
 }
 
-fn ptc_phase<S: System>(wk: &mut Work<'_, S>, x: &mut [f64], st: &NewtonSettings, history: &mut Vec<IterationRecord>) -> NewtonStatus {
+fn ptc_phase<S: System>(wk: &mut Work<'_, S>, x: &mut [f64], st: &NewtonSettings, history: &mut Observed<'_>) -> NewtonStatus {
     let mass = wk.sys.mass();
     let mut dt = st.ptc_dt0;
     let mut prev_norm = f64::NAN;

@@ -4,7 +4,7 @@ use faer::Mat;
 use plantwide_flowsheet::Plant;
 use plantwide_model::VarKind;
 
-use crate::{maximum_matching, solve_steady, NewtonReport, NewtonSettings, NewtonStatus, System};
+use crate::{maximum_matching, solve_steady_observed, NewtonReport, NewtonSettings, NewtonStatus, System};
 
 /// The plant at fixed inputs `u`, seen as a nonlinear system.
 pub struct PlantSystem<'a> {
@@ -207,13 +207,24 @@ pub struct ConvergenceFailure {
 
 /// Solve the plant's steady state at inputs `u` from `x0` (or the cold-start guess).
 pub fn steady_state(plant: &Plant, u: &[f64], x0: Option<&[f64]>, settings: &NewtonSettings) -> Result<SteadyState, SteadyError> {
+    steady_state_observed(plant, u, x0, settings, &mut |_| {})
+}
+
+/// [`steady_state`] reporting every iteration to `observer`.
+pub fn steady_state_observed(
+    plant: &Plant,
+    u: &[f64],
+    x0: Option<&[f64]>,
+    settings: &NewtonSettings,
+    observer: &mut dyn FnMut(&crate::IterationRecord),
+) -> Result<SteadyState, SteadyError> {
     let mut x = match x0 {
         Some(x0) => x0.to_vec(),
         None => plant.initial_guess_at(u),
     };
     dof_check(plant, u, &x)?;
     let sys = PlantSystem::new(plant, u);
-    let report = solve_steady(&sys, &mut x, settings);
+    let report = solve_steady_observed(&sys, &mut x, settings, observer);
     if report.status == NewtonStatus::Converged {
         return Ok(SteadyState { x, u: u.to_vec(), report });
     }

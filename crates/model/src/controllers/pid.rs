@@ -27,7 +27,8 @@ pub struct PidConfig {
     /// Variable path of the measurement, e.g. `"tank.level"`.
     pub pv: String,
     /// Input driven by the output, e.g. `"tank.outflow"` or `"column.reflux"`.
-    pub output: String,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub output: Option<String>,
     /// Setpoint: a value (e.g. `"1.2 m"`) or `{"from": "<master>.op"}`.
     pub sp: Setpoint,
     /// Controller gain in output units per measurement unit (e.g. `"10 kmol/min/kmol"`); > 0.
@@ -67,7 +68,14 @@ impl super::ControllerConfig for PidConfig {
         if let Setpoint::Remote { from } = &self.sp {
             measured.push(("sp.from".to_string(), from.clone()));
         }
-        super::ControllerPaths { measured, driven: vec![("output".to_string(), self.output.clone())] }
+        let driven = self.output.iter().map(|o| ("output".to_string(), o.clone())).collect();
+        super::ControllerPaths { measured, driven }
+    }
+    fn op_dimension(&self, pv_dim: Dimension) -> Option<Dimension> {
+        match &self.kc {
+            QuantityValue::Text(t) => plantwide_units::parse_quantity(t).ok().map(|q| q.dim * pv_dim),
+            QuantityValue::Number(_) => None,
+        }
     }
 }
 
