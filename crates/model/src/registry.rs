@@ -62,6 +62,9 @@ registry!(
     "valve" => Valve(units::valve::ValveConfig, units::valve::Valve),
     "pump" => Pump(units::pump::PumpConfig, units::pump::Pump),
     "heat_exchanger" => HeatExchanger(units::hx::HeatExchangerConfig, units::hx::HeatExchanger),
+    "tank" => Tank(units::tank::TankConfig, units::tank::Tank),
+    "flash" => Flash(units::flash::FlashConfig, units::flash::Flash),
+    "cstr" => Cstr(units::cstr::CstrConfig, units::cstr::Cstr),
 ]);
 
 registry!(

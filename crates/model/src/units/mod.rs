@@ -2,13 +2,17 @@
 //! and one line of the registry in `crate::registry`.
 
 pub mod column;
+pub mod cstr;
 pub mod feed;
+pub mod flash;
 pub mod heater;
 pub mod hx;
 pub mod mixer;
+pub mod outflow;
 pub mod product;
 pub mod pump;
 pub mod splitter;
+pub mod tank;
 pub mod valve;
 
 use schemars::JsonSchema;
