@@ -1,5 +1,4 @@
-//! Tray-by-tray distillation column with its total condenser (reflux drum) and partial reboiler
-//! (sump) as stages of the same unit.
+//! The simple column model: constant molar overflow (Skogestad's column A).
 //!
 //! **Stage numbering** (as Skogestad's column A): stage 1 is the reboiler, stages 2 … N−1 are the
 //! trays counted from the bottom, stage N is the total condenser. Paths use these numbers:
@@ -32,92 +31,12 @@
 //! - S. Skogestad, I. Postlethwaite, *Multivariable Feedback Control*, Wiley 2005, §12.4 (column A).
 //! - W. L. Luyben (ed.), *Practical Distillation Control*, Van Nostrand Reinhold 1992, ch. 3–4.
 
-use plantwide_units::{Dimension, QuantityValue};
-use schemars::JsonSchema;
-use serde::{Deserialize, Serialize};
+use plantwide_units::Dimension;
+
+use super::ColumnConfig;
 
 use crate::stream::{F, H, P, T, Z0};
 use crate::{BuildCx, FieldError, InputSpec, LocalLayout, Scalar, UnitIo, UnitModel, VarSpec};
-
-/// Fidelity of the column model.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
-#[serde(rename_all = "snake_case")]
-pub enum ColumnModel {
-    /// Constant molar overflow, linearized tray hydraulics, no energy balances.
-    #[default]
-    Simple,
-}
-
-/// A feed to the column.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields)]
-pub struct ColumnFeed {
-    /// Inlet port name (default `feed`).
-    #[serde(default = "default_feed_port")]
-    pub port: String,
-    /// Stage the feed enters (1 = reboiler, N = condenser).
-    pub stage: usize,
-    /// Feed quality q (liquid fraction; 1 = saturated liquid); default from enthalpies.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub q: Option<f64>,
-    /// Nominal feed flow for the tray hydraulics (default: nominal D + B when there is one feed).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub nominal_flow: Option<QuantityValue>,
-}
-
-fn default_feed_port() -> String {
-    "feed".into()
-}
-
-/// A liquid side draw.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields)]
-pub struct SideDraw {
-    /// Outlet port name (also the name of its flow input).
-    pub port: String,
-    /// Stage it is drawn from.
-    pub stage: usize,
-    /// Draw flow (e.g. `"0.1 kmol/min"`).
-    pub flow: QuantityValue,
-}
-
-/// Flowsheet description of a column.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields)]
-pub struct ColumnConfig {
-    /// Fidelity (default `simple`).
-    #[serde(default)]
-    pub model: ColumnModel,
-    /// Number of stages N including reboiler (stage 1) and condenser (stage N); ≥ 3.
-    pub stages: usize,
-    /// Feeds.
-    pub feeds: Vec<ColumnFeed>,
-    /// Liquid side draws (default none).
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub side_draws: Vec<SideDraw>,
-    /// Column pressure (default 1 atm).
-    #[serde(rename = "P", default, skip_serializing_if = "Option::is_none")]
-    pub pressure: Option<QuantityValue>,
-    /// Nominal liquid holdup of a tray (e.g. `"0.5 kmol"`).
-    pub tray_holdup: QuantityValue,
-    /// Nominal liquid holdup of the condenser / reflux drum.
-    pub condenser_holdup: QuantityValue,
-    /// Nominal liquid holdup of the reboiler / sump.
-    pub reboiler_holdup: QuantityValue,
-    /// Liquid hydraulic time constant τ_L of a tray (e.g. `"0.063 min"`).
-    pub tau_l: QuantityValue,
-    /// Effect of vapour flow on liquid flow λ [-] (default 0).
-    #[serde(default)]
-    pub lambda: f64,
-    /// Reflux flow L.
-    pub reflux: QuantityValue,
-    /// Boilup V.
-    pub boilup: QuantityValue,
-    /// Distillate flow D.
-    pub distillate: QuantityValue,
-    /// Bottoms flow B.
-    pub bottoms: QuantityValue,
-}
 
 #[derive(Debug, Clone)]
 struct Feed {
@@ -131,9 +50,9 @@ struct Draw {
     flow: f64,
 }
 
-/// A distillation column.
+/// A distillation column, simple model.
 #[derive(Debug, Clone)]
-pub struct Column {
+pub struct SimpleColumn {
     n_stages: usize,
     feeds: Vec<Feed>,
     feed_ports: Vec<String>,
@@ -158,9 +77,9 @@ const IN_BOILUP: usize = 1;
 const IN_DISTILLATE: usize = 2;
 const IN_BOTTOMS: usize = 3;
 
-impl Column {
+impl SimpleColumn {
     /// Build from the flowsheet description.
-    pub fn build(c: &ColumnConfig, mut cx: BuildCx<'_>, _links: ()) -> Result<Column, Vec<FieldError>> {
+    pub fn build(c: &ColumnConfig, mut cx: BuildCx<'_>) -> Result<SimpleColumn, Vec<FieldError>> {
         let n = c.stages;
         if n < 3 {
             cx.error("stages", format!("a column needs at least 3 stages (reboiler, one tray, condenser); got {n}"));
@@ -251,7 +170,7 @@ impl Column {
             }
             l0[i] = l;
         }
-        let column = Column {
+        let column = SimpleColumn {
             n_stages: n,
             feeds,
             feed_ports,
@@ -316,7 +235,7 @@ impl StageIdx {
     }
 }
 
-impl UnitModel for Column {
+impl UnitModel for SimpleColumn {
     fn type_name(&self) -> &'static str {
         "column"
     }
