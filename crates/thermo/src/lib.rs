@@ -13,6 +13,7 @@
 
 pub mod component;
 mod correlations;
+pub mod equilibrium;
 pub mod error;
 pub mod flash;
 pub mod library;

@@ -327,7 +327,7 @@ impl UnitModel for Cstr {
             }
             None => {
                 let h = if inlet.f() > 0.0 { inlet.h() + io.input(1) / inlet.f() } else { inlet.h() };
-                (Phase::Liquid.temperature(io.thermo, h, &x, inlet.t()), 0.0, io.input(1))
+                (Phase::Liquid.temperature(io.thermo, h, inlet.p(), &x, inlet.t()), 0.0, io.input(1))
             }
         };
         let h = io.thermo.h_liq(t, &x);

@@ -135,7 +135,7 @@ impl UnitModel for Feed {
             _ => out.t() - io.input(2),
         };
         let phase = if self.condition == FeedCondition::Vapour { Phase::Vapour } else { Phase::Liquid };
-        r[H] = out.h() - phase.enthalpy(io.thermo, out.t(), z);
+        r[H] = out.h() - phase.enthalpy(io.thermo, out.t(), out.p(), z);
     }
     fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]) {
         own[F] = self.flow;
@@ -147,6 +147,6 @@ impl UnitModel for Feed {
             io.thermo.bubble_t(self.pressure, &self.z).map(|s| s.t).unwrap_or(350.0)
         };
         let phase = if self.condition == FeedCondition::Vapour { Phase::Vapour } else { Phase::Liquid };
-        own[H] = phase.enthalpy(io.thermo, own[T], &self.z);
+        own[H] = phase.enthalpy(io.thermo, own[T], own[P], &self.z);
     }
 }

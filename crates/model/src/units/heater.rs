@@ -95,7 +95,7 @@ impl UnitModel for Heater {
         for (i, (zo, zi)) in out.z().iter().zip(inlet.z()).enumerate() {
             r[Z0 + i] = *zo - *zi;
         }
-        let state = out.h() - self.phase.enthalpy(io.thermo, out.t(), out.z());
+        let state = out.h() - self.phase.enthalpy(io.thermo, out.t(), out.p(), out.z());
         let energy = out.f() * (out.h() - inlet.h()) - q;
         match self.mode {
             Mode::Duty(_) => {
@@ -121,12 +121,12 @@ impl UnitModel for Heater {
             Mode::Duty(_) => {
                 let q = io.input(0);
                 own[H] = inlet.h() + if inlet.f() > 0.0 { q / inlet.f() } else { 0.0 };
-                own[T] = self.phase.temperature(io.thermo, own[H], &z, inlet.t());
+                own[T] = self.phase.temperature(io.thermo, own[H], own[P], &z, inlet.t());
                 own[len + Q] = q;
             }
             Mode::Temperature(_) => {
                 own[T] = io.input(0);
-                own[H] = self.phase.enthalpy(io.thermo, own[T], &z);
+                own[H] = self.phase.enthalpy(io.thermo, own[T], own[P], &z);
                 own[len + Q] = inlet.f() * (own[H] - inlet.h());
             }
         }

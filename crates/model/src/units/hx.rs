@@ -185,7 +185,7 @@ impl UnitModel for HeatExchanger {
             for (i, (zo, zi)) in out.z().iter().zip(inlet.z()).enumerate() {
                 rs[Z0 + i] = *zo - *zi;
             }
-            rs[T] = out.h() - self.phase[s].enthalpy(io.thermo, out.t(), out.z());
+            rs[T] = out.h() - self.phase[s].enthalpy(io.thermo, out.t(), out.p(), out.z());
         }
         let (hi, ci, ho, co) = (io.inlet(0), io.inlet(1), io.outlet(0), io.outlet(1));
         let (q_row, hot_row, cold_row) = (2 * len + Q, H, len + H);
@@ -219,8 +219,8 @@ impl UnitModel for HeatExchanger {
         }
         for k in 1..n {
             let ((th, hh), (tc, hc)) = (hot(k), cold(k));
-            r[cell(k, 0)] = hh - self.phase[0].enthalpy(io.thermo, th, hi.z());
-            r[cell(k, 1)] = hc - self.phase[1].enthalpy(io.thermo, tc, ci.z());
+            r[cell(k, 0)] = hh - self.phase[0].enthalpy(io.thermo, th, hi.p() - self.dp[0], hi.z());
+            r[cell(k, 1)] = hc - self.phase[1].enthalpy(io.thermo, tc, ci.p() - self.dp[1], ci.z());
         }
         r[q_row] = q - q_sum;
     }
@@ -237,7 +237,7 @@ impl UnitModel for HeatExchanger {
         // ε-NTU with F ∂h/∂T at the inlets (exact for constant c_p and method lmtd)
         let c = |s: usize| {
             let (st, z) = (io.inlet(s), io.inlet(s).z().iter().map(|&v| Dual64::from_re(v)).collect::<Vec<_>>());
-            st.f() * self.phase[s].enthalpy(io.thermo, Dual64::new(st.t(), 1.0), &z).eps
+            st.f() * self.phase[s].enthalpy(io.thermo, Dual64::new(st.t(), 1.0), Dual64::from_re(st.p()), &z).eps
         };
         let (c_min, c_max, ua) = (c(0).min(c(1)), c(0).max(c(1)), io.input(0));
         let (ntu, cr) = (ua / c_min, c_min / c_max);
@@ -253,8 +253,8 @@ impl UnitModel for HeatExchanger {
             let f = k as f64 / n as f64;
             let h_hot = hi.h() - f * dh_hot;
             let h_cold = ci.h() + (1.0 - f) * dh_cold;
-            let t_hot = self.phase[0].temperature(io.thermo, h_hot, hi.z(), hi.t());
-            let t_cold = self.phase[1].temperature(io.thermo, h_cold, ci.z(), ci.t());
+            let t_hot = self.phase[0].temperature(io.thermo, h_hot, hi.p() - self.dp[0], hi.z(), hi.t());
+            let t_cold = self.phase[1].temperature(io.thermo, h_cold, ci.p() - self.dp[1], ci.z(), ci.t());
             if k == n {
                 own[H] = h_hot;
                 own[T] = t_hot;
@@ -264,7 +264,7 @@ impl UnitModel for HeatExchanger {
             }
             if k == 1 {
                 own[len + H] = ci.h() + dh_cold;
-                own[len + T] = self.phase[1].temperature(io.thermo, own[len + H], ci.z(), ci.t());
+                own[len + T] = self.phase[1].temperature(io.thermo, own[len + H], ci.p() - self.dp[1], ci.z(), ci.t());
             }
         }
         own[2 * len + Q] = q;
@@ -297,7 +297,7 @@ mod tests {
     ) -> (LocalLayout, Vec<f64>) {
         let layout = layout_of(u);
         let mut x = vec![0.0; layout.len()];
-        let (hh, hc) = (u.phase[0].enthalpy(thermo, th, &[0.2, 0.8]), u.phase[1].enthalpy(thermo, tc, &[0.6, 0.4]));
+        let (hh, hc) = (u.phase[0].enthalpy(thermo, th, 1e5, &[0.2, 0.8]), u.phase[1].enthalpy(thermo, tc, 1e5, &[0.6, 0.4]));
         let i0 = layout.inlets_offset();
         x[i0..i0 + 12].copy_from_slice(&[fh, th, 3e5, hh, 0.2, 0.8, fc, tc, 2e5, hc, 0.6, 0.4]);
         x[layout.inputs_offset()] = ua;

@@ -89,7 +89,7 @@ impl UnitModel for Mixer {
             Some(p) => out.p() - p,
             None => out.p() - io.inlet(0).p(),
         };
-        r[T] = out.h() - self.phase.enthalpy(io.thermo, out.t(), out.z());
+        r[T] = out.h() - self.phase.enthalpy(io.thermo, out.t(), out.p(), out.z());
     }
     fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]) {
         let n = io.n_comp();
@@ -111,6 +111,6 @@ impl UnitModel for Mixer {
             own[H] = s0.h();
             own[Z0..].copy_from_slice(s0.z());
         }
-        own[T] = self.phase.temperature(io.thermo, own[H], &own[Z0..], s0.t());
+        own[T] = self.phase.temperature(io.thermo, own[H], own[P], &own[Z0..], s0.t());
     }
 }

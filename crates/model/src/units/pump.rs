@@ -112,7 +112,7 @@ impl UnitModel for Pump {
         // specific work W/F = v ΔP / η [J/mol]
         let work = io.thermo.v_liq(inlet.t(), inlet.z()) * (out.p() - inlet.p()) / self.efficiency;
         r[H] = out.h() - inlet.h() - work;
-        r[T] = out.h() - Phase::Liquid.enthalpy(io.thermo, out.t(), out.z());
+        r[T] = out.h() - Phase::Liquid.enthalpy(io.thermo, out.t(), out.p(), out.z());
         r[len + W] = io.var(W) - out.f() * work;
     }
     fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]) {
@@ -126,7 +126,7 @@ impl UnitModel for Pump {
         };
         let work = io.thermo.v_liq(inlet.t(), inlet.z()) * (own[P] - inlet.p()) / self.efficiency;
         own[H] = inlet.h() + work;
-        own[T] = Phase::Liquid.temperature(io.thermo, own[H], inlet.z(), inlet.t());
+        own[T] = Phase::Liquid.temperature(io.thermo, own[H], own[P], inlet.z(), inlet.t());
         own[len + W] = inlet.f() * work;
     }
 }

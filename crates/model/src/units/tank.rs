@@ -126,7 +126,7 @@ impl UnitModel for Tank {
         let (p, q) = (io.input(0), io.input(1));
         let x = normalized(inlet.z());
         let h = if inlet.f() > 0.0 { inlet.h() + q / inlet.f() } else { inlet.h() };
-        let t = Phase::Liquid.temperature(io.thermo, h, &x, inlet.t());
+        let t = Phase::Liquid.temperature(io.thermo, h, inlet.p(), &x, inlet.t());
         let (f, op) = self.law.guess_flow(io, N_FIXED_INPUTS, inlet.f());
         let mut liq = LiquidState { p, level: 0.0, mw: io.thermo.mw(&x), v: io.thermo.v_liq(t, &x) };
         let mlv = self.holdup.guess(&self.law, f, op, &liq);

@@ -159,7 +159,8 @@ impl Valve {
         let z = inlet.z();
         let mw = io.thermo.mw(z);
         let rho = match self.phase {
-            Phase::Liquid => mw / io.thermo.v_liq(inlet.t(), z),
+            // A flashing valve (outlet in equilibrium) still meters the liquid that enters it.
+            Phase::Liquid | Phase::Equilibrium => mw / io.thermo.v_liq(inlet.t(), z),
             Phase::Vapour => inlet.p() * mw / (inlet.t() * R_GAS),
         };
         let op = if op < 0.0 {
@@ -215,7 +216,7 @@ impl UnitModel for Valve {
         for (i, (zo, zi)) in out.z().iter().zip(inlet.z()).enumerate() {
             r[Z0 + i] = *zo - *zi;
         }
-        r[T] = out.h() - self.phase.enthalpy(io.thermo, out.t(), out.z());
+        r[T] = out.h() - self.phase.enthalpy(io.thermo, out.t(), out.p(), out.z());
         r[len] = match self.mode {
             Mode::FlowSet { .. } => inlet.f() - io.input(0),
             Mode::PressureDrop { .. } => inlet.f() - self.dp_flow(io, inlet, io.input(0)),
@@ -232,7 +233,7 @@ impl UnitModel for Valve {
         own[P] = self.p_out;
         own[H] = inlet.h();
         own[Z0..len].copy_from_slice(inlet.z());
-        own[T] = self.phase.temperature(io.thermo, inlet.h(), inlet.z(), inlet.t());
+        own[T] = self.phase.temperature(io.thermo, inlet.h(), own[P], inlet.z(), inlet.t());
     }
 }
 
@@ -258,7 +259,7 @@ mod tests {
     fn local(v: &Valve, thermo: &ThermoPackage, input: f64) -> (LocalLayout, Vec<f64>) {
         let layout = layout_of(v);
         let z = [0.4, 0.6];
-        let h = v.phase.enthalpy(thermo, 340.0, &z);
+        let h = v.phase.enthalpy(thermo, 340.0, 101_325.0, &z);
         let mut x = vec![0.0; layout.len()];
         x[layout.inlets_offset()..layout.inputs_offset()].copy_from_slice(&[7.0, 340.0, 3e5, h, z[0], z[1]]);
         x[layout.inputs_offset()] = input;
@@ -317,7 +318,7 @@ mod tests {
                 Mode::PressureDrop { cv, characteristic, ln_r, .. } => {
                     let mw = 0.05 * z[0] + 0.08 * z[1];
                     let rho = match v.phase {
-                        Phase::Liquid => mw / 1e-4,
+                        Phase::Liquid | Phase::Equilibrium => mw / 1e-4,
                         Phase::Vapour => p_in * mw / (R_GAS * t_in),
                     };
                     let f = match characteristic {
