@@ -23,6 +23,8 @@ const CASES: &[(&str, &[&str])] = &[
     ("controller_gain_dimension.json", &["controllers.tc1.kc", "is a molar flow but a heat-transfer conductance"]),
     ("wrong_format_version.json", &["format_version", "reads format_version 1, the file has 2"]),
     ("heater_overspecified.json", &["units.h1", "exactly one of `duty`"]),
+    ("uncontrolled_level.json", &["steady state is not determined", "tank.N[water]", "inventory of `tank` is uncontrolled", "level (or pressure) controller"]),
+    ("flow_fixed_twice.json", &["11 equations for 10 variables", "a flow is set twice"]),
 ];
 
 #[test]

@@ -17,7 +17,19 @@ impl ThermoPackage {
     /// Molar enthalpy [J/mol] of composition `z` at `t` [K], `p` [Pa] in phase equilibrium: the
     /// liquid enthalpy below the bubble point, the vapour enthalpy above the dew point, and the
     /// flash-weighted mixture between them. Falls back to the liquid enthalpy if the flash fails.
+    ///
+    /// Like `h_liq` and `h_vap` it is homogeneous of degree one in `z` (`h(c z) = c h(z)`), so its
+    /// derivatives agree in every direction, also off `Σ z = 1`.
     pub fn h_equilibrium<S: Scalar>(&self, t: S, p: S, z: &[S]) -> S {
+        let sum = z.iter().fold(S::from(0.0), |a, b| a + *b);
+        if sum.re() <= 0.0 {
+            return self.h_liq(t, z);
+        }
+        let zn: Vec<S> = z.iter().map(|v| *v / sum).collect();
+        sum * self.h_equilibrium_normalized(t, p, &zn)
+    }
+
+    fn h_equilibrium_normalized<S: Scalar>(&self, t: S, p: S, z: &[S]) -> S {
         let zr: Vec<f64> = z.iter().map(|v| v.re()).collect();
         let Ok(fl) = self.flash_tp(t.re(), p.re(), &zr) else {
             return self.h_liq(t, z);
