@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use plantwide::flowsheet::{load_file, BlockKind};
-use plantwide::solve::dof_check;
+use plantwide::solve::{dof_check, DofProbe};
 
 use super::CliError;
 
@@ -53,7 +53,7 @@ pub fn run(file: &Path) -> Result<(), CliError> {
     }
     let u = plant.input_values();
     let x = plant.initial_guess();
-    dof_check(&plant, &u, &x).map_err(|e| CliError::user(e.to_string()))?;
+    dof_check(&plant, &u, &x, DofProbe::Numerical).map_err(|e| CliError::user(e.to_string()))?;
     outln!("degrees of freedom: 0 — square, structurally nonsingular{}", if plant.n_vars() <= plantwide::solve::steady::DENSE_PROBE_LIMIT { ", numerically nonsingular at the initial guess" } else { "" });
     Ok(())
 }

@@ -40,6 +40,8 @@ pub fn load_with_overrides(file: &Path, sets: &[String]) -> Result<(Plant, Vec<f
 /// Converge with a progress spinner on stderr (hidden when stderr is not a terminal), mapping
 /// failures to exit codes.
 pub fn converge(plant: &Plant, u: &[f64]) -> Result<SteadyState, CliError> {
+    let x0 = plant.initial_guess_at(u);
+    plantwide::solve::dof_check(plant, u, &x0, plantwide::solve::DofProbe::Numerical).map_err(|e| CliError::user(e.to_string()))?;
     let bar = indicatif::ProgressBar::new_spinner();
     let mut observer = |r: &plantwide::solve::IterationRecord| {
         let phase = if r.pseudo_dt.is_some() { "pseudo-transient" } else { "Newton" };

@@ -5,6 +5,7 @@
 //! **Architecture Invariant:** solvers see a [`System`] (residual, Jacobian triplets, bounds,
 //! nominal magnitudes, mass-matrix pattern), never a unit, a stream or a file.
 
+pub mod dae;
 pub mod newton;
 pub mod sparse;
 pub mod steady;
@@ -13,5 +14,5 @@ pub mod system;
 
 pub use newton::{solve_steady, solve_steady_observed, IterationRecord, NewtonReport, NewtonSettings, NewtonStatus};
 pub use structure::{maximum_matching, Matching};
-pub use steady::{dof_check, steady_state, steady_state_observed, ConvergenceFailure, DofError, PlantSystem, SteadyError, SteadyState};
+pub use steady::{dof_check, DofProbe, steady_state, steady_state_observed, ConvergenceFailure, DofError, PlantSystem, SteadyError, SteadyState};
 pub use system::System;

@@ -81,10 +81,20 @@ pub enum DofError {
 /// Largest plant for which the numerical null-space probe (a dense SVD) is run.
 pub const DENSE_PROBE_LIMIT: usize = 1500;
 
+/// How thorough the degrees-of-freedom check is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DofProbe {
+    /// Equation count and structural rank only (cheap: O(nnz · n) at worst).
+    Structural,
+    /// Also the dense numerical null-space probe (an SVD; plants up to [`DENSE_PROBE_LIMIT`]).
+    Numerical,
+}
+
 /// Degrees-of-freedom check at the point `x`: equation count, structural rank (maximum matching)
-/// and, for plants up to [`DENSE_PROBE_LIMIT`] variables, a numerical null-space probe that names
-/// the inventory or variable left free (an uncontrolled level, a flow fixed at both ends).
-pub fn dof_check(plant: &Plant, u: &[f64], x: &[f64]) -> Result<(), DofError> {
+/// and, with [`DofProbe::Numerical`] for plants up to [`DENSE_PROBE_LIMIT`] variables, a numerical
+/// null-space probe that names the inventory or variable left free (an uncontrolled level, a flow
+/// fixed at both ends).
+pub fn dof_check(plant: &Plant, u: &[f64], x: &[f64], probe: DofProbe) -> Result<(), DofError> {
     let file = plant.file.clone();
     let (n_eqs, n_vars) = (plant.n_eqs(), plant.n_vars());
     if n_eqs != n_vars {
@@ -104,7 +114,7 @@ pub fn dof_check(plant: &Plant, u: &[f64], x: &[f64]) -> Result<(), DofError> {
     if !loose.is_empty() {
         return Err(DofError::Underdetermined { file, explanation: explain_loose(plant, &loose, "no equation is left to determine") });
     }
-    if n_vars <= DENSE_PROBE_LIMIT && n_vars > 0 {
+    if probe == DofProbe::Numerical && n_vars <= DENSE_PROBE_LIMIT && n_vars > 0 {
         // Scale columns by their nominal values and rows by their largest entry, then look for a
         // (numerically) zero singular value.
         let mut a = Mat::<f64>::zeros(n_eqs, n_vars);
@@ -205,7 +215,8 @@ pub struct ConvergenceFailure {
     pub x: Vec<f64>,
 }
 
-/// Solve the plant's steady state at inputs `u` from `x0` (or the cold-start guess).
+/// Solve the plant's steady state at inputs `u` from `x0` (or the cold-start guess). The structural
+/// DOF check runs first; if Newton fails, the numerical probe runs to explain an ill-posed plant.
 pub fn steady_state(plant: &Plant, u: &[f64], x0: Option<&[f64]>, settings: &NewtonSettings) -> Result<SteadyState, SteadyError> {
     steady_state_observed(plant, u, x0, settings, &mut |_| {})
 }
@@ -222,12 +233,14 @@ pub fn steady_state_observed(
         Some(x0) => x0.to_vec(),
         None => plant.initial_guess_at(u),
     };
-    dof_check(plant, u, &x)?;
+    dof_check(plant, u, &x, DofProbe::Structural)?;
+    let x_start = x.clone();
     let sys = PlantSystem::new(plant, u);
     let report = solve_steady_observed(&sys, &mut x, settings, observer);
     if report.status == NewtonStatus::Converged {
         return Ok(SteadyState { x, u: u.to_vec(), report });
     }
+    dof_check(plant, u, &x_start, DofProbe::Numerical)?;
     let (eq, worst) = report.worst.unwrap_or((0, f64::NAN));
     let equation = plant.equation_name(eq);
     let variable = plant.equation_variable(eq).map(|j| plant.vars[j].path.clone()).unwrap_or_else(|| "-".into());

@@ -1,0 +1,51 @@
+//! The BDF iteration matrix: assembled from the Jacobian triplets, factorized by faer's sparse LU
+//! with the symbolic analysis kept while the pattern is unchanged, and the numeric factors kept for
+//! as many solves as the integrator wants.
+
+use faer::col::ColMut;
+use faer::linalg::solvers::Solve;
+use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
+use faer::sparse::{SparseColMat, Triplet};
+
+/// A factorized sparse matrix and the symbolic analysis of its pattern.
+#[derive(Debug, Default)]
+pub(crate) struct IterationMatrix {
+    symbolic: Option<(Vec<(usize, usize)>, SymbolicLu<usize>)>,
+    lu: Option<Lu<usize, f64>>,
+}
+
+impl IterationMatrix {
+    /// Factorize the `n × n` matrix given by `triplets` (duplicates are summed).
+    pub(crate) fn factor(&mut self, n: usize, triplets: &[(usize, usize, f64)]) -> Result<(), String> {
+        let trip: Vec<Triplet<usize, usize, f64>> = triplets.iter().map(|&(i, j, v)| Triplet::new(i, j, v)).collect();
+        let a = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &trip).map_err(|e| format!("{e:?}"))?;
+        let pattern: Vec<(usize, usize)> = triplets.iter().map(|&(i, j, _)| (i, j)).collect();
+        let symbolic = match self.symbolic.take() {
+            Some((p, s)) if p == pattern => s,
+            _ => SymbolicLu::try_new(a.symbolic()).map_err(|e| format!("{e:?}"))?,
+        };
+        self.lu = None;
+        let lu = Lu::try_new_with_symbolic(symbolic.clone(), a.as_ref()).map_err(|e| format!("{e:?}"))?;
+        self.symbolic = Some((pattern, symbolic));
+        self.lu = Some(lu);
+        Ok(())
+    }
+
+    /// Whether factors are held.
+    pub(crate) fn is_factored(&self) -> bool {
+        self.lu.is_some()
+    }
+
+    /// Drop the numeric factors (the symbolic analysis is kept).
+    pub(crate) fn invalidate(&mut self) {
+        self.lu = None;
+    }
+
+    /// Solve `A x = b` in place with the held factors; false if none are held or the result is not
+    /// finite.
+    pub(crate) fn solve_in_place(&self, b: &mut [f64]) -> bool {
+        let Some(lu) = &self.lu else { return false };
+        lu.solve_in_place(ColMut::from_slice_mut(b));
+        b.iter().all(|v| v.is_finite())
+    }
+}

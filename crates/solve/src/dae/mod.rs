@@ -1,0 +1,112 @@
+//! Stiff integration of the plant's semi-explicit index-1 DAE `M dx/dt = f(t, x)`, where `M` is a
+//! 0/1 selection: each pair `(equation i, variable j)` of [`DaeSystem::mass`] says that equation `i`
+//! *is* `dx_j/dt`; every other equation is algebraic (`0 = f_i`) and every other variable algebraic.
+//!
+//! [`Bdf`] is a variable-step, variable-order (1–5) backward differentiation formula in the
+//! quasi-constant step-size form of Shampine & Reichelt (ode15s) as SciPy implements it: a modified
+//! divided-difference array that is re-interpolated when the step changes. Error control is on the
+//! differential variables only; the algebraic variables are solved exactly (to the Newton
+//! tolerance) at every step, and solved for consistency ([`consistent_algebraic`]) at the start and
+//! after every event. [`DaeIntegrator`] is the interface the simulation driver uses, so another
+//! integrator can be put behind it.
+
+pub mod bdf;
+mod init;
+mod linear;
+
+pub use bdf::{Bdf, BdfSettings, BdfState, BdfStats};
+pub use init::consistent_algebraic;
+
+/// A time-aware semi-explicit DAE `M dx/dt = f(t, x)` with a 0/1 mass matrix.
+pub trait DaeSystem {
+    /// Number of variables (= number of equations).
+    fn n(&self) -> usize;
+    /// `f(t, x)` into `r`.
+    fn residual(&self, t: f64, x: &[f64], r: &mut [f64]);
+    /// `f(t, x)` into `r` and `∂f/∂x` as triplets `(row, column, value)` into `jac` (cleared first);
+    /// the pattern must not depend on the point.
+    fn jacobian(&self, t: f64, x: &[f64], r: &mut [f64], jac: &mut Vec<(usize, usize, f64)>);
+    /// The `(equation, variable)` pairs that carry a time derivative.
+    fn mass(&self) -> &[(usize, usize)];
+    /// Typical magnitude of variable `i` (in its own units): absolute tolerances are relative to it.
+    fn nominal(&self, i: usize) -> f64;
+    /// Bounds of variable `i`, respected by the consistent initialization.
+    fn bounds(&self, i: usize) -> (f64, f64);
+    /// Whether variable `i` takes part in the local error test (default: the differential ones).
+    /// Quadratures (running integrals recorded for output) are differential but need not.
+    fn error_controlled(&self, i: usize) -> bool;
+}
+
+/// Why an integration stopped.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum DaeError {
+    /// The step size fell below the resolution of the time axis.
+    #[error("step size too small ({h:.3e} s) at t = {time} s: the model may be discontinuous or ill-posed there")]
+    StepSizeTooSmall {
+        /// Time [s].
+        time: f64,
+        /// Step size [s].
+        h: f64,
+    },
+    /// More steps than [`BdfSettings::max_steps`].
+    #[error("more than {max_steps} steps before t = {time} s (raise max_steps or loosen the tolerances)")]
+    TooManySteps {
+        /// Time reached [s].
+        time: f64,
+        /// The limit.
+        max_steps: usize,
+    },
+    /// The algebraic variables could not be made consistent.
+    #[error("consistent initialization failed at t = {time} s: scaled residual {residual:.3e} in equation {equation}")]
+    Initialization {
+        /// Time [s].
+        time: f64,
+        /// Final scaled residual.
+        residual: f64,
+        /// Global index of the worst equation.
+        equation: usize,
+    },
+    /// The iteration matrix could not be factorized.
+    #[error("iteration matrix singular at t = {time} s: {reason}")]
+    Singular {
+        /// Time [s].
+        time: f64,
+        /// What the factorization said.
+        reason: String,
+    },
+    /// A restored state does not fit the system.
+    #[error("integrator state does not fit the system: {0}")]
+    BadState(String),
+}
+
+/// A DAE integrator that can be stopped exactly at given times and restarted after events.
+pub trait DaeIntegrator {
+    /// (Re)start at `t` from `x`: the algebraic variables are solved for consistency with the
+    /// differential ones, and the history is discarded (restart at order 1).
+    fn restart(&mut self, sys: &dyn DaeSystem, t: f64, x: &[f64]) -> Result<(), DaeError>;
+    /// Take one step, never past `t_stop` (a step that would cross it ends exactly on it).
+    fn step(&mut self, sys: &dyn DaeSystem, t_stop: f64) -> Result<(), DaeError>;
+    /// Current time [s].
+    fn t(&self) -> f64;
+    /// Current state.
+    fn x(&self) -> &[f64];
+    /// Time at the start of the last step [s]: [`DaeIntegrator::interpolate`] is valid on
+    /// `[t_prev, t]`.
+    fn t_prev(&self) -> f64;
+    /// The state at `t` within the last step, from the integrator's interpolating polynomial.
+    fn interpolate(&self, t: f64, out: &mut [f64]);
+    /// Counters.
+    fn stats(&self) -> BdfStats;
+}
+
+/// Weighted root-mean-square norm `√(Σ (v_i/s_i)² / n)` over the indices where `mask` is true.
+fn rms(v: &[f64], scale: &[f64], mask: &[bool]) -> f64 {
+    let (mut sum, mut n) = (0.0, 0usize);
+    for ((a, s), m) in v.iter().zip(scale).zip(mask) {
+        if *m {
+            sum += (a / s) * (a / s);
+            n += 1;
+        }
+    }
+    if n == 0 { 0.0 } else { (sum / n as f64).sqrt() }
+}
