@@ -16,5 +16,5 @@ pub mod spec;
 pub use assemble::{assemble, load_file, load_str};
 pub use error::{Diagnostic, LoadError};
 pub use parse::parse_spec;
-pub use plant::{Block, BlockKind, InputInfo, Plant, Read, StreamInfo, VarInfo};
+pub use plant::{Block, BlockKind, InputInfo, Parallelism, Plant, Read, StreamInfo, VarInfo};
 pub use spec::FlowsheetSpec;

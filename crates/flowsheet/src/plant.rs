@@ -4,6 +4,8 @@
 
 use std::collections::HashMap;
 
+use rayon::prelude::*;
+
 use plantwide_model::stream::StreamLayout;
 use plantwide_model::{LocalLayout, Unit, UnitIo, VarKind, VarSpec};
 use plantwide_thermo::ThermoPackage;
@@ -183,35 +185,73 @@ impl Plant {
 
     /// Residuals and Jacobians: `∂f/∂x` as triplets `(row, col, value)` into `jx`, and `∂f/∂u`
     /// (free inputs only) into `ju`. Structural entries are kept even when their value is zero, so
-    /// the pattern is the same at every point.
+    /// the pattern is the same at every point. Blocks are evaluated in parallel (rayon) when the
+    /// plant is large enough for it to pay; the result is identical to the sequential one.
     pub fn jacobian(&self, x: &[f64], u: &[f64], t: f64, r: &mut [f64], jx: &mut Vec<(usize, usize, f64)>, ju: &mut Vec<(usize, usize, f64)>) {
+        let work: usize = self.blocks.iter().map(|b| b.n_eq * (b.layout.len() + 1)).sum();
+        let par = if self.blocks.len() > 1 && work > PARALLEL_WORK { Parallelism::Rayon } else { Parallelism::Sequential };
+        self.jacobian_with(par, x, u, t, r, jx, ju);
+    }
+
+    /// [`Plant::jacobian`] with the parallelism chosen by the caller.
+    #[allow(clippy::too_many_arguments)]
+    pub fn jacobian_with(&self, par: Parallelism, x: &[f64], u: &[f64], t: f64, r: &mut [f64], jx: &mut Vec<(usize, usize, f64)>, ju: &mut Vec<(usize, usize, f64)>) {
         jx.clear();
         ju.clear();
-        let mut local = Vec::new();
-        let mut jac = Vec::new();
-        for b in &self.blocks {
-            self.gather(b, x, u, &mut local);
-            let n = local.len();
-            jac.clear();
-            jac.resize(b.n_eq * n, 0.0);
-            let io = UnitIo { local: &local, layout: &b.layout, thermo: &self.thermo, time: t };
-            b.unit.jacobian(&io, &mut r[b.eq_offset..b.eq_offset + b.n_eq], &mut jac);
-            let n_own = b.layout.n_own();
-            let mut push = |k: usize, j: usize| {
-                let (row, v) = (b.eq_offset + k, jac[k * n + j]);
-                if j < n_own {
-                    jx.push((row, b.own_offset + j, v));
-                } else {
-                    match b.reads[j - n_own] {
-                        Read::Var(i) => jx.push((row, i, v)),
-                        Read::Input(i) => ju.push((row, i, v)),
-                    }
-                }
-            };
-            match &b.pattern {
-                Some(p) => p.iter().for_each(|&(k, j)| push(k, j)),
-                None => (0..b.n_eq).for_each(|k| (0..n).for_each(|j| push(k, j))),
-            }
+        let parts: Vec<BlockJacobian> = match par {
+            Parallelism::Sequential => self.blocks.iter().map(|b| self.block_jacobian(b, x, u, t)).collect(),
+            Parallelism::Rayon => self.blocks.par_iter().map(|b| self.block_jacobian(b, x, u, t)).collect(),
+        };
+        for (b, part) in self.blocks.iter().zip(parts) {
+            r[b.eq_offset..b.eq_offset + b.n_eq].copy_from_slice(&part.r);
+            jx.extend(part.jx);
+            ju.extend(part.ju);
         }
     }
+
+    fn block_jacobian(&self, b: &Block, x: &[f64], u: &[f64], t: f64) -> BlockJacobian {
+        let mut local = Vec::new();
+        self.gather(b, x, u, &mut local);
+        let n = local.len();
+        let mut jac = vec![0.0; b.n_eq * n];
+        let mut out = BlockJacobian { r: vec![0.0; b.n_eq], jx: Vec::new(), ju: Vec::new() };
+        let io = UnitIo { local: &local, layout: &b.layout, thermo: &self.thermo, time: t };
+        b.unit.jacobian(&io, &mut out.r, &mut jac);
+        let n_own = b.layout.n_own();
+        let mut push = |k: usize, j: usize| {
+            let (row, v) = (b.eq_offset + k, jac[k * n + j]);
+            if j < n_own {
+                out.jx.push((row, b.own_offset + j, v));
+            } else {
+                match b.reads[j - n_own] {
+                    Read::Var(i) => out.jx.push((row, i, v)),
+                    Read::Input(i) => out.ju.push((row, i, v)),
+                }
+            }
+        };
+        match &b.pattern {
+            Some(p) => p.iter().for_each(|&(k, j)| push(k, j)),
+            None => (0..b.n_eq).for_each(|k| (0..n).for_each(|j| push(k, j))),
+        }
+        out
+    }
+}
+
+/// Work (Σ equations × local length) above which block Jacobians are evaluated in parallel.
+const PARALLEL_WORK: usize = 20_000;
+
+/// How to evaluate independent blocks.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Parallelism {
+    /// One block after another.
+    Sequential,
+    /// Blocks on the rayon pool; results merged in block order (bit-identical to sequential).
+    Rayon,
+}
+
+/// One block's residuals and Jacobian entries.
+struct BlockJacobian {
+    r: Vec<f64>,
+    jx: Vec<(usize, usize, f64)>,
+    ju: Vec<(usize, usize, f64)>,
 }
