@@ -1,0 +1,80 @@
+//! The `plantwide` command line: output formats, overrides and exit codes.
+
+mod common;
+
+use std::process::Command;
+
+fn plantwide(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_plantwide")).args(args).output().unwrap()
+}
+
+fn steady_json(args: &[&str]) -> serde_json::Value {
+    let mut all = vec!["steady", "--json"];
+    all.extend_from_slice(args);
+    let out = plantwide(&all);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+#[test]
+fn steady_json_has_the_documented_shape() {
+    let v = steady_json(&[&common::flowsheet("column_a.json")]);
+    assert_eq!(v["converged"], true);
+    assert!(v["iterations"].as_u64().is_some());
+    assert!(v["residual"].as_f64().is_some_and(|r| r < 1e-9));
+    let values = v["values"].as_object().unwrap();
+    // Every stream and unit variable under its path, in SI units, plus free inputs.
+    for path in ["feed.F", "distillate.x[light]", "bottoms.T", "column.M[41]", "column.x[21][light]", "condenser_level.op", "column.reflux"] {
+        assert!(values.contains_key(path), "missing {path}");
+    }
+    assert!((values["distillate.x[light]"].as_f64().unwrap() - 0.99).abs() < 1e-6);
+    assert!((values["column.reflux"].as_f64().unwrap() - 2.70629e3 / 60.0).abs() < 1e-9);
+}
+
+#[test]
+fn set_overrides_an_input_through_its_stream_and_a_unit_field() {
+    // `feed.F` names the stream; the input belongs to the feed unit that produces it.
+    let v = steady_json(&[&common::flowsheet("column_a.json"), "--set", "feed.F=1.01kmol/min"]);
+    let f = v["values"]["feed.F"].as_f64().unwrap();
+    assert!((f - 1010.0 / 60.0).abs() < 1e-9, "feed.F = {f}");
+    // The mass balance moves the extra feed to the products.
+    let d = v["values"]["distillate.F"].as_f64().unwrap();
+    let b = v["values"]["bottoms.F"].as_f64().unwrap();
+    assert!((d + b - f).abs() < 1e-9 * f);
+    // A unit parameter that is not an input: the tray holdup.
+    let v = steady_json(&[&common::flowsheet("column_a.json"), "--set", "column.tray_holdup=1kmol"]);
+    assert!((v["values"]["column.M[10]"].as_f64().unwrap() - 1000.0).abs() < 1e-6);
+}
+
+#[test]
+fn bad_overrides_are_user_errors() {
+    let out = plantwide(&["steady", &common::flowsheet("column_a.json"), "--set", "column.trays=3"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("`column` has no field `trays`"));
+    let out = plantwide(&["steady", &common::flowsheet("column_a.json"), "--set", "feed.F=3 K"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("is a temperature but a molar flow is expected"));
+    let out = plantwide(&["steady", &common::flowsheet("column_a.json"), "--set", "column.distillate=1kmol/min"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("driven by a controller"));
+}
+
+/// A duty that vaporizes the whole feed leaves the drum without liquid: there is no steady state,
+/// and the failure is numerical (exit 2) with the worst equation named.
+#[test]
+fn no_steady_state_is_a_numerical_failure_naming_the_worst_equation() {
+    let out = plantwide(&["steady", &common::flowsheet("flash_recycle.json"), "--set", "heater.duty=1.6MW"]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("steady state not found") && err.contains("worst equation:") && err.contains("variable"), "{err}");
+}
+
+#[test]
+fn components_lists_the_library() {
+    let out = plantwide(&["components"]);
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    for c in ["water", "ethanol", "benzene", "toluene", "o-xylene", "diphenyl", "hydrogen", "nrtl"] {
+        assert!(text.contains(c), "missing {c}");
+    }
+}
