@@ -5,7 +5,7 @@
 use std::time::{Duration, Instant};
 
 use plantwide::flowsheet::load_file;
-use plantwide::solve::{steady_state, NewtonSettings};
+use plantwide::solve::{NewtonSettings, steady_state};
 
 fn median(mut v: Vec<Duration>) -> Duration {
     v.sort();
@@ -35,7 +35,10 @@ fn main() {
         .filter(|p| filter.as_ref().is_none_or(|f| p.to_string_lossy().contains(f.as_str())))
         .collect();
     files.sort();
-    println!("{:<32} {:>6} {:>8} {:>12} {:>14} {:>12} {:>6}", "flowsheet", "n", "nnz(J)", "residual", "residual+jac", "newton", "iters");
+    println!(
+        "{:<32} {:>6} {:>8} {:>12} {:>14} {:>12} {:>6}",
+        "flowsheet", "n", "nnz(J)", "residual", "residual+jac", "newton", "iters"
+    );
     for f in files {
         let plant = match load_file(&f) {
             Ok(p) => p,

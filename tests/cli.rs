@@ -24,7 +24,15 @@ fn steady_json_has_the_documented_shape() {
     assert!(v["residual"].as_f64().is_some_and(|r| r < 1e-9));
     let values = v["values"].as_object().unwrap();
     // Every stream and unit variable under its path, in SI units, plus free inputs.
-    for path in ["feed.F", "distillate.x[light]", "bottoms.T", "column.M[41]", "column.x[21][light]", "condenser_level.op", "column.reflux"] {
+    for path in [
+        "feed.F",
+        "distillate.x[light]",
+        "bottoms.T",
+        "column.M[41]",
+        "column.x[21][light]",
+        "condenser_level.op",
+        "column.reflux",
+    ] {
         assert!(values.contains_key(path), "missing {path}");
     }
     assert!((values["distillate.x[light]"].as_f64().unwrap() - 0.99).abs() < 1e-6);
@@ -66,7 +74,10 @@ fn no_steady_state_is_a_numerical_failure_naming_the_worst_equation() {
     let out = plantwide(&["steady", &common::flowsheet("flash_recycle.json"), "--set", "heater.duty=1.6MW"]);
     assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("steady state not found") && err.contains("worst equation:") && err.contains("variable"), "{err}");
+    assert!(
+        err.contains("steady state not found") && err.contains("worst equation:") && err.contains("variable"),
+        "{err}"
+    );
 }
 
 #[test]

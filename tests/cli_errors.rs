@@ -12,7 +12,10 @@ const CASES: &[(&str, &[&str])] = &[
     ("unknown_component.json", &["components[1]", "unknown component `toulene`", "did you mean `toluene`"]),
     ("stream_to_missing_unit.json", &["streams.s1.to", "no unit named `heater1`"]),
     ("stream_to_missing_port.json", &["streams.s1.to", "has no inlet port `inlet`", "inlet ports: in"]),
-    ("port_connected_twice.json", &["streams.s3.from", "already the source of stream `s2`", "streams.s3.to", "already fed by stream `s2`"]),
+    (
+        "port_connected_twice.json",
+        &["streams.s3.from", "already the source of stream `s2`", "streams.s3.to", "already fed by stream `s2`"],
+    ),
     ("port_left_open.json", &["outlet port `h1.out` is not connected", "inlet port `sink.in` is not connected"]),
     ("negative_flow.json", &["units.src.F", "must not be negative", "-5 kmol/h"]),
     ("non_finite_temperature.json", &["units.src.T", "1e400 K"]),
@@ -23,7 +26,15 @@ const CASES: &[(&str, &[&str])] = &[
     ("controller_gain_dimension.json", &["controllers.tc1.kc", "is a molar flow but a heat-transfer conductance"]),
     ("wrong_format_version.json", &["format_version", "reads format_version 1, the file has 2"]),
     ("heater_overspecified.json", &["units.h1", "exactly one of `duty`"]),
-    ("uncontrolled_level.json", &["steady state is not determined", "tank.N[water]", "inventory of `tank` is uncontrolled", "level (or pressure) controller"]),
+    (
+        "uncontrolled_level.json",
+        &[
+            "steady state is not determined",
+            "tank.N[water]",
+            "inventory of `tank` is uncontrolled",
+            "level (or pressure) controller",
+        ],
+    ),
     ("flow_fixed_twice.json", &["11 equations for 10 variables", "a flow is set twice"]),
 ];
 
@@ -32,11 +43,13 @@ fn broken_flowsheets_give_clear_errors_and_exit_1() {
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/broken");
     let mut listed: Vec<&str> = CASES.iter().map(|(f, _)| *f).collect();
     listed.sort();
-    let mut on_disk: Vec<String> = std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().into_string().unwrap()).collect();
+    let mut on_disk: Vec<String> =
+        std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().into_string().unwrap()).collect();
     on_disk.sort();
     assert_eq!(listed, on_disk, "every broken file needs a case, every case a file");
     for (file, fragments) in CASES {
-        let out = Command::new(env!("CARGO_BIN_EXE_plantwide")).args(["check", &format!("{dir}/{file}")]).output().unwrap();
+        let out =
+            Command::new(env!("CARGO_BIN_EXE_plantwide")).args(["check", &format!("{dir}/{file}")]).output().unwrap();
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(1), "{file}: expected exit 1, stderr:\n{stderr}");
         assert!(!stderr.contains("panicked"), "{file} panicked:\n{stderr}");

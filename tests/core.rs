@@ -3,8 +3,8 @@
 mod common;
 
 use common::{component_balance_error, converge, flowsheet, value};
-use plantwide::flowsheet::{assemble, load_file, parse_spec, Plant};
-use plantwide::solve::{steady_state, NewtonSettings};
+use plantwide::flowsheet::{Plant, assemble, load_file, parse_spec};
+use plantwide::solve::{NewtonSettings, steady_state};
 
 fn newton_only() -> NewtonSettings {
     NewtonSettings { pseudo_transient: false, ..NewtonSettings::default() }
@@ -94,7 +94,9 @@ fn guess_at(plant: &Plant, t: f64) -> Vec<f64> {
 fn exothermic_cstr_has_three_steady_states_found_from_three_guesses() {
     // Independent roots of the reduced energy balance (brackets from a scan of its sign).
     let roots = [bisect(295.0, 320.0), bisect(320.0, 400.0), bisect(400.0, 500.0)];
-    assert!((roots[0] - 301.848).abs() < 0.01 && (roots[1] - 335.787).abs() < 0.01 && (roots[2] - 450.020).abs() < 0.01);
+    assert!(
+        (roots[0] - 301.848).abs() < 0.01 && (roots[1] - 335.787).abs() < 0.01 && (roots[2] - 450.020).abs() < 0.01
+    );
     let plant = load_file(std::path::Path::new(&flowsheet("cstr_multiplicity.json"))).unwrap();
     let u = plant.input_values();
     for (&root, start) in roots.iter().zip([300.0, 336.5, 460.0]) {
@@ -149,7 +151,9 @@ fn plant_jacobians_match_central_differences() {
             for &(i, j, v) in &jx {
                 dense[i * n + j] += v;
             }
-            let row_scale: Vec<f64> = (0..n).map(|i| (0..n).map(|j| (dense[i * n + j] * plant.vars[j].spec.nominal).abs()).fold(1e-300, f64::max)).collect();
+            let row_scale: Vec<f64> = (0..n)
+                .map(|i| (0..n).map(|j| (dense[i * n + j] * plant.vars[j].spec.nominal).abs()).fold(1e-300, f64::max))
+                .collect();
             let (mut rp, mut rm) = (vec![0.0; n], vec![0.0; n]);
             let mut worst: f64 = 0.0;
             for j in 0..n {

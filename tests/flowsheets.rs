@@ -31,7 +31,10 @@ fn shipped_schema_matches_the_types() {
     let generated: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/flowsheets/plantwide.schema.json");
     let shipped: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
-    assert!(generated == shipped, "flowsheets/plantwide.schema.json is stale: regenerate it with `plantwide schema > flowsheets/plantwide.schema.json`");
+    assert!(
+        generated == shipped,
+        "flowsheets/plantwide.schema.json is stale: regenerate it with `plantwide schema > flowsheets/plantwide.schema.json`"
+    );
 }
 
 #[test]

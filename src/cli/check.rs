@@ -2,8 +2,8 @@
 
 use std::path::Path;
 
-use plantwide::flowsheet::{load_file, BlockKind};
-use plantwide::solve::{dof_check, DofProbe};
+use plantwide::flowsheet::{BlockKind, load_file};
+use plantwide::solve::{DofProbe, dof_check};
 
 use super::CliError;
 
@@ -22,14 +22,36 @@ pub fn run(file: &Path) -> Result<(), CliError> {
         let (tb, tp) = s.to;
         let from = &plant.blocks[fb];
         let to = &plant.blocks[tb];
-        outln!("  {:<16} {}.{} -> {}.{}", s.name, from.name, from.unit.outlet_ports()[fp], to.name, to.unit.inlet_ports()[tp]);
+        outln!(
+            "  {:<16} {}.{} -> {}.{}",
+            s.name,
+            from.name,
+            from.unit.outlet_ports()[fp],
+            to.name,
+            to.unit.inlet_ports()[tp]
+        );
     }
     let ctrls: Vec<_> = plant.blocks.iter().filter(|b| b.kind == BlockKind::Controller).collect();
     outln!("controllers ({}):", ctrls.len());
     for b in &ctrls {
         let measured: Vec<String> = b.unit.signals().iter().map(|s| format!("{}={}", s.role, s.path)).collect();
-        let driven: Vec<&str> = plant.inputs.iter().filter(|i| i.driven_by.is_some_and(|v| plant.vars[v].block == plant.blocks.iter().position(|x| std::ptr::eq(x, *b)).unwrap_or(usize::MAX))).map(|i| i.path.as_str()).collect();
-        outln!("  {:<16} {:<12} reads {} drives {}", b.name, b.unit.type_name(), measured.join(", "), driven.join(", "));
+        let driven: Vec<&str> = plant
+            .inputs
+            .iter()
+            .filter(|i| {
+                i.driven_by.is_some_and(|v| {
+                    plant.vars[v].block == plant.blocks.iter().position(|x| std::ptr::eq(x, *b)).unwrap_or(usize::MAX)
+                })
+            })
+            .map(|i| i.path.as_str())
+            .collect();
+        outln!(
+            "  {:<16} {:<12} reads {} drives {}",
+            b.name,
+            b.unit.type_name(),
+            measured.join(", "),
+            driven.join(", ")
+        );
     }
     let n_diff = plant.differential().iter().filter(|d| **d).count();
     let free: Vec<&str> = plant.inputs.iter().filter(|i| i.driven_by.is_none()).map(|i| i.path.as_str()).collect();
@@ -54,6 +76,13 @@ pub fn run(file: &Path) -> Result<(), CliError> {
     let u = plant.input_values();
     let x = plant.initial_guess();
     dof_check(&plant, &u, &x, DofProbe::Numerical).map_err(|e| CliError::user(e.to_string()))?;
-    outln!("degrees of freedom: 0 — square, structurally nonsingular{}", if plant.n_vars() <= plantwide::solve::steady::DENSE_PROBE_LIMIT { ", numerically nonsingular at the initial guess" } else { "" });
+    outln!(
+        "degrees of freedom: 0 — square, structurally nonsingular{}",
+        if plant.n_vars() <= plantwide::solve::steady::DENSE_PROBE_LIMIT {
+            ", numerically nonsingular at the initial guess"
+        } else {
+            ""
+        }
+    );
     Ok(())
 }

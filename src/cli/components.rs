@@ -14,7 +14,15 @@ pub fn run(json: bool) -> Result<(), CliError> {
     outln!("{:<16} {:<10} {:>10} {:>9} {:>9} {:>8}", "name", "formula", "MW g/mol", "Tb K", "Tc K", "Pc bar");
     for c in &lib.components {
         let opt = |v: Option<f64>, s: f64| v.map_or("-".to_string(), |v| format!("{:.2}", v / s));
-        outln!("{:<16} {:<10} {:>10.3} {:>9.2} {:>9} {:>8}", c.name, c.formula, c.mw * 1e3, c.tb, opt(c.tc, 1.0), opt(c.pc, 1e5));
+        outln!(
+            "{:<16} {:<10} {:>10.3} {:>9.2} {:>9} {:>8}",
+            c.name,
+            c.formula,
+            c.mw * 1e3,
+            c.tb,
+            opt(c.tc, 1.0),
+            opt(c.pc, 1e5)
+        );
     }
     outln!("\n{} components; binary pairs:", lib.components.len());
     for p in &lib.binary_pairs {

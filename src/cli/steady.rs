@@ -3,16 +3,17 @@
 use std::path::Path;
 
 use plantwide::flowsheet::overrides::{set_field, set_input, split_assignment};
-use plantwide::flowsheet::{assemble, parse_spec, BlockKind, Plant};
+use plantwide::flowsheet::{BlockKind, Plant, assemble, parse_spec};
 use plantwide::model::stream::{F, H, P, T, Z0};
-use plantwide::solve::{steady_state_observed, NewtonSettings, SteadyError, SteadyState};
+use plantwide::solve::{NewtonSettings, SteadyError, SteadyState, steady_state_observed};
 
 use super::CliError;
 
 /// Load `file`, apply `--set` overrides, return the plant and its input vector.
 pub fn load_with_overrides(file: &Path, sets: &[String]) -> Result<(Plant, Vec<f64>), CliError> {
     let name = file.display().to_string();
-    let text = std::fs::read_to_string(file).map_err(|e| CliError::user(format!("{name}: cannot read the file: {e}")))?;
+    let text =
+        std::fs::read_to_string(file).map_err(|e| CliError::user(format!("{name}: cannot read the file: {e}")))?;
     let mut spec = parse_spec(&text, &name).map_err(|e| CliError::user(e.to_string()))?;
     let mut plant = assemble(&spec, &name).map_err(|e| CliError::user(e.to_string()))?;
     let mut assignments = Vec::new();
@@ -41,7 +42,8 @@ pub fn load_with_overrides(file: &Path, sets: &[String]) -> Result<(Plant, Vec<f
 /// failures to exit codes.
 pub fn converge(plant: &Plant, u: &[f64]) -> Result<SteadyState, CliError> {
     let x0 = plant.initial_guess_at(u);
-    plantwide::solve::dof_check(plant, u, &x0, plantwide::solve::DofProbe::Numerical).map_err(|e| CliError::user(e.to_string()))?;
+    plantwide::solve::dof_check(plant, u, &x0, plantwide::solve::DofProbe::Numerical)
+        .map_err(|e| CliError::user(e.to_string()))?;
     let bar = indicatif::ProgressBar::new_spinner();
     let mut observer = |r: &plantwide::solve::IterationRecord| {
         let phase = if r.pseudo_dt.is_some() { "pseudo-transient" } else { "Newton" };
@@ -78,7 +80,12 @@ pub fn run(file: &Path, json: bool, sets: &[String]) -> Result<(), CliError> {
         outln!("{}", serde_json::to_string_pretty(&out).map_err(|e| CliError::user(e.to_string()))?);
         return Ok(());
     }
-    outln!("steady state of `{}`: converged in {} iterations, scaled residual {:.2e}\n", plant.name, ss.report.iterations, ss.report.residual);
+    outln!(
+        "steady state of `{}`: converged in {} iterations, scaled residual {:.2e}\n",
+        plant.name,
+        ss.report.iterations,
+        ss.report.residual
+    );
     let comps = &plant.components;
     out!("{:<14} {:>12} {:>9} {:>10} {:>11}", "stream", "F kmol/h", "T K", "P kPa", "h kJ/mol");
     for c in comps {
@@ -87,7 +94,14 @@ pub fn run(file: &Path, json: bool, sets: &[String]) -> Result<(), CliError> {
     outln!();
     for s in &plant.streams {
         let v = &ss.x[s.offset..s.offset + plant.stream_layout.len()];
-        out!("{:<14} {:>12.4} {:>9.3} {:>10.3} {:>11.4}", truncate(&s.name, 14), v[F] * 3.6, v[T], v[P] / 1e3, v[H] / 1e3);
+        out!(
+            "{:<14} {:>12.4} {:>9.3} {:>10.3} {:>11.4}",
+            truncate(&s.name, 14),
+            v[F] * 3.6,
+            v[T],
+            v[P] / 1e3,
+            v[H] / 1e3
+        );
         for z in &v[Z0..] {
             out!(" {:>10.6}", z);
         }
@@ -99,12 +113,20 @@ pub fn run(file: &Path, json: bool, sets: &[String]) -> Result<(), CliError> {
             .vars
             .iter()
             .zip(&ss.x)
-            .filter(|(v, _)| v.block == bi && !plant.streams.iter().any(|s| v.path.starts_with(&format!("{}.", s.name))))
+            .filter(|(v, _)| {
+                v.block == bi && !plant.streams.iter().any(|s| v.path.starts_with(&format!("{}.", s.name)))
+            })
             .map(|(v, x)| format!("{}={:.6}", v.path.trim_start_matches(&format!("{}.", b.name)), x))
             .collect();
         let kind = if b.kind == BlockKind::Controller { "controller" } else { "unit" };
         if internal.len() > 12 {
-            outln!("{kind} {:<14} {:<10} {} … ({} variables; `--json` lists them all)", b.name, b.unit.type_name(), internal[..6].join("  "), internal.len());
+            outln!(
+                "{kind} {:<14} {:<10} {} … ({} variables; `--json` lists them all)",
+                b.name,
+                b.unit.type_name(),
+                internal[..6].join("  "),
+                internal.len()
+            );
         } else if !internal.is_empty() {
             outln!("{kind} {:<14} {:<10} {}", b.name, b.unit.type_name(), internal.join("  "));
         }

@@ -2,9 +2,9 @@
 //! path, and check conservation around every unit.
 #![allow(dead_code)]
 
-use plantwide::flowsheet::{load_file, BlockKind, Plant};
+use plantwide::flowsheet::{BlockKind, Plant, load_file};
 use plantwide::model::stream::{F, Z0};
-use plantwide::solve::{steady_state, NewtonSettings, SteadyState};
+use plantwide::solve::{NewtonSettings, SteadyState, steady_state};
 
 /// Path of a shipped flowsheet.
 pub fn flowsheet(name: &str) -> String {
@@ -34,7 +34,11 @@ pub fn component_balance_error(plant: &Plant, x: &[f64], generating: &[&str]) ->
         (0..nc).map(|j| v[F] * v[Z0 + j]).collect()
     };
     for (bi, b) in plant.blocks.iter().enumerate() {
-        if b.kind != BlockKind::Unit || b.layout.n_inlets == 0 || b.layout.n_outlets == 0 || generating.contains(&b.name.as_str()) {
+        if b.kind != BlockKind::Unit
+            || b.layout.n_inlets == 0
+            || b.layout.n_outlets == 0
+            || generating.contains(&b.name.as_str())
+        {
             continue;
         }
         let mut inn = vec![0.0; nc];

@@ -9,7 +9,7 @@ use plantwide_model::stream::StreamLayout;
 use plantwide_model::{BuildCx, LocalLayout, Unit};
 
 use crate::components::thermo_package;
-use crate::error::{did_you_mean, Diagnostic, LoadError};
+use crate::error::{Diagnostic, LoadError, did_you_mean};
 use crate::parse::parse_spec;
 use crate::plant::{Block, BlockKind, InputInfo, Plant, Read, StreamInfo, VarInfo};
 use crate::spec::FlowsheetSpec;
@@ -17,7 +17,8 @@ use crate::spec::FlowsheetSpec;
 /// Read, validate and assemble the flowsheet file at `path`.
 pub fn load_file(path: &Path) -> Result<Plant, LoadError> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| LoadError::Io { file: file.clone(), reason: e.to_string() })?;
+    let text =
+        std::fs::read_to_string(path).map_err(|e| LoadError::Io { file: file.clone(), reason: e.to_string() })?;
     load_str(&text, &file)
 }
 
@@ -50,10 +51,16 @@ pub fn assemble(spec: &FlowsheetSpec, file: &str) -> Result<Plant, LoadError> {
         }
     }
     for name in spec.controllers.keys().filter(|n| spec.units.contains_key(*n)) {
-        diags.push(Diagnostic::new(format!("controllers.{name}"), format!("`{name}` is also a unit name; units and controllers share one name space")));
+        diags.push(Diagnostic::new(
+            format!("controllers.{name}"),
+            format!("`{name}` is also a unit name; units and controllers share one name space"),
+        ));
     }
     for name in spec.streams.keys().filter(|n| spec.units.contains_key(*n) || spec.controllers.contains_key(*n)) {
-        diags.push(Diagnostic::new(format!("streams.{name}"), format!("`{name}` is also a unit or controller name; stream paths would be ambiguous")));
+        diags.push(Diagnostic::new(
+            format!("streams.{name}"),
+            format!("`{name}` is also a unit or controller name; stream paths would be ambiguous"),
+        ));
     }
 
     // Units.
@@ -79,7 +86,10 @@ pub fn assemble(spec: &FlowsheetSpec, file: &str) -> Result<Plant, LoadError> {
             let path = format!("streams.{sname}.{end}");
             let (uname, port) = split_port(text);
             let Some(&ui) = unit_index.get(uname) else {
-                diags.push(Diagnostic::new(path, format!("no unit named `{uname}`{}", did_you_mean(uname, unit_index.keys().copied()))));
+                diags.push(Diagnostic::new(
+                    path,
+                    format!("no unit named `{uname}`{}", did_you_mean(uname, unit_index.keys().copied())),
+                ));
                 return None;
             };
             let unit = &units[ui].1;
@@ -89,15 +99,34 @@ pub fn assemble(spec: &FlowsheetSpec, file: &str) -> Result<Plant, LoadError> {
                 Some(p) => p.to_string(),
                 None if ports.len() == 1 => ports[0].clone(),
                 None => {
-                    diags.push(Diagnostic::new(path, format!("`{uname}` ({}) has {} {dir} ports: name one as `{uname}.<port>` ({})", unit.type_name(), ports.len(), ports.join(", "))));
+                    diags.push(Diagnostic::new(
+                        path,
+                        format!(
+                            "`{uname}` ({}) has {} {dir} ports: name one as `{uname}.<port>` ({})",
+                            unit.type_name(),
+                            ports.len(),
+                            ports.join(", ")
+                        ),
+                    ));
                     return None;
                 }
             };
             match ports.iter().position(|p| *p == port) {
                 Some(k) => Some((ui, k)),
                 None => {
-                    let hint = if ports.is_empty() { format!("it has no {dir} ports") } else { format!("{dir} ports: {}", ports.join(", ")) };
-                    diags.push(Diagnostic::new(path, format!("`{uname}` ({}) has no {dir} port `{port}`{}; {hint}", unit.type_name(), did_you_mean(&port, ports.iter().map(String::as_str)))));
+                    let hint = if ports.is_empty() {
+                        format!("it has no {dir} ports")
+                    } else {
+                        format!("{dir} ports: {}", ports.join(", "))
+                    };
+                    diags.push(Diagnostic::new(
+                        path,
+                        format!(
+                            "`{uname}` ({}) has no {dir} port `{port}`{}; {hint}",
+                            unit.type_name(),
+                            did_you_mean(&port, ports.iter().map(String::as_str))
+                        ),
+                    ));
                     None
                 }
             }
@@ -105,10 +134,19 @@ pub fn assemble(spec: &FlowsheetSpec, file: &str) -> Result<Plant, LoadError> {
         let from = resolve("from", &s.from, true);
         let to = resolve("to", &s.to, false);
         if let Some(prev) = from.and_then(|f| outlet_of.insert(f, sname.clone())) {
-            diags.push(Diagnostic::new(format!("streams.{sname}.from"), format!("outlet `{}` is already the source of stream `{prev}`: a port takes one stream (use a splitter)", s.from)));
+            diags.push(Diagnostic::new(
+                format!("streams.{sname}.from"),
+                format!(
+                    "outlet `{}` is already the source of stream `{prev}`: a port takes one stream (use a splitter)",
+                    s.from
+                ),
+            ));
         }
         if let Some(prev) = to.and_then(|t| inlet_of.insert(t, sname.clone())) {
-            diags.push(Diagnostic::new(format!("streams.{sname}.to"), format!("inlet `{}` is already fed by stream `{prev}`: a port takes one stream (use a mixer)", s.to)));
+            diags.push(Diagnostic::new(
+                format!("streams.{sname}.to"),
+                format!("inlet `{}` is already fed by stream `{prev}`: a port takes one stream (use a mixer)", s.to),
+            ));
         }
         if let (Some(f), Some(t)) = (from, to) {
             links.push((sname.clone(), f, t, s.tear));
@@ -122,7 +160,10 @@ pub fn assemble(spec: &FlowsheetSpec, file: &str) -> Result<Plant, LoadError> {
         }
         for (k, p) in unit.inlet_ports().iter().enumerate() {
             if !inlet_of.contains_key(&(ui, k)) {
-                diags.push(Diagnostic::new(format!("units.{name}"), format!("inlet port `{name}.{p}` is not connected: add a stream to it")));
+                diags.push(Diagnostic::new(
+                    format!("units.{name}"),
+                    format!("inlet port `{name}.{p}` is not connected: add a stream to it"),
+                ));
             }
         }
     }
@@ -153,7 +194,13 @@ pub fn assemble(spec: &FlowsheetSpec, file: &str) -> Result<Plant, LoadError> {
             .inputs()
             .into_iter()
             .map(|i| {
-                inputs.push(InputInfo { path: format!("{name}.{}", i.name), dim: i.dim, value: i.value, driven_by: None, block: ui });
+                inputs.push(InputInfo {
+                    path: format!("{name}.{}", i.name),
+                    dim: i.dim,
+                    value: i.value,
+                    driven_by: None,
+                    block: ui,
+                });
                 inputs.len() - 1
             })
             .collect();
@@ -166,9 +213,29 @@ pub fn assemble(spec: &FlowsheetSpec, file: &str) -> Result<Plant, LoadError> {
             n_signals: 0,
         };
         let n_eq = (layout.n_own() as isize + unit.extra_equations()).max(0) as usize;
-        blocks.push(Block { name, kind: BlockKind::Unit, unit, layout, own_offset, eq_offset: 0, n_eq, reads: Vec::new(), input_ids, pattern: None });
+        blocks.push(Block {
+            name,
+            kind: BlockKind::Unit,
+            unit,
+            layout,
+            own_offset,
+            eq_offset: 0,
+            n_eq,
+            reads: Vec::new(),
+            input_ids,
+            pattern: None,
+        });
     }
-    let streams: Vec<StreamInfo> = links.iter().map(|(name, f, t, tear)| StreamInfo { name: name.clone(), from: *f, to: *t, offset: stream_offset[f], tear: *tear }).collect();
+    let streams: Vec<StreamInfo> = links
+        .iter()
+        .map(|(name, f, t, tear)| StreamInfo {
+            name: name.clone(),
+            from: *f,
+            to: *t,
+            offset: stream_offset[f],
+            tear: *tear,
+        })
+        .collect();
     let mut var_index: HashMap<String, usize> = vars.iter().enumerate().map(|(i, v)| (v.path.clone(), i)).collect();
     let mut input_index: HashMap<String, usize> = inputs.iter().enumerate().map(|(i, v)| (v.path.clone(), i)).collect();
 
@@ -190,7 +257,10 @@ pub fn assemble(spec: &FlowsheetSpec, file: &str) -> Result<Plant, LoadError> {
                 Some(_) => measured.push(p.clone()),
                 None => {
                     ok = false;
-                    diags.push(Diagnostic::new(format!("controllers.{cname}.{field}"), format!("no variable `{p}`{}", did_you_mean(p, var_index.keys().map(String::as_str)))));
+                    diags.push(Diagnostic::new(
+                        format!("controllers.{cname}.{field}"),
+                        format!("no variable `{p}`{}", did_you_mean(p, var_index.keys().map(String::as_str))),
+                    ));
                 }
             }
         }
@@ -221,22 +291,20 @@ pub fn assemble(spec: &FlowsheetSpec, file: &str) -> Result<Plant, LoadError> {
         return Err(invalid(diags));
     }
     for (cname, c, measured, driven) in &pending {
-        let pv_dim = measured.first().and_then(|p| var_index.get(p).map(|&i| vars[i].spec.dim)).or_else(|| measured.first().and_then(|p| {
-            let (head, _) = split_port(p);
-            pending.iter().find(|(n, ..)| n == head).and_then(|(_, _, _, d)| d.first().map(|&i| inputs[i].dim))
-        }));
+        let pv_dim = measured.first().and_then(|p| var_index.get(p).map(|&i| vars[i].spec.dim)).or_else(|| {
+            measured.first().and_then(|p| {
+                let (head, _) = split_port(p);
+                pending.iter().find(|(n, ..)| n == head).and_then(|(_, _, _, d)| d.first().map(|&i| inputs[i].dim))
+            })
+        });
         let first = driven.first().copied();
         let pv_dim = pv_dim.unwrap_or(plantwide_units::Dimension::DIMENSIONLESS);
         let op_dim = match first {
             Some(i) => inputs[i].dim,
             None => c.config().op_dimension(pv_dim).unwrap_or(plantwide_units::Dimension::DIMENSIONLESS),
         };
-        let links = ControllerLinks {
-            pv_dim,
-            op_dim,
-            op_value: first.map_or(0.0, |i| inputs[i].value),
-            pv_nominal: 1.0,
-        };
+        let links =
+            ControllerLinks { pv_dim, op_dim, op_value: first.map_or(0.0, |i| inputs[i].value), pv_nominal: 1.0 };
         let cx = BuildCx::new(&components, &thermo, format!("controllers.{cname}"));
         match c.build(cx, &links) {
             Ok(unit) => {
@@ -249,14 +317,38 @@ pub fn assemble(spec: &FlowsheetSpec, file: &str) -> Result<Plant, LoadError> {
                     .inputs()
                     .into_iter()
                     .map(|i| {
-                        inputs.push(InputInfo { path: format!("{cname}.{}", i.name), dim: i.dim, value: i.value, driven_by: None, block: blocks.len() });
+                        inputs.push(InputInfo {
+                            path: format!("{cname}.{}", i.name),
+                            dim: i.dim,
+                            value: i.value,
+                            driven_by: None,
+                            block: blocks.len(),
+                        });
                         input_index.insert(inputs[inputs.len() - 1].path.clone(), inputs.len() - 1);
                         inputs.len() - 1
                     })
                     .collect();
-                let layout = LocalLayout { stream: stream_layout, n_outlets: 0, n_internal: unit.internal_vars().len(), n_inlets: 0, n_inputs: unit.inputs().len(), n_signals: unit.signals().len() };
+                let layout = LocalLayout {
+                    stream: stream_layout,
+                    n_outlets: 0,
+                    n_internal: unit.internal_vars().len(),
+                    n_inlets: 0,
+                    n_inputs: unit.inputs().len(),
+                    n_signals: unit.signals().len(),
+                };
                 let n_eq = (layout.n_own() as isize + unit.extra_equations()).max(0) as usize;
-                blocks.push(Block { name: cname.clone(), kind: BlockKind::Controller, unit, layout, own_offset, eq_offset: 0, n_eq, reads: Vec::new(), input_ids, pattern: None });
+                blocks.push(Block {
+                    name: cname.clone(),
+                    kind: BlockKind::Controller,
+                    unit,
+                    layout,
+                    own_offset,
+                    eq_offset: 0,
+                    n_eq,
+                    reads: Vec::new(),
+                    input_ids,
+                    pattern: None,
+                });
             }
             Err(errs) => diags.extend(errs.into_iter().map(|e| Diagnostic::new(e.path, e.message))),
         }
@@ -280,7 +372,10 @@ pub fn assemble(spec: &FlowsheetSpec, file: &str) -> Result<Plant, LoadError> {
             Some(&i) => {
                 aliases.insert(alias.clone(), i);
             }
-            None => diags.push(Diagnostic::new(format!("inputs.{alias}"), format!("no manipulable input `{p}`{}", did_you_mean(p, input_index.keys().map(String::as_str))))),
+            None => diags.push(Diagnostic::new(
+                format!("inputs.{alias}"),
+                format!("no manipulable input `{p}`{}", did_you_mean(p, input_index.keys().map(String::as_str))),
+            )),
         }
     }
 
@@ -303,7 +398,10 @@ pub fn assemble(spec: &FlowsheetSpec, file: &str) -> Result<Plant, LoadError> {
         for s in b.unit.signals() {
             match var_index.get(&s.path).or_else(|| var_index.get(&s.path.replace(".z[", ".x["))) {
                 Some(&v) => reads.push(Read::Var(v)),
-                None => diags.push(Diagnostic::new(format!("controllers.{}.{}", b.name, s.role), format!("no variable `{}`", s.path))),
+                None => diags.push(Diagnostic::new(
+                    format!("controllers.{}.{}", b.name, s.role),
+                    format!("no variable `{}`", s.path),
+                )),
             }
         }
         b.reads = reads;

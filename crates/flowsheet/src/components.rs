@@ -3,11 +3,15 @@
 use plantwide_thermo::{Component, Library, ThermoPackage, VleModel};
 use plantwide_units::{Dimension, QuantityValue};
 
-use crate::error::{did_you_mean, Diagnostic};
+use crate::error::{Diagnostic, did_you_mean};
 use crate::spec::{ComponentSpec, ThermoSpec, VleChoice};
 
 /// Component names and the thermodynamic package, or diagnostics.
-pub fn thermo_package(components: &[ComponentSpec], thermo: &ThermoSpec, diags: &mut Vec<Diagnostic>) -> Option<(Vec<String>, ThermoPackage, Vec<Option<f64>>)> {
+pub fn thermo_package(
+    components: &[ComponentSpec],
+    thermo: &ThermoSpec,
+    diags: &mut Vec<Diagnostic>,
+) -> Option<(Vec<String>, ThermoPackage, Vec<Option<f64>>)> {
     let library = match Library::builtin() {
         Ok(l) => l,
         Err(e) => {
@@ -94,7 +98,10 @@ pub fn thermo_package(components: &[ComponentSpec], thermo: &ThermoSpec, diags: 
             }
             if let Some(m) = &thermo.alpha {
                 for k in m.keys().filter(|k| !names.contains(k)) {
-                    diags.push(Diagnostic::new(format!("thermo.alpha.{k}"), format!("`{k}` is not a component of this flowsheet")));
+                    diags.push(Diagnostic::new(
+                        format!("thermo.alpha.{k}"),
+                        format!("`{k}` is not a component of this flowsheet"),
+                    ));
                 }
             }
             VleModel::ConstantAlpha { alpha }

@@ -33,7 +33,8 @@ impl Plant {
         sccs.into_iter()
             .filter(|c| c.len() > 1 || g.contains_edge(c[0], c[0]))
             .map(|c| {
-                let mut names: Vec<(usize, String)> = c.iter().map(|&n| (g[n], self.blocks[g[n]].name.clone())).collect();
+                let mut names: Vec<(usize, String)> =
+                    c.iter().map(|&n| (g[n], self.blocks[g[n]].name.clone())).collect();
                 names.sort();
                 names.into_iter().map(|(_, n)| n).collect()
             })

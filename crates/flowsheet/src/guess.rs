@@ -3,8 +3,8 @@
 
 use std::collections::VecDeque;
 
-use plantwide_model::stream::{F, H, P, T, Z0};
 use plantwide_model::UnitIo;
+use plantwide_model::stream::{F, H, P, T, Z0};
 
 use crate::plant::{BlockKind, Plant};
 
@@ -15,7 +15,8 @@ impl Plant {
         let n = self.blocks.len();
         let mut seen = vec![false; n];
         let mut order = Vec::with_capacity(n);
-        let mut queue: VecDeque<usize> = (0..n).filter(|&b| self.blocks[b].kind == BlockKind::Unit && self.blocks[b].layout.n_inlets == 0).collect();
+        let mut queue: VecDeque<usize> =
+            (0..n).filter(|&b| self.blocks[b].kind == BlockKind::Unit && self.blocks[b].layout.n_inlets == 0).collect();
         loop {
             while let Some(b) = queue.pop_front() {
                 if std::mem::replace(&mut seen[b], true) {

@@ -21,7 +21,9 @@ pub fn resolve_input(plant: &Plant, path: &str) -> Option<usize> {
 
 /// Split `PATH=VALUE`.
 pub fn split_assignment(text: &str) -> Result<(&str, &str), String> {
-    text.split_once('=').map(|(p, v)| (p.trim(), v.trim())).ok_or_else(|| format!("`{text}`: expected PATH=VALUE, e.g. feed.F=1.01kmol/min"))
+    text.split_once('=')
+        .map(|(p, v)| (p.trim(), v.trim()))
+        .ok_or_else(|| format!("`{text}`: expected PATH=VALUE, e.g. feed.F=1.01kmol/min"))
 }
 
 /// Apply one assignment to the input vector `u` if `path` names an input.
@@ -29,7 +31,9 @@ pub fn set_input(plant: &Plant, u: &mut [f64], path: &str, value: &str) -> Resul
     let Some(i) = resolve_input(plant, path) else { return Ok(false) };
     let info = &plant.inputs[i];
     if info.driven_by.is_some() {
-        return Err(format!("--set {path}: this input is driven by a controller; set the controller's setpoint (`<ctrl>.sp`) instead"));
+        return Err(format!(
+            "--set {path}: this input is driven by a controller; set the controller's setpoint (`<ctrl>.sp`) instead"
+        ));
     }
     u[i] = parse_quantity_as(value, info.dim).map_err(|e| format!("--set {path}: {e}"))?;
     Ok(true)
@@ -46,12 +50,18 @@ pub fn set_field(spec: &mut FlowsheetSpec, path: &str, value: &str) -> Result<()
         "controllers"
     } else {
         let names = spec.units.keys().chain(spec.controllers.keys()).map(String::as_str);
-        return Err(format!("--set {path}: no unit, controller, stream or input named `{head}`{}", did_you_mean(head, names)));
+        return Err(format!(
+            "--set {path}: no unit, controller, stream or input named `{head}`{}",
+            did_you_mean(head, names)
+        ));
     };
     let obj = doc[section][head].as_object_mut().ok_or_else(|| format!("--set {path}: `{head}` is not an object"))?;
     if !obj.contains_key(field) {
         let known: Vec<&str> = obj.keys().map(String::as_str).collect();
-        return Err(format!("--set {path}: `{head}` has no field `{field}` set in the file (fields: {})", known.join(", ")));
+        return Err(format!(
+            "--set {path}: `{head}` has no field `{field}` set in the file (fields: {})",
+            known.join(", ")
+        ));
     }
     let parsed = serde_json::from_str::<Value>(value).unwrap_or_else(|_| Value::String(value.to_string()));
     obj.insert(field.to_string(), parsed);

@@ -6,10 +6,11 @@ use plantwide_model::{ControllerSpec, UnitSpec};
 use serde::de::DeserializeOwned;
 use serde_json::Value;
 
-use crate::error::{did_you_mean, Diagnostic, LoadError};
-use crate::spec::{ComponentSpec, FlowsheetSpec, StreamSpec, ThermoSpec, FORMAT_VERSION};
+use crate::error::{Diagnostic, LoadError, did_you_mean};
+use crate::spec::{ComponentSpec, FORMAT_VERSION, FlowsheetSpec, StreamSpec, ThermoSpec};
 
-const TOP_LEVEL: &[&str] = &["format_version", "name", "description", "components", "thermo", "units", "streams", "controllers", "inputs"];
+const TOP_LEVEL: &[&str] =
+    &["format_version", "name", "description", "components", "thermo", "units", "streams", "controllers", "inputs"];
 
 /// Parse the text of a flowsheet file named `file` (the name is only used in messages).
 pub fn parse_spec(text: &str, file: &str) -> Result<FlowsheetSpec, LoadError> {
@@ -23,30 +24,58 @@ pub fn parse_spec(text: &str, file: &str) -> Result<FlowsheetSpec, LoadError> {
     let Some(obj) = root.as_object() else {
         return Err(LoadError::Invalid {
             file: file.into(),
-            diagnostics: vec![Diagnostic::new("", "the file must hold a JSON object with format_version, components, thermo, units and streams")],
+            diagnostics: vec![Diagnostic::new(
+                "",
+                "the file must hold a JSON object with format_version, components, thermo, units and streams",
+            )],
         });
     };
     for key in obj.keys() {
         if !TOP_LEVEL.contains(&key.as_str()) {
-            diags.push(Diagnostic::new(key.clone(), format!("unknown field{}; the top level has: {}", did_you_mean(key, TOP_LEVEL.iter().copied()), TOP_LEVEL.join(", "))));
+            diags.push(Diagnostic::new(
+                key.clone(),
+                format!(
+                    "unknown field{}; the top level has: {}",
+                    did_you_mean(key, TOP_LEVEL.iter().copied()),
+                    TOP_LEVEL.join(", ")
+                ),
+            ));
         }
     }
     let format_version: u32 = field(obj, "format_version", &mut diags, true).unwrap_or(FORMAT_VERSION);
     if format_version != FORMAT_VERSION {
-        diags.push(Diagnostic::new("format_version", format!("this build reads format_version {FORMAT_VERSION}, the file has {format_version}")));
+        diags.push(Diagnostic::new(
+            "format_version",
+            format!("this build reads format_version {FORMAT_VERSION}, the file has {format_version}"),
+        ));
     }
     let name: String = field(obj, "name", &mut diags, false).unwrap_or_default();
     let description: String = field(obj, "description", &mut diags, false).unwrap_or_default();
     let components = components(obj.get("components"), &mut diags);
     let thermo: Option<ThermoSpec> = field(obj, "thermo", &mut diags, true);
     let units = tagged_map::<UnitSpec>(obj.get("units"), "units", UnitSpec::TYPES, "unit", true, &mut diags);
-    let controllers = tagged_map::<ControllerSpec>(obj.get("controllers"), "controllers", ControllerSpec::TYPES, "controller", false, &mut diags);
+    let controllers = tagged_map::<ControllerSpec>(
+        obj.get("controllers"),
+        "controllers",
+        ControllerSpec::TYPES,
+        "controller",
+        false,
+        &mut diags,
+    );
     let streams = plain_map::<StreamSpec>(obj.get("streams"), "streams", true, &mut diags);
     let inputs = plain_map::<String>(obj.get("inputs"), "inputs", false, &mut diags);
     match thermo {
-        Some(thermo) if diags.is_empty() => {
-            Ok(FlowsheetSpec { format_version, name, description, components, thermo, units, streams, controllers, inputs })
-        }
+        Some(thermo) if diags.is_empty() => Ok(FlowsheetSpec {
+            format_version,
+            name,
+            description,
+            components,
+            thermo,
+            units,
+            streams,
+            controllers,
+            inputs,
+        }),
         _ => Err(LoadError::Invalid { file: file.into(), diagnostics: diags }),
     }
 }
@@ -82,7 +111,12 @@ fn explain(msg: &str) -> String {
     msg.to_string()
 }
 
-fn field<T: DeserializeOwned>(obj: &serde_json::Map<String, Value>, key: &str, diags: &mut Vec<Diagnostic>, required: bool) -> Option<T> {
+fn field<T: DeserializeOwned>(
+    obj: &serde_json::Map<String, Value>,
+    key: &str,
+    diags: &mut Vec<Diagnostic>,
+    required: bool,
+) -> Option<T> {
     match obj.get(key) {
         Some(v) => typed(v, key, diags),
         None => {
@@ -96,7 +130,10 @@ fn field<T: DeserializeOwned>(obj: &serde_json::Map<String, Value>, key: &str, d
 
 fn components(value: Option<&Value>, diags: &mut Vec<Diagnostic>) -> Vec<ComponentSpec> {
     let Some(value) = value else {
-        diags.push(Diagnostic::new("components", "missing required field: list the components, e.g. [\"benzene\", \"toluene\"]"));
+        diags.push(Diagnostic::new(
+            "components",
+            "missing required field: list the components, e.g. [\"benzene\", \"toluene\"]",
+        ));
         return Vec::new();
     };
     let Some(items) = value.as_array() else {
@@ -115,11 +152,15 @@ fn components(value: Option<&Value>, diags: &mut Vec<Diagnostic>) -> Vec<Compone
                     name: String,
                     hypothetical: crate::spec::HypotheticalSpec,
                 }
-                typed::<Hypo>(item, &path, diags).map(|h| ComponentSpec::Hypothetical { name: h.name, hypothetical: h.hypothetical })
+                typed::<Hypo>(item, &path, diags)
+                    .map(|h| ComponentSpec::Hypothetical { name: h.name, hypothetical: h.hypothetical })
             }
             Value::Object(_) => typed(item, &path, diags).map(|c| ComponentSpec::Inline(Box::new(c))),
             _ => {
-                diags.push(Diagnostic::new(path, "expected a component name (\"water\") or an object ({\"name\": …, \"hypothetical\": {…}})"));
+                diags.push(Diagnostic::new(
+                    path,
+                    "expected a component name (\"water\") or an object ({\"name\": …, \"hypothetical\": {…}})",
+                ));
                 None
             }
         };
@@ -128,7 +169,12 @@ fn components(value: Option<&Value>, diags: &mut Vec<Diagnostic>) -> Vec<Compone
     out
 }
 
-fn plain_map<T: DeserializeOwned>(value: Option<&Value>, section: &str, required: bool, diags: &mut Vec<Diagnostic>) -> IndexMap<String, T> {
+fn plain_map<T: DeserializeOwned>(
+    value: Option<&Value>,
+    section: &str,
+    required: bool,
+    diags: &mut Vec<Diagnostic>,
+) -> IndexMap<String, T> {
     let mut out = IndexMap::new();
     match value {
         None if required => diags.push(Diagnostic::new(section, "missing required field")),
@@ -167,7 +213,11 @@ fn tagged_map<T: DeserializeOwned>(
                     )),
                     Some(t) if !types.contains(&t) => diags.push(Diagnostic::new(
                         format!("{path}.type"),
-                        format!("unknown {what} type `{t}`{}; known types: {}", did_you_mean(t, types.iter().copied()), types.join(", ")),
+                        format!(
+                            "unknown {what} type `{t}`{}; known types: {}",
+                            did_you_mean(t, types.iter().copied()),
+                            types.join(", ")
+                        ),
                     )),
                     Some(_) => {
                         if let Some(spec) = typed(v, &path, diags) {

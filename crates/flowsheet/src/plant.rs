@@ -152,7 +152,8 @@ impl Plant {
         let Some(b) = self.blocks.iter().find(|b| eq >= b.eq_offset && eq < b.eq_offset + b.n_eq) else {
             return format!("equation {eq}");
         };
-        let own: Vec<String> = self.vars[b.own_offset..b.own_offset + b.layout.n_own()].iter().map(|v| v.path.clone()).collect();
+        let own: Vec<String> =
+            self.vars[b.own_offset..b.own_offset + b.layout.n_own()].iter().map(|v| v.path.clone()).collect();
         format!("{}: {}", b.name, b.unit.equation_name(eq - b.eq_offset, &own))
     }
 
@@ -187,15 +188,33 @@ impl Plant {
     /// (free inputs only) into `ju`. Structural entries are kept even when their value is zero, so
     /// the pattern is the same at every point. Blocks are evaluated in parallel (rayon) when the
     /// plant is large enough for it to pay; the result is identical to the sequential one.
-    pub fn jacobian(&self, x: &[f64], u: &[f64], t: f64, r: &mut [f64], jx: &mut Vec<(usize, usize, f64)>, ju: &mut Vec<(usize, usize, f64)>) {
+    pub fn jacobian(
+        &self,
+        x: &[f64],
+        u: &[f64],
+        t: f64,
+        r: &mut [f64],
+        jx: &mut Vec<(usize, usize, f64)>,
+        ju: &mut Vec<(usize, usize, f64)>,
+    ) {
         let work: usize = self.blocks.iter().map(|b| b.n_eq * (b.layout.len() + 1)).sum();
-        let par = if self.blocks.len() > 1 && work > PARALLEL_WORK { Parallelism::Rayon } else { Parallelism::Sequential };
+        let par =
+            if self.blocks.len() > 1 && work > PARALLEL_WORK { Parallelism::Rayon } else { Parallelism::Sequential };
         self.jacobian_with(par, x, u, t, r, jx, ju);
     }
 
     /// [`Plant::jacobian`] with the parallelism chosen by the caller.
     #[allow(clippy::too_many_arguments)]
-    pub fn jacobian_with(&self, par: Parallelism, x: &[f64], u: &[f64], t: f64, r: &mut [f64], jx: &mut Vec<(usize, usize, f64)>, ju: &mut Vec<(usize, usize, f64)>) {
+    pub fn jacobian_with(
+        &self,
+        par: Parallelism,
+        x: &[f64],
+        u: &[f64],
+        t: f64,
+        r: &mut [f64],
+        jx: &mut Vec<(usize, usize, f64)>,
+        ju: &mut Vec<(usize, usize, f64)>,
+    ) {
         jx.clear();
         ju.clear();
         let parts: Vec<BlockJacobian> = match par {

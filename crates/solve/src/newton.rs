@@ -12,8 +12,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::sparse::SparseLu;
 use crate::System;
+use crate::sparse::SparseLu;
 
 /// Settings of the steady-state solver.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -172,9 +172,15 @@ pub fn solve_steady<S: System>(sys: &S, x: &mut [f64], settings: &NewtonSettings
 }
 
 /// [`solve_steady`] reporting every iteration to `observer` (progress display).
-pub fn solve_steady_observed<S: System>(sys: &S, x: &mut [f64], settings: &NewtonSettings, observer: &mut dyn FnMut(&IterationRecord)) -> NewtonReport {
+pub fn solve_steady_observed<S: System>(
+    sys: &S,
+    x: &mut [f64],
+    settings: &NewtonSettings,
+    observer: &mut dyn FnMut(&IterationRecord),
+) -> NewtonReport {
     let n = sys.n();
-    let mut wk = Work { sys, n, lu: SparseLu::default(), jac: Vec::new(), r: vec![0.0; n], w: vec![1.0; n], n_res: 0, n_jac: 0 };
+    let mut wk =
+        Work { sys, n, lu: SparseLu::default(), jac: Vec::new(), r: vec![0.0; n], w: vec![1.0; n], n_res: 0, n_jac: 0 };
     let mut history = Observed { records: Vec::new(), observer };
     let mut status = newton_phase(&mut wk, x, settings, &mut history);
     if status != NewtonStatus::Converged && settings.pseudo_transient {
@@ -214,7 +220,12 @@ impl Observed<'_> {
     }
 }
 
-fn newton_phase<S: System>(wk: &mut Work<'_, S>, x: &mut [f64], st: &NewtonSettings, history: &mut Observed<'_>) -> NewtonStatus {
+fn newton_phase<S: System>(
+    wk: &mut Work<'_, S>,
+    x: &mut [f64],
+    st: &NewtonSettings,
+    history: &mut Observed<'_>,
+) -> NewtonStatus {
     for _ in 0..st.max_iter {
         wk.linearize(x);
         let (norm, _) = wk.scaled_norm(&wk.r);
@@ -238,7 +249,12 @@ fn newton_phase<S: System>(wk: &mut Work<'_, S>, x: &mut [f64], st: &NewtonSetti
     if wk.scaled_norm(&wk.r).0 <= st.tol { NewtonStatus::Converged } else { NewtonStatus::MaxIterations }
 }
 
-fn ptc_phase<S: System>(wk: &mut Work<'_, S>, x: &mut [f64], st: &NewtonSettings, history: &mut Observed<'_>) -> NewtonStatus {
+fn ptc_phase<S: System>(
+    wk: &mut Work<'_, S>,
+    x: &mut [f64],
+    st: &NewtonSettings,
+    history: &mut Observed<'_>,
+) -> NewtonStatus {
     let mass = wk.sys.mass();
     let mut dt = st.ptc_dt0;
     let mut prev_norm = f64::NAN;

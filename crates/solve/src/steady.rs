@@ -4,7 +4,7 @@ use faer::Mat;
 use plantwide_flowsheet::Plant;
 use plantwide_model::VarKind;
 
-use crate::{maximum_matching, solve_steady_observed, NewtonReport, NewtonSettings, NewtonStatus, System};
+use crate::{NewtonReport, NewtonSettings, NewtonStatus, System, maximum_matching, solve_steady_observed};
 
 /// The plant at fixed inputs `u`, seen as a nonlinear system.
 pub struct PlantSystem<'a> {
@@ -99,7 +99,8 @@ pub fn dof_check(plant: &Plant, u: &[f64], x: &[f64], probe: DofProbe) -> Result
     let (n_eqs, n_vars) = (plant.n_eqs(), plant.n_vars());
     if n_eqs != n_vars {
         let hint = if n_eqs > n_vars {
-            "a flow is set twice — e.g. a valve or pump in flow mode downstream of a vessel whose outflow is not `free`".to_string()
+            "a flow is set twice — e.g. a valve or pump in flow mode downstream of a vessel whose outflow is not `free`"
+                .to_string()
         } else {
             "a flow is set nowhere — e.g. a vessel with a `free` outflow but no valve or pump after it".to_string()
         };
@@ -112,7 +113,10 @@ pub fn dof_check(plant: &Plant, u: &[f64], x: &[f64], probe: DofProbe) -> Result
     let m = maximum_matching(n_eqs, n_vars, &entries);
     let loose = m.unmatched_cols();
     if !loose.is_empty() {
-        return Err(DofError::Underdetermined { file, explanation: explain_loose(plant, &loose, "no equation is left to determine") });
+        return Err(DofError::Underdetermined {
+            file,
+            explanation: explain_loose(plant, &loose, "no equation is left to determine"),
+        });
     }
     if probe == DofProbe::Numerical && n_vars <= DENSE_PROBE_LIMIT && n_vars > 0 {
         // Scale columns by their nominal values and rows by their largest entry, then look for a
@@ -140,7 +144,11 @@ pub fn dof_check(plant: &Plant, u: &[f64], x: &[f64], probe: DofProbe) -> Result
                 idx.sort_by(|&a, &b| null[b].total_cmp(&null[a]));
                 return Err(DofError::Underdetermined {
                     file,
-                    explanation: explain_loose(plant, &idx, "these variables can move together without changing any equation"),
+                    explanation: explain_loose(
+                        plant,
+                        &idx,
+                        "these variables can move together without changing any equation",
+                    ),
                 });
             }
         }
@@ -150,7 +158,11 @@ pub fn dof_check(plant: &Plant, u: &[f64], x: &[f64], probe: DofProbe) -> Result
 
 fn explain_loose(plant: &Plant, vars: &[usize], why: &str) -> String {
     let paths: Vec<&str> = vars.iter().take(8).map(|&j| plant.vars[j].path.as_str()).collect();
-    let inventories: Vec<&str> = vars.iter().filter(|&&j| plant.vars[j].spec.kind == VarKind::Differential).map(|&j| plant.vars[j].path.as_str()).collect();
+    let inventories: Vec<&str> = vars
+        .iter()
+        .filter(|&&j| plant.vars[j].spec.kind == VarKind::Differential)
+        .map(|&j| plant.vars[j].path.as_str())
+        .collect();
     let mut s = format!("{why}: {}", paths.join(", "));
     if vars.len() > 8 {
         s.push_str(&format!(" and {} more", vars.len() - 8));
@@ -193,7 +205,9 @@ pub enum SteadyError {
 
 /// A steady-state solve that did not converge: where and how it failed.
 #[derive(Debug, Clone, thiserror::Error)]
-#[error("{file}: steady state not found ({status:?} after {iterations} iterations, scaled residual {residual:.3e}); worst equation: {equation} (variable {variable}, scaled residual {worst:.3e})")]
+#[error(
+    "{file}: steady state not found ({status:?} after {iterations} iterations, scaled residual {residual:.3e}); worst equation: {equation} (variable {variable}, scaled residual {worst:.3e})"
+)]
 pub struct ConvergenceFailure {
     /// Flowsheet file.
     pub file: String,
@@ -217,7 +231,12 @@ pub struct ConvergenceFailure {
 
 /// Solve the plant's steady state at inputs `u` from `x0` (or the cold-start guess). The structural
 /// DOF check runs first; if Newton fails, the numerical probe runs to explain an ill-posed plant.
-pub fn steady_state(plant: &Plant, u: &[f64], x0: Option<&[f64]>, settings: &NewtonSettings) -> Result<SteadyState, SteadyError> {
+pub fn steady_state(
+    plant: &Plant,
+    u: &[f64],
+    x0: Option<&[f64]>,
+    settings: &NewtonSettings,
+) -> Result<SteadyState, SteadyError> {
     steady_state_observed(plant, u, x0, settings, &mut |_| {})
 }
 

@@ -178,7 +178,9 @@ mod tests {
         let zd = [Dual64::new(z[0], 1.0), Dual64::from_re(z[1]), Dual64::new(z[2], -1.0)];
         let d = pk.h_equilibrium(Dual64::from_re(t), Dual64::from_re(p), &zd);
         let e = 1e-6;
-        let fd = (pk.h_equilibrium(t, p, &[z[0] + e, z[1], z[2] - e]) - pk.h_equilibrium(t, p, &[z[0] - e, z[1], z[2] + e])) / (2.0 * e);
+        let fd = (pk.h_equilibrium(t, p, &[z[0] + e, z[1], z[2] - e])
+            - pk.h_equilibrium(t, p, &[z[0] - e, z[1], z[2] + e]))
+            / (2.0 * e);
         assert!((d.eps - fd).abs() < 1e-5 * fd.abs().max(1.0), "dh/dz {} vs {fd}", d.eps);
     }
 }
