@@ -50,6 +50,24 @@ pub enum Characteristic {
     EqualPercentage,
 }
 
+impl Characteristic {
+    /// Fraction of the full-open flow coefficient at opening `op` (clamped to [0, 1]) for
+    /// rangeability `e^ln_r`.
+    pub fn fraction<S: Scalar>(self, op: S, ln_r: f64) -> S {
+        let op = if op.re() < 0.0 {
+            S::from(0.0)
+        } else if op.re() > 1.0 {
+            S::from(1.0)
+        } else {
+            op
+        };
+        match self {
+            Characteristic::Linear => op,
+            Characteristic::EqualPercentage => ((op - 1.0) * ln_r).exp(),
+        }
+    }
+}
+
 /// How the liquid leaves a vessel (`"type": "valve" | "flow" | "free"`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
@@ -148,26 +166,13 @@ impl OutflowLaw {
             OutflowLaw::Free => liq.p + liq.mw / liq.v * liq.level * GRAVITY,
         }
     }
-    fn characteristic<S: Scalar>(characteristic: Characteristic, rangeability: f64, op: S) -> S {
-        let op = if op.re() < 0.0 {
-            S::from(0.0)
-        } else if op.re() > 1.0 {
-            S::from(1.0)
-        } else {
-            op
-        };
-        match characteristic {
-            Characteristic::Linear => op,
-            Characteristic::EqualPercentage => ((op - 1.0) * rangeability.ln()).exp(),
-        }
-    }
     /// Residual [mol/s] of the law for the outflow `f`, the law's inputs starting at `inputs[0]`;
     /// None for `free`.
     pub fn outflow_residual<S: Scalar>(&self, f: S, liq: &LiquidState<S>, inputs: &[S]) -> Option<S> {
         match self {
             OutflowLaw::Valve { cv, characteristic, rangeability, p_out, .. } => {
                 let dp = liq.p + liq.mw / liq.v * liq.level * GRAVITY - *p_out;
-                let fop = Self::characteristic(*characteristic, *rangeability, inputs[0]);
+                let fop = characteristic.fraction(inputs[0], rangeability.ln());
                 Some(f - fop * *cv * signed_sqrt(dp) / (liq.mw * liq.v).sqrt())
             }
             OutflowLaw::Flow { .. } => Some(f - inputs[0]),
@@ -206,7 +211,7 @@ impl OutflowLaw {
     /// None for other laws, no flow, or a level ≤ 0.
     pub fn steady_level(&self, flow: f64, op: f64, liq: &LiquidState<f64>) -> Option<f64> {
         let OutflowLaw::Valve { cv, characteristic, rangeability, p_out, .. } = self else { return None };
-        let s = flow * (liq.mw * liq.v).sqrt() / (cv * Self::characteristic(*characteristic, *rangeability, op));
+        let s = flow * (liq.mw * liq.v).sqrt() / (cv * characteristic.fraction(op, rangeability.ln()));
         let level = (s * s - liq.p + p_out) / (liq.mw / liq.v * GRAVITY);
         (flow > 0.0 && level.is_finite() && level > 0.0).then_some(level)
     }

@@ -43,22 +43,12 @@ use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 use super::Phase;
+use super::outflow::Characteristic;
 use crate::stream::{F, H, P, Stream, T, Z0};
 use crate::{BuildCx, FieldError, InputSpec, Scalar, UnitIo, UnitModel};
 
 /// Smoothing pressure of the square root near `ΔP = 0` [Pa].
 pub const DP_SMOOTH: f64 = 1.0;
-
-/// Inherent flow characteristic of a valve trim.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
-#[serde(rename_all = "snake_case")]
-pub enum Characteristic {
-    /// `f(op) = op`.
-    #[default]
-    Linear,
-    /// `f(op) = R^(op − 1)`, `R` the rangeability.
-    EqualPercentage,
-}
 
 /// How the valve sets its flow.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
@@ -163,17 +153,7 @@ impl Valve {
             Phase::Liquid | Phase::Equilibrium => mw / io.thermo.v_liq(inlet.t(), z),
             Phase::Vapour => inlet.p() * mw / (inlet.t() * R_GAS),
         };
-        let op = if op < 0.0 {
-            S::from(0.0)
-        } else if op > 1.0 {
-            S::from(1.0)
-        } else {
-            op
-        };
-        let f_op = match characteristic {
-            Characteristic::Linear => op,
-            Characteristic::EqualPercentage => ((op - 1.0) * ln_r).exp(),
-        };
+        let f_op = characteristic.fraction(op, ln_r);
         // Q ρ / M = Cv f √(ΔP/ρ) ρ/M = Cv f √ΔP √ρ / M
         f_op * cv * smooth_sqrt(inlet.p() - self.p_out) * rho.sqrt() / mw
     }
