@@ -54,7 +54,15 @@ pub fn converge(plant: &Plant, u: &[f64]) -> Result<SteadyState, CliError> {
     bar.finish_and_clear();
     result.map_err(|e| match e {
         SteadyError::Dof(d) => CliError::user(d.to_string()),
-        SteadyError::NotConverged(f) => CliError::numerical(f.to_string()),
+        SteadyError::NotConverged(f) => {
+            let mut msg = f.to_string();
+            msg.push_str("\niteration history (scaled residual, accepted step, pseudo time step):");
+            for h in &f.report.history {
+                let dt = h.pseudo_dt.map_or("-".to_string(), |d| format!("{d:.3e} s"));
+                msg.push_str(&format!("\n  {:>4}  {:.3e}  {:.3e}  {}", h.iter + 1, h.residual, h.step, dt));
+            }
+            CliError::numerical(msg)
+        }
     })
 }
 

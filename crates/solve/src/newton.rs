@@ -258,6 +258,7 @@ fn ptc_phase<S: System>(
     let mass = wk.sys.mass();
     let mut dt = st.ptc_dt0;
     let mut prev_norm = f64::NAN;
+    let mut failures = 0;
     for _ in 0..st.max_ptc_iter {
         wk.linearize(x);
         let (norm, _) = wk.scaled_norm(&wk.r);
@@ -276,9 +277,16 @@ fn ptc_phase<S: System>(
         a.extend(mass.iter().map(|&(i, j)| (i, j, -1.0 / dt)));
         let mut dx: Vec<f64> = wk.r.iter().map(|v| -v).collect();
         if wk.lu.solve(wk.n, &a, &mut dx).is_err() {
+            // A smaller pseudo time step makes M/δ dominate the differential rows; if even that
+            // stays singular, the algebraic part itself is singular.
+            failures += 1;
+            if failures > 8 {
+                return NewtonStatus::Singular;
+            }
             dt *= 0.1;
             continue;
         }
+        failures = 0;
         let tau = wk.max_step(x, &dx).max(0.05);
         for i in 0..wk.n {
             let (lo, hi) = wk.sys.bounds(i);
