@@ -119,41 +119,66 @@ pub fn dof_check(plant: &Plant, u: &[f64], x: &[f64], probe: DofProbe) -> Result
         });
     }
     if probe == DofProbe::Numerical && n_vars <= DENSE_PROBE_LIMIT && n_vars > 0 {
-        // Scale columns by their nominal values and rows by their largest entry, then look for a
-        // (numerically) zero singular value.
-        let mut a = Mat::<f64>::zeros(n_eqs, n_vars);
-        for &(i, j, v) in &jx {
-            a[(i, j)] += v * plant.vars[j].spec.nominal;
-        }
-        for i in 0..n_eqs {
-            let s = (0..n_vars).map(|j| a[(i, j)].abs()).fold(0.0, f64::max);
-            if s > 0.0 {
-                for j in 0..n_vars {
-                    a[(i, j)] /= s;
-                }
-            }
-        }
-        if let Ok(svd) = a.svd() {
-            let s = svd.S().column_vector();
-            let (smax, smin) = (s[0], s[n_vars - 1]);
-            if smin <= 1e-12 * smax {
-                let v = svd.V();
-                let null: Vec<f64> = (0..n_vars).map(|j| v[(j, n_vars - 1)].abs()).collect();
-                let top = null.iter().cloned().fold(0.0, f64::max);
-                let mut idx: Vec<usize> = (0..n_vars).filter(|&j| null[j] > 0.05 * top).collect();
-                idx.sort_by(|&a, &b| null[b].total_cmp(&null[a]));
-                return Err(DofError::Underdetermined {
-                    file,
-                    explanation: explain_loose(
-                        plant,
-                        &idx,
-                        "these variables can move together without changing any equation",
-                    ),
-                });
-            }
+        // A plant that is ill-posed is singular everywhere; a guess can be singular by accident
+        // (a loop with no gain at a linear profile). Only a null direction found at the guess and
+        // again at a perturbed point is reported.
+        let Some(_) = null_direction(plant, u, x) else { return Ok(()) };
+        let xp = perturbed(plant, x);
+        if let Some(idx) = null_direction(plant, u, &xp) {
+            return Err(DofError::Underdetermined {
+                file,
+                explanation: explain_loose(plant, &idx, "these variables can move together without changing any equation"),
+            });
         }
     }
     Ok(())
+}
+
+/// The variables spanning a numerical null direction of the scaled Jacobian at `x`, largest first,
+/// or `None` if the smallest singular value is not negligible.
+fn null_direction(plant: &Plant, u: &[f64], x: &[f64]) -> Option<Vec<usize>> {
+    let n = plant.n_vars();
+    let mut r = vec![0.0; n];
+    let (mut jx, mut ju) = (Vec::new(), Vec::new());
+    plant.jacobian(x, u, 0.0, &mut r, &mut jx, &mut ju);
+    // Scale columns by their nominal values and rows by their largest entry.
+    let mut a = Mat::<f64>::zeros(n, n);
+    for &(i, j, v) in &jx {
+        a[(i, j)] += v * plant.vars[j].spec.nominal;
+    }
+    for i in 0..n {
+        let s = (0..n).map(|j| a[(i, j)].abs()).fold(0.0, f64::max);
+        if s > 0.0 {
+            for j in 0..n {
+                a[(i, j)] /= s;
+            }
+        }
+    }
+    let svd = a.svd().ok()?;
+    let s = svd.S().column_vector();
+    if s[n - 1] > 1e-12 * s[0] {
+        return None;
+    }
+    let v = svd.V();
+    let null: Vec<f64> = (0..n).map(|j| v[(j, n - 1)].abs()).collect();
+    let top = null.iter().cloned().fold(0.0, f64::max);
+    let mut idx: Vec<usize> = (0..n).filter(|&j| null[j] > 0.05 * top).collect();
+    idx.sort_by(|&a, &b| null[b].total_cmp(&null[a]));
+    Some(idx)
+}
+
+/// `x` moved by up to 1 % of each variable's magnitude (deterministic), inside the bounds.
+fn perturbed(plant: &Plant, x: &[f64]) -> Vec<f64> {
+    let mut state: u64 = 0x9E37_79B9_7F4A_7C15;
+    x.iter()
+        .zip(&plant.vars)
+        .map(|(&v, info)| {
+            state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+            let xi = ((state >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0;
+            let step = 0.01 * xi * v.abs().max(1e-3 * info.spec.nominal);
+            (v + step).clamp(info.spec.lower, info.spec.upper)
+        })
+        .collect()
 }
 
 fn explain_loose(plant: &Plant, vars: &[usize], why: &str) -> String {
