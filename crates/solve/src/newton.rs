@@ -287,12 +287,26 @@ fn ptc_phase<S: System>(
             continue;
         }
         failures = 0;
-        let tau = wk.max_step(x, &dx).max(0.05);
-        for i in 0..wk.n {
-            let (lo, hi) = wk.sys.bounds(i);
-            x[i] = (x[i] + tau * dx[i]).clamp(lo, hi);
+        // The pseudo time step already damps the step: take it whole, projected onto the bounds,
+        // unless the residual blows up, in which case retreat to a shorter pseudo time step.
+        let trial: Vec<f64> = (0..wk.n)
+            .map(|i| {
+                let (lo, hi) = wk.sys.bounds(i);
+                (x[i] + dx[i]).clamp(lo, hi)
+            })
+            .collect();
+        let mut r = vec![0.0; wk.n];
+        wk.sys.residual(&trial, &mut r);
+        wk.n_res += 1;
+        let trial_norm = wk.scaled_norm(&r).0;
+        if !(trial_norm.is_finite() && trial_norm <= 10.0 * norm) {
+            dt *= 0.25;
+            prev_norm = f64::NAN;
+            history.push(IterationRecord { iter: history.len(), residual: norm, step: 0.0, pseudo_dt: Some(dt) });
+            continue;
         }
-        history.push(IterationRecord { iter: history.len(), residual: norm, step: tau, pseudo_dt: Some(dt) });
+        x.copy_from_slice(&trial);
+        history.push(IterationRecord { iter: history.len(), residual: norm, step: 1.0, pseudo_dt: Some(dt) });
     }
     NewtonStatus::MaxIterations
 }
