@@ -57,15 +57,16 @@ fn main() {
         let budget = Duration::from_millis(400);
         let (t_res, _) = time(|| plant.residual(&x0, &u, 0.0, &mut r), budget);
         let (t_jac, _) = time(|| plant.jacobian(&x0, &u, 0.0, &mut r, &mut jx, &mut ju), budget);
-        let mut iters = 0;
+        let mut iters: Option<usize> = None;
         let (t_newton, _) = time(
             || match steady_state(&plant, &u, None, &NewtonSettings::default()) {
-                Ok(ss) => iters = ss.report.iterations,
-                Err(_) => iters = usize::MAX,
+                Ok(ss) => iters = Some(ss.report.iterations),
+                Err(_) => iters = None,
             },
             Duration::from_secs(2),
         );
         let name = f.file_name().map(|s| s.to_string_lossy().to_string()).unwrap_or_default();
+        let iters = iters.map_or("failed".to_string(), |k| k.to_string());
         println!("{:<32} {:>6} {:>8} {:>12.3?} {:>14.3?} {:>12.3?} {:>6}", name, n, nnz, t_res, t_jac, t_newton, iters);
     }
 }
