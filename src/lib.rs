@@ -4,6 +4,8 @@
 //! [`analysis`]. The `plantwide` binary (src/main.rs) is the only code that touches files and the
 //! terminal.
 
+pub mod plot;
+
 pub use plantwide_analysis as analysis;
 pub use plantwide_flowsheet as flowsheet;
 pub use plantwide_model as model;

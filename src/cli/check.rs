@@ -84,5 +84,6 @@ pub fn run(file: &Path) -> Result<(), CliError> {
             ""
         }
     );
+    plantwide::solve::sequential::plan(&plant, &u, &x).describe(&plant).iter().for_each(|l| outln!("{l}"));
     Ok(())
 }

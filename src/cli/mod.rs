@@ -21,6 +21,10 @@ pub fn write_out(args: std::fmt::Arguments<'_>) {
 
 mod check;
 mod components;
+mod gains;
+mod linearize;
+mod run;
+mod sensitivity;
 mod steady;
 
 use std::path::PathBuf;
@@ -59,9 +63,46 @@ enum Command {
         /// Override an input or a unit parameter for this run, e.g. `--set feed.F=1.01kmol/min`.
         #[arg(long = "set", value_name = "PATH=VALUE")]
         set: Vec<String>,
+        /// How to converge: `eo` whole-plant Newton, `sm` sequential modular (unit by unit,
+        /// recycles by tearing), `auto` sequential modular to 1e-4 then Newton.
+        #[arg(long, value_enum, default_value = "auto")]
+        method: steady::MethodArg,
+    },
+    /// Simulate the plant through a scenario from its steady state (or a snapshot): CSV of the
+    /// recorded paths, a summary (IAE, ISE, max deviation, settling time) and optional trend plots.
+    Run {
+        /// Flowsheet file (JSON).
+        file: PathBuf,
+        /// Scenario file (JSON): duration, events, sampling, analyzers, record, snapshots.
+        #[arg(long)]
+        scenario: PathBuf,
+        /// Write the recorded trends here (CSV, units in the header).
+        #[arg(long)]
+        csv: PathBuf,
+        /// Write trend plots here (.png or .svg).
+        #[arg(long)]
+        plot: Option<PathBuf>,
+        /// Print the summary as JSON.
+        #[arg(long)]
+        json: bool,
+        /// Override an input or a unit parameter, e.g. `--set lc.kc=20mol/s/m`.
+        #[arg(long = "set", value_name = "PATH=VALUE")]
+        set: Vec<String>,
+        /// Resume from a snapshot file written by an earlier run.
+        #[arg(long)]
+        resume: Option<PathBuf>,
     },
     /// Print the JSON Schema of flowsheet files (the shipped flowsheets/plantwide.schema.json).
     Schema,
+    /// Steady-state gains (linearization or perturbation) and interaction measures: RGA, SVD,
+    /// condition numbers, Niederlinski index, block relative gain; also of a transfer-function model.
+    Gains(gains::GainsArgs),
+    /// State-space model A, B, C, D at the steady state, eigenvalues, time constants; JSON export.
+    Linearize(linearize::LinearizeArgs),
+    /// Disturbance sweeps with the control structure active: table, CSV and plot.
+    Sensitivity(sensitivity::SensitivityArgs),
+    /// Tray-temperature sensor selection for a column (SVD, sensitivity and slope criteria).
+    Sensors(gains::SensorsArgs),
 }
 
 /// A failed command: message and exit code.
@@ -87,7 +128,14 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
     match cli.command {
         Command::Check { file } => check::run(&file),
         Command::Components { json } => components::run(json),
-        Command::Steady { file, json, set } => steady::run(&file, json, &set),
+        Command::Steady { file, json, set, method } => steady::run(&file, json, &set, method),
+        Command::Run { file, scenario, csv, plot, json, set, resume } => {
+            run::run(&run::RunArgs { file, scenario, csv, plot, json, set, resume })
+        }
+        Command::Gains(a) => gains::run(&a),
+        Command::Linearize(a) => linearize::run(&a),
+        Command::Sensitivity(a) => sensitivity::run(&a),
+        Command::Sensors(a) => gains::run_sensors(&a),
         Command::Schema => {
             let schema = schemars::schema_for!(plantwide::flowsheet::FlowsheetSpec);
             let text = serde_json::to_string_pretty(&schema).map_err(|e| CliError::user(e.to_string()))?;

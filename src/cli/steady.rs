@@ -1,10 +1,11 @@
-//! `plantwide steady FILE [--json] [--set PATH=VALUE ...]`.
+//! `plantwide steady FILE [--json] [--set PATH=VALUE ...] [--method eo|sm|auto]`.
 
 use std::path::Path;
 
 use plantwide::flowsheet::overrides::{set_field, set_input, split_assignment};
 use plantwide::flowsheet::{BlockKind, Plant, assemble, parse_spec};
 use plantwide::model::stream::{F, H, P, T, Z0};
+use plantwide::solve::sequential::{Method, Progress, Solution, StrategySettings, steady_state_by};
 use plantwide::solve::{NewtonSettings, SteadyError, SteadyState, steady_state_observed};
 
 use super::CliError;
@@ -66,34 +67,95 @@ pub fn converge(plant: &Plant, u: &[f64]) -> Result<SteadyState, CliError> {
     })
 }
 
-pub fn run(file: &Path, json: bool, sets: &[String]) -> Result<(), CliError> {
+/// How `--method` finds the steady state.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum MethodArg {
+    /// Whole-plant Newton (equation oriented).
+    Eo,
+    /// Sequential modular: unit by unit in flow order, recycles converged on tear streams.
+    Sm,
+    /// Sequential modular to a loose tolerance, then whole-plant Newton (plants with recycles);
+    /// whole-plant Newton alone otherwise.
+    Auto,
+}
+
+/// Converge by `method` with a progress spinner on stderr (hidden when stderr is not a terminal),
+/// mapping failures to exit codes.
+pub fn converge_by(plant: &Plant, u: &[f64], method: MethodArg) -> Result<Solution, CliError> {
+    let x0 = plant.initial_guess_at(u);
+    plantwide::solve::dof_check(plant, u, &x0, plantwide::solve::DofProbe::Numerical)
+        .map_err(|e| CliError::user(e.to_string()))?;
+    let method = match method {
+        MethodArg::Eo => Method::Eo,
+        MethodArg::Sm => Method::Sm,
+        MethodArg::Auto => Method::Auto,
+    };
+    let bar = indicatif::ProgressBar::new_spinner();
+    let mut observer = |p: Progress<'_>| {
+        bar.set_message(match p {
+            Progress::Pass(r) => {
+                format!("sequential modular, recycle {} pass {}: tear residual {:.2e}", r.recycle, r.pass, r.residual)
+            }
+            Progress::Newton(r) => {
+                let phase = if r.pseudo_dt.is_some() { "pseudo-transient" } else { "Newton" };
+                format!("{phase} iteration {}: scaled residual {:.2e}", r.iter + 1, r.residual)
+            }
+        });
+        bar.tick();
+    };
+    let settings = StrategySettings { method, ..StrategySettings::default() };
+    let result = steady_state_by(plant, u, &settings, &mut observer);
+    bar.finish_and_clear();
+    result
+        .map_err(|e| if e.is_user_error() { CliError::user(e.to_string()) } else { CliError::numerical(e.to_string()) })
+}
+
+pub fn run(file: &Path, json: bool, sets: &[String], method: MethodArg) -> Result<(), CliError> {
     let (plant, u) = load_with_overrides(file, sets)?;
-    let ss = converge(&plant, &u)?;
+    let sol = converge_by(&plant, &u, method)?;
+    let (iterations, residual) = match (&sol.newton, &sol.sm) {
+        (Some(n), _) => (n.iterations, n.residual),
+        (None, Some(sm)) => (0, sm.sccs.iter().map(|s| s.residual).fold(0.0, f64::max)),
+        (None, None) => (0, 0.0),
+    };
     if json {
         let mut values = serde_json::Map::new();
-        for (v, x) in plant.vars.iter().zip(&ss.x) {
+        for (v, x) in plant.vars.iter().zip(&sol.x) {
             values.insert(v.path.clone(), (*x).into());
         }
-        for (i, x) in plant.inputs.iter().zip(&ss.u) {
+        for (i, x) in plant.inputs.iter().zip(&sol.u) {
             if i.driven_by.is_none() {
                 values.insert(i.path.clone(), (*x).into());
             }
         }
         let out = serde_json::json!({
             "converged": true,
-            "iterations": ss.report.iterations,
-            "residual": ss.report.residual,
+            "method": format!("{method:?}").to_lowercase(),
+            "iterations": iterations,
+            "residual": residual,
+            "sequential_modular": sol.sm,
             "values": values,
         });
         outln!("{}", serde_json::to_string_pretty(&out).map_err(|e| CliError::user(e.to_string()))?);
         return Ok(());
     }
-    outln!(
-        "steady state of `{}`: converged in {} iterations, scaled residual {:.2e}\n",
-        plant.name,
-        ss.report.iterations,
-        ss.report.residual
-    );
+    if let Some(sm) = &sol.sm {
+        sm.log().iter().for_each(|l| outln!("{l}"));
+    }
+    if let Some(why) = &sol.sm_failure {
+        outln!("sequential-modular start incomplete ({why}); Newton took over");
+    }
+    match (&sol.newton, &sol.sm) {
+        (None, Some(sm)) => outln!(
+            "steady state of `{}`: converged by the sequential-modular method in {} passes, tear residual {residual:.2e}\n",
+            plant.name,
+            sm.passes()
+        ),
+        _ => outln!(
+            "steady state of `{}`: converged in {iterations} iterations, scaled residual {residual:.2e}\n",
+            plant.name
+        ),
+    }
     let comps = &plant.components;
     out!("{:<14} {:>12} {:>9} {:>10} {:>11}", "stream", "F kmol/h", "T K", "P kPa", "h kJ/mol");
     for c in comps {
@@ -101,7 +163,7 @@ pub fn run(file: &Path, json: bool, sets: &[String]) -> Result<(), CliError> {
     }
     outln!();
     for s in &plant.streams {
-        let v = &ss.x[s.offset..s.offset + plant.stream_layout.len()];
+        let v = &sol.x[s.offset..s.offset + plant.stream_layout.len()];
         out!(
             "{:<14} {:>12.4} {:>9.3} {:>10.3} {:>11.4}",
             truncate(&s.name, 14),
@@ -120,7 +182,7 @@ pub fn run(file: &Path, json: bool, sets: &[String]) -> Result<(), CliError> {
         let internal: Vec<String> = plant
             .vars
             .iter()
-            .zip(&ss.x)
+            .zip(&sol.x)
             .filter(|(v, _)| {
                 v.block == bi && !plant.streams.iter().any(|s| v.path.starts_with(&format!("{}.", s.name)))
             })

@@ -1,1 +1,37 @@
-//! plantwide-analysis
+//! Control analysis of a plant (or of a transfer-function model): linearization, steady-state
+//! gains by two independent routes, interaction measures, sensitivity sweeps and temperature-sensor
+//! selection.
+//!
+//! - [`linear`]: Jacobians at a steady state → `G(0) = −C J⁻¹ B`, state space `A, B, C, D` with
+//!   the algebraic variables eliminated, eigenvalues, `G(jω)`.
+//! - [`perturb`]: the book's gains — each input moved ± h, the plant re-converged, central
+//!   differences.
+//! - [`measures`], [`min_cond`]: RGA, RGA number, SVD, condition number and its minimized value,
+//!   Niederlinski index, block relative gain, scaling, Morari resiliency index.
+//! - [`tf`]: transfer-function matrix files (gain, lags, leads, dead time per element).
+//! - [`sensitivity`]: disturbance sweeps with the control structure active, by continuation.
+//! - [`sensors`]: tray-temperature sensor selection (SVD and slope criteria).
+//! - [`report`]: the gain report shared by flowsheets and transfer-function models.
+//! - [`export`]: the state-space model as JSON for MATLAB and python-control.
+//! - [`plot`]: sensitivity plots (plotters; the caller chooses the backend and the file).
+//!
+//! **Architecture Invariant:** nothing here reads or writes files or the terminal; the CLI does.
+
+#![warn(missing_docs)]
+
+pub mod error;
+pub mod export;
+pub mod linear;
+pub mod measures;
+pub mod min_cond;
+pub mod perturb;
+pub mod plot;
+pub mod report;
+pub mod select;
+pub mod sensitivity;
+pub mod sensors;
+pub mod tf;
+
+pub use error::AnalysisError;
+/// The linear algebra the API speaks (`Mat`, `c64`).
+pub use faer;

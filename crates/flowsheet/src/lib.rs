@@ -11,7 +11,9 @@ pub mod guess;
 pub mod overrides;
 pub mod parse;
 pub mod plant;
+pub mod scenario;
 pub mod spec;
+pub mod tears;
 
 pub use assemble::{assemble, load_file, load_str};
 pub use error::{Diagnostic, LoadError};

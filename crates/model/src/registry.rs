@@ -71,6 +71,8 @@ registry!(
     /// A controller's description in a flowsheet file.
     ControllerSpec, &ControllerLinks, ControllerConfig, [
     "pid" => Pid(controllers::pid::PidConfig, controllers::pid::Pid),
+    "lag" => Lag(controllers::lag::LagConfig, controllers::lag::Lag),
+    "delay" => Delay(controllers::delay::DelayConfig, controllers::delay::Delay),
     "ratio" => Ratio(controllers::ratio::RatioConfig, controllers::ratio::Ratio),
     "summer" => Summer(controllers::summer::SummerConfig, controllers::summer::Summer),
     "split_range" => SplitRange(controllers::split_range::SplitRangeConfig, controllers::split_range::SplitRange),

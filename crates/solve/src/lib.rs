@@ -6,13 +6,15 @@
 //! nominal magnitudes, mass-matrix pattern), never a unit, a stream or a file.
 
 pub mod dae;
+pub mod dynamic;
 pub mod newton;
+pub mod sequential;
 pub mod sparse;
 pub mod steady;
 pub mod structure;
 pub mod system;
 
-pub use newton::{solve_steady, solve_steady_observed, IterationRecord, NewtonReport, NewtonSettings, NewtonStatus};
+pub use newton::{pseudo_transient_steps, solve_steady, solve_steady_observed, IterationRecord, NewtonReport, NewtonSettings, NewtonStatus};
 pub use structure::{maximum_matching, Matching};
 pub use steady::{dof_check, DofProbe, steady_state, steady_state_observed, ConvergenceFailure, DofError, PlantSystem, SteadyError, SteadyState};
 pub use system::System;

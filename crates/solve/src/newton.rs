@@ -204,6 +204,28 @@ pub fn solve_steady_observed<S: System>(
     }
 }
 
+/// Take `steps` pseudo-transient steps `(M/δ − J) Δx = f` of fixed pseudo time step `dt` [s] from
+/// `x`, projected onto the bounds: the algebraic equations are (nearly) satisfied afterwards and the
+/// differential variables have moved a little along the plant's own dynamics.
+pub fn pseudo_transient_steps<S: System>(sys: &S, x: &mut [f64], steps: usize, dt: f64) {
+    let n = sys.n();
+    let mut wk = Work { sys, n, lu: SparseLu::default(), jac: Vec::new(), r: vec![0.0; n], w: vec![1.0; n], n_res: 0, n_jac: 0 };
+    let mass = sys.mass();
+    for _ in 0..steps {
+        wk.linearize(x);
+        let mut a = wk.jac.clone();
+        a.extend(mass.iter().map(|&(i, j)| (i, j, -1.0 / dt)));
+        let mut dx: Vec<f64> = wk.r.iter().map(|v| -v).collect();
+        if wk.lu.solve(n, &a, &mut dx).is_err() {
+            return;
+        }
+        for i in 0..n {
+            let (lo, hi) = sys.bounds(i);
+            x[i] = (x[i] + dx[i]).clamp(lo, hi);
+        }
+    }
+}
+
 /// The iteration history, shown to an observer as it grows.
 struct Observed<'a> {
     records: Vec<IterationRecord>,

@@ -119,11 +119,14 @@ pub fn dof_check(plant: &Plant, u: &[f64], x: &[f64], probe: DofProbe) -> Result
         });
     }
     if probe == DofProbe::Numerical && n_vars <= DENSE_PROBE_LIMIT && n_vars > 0 {
-        // A plant that is ill-posed is singular everywhere; a guess can be singular by accident
-        // (a loop with no gain at a linear profile). Only a null direction found at the guess and
-        // again at a perturbed point is reported.
+        // A plant that is ill-posed is singular at every consistent point; a guess can be singular
+        // by accident (a component absent from a loop's measurement at a linear profile). Only a
+        // null direction found at the guess and again after a few pseudo-transient steps (which
+        // satisfy the algebraic equations and move the inventories along the plant's dynamics) is
+        // reported.
         let Some(_) = null_direction(plant, u, x) else { return Ok(()) };
-        let xp = perturbed(plant, x);
+        let mut xp = x.to_vec();
+        crate::pseudo_transient_steps(&PlantSystem::new(plant, u), &mut xp, 3, 10.0);
         if let Some(idx) = null_direction(plant, u, &xp) {
             return Err(DofError::Underdetermined {
                 file,
@@ -165,20 +168,6 @@ fn null_direction(plant: &Plant, u: &[f64], x: &[f64]) -> Option<Vec<usize>> {
     let mut idx: Vec<usize> = (0..n).filter(|&j| null[j] > 0.05 * top).collect();
     idx.sort_by(|&a, &b| null[b].total_cmp(&null[a]));
     Some(idx)
-}
-
-/// `x` moved by up to 1 % of each variable's magnitude (deterministic), inside the bounds.
-fn perturbed(plant: &Plant, x: &[f64]) -> Vec<f64> {
-    let mut state: u64 = 0x9E37_79B9_7F4A_7C15;
-    x.iter()
-        .zip(&plant.vars)
-        .map(|(&v, info)| {
-            state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
-            let xi = ((state >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0;
-            let step = 0.01 * xi * v.abs().max(1e-3 * info.spec.nominal);
-            (v + step).clamp(info.spec.lower, info.spec.upper)
-        })
-        .collect()
 }
 
 fn explain_loose(plant: &Plant, vars: &[usize], why: &str) -> String {

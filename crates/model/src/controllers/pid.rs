@@ -10,6 +10,10 @@
 //!   `τ_f = τ_D/N`; the derivative term is `D = τ_D (e − xf)/τ_f`.
 //! - `op` (algebraic): `op = clamp(u, op_min, op_max)` in auto, `op = op_man` in manual.
 //!
+//! Inputs: `sp` (local setpoint only), `op_manual`, and `auto` [-] (1 = auto, 0 = manual; its
+//! flowsheet value comes from `mode`): the mode is an input so that a dynamic scenario can switch
+//! it while the plant runs.
+//!
 //! At steady state with integral action `e = 0` (the measurement sits on its setpoint); a P-only
 //! controller leaves the offset `e = (op − bias)/Kc`.
 
@@ -142,6 +146,11 @@ impl Pid {
         usize::from(self.tau_i.is_some()) + usize::from(self.tau_d.is_some())
     }
 
+    /// The mode from the input `auto` (≥ 0.5: auto, else manual), so that a scenario can switch it.
+    fn is_auto<S: Scalar>(&self, io: &UnitIo<'_, S>) -> bool {
+        io.input(usize::from(self.remote_sp.is_none()) + 1).re() >= 0.5
+    }
+
     fn error<S: Scalar>(&self, io: &UnitIo<'_, S>) -> S {
         let pv = io.signal(0);
         let sp = if self.remote_sp.is_some() { io.signal(1) } else { io.input(0) };
@@ -190,6 +199,8 @@ impl UnitModel for Pid {
             v.push(InputSpec { name: "sp".into(), dim: self.links.pv_dim, value: self.sp });
         }
         v.push(InputSpec { name: "op_manual".into(), dim: self.links.op_dim, value: self.op_manual });
+        let auto = f64::from(u8::from(self.mode == Mode::Auto));
+        v.push(InputSpec { name: "auto".into(), dim: Dimension::DIMENSIONLESS, value: auto });
         v
     }
     fn signals(&self) -> Vec<SignalSpec> {
@@ -204,6 +215,7 @@ impl UnitModel for Pid {
         let n_diff = self.n_diff();
         let op = io.var(n_diff);
         let op_manual = io.input(usize::from(self.remote_sp.is_none()));
+        let auto = self.is_auto(io);
         let mut k = 0;
         let integral = self.tau_i.map(|ti| {
             let i = io.var(k);
@@ -225,19 +237,13 @@ impl UnitModel for Pid {
         let u = u * self.kc + self.bias;
         let mut k = 0;
         if let Some((i, ti)) = integral {
-            r[k] = match self.mode {
-                Mode::Auto => e + (op - u) / self.kc,
-                Mode::Manual => (op_manual - self.bias) / self.kc - e - i / ti,
-            };
+            r[k] = if auto { e + (op - u) / self.kc } else { (op_manual - self.bias) / self.kc - e - i / ti };
             k += 1;
         }
         if let Some((xf, tf, _)) = derivative {
             r[k] = (e - xf) / tf;
         }
-        r[n_diff] = match self.mode {
-            Mode::Auto => op - clamp(u, self.op_min, self.op_max),
-            Mode::Manual => op - op_manual,
-        };
+        r[n_diff] = if auto { op - clamp(u, self.op_min, self.op_max) } else { op - op_manual };
     }
     fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]) {
         let e = self.error(io);
@@ -250,10 +256,8 @@ impl UnitModel for Pid {
             own[k] = e;
         }
         let n_diff = self.n_diff();
-        own[n_diff] = match self.mode {
-            Mode::Auto => clamp(self.bias + self.kc * e, self.op_min, self.op_max),
-            Mode::Manual => self.op_manual,
-        };
+        own[n_diff] =
+            if self.is_auto(io) { clamp(self.bias + self.kc * e, self.op_min, self.op_max) } else { self.op_manual };
     }
 }
 
@@ -320,13 +324,13 @@ mod tests {
         let u = build(json!({"tau_i": "100 s"}));
         assert_eq!(
             names(&u),
-            (vec!["I".into(), "op".into()], vec!["sp".into(), "op_manual".into()], vec!["pv".into()])
+            (vec!["I".into(), "op".into()], vec!["sp".into(), "op_manual".into(), "auto".into()], vec!["pv".into()])
         );
         let (sp, bias, kc, ti) = (1.2, 5.0, 10.0, 100.0);
-        // local = [I, op | sp, op_manual | pv]; op = u (inside the limits).
+        // local = [I, op | sp, op_manual, auto | pv]; op = u (inside the limits).
         let at = |i: f64, pv: f64| {
             let op = bias + kc * (sp - pv + i / ti);
-            residual(&u, &[i, op, sp, bias, pv])
+            residual(&u, &[i, op, sp, bias, 1.0, pv])
         };
         // On setpoint: a steady state for any integral (the integral carries the output's offset).
         for i in [-30.0, 0.0, 42.0] {
@@ -338,28 +342,34 @@ mod tests {
         assert!((r[0] - 0.2).abs() < 1e-12 && r[1].abs() < 1e-12, "{r:?}");
         let direct = build(json!({"tau_i": "100 s", "action": "direct"}));
         let op = bias + kc * (1.0 - sp);
-        let r = residual(&direct, &[0.0, op, sp, bias, 1.0]);
+        let r = residual(&direct, &[0.0, op, sp, bias, 1.0, 1.0]);
         assert!((r[0] + 0.2).abs() < 1e-12 && r[1].abs() < 1e-12, "{r:?}");
     }
 
     #[test]
     fn p_only_leaves_the_offset_op_minus_bias_over_kc() {
         let u = build(json!({}));
-        assert_eq!(names(&u), (vec!["op".into()], vec!["sp".into(), "op_manual".into()], vec!["pv".into()]));
+        assert_eq!(
+            names(&u),
+            (vec!["op".into()], vec!["sp".into(), "op_manual".into(), "auto".into()], vec!["pv".into()])
+        );
         let (sp, bias, kc) = (1.2, 5.0, 10.0);
         // The process needs op = 7 mol/s: the loop settles with e = (op − bias)/Kc = 0.2 m.
         let op = 7.0;
         let e = (op - bias) / kc;
-        let r = residual(&u, &[op, sp, bias, sp - e]);
+        let r = residual(&u, &[op, sp, bias, 1.0, sp - e]);
         assert!(r[0].abs() < 1e-12, "{r:?}");
         // Any other level leaves a residual Kc·Δe.
-        let r = residual(&u, &[op, sp, bias, sp]);
+        let r = residual(&u, &[op, sp, bias, 1.0, sp]);
         assert!((r[0] - 2.0).abs() < 1e-12, "{r:?}");
         // The guess puts op on the P law.
         let thermo = binary_package();
         let layout = layout(&u);
         let mut own = [0.0];
-        u.guess(&UnitIo { local: &[0.0, sp, bias, sp - e], layout: &layout, thermo: &thermo, time: 0.0 }, &mut own);
+        u.guess(
+            &UnitIo { local: &[0.0, sp, bias, 1.0, sp - e], layout: &layout, thermo: &thermo, time: 0.0 },
+            &mut own,
+        );
         assert!((own[0] - op).abs() < 1e-12);
     }
 
@@ -373,14 +383,14 @@ mod tests {
             let pv = sp - e;
             let unclamped = bias + kc * (e + i_sat / ti);
             assert!(unclamped > op_max);
-            let r = residual(&u, &[i_sat, op_max, sp, bias, pv]);
+            let r = residual(&u, &[i_sat, op_max, sp, bias, 1.0, pv]);
             assert!(r[0].abs() < 1e-12 && r[1].abs() < 1e-12, "e = {e}: {r:?}");
             // Away from that integral, it relaxes towards it: dI/dt = (op_max − bias)/Kc − I/τ_I.
-            let r = residual(&u, &[i_sat + 5.0, op_max, sp, bias, pv]);
+            let r = residual(&u, &[i_sat + 5.0, op_max, sp, bias, 1.0, pv]);
             assert!((r[0] + 5.0 / ti).abs() < 1e-12, "{r:?}");
         }
         // Inside the limits the back-calculation term vanishes: dI/dt = e.
-        let r = residual(&u, &[0.0, bias + kc * 0.05, sp, bias, sp - 0.05]);
+        let r = residual(&u, &[0.0, bias + kc * 0.05, sp, bias, 1.0, sp - 0.05]);
         assert!((r[0] - 0.05).abs() < 1e-12 && r[1].abs() < 1e-12, "{r:?}");
     }
 
@@ -389,40 +399,54 @@ mod tests {
         let u = build(json!({"tau_i": "100 s", "mode": "manual", "op_manual": "4 mol/s"}));
         let (sp, bias, kc, ti) = (1.2, 5.0, 10.0, 100.0);
         assert_eq!(u.inputs()[1].value, 4.0);
+        assert_eq!(u.inputs()[2].value, 0.0, "manual in the file: input `auto` = 0");
         // At the tracking steady state the unclamped auto output equals op_manual (bumpless).
         let pv = 1.0;
         let i = ti * ((4.0 - bias) / kc - (sp - pv));
-        let r = residual(&u, &[i, 4.0, sp, 4.0, pv]);
+        let r = residual(&u, &[i, 4.0, sp, 4.0, 0.0, pv]);
         assert!(r[0].abs() < 1e-12 && r[1].abs() < 1e-14, "{r:?}");
         assert!((bias + kc * (sp - pv + i / ti) - 4.0).abs() < 1e-12);
     }
 
     #[test]
+    fn the_auto_input_switches_the_mode_at_run_time() {
+        let u = build(json!({"tau_i": "100 s"}));
+        let (sp, bias, kc, ti, pv, i) = (1.2, 5.0, 10.0, 100.0, 1.0, 3.0);
+        // [I, op | sp, op_manual, auto | pv]: in manual op = op_manual and the integral tracks it.
+        let manual = residual(&u, &[i, 4.0, sp, 4.0, 0.0, pv]);
+        assert!(manual[1].abs() < 1e-14, "{manual:?}");
+        assert!((manual[0] - ((4.0 - bias) / kc - (sp - pv) - i / ti)).abs() < 1e-14, "{manual:?}");
+        // The same point in auto: op must follow the PI law.
+        let auto = residual(&u, &[i, 4.0, sp, 4.0, 1.0, pv]);
+        assert!((auto[1] - (4.0 - (bias + kc * (sp - pv + i / ti)))).abs() < 1e-12, "{auto:?}");
+    }
+
+    #[test]
     fn jacobians_match_finite_differences() {
-        // P: [op | sp, op_manual | pv]
+        // P: [op | sp, op_manual, auto | pv]
         let p = build(json!({}));
-        assert!(jac_err(&p, &[6.0, 1.2, 5.0, 1.1]) < 1e-7);
-        // PI: [I, op | sp, op_manual | pv]
+        assert!(jac_err(&p, &[6.0, 1.2, 5.0, 1.0, 1.1]) < 1e-7);
+        // PI: [I, op | sp, op_manual, auto | pv]
         let pi = build(json!({"tau_i": "5 min"}));
-        assert!(jac_err(&pi, &[3.0, 6.0, 1.2, 5.0, 1.1]) < 1e-7);
+        assert!(jac_err(&pi, &[3.0, 6.0, 1.2, 5.0, 1.0, 1.1]) < 1e-7);
         // PI saturated at op_max.
         let sat = build(json!({"tau_i": "100 s", "op_max": 6.0}));
-        assert!(jac_err(&sat, &[10.0, 6.0, 1.2, 5.0, 0.7]) < 1e-7);
-        // PID: [I, xf, op | sp, op_manual | pv]
+        assert!(jac_err(&sat, &[10.0, 6.0, 1.2, 5.0, 1.0, 0.7]) < 1e-7);
+        // PID: [I, xf, op | sp, op_manual, auto | pv]
         let pid = build(json!({"tau_i": "100 s", "tau_d": "20 s", "filter_ratio": 8.0, "action": "direct"}));
         assert_eq!(names(&pid).0, ["I", "xf", "op"]);
-        assert!(jac_err(&pid, &[3.0, 0.05, 6.0, 1.2, 5.0, 1.1]) < 1e-7);
+        assert!(jac_err(&pid, &[3.0, 0.05, 6.0, 1.2, 5.0, 1.0, 1.1]) < 1e-7);
         // Manual PI.
         let manual = build(json!({"tau_i": "100 s", "mode": "manual"}));
-        assert!(jac_err(&manual, &[3.0, 6.0, 1.2, 5.5, 1.1]) < 1e-7);
-        // Remote setpoint: [I, op | op_manual | pv, sp]
+        assert!(jac_err(&manual, &[3.0, 6.0, 1.2, 5.5, 0.0, 1.1]) < 1e-7);
+        // Remote setpoint: [I, op | op_manual, auto | pv, sp]
         let remote = build(json!({"tau_i": "100 s", "sp": {"from": "master.op"}}));
         assert_eq!(
             names(&remote),
-            (vec!["I".into(), "op".into()], vec!["op_manual".into()], vec!["pv".into(), "sp".into()])
+            (vec!["I".into(), "op".into()], vec!["op_manual".into(), "auto".into()], vec!["pv".into(), "sp".into()])
         );
-        assert!(jac_err(&remote, &[3.0, 6.0, 5.0, 1.1, 1.3]) < 1e-7);
-        let r = residual(&remote, &[0.0, 5.0 + 10.0 * 0.2, 5.0, 1.1, 1.3]);
+        assert!(jac_err(&remote, &[3.0, 6.0, 5.0, 1.0, 1.1, 1.3]) < 1e-7);
+        let r = residual(&remote, &[0.0, 5.0 + 10.0 * 0.2, 5.0, 1.0, 1.1, 1.3]);
         assert!((r[0] - 0.2).abs() < 1e-12 && r[1].abs() < 1e-12, "remote sp is signal 1: {r:?}");
     }
 

@@ -39,7 +39,7 @@ use serde::{Deserialize, Serialize};
 use super::Phase;
 use super::outflow::{ATM, Holdup, LiquidState, Outflow, OutflowLaw, normalized};
 use crate::stream::{H, T, Z0};
-use crate::{BuildCx, FieldError, InputSpec, Scalar, UnitIo, UnitModel, VarSpec};
+use crate::{BuildCx, FieldError, InputSpec, Scalar, Stream, UnitIo, UnitModel, VarSpec};
 
 /// One reaction.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
@@ -219,6 +219,37 @@ impl Cstr {
     fn i_m(&self, nc: usize) -> usize {
         nc + 1 + usize::from(self.jacket.is_some())
     }
+    /// Outlet composition for a guess: the component balances `F_in z_i − F x_i + V Σ_k ν_ik r_k = 0`
+    /// for outflow `f` [mol/s] at temperature `t` [K] and `mlv = [M, level, V]` ([mol], [m], [m³]),
+    /// by the positive iteration `x_i ← (F_in z_i + V·made_i) / (F + V·used_i/x_i)` (production
+    /// explicit, consumption implicit; exact in one step for a first-order reactant), normalised.
+    /// Starts from the inlet composition.
+    fn reacted_composition(&self, inlet: Stream<'_, f64>, f: f64, t: f64, mlv: [f64; 3]) -> Vec<f64> {
+        let (f_in, z_in, m, vol) = (inlet.f(), inlet.z(), mlv[0], mlv[2]);
+        let mut x = normalized(z_in);
+        if self.reactions.is_empty() || !(f > 0.0 && m > 0.0 && vol > 0.0) {
+            return x;
+        }
+        for _ in 0..30 {
+            let c: Vec<f64> = x.iter().map(|xi| xi * m / vol).collect();
+            let rates: Vec<f64> = self.reactions.iter().map(|rx| Self::rate(rx, t, &c)).collect();
+            let next: Vec<f64> = (0..x.len())
+                .map(|i| {
+                    let (mut made, mut used) = (0.0, 0.0);
+                    for (rx, rk) in self.reactions.iter().zip(&rates) {
+                        if rx.nu[i] > 0.0 { made += rx.nu[i] * rk } else { used -= rx.nu[i] * rk }
+                    }
+                    let sink = if x[i] > 0.0 { vol * used / x[i] } else { 0.0 };
+                    (f_in * z_in[i] + vol * made) / (f + sink)
+                })
+                .collect();
+            if next.iter().any(|v| !v.is_finite()) {
+                break;
+            }
+            x = normalized(&next);
+        }
+        x
+    }
     /// Rate [mol/(m³·s)] of `r` at `t` [K] and concentrations `c` [mol/m³].
     fn rate<S: Scalar>(r: &Reaction, t: S, c: &[S]) -> S {
         let mut v = (t.recip() * (-r.ea / R_GAS)).exp() * r.k0;
@@ -330,10 +361,11 @@ impl UnitModel for Cstr {
                 (Phase::Liquid.temperature(io.thermo, h, inlet.p(), &x, inlet.t()), 0.0, io.input(1))
             }
         };
-        let h = io.thermo.h_liq(t, &x);
         let mut liq = LiquidState { p: io.input(0), level: 0.0, mw: io.thermo.mw(&x), v: io.thermo.v_liq(t, &x) };
         let mlv = self.holdup.guess(&self.law, f, op, &liq);
         liq.level = mlv[1];
+        let x = self.reacted_composition(inlet, f, t, mlv);
+        let h = io.thermo.h_liq(t, &x);
         own[..Z0].copy_from_slice(&[f, t, self.law.outlet_pressure(&liq), h]);
         own[Z0..len].copy_from_slice(&x);
         (0..nc).for_each(|i| own[len + i] = mlv[0] * x[i]);

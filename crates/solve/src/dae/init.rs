@@ -3,7 +3,7 @@
 //! steady-state Newton solver (line search, bounds) on that subsystem.
 
 use super::{DaeError, DaeSystem};
-use crate::{solve_steady, NewtonSettings, NewtonStatus, System};
+use crate::{NewtonSettings, NewtonStatus, System, solve_steady};
 
 /// The algebraic subsystem of a DAE at fixed time and differential variables.
 struct Algebraic<'a> {
@@ -64,8 +64,8 @@ impl System for Algebraic<'_> {
 }
 
 /// Solve the algebraic variables of `x` (in place) for consistency with its differential variables
-/// at time `t`. Returns the number of Newton iterations.
-pub fn consistent_algebraic(sys: &dyn DaeSystem, t: f64, x: &mut [f64]) -> Result<usize, DaeError> {
+/// at time `t`. Returns the numbers of residual and Jacobian evaluations it took.
+pub fn consistent_algebraic(sys: &dyn DaeSystem, t: f64, x: &mut [f64]) -> Result<(usize, usize), DaeError> {
     let n = sys.n();
     let (mut diff_row, mut diff_col) = (vec![false; n], vec![false; n]);
     for &(i, j) in sys.mass() {
@@ -80,7 +80,7 @@ pub fn consistent_algebraic(sys: &dyn DaeSystem, t: f64, x: &mut [f64]) -> Resul
     cols.iter().enumerate().for_each(|(k, &j)| col_map[j] = k);
     let alg = Algebraic { sys, t, base: x.to_vec(), rows, cols, row_map, col_map };
     if alg.cols.is_empty() {
-        return Ok(0);
+        return Ok((0, 0));
     }
     let mut xa: Vec<f64> = alg.cols.iter().map(|&j| x[j]).collect();
     let settings = NewtonSettings { pseudo_transient: false, ..NewtonSettings::default() };
@@ -92,5 +92,5 @@ pub fn consistent_algebraic(sys: &dyn DaeSystem, t: f64, x: &mut [f64]) -> Resul
     for (k, &j) in alg.cols.iter().enumerate() {
         x[j] = xa[k];
     }
-    Ok(report.iterations)
+    Ok((report.n_residual_evals, report.n_jacobian_evals))
 }

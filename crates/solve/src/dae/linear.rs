@@ -7,19 +7,26 @@ use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
 use faer::sparse::{SparseColMat, Triplet};
 
+/// A pattern (as triplet positions) and its symbolic LU.
+type Symbolic = (Vec<(usize, usize)>, SymbolicLu<usize>);
+
 /// A factorized sparse matrix and the symbolic analysis of its pattern.
 #[derive(Debug, Default)]
 pub(crate) struct IterationMatrix {
-    symbolic: Option<(Vec<(usize, usize)>, SymbolicLu<usize>)>,
+    symbolic: Option<Symbolic>,
     lu: Option<Lu<usize, f64>>,
 }
 
 impl IterationMatrix {
-    /// Factorize the `n × n` matrix given by `triplets` (duplicates are summed).
+    /// Factorize the `n × n` matrix given by `triplets` (duplicates are summed). Entries whose
+    /// value is exactly zero are left out: the units declare generous structural patterns (column
+    /// A: 15 708 structural entries, 1 675 nonzero values), and the LU of the values' own pattern
+    /// is about 20 times cheaper; the symbolic analysis is redone only if that pattern changes.
     pub(crate) fn factor(&mut self, n: usize, triplets: &[(usize, usize, f64)]) -> Result<(), String> {
-        let trip: Vec<Triplet<usize, usize, f64>> = triplets.iter().map(|&(i, j, v)| Triplet::new(i, j, v)).collect();
+        let trip: Vec<Triplet<usize, usize, f64>> =
+            triplets.iter().filter(|t| t.2 != 0.0).map(|&(i, j, v)| Triplet::new(i, j, v)).collect();
         let a = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &trip).map_err(|e| format!("{e:?}"))?;
-        let pattern: Vec<(usize, usize)> = triplets.iter().map(|&(i, j, _)| (i, j)).collect();
+        let pattern: Vec<(usize, usize)> = trip.iter().map(|t| (t.row, t.col)).collect();
         let symbolic = match self.symbolic.take() {
             Some((p, s)) if p == pattern => s,
             _ => SymbolicLu::try_new(a.symbolic()).map_err(|e| format!("{e:?}"))?,

@@ -18,7 +18,7 @@ pub use bdf::{Bdf, BdfSettings, BdfState, BdfStats};
 pub use init::consistent_algebraic;
 
 /// A time-aware semi-explicit DAE `M dx/dt = f(t, x)` with a 0/1 mass matrix.
-pub trait DaeSystem {
+pub trait DaeSystem: Sync {
     /// Number of variables (= number of equations).
     fn n(&self) -> usize;
     /// `f(t, x)` into `r`.
@@ -35,6 +35,11 @@ pub trait DaeSystem {
     /// Whether variable `i` takes part in the local error test (default: the differential ones).
     /// Quadratures (running integrals recorded for output) are differential but need not.
     fn error_controlled(&self, i: usize) -> bool;
+    /// Whether variable `i` is a quadrature (a running integral that nothing else reads): such
+    /// variables are left out of the Newton convergence test as well (default: none).
+    fn quadrature(&self, _i: usize) -> bool {
+        false
+    }
 }
 
 /// Why an integration stopped.

@@ -1,0 +1,245 @@
+//! Sensitivity sweeps (Luyben 1975; *Practical Distillation Control* fig. 6-6): one disturbance at
+//! a time moved over a range with the flowsheet's control structure active, the plant
+//! re-converged at each point, chosen outputs recorded.
+//!
+//! Each sweep walks outward from the base case in both directions, every point started from its
+//! converged neighbour (natural-parameter continuation); a point that does not converge is
+//! approached in halved steps (down to 1/64 of the spacing) before the walk on that side stops and
+//! the failure is recorded. The `2 × disturbances` walks are independent and run in parallel.
+//!
+//! Ranges are written `PATH[@unit]=LOW:HIGH`, each end a percentage of the base value (`-10%`,
+//! `+10%`) or a quantity (`0.9 kmol/min`).
+
+use plantwide_flowsheet::Plant;
+use plantwide_solve::{NewtonSettings, NewtonStatus, PlantSystem, solve_steady};
+use plantwide_units::parse_quantity_as;
+use rayon::prelude::*;
+
+use crate::error::{AnalysisError, request};
+use crate::select::{Signal, select_input};
+
+/// A disturbance and its range (SI).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Disturbance {
+    /// The input moved (display unit for absolute values).
+    pub signal: Signal,
+    /// Base value (SI).
+    pub base: f64,
+    /// Low end of the range (SI).
+    pub low: f64,
+    /// High end of the range (SI).
+    pub high: f64,
+}
+
+impl Disturbance {
+    /// Parse `PATH[@unit]=LOW:HIGH` for `plant` at inputs `u`.
+    pub fn parse(plant: &Plant, u: &[f64], text: &str) -> Result<Disturbance, AnalysisError> {
+        let (path, range) = text.split_once('=').ok_or_else(|| {
+            request(format!("--disturb `{text}`: expected PATH=LOW:HIGH, e.g. `feed_source.F=-10%:+10%`"))
+        })?;
+        let signal = select_input(plant, path)?;
+        let base = u[signal.index];
+        let (lo, hi) = range
+            .split_once(':')
+            .ok_or_else(|| request(format!("--disturb `{text}`: the range needs LOW:HIGH, e.g. `-10%:+10%`")))?;
+        let dim = plant.inputs[signal.index].dim;
+        let end = |s: &str| -> Result<f64, AnalysisError> {
+            let s = s.trim();
+            if let Some(p) = s.strip_suffix('%') {
+                let pct: f64 =
+                    p.trim().parse().map_err(|_| request(format!("--disturb `{text}`: `{s}` is not a percentage")))?;
+                if base == 0.0 {
+                    return Err(request(format!(
+                        "--disturb `{text}`: `{}` is zero at the base case, so give the range as quantities, not percentages",
+                        signal.path
+                    )));
+                }
+                Ok(base + pct / 100.0 * base.abs())
+            } else {
+                parse_quantity_as(s, dim).map_err(|e| request(format!("--disturb `{text}`: {e}")))
+            }
+        };
+        let (low, high) = (end(lo)?, end(hi)?);
+        if !(low.is_finite() && high.is_finite() && low < high) {
+            return Err(request(format!("--disturb `{text}`: the range must go from low to high")));
+        }
+        Ok(Disturbance { signal, base, low, high })
+    }
+
+    /// Change from the base in percent (the value itself when the base is zero).
+    pub fn percent(&self, value: f64) -> f64 {
+        if self.base == 0.0 { value } else { (value - self.base) / self.base.abs() * 100.0 }
+    }
+}
+
+/// Settings of a sweep.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SweepSettings {
+    /// Points over the range, ends included (default 21); the base case is added.
+    pub points: usize,
+    /// Newton settings at each point.
+    pub newton: NewtonSettings,
+}
+
+impl Default for SweepSettings {
+    fn default() -> Self {
+        SweepSettings { points: 21, newton: NewtonSettings::default() }
+    }
+}
+
+/// One swept disturbance: its values and the outputs at each (`None` where not converged).
+#[derive(Debug, Clone)]
+pub struct Curve {
+    /// The disturbance.
+    pub disturbance: Disturbance,
+    /// Disturbance values (SI), increasing, base included.
+    pub values: Vec<f64>,
+    /// Outputs (SI) at each value.
+    pub outputs: Vec<Option<Vec<f64>>>,
+    /// Why the walk stopped early on a side, if it did.
+    pub failures: Vec<String>,
+}
+
+/// Outputs at each target of one walk (`None` past a failure) and why it stopped, if it did.
+type Walk = (Vec<Option<Vec<f64>>>, Option<String>);
+
+/// Walk from `(x0, base)` through `targets` (ordered away from the base), each from its neighbour.
+fn walk(
+    plant: &Plant,
+    u0: &[f64],
+    x0: &[f64],
+    d: &Disturbance,
+    targets: &[f64],
+    outputs: &[usize],
+    settings: &NewtonSettings,
+) -> Walk {
+    let mut x = x0.to_vec();
+    let mut at = d.base;
+    let mut res = Vec::with_capacity(targets.len());
+    let solve = |x: &mut Vec<f64>, value: f64| -> Result<(), String> {
+        let mut u = u0.to_vec();
+        u[d.signal.index] = value;
+        let mut trial = x.clone();
+        let report = solve_steady(&PlantSystem::new(plant, &u), &mut trial, settings);
+        if report.status == NewtonStatus::Converged {
+            *x = trial;
+            Ok(())
+        } else {
+            let (eq, r) = report.worst.unwrap_or((0, f64::NAN));
+            Err(format!("{:?} (worst: {}, scaled residual {r:.2e})", report.status, plant.equation_name(eq)))
+        }
+    };
+    for (k, &target) in targets.iter().enumerate() {
+        // Try the full step, then halve it until a sub-step converges; repeat until at the target.
+        let mut step = target - at;
+        let mut halvings = 0;
+        while at != target {
+            let next = if (target - at).abs() <= step.abs() { target } else { at + step };
+            match solve(&mut x, next) {
+                Ok(()) => at = next,
+                Err(e) if halvings >= 6 => {
+                    res.extend(std::iter::repeat_n(None, targets.len() - k));
+                    let why = format!("`{}` = {:.6e} (SI): not converged from {:.6e}: {e}", d.signal.path, next, at);
+                    return (res, Some(why));
+                }
+                Err(_) => {
+                    step /= 2.0;
+                    halvings += 1;
+                }
+            }
+        }
+        res.push(Some(outputs.iter().map(|&i| x[i]).collect()));
+    }
+    (res, None)
+}
+
+/// Sweep each disturbance over its range at `points` values (plus the base case) with the other
+/// inputs at `u0`, from the converged base state `x0`; outputs are variable indices.
+pub fn sweep(
+    plant: &Plant,
+    x0: &[f64],
+    u0: &[f64],
+    disturbances: &[Disturbance],
+    outputs: &[usize],
+    settings: &SweepSettings,
+) -> Result<Vec<Curve>, AnalysisError> {
+    if settings.points < 2 {
+        return Err(request(format!("--points must be at least 2 (got {})", settings.points)));
+    }
+    let n = settings.points;
+    let grids: Vec<Vec<f64>> = disturbances
+        .iter()
+        .map(|d| {
+            let mut g: Vec<f64> = (0..n).map(|k| d.low + (d.high - d.low) * k as f64 / (n - 1) as f64).collect();
+            if !g.iter().any(|v| (v - d.base).abs() <= 1e-12 * d.base.abs()) {
+                g.push(d.base);
+            }
+            g.sort_by(f64::total_cmp);
+            g
+        })
+        .collect();
+    let base_out: Vec<f64> = outputs.iter().map(|&i| x0[i]).collect();
+    // Tasks: (disturbance, side), side 0 walks up from the base, side 1 walks down.
+    let tasks: Vec<(usize, usize)> = (0..disturbances.len()).flat_map(|k| [(k, 0), (k, 1)]).collect();
+    let walks: Vec<Walk> = tasks
+        .par_iter()
+        .map(|&(k, side)| {
+            let d = &disturbances[k];
+            let targets: Vec<f64> = if side == 0 {
+                grids[k].iter().copied().filter(|v| *v > d.base).collect()
+            } else {
+                grids[k].iter().rev().copied().filter(|v| *v < d.base).collect()
+            };
+            walk(plant, u0, x0, d, &targets, outputs, &settings.newton)
+        })
+        .collect();
+    let mut curves = Vec::new();
+    for (k, d) in disturbances.iter().enumerate() {
+        let (up, up_fail) = &walks[2 * k];
+        let (down, down_fail) = &walks[2 * k + 1];
+        let mut out: Vec<Option<Vec<f64>>> = down.iter().rev().cloned().collect();
+        out.extend(grids[k].iter().filter(|v| **v == d.base).map(|_| Some(base_out.clone())));
+        out.extend(up.iter().cloned());
+        curves.push(Curve {
+            disturbance: d.clone(),
+            values: grids[k].clone(),
+            outputs: out,
+            failures: [down_fail, up_fail].into_iter().flatten().cloned().collect(),
+        });
+    }
+    Ok(curves)
+}
+
+/// CSV of the curves: one row per point, columns `disturbance, value, change_percent` and one per
+/// output (display units; empty where not converged).
+pub fn to_csv(curves: &[Curve], outputs: &[Signal]) -> String {
+    let mut s = String::from("disturbance,unit,value,change_percent");
+    for o in outputs {
+        s.push_str(&format!(",{} [{}]", csv_field(&o.path), csv_field(&o.unit)));
+    }
+    s.push('\n');
+    for c in curves {
+        let d = &c.disturbance;
+        for (v, out) in c.values.iter().zip(&c.outputs) {
+            s.push_str(&format!(
+                "{},{},{},{}",
+                csv_field(&d.signal.path),
+                csv_field(&d.signal.unit),
+                d.signal.display_value(*v),
+                d.percent(*v)
+            ));
+            for (k, o) in outputs.iter().enumerate() {
+                match out {
+                    Some(y) => s.push_str(&format!(",{}", o.display_value(y[k]))),
+                    None => s.push(','),
+                }
+            }
+            s.push('\n');
+        }
+    }
+    s
+}
+
+fn csv_field(text: &str) -> String {
+    if text.contains([',', '"', '\n']) { format!("\"{}\"", text.replace('"', "\"\"")) } else { text.to_string() }
+}

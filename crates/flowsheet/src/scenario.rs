@@ -1,0 +1,674 @@
+//! Dynamic scenario files (JSON): how long to run, what happens when (steps, ramps, pulses,
+//! sinusoids on any input, setpoint changes through `<ctrl>.sp`, auto/manual switches, a valve
+//! stuck, a feed lost), the discrete-time behaviour of controllers (DCS scan interval, analyzer
+//! sample and dead time), what to record, and when to write snapshots.
+//!
+//! [`parse_scenario`] reads the file into a [`ScenarioSpec`] (every problem reported with its JSON
+//! path); [`resolve`] checks it against a [`Plant`] (paths, dimensions) and converts every quantity
+//! to SI, giving a [`Scenario`]. Times are from the start of the run, which is the converged
+//! steady state unless a snapshot is resumed.
+//!
+//! ```json
+//! {"format_version": 1, "duration": "2000 min",
+//!  "events": [{"type": "step", "at": "0 min", "path": "feed_source.F", "to": "1.01 kmol/min"}],
+//!  "record": {"interval": "1 min", "paths": ["bottoms.x[light]", {"path": "distillate.F", "unit": "kmol/min"}]}}
+//! ```
+
+use indexmap::IndexMap;
+use plantwide_model::controllers::Mode;
+use plantwide_units::{Dimension, QuantityValue, convert_from_si, unit_dimension};
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Diagnostic, LoadError, did_you_mean};
+use crate::overrides::resolve_input;
+use crate::plant::{BlockKind, Plant, Read};
+
+/// The scenario format version this build reads.
+pub const SCENARIO_FORMAT_VERSION: u32 = 1;
+
+/// A scenario file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ScenarioSpec {
+    /// Format version; must be 1.
+    pub format_version: u32,
+    /// Short name.
+    #[serde(default)]
+    pub name: String,
+    /// What the scenario studies.
+    #[serde(default)]
+    pub description: String,
+    /// Length of the run (e.g. `"2000 min"`).
+    pub duration: QuantityValue,
+    /// Integrator tolerances and step limits (defaults: rtol 1e-6, atol 1e-8 of each variable's
+    /// nominal value, no step limit).
+    #[serde(default)]
+    pub integrator: IntegratorSpec,
+    /// Events, in any order.
+    #[serde(default)]
+    pub events: Vec<EventSpec>,
+    /// DCS scan interval by controller name: the controller's output is held between scans.
+    #[serde(default)]
+    pub sampling: IndexMap<String, QuantityValue>,
+    /// Analyzers by controller name: the controller's measurement is sampled every `sample_time`
+    /// and each result reaches the controller `dead_time` later, held until the next one.
+    #[serde(default)]
+    pub analyzers: IndexMap<String, AnalyzerSpec>,
+    /// What to record (default: every controller's measurement and output, every input an event moves).
+    #[serde(default)]
+    pub record: RecordSpec,
+    /// Snapshot files to write during the run.
+    #[serde(default)]
+    pub snapshots: Vec<SnapshotSpec>,
+}
+
+/// Integrator settings of a scenario.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct IntegratorSpec {
+    /// Relative tolerance (default 1e-6).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rtol: Option<f64>,
+    /// Absolute tolerance as a fraction of each variable's nominal value (default 1e-8).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub atol: Option<f64>,
+    /// Largest step (e.g. `"1 min"`; default none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_step: Option<QuantityValue>,
+    /// First step after each (re)start (default from the initial derivatives).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub first_step: Option<QuantityValue>,
+}
+
+/// One event (`"type"`): every event has `at`, its time from the start of the run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum EventSpec {
+    /// The input jumps `to` a value or `by` a change.
+    Step {
+        /// Time.
+        at: QuantityValue,
+        /// Input path (`feed_source.F`, an alias, `stream.F` of a feed, `lc.sp`).
+        path: String,
+        /// New value.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        to: Option<QuantityValue>,
+        /// Change.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        by: Option<QuantityValue>,
+    },
+    /// The input moves linearly `to` a value or `by` a change over `duration`, then stays.
+    Ramp {
+        /// Time.
+        at: QuantityValue,
+        /// Input path.
+        path: String,
+        /// Final value.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        to: Option<QuantityValue>,
+        /// Change.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        by: Option<QuantityValue>,
+        /// Ramp time.
+        duration: QuantityValue,
+    },
+    /// The input jumps `to` a value or `by` a change for `width`, then returns.
+    Pulse {
+        /// Time.
+        at: QuantityValue,
+        /// Input path.
+        path: String,
+        /// Value during the pulse.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        to: Option<QuantityValue>,
+        /// Change during the pulse.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        by: Option<QuantityValue>,
+        /// Pulse width.
+        width: QuantityValue,
+    },
+    /// The input oscillates `u0 + amplitude·sin(2π(t − at)/period)` around its value `u0` at
+    /// `at`, for `duration` (default: to the end), then returns to `u0`.
+    Sinusoid {
+        /// Time.
+        at: QuantityValue,
+        /// Input path.
+        path: String,
+        /// Amplitude (units of the input).
+        amplitude: QuantityValue,
+        /// Period.
+        period: QuantityValue,
+        /// How long it lasts.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        duration: Option<QuantityValue>,
+    },
+    /// A PID controller goes to manual (output held at `output`, default its current output:
+    /// bumpless) or back to auto (the integral has tracked the manual output with lag τ_I, so the
+    /// return is bumpless once the error has been steady for a few τ_I).
+    Mode {
+        /// Time.
+        at: QuantityValue,
+        /// Controller name.
+        controller: String,
+        /// `auto` or `manual`.
+        mode: Mode,
+        /// Manual output (units of the driven input).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        output: Option<QuantityValue>,
+    },
+    /// The input (a valve opening, a flow a controller drives) freezes at its current value; a
+    /// controller that drove it keeps acting on nothing (and winds up if it integrates).
+    ValveStuck {
+        /// Time.
+        at: QuantityValue,
+        /// Input path.
+        path: String,
+    },
+    /// A feed unit's flow `F` drops to zero.
+    FeedLost {
+        /// Time.
+        at: QuantityValue,
+        /// Feed unit name.
+        unit: String,
+    },
+}
+
+/// An analyzer on a controller's measurement.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct AnalyzerSpec {
+    /// Time between samples (e.g. `"5 min"`).
+    pub sample_time: QuantityValue,
+    /// Delay from sampling to result (default 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dead_time: Option<QuantityValue>,
+}
+
+/// What to record.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct RecordSpec {
+    /// Interval between recorded points (default: duration/1000).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub interval: Option<QuantityValue>,
+    /// Unit of the time column (default `min`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub time_unit: Option<String>,
+    /// Variable or input paths, each a string (SI units) or `{"path": …, "unit": …}`.
+    #[serde(default)]
+    pub paths: Vec<RecordPathSpec>,
+    /// Streams whose cumulative component amounts `∫ F x_c dt` [mol] are integrated with the
+    /// plant (recorded as `<stream>.total[<component>]`).
+    #[serde(default)]
+    pub totals: Vec<String>,
+}
+
+/// A recorded path.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(untagged)]
+pub enum RecordPathSpec {
+    /// In SI units.
+    Path(String),
+    /// In a given unit.
+    WithUnit {
+        /// Variable or input path.
+        path: String,
+        /// Unit (e.g. `"kmol/min"`).
+        unit: String,
+    },
+}
+
+/// A snapshot to write.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct SnapshotSpec {
+    /// Time: the snapshot is taken at the end of the first integration step at or after it.
+    pub at: QuantityValue,
+    /// File to write (relative to the working directory).
+    pub file: String,
+}
+
+/// A change of an input value.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub enum Change {
+    /// To this value (SI).
+    To(f64),
+    /// By this amount (SI).
+    By(f64),
+}
+
+impl Change {
+    /// The new value from the current one.
+    pub fn apply(self, current: f64) -> f64 {
+        match self {
+            Change::To(v) => v,
+            Change::By(d) => current + d,
+        }
+    }
+}
+
+/// What an event does (indices are the plant's input, variable and block indices).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub enum Action {
+    /// Jump.
+    Step { input: usize, change: Change },
+    /// Start a ramp ending at `end` [s].
+    Ramp { input: usize, change: Change, end: f64 },
+    /// End of a ramp: hold its final value.
+    Hold { input: usize },
+    /// Start of a pulse: save the value, then jump.
+    Pulse { input: usize, change: Change },
+    /// Start a sinusoid [SI, s].
+    Sinusoid { input: usize, amplitude: f64, period: f64 },
+    /// End of a pulse or sinusoid: back to the value before it.
+    Restore { input: usize },
+    /// Switch a PID: its `auto` and `op_manual` inputs, its output variable.
+    Mode { auto_input: usize, manual_input: usize, op: usize, auto: bool, output: Option<f64> },
+    /// Freeze an input.
+    Stuck { input: usize },
+}
+
+/// An event at a time.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Event {
+    /// Time [s].
+    pub t: f64,
+    /// What happens.
+    pub action: Action,
+    /// Where it came from (`events[3]`), for messages.
+    pub origin: String,
+}
+
+/// A recorded quantity.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Recorded {
+    /// Path as written.
+    pub path: String,
+    /// What it reads.
+    pub source: Read,
+    /// Unit of the output, and its SI dimension.
+    pub unit: String,
+    /// Dimension.
+    pub dim: Dimension,
+}
+
+/// A scenario checked against a plant, in SI units.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Scenario {
+    /// Name.
+    pub name: String,
+    /// Duration [s].
+    pub duration: f64,
+    /// Relative tolerance.
+    pub rtol: f64,
+    /// Absolute tolerance (fraction of nominal values).
+    pub atol: f64,
+    /// Largest step [s].
+    pub max_step: f64,
+    /// First step [s].
+    pub first_step: Option<f64>,
+    /// Events sorted by time (stable).
+    pub events: Vec<Event>,
+    /// `(controller block, scan interval [s])`.
+    pub sampling: Vec<(usize, f64)>,
+    /// `(controller block, sample time [s], dead time [s])`.
+    pub analyzers: Vec<(usize, f64, f64)>,
+    /// Recording interval [s].
+    pub interval: f64,
+    /// Time unit of the output.
+    pub time_unit: String,
+    /// Recorded quantities.
+    pub record: Vec<Recorded>,
+    /// Streams (indices) whose component totals are integrated.
+    pub totals: Vec<usize>,
+    /// `(time [s], file)`.
+    pub snapshots: Vec<(f64, String)>,
+}
+
+/// Parse scenario text; `file` names it in messages.
+pub fn parse_scenario(text: &str, file: &str) -> Result<ScenarioSpec, LoadError> {
+    let mut de = serde_json::Deserializer::from_str(text);
+    let spec: ScenarioSpec = serde_path_to_error::deserialize(&mut de).map_err(|e| {
+        let path = e.path().to_string();
+        let inner = e.into_inner();
+        if inner.is_syntax() || inner.is_eof() {
+            return LoadError::Syntax {
+                file: file.into(),
+                line: inner.line(),
+                column: inner.column(),
+                reason: inner.to_string(),
+            };
+        }
+        let path = if path == "." { String::new() } else { path };
+        LoadError::Invalid {
+            file: file.into(),
+            diagnostics: vec![Diagnostic::new(path, strip_position(&inner.to_string()))],
+        }
+    })?;
+    if spec.format_version != SCENARIO_FORMAT_VERSION {
+        let msg =
+            format!("this build reads format_version {SCENARIO_FORMAT_VERSION}, the file has {}", spec.format_version);
+        return Err(LoadError::Invalid {
+            file: file.into(),
+            diagnostics: vec![Diagnostic::new("format_version", msg)],
+        });
+    }
+    Ok(spec)
+}
+
+fn strip_position(msg: &str) -> String {
+    msg.rfind(" at line ").map_or(msg, |i| &msg[..i]).to_string()
+}
+
+/// Collects diagnostics while converting quantities.
+struct Cx<'a> {
+    plant: &'a Plant,
+    diags: Vec<Diagnostic>,
+}
+
+impl Cx<'_> {
+    fn quantity(&mut self, path: &str, q: &QuantityValue, dim: Dimension) -> f64 {
+        q.to_si(dim).unwrap_or_else(|e| {
+            self.diags.push(Diagnostic::new(path, e.to_string()));
+            f64::NAN
+        })
+    }
+    fn time(&mut self, path: &str, q: &QuantityValue, positive: bool) -> f64 {
+        let t = self.quantity(path, q, Dimension::TIME);
+        if t.is_finite() && (t < 0.0 || (positive && t == 0.0)) {
+            self.diags.push(Diagnostic::new(
+                path,
+                format!("must be {} (got {t} s)", if positive { "positive" } else { "≥ 0" }),
+            ));
+        }
+        t
+    }
+    fn input(&mut self, path: &str, field: &str, free: bool) -> Option<usize> {
+        let Some(i) = resolve_input(self.plant, path) else {
+            let names =
+                self.plant.inputs.iter().map(|i| i.path.as_str()).chain(self.plant.aliases.keys().map(String::as_str));
+            self.diags.push(Diagnostic::new(field, format!("no input `{path}`{}", did_you_mean(path, names))));
+            return None;
+        };
+        if free && let Some(v) = self.plant.inputs[i].driven_by {
+            let ctrl = &self.plant.blocks[self.plant.vars[v].block].name;
+            self.diags.push(Diagnostic::new(
+                field,
+                format!("input `{path}` is driven by controller `{ctrl}`: move its setpoint `{ctrl}.sp`, or switch it to manual with a `mode` event"),
+            ));
+            return None;
+        }
+        Some(i)
+    }
+    fn change(
+        &mut self,
+        base: &str,
+        input: Option<usize>,
+        to: &Option<QuantityValue>,
+        by: &Option<QuantityValue>,
+    ) -> Option<Change> {
+        let dim = self.plant.inputs[input?].dim;
+        match (to, by) {
+            (Some(v), None) => Some(Change::To(self.quantity(&format!("{base}.to"), v, dim))),
+            (None, Some(d)) => {
+                let v = d.to_si_difference(dim).unwrap_or_else(|e| {
+                    self.diags.push(Diagnostic::new(format!("{base}.by"), e.to_string()));
+                    f64::NAN
+                });
+                Some(Change::By(v))
+            }
+            _ => {
+                self.diags.push(Diagnostic::new(base, "give exactly one of `to` (new value) and `by` (change)"));
+                None
+            }
+        }
+    }
+    fn controller(&mut self, name: &str, field: &str) -> Option<usize> {
+        let found = self.plant.blocks.iter().position(|b| b.kind == BlockKind::Controller && b.name == name);
+        if found.is_none() {
+            let names = self.plant.blocks.iter().filter(|b| b.kind == BlockKind::Controller).map(|b| b.name.as_str());
+            self.diags.push(Diagnostic::new(field, format!("no controller `{name}`{}", did_you_mean(name, names))));
+        }
+        found
+    }
+}
+
+/// Check `spec` against `plant` and convert it to SI; `file` names the scenario in messages.
+pub fn resolve(spec: &ScenarioSpec, plant: &Plant, file: &str) -> Result<Scenario, LoadError> {
+    let mut cx = Cx { plant, diags: Vec::new() };
+    let duration = cx.time("duration", &spec.duration, true);
+    let int = &spec.integrator;
+    let rtol = int.rtol.unwrap_or(1e-6);
+    let atol = int.atol.unwrap_or(1e-8);
+    for (name, v) in [("integrator.rtol", rtol), ("integrator.atol", atol)] {
+        if !(v.is_finite() && v > 0.0 && v < 1.0) {
+            cx.diags.push(Diagnostic::new(name, format!("must be a number between 0 and 1 (got {v})")));
+        }
+    }
+    let max_step = int.max_step.as_ref().map_or(f64::INFINITY, |q| cx.time("integrator.max_step", q, true));
+    let first_step = int.first_step.as_ref().map(|q| cx.time("integrator.first_step", q, true));
+    let mut events = Vec::new();
+    for (k, e) in spec.events.iter().enumerate() {
+        events.extend(event(&mut cx, &format!("events[{k}]"), e));
+    }
+    events.retain(|e: &Event| e.t.is_finite());
+    events.sort_by(|a, b| a.t.total_cmp(&b.t));
+    let mut sampling = Vec::new();
+    for (name, q) in &spec.sampling {
+        let field = format!("sampling.{name}");
+        let scan = cx.time(&field, q, true);
+        if let Some(b) = cx.controller(name, &field) {
+            sampling.push((b, scan));
+        }
+    }
+    let mut analyzers = Vec::new();
+    for (name, a) in &spec.analyzers {
+        let field = format!("analyzers.{name}");
+        let ts = cx.time(&format!("{field}.sample_time"), &a.sample_time, true);
+        let td = a.dead_time.as_ref().map_or(0.0, |q| cx.time(&format!("{field}.dead_time"), q, false));
+        if let Some(b) = cx.controller(name, &field) {
+            if plant.blocks[b].layout.n_signals == 0 {
+                cx.diags.push(Diagnostic::new(field, format!("controller `{name}` reads no measurement")));
+            } else {
+                analyzers.push((b, ts, td));
+            }
+        }
+    }
+    let rec = &spec.record;
+    let interval = rec.interval.as_ref().map_or(duration / 1000.0, |q| cx.time("record.interval", q, true));
+    let time_unit = rec.time_unit.clone().unwrap_or_else(|| "min".into());
+    if unit_dimension(&time_unit).ok() != Some(Dimension::TIME) {
+        cx.diags.push(Diagnostic::new(
+            "record.time_unit",
+            format!("`{time_unit}` is not a unit of time (e.g. \"s\", \"min\", \"h\")"),
+        ));
+    }
+    let mut record = Vec::new();
+    let paths: Vec<(String, Option<String>)> = if rec.paths.is_empty() {
+        default_paths(plant, &events)
+    } else {
+        rec.paths
+            .iter()
+            .map(|p| match p {
+                RecordPathSpec::Path(p) => (p.clone(), None),
+                RecordPathSpec::WithUnit { path, unit } => (path.clone(), Some(unit.clone())),
+            })
+            .collect()
+    };
+    for (k, (path, unit)) in paths.iter().enumerate() {
+        let field = format!("record.paths[{k}]");
+        let (source, dim) = match (plant.var(path), resolve_input(plant, path)) {
+            (Some(v), _) => (Read::Var(v), plant.vars[v].spec.dim),
+            (None, Some(i)) => (Read::Input(i), plant.inputs[i].dim),
+            (None, None) => {
+                let names =
+                    plant.vars.iter().map(|v| v.path.as_str()).chain(plant.inputs.iter().map(|i| i.path.as_str()));
+                cx.diags.push(Diagnostic::new(
+                    field,
+                    format!("no variable or input `{path}`{}", did_you_mean(path, names)),
+                ));
+                continue;
+            }
+        };
+        let unit = match unit {
+            Some(u) if unit_dimension(u).ok() == Some(dim) && convert_from_si(1.0, u).is_ok() => u.clone(),
+            Some(u) => {
+                cx.diags.push(Diagnostic::new(
+                    format!("{field}.unit"),
+                    format!("`{u}` is not a unit of {} (SI: {dim})", dim.describe()),
+                ));
+                continue;
+            }
+            None => dim.to_string(),
+        };
+        record.push(Recorded { path: path.clone(), source, unit, dim });
+    }
+    let mut totals = Vec::new();
+    for (k, name) in rec.totals.iter().enumerate() {
+        match plant.streams.iter().position(|s| s.name == *name) {
+            Some(s) => totals.push(s),
+            None => cx.diags.push(Diagnostic::new(
+                format!("record.totals[{k}]"),
+                format!("no stream `{name}`{}", did_you_mean(name, plant.streams.iter().map(|s| s.name.as_str()))),
+            )),
+        }
+    }
+    let mut snapshots = Vec::new();
+    for (k, s) in spec.snapshots.iter().enumerate() {
+        snapshots.push((cx.time(&format!("snapshots[{k}].at"), &s.at, false), s.file.clone()));
+    }
+    if !cx.diags.is_empty() {
+        return Err(LoadError::Invalid { file: file.into(), diagnostics: cx.diags });
+    }
+    Ok(Scenario {
+        name: spec.name.clone(),
+        duration,
+        rtol,
+        atol,
+        max_step,
+        first_step,
+        events,
+        sampling,
+        analyzers,
+        interval,
+        time_unit,
+        record,
+        totals,
+        snapshots,
+    })
+}
+
+/// Every controller's measurement and output, and every input an event moves.
+fn default_paths(plant: &Plant, events: &[Event]) -> Vec<(String, Option<String>)> {
+    let mut paths: Vec<String> = Vec::new();
+    for b in plant.blocks.iter().filter(|b| b.kind == BlockKind::Controller) {
+        paths.extend(b.unit.signals().into_iter().filter(|s| s.role == "pv").map(|s| s.path));
+        paths.extend(
+            plant.vars[b.own_offset..b.own_offset + b.layout.n_own()]
+                .iter()
+                .filter(|v| v.path.ends_with(".op"))
+                .map(|v| v.path.clone()),
+        );
+    }
+    for e in events {
+        if let Action::Step { input, .. }
+        | Action::Ramp { input, .. }
+        | Action::Pulse { input, .. }
+        | Action::Sinusoid { input, .. }
+        | Action::Stuck { input } = e.action
+        {
+            paths.push(plant.inputs[input].path.clone());
+        }
+    }
+    let mut seen = std::collections::HashSet::new();
+    paths.retain(|p| seen.insert(p.clone()));
+    paths.into_iter().map(|p| (p, None)).collect()
+}
+
+fn event(cx: &mut Cx<'_>, base: &str, e: &EventSpec) -> Vec<Event> {
+    let at = |cx: &mut Cx<'_>, q: &QuantityValue| cx.time(&format!("{base}.at"), q, false);
+    let ev = |t: f64, action: Action| Event { t, action, origin: base.to_string() };
+    let path_field = format!("{base}.path");
+    match e {
+        EventSpec::Step { at: t, path, to, by } => {
+            let t = at(cx, t);
+            let input = cx.input(path, &path_field, true);
+            let change = cx.change(base, input, to, by);
+            input.zip(change).map(|(input, change)| vec![ev(t, Action::Step { input, change })]).unwrap_or_default()
+        }
+        EventSpec::Ramp { at: t, path, to, by, duration } => {
+            let t = at(cx, t);
+            let d = cx.time(&format!("{base}.duration"), duration, true);
+            let input = cx.input(path, &path_field, true);
+            let change = cx.change(base, input, to, by);
+            input
+                .zip(change)
+                .map(|(input, change)| {
+                    vec![ev(t, Action::Ramp { input, change, end: t + d }), ev(t + d, Action::Hold { input })]
+                })
+                .unwrap_or_default()
+        }
+        EventSpec::Pulse { at: t, path, to, by, width } => {
+            let t = at(cx, t);
+            let w = cx.time(&format!("{base}.width"), width, true);
+            let input = cx.input(path, &path_field, true);
+            let change = cx.change(base, input, to, by);
+            input
+                .zip(change)
+                .map(|(input, change)| {
+                    vec![ev(t, Action::Pulse { input, change }), ev(t + w, Action::Restore { input })]
+                })
+                .unwrap_or_default()
+        }
+        EventSpec::Sinusoid { at: t, path, amplitude, period, duration } => {
+            let t = at(cx, t);
+            let input = cx.input(path, &path_field, true);
+            let period = cx.time(&format!("{base}.period"), period, true);
+            let end = duration.as_ref().map(|d| t + cx.time(&format!("{base}.duration"), d, true));
+            let Some(input) = input else { return Vec::new() };
+            let amplitude = amplitude.to_si_difference(cx.plant.inputs[input].dim).unwrap_or_else(|err| {
+                cx.diags.push(Diagnostic::new(format!("{base}.amplitude"), err.to_string()));
+                f64::NAN
+            });
+            let mut v = vec![ev(t, Action::Sinusoid { input, amplitude, period })];
+            v.extend(end.map(|end| ev(end, Action::Restore { input })));
+            v
+        }
+        EventSpec::Mode { at: t, controller, mode, output } => {
+            let t = at(cx, t);
+            let field = format!("{base}.controller");
+            let Some(b) = cx.controller(controller, &field) else { return Vec::new() };
+            let (auto_input, manual_input) =
+                (cx.plant.input(&format!("{controller}.auto")), cx.plant.input(&format!("{controller}.op_manual")));
+            let (Some(auto_input), Some(manual_input), Some(op)) =
+                (auto_input, manual_input, cx.plant.var(&format!("{controller}.op")))
+            else {
+                let kind = cx.plant.blocks[b].unit.type_name();
+                cx.diags.push(Diagnostic::new(
+                    field,
+                    format!("controller `{controller}` ({kind}) has no auto/manual switch; only `pid` controllers do"),
+                ));
+                return Vec::new();
+            };
+            let dim = cx.plant.inputs[manual_input].dim;
+            let output = output.as_ref().map(|q| cx.quantity(&format!("{base}.output"), q, dim));
+            vec![ev(t, Action::Mode { auto_input, manual_input, op, auto: *mode == Mode::Auto, output })]
+        }
+        EventSpec::ValveStuck { at: t, path } => {
+            let t = at(cx, t);
+            cx.input(path, &path_field, false).map(|input| vec![ev(t, Action::Stuck { input })]).unwrap_or_default()
+        }
+        EventSpec::FeedLost { at: t, unit } => {
+            let t = at(cx, t);
+            let input = cx.plant.input(&format!("{unit}.F"));
+            if input.is_none() || !cx.plant.blocks.iter().any(|b| b.name == *unit && b.unit.type_name() == "feed") {
+                cx.diags
+                    .push(Diagnostic::new(format!("{base}.unit"), format!("no feed unit `{unit}` with an input `F`")));
+                return Vec::new();
+            }
+            let input = cx.input(&format!("{unit}.F"), &format!("{base}.unit"), true);
+            input.map(|input| vec![ev(t, Action::Step { input, change: Change::To(0.0) })]).unwrap_or_default()
+        }
+    }
+}

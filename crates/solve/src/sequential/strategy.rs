@@ -1,0 +1,131 @@
+//! The steady-state strategy: sequential-modular, equation-oriented (whole-plant Newton), or
+//! `auto` — a sequential-modular pass to a loose tolerance as the start of the whole-plant Newton.
+
+use plantwide_flowsheet::Plant;
+use serde::{Deserialize, Serialize};
+
+use super::{PassRecord, SmError, SmReport, SmSettings, plan, solve_sequential_observed};
+use crate::{IterationRecord, NewtonReport, NewtonSettings, SteadyError, steady_state_observed};
+
+/// How to find the steady state.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Method {
+    /// Whole-plant Newton from the cold-start guess (equation oriented).
+    Eo,
+    /// Sequential modular alone, to [`SmSettings::tol`].
+    Sm,
+    /// Plants with recycles: sequential modular to [`StrategySettings::auto_tol`], then whole-plant
+    /// Newton from there (from the cold start if the pass fails). Plants without: Newton.
+    Auto,
+}
+
+/// Settings of [`steady_state_by`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct StrategySettings {
+    /// Method (default: `auto`).
+    pub method: Method,
+    /// Sequential-modular settings.
+    pub sm: SmSettings,
+    /// Whole-plant Newton settings.
+    pub newton: NewtonSettings,
+    /// Tear tolerance of the sequential-modular pass in `auto` (default: 1e-4).
+    pub auto_tol: f64,
+}
+
+impl Default for StrategySettings {
+    fn default() -> Self {
+        StrategySettings {
+            method: Method::Auto,
+            sm: SmSettings::default(),
+            newton: NewtonSettings::default(),
+            auto_tol: 1e-4,
+        }
+    }
+}
+
+/// Progress of [`steady_state_by`].
+#[derive(Debug, Clone, Copy)]
+pub enum Progress<'a> {
+    /// A sequential-modular pass.
+    Pass(&'a PassRecord),
+    /// A whole-plant Newton iteration.
+    Newton(&'a IterationRecord),
+}
+
+/// A steady state and how it was found.
+#[derive(Debug, Clone)]
+pub struct Solution {
+    /// Variable values (SI).
+    pub x: Vec<f64>,
+    /// Input values (SI).
+    pub u: Vec<f64>,
+    /// The sequential-modular report, if a pass ran.
+    pub sm: Option<SmReport>,
+    /// Why the sequential-modular pass of `auto` was abandoned, if it was.
+    pub sm_failure: Option<String>,
+    /// The whole-plant Newton report, if Newton ran.
+    pub newton: Option<NewtonReport>,
+}
+
+/// Why no steady state was found.
+#[derive(Debug, Clone, thiserror::Error)]
+pub enum SolveError {
+    /// From the sequential-modular pass.
+    #[error(transparent)]
+    Sm(#[from] SmError),
+    /// From the whole-plant Newton.
+    #[error(transparent)]
+    Eo(#[from] SteadyError),
+}
+
+impl SolveError {
+    /// True for an ill-posed plant or bad settings (a user error), false for a numerical failure.
+    pub fn is_user_error(&self) -> bool {
+        matches!(self, SolveError::Sm(SmError::Dof(_) | SmError::Settings(_)) | SolveError::Eo(SteadyError::Dof(_)))
+    }
+}
+
+/// Find the steady state of `plant` at inputs `u` by `settings.method`, from the cold start.
+pub fn steady_state_by(
+    plant: &Plant,
+    u: &[f64],
+    settings: &StrategySettings,
+    observer: &mut dyn FnMut(Progress<'_>),
+) -> Result<Solution, SolveError> {
+    let eo = |x0: Option<&[f64]>, observer: &mut dyn FnMut(Progress<'_>)| {
+        steady_state_observed(plant, u, x0, &settings.newton, &mut |r| observer(Progress::Newton(r)))
+    };
+    match settings.method {
+        Method::Eo => {
+            let ss = eo(None, observer)?;
+            Ok(Solution { x: ss.x, u: ss.u, sm: None, sm_failure: None, newton: Some(ss.report) })
+        }
+        Method::Sm => {
+            let sol = solve_sequential_observed(plant, u, None, &settings.sm, &mut |p| observer(Progress::Pass(p)))?;
+            Ok(Solution { x: sol.x, u: sol.u, sm: Some(sol.report), sm_failure: None, newton: None })
+        }
+        Method::Auto => {
+            let x0 = plant.initial_guess_at(u);
+            if plan(plant, u, &x0).recycles().next().is_none() {
+                let ss = eo(Some(&x0), observer)?;
+                return Ok(Solution { x: ss.x, u: ss.u, sm: None, sm_failure: None, newton: Some(ss.report) });
+            }
+            let loose = SmSettings { tol: settings.auto_tol, ..settings.sm.clone() };
+            let (start, sm, sm_failure) =
+                match solve_sequential_observed(plant, u, Some(&x0), &loose, &mut |p| observer(Progress::Pass(p))) {
+                    Ok(sol) => (sol.x, Some(sol.report), None),
+                    Err(e @ (SmError::Dof(_) | SmError::Settings(_))) => return Err(e.into()),
+                    Err(SmError::NotConverged(f)) => (f.x.clone(), Some(f.report.clone()), Some(f.to_string())),
+                    Err(SmError::Local(f)) => (x0.clone(), None, Some(f.to_string())),
+                };
+            let ss = match eo(Some(&start), observer) {
+                Ok(ss) => ss,
+                Err(first) if sm_failure.is_none() => eo(Some(&x0), observer).map_err(|_| first)?,
+                Err(e) => return Err(e.into()),
+            };
+            Ok(Solution { x: ss.x, u: ss.u, sm, sm_failure, newton: Some(ss.report) })
+        }
+    }
+}

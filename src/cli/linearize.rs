@@ -1,0 +1,153 @@
+//! `plantwide linearize FILE --inputs P1,P2 --outputs Q1,Q2 --out model.json [--time-unit min]
+//! [--frequencies LOW:HIGH:N]`: the state-space model at the steady state, for MATLAB and
+//! python-control (see `plantwide_analysis::export` for how to load it).
+
+use std::path::PathBuf;
+
+use plantwide::analysis::export::ModelExport;
+use plantwide::analysis::faer::{Mat, c64};
+use plantwide::analysis::linear::Linearization;
+use plantwide::analysis::select::{select_inputs, select_outputs};
+use plantwide::units::{Dimension, Unit};
+
+use super::CliError;
+use super::gains::{display_gain, sig};
+use super::steady::{converge, load_with_overrides};
+
+/// Arguments of `plantwide linearize`.
+#[derive(Debug, clap::Args)]
+pub struct LinearizeArgs {
+    /// Flowsheet file (JSON).
+    file: PathBuf,
+    /// Inputs, comma-separated, each `PATH[@unit]`.
+    #[arg(long, value_delimiter = ',', required = true)]
+    inputs: Vec<String>,
+    /// Outputs, comma-separated variable paths, each `PATH[@unit]`.
+    #[arg(long, value_delimiter = ',', required = true)]
+    outputs: Vec<String>,
+    /// Write the model (JSON) here.
+    #[arg(long, value_name = "MODEL.json")]
+    out: Option<PathBuf>,
+    /// Time unit of the exported A and B, eigenvalues and time constants (default s).
+    #[arg(long, default_value = "s")]
+    time_unit: String,
+    /// Also export G(jω) at `LOW:HIGH:N` (log-spaced, rad per --time-unit).
+    #[arg(long, value_name = "LOW:HIGH:N")]
+    frequencies: Option<String>,
+    /// Override an input or a unit parameter first.
+    #[arg(long = "set", value_name = "PATH=VALUE")]
+    set: Vec<String>,
+}
+
+/// A time unit for display: its name and length in seconds.
+pub struct TimeUnit {
+    /// As written (`min`).
+    pub name: String,
+    /// Seconds per unit.
+    pub seconds: f64,
+}
+
+impl TimeUnit {
+    /// Parse a time unit (`s`, `min`, `h`).
+    pub fn parse(name: &str) -> Result<TimeUnit, CliError> {
+        let u = Unit::parse(name).map_err(|e| CliError::user(format!("--time-unit {name}: {e}")))?;
+        if u.dimension() != Dimension::TIME {
+            return Err(CliError::user(format!("--time-unit {name}: not a time unit (e.g. s, min, h)")));
+        }
+        Ok(TimeUnit { name: name.to_string(), seconds: u.factor() })
+    }
+}
+
+/// `LOW:HIGH:N` (rad per time unit) → `N` log-spaced frequencies in rad/s.
+pub fn frequency_grid(text: &str, tu: &TimeUnit) -> Result<Vec<f64>, CliError> {
+    let bad = || {
+        CliError::user(format!(
+            "--frequencies `{text}`: expected LOW:HIGH:N with 0 < LOW < HIGH and N ≥ 2, e.g. 0.001:1:25"
+        ))
+    };
+    let parts: Vec<&str> = text.split(':').map(str::trim).collect();
+    let [lo, hi, n] = parts[..] else { return Err(bad()) };
+    let (lo, hi, n): (f64, f64, usize) =
+        (lo.parse().map_err(|_| bad())?, hi.parse().map_err(|_| bad())?, n.parse().map_err(|_| bad())?);
+    if !(lo > 0.0 && hi > lo && hi.is_finite() && n >= 2) {
+        return Err(bad());
+    }
+    Ok((0..n).map(|k| lo * (hi / lo).powf(k as f64 / (n - 1) as f64) / tu.seconds).collect())
+}
+
+pub fn run(a: &LinearizeArgs) -> Result<(), CliError> {
+    let tu = TimeUnit::parse(&a.time_unit)?;
+    let (plant, u) = load_with_overrides(&a.file, &a.set)?;
+    let map = |e: plantwide::analysis::AnalysisError| {
+        if e.is_user_error() { CliError::user(e.to_string()) } else { CliError::numerical(e.to_string()) }
+    };
+    let inputs = select_inputs(&plant, &a.inputs).map_err(map)?;
+    let outputs = select_outputs(&plant, &a.outputs).map_err(map)?;
+    let omegas = a.frequencies.as_deref().map(|f| frequency_grid(f, &tu)).transpose()?.unwrap_or_default();
+    let ss = converge(&plant, &u)?;
+    let (ii, oo): (Vec<usize>, Vec<usize>) =
+        (inputs.iter().map(|s| s.index).collect(), outputs.iter().map(|s| s.index).collect());
+    let lin = Linearization::new(&plant, &ss.x, &ss.u);
+    let model = lin.state_space(&ii, &oo).map_err(map)?;
+    let direct = lin.steady_gain(&ii, &oo).map_err(map)?;
+    let eigenvalues = model.eigenvalues().map_err(map)?;
+    let responses: Vec<(f64, Mat<c64>)> = lin
+        .frequency_response(&ii, &oo, &omegas)
+        .map_err(map)?
+        .into_iter()
+        .zip(&omegas)
+        .map(|(g, &w)| {
+            (w, Mat::from_fn(g.nrows(), g.ncols(), |i, j| g[(i, j)] * (inputs[j].factor / outputs[i].factor)))
+        })
+        .collect();
+    outln!(
+        "linear model of `{}` at its steady state: {} states, {} inputs, {} outputs",
+        plant.name,
+        model.states.len(),
+        inputs.len(),
+        outputs.len()
+    );
+    let slow: Vec<String> = model.time_constants().map_err(map)?.iter().take(5).map(|t| sig(t / tu.seconds)).collect();
+    outln!("slowest time constants [{}]: {}", tu.name, slow.join(", "));
+    let unstable = model.unstable(1e-12).map_err(map)?;
+    if !unstable.is_empty() {
+        let ev: Vec<String> =
+            unstable.iter().map(|l| format!("{:.4e}{:+.4e}j", l.re * tu.seconds, l.im * tu.seconds)).collect();
+        outln!("integrating or unstable modes [1/{}]: {}", tu.name, ev.join(", "));
+    }
+    if unstable.is_empty() {
+        let g = display_gain(&model.steady_gain().map_err(map)?, &inputs, &outputs);
+        let gd = display_gain(&direct, &inputs, &outputs);
+        let diff = (0..g.nrows())
+            .flat_map(|i| (0..g.ncols()).map(move |j| (i, j)))
+            .map(|(i, j)| (g[(i, j)] - gd[(i, j)]).abs() / gd[(i, j)].abs().max(f64::MIN_POSITIVE))
+            .fold(0.0, f64::max);
+        outln!("steady-state gain D − C A⁻¹ B (agrees with −C J⁻¹ B to {diff:.1e} relative):");
+        for (i, o) in outputs.iter().enumerate() {
+            let cells: Vec<String> = (0..g.ncols()).map(|j| format!("{:>14}", sig(g[(i, j)]))).collect();
+            outln!("  {:<28} {}", format!("{} [{}]", o.path, o.unit), cells.join(" "));
+        }
+    }
+    if let Some(out) = &a.out {
+        let doc = ModelExport {
+            name: &plant.name,
+            model: &model,
+            states: model.states.iter().map(|&i| plant.vars[i].path.clone()).collect(),
+            state_values: model.states.iter().map(|&i| ss.x[i]).collect(),
+            inputs: &inputs,
+            input_values: ii.iter().map(|&i| ss.u[i]).collect(),
+            outputs: &outputs,
+            output_values: oo.iter().map(|&i| ss.x[i]).collect(),
+            time_unit: (&tu.name, tu.seconds),
+            eigenvalues: &eigenvalues,
+            frequency_response: &responses,
+        }
+        .to_json_string();
+        std::fs::write(out, doc + "\n").map_err(|e| CliError::user(format!("{}: cannot write: {e}", out.display())))?;
+        outln!(
+            "wrote {} (A, B, C, D; load with python-control `control.ss(A, B, C, D)` or MATLAB `ss(m.A, m.B, m.C, m.D)`)",
+            out.display()
+        );
+    }
+    Ok(())
+}

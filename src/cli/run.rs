@@ -1,0 +1,201 @@
+//! `plantwide run FILE --scenario SCEN --csv OUT.csv [--plot OUT.png|OUT.svg] [--json]
+//! [--set PATH=VALUE ...] [--resume SNAPSHOT]`: dynamic simulation from the converged steady state
+//! (or a snapshot), with a progress bar on stderr, recorded trends as CSV, a summary (table, or
+//! JSON with `--json`) and an optional trend plot.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use plantwide::flowsheet::scenario::{parse_scenario, resolve};
+use plantwide::plot::{Trend, write_trends};
+use plantwide::solve::dynamic::{Progress, SimError, SimulationResult, Snapshot, Start, simulate};
+use plantwide::units::convert_from_si;
+
+use super::CliError;
+use super::steady::{converge, load_with_overrides};
+
+/// Options of `plantwide run`.
+#[derive(Debug)]
+pub struct RunArgs {
+    /// Flowsheet file.
+    pub file: PathBuf,
+    /// Scenario file.
+    pub scenario: PathBuf,
+    /// CSV output.
+    pub csv: PathBuf,
+    /// Plot output (`.png` or `.svg`).
+    pub plot: Option<PathBuf>,
+    /// Print the summary as JSON.
+    pub json: bool,
+    /// `--set` overrides.
+    pub set: Vec<String>,
+    /// Snapshot to resume from.
+    pub resume: Option<PathBuf>,
+}
+
+/// FNV-1a hash of the flowsheet text and the overrides: identifies the plant in snapshots.
+fn fingerprint(text: &str, sets: &[String]) -> String {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for b in text.bytes().chain(sets.iter().flat_map(|s| std::iter::once(0u8).chain(s.bytes()))) {
+        h = (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3);
+    }
+    format!("{h:016x}")
+}
+
+fn read(path: &Path, what: &str) -> Result<String, CliError> {
+    std::fs::read_to_string(path)
+        .map_err(|e| CliError::user(format!("{}: cannot read the {what}: {e}", path.display())))
+}
+
+pub fn run(args: &RunArgs) -> Result<(), CliError> {
+    let flowsheet_text = read(&args.file, "flowsheet")?;
+    let (mut plant, u) = load_with_overrides(&args.file, &args.set)?;
+    plant.inputs.iter_mut().zip(&u).for_each(|(info, v)| info.value = *v);
+    let scen_name = args.scenario.display().to_string();
+    let spec =
+        parse_scenario(&read(&args.scenario, "scenario")?, &scen_name).map_err(|e| CliError::user(e.to_string()))?;
+    let sc = resolve(&spec, &plant, &scen_name).map_err(|e| CliError::user(e.to_string()))?;
+    let snapshot: Option<Snapshot> = match &args.resume {
+        Some(p) => Some(
+            serde_json::from_str(&read(p, "snapshot")?)
+                .map_err(|e| CliError::user(format!("{}: not a snapshot file: {e}", p.display())))?,
+        ),
+        None => None,
+    };
+    let x0 = match &snapshot {
+        Some(_) => Vec::new(),
+        None => converge(&plant, &u)?.x,
+    };
+    let start = snapshot.as_ref().map_or(Start::Steady(&x0), Start::Snapshot);
+    let time_factor = convert_from_si(1.0, &sc.time_unit).map_err(|e| CliError::user(e.to_string()))?;
+    let bar = indicatif::ProgressBar::new(1000);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:40} {msg}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let started = Instant::now();
+    let mut write_error = None;
+    let fp = fingerprint(&flowsheet_text, &args.set);
+    let result = simulate(&mut plant, &sc, start, &fp, &mut |p| match p {
+        Progress::Step { t, duration } => {
+            let real = started.elapsed().as_secs_f64().max(1e-9);
+            bar.set_position((1000.0 * t / duration) as u64);
+            bar.set_message(format!("t = {:.4} {} ({:.0}× real time)", t * time_factor, sc.time_unit, t / real));
+        }
+        Progress::Snapshot { file, snapshot } => {
+            let text = serde_json::to_string(snapshot).map_err(|e| e.to_string());
+            if let Err(e) = text.and_then(|t| std::fs::write(file, t).map_err(|e| e.to_string())) {
+                write_error = Some(CliError::user(format!("{file}: cannot write the snapshot: {e}")));
+            }
+        }
+    });
+    bar.finish_and_clear();
+    let res = result.map_err(|e| match e {
+        SimError::Integration { .. } => CliError::numerical(e.to_string()),
+        SimError::Snapshot { .. } => CliError::user(e.to_string()),
+    })?;
+    if let Some(e) = write_error {
+        return Err(e);
+    }
+    write_csv(&args.csv, &res, &sc.time_unit, time_factor)?;
+    if let Some(p) = &args.plot {
+        let times: Vec<f64> = res.times.iter().map(|t| t * time_factor).collect();
+        let trends: Vec<Trend> = (0..res.columns.len())
+            .map(|k| Trend {
+                label: format!("{} [{}]", res.columns[k].path, res.columns[k].unit),
+                values: res.rows.iter().map(|r| to_unit(r[k], &res.columns[k].unit)).collect(),
+            })
+            .collect();
+        let title = if sc.name.is_empty() { plant.name.clone() } else { format!("{}: {}", plant.name, sc.name) };
+        write_trends(p, &title, &format!("time [{}]", sc.time_unit), &times, &trends).map_err(CliError::user)?;
+    }
+    let wall = started.elapsed().as_secs_f64();
+    print_summary(&res, args.json, wall, time_factor, &sc.time_unit)
+}
+
+fn to_unit(v: f64, unit: &str) -> f64 {
+    convert_from_si(v, unit).unwrap_or(v)
+}
+
+fn write_csv(path: &Path, res: &SimulationResult, time_unit: &str, time_factor: f64) -> Result<(), CliError> {
+    let fail = |e: std::io::Error| CliError::user(format!("{}: cannot write the CSV file: {e}", path.display()));
+    let file = std::fs::File::create(path).map_err(fail)?;
+    let mut w = std::io::BufWriter::new(file);
+    let mut header = vec![format!("time [{time_unit}]")];
+    header.extend(res.columns.iter().map(|c| format!("{} [{}]", c.path, c.unit)));
+    writeln!(w, "{}", header.iter().map(|h| csv_field(h)).collect::<Vec<_>>().join(",")).map_err(fail)?;
+    for (t, row) in res.times.iter().zip(&res.rows) {
+        let mut fields = vec![format!("{}", t * time_factor)];
+        fields.extend(row.iter().zip(&res.columns).map(|(v, c)| format!("{}", to_unit(*v, &c.unit))));
+        writeln!(w, "{}", fields.join(",")).map_err(fail)?;
+    }
+    w.flush().map_err(fail)
+}
+
+/// Quote a CSV field that holds a comma or a quote.
+fn csv_field(s: &str) -> String {
+    if s.contains([',', '"']) { format!("\"{}\"", s.replace('"', "\"\"")) } else { s.to_string() }
+}
+
+fn print_summary(
+    res: &SimulationResult,
+    json: bool,
+    wall: f64,
+    time_factor: f64,
+    time_unit: &str,
+) -> Result<(), CliError> {
+    let summary = res.summary();
+    let s = &res.stats;
+    if json {
+        let finals: serde_json::Map<String, serde_json::Value> =
+            summary.iter().map(|p| (p.path.clone(), p.last.into())).collect();
+        let out = serde_json::json!({
+            "t_end": res.t,
+            "wall_time_s": wall,
+            "stats": s,
+            "events": res.events.iter().map(|(t, o)| serde_json::json!({"t": t, "event": o})).collect::<Vec<_>>(),
+            "final_values": finals,
+            "paths": summary,
+        });
+        outln!("{}", serde_json::to_string_pretty(&out).map_err(|e| CliError::user(e.to_string()))?);
+        return Ok(());
+    }
+    outln!(
+        "simulated {:.4} {time_unit} in {wall:.2} s: {} steps ({} error-test failures, {} Newton failures), {} residual and {} Jacobian evaluations, {} LU factorizations, {} restarts",
+        res.t * time_factor,
+        s.n_steps,
+        s.n_error_test_failures,
+        s.n_newton_failures,
+        s.n_residual_evals,
+        s.n_jacobian_evals,
+        s.n_lu,
+        s.n_restarts
+    );
+    outln!(
+        "{:<28} {:>10} {:>14} {:>14} {:>12} {:>12} {:>14} {:>12}",
+        "path (SI units)",
+        "reference",
+        "initial",
+        "final",
+        "IAE",
+        "ISE",
+        "max deviation",
+        "settling"
+    );
+    for p in &summary {
+        let settling = p.settling_time.map_or("-".to_string(), |t| format!("{:.4} {time_unit}", t * time_factor));
+        outln!(
+            "{:<28} {:>10} {:>14.7e} {:>14.7e} {:>12.4e} {:>12.4e} {:>14.4e} {:>12}",
+            p.path,
+            p.reference,
+            p.initial,
+            p.last,
+            p.iae,
+            p.ise,
+            p.max_deviation,
+            settling
+        );
+    }
+    Ok(())
+}

@@ -1,0 +1,109 @@
+//! `plantwide sensitivity FILE --disturb PATH=-10%:+10% … --outputs Q1,Q2 [--points N] [--csv OUT]
+//! [--plot OUT.png|OUT.svg]`: disturbance sweeps with the flowsheet's control structure active.
+
+use std::path::PathBuf;
+
+use plantwide::analysis::AnalysisError;
+use plantwide::analysis::plot::draw_sensitivity;
+use plantwide::analysis::select::select_outputs;
+use plantwide::analysis::sensitivity::{Disturbance, SweepSettings, sweep, to_csv};
+use plotters::prelude::{BitMapBackend, IntoDrawingArea, SVGBackend};
+
+use super::CliError;
+use super::gains::sig;
+use super::steady::{converge, load_with_overrides};
+
+/// Arguments of `plantwide sensitivity`.
+#[derive(Debug, clap::Args)]
+pub struct SensitivityArgs {
+    /// Flowsheet file (JSON).
+    file: PathBuf,
+    /// A disturbance and its range, `PATH[@unit]=LOW:HIGH` with percentages of the base value or
+    /// quantities (`feed_source.F=-10%:+10%`, `feed_source.F=0.9kmol/min:1.1kmol/min`); repeatable.
+    #[arg(long = "disturb", value_name = "PATH=LOW:HIGH", required = true)]
+    disturb: Vec<String>,
+    /// Outputs, comma-separated variable paths, each `PATH[@unit]`.
+    #[arg(long, value_delimiter = ',', required = true)]
+    outputs: Vec<String>,
+    /// Points over each range, ends included (the base case is added).
+    #[arg(long, default_value_t = 21)]
+    points: usize,
+    /// Write the table as CSV here.
+    #[arg(long, value_name = "OUT.csv")]
+    csv: Option<PathBuf>,
+    /// Draw the curves into a PNG or SVG file.
+    #[arg(long, value_name = "OUT.png|OUT.svg")]
+    plot: Option<PathBuf>,
+    /// Override an input or a unit parameter first.
+    #[arg(long = "set", value_name = "PATH=VALUE")]
+    set: Vec<String>,
+}
+
+fn analysis_error(e: AnalysisError) -> CliError {
+    if e.is_user_error() { CliError::user(e.to_string()) } else { CliError::numerical(e.to_string()) }
+}
+
+pub fn run(a: &SensitivityArgs) -> Result<(), CliError> {
+    let svg = match a.plot.as_ref().and_then(|p| p.extension()).and_then(|e| e.to_str()) {
+        None if a.plot.is_none() => false,
+        Some("svg") => true,
+        Some("png") => false,
+        _ => return Err(CliError::user("--plot: the file must end in .png or .svg")),
+    };
+    let (plant, u) = load_with_overrides(&a.file, &a.set)?;
+    let disturbances = a
+        .disturb
+        .iter()
+        .map(|d| Disturbance::parse(&plant, &u, d))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(analysis_error)?;
+    let outputs = select_outputs(&plant, &a.outputs).map_err(analysis_error)?;
+    let ss = converge(&plant, &u)?;
+    let settings = SweepSettings { points: a.points, ..SweepSettings::default() };
+    let idx: Vec<usize> = outputs.iter().map(|s| s.index).collect();
+    let curves = sweep(&plant, &ss.x, &ss.u, &disturbances, &idx, &settings).map_err(analysis_error)?;
+    outln!(
+        "sensitivity of `{}` (control structure as in the flowsheet, each point re-converged from its neighbour)",
+        plant.name
+    );
+    for c in &curves {
+        let d = &c.disturbance;
+        outln!("\n{} [{}] (base {})", d.signal.path, d.signal.unit, sig(d.signal.display_value(d.base)));
+        out!("{:>12} {:>14}", "change %", "value");
+        for o in &outputs {
+            out!(" {:>24}", format!("{} [{}]", o.path, o.unit));
+        }
+        outln!();
+        for (v, y) in c.values.iter().zip(&c.outputs) {
+            out!("{:>12} {:>14}", sig(d.percent(*v)), sig(d.signal.display_value(*v)));
+            match y {
+                Some(y) => outputs.iter().zip(y).for_each(|(o, yi)| out!(" {:>24}", sig(o.display_value(*yi)))),
+                None => out!(" {:>24}", "not converged"),
+            }
+            outln!();
+        }
+    }
+    if let Some(path) = &a.csv {
+        std::fs::write(path, to_csv(&curves, &outputs))
+            .map_err(|e| CliError::user(format!("{}: cannot write: {e}", path.display())))?;
+        outln!("\nwrote {}", path.display());
+    }
+    if let Some(path) = &a.plot {
+        let title = format!("{}: sensitivity", plant.name);
+        let height = 120 + 380 * outputs.len() as u32;
+        if svg {
+            let root = SVGBackend::new(path, (900, height)).into_drawing_area();
+            draw_sensitivity(&root, &title, &curves, &outputs).map_err(analysis_error)?;
+        } else {
+            let root = BitMapBackend::new(path, (900, height)).into_drawing_area();
+            draw_sensitivity(&root, &title, &curves, &outputs).map_err(analysis_error)?;
+        }
+        outln!("wrote {}", path.display());
+    }
+    let failures: Vec<&String> = curves.iter().flat_map(|c| &c.failures).collect();
+    if !failures.is_empty() {
+        let list: Vec<&str> = failures.iter().map(|s| s.as_str()).collect();
+        return Err(CliError::numerical(format!("{}: the sweep stopped early: {}", plant.file, list.join("; "))));
+    }
+    Ok(())
+}

@@ -1,0 +1,111 @@
+//! Trend plots of a dynamic run: one panel per recorded path against time, stacked, as PNG or SVG
+//! (chosen by the file extension). Text is drawn with the embedded DejaVu Sans font, so no system
+//! font library is needed.
+
+use std::path::Path;
+use std::sync::Once;
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::{FontStyle, register_font};
+
+/// One curve: its label (path and unit) and its values at the plot's times.
+#[derive(Debug, Clone)]
+pub struct Trend {
+    /// Axis label, e.g. `bottoms.x[light] [-]`.
+    pub label: String,
+    /// Values, one per time.
+    pub values: Vec<f64>,
+}
+
+static FONTS: Once = Once::new();
+
+fn register_fonts() {
+    FONTS.call_once(|| {
+        // The embedded faces are valid TrueType data; a failure here would leave text undrawn.
+        let _ = register_font("sans-serif", FontStyle::Normal, dejavu::sans::regular());
+        let _ = register_font("sans-serif", FontStyle::Bold, dejavu::sans::bold());
+    });
+}
+
+/// Write the trends to `file` (`.png` or `.svg`): `times` along x, labelled `time_label`.
+pub fn write_trends(file: &Path, title: &str, time_label: &str, times: &[f64], trends: &[Trend]) -> Result<(), String> {
+    register_fonts();
+    let height = 70 + 240 * trends.len().max(1) as u32;
+    let size = (1000, height);
+    let ext = file.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    match ext.as_deref() {
+        Some("svg") => draw(SVGBackend::new(file, size).into_drawing_area(), title, time_label, times, trends),
+        Some("png") => draw(BitMapBackend::new(file, size).into_drawing_area(), title, time_label, times, trends),
+        _ => Err(format!("{}: the plot file must end in .png or .svg", file.display())),
+    }
+}
+
+fn draw<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    title: &str,
+    time_label: &str,
+    times: &[f64],
+    trends: &[Trend],
+) -> Result<(), String> {
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+    root.fill(&WHITE).map_err(err)?;
+    let root = root.titled(title, ("sans-serif", 24).into_font()).map_err(err)?;
+    let panels = root.split_evenly((trends.len().max(1), 1));
+    let (t0, t1) = (times.first().copied().unwrap_or(0.0), times.last().copied().unwrap_or(1.0));
+    let t1 = if t1 > t0 { t1 } else { t0 + 1.0 };
+    for (panel, trend) in panels.iter().zip(trends) {
+        let finite = trend.values.iter().copied().filter(|v| v.is_finite());
+        let (lo, hi) = finite.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
+        let (lo, hi) = if !lo.is_finite() {
+            (0.0, 1.0)
+        } else {
+            let pad = ((hi - lo) * 0.05).max(1e-9 * lo.abs().max(1e-300));
+            (lo - pad, hi + pad)
+        };
+        // Enough decimals to tell the ticks apart (about three significant digits of the span).
+        let decimals = (2.0 - (hi - lo).log10().floor()).clamp(0.0, 10.0) as usize;
+        let mut chart = ChartBuilder::on(panel)
+            .margin(10)
+            .x_label_area_size(35)
+            .y_label_area_size(90)
+            .build_cartesian_2d(t0..t1, lo..hi)
+            .map_err(err)?;
+        chart
+            .configure_mesh()
+            .x_desc(time_label)
+            .y_desc(trend.label.as_str())
+            .axis_desc_style(("sans-serif", 15))
+            .y_label_formatter(&|v| format!("{v:.decimals$}"))
+            .draw()
+            .map_err(err)?;
+        let points = times.iter().copied().zip(trend.values.iter().copied()).filter(|(_, v)| v.is_finite());
+        chart.draw_series(LineSeries::new(points, BLUE.stroke_width(2))).map_err(err)?;
+    }
+    root.present().map_err(err)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn png_and_svg_are_written_and_other_extensions_refused() {
+        let dir = std::env::temp_dir().join(format!("plantwide_plot_{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let times: Vec<f64> = (0..50).map(f64::from).collect();
+        let trends = vec![
+            Trend { label: "level [m]".into(), values: times.iter().map(|t| 1.0 - (-t / 10.0).exp()).collect() },
+            Trend { label: "flat [-]".into(), values: vec![2.0; 50] },
+        ];
+        for name in ["t.png", "t.svg"] {
+            let file = dir.join(name);
+            write_trends(&file, "step response", "time [min]", &times, &trends).unwrap();
+            assert!(std::fs::metadata(&file).unwrap().len() > 1000, "{name} written");
+        }
+        let svg = std::fs::read_to_string(dir.join("t.svg")).unwrap();
+        assert!(svg.contains("level [m]") && svg.contains("step response"));
+        assert!(write_trends(&dir.join("t.jpg"), "x", "t", &times, &trends).is_err());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

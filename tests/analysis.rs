@@ -1,0 +1,415 @@
+//! Control analysis against published numbers and independent closed forms: column A gains by
+//! linearization and by perturbation, its dominant time constant, the surge tank's eigenvalues,
+//! Wood–Berry from its transfer-function file, sensitivity sweeps and the CLI.
+
+mod common;
+
+use std::process::Command;
+
+use common::{converge, flowsheet, value};
+use plantwide::analysis::faer::linalg::solvers::Solve;
+use plantwide::analysis::faer::{Mat, c64};
+use plantwide::analysis::linear::Linearization;
+use plantwide::analysis::measures::{niederlinski, rga};
+use plantwide::analysis::perturb::{PerturbSettings, perturb_gains};
+use plantwide::analysis::select::{Signal, select_inputs, select_outputs};
+use plantwide::analysis::sensitivity::{Disturbance, SweepSettings, sweep};
+use plantwide::analysis::sensors::select_temperature_sensors;
+use plantwide::analysis::tf::TfModel;
+use plantwide::solve::{NewtonSettings, steady_state};
+
+fn plantwide(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_plantwide")).args(args).output().unwrap()
+}
+
+fn strings(v: &[&str]) -> Vec<String> {
+    v.iter().map(|s| s.to_string()).collect()
+}
+
+fn indices(s: &[Signal]) -> Vec<usize> {
+    s.iter().map(|s| s.index).collect()
+}
+
+/// SI gains in the signals' display units.
+fn display(g: &Mat<f64>, inputs: &[Signal], outputs: &[Signal]) -> Mat<f64> {
+    Mat::from_fn(g.nrows(), g.ncols(), |i, j| g[(i, j)] * inputs[j].factor / outputs[i].factor)
+}
+
+fn max_rel_diff(a: &Mat<f64>, b: &Mat<f64>) -> f64 {
+    let mut worst: f64 = 0.0;
+    for i in 0..a.nrows() {
+        for j in 0..a.ncols() {
+            worst = worst.max((a[(i, j)] - b[(i, j)]).abs() / b[(i, j)].abs());
+        }
+    }
+    worst
+}
+
+const LV_INPUTS: [&str; 2] = ["column.reflux@kmol/min", "column.boilup@kmol/min"];
+const LV_OUTPUTS: [&str; 2] = ["distillate.x[light]", "bottoms.x[light]"];
+
+/// Column A (S&P 2005 §12.4), LV configuration with P level loops. Published idealized LV model
+/// (eq. 12.17): G(0) = [0.878 −0.864; 1.082 −1.096], λ11 = 35.1; MATLAB `cola` linearization of
+/// the same nonlinear column: about [0.8780 −0.8644; 1.0819 −1.0958].
+#[test]
+fn column_a_gains_by_linearization_and_by_perturbation_agree() {
+    let (plant, ss) = converge("column_a.json");
+    let inputs = select_inputs(&plant, &strings(&LV_INPUTS)).unwrap();
+    let outputs = select_outputs(&plant, &strings(&LV_OUTPUTS)).unwrap();
+    let (ii, oo) = (indices(&inputs), indices(&outputs));
+    let lin = Linearization::new(&plant, &ss.x, &ss.u);
+    let g_lin = display(&lin.steady_gain(&ii, &oo).unwrap(), &inputs, &outputs);
+    let p = perturb_gains(&plant, &ss.x, &ss.u, &ii, &oo, &PerturbSettings::default()).unwrap();
+    let g_pert = display(&p.gain, &inputs, &outputs);
+    // Two independent routes: exact Jacobians + one sparse LU, and re-converged nonlinear steady
+    // states. Central differences err by ~1e4·step² here (1.5e-6 at step 1e-5).
+    assert!(max_rel_diff(&g_pert, &g_lin) < 1e-3, "linear {g_lin:?} vs perturb {g_pert:?}");
+    assert!(max_rel_diff(&g_pert, &g_lin) < 1e-5, "the default step should agree far better than 0.1 %");
+    assert!(p.error_ratio < 1e-6);
+    let cola = Mat::from_fn(2, 2, |i, j| [[0.8780, -0.8644], [1.0819, -1.0958]][i][j]);
+    let published = Mat::from_fn(2, 2, |i, j| [[0.878, -0.864], [1.082, -1.096]][i][j]);
+    assert!(max_rel_diff(&g_lin, &cola) < 0.01, "{g_lin:?}");
+    assert!(max_rel_diff(&g_lin, &published) < 0.03, "{g_lin:?}");
+    let l11 = rga(g_lin.as_ref()).unwrap()[(0, 0)];
+    assert!((l11 - 35.1).abs() < 0.05 * 35.1, "λ11 = {l11}");
+}
+
+/// Three routes to G(0) on the full column must agree to round-off: −C J⁻¹ B, D − C A⁻¹ B of the
+/// eliminated state-space model, and the sparse complex solve of (jωM − J) at ω = 0; and the
+/// sparse G(jω) of the whole DAE equals the dense D + C (jωI − A)⁻¹ B.
+#[test]
+fn column_a_state_space_agrees_with_the_full_jacobian() {
+    let (plant, ss) = converge("column_a.json");
+    let inputs = select_inputs(&plant, &strings(&LV_INPUTS)).unwrap();
+    let outputs = select_outputs(&plant, &strings(&LV_OUTPUTS)).unwrap();
+    let (ii, oo) = (indices(&inputs), indices(&outputs));
+    let lin = Linearization::new(&plant, &ss.x, &ss.u);
+    let model = lin.state_space(&ii, &oo).unwrap();
+    assert_eq!(model.states.len(), 82, "41 stages × 2 component holdups");
+    let g = lin.steady_gain(&ii, &oo).unwrap();
+    assert!(max_rel_diff(&model.steady_gain().unwrap(), &g) < 1e-9);
+    let omegas = [0.0, 1e-4, 1e-2];
+    let responses = lin.frequency_response(&ii, &oo, &omegas).unwrap();
+    for (w, gw) in omegas.iter().zip(&responses) {
+        let dense = model.frequency_response(*w);
+        for i in 0..2 {
+            for j in 0..2 {
+                assert!((gw[(i, j)] - dense[(i, j)]).norm() < 1e-9 * dense[(i, j)].norm(), "ω = {w}");
+            }
+        }
+    }
+    assert!(max_rel_diff(&Mat::from_fn(2, 2, |i, j| responses[0][(i, j)].re), &g) < 1e-9);
+}
+
+/// The slowest mode of column A: S&P report a dominant time constant of 194 min for this column.
+#[test]
+fn column_a_slowest_time_constant_is_194_minutes() {
+    let (plant, ss) = converge("column_a.json");
+    let inputs = select_inputs(&plant, &strings(&LV_INPUTS)).unwrap();
+    let outputs = select_outputs(&plant, &strings(&LV_OUTPUTS)).unwrap();
+    let model = Linearization::new(&plant, &ss.x, &ss.u).state_space(&indices(&inputs), &indices(&outputs)).unwrap();
+    let tau = model.time_constants().unwrap();
+    assert!(model.unstable(1e-12).unwrap().is_empty());
+    let slowest_min = tau[0] / 60.0;
+    assert!((slowest_min - 194.0).abs() < 0.01 * 194.0, "τ = {slowest_min} min");
+    assert!(tau[1] / 60.0 < 20.0, "the second mode is much faster: {} min", tau[1] / 60.0);
+}
+
+/// Surge tank under PI level control (flowsheets/surge_tank.json), a closed form: with
+/// `a = Kc v_L / A` the level loop's poles are the roots of `s² + a s + a/τ_I`, the mixing mode
+/// (enthalpy) is `−F/M`; all inflow leaves (gain 1) and the level returns to its setpoint (gain 0).
+#[test]
+fn surge_tank_eigenvalues_and_gains_match_the_closed_form() {
+    let (plant, ss) = converge("surge_tank.json");
+    let inputs = select_inputs(&plant, &strings(&["inflow.F"])).unwrap();
+    let outputs = select_outputs(&plant, &strings(&["tank.level", "out.F"])).unwrap();
+    let lin = Linearization::new(&plant, &ss.x, &ss.u);
+    let g = lin.steady_gain(&indices(&inputs), &indices(&outputs)).unwrap();
+    assert!(g[(0, 0)].abs() < 1e-12 && (g[(1, 0)] - 1.0).abs() < 1e-12, "{g:?}");
+    let model = lin.state_space(&indices(&inputs), &indices(&outputs)).unwrap();
+    let (m, v, f) = (value(&plant, &ss.x, "tank.M"), value(&plant, &ss.x, "tank.V"), value(&plant, &ss.x, "out.F"));
+    // Parameters as the file gives them (vertical cylinder; PI gain and reset time).
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(flowsheet("surge_tank.json")).unwrap()).unwrap();
+    let si = |v: &serde_json::Value| plantwide::units::parse_quantity(v.as_str().unwrap()).unwrap().value_si;
+    let diameter = si(&doc["units"]["tank"]["diameter"]);
+    let area = std::f64::consts::PI * diameter * diameter / 4.0;
+    let (kc, tau_i) =
+        (si(&doc["controllers"]["level_control"]["kc"]), si(&doc["controllers"]["level_control"]["tau_i"]));
+    let a = kc * (v / m) / area;
+    let disc = c64::new(a * a - 4.0 * a / tau_i, 0.0).sqrt();
+    let mut expected =
+        [(c64::new(-a, 0.0) + disc) / 2.0, (c64::new(-a, 0.0) - disc) / 2.0, c64::new(-f / m, 0.0)].to_vec();
+    let mut got = model.eigenvalues().unwrap();
+    assert_eq!(got.len(), 3, "states: water holdup, internal energy, controller integral");
+    let key = |l: &c64| (l.re, l.im);
+    expected.sort_by(|p, q| key(p).partial_cmp(&key(q)).unwrap());
+    got.sort_by(|p, q| key(p).partial_cmp(&key(q)).unwrap());
+    for (e, g) in expected.iter().zip(&got) {
+        assert!((e - g).norm() < 1e-9 * e.norm(), "expected {expected:?}, got {got:?}");
+    }
+}
+
+/// Wood & Berry (1973) from flowsheets/transfer_functions/wood_berry.tf.json: λ11 ≈ 2.01 (validation-cases.md §3),
+/// and the Niederlinski index by hand: NI = det G(0) / (g11 g22).
+#[test]
+fn wood_berry_relative_gain_and_niederlinski_index() {
+    let text = std::fs::read_to_string(flowsheet("transfer_functions/wood_berry.tf.json")).unwrap();
+    let model = TfModel::parse(&text, "wood_berry.tf.json").unwrap();
+    let g = model.gain();
+    let l = rga(g.as_ref()).unwrap();
+    assert!((l[(0, 0)] - 2.01).abs() < 0.005, "λ11 = {}", l[(0, 0)]);
+    let hand = (12.8 * -19.4 - -18.9 * 6.6) / (12.8 * -19.4);
+    assert!((niederlinski(g.as_ref(), &[0, 1]).unwrap() - hand).abs() < 1e-14);
+    assert!((hand - 0.4977).abs() < 1e-4);
+    // The off-diagonal pairing is the one with negative relative gains: NI < 0.
+    assert!(niederlinski(g.as_ref(), &[1, 0]).unwrap() < 0.0);
+    // Dead times only rotate phases: |g12(jω)| = 18.9/|1 + 21jω| (ω in rad/min).
+    let w = 0.05 / 60.0;
+    assert!((model.response(w)[(0, 1)].norm() - 18.9 / c64::new(1.0, 21.0 * 60.0 * w).norm()).abs() < 1e-12);
+}
+
+/// A sweep by continuation lands on the same steady states as independent cold starts.
+#[test]
+fn column_a_sensitivity_sweep_matches_cold_starts() {
+    let (plant, ss) = converge("column_a.json");
+    let d = Disturbance::parse(&plant, &ss.u, "feed_source.F=-10%:+10%").unwrap();
+    assert!((d.low - 0.9 * 1000.0 / 60.0).abs() < 1e-9 && (d.high - 1.1 * 1000.0 / 60.0).abs() < 1e-9);
+    let out = select_outputs(&plant, &strings(&["bottoms.x[light]"])).unwrap();
+    let curves =
+        sweep(&plant, &ss.x, &ss.u, &[d], &indices(&out), &SweepSettings { points: 3, ..SweepSettings::default() })
+            .unwrap();
+    let c = &curves[0];
+    assert!(c.failures.is_empty());
+    assert_eq!(c.values.len(), 3, "−10 %, base, +10 %");
+    for (v, y) in c.values.iter().zip(&c.outputs) {
+        let mut u = ss.u.clone();
+        u[c.disturbance.signal.index] = *v;
+        let cold = steady_state(&plant, &u, None, &NewtonSettings::default()).unwrap();
+        let yc = value(&plant, &cold.x, "bottoms.x[light]");
+        assert!((y.as_ref().unwrap()[0] - yc).abs() < 1e-9 * yc, "F = {v}: {y:?} vs {yc}");
+    }
+    // More feed with L and V fixed sends light component down: xB rises.
+    assert!(c.outputs[2].as_ref().unwrap()[0] > c.outputs[1].as_ref().unwrap()[0]);
+}
+
+/// Stage-temperature gains from the linearization agree with perturbation gains, and the slope
+/// criterion finds the steepest step of the profile.
+#[test]
+fn column_a_temperature_sensor_selection() {
+    let (plant, ss) = converge("column_a.json");
+    let inputs = select_inputs(&plant, &strings(&LV_INPUTS)).unwrap();
+    let s = select_temperature_sensors(&plant, &ss.x, &ss.u, "column", &inputs).unwrap();
+    assert_eq!(s.stages, (1..=41).collect::<Vec<_>>());
+    let stages = ["column.T[10]", "column.T[15]", "column.T[30]"];
+    let outs = select_outputs(&plant, &strings(&stages)).unwrap();
+    let p =
+        perturb_gains(&plant, &ss.x, &ss.u, &indices(&inputs), &indices(&outs), &PerturbSettings::default()).unwrap();
+    let p = display(&p.gain, &inputs, &outs);
+    for (k, stage) in [10usize, 15, 30].iter().enumerate() {
+        for j in 0..2 {
+            let lin = s.gains[(stage - 1, j)];
+            assert!((lin - p[(k, j)]).abs() < 1e-4 * lin.abs(), "stage {stage}: {lin} vs {}", p[(k, j)]);
+        }
+    }
+    let steepest = (1..41).max_by(|&a, &b| {
+        let d = |i: usize| (s.temperatures[i] - s.temperatures[i - 1]).abs();
+        d(a).total_cmp(&d(b))
+    });
+    assert_eq!(Some(s.slope.0.1), steepest.map(|i| i + 1));
+    assert_eq!(s.svd_stages.len(), 2);
+    assert_ne!(s.svd_stages[0], s.svd_stages[1]);
+    // The first singular direction (both inputs moving together, the "large gain" direction) sits
+    // in the stripping section below the feed (stage 21), the second above it.
+    assert!(s.svd_stages[0] < 21 && s.svd_stages[1] > 21, "{:?}", s.svd_stages);
+}
+
+#[test]
+fn gains_json_has_exactly_the_documented_shape() {
+    let file = flowsheet("column_a.json");
+    for method in ["linear", "perturb"] {
+        let out = plantwide(&[
+            "gains",
+            &file,
+            "--inputs",
+            &LV_INPUTS.join(","),
+            "--outputs",
+            &LV_OUTPUTS.join(","),
+            "--method",
+            method,
+            "--json",
+        ]);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let keys: Vec<&str> = v.as_object().unwrap().keys().map(String::as_str).collect();
+        let mut sorted = keys.clone();
+        sorted.sort_unstable();
+        assert_eq!(
+            sorted,
+            ["condition_number", "gain", "inputs", "method", "niederlinski", "outputs", "rga", "singular_values"]
+        );
+        assert_eq!(v["method"], method);
+        assert_eq!(v["inputs"][0]["path"], "column.reflux");
+        assert_eq!(v["inputs"][0]["unit"], "kmol/min");
+        assert_eq!(v["outputs"][1]["path"], "bottoms.x[light]");
+        let g11 = v["gain"][0][0].as_f64().unwrap();
+        assert!((g11 - 0.8754).abs() < 1e-3, "g11 = {g11} (kmol/min units)");
+        let l11 = v["rga"][0][0].as_f64().unwrap();
+        let ni = v["niederlinski"].as_f64().unwrap();
+        assert!((ni * l11 - 1.0).abs() < 1e-9, "for 2×2, NI = 1/λ11");
+        assert_eq!(v["singular_values"].as_array().unwrap().len(), 2);
+        assert!(v["condition_number"].as_f64().unwrap() > 100.0);
+    }
+    let text = String::from_utf8(
+        plantwide(&["gains", "--tf", &flowsheet("transfer_functions/wood_berry.tf.json"), "--json"]).stdout,
+    )
+    .unwrap();
+    let order = [
+        "\"method\"",
+        "\"inputs\"",
+        "\"outputs\"",
+        "\"gain\"",
+        "\"rga\"",
+        "\"singular_values\"",
+        "\"condition_number\"",
+        "\"niederlinski\"",
+    ];
+    let at: Vec<usize> = order.iter().map(|k| text.find(k).unwrap()).collect();
+    assert!(at.windows(2).all(|w| w[0] < w[1]), "keys in the documented order:\n{text}");
+}
+
+#[test]
+fn gains_requests_that_cannot_work_are_user_errors() {
+    let file = flowsheet("column_a.json");
+    let cases: [(&[&str], &[&str]); 4] = [
+        (
+            &["--inputs", "column.reflx", "--outputs", "distillate.x[light]"],
+            &["no input `column.reflx`", "did you mean `column.reflux`"],
+        ),
+        (
+            &["--inputs", "column.distillate", "--outputs", "distillate.x[light]"],
+            &["driven by controller `condenser_level`", "condenser_level.sp"],
+        ),
+        (
+            &["--inputs", "column.reflux@degC", "--outputs", "distillate.x[light]"],
+            &["column.reflux@degC", "is a molar flow"],
+        ),
+        (
+            &["--inputs", "column.reflux", "--outputs", "distillate.x[lite]"],
+            &["no variable `distillate.x[lite]`", "did you mean"],
+        ),
+    ];
+    for (args, fragments) in cases {
+        let mut all = vec!["gains", file.as_str()];
+        all.extend_from_slice(args);
+        let out = plantwide(&all);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {stderr}");
+        for f in fragments {
+            assert!(stderr.contains(f), "{args:?}: missing `{f}` in {stderr}");
+        }
+    }
+}
+
+#[test]
+fn linearize_exports_a_model_python_control_can_read() {
+    let dir = std::env::temp_dir().join(format!("plantwide-linearize-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("model.json");
+    let out = plantwide(&[
+        "linearize",
+        &flowsheet("column_a.json"),
+        "--inputs",
+        &LV_INPUTS.join(","),
+        "--outputs",
+        &LV_OUTPUTS.join(","),
+        "--out",
+        path.to_str().unwrap(),
+        "--time-unit",
+        "min",
+        "--frequencies",
+        "0.01:0.1:2",
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let m: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    let mat = |k: &str| {
+        let rows = m[k].as_array().unwrap();
+        let ncols = rows[0].as_array().unwrap().len();
+        Mat::from_fn(rows.len(), ncols, |i, j| rows[i][j].as_f64().unwrap())
+    };
+    let (a, b, c, d) = (mat("A"), mat("B"), mat("C"), mat("D"));
+    assert_eq!((a.nrows(), b.ncols(), c.nrows(), d.ncols()), (82, 2, 2, 2));
+    assert_eq!(m["states"].as_array().unwrap().len(), 82);
+    // The exported frequency response (from the sparse DAE) equals D + C (jωI − A)⁻¹ B of the
+    // exported matrices, in the exported units (ω in rad/min).
+    for r in m["frequency_response"].as_array().unwrap() {
+        let w = r["omega"].as_f64().unwrap();
+        let lhs = Mat::from_fn(82, 82, |i, j| c64::new(-a[(i, j)], if i == j { w } else { 0.0 }));
+        let rhs = Mat::from_fn(82, 2, |i, j| c64::new(b[(i, j)], 0.0));
+        let x = lhs.partial_piv_lu().solve(&rhs);
+        for i in 0..2 {
+            for j in 0..2 {
+                let g: c64 = (0..82).map(|k| x[(k, j)] * c[(i, k)]).sum::<c64>() + c64::new(d[(i, j)], 0.0);
+                let exported = c64::new(r["re"][i][j].as_f64().unwrap(), r["im"][i][j].as_f64().unwrap());
+                assert!((g - exported).norm() < 1e-8 * g.norm(), "ω = {w} rad/min: {g:?} vs {exported:?}");
+            }
+        }
+    }
+    let tc = m["time_constants"][0].as_f64().unwrap();
+    assert!((tc - 194.0).abs() < 2.0, "slowest time constant {tc} min");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn sensitivity_writes_csv_and_plots() {
+    let dir = std::env::temp_dir().join(format!("plantwide-sensitivity-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let csv = dir.join("s.csv");
+    for ext in ["png", "svg"] {
+        let plot = dir.join(format!("s.{ext}"));
+        let out = plantwide(&[
+            "sensitivity",
+            &flowsheet("column_a.json"),
+            "--disturb",
+            "feed_source.F=-5%:+5%",
+            "--disturb",
+            "feed_source.z[light]=0.48:0.52",
+            "--outputs",
+            "bottoms.x[light],distillate.x[light]",
+            "--points",
+            "3",
+            "--csv",
+            csv.to_str().unwrap(),
+            "--plot",
+            plot.to_str().unwrap(),
+        ]);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let bytes = std::fs::read(&plot).unwrap();
+        match ext {
+            "png" => assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n"),
+            _ => assert!(
+                String::from_utf8_lossy(&bytes).contains("<svg")
+                    && String::from_utf8_lossy(&bytes).contains("feed_source.F")
+            ),
+        }
+    }
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines[0], "disturbance,unit,value,change_percent,bottoms.x[light] [-],distillate.x[light] [-]");
+    assert_eq!(lines.len(), 1 + 3 + 3, "header, 3 points per disturbance (the base is one of them)");
+    let base: Vec<&str> = lines[2].split(',').collect();
+    assert_eq!(base[0], "feed_source.F");
+    assert_eq!(base[3].parse::<f64>().unwrap(), 0.0);
+    assert!((base[4].parse::<f64>().unwrap() - 0.01).abs() < 1e-6, "xB at the base case");
+    let bad = plantwide(&[
+        "sensitivity",
+        &flowsheet("column_a.json"),
+        "--disturb",
+        "feed_source.F=10%",
+        "--outputs",
+        "bottoms.x[light]",
+    ]);
+    assert_eq!(bad.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("LOW:HIGH"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}

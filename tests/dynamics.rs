@@ -1,0 +1,519 @@
+//! Dynamic simulation against closed forms and steady states: the surge tank's PI (second-order)
+//! and P-only (first-order) level responses, column A's response to a feed step (final state =
+//! the new steady state, time constant, conservation, step count), event timing, controller
+//! mode switches and failures, sampled controllers and analyzers, and snapshot → resume.
+
+mod common;
+
+use plantwide::flowsheet::overrides::{set_field, set_input};
+use plantwide::flowsheet::scenario::{parse_scenario, resolve};
+use plantwide::flowsheet::{FlowsheetSpec, Plant, assemble, parse_spec};
+use plantwide::solve::dynamic::{Progress, SimulationResult, Snapshot, Start, simulate};
+use plantwide::solve::{NewtonSettings, steady_state};
+
+use common::flowsheet;
+
+/// Load a shipped flowsheet with `--set`-style field overrides, converge it, run `scenario`.
+fn run(name: &str, fields: &[(&str, &str)], scenario: &str) -> (Plant, Vec<f64>, SimulationResult) {
+    let (mut plant, x0) = converged(name, fields);
+    let res = run_from(&mut plant, scenario, Start::Steady(&x0), &mut |_| {});
+    (plant, x0, res)
+}
+
+fn converged(name: &str, fields: &[(&str, &str)]) -> (Plant, Vec<f64>) {
+    let path = flowsheet(name);
+    let text = std::fs::read_to_string(&path).unwrap();
+    let mut spec: FlowsheetSpec = parse_spec(&text, &path).unwrap();
+    for (p, v) in fields {
+        set_field(&mut spec, p, v).unwrap();
+    }
+    let plant = assemble(&spec, &path).unwrap();
+    let ss = steady_state(&plant, &plant.input_values(), None, &NewtonSettings::default()).unwrap();
+    (plant, ss.x)
+}
+
+fn run_from(
+    plant: &mut Plant,
+    scenario: &str,
+    start: Start<'_>,
+    observer: &mut dyn FnMut(Progress<'_>),
+) -> SimulationResult {
+    let spec = parse_scenario(scenario, "scenario.json").unwrap_or_else(|e| panic!("{e}"));
+    let sc = resolve(&spec, plant, "scenario.json").unwrap_or_else(|e| panic!("{e}"));
+    simulate(plant, &sc, start, "test", observer).unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn column(res: &SimulationResult, path: &str) -> Vec<f64> {
+    let k = res.columns.iter().position(|c| c.path == path).unwrap_or_else(|| panic!("no column {path}"));
+    res.rows.iter().map(|r| r[k]).collect()
+}
+
+/// Surge tank, level loop, step of the inflow by dF at t_s: deviation of level and outflow.
+/// `v = v_L/A` [m/mol] is the level per mole; `kc` [mol/s/m]; `tau_i` [s] (None: P only).
+fn tank_closed_form(t: f64, v: f64, kc: f64, tau_i: Option<f64>, df: f64) -> (f64, f64) {
+    let a = v * kc;
+    match tau_i {
+        // h' = v(dF − Kc h): h = dF/Kc (1 − e^{−a t}), F_out − F0 = dF (1 − e^{−a t}).
+        None => (df / kc * (1.0 - (-a * t).exp()), df * (1.0 - (-a * t).exp())),
+        // h'' + a h' + (a/τ_I) h = 0, h(0) = 0, h'(0) = v dF (underdamped here):
+        // h = (v dF/ω) e^{−σt} sin ωt; F_out = F_in − h'/v.
+        Some(ti) => {
+            let (sigma, omega) = (a / 2.0, (a / ti - a * a / 4.0).sqrt());
+            assert!(omega.is_finite() && omega > 0.0, "the test case is underdamped");
+            let e = (-sigma * t).exp();
+            let h = v * df / omega * e * (omega * t).sin();
+            let dh = v * df * e * ((omega * t).cos() - sigma / omega * (omega * t).sin());
+            (h, df - dh / v)
+        }
+    }
+}
+
+const TANK_STEP: &str = r#"{"format_version": 1, "duration": "2500 s",
+    "integrator": {"rtol": 1e-10, "atol": 1e-12},
+    "events": [{"type": "step", "at": "100 s", "path": "F_in", "to": "60 mol/s"}],
+    "record": {"interval": "5 s", "time_unit": "s", "paths": ["tank.level", "out.F", "tank.M"]}}"#;
+
+fn check_tank(fields: &[(&str, &str)], tau_i: Option<f64>) {
+    let (plant, x0, res) = run("surge_tank_pi.json", fields, TANK_STEP);
+    let (kc, df, t_s) = (50.0, 10.0, 100.0);
+    // Level per mole from the model's own liquid volume at the (constant) tank temperature.
+    let v = common::value(&plant, &x0, "tank.level") / common::value(&plant, &x0, "tank.M");
+    let (level, out) = (column(&res, "tank.level"), column(&res, "out.F"));
+    let (mut err_h, mut err_f): (f64, f64) = (0.0, 0.0);
+    for (i, &t) in res.times.iter().enumerate() {
+        let (h, f) = if t < t_s || (t == t_s && i + 1 < res.times.len() && res.times[i + 1] == t_s) {
+            (0.0, 0.0)
+        } else {
+            tank_closed_form(t - t_s, v, kc, tau_i, df)
+        };
+        err_h = err_h.max((level[i] - 1.0 - h).abs());
+        err_f = err_f.max((out[i] - 50.0 - f).abs());
+    }
+    eprintln!("tank τ_I = {tau_i:?}: max |Δlevel| {err_h:.2e} m, max |Δoutflow| {err_f:.2e} mol/s; {:?}", res.stats);
+    // 1e-6 of the response's own scale: dF/Kc = 0.2 m of level, dF = 10 mol/s of outflow.
+    assert!(err_h < 1e-6 * df / kc, "level error {err_h}");
+    assert!(err_f < 1e-6 * df, "outflow error {err_f}");
+}
+
+#[test]
+fn surge_tank_pi_level_follows_the_second_order_closed_form() {
+    check_tank(&[], Some(200.0));
+}
+
+#[test]
+fn surge_tank_p_only_level_follows_the_first_order_closed_form() {
+    check_tank(&[("lc.tau_i", "null")], None);
+}
+
+#[test]
+fn events_land_exactly_on_their_times() {
+    let (_, _, res) = run(
+        "surge_tank_pi.json",
+        &[],
+        r#"{"format_version": 1, "duration": "1000 s",
+        "events": [{"type": "step", "at": "100.3 s", "path": "F_in", "by": "5 mol/s"},
+                   {"type": "pulse", "at": "1.7 min", "path": "lc.sp", "by": "0.1 m", "width": "33.3 s"},
+                   {"type": "ramp", "at": "400 s", "path": "F_in", "to": "40 mol/s", "duration": "77.7 s"}],
+        "record": {"interval": "50 s", "time_unit": "s", "paths": ["tank.level", "F_in", "lc.sp"]}}"#,
+    );
+    let want = [100.3, 102.0, 102.0 + 33.3, 400.0, 400.0 + 77.7];
+    let got: Vec<f64> = res.events.iter().map(|e| e.0).collect();
+    assert_eq!(got, want, "event times are hit exactly");
+    // A row just before and just after each scenario event, at exactly its time.
+    for t in want {
+        assert_eq!(res.times.iter().filter(|&&r| r == t).count(), 2, "rows at {t}");
+    }
+    let f_in = column(&res, "F_in");
+    let k = res.times.iter().rposition(|&t| t == 400.0 + 77.7).unwrap();
+    assert_eq!(f_in[k], 40.0, "the ramp ends on its target");
+}
+
+const COLUMN_A_STEP: &str = r#"{"format_version": 1, "duration": "2000 min",
+    "events": [{"type": "step", "at": "0 min", "path": "feed_source.F", "to": "1.01 kmol/min"}],
+    "record": {"interval": "1 min", "paths": ["bottoms.x[light]", "distillate.x[light]", "column.M[1]", "column.M[41]"],
+               "totals": ["feed", "distillate", "bottoms"]}}"#;
+
+/// Column A (S&P 2005 §12.4), LV with P level loops, feed 1 → 1.01 kmol/min at t = 0.
+#[test]
+fn column_a_feed_step_settles_on_the_new_steady_state_with_a_200_min_time_constant() {
+    let (plant, x0, res) = run("column_a.json", &[], COLUMN_A_STEP);
+    // The steady state at F = 1.01 kmol/min, as `plantwide steady --set feed_source.F=1.01kmol/min`.
+    let mut u = plant.input_values();
+    assert!(set_input(&plant, &mut u, "feed_source.F", "1.01 kmol/min").unwrap());
+    let ss = steady_state(&plant, &u, Some(&x0), &NewtonSettings::default()).unwrap();
+    let xb = column(&res, "bottoms.x[light]");
+    let yd = column(&res, "distillate.x[light]");
+    let (xb_ss, yd_ss) =
+        (common::value(&plant, &ss.x, "bottoms.x[light]"), common::value(&plant, &ss.x, "distillate.x[light]"));
+    let (xb_end, yd_end) = (*xb.last().unwrap(), *yd.last().unwrap());
+    eprintln!("xB {xb_end:.9} vs {xb_ss:.9}, yD {yd_end:.9} vs {yd_ss:.9}; {:?}", res.stats);
+    assert!((xb_end - xb_ss).abs() < 1e-6 && (yd_end - yd_ss).abs() < 1e-6);
+    // First-order-like: 63.2 % of the change at τ, 86.5 % at 2τ, and τ near 200 min (S&P: 194 min).
+    let xb0 = xb[0];
+    let reach = |frac: f64| {
+        let target = xb0 + frac * (xb_end - xb0);
+        let i = (1..xb.len()).find(|&i| (xb[i] - target) * (xb_end - xb0) >= 0.0).unwrap();
+        let (t0, t1) = (res.times[i - 1], res.times[i]);
+        (t0 + (t1 - t0) * (target - xb[i - 1]) / (xb[i] - xb[i - 1])) / 60.0
+    };
+    let (tau, t86) = (reach(1.0 - (-1.0f64).exp()), reach(1.0 - (-2.0f64).exp()));
+    eprintln!("xB: 63 % at {tau:.1} min, 86 % at {t86:.1} min (2τ = {:.1})", 2.0 * tau);
+    assert!((170.0..230.0).contains(&tau), "time constant {tau} min");
+    assert!((t86 / (2.0 * tau) - 1.0).abs() < 0.1, "first-order-like: 86 % at {t86} min vs 2τ = {}", 2.0 * tau);
+    // The stiff case (τL = 0.063 min against a 200 min composition mode) in few steps.
+    assert!(res.stats.n_steps < 2000, "{:?}", res.stats);
+}
+
+/// Component inventories: Δ(Σ stage holdups) = ∫(feed − distillate − bottoms) dt, the integrals
+/// taken by the integrator's own BDF formula as quadratures.
+#[test]
+fn column_a_conserves_component_inventories() {
+    let (plant, x0, res) = run("column_a.json", &[], COLUMN_A_STEP);
+    let x = &res.x;
+    for c in ["light", "heavy"] {
+        let holdup =
+            |x: &[f64]| (1..=41).map(|s| common::value(&plant, x, &format!("column.n[{s}][{c}]"))).sum::<f64>();
+        let total = |s: &str| *column(&res, &format!("{s}.total[{c}]")).last().unwrap();
+        let net = total("feed") - total("distillate") - total("bottoms");
+        let change = holdup(x) - holdup(&x0);
+        let rel = (change - net).abs() / total("feed");
+        eprintln!(
+            "{c}: Δholdup {change:.6} mol, ∫(in − out) {net:.6} mol, fed {:.1} mol: relative gap {rel:.1e}",
+            total("feed")
+        );
+        assert!(rel < 1e-8 && (change - net).abs() < 1e-8 * change.abs().max(1.0), "{c}: {change} vs {net}");
+    }
+}
+
+/// Snapshot at 700 min → JSON → resume: the same trajectory as the uninterrupted run (bit for
+/// bit: the snapshot holds the BDF history and Jacobian). A resume with a retuned level loop
+/// (changed fingerprint) restarts from the same state and settles on the same compositions.
+#[test]
+fn snapshot_and_resume_continue_the_uninterrupted_trajectory() {
+    let scenario = COLUMN_A_STEP.replace(
+        r#""duration": "2000 min","#,
+        r#""duration": "1200 min", "snapshots": [{"at": "700 min", "file": "snap.json"}],"#,
+    );
+    let (mut plant, x0) = converged("column_a.json", &[]);
+    let mut saved = None;
+    let full = run_from(&mut plant, &scenario, Start::Steady(&x0), &mut |p| {
+        if let Progress::Snapshot { file, snapshot } = p {
+            assert_eq!(file, "snap.json");
+            saved = Some(serde_json::to_string(snapshot).unwrap());
+        }
+    });
+    let snap: Snapshot = serde_json::from_str(&saved.expect("snapshot taken")).unwrap();
+    assert!(snap.t >= 700.0 * 60.0 && snap.t < 800.0 * 60.0, "{}", snap.t);
+    let (mut plant2, _) = converged("column_a.json", &[]);
+    let resumed = run_from(&mut plant2, &scenario, Start::Snapshot(&snap), &mut |_| {});
+    let mut compared = 0;
+    let mut worst: f64 = 0.0;
+    for (i, t) in resumed.times.iter().enumerate() {
+        let j = full.times.iter().position(|u| u == t).unwrap_or_else(|| panic!("time {t} not in the full run"));
+        for (a, b) in resumed.rows[i].iter().zip(&full.rows[j]) {
+            worst = worst.max((a - b).abs() / b.abs().max(1e-3));
+        }
+        compared += 1;
+    }
+    eprintln!("resumed at {:.3} min: {compared} rows, largest relative difference {worst:.1e}", snap.t / 60.0);
+    assert!(compared > 400 && worst <= 1e-10, "{compared} rows, {worst}");
+    // Retuned: Kc of the reboiler level loop doubled for the rest of the run.
+    let (mut plant3, _) = converged("column_a.json", &[("reboiler_level.kc", "\"20 kmol/min/kmol\"")]);
+    let spec = parse_scenario(&scenario, "s.json").unwrap();
+    let sc = resolve(&spec, &plant3, "s.json").unwrap();
+    let retuned = simulate(&mut plant3, &sc, Start::Snapshot(&snap), "retuned", &mut |_| {}).unwrap();
+    assert!(retuned.stats.n_restarts >= 1);
+    let xb = column(&retuned, "bottoms.x[light]");
+    let xb_full = column(&full, "bottoms.x[light]");
+    let diff = (xb.last().unwrap() - xb_full.last().unwrap()).abs();
+    eprintln!("retuned resume: xB(end) differs by {diff:.2e}");
+    assert!(diff < 1e-6, "level tuning does not move the compositions' steady state: {diff}");
+}
+
+/// Level per mole `v` of the surge tank and its initial state.
+fn tank(fields: &[(&str, &str)]) -> (Plant, Vec<f64>, f64) {
+    let (plant, x0) = converged("surge_tank_pi.json", fields);
+    let v = common::value(&plant, &x0, "tank.level") / common::value(&plant, &x0, "tank.M");
+    (plant, x0, v)
+}
+
+/// Manual at 100 s (bumpless), inflow +10 mol/s at 200 s: the level ramps at v·10 m/s exactly;
+/// back to auto at 500 s, the PI loop returns the level to its setpoint (the integral tracked the
+/// manual output with lag τ_I, so the return bumps by about τ_I·Kc·de/dt while the level ramps).
+#[test]
+fn manual_mode_holds_the_output_and_auto_returns_to_setpoint() {
+    let (mut plant, x0, v) = tank(&[]);
+    let res = run_from(
+        &mut plant,
+        r#"{"format_version": 1, "duration": "3000 s", "integrator": {"rtol": 1e-9},
+        "events": [{"type": "mode", "at": "100 s", "controller": "lc", "mode": "manual"},
+                   {"type": "step", "at": "200 s", "path": "F_in", "to": "60 mol/s"},
+                   {"type": "mode", "at": "500 s", "controller": "lc", "mode": "auto"}],
+        "record": {"interval": "10 s", "time_unit": "s", "paths": ["tank.level", "out.F", "lc.op"]}}"#,
+        Start::Steady(&x0),
+        &mut |_| {},
+    );
+    let (level, out) = (column(&res, "tank.level"), column(&res, "out.F"));
+    let mut worst: f64 = 0.0;
+    for (i, &t) in res.times.iter().enumerate().filter(|(_, t)| (100.0..500.0).contains(*t)) {
+        assert!((out[i] - 50.0).abs() < 1e-9, "manual output held at {t}: {}", out[i]);
+        worst = worst.max((level[i] - (1.0 + v * 10.0 * (t - 200.0).max(0.0))).abs());
+    }
+    assert!(worst < 1e-9, "level ramp {worst}");
+    assert!((level.last().unwrap() - 1.0).abs() < 1e-3 && (out.last().unwrap() - 60.0).abs() < 1e-2);
+}
+
+/// The outflow's flow setpoint sticks at 200 s; the inflow then rises: the level ramps exactly
+/// while the controller's output (driving nothing any more) winds up.
+#[test]
+fn stuck_valve_freezes_the_input_and_the_controller_winds_up() {
+    // Continuous, and scanned every 5 s (the scan must not move a stuck input either).
+    for sampling in ["{}", r#"{"lc": "5 s"}"#] {
+        let (mut plant, x0, v) = tank(&[]);
+        let scenario = r#"{"format_version": 1, "duration": "600 s", "integrator": {"rtol": 1e-9},
+            "events": [{"type": "valve_stuck", "at": "100 s", "path": "tank.outflow"},
+                       {"type": "step", "at": "200 s", "path": "F_in", "to": "60 mol/s"}],
+            "sampling": SAMPLING,
+            "record": {"interval": "10 s", "time_unit": "s", "paths": ["tank.level", "out.F", "lc.op"]}}"#;
+        let res = run_from(&mut plant, &scenario.replace("SAMPLING", sampling), Start::Steady(&x0), &mut |_| {});
+        let (level, out, op) = (column(&res, "tank.level"), column(&res, "out.F"), column(&res, "lc.op"));
+        let n = level.len() - 1;
+        assert!(out.iter().all(|f| (f - 50.0).abs() < 1e-9), "outflow frozen ({sampling})");
+        assert!((level[n] - (1.0 + v * 10.0 * 400.0)).abs() < 1e-9, "{}", level[n]);
+        assert!(op[n] > 60.0, "the PI output keeps rising: {}", op[n]);
+    }
+}
+
+/// Feed lost at 100 s with a P-only loop: the first-order closed form with dF = −50 mol/s.
+#[test]
+fn feed_lost_drains_the_tank_along_the_first_order_closed_form() {
+    let (mut plant, x0, v) = tank(&[("lc.tau_i", "null")]);
+    let res = run_from(
+        &mut plant,
+        r#"{"format_version": 1, "duration": "1000 s", "integrator": {"rtol": 1e-10, "atol": 1e-12},
+        "events": [{"type": "feed_lost", "at": "100 s", "unit": "inflow"}],
+        "record": {"interval": "10 s", "time_unit": "s", "paths": ["tank.level", "feed.F"]}}"#,
+        Start::Steady(&x0),
+        &mut |_| {},
+    );
+    let level = column(&res, "tank.level");
+    let n = level.len() - 1;
+    let (h, _) = tank_closed_form(900.0, v, 50.0, None, -50.0);
+    assert!((level[n] - 1.0 - h).abs() < 1e-7, "{} vs {}", level[n], 1.0 + h);
+    assert!(column(&res, "feed.F").last().unwrap().abs() < 1e-12);
+}
+
+/// P-only loop scanned every 10 s: the pump setpoint is held between scans, so the level is
+/// piecewise linear: h_{k+1} = h_k + v T (F_in − F0 − Kc (h_k − sp)) (exact recurrence).
+#[test]
+fn sampled_controller_holds_its_output_between_scans() {
+    let (mut plant, x0, v) = tank(&[("lc.tau_i", "null")]);
+    let res = run_from(
+        &mut plant,
+        r#"{"format_version": 1, "duration": "600 s", "integrator": {"rtol": 1e-10, "atol": 1e-12},
+        "events": [{"type": "step", "at": "0 s", "path": "F_in", "to": "60 mol/s"}],
+        "sampling": {"lc": "10 s"},
+        "record": {"interval": "10 s", "time_unit": "s", "paths": ["tank.level", "out.F"]}}"#,
+        Start::Steady(&x0),
+        &mut |_| {},
+    );
+    let level = column(&res, "tank.level");
+    let mut h = 1.0;
+    let mut worst: f64 = 0.0;
+    for (i, &t) in res.times.iter().enumerate().skip(2) {
+        let k = (t / 10.0).round();
+        assert_eq!(t, k * 10.0);
+        h += v * 10.0 * (10.0 - 50.0 * (h - 1.0));
+        worst = worst.max((level[i] - h).abs());
+    }
+    assert!(worst < 1e-9, "{worst}");
+}
+
+/// Analyzer on the level (sample 20 s, dead time 30 s) with a P-only loop: the controller acts on
+/// h(kT) from kT + 30 s on; the level is piecewise linear between releases (exact recurrence).
+#[test]
+fn analyzer_samples_and_delays_the_measurement() {
+    let (mut plant, x0, v) = tank(&[("lc.tau_i", "null")]);
+    let res = run_from(
+        &mut plant,
+        r#"{"format_version": 1, "duration": "400 s", "integrator": {"rtol": 1e-10, "atol": 1e-12},
+        "events": [{"type": "step", "at": "0 s", "path": "F_in", "to": "60 mol/s"}],
+        "analyzers": {"lc": {"sample_time": "20 s", "dead_time": "30 s"}},
+        "record": {"interval": "10 s", "time_unit": "s", "paths": ["tank.level", "out.F"]}}"#,
+        Start::Steady(&x0),
+        &mut |_| {},
+    );
+    // Exact piecewise-linear solution on a 10 s grid (all sample and release times are on it).
+    let (mut h, mut held, mut queue) = (1.0, 1.0, Vec::new());
+    let mut exact = vec![(0.0, h)];
+    for k in 0..40 {
+        let t = k as f64 * 10.0;
+        if k % 2 == 0 {
+            queue.push((t + 30.0, h));
+        }
+        if let Some(p) = queue.iter().position(|&(r, _)| r <= t) {
+            held = queue.remove(p).1;
+        }
+        h += v * 10.0 * (10.0 - 50.0 * (held - 1.0));
+        exact.push((t + 10.0, h));
+    }
+    let level = column(&res, "tank.level");
+    let mut worst: f64 = 0.0;
+    for (i, &t) in res.times.iter().enumerate() {
+        if let Some(&(_, h)) = exact.iter().find(|(te, _)| *te == t) {
+            worst = worst.max((level[i] - h).abs());
+        }
+    }
+    assert!(worst < 1e-9, "{worst}");
+}
+
+/// The surge tank with extra controllers (JSON object of name → description) added to the file.
+fn tank_with(controllers: serde_json::Value) -> (Plant, Vec<f64>) {
+    let path = flowsheet("surge_tank_pi.json");
+    let mut doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    let map = doc["controllers"].as_object_mut().unwrap();
+    for (k, v) in controllers.as_object().unwrap() {
+        map.insert(k.clone(), v.clone());
+    }
+    let spec = parse_spec(&doc.to_string(), &path).unwrap_or_else(|e| panic!("{e}"));
+    let plant = assemble(&spec, &path).unwrap_or_else(|e| panic!("{e}"));
+    let ss = steady_state(&plant, &plant.input_values(), None, &NewtonSettings::default()).unwrap();
+    (plant, ss.x)
+}
+
+/// A first-order lag on the inflow, with and without a rate limit, after a step of 10 mol/s:
+/// `op = u − Δ e^{−t/τ}`; rate-limited at r, it ramps at r until `u − op = rτ`, then lags.
+#[test]
+fn lag_and_rate_limit_follow_their_closed_forms() {
+    let (mut plant, x0) = tank_with(serde_json::json!({
+        "lag": {"type": "lag", "pv": "feed.F", "tau": "20 s"},
+        "slow": {"type": "lag", "pv": "feed.F", "tau": "20 s", "rate_limit": "0.1 mol/s/s"}
+    }));
+    let res = run_from(
+        &mut plant,
+        r#"{"format_version": 1, "duration": "300 s", "integrator": {"rtol": 1e-10, "atol": 1e-12},
+        "events": [{"type": "step", "at": "0 s", "path": "F_in", "by": "10 mol/s"}],
+        "record": {"interval": "1 s", "time_unit": "s", "paths": ["lag.op", "slow.op"]}}"#,
+        Start::Steady(&x0),
+        &mut |_| {},
+    );
+    let (lag, slow) = (column(&res, "lag.op"), column(&res, "slow.op"));
+    let (tau, r, du) = (20.0, 0.1, 10.0);
+    let t1 = (du - r * tau) / r;
+    let (mut e_lag, mut e_slow): (f64, f64) = (0.0, 0.0);
+    for (i, &t) in res.times.iter().enumerate().skip(2) {
+        e_lag = e_lag.max((lag[i] - (60.0 - du * (-t / tau).exp())).abs());
+        let want = if t <= t1 { 50.0 + r * t } else { 60.0 - r * tau * (-(t - t1) / tau).exp() };
+        e_slow = e_slow.max((slow[i] - want).abs());
+    }
+    eprintln!("lag error {e_lag:.1e}, rate-limited lag error {e_slow:.1e} mol/s");
+    assert!(e_lag < 1e-6 && e_slow < 1e-6, "{e_lag} {e_slow}");
+}
+
+/// Padé (4,4) dead time of 30 s on the inflow, driven by a sinusoid of period 600 s (ωθ = 0.31):
+/// once the filter's own transient has died out, the output is the input 30 s earlier (Padé
+/// phase error ~ (ωθ)⁹/(8! 9!), far below the integration tolerance; all-pass gain 1).
+#[test]
+fn pade_delay_delays_a_sinusoid_by_its_dead_time() {
+    let (mut plant, x0) =
+        tank_with(serde_json::json!({"dly": {"type": "delay", "pv": "feed.F", "delay": "30 s", "order": 4}}));
+    let res = run_from(
+        &mut plant,
+        r#"{"format_version": 1, "duration": "3000 s", "integrator": {"rtol": 1e-9, "atol": 1e-12},
+        "events": [{"type": "sinusoid", "at": "0 s", "path": "F_in", "amplitude": "5 mol/s", "period": "600 s"}],
+        "record": {"interval": "5 s", "time_unit": "s", "paths": ["dly.op"]}}"#,
+        Start::Steady(&x0),
+        &mut |_| {},
+    );
+    let out = column(&res, "dly.op");
+    let w = std::f64::consts::TAU / 600.0;
+    let worst = res
+        .times
+        .iter()
+        .zip(&out)
+        .filter(|(t, _)| **t >= 1000.0)
+        .map(|(t, y)| (y - (50.0 + 5.0 * (w * (t - 30.0)).sin())).abs())
+        .fold(0.0, f64::max);
+    eprintln!("Padé-4 delay: largest error {worst:.1e} mol/s on a 5 mol/s sinusoid");
+    assert!(worst < 1e-5 * 5.0, "{worst}");
+}
+
+/// `plantwide run`: CSV with units in the header, JSON summary, SVG plot, a snapshot written by
+/// the scenario and a resume from it that reproduces the rest of the CSV.
+#[test]
+fn cli_run_writes_csv_summary_plot_and_resumes_from_its_snapshot() {
+    use std::process::Command;
+    let dir = std::env::temp_dir().join(format!("plantwide_run_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let fs = flowsheet("surge_tank_pi.json");
+    let sc = flowsheet("scenarios/surge_tank_inflow_step.json");
+    let run = |extra: &[&str], csv: &str| {
+        let out = Command::new(env!("CARGO_BIN_EXE_plantwide"))
+            .current_dir(&dir)
+            .args(["run", &fs, "--scenario", &sc, "--csv", csv])
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        String::from_utf8(out.stdout).unwrap()
+    };
+    let json = run(&["--json", "--plot", "trend.svg"], "full.csv");
+    let summary: serde_json::Value = serde_json::from_str(&json).unwrap();
+    let level = summary["paths"].as_array().unwrap().iter().find(|p| p["path"] == "tank.level").unwrap();
+    assert_eq!(level["reference"], "setpoint");
+    assert!(level["iae"].as_f64().unwrap() > 0.0 && level["max_deviation"].as_f64().unwrap() > 0.0);
+    assert!((summary["final_values"]["out.F"].as_f64().unwrap() - 60.0).abs() < 1e-3);
+    let full = std::fs::read_to_string(dir.join("full.csv")).unwrap();
+    assert_eq!(full.lines().next().unwrap(), "time [s],tank.level [m],out.F [mol/s],lc.sp [m]");
+    assert!(std::fs::read_to_string(dir.join("trend.svg")).unwrap().contains("tank.level [m]"));
+    // Resume from the snapshot the scenario wrote at 1000 s.
+    run(&["--resume", "surge_tank_1000s.snapshot.json"], "resumed.csv");
+    let resumed = std::fs::read_to_string(dir.join("resumed.csv")).unwrap();
+    let tail: Vec<&str> = resumed.lines().skip(1).collect();
+    assert!(
+        tail.len() > 250 && full.lines().skip(1).collect::<Vec<_>>().ends_with(&tail),
+        "the resumed rows are the full run's"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn cli_run_reports_scenario_errors_with_their_json_paths() {
+    use std::process::Command;
+    let dir = std::env::temp_dir().join(format!("plantwide_run_err_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let bad = dir.join("bad.json");
+    std::fs::write(
+        &bad,
+        r#"{"format_version": 1, "duration": "10 min",
+        "events": [{"type": "step", "at": "1 min", "path": "F_inn", "to": "60 mol/s"},
+                   {"type": "step", "at": "2 min", "path": "tank.outflow", "to": "60 mol/s"},
+                   {"type": "ramp", "at": "3 min", "path": "lc.sp", "to": "5 kg", "duration": "1 min"}]}"#,
+    )
+    .unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_plantwide"))
+        .args(["run", &flowsheet("surge_tank_pi.json"), "--scenario"])
+        .arg(&bad)
+        .args(["--csv", "/dev/null"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("events[0].path: no input `F_inn` (did you mean `F_in`?)"), "{err}");
+    assert!(err.contains("events[1].path: input `tank.outflow` is driven by controller `lc`"), "{err}");
+    assert!(err.contains("events[2].to: `5 kg` is a mass but a length is expected"), "{err}");
+    std::fs::write(&bad, r#"{"format_version": 1, "duration": "10 min", "events": [{"type": "jump", "at": 0}]}"#)
+        .unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_plantwide"))
+        .args(["run", &flowsheet("surge_tank_pi.json"), "--scenario"])
+        .arg(&bad)
+        .args(["--csv", "/dev/null"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        out.status.code() == Some(1) && err.contains("events[0]") && err.contains("unknown variant `jump`"),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
