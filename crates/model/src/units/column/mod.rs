@@ -9,8 +9,14 @@
 //!
 //! Ports: one inlet per feed (`feeds[k].port`, default `feed`), outlets `distillate`, `bottoms` and
 //! one per side draw. Manipulated inputs declared by both models: `reflux`, `distillate`,
-//! `bottoms`, each side draw's flow, and `boilup` (simple) or `reboiler_duty` (rigorous).
+//! `bottoms`, each side draw's flow, and `boilup` (simple) or `reboiler_duty` (rigorous, plus
+//! `condenser_duty` when the condenser is duty-specified).
+//!
+//! Fields only one model uses are optional here; building with the other model reports each of
+//! them by name (simple: `tray_holdup`, `tau_l`, `boilup`, `lambda`, `feeds[k].q`,
+//! `feeds[k].nominal_flow`; rigorous: `rigorous`).
 
+pub mod rigorous;
 pub mod simple;
 
 use plantwide_units::QuantityValue;
@@ -19,6 +25,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::{BuildCx, FieldError, InputSpec, LocalLayout, Scalar, UnitIo, UnitModel, VarSpec};
 
+pub use rigorous::{RigorousColumn, RigorousConfig};
 pub use simple::SimpleColumn;
 
 /// Fidelity of the column model.
@@ -28,6 +35,8 @@ pub enum ColumnModel {
     /// Constant molar overflow, linearized tray hydraulics, no energy balances.
     #[default]
     Simple,
+    /// Energy balances, Murphree efficiency, Francis-weir hydraulics, tray pressure drop.
+    Rigorous,
 }
 
 /// A feed to the column.
@@ -39,10 +48,12 @@ pub struct ColumnFeed {
     pub port: String,
     /// Stage the feed enters (1 = reboiler, N = condenser).
     pub stage: usize,
-    /// Feed quality q (liquid fraction; 1 = saturated liquid); default from enthalpies.
+    /// Feed quality q (liquid fraction; 1 = saturated liquid); default from enthalpies (simple
+    /// model only: the rigorous model takes the feed's enthalpy from the stream).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub q: Option<f64>,
-    /// Nominal feed flow for the tray hydraulics (default: nominal D + B when there is one feed).
+    /// Nominal feed flow for the tray hydraulics (default: nominal D + B when there is one feed;
+    /// simple model only).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub nominal_flow: Option<QuantityValue>,
 }
@@ -77,43 +88,79 @@ pub struct ColumnConfig {
     /// Liquid side draws (default none).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub side_draws: Vec<SideDraw>,
-    /// Column pressure (default 1 atm).
+    /// Column pressure (default 1 atm); for the rigorous model the top (condenser) pressure.
     #[serde(rename = "P", default, skip_serializing_if = "Option::is_none")]
     pub pressure: Option<QuantityValue>,
-    /// Nominal liquid holdup of a tray (e.g. `"0.5 kmol"`).
-    pub tray_holdup: QuantityValue,
+    /// Nominal liquid holdup of a tray (e.g. `"0.5 kmol"`; simple model only, required).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tray_holdup: Option<QuantityValue>,
     /// Nominal liquid holdup of the condenser / reflux drum.
     pub condenser_holdup: QuantityValue,
     /// Nominal liquid holdup of the reboiler / sump.
     pub reboiler_holdup: QuantityValue,
-    /// Liquid hydraulic time constant τ_L of a tray (e.g. `"0.063 min"`).
-    pub tau_l: QuantityValue,
-    /// Effect of vapour flow on liquid flow λ [-] (default 0).
-    #[serde(default)]
-    pub lambda: f64,
+    /// Liquid hydraulic time constant τ_L of a tray (e.g. `"0.063 min"`; simple model only, required).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tau_l: Option<QuantityValue>,
+    /// Effect of vapour flow on liquid flow λ [-] (simple model only; default 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lambda: Option<f64>,
     /// Reflux flow L.
     pub reflux: QuantityValue,
-    /// Boilup V.
-    pub boilup: QuantityValue,
+    /// Boilup V (simple model only, required).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub boilup: Option<QuantityValue>,
     /// Distillate flow D.
     pub distillate: QuantityValue,
     /// Bottoms flow B.
     pub bottoms: QuantityValue,
+    /// Rigorous-model data: duties, efficiency, tray geometry (rigorous model only, required).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rigorous: Option<RigorousConfig>,
 }
 
+impl ColumnConfig {
+    /// Report every field the chosen model needs but lacks, or does not use but has.
+    fn check_model_fields(&self, cx: &mut BuildCx<'_>) {
+        let simple = self.model == ColumnModel::Simple;
+        let (this, other) = if simple { ("simple", "rigorous") } else { ("rigorous", "simple") };
+        // (field, given, belongs to the simple model, example when its model requires it)
+        let mut fields: Vec<(String, bool, bool, Option<&str>)> = vec![
+            ("tray_holdup".into(), self.tray_holdup.is_some(), true, Some("\"0.5 kmol\"")),
+            ("tau_l".into(), self.tau_l.is_some(), true, Some("\"0.063 min\"")),
+            ("boilup".into(), self.boilup.is_some(), true, Some("\"3.2 kmol/min\"")),
+            ("lambda".into(), self.lambda.is_some(), true, None),
+            ("rigorous".into(), self.rigorous.is_some(), false, Some(rigorous::EXAMPLE)),
+        ];
+        for (k, f) in self.feeds.iter().enumerate() {
+            fields.push((format!("feeds[{k}].q"), f.q.is_some(), true, None));
+            fields.push((format!("feeds[{k}].nominal_flow"), f.nominal_flow.is_some(), true, None));
+        }
+        for (field, given, of_simple, example) in fields {
+            if of_simple != simple && given {
+                cx.error(&field, format!("the {this} model does not use `{field}` (a {other}-model field): remove it"));
+            } else if let (false, Some(e)) = (given, example.filter(|_| of_simple == simple)) {
+                cx.error(&field, format!("the {this} model needs `{field}`, e.g. {e}"));
+            }
+        }
+    }
+}
 
 /// A distillation column at the chosen fidelity.
 #[derive(Debug, Clone)]
 pub enum Column {
     /// Constant molar overflow.
     Simple(SimpleColumn),
+    /// Energy balances, Murphree efficiency, Francis weir.
+    Rigorous(RigorousColumn),
 }
 
 impl Column {
     /// Build from the flowsheet description.
-    pub fn build(c: &ColumnConfig, cx: BuildCx<'_>, _links: ()) -> Result<Column, Vec<FieldError>> {
+    pub fn build(c: &ColumnConfig, mut cx: BuildCx<'_>, _links: ()) -> Result<Column, Vec<FieldError>> {
+        c.check_model_fields(&mut cx);
         match c.model {
             ColumnModel::Simple => SimpleColumn::build(c, cx).map(Column::Simple),
+            ColumnModel::Rigorous => RigorousColumn::build(c, cx).map(Column::Rigorous),
         }
     }
 }
@@ -122,6 +169,7 @@ macro_rules! delegate {
     ($self:ident, $m:ident($($a:expr),*)) => {
         match $self {
             Column::Simple(c) => c.$m($($a),*),
+            Column::Rigorous(c) => c.$m($($a),*),
         }
     };
 }

@@ -87,12 +87,12 @@ impl SimpleColumn {
         let amount = Dimension::AMOUNT;
         let flow = Dimension::MOLAR_FLOW;
         let pressure = c.pressure.as_ref().map_or(101_325.0, |p| cx.positive("P", p, Dimension::PRESSURE));
-        let tray = cx.positive("tray_holdup", &c.tray_holdup, amount);
+        let tray = c.tray_holdup.as_ref().map_or(f64::NAN, |v| cx.positive("tray_holdup", v, amount));
         let cond = cx.positive("condenser_holdup", &c.condenser_holdup, amount);
         let reb = cx.positive("reboiler_holdup", &c.reboiler_holdup, amount);
-        let tau_l = cx.positive("tau_l", &c.tau_l, Dimension::TIME);
+        let tau_l = c.tau_l.as_ref().map_or(f64::NAN, |v| cx.positive("tau_l", v, Dimension::TIME));
         let reflux = cx.non_negative("reflux", &c.reflux, flow);
-        let boilup = cx.non_negative("boilup", &c.boilup, flow);
+        let boilup = c.boilup.as_ref().map_or(f64::NAN, |v| cx.non_negative("boilup", v, flow));
         let distillate = cx.non_negative("distillate", &c.distillate, flow);
         let bottoms = cx.non_negative("bottoms", &c.bottoms, flow);
         if c.feeds.is_empty() {
@@ -180,7 +180,7 @@ impl SimpleColumn {
             m0,
             l0,
             tau_l,
-            lambda: c.lambda,
+            lambda: c.lambda.unwrap_or(0.0),
             v0: boilup,
             reflux,
             boilup,

@@ -1,0 +1,392 @@
+//! The rigorous column model: component, total and energy balances per stage, VLE from the thermo
+//! package (activity coefficients allowed), Murphree vapour efficiency, Francis-weir tray hydraulics
+//! and a fixed tray pressure drop — Grassi's model 2a (Luyben (ed.) 1992, ch. 3).
+//!
+//! **Stages** as in [`super`]: 1 = reboiler (sump, an equilibrium stage heated by the input
+//! `reboiler_duty`), 2 … N−1 = trays from the bottom, N = total condenser with its reflux drum.
+//! Pressures are fixed: `P_i = P + (N − i) ΔP` [Pa], `P` the top (drum) pressure and `ΔP` the
+//! pressure drop per tray (`rigorous.tray_pressure_drop`, default 0).
+//!
+//! # Variables
+//! Per stage i: `n[i][c]` [mol] component holdups (differential), `x[i][c]`, `y[i][c]` [-], `T[i]`
+//! [K], `M[i]` [mol], `L[i]`, `V[i]` [mol/s] (liquid and vapour leaving the stage); then `Qc` [W],
+//! the heat removed in the condenser. Inputs: `reflux` L_N, `reboiler_duty` Q_R [W], `distillate`
+//! D, `bottoms` B [mol/s], `condenser_duty` Q_C [W] (duty-specified condenser only) and each side
+//! draw's flow [mol/s].
+//!
+//! # Equations (stage i; `h_L,i = h_liq(T_i, x_i)`, `h_V,i = h_vap(T_i, y_i)` [J/mol])
+//! - component balances `dn_ij/dt = L_{i+1} x_{i+1,j} + V_{i−1} y_{i−1,j} + Σ_feeds F z_j
+//!   − (L_i + S_i + D δ_iN) x_ij − V_i y_ij` (S_i liquid side draws);
+//! - holdup `M_i = Σ_j n_ij`, `x_ij M_i = n_ij`;
+//! - bubble point `Σ_j K_ij(T_i, P_i, x_i) x_ij = 1` (the liquid is saturated on every stage);
+//! - vapour: reboiler and drum `y_ij = K_ij x_ij`; trays, Murphree vapour efficiency E,
+//!   `y_ij = y_{i−1,j} + E (K_ij x_ij − y_{i−1,j})`;
+//! - liquid: trays, Francis weir on the clear liquid,
+//!   `L_i = 1.84 l_w ĥ_ow^{3/2} / v_L` with `ĥ_ow = smax(M_i v_L / A − h_w)` [m],
+//!   `v_L = v_liq(T_i, x_i)` [m³/mol], `l_w`, `h_w`, `A` the weir length, weir height and tray
+//!   area ([`Weir`]); drum `L_N = reflux`; reboiler `L_1 = B`;
+//! - energy (quasi-steady, below), giving `V_i` on the reboiler and trays and `Qc` (drum at its
+//!   bubble point) or `T_N` (duty-specified condenser, `Qc = condenser_duty`); the drum sends no
+//!   vapour on, `V_N = 0`, and its `y_N = K x_N` is the equilibrium vapour of the drum liquid.
+//!
+//! # Energy balance and why the model is index 1
+//! The stage energy balance is
+//! `d(M_i h_L,i)/dt = Σ_in F h − (L_i + S_i + D δ_iN) h_L,i − V_i h_V,i + Q_i`
+//! with `Q_1 = Q_R`, `Q_N = −Qc`. At fixed pressure the liquid sits at its bubble point, so
+//! `h_L,i` is a function of `x_i`: `U = M h_L` is not an independent state. Model 2a neglects the
+//! specific-enthalpy accumulation, `M_i dh_L,i/dt ≈ 0`; subtracting `h_L,i` times the total
+//! balance then leaves the algebraic equation
+//!
+//! `0 = Σ_in F (h_in − h_L,i) + Q_i − V_i (h_V,i − h_L,i)`,
+//!
+//! in which the liquid outflows drop out. Given the differential states `n`, the algebraic
+//! variables follow in order — `M, x` (holdup), `T` (bubble point), `y` (equilibrium or Murphree,
+//! from the stage below), `L` (weir), then `V_i` from the energy balance sweeping up from the
+//! reboiler (its coefficient `h_V,i − h_L,i`, the latent heat, is nonzero) — so the algebraic
+//! Jacobian is nonsingular: index 1. Keeping `M h_L` as a differential state instead would
+//! over-determine `T` (energy and bubble point) and make the system index 2. At steady state the
+//! total balance vanishes and the equation is the exact energy balance, so steady states close
+//! energy to solver precision: `Q_R + Σ F h_F = Qc + D h_D + B h_B + Σ S h_S`.
+//!
+//! A duty-specified condenser (`condenser_duty` given) returns a subcooled reflux: its energy
+//! balance `V_{N−1} (h_V,N−1 − h_L,N) = Q_C` fixes `T_N` (the heated-tank case of ch. 3, index 1).
+//! At fixed pressure the duty has a narrow window: at least the bubble-point duty (below it the
+//! "liquid" would be superheated), and at most what the subcooled reflux allows — the colder the
+//! reflux, the more vapour it condenses on the top tray, so the less reaches the condenser;
+//! outside the window there is no steady state.
+//!
+//! Not modelled: partial condensers (vapour distillate), steam-flow reboilers, froth density,
+//! downcomer holdup, vapour side draws.
+//!
+//! # Initial guess
+//! The bubble-point (Wang–Henke) method solves the steady column at the current inputs `reflux`
+//! and `reboiler_duty` (D and B follow from the balances); Newton on the column's own equations,
+//! with a pseudo-transient fallback, finishes it. See [`profile`] and [`polish`].
+//!
+//! # References
+//! - V. G. Grassi II, "Rigorous modeling and conventional simulation", in W. L. Luyben (ed.),
+//!   *Practical Distillation Control*, Van Nostrand Reinhold 1992, ch. 3 (model 2a, Figs 3-8, 3-10).
+//! - J. C. Wang, G. E. Henke, *Tridiagonal matrix for distillation*, Hydrocarbon Processing 45(8)
+//!   (1966) 155–163.
+
+mod build;
+mod polish;
+mod profile;
+#[cfg(test)]
+mod tests;
+mod weir;
+
+use plantwide_thermo::VleModel;
+use plantwide_units::Dimension;
+
+use crate::stream::{F, H, P, T, Z0};
+use crate::{InputSpec, LocalLayout, Scalar, UnitIo, UnitModel, VarSpec};
+
+pub use build::{EXAMPLE, RigorousConfig};
+pub use weir::{CREST_SMOOTH, FRANCIS, Weir};
+
+#[derive(Debug, Clone)]
+struct Draw {
+    stage: usize,
+    flow: f64,
+}
+
+/// A distillation column, rigorous model.
+#[derive(Debug, Clone)]
+pub struct RigorousColumn {
+    n_stages: usize,
+    /// Stage (0-based) of each feed.
+    feeds: Vec<usize>,
+    feed_ports: Vec<String>,
+    draws: Vec<Draw>,
+    draw_ports: Vec<String>,
+    /// Stage pressures [Pa], 0-based from the reboiler.
+    pressure: Vec<f64>,
+    efficiency: f64,
+    weir: Weir,
+    m_condenser: f64,
+    m_reboiler: f64,
+    m_tray: f64,
+    reflux: f64,
+    reboiler_duty: f64,
+    distillate: f64,
+    bottoms: f64,
+    condenser_duty: Option<f64>,
+    comp_names: Vec<String>,
+}
+
+// Inputs, in declaration order; `condenser_duty` (if any) follows, then the side draws.
+const IN_REFLUX: usize = 0;
+const IN_REBOILER_DUTY: usize = 1;
+const IN_DISTILLATE: usize = 2;
+const IN_BOTTOMS: usize = 3;
+const IN_CONDENSER_DUTY: usize = 4;
+
+impl RigorousColumn {
+    fn nc(&self) -> usize {
+        self.comp_names.len()
+    }
+    /// Variables per stage: n (nc), x (nc), y (nc), T, M, L, V.
+    fn per_stage(&self) -> usize {
+        3 * self.nc() + 4
+    }
+    fn n_outlets(&self) -> usize {
+        2 + self.draws.len()
+    }
+    /// Offset of stage `s` (0-based) in the internal variables.
+    fn stage(&self, s: usize) -> usize {
+        s * self.per_stage()
+    }
+    /// Offset of `Qc` in the internal variables.
+    fn qc(&self) -> usize {
+        self.n_stages * self.per_stage()
+    }
+    /// Input index of side draw `k`.
+    fn draw_input(&self, k: usize) -> usize {
+        IN_CONDENSER_DUTY + usize::from(self.condenser_duty.is_some()) + k
+    }
+    /// Outlet `k`'s stage: distillate from the drum, bottoms from the reboiler, draws from trays.
+    fn outlet_stage(&self, k: usize) -> usize {
+        match k {
+            0 => self.n_stages - 1,
+            1 => 0,
+            _ => self.draws[k - 2].stage,
+        }
+    }
+}
+
+/// Offsets within a stage block.
+struct StageIdx {
+    nc: usize,
+}
+impl StageIdx {
+    fn n(&self, j: usize) -> usize {
+        j
+    }
+    fn x(&self, j: usize) -> usize {
+        self.nc + j
+    }
+    fn y(&self, j: usize) -> usize {
+        2 * self.nc + j
+    }
+    fn t(&self) -> usize {
+        3 * self.nc
+    }
+    fn m(&self) -> usize {
+        3 * self.nc + 1
+    }
+    fn l(&self) -> usize {
+        3 * self.nc + 2
+    }
+    fn v(&self) -> usize {
+        3 * self.nc + 3
+    }
+}
+
+impl UnitModel for RigorousColumn {
+    fn type_name(&self) -> &'static str {
+        "column"
+    }
+    fn inlet_ports(&self) -> Vec<String> {
+        self.feed_ports.clone()
+    }
+    fn outlet_ports(&self) -> Vec<String> {
+        let mut v = vec!["distillate".to_string(), "bottoms".to_string()];
+        v.extend(self.draw_ports.iter().cloned());
+        v
+    }
+    fn internal_vars(&self) -> Vec<VarSpec> {
+        let mut v = Vec::with_capacity(self.qc() + 1);
+        let flow_nom = (self.reflux + self.distillate + self.bottoms).max(1e-3);
+        let nc = self.nc().max(1) as f64;
+        for s in 0..self.n_stages {
+            let st = s + 1;
+            let m0 = match s {
+                0 => self.m_reboiler,
+                _ if s + 1 == self.n_stages => self.m_condenser,
+                _ => self.m_tray,
+            };
+            for c in &self.comp_names {
+                let spec = VarSpec::differential(format!("n[{st}][{c}]"), Dimension::AMOUNT, m0 / nc);
+                v.push(spec.bounded(0.0, f64::INFINITY));
+            }
+            for c in &self.comp_names {
+                v.push(VarSpec::algebraic(format!("x[{st}][{c}]"), Dimension::DIMENSIONLESS, 1.0).bounded(0.0, 1.0));
+            }
+            for c in &self.comp_names {
+                v.push(VarSpec::algebraic(format!("y[{st}][{c}]"), Dimension::DIMENSIONLESS, 1.0).bounded(0.0, 1.0));
+            }
+            v.push(VarSpec::algebraic(format!("T[{st}]"), Dimension::TEMPERATURE, 350.0).bounded(1.0, 5000.0));
+            v.push(VarSpec::algebraic(format!("M[{st}]"), Dimension::AMOUNT, m0).bounded(1e-12 * m0, f64::INFINITY));
+            v.push(VarSpec::algebraic(format!("L[{st}]"), Dimension::MOLAR_FLOW, flow_nom).bounded(0.0, f64::INFINITY));
+            v.push(VarSpec::algebraic(format!("V[{st}]"), Dimension::MOLAR_FLOW, flow_nom).bounded(0.0, f64::INFINITY));
+        }
+        v.push(VarSpec::algebraic("Qc", Dimension::POWER, self.reboiler_duty.max(1.0)));
+        v
+    }
+    fn inputs(&self) -> Vec<InputSpec> {
+        let flow = Dimension::MOLAR_FLOW;
+        let mut v = vec![
+            InputSpec { name: "reflux".into(), dim: flow, value: self.reflux },
+            InputSpec { name: "reboiler_duty".into(), dim: Dimension::POWER, value: self.reboiler_duty },
+            InputSpec { name: "distillate".into(), dim: flow, value: self.distillate },
+            InputSpec { name: "bottoms".into(), dim: flow, value: self.bottoms },
+        ];
+        if let Some(q) = self.condenser_duty {
+            v.push(InputSpec { name: "condenser_duty".into(), dim: Dimension::POWER, value: q });
+        }
+        for (d, p) in self.draws.iter().zip(&self.draw_ports) {
+            v.push(InputSpec { name: p.clone(), dim: flow, value: d.flow });
+        }
+        v
+    }
+    fn pattern(&self, layout: &LocalLayout) -> Option<Vec<(usize, usize)>> {
+        let slen = layout.stream.len();
+        let internal0 = self.n_outlets() * slen;
+        let ps = self.per_stage();
+        let n = self.n_stages;
+        let qc = internal0 + self.qc();
+        let shared: Vec<usize> = (layout.n_own()..layout.len()).collect();
+        let stage_cols = |s: usize| internal0 + self.stage(s)..internal0 + self.stage(s) + ps;
+        let mut p = Vec::new();
+        for k in 0..self.n_outlets() {
+            for row in k * slen..(k + 1) * slen {
+                p.extend((k * slen..(k + 1) * slen).map(|c| (row, c)));
+                p.extend(stage_cols(self.outlet_stage(k)).map(|c| (row, c)));
+                p.extend(shared.iter().map(|&c| (row, c)));
+            }
+        }
+        for s in 0..n {
+            for row in stage_cols(s) {
+                for t in s.saturating_sub(1)..=(s + 1).min(n - 1) {
+                    p.extend(stage_cols(t).map(|c| (row, c)));
+                }
+                if s + 1 == n {
+                    p.push((row, qc));
+                }
+                p.extend(shared.iter().map(|&c| (row, c)));
+            }
+        }
+        for t in n.saturating_sub(2)..n {
+            p.extend(stage_cols(t).map(|c| (qc, c)));
+        }
+        p.push((qc, qc));
+        p.extend(shared.iter().map(|&c| (qc, c)));
+        Some(p)
+    }
+    fn eval<S: Scalar>(&self, io: &UnitIo<'_, S>, r: &mut [S]) {
+        let nc = self.nc();
+        let n = self.n_stages;
+        let slen = io.layout.stream.len();
+        let internal0 = self.n_outlets() * slen;
+        let ix = StageIdx { nc };
+        let th = io.thermo;
+        let st = |s: usize| io.vars(self.stage(s), self.per_stage());
+        let (l_in, q_r, d_in, b_in) =
+            (io.input(IN_REFLUX), io.input(IN_REBOILER_DUTY), io.input(IN_DISTILLATE), io.input(IN_BOTTOMS));
+        let qc = io.var(self.qc());
+        let draw_flow: Vec<S> = (0..self.draws.len()).map(|k| io.input(self.draw_input(k))).collect();
+        let h_l: Vec<S> = (0..n).map(|s| th.h_liq(st(s)[ix.t()], &st(s)[ix.x(0)..ix.x(0) + nc])).collect();
+        let h_v: Vec<S> = (0..n).map(|s| th.h_vap(st(s)[ix.t()], &st(s)[ix.y(0)..ix.y(0) + nc])).collect();
+        let mut k = vec![S::from(0.0); nc];
+        let mut comp_in = vec![S::from(0.0); nc];
+        let mut condenser_energy = S::from(0.0);
+        for s in 0..n {
+            let v = st(s);
+            let o = internal0 + self.stage(s);
+            let (t, m, l, vap) = (v[ix.t()], v[ix.m()], v[ix.l()], v[ix.v()]);
+            let x = &v[ix.x(0)..ix.x(0) + nc];
+            let p = S::from(self.pressure[s]);
+            // Inflows: components, and enthalpy relative to the stage liquid.
+            comp_in.iter_mut().for_each(|c| *c = S::from(0.0));
+            let mut energy = -vap * (h_v[s] - h_l[s]);
+            if s + 1 < n {
+                let up = st(s + 1);
+                comp_in.iter_mut().enumerate().for_each(|(j, c)| *c += up[ix.l()] * up[ix.x(j)]);
+                energy += up[ix.l()] * (h_l[s + 1] - h_l[s]);
+            }
+            if s > 0 {
+                let dn = st(s - 1);
+                comp_in.iter_mut().enumerate().for_each(|(j, c)| *c += dn[ix.v()] * dn[ix.y(j)]);
+                energy += dn[ix.v()] * (h_v[s - 1] - h_l[s]);
+            }
+            for (f, _) in self.feeds.iter().enumerate().filter(|(_, st)| **st == s) {
+                let feed = io.inlet(f);
+                comp_in.iter_mut().zip(feed.z()).for_each(|(c, z)| *c += feed.f() * *z);
+                energy += feed.f() * (feed.h() - h_l[s]);
+            }
+            // Liquid leaving: to the stage below (or bottoms), distillate, side draws.
+            let mut liquid_out = l;
+            if s + 1 == n {
+                liquid_out += d_in;
+                energy -= qc;
+                condenser_energy = energy;
+            }
+            if s == 0 {
+                energy += q_r;
+            }
+            for (d, fl) in self.draws.iter().zip(&draw_flow) {
+                if d.stage == s {
+                    liquid_out += *fl;
+                }
+            }
+            for j in 0..nc {
+                r[o + ix.n(j)] = comp_in[j] - liquid_out * x[j] - vap * v[ix.y(j)];
+                r[o + ix.x(j)] = x[j] * m - v[ix.n(j)];
+            }
+            th.k_values(t, p, x, &mut k);
+            let tray = s > 0 && s + 1 < n;
+            for j in 0..nc {
+                r[o + ix.y(j)] = if tray {
+                    let below = st(s - 1)[ix.y(j)];
+                    v[ix.y(j)] - below - (k[j] * x[j] - below) * self.efficiency
+                } else {
+                    v[ix.y(j)] - k[j] * x[j]
+                };
+            }
+            let duty_condenser = s + 1 == n && self.condenser_duty.is_some();
+            r[o + ix.t()] = if duty_condenser {
+                energy
+            } else if let VleModel::ConstantAlpha { .. } = th.vle {
+                th.bubble_residual(t, p, x)
+            } else {
+                // Σ K x − 1 with the K-values already at hand (what `bubble_residual` computes).
+                k.iter().zip(x).fold(S::from(-1.0), |acc, (k, x)| acc + *k * *x)
+            };
+            r[o + ix.m()] = m - v[ix.n(0)..ix.n(0) + nc].iter().fold(S::from(0.0), |a, b| a + *b);
+            r[o + ix.l()] = if s + 1 == n {
+                l - l_in
+            } else if s == 0 {
+                l - b_in
+            } else {
+                l - self.weir.flow(m, th.v_liq(t, x))
+            };
+            r[o + ix.v()] = if s + 1 == n { vap } else { energy };
+        }
+        r[internal0 + self.qc()] = match self.condenser_duty {
+            Some(_) => qc - io.input(IN_CONDENSER_DUTY),
+            None => condenser_energy,
+        };
+        for k in 0..self.n_outlets() {
+            let s = self.outlet_stage(k);
+            let flow = match k {
+                0 => d_in,
+                1 => st(0)[ix.l()],
+                _ => draw_flow[k - 2],
+            };
+            let out = io.outlet(k);
+            let v = st(s);
+            let rr = &mut r[k * slen..(k + 1) * slen];
+            rr[F] = out.f() - flow;
+            rr[T] = out.t() - v[ix.t()];
+            rr[P] = out.p() - self.pressure[s];
+            rr[H] = out.h() - h_l[s];
+            for j in 0..nc {
+                rr[Z0 + j] = out.z()[j] - v[ix.x(j)];
+            }
+        }
+    }
+    fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]) {
+        profile::guess(self, io, own);
+    }
+}

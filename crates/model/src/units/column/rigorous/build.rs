@@ -1,0 +1,141 @@
+//! The flowsheet description of the rigorous column and its build.
+
+use plantwide_units::{Dimension, QuantityValue};
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+use super::{Draw, RigorousColumn, Weir};
+use crate::units::column::ColumnConfig;
+use crate::{BuildCx, FieldError};
+
+/// An example of the `rigorous` block, for error messages.
+pub const EXAMPLE: &str =
+    r#"{"reboiler_duty": "1.2 MW", "weir_length": "0.8 m", "weir_height": "50 mm", "tray_area": "0.6 m2"}"#;
+
+/// Rigorous-model data of a column (`"rigorous": {...}` with `"model": "rigorous"`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct RigorousConfig {
+    /// Reboiler duty Q_R [W] (input `reboiler_duty`; e.g. `"1.2 MW"`).
+    pub reboiler_duty: QuantityValue,
+    /// Condenser duty Q_C [W] (input `condenser_duty`; e.g. `"1.1 MW"`); omit for a drum at its
+    /// bubble point, whose duty is computed (variable `Qc`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub condenser_duty: Option<QuantityValue>,
+    /// Murphree vapour efficiency E of every tray [-], 0 < E ≤ 1 (default 1: equilibrium trays).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub murphree_efficiency: Option<f64>,
+    /// Pressure drop per tray ΔP [Pa] (e.g. `"0.7 kPa"`; default 0): `P_i = P + (N − i) ΔP`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tray_pressure_drop: Option<QuantityValue>,
+    /// Outlet weir length l_w [m] (e.g. `"0.8 m"`).
+    pub weir_length: QuantityValue,
+    /// Outlet weir height h_w [m] (e.g. `"50 mm"`).
+    pub weir_height: QuantityValue,
+    /// Tray active area A [m²] (e.g. `"0.6 m2"`): liquid height on the tray is `M v_L / A`.
+    pub tray_area: QuantityValue,
+}
+
+impl RigorousColumn {
+    /// Build from the flowsheet description (the model-specific fields were checked by the caller).
+    pub fn build(c: &ColumnConfig, mut cx: BuildCx<'_>) -> Result<RigorousColumn, Vec<FieldError>> {
+        let n = c.stages;
+        if n < 3 {
+            cx.error("stages", format!("a column needs at least 3 stages (reboiler, one tray, condenser); got {n}"));
+        }
+        let flow = Dimension::MOLAR_FLOW;
+        let p_top = c.pressure.as_ref().map_or(101_325.0, |p| cx.positive("P", p, Dimension::PRESSURE));
+        let m_condenser = cx.positive("condenser_holdup", &c.condenser_holdup, Dimension::AMOUNT);
+        let m_reboiler = cx.positive("reboiler_holdup", &c.reboiler_holdup, Dimension::AMOUNT);
+        let reflux = cx.non_negative("reflux", &c.reflux, flow);
+        let distillate = cx.non_negative("distillate", &c.distillate, flow);
+        let bottoms = cx.non_negative("bottoms", &c.bottoms, flow);
+        let (mut reboiler_duty, mut condenser_duty, mut efficiency, mut dp) = (f64::NAN, None, 1.0, 0.0);
+        let mut weir = Weir { length: f64::NAN, height: f64::NAN, area: f64::NAN };
+        if let Some(r) = &c.rigorous {
+            reboiler_duty = cx.non_negative("rigorous.reboiler_duty", &r.reboiler_duty, Dimension::POWER);
+            condenser_duty =
+                r.condenser_duty.as_ref().map(|q| cx.non_negative("rigorous.condenser_duty", q, Dimension::POWER));
+            if let Some(e) = r.murphree_efficiency {
+                if !(e.is_finite() && e > 0.0 && e <= 1.0) {
+                    cx.error(
+                        "rigorous.murphree_efficiency",
+                        format!("must lie in (0, 1] (1 = equilibrium trays); got {e}"),
+                    );
+                }
+                efficiency = e;
+            }
+            dp = r
+                .tray_pressure_drop
+                .as_ref()
+                .map_or(0.0, |v| cx.non_negative("rigorous.tray_pressure_drop", v, Dimension::PRESSURE));
+            weir = Weir {
+                length: cx.positive("rigorous.weir_length", &r.weir_length, Dimension::LENGTH),
+                height: cx.non_negative("rigorous.weir_height", &r.weir_height, Dimension::LENGTH),
+                area: cx.positive("rigorous.tray_area", &r.tray_area, Dimension::AREA),
+            };
+        }
+        if c.feeds.is_empty() {
+            cx.error("feeds", "give at least one feed, e.g. [{\"port\": \"feed\", \"stage\": 10}]");
+        }
+        let mut feeds = Vec::new();
+        let mut feed_ports: Vec<String> = Vec::new();
+        for (k, f) in c.feeds.iter().enumerate() {
+            if f.stage < 1 || f.stage > n {
+                cx.error(
+                    &format!("feeds[{k}].stage"),
+                    format!("must be between 1 (reboiler) and {n} (condenser); got {}", f.stage),
+                );
+            }
+            if feed_ports.contains(&f.port) {
+                cx.error(&format!("feeds[{k}].port"), format!("port `{}` is used twice", f.port));
+            }
+            feed_ports.push(f.port.clone());
+            feeds.push(f.stage.saturating_sub(1));
+        }
+        let mut draws = Vec::new();
+        let mut draw_ports = Vec::new();
+        for (k, d) in c.side_draws.iter().enumerate() {
+            if d.stage < 2 || d.stage + 1 > n {
+                cx.error(
+                    &format!("side_draws[{k}].stage"),
+                    format!("side draws come from trays 2 … {}; got {}", n.saturating_sub(1), d.stage),
+                );
+            }
+            if ["distillate", "bottoms"].contains(&d.port.as_str())
+                || feed_ports.contains(&d.port)
+                || draw_ports.contains(&d.port)
+            {
+                cx.error(&format!("side_draws[{k}].port"), format!("port name `{}` is already used", d.port));
+            }
+            let f = cx.non_negative(&format!("side_draws[{k}].flow"), &d.flow, flow);
+            draws.push(Draw { stage: d.stage.saturating_sub(1), flow: f });
+            draw_ports.push(d.port.clone());
+        }
+        let pressure = (0..n).map(|s| p_top + (n - 1 - s) as f64 * dp).collect();
+        let n_comp = cx.thermo.n().max(1) as f64;
+        let v_mean = cx.thermo.components.iter().map(|c| c.v_liq(298.15)).sum::<f64>() / n_comp;
+        let v_mean = if v_mean.is_finite() && v_mean > 0.0 { v_mean } else { 1e-4 };
+        let m_tray = weir.holdup(reflux, v_mean);
+        let column = RigorousColumn {
+            n_stages: n,
+            feeds,
+            feed_ports,
+            draws,
+            draw_ports,
+            pressure,
+            efficiency,
+            weir,
+            m_condenser,
+            m_reboiler,
+            m_tray: if m_tray.is_finite() && m_tray > 0.0 { m_tray } else { 1.0 },
+            reflux,
+            reboiler_duty,
+            distillate,
+            bottoms,
+            condenser_duty,
+            comp_names: cx.components.to_vec(),
+        };
+        cx.finish(column)
+    }
+}
