@@ -6,7 +6,7 @@ use std::path::Path;
 
 use plantwide_model::controllers::ControllerLinks;
 use plantwide_model::stream::StreamLayout;
-use plantwide_model::{BuildCx, LocalLayout, Unit};
+use plantwide_model::{BuildCx, Coloring, LocalLayout, Unit};
 
 use crate::components::thermo_package;
 use crate::error::{Diagnostic, LoadError, did_you_mean};
@@ -224,6 +224,7 @@ pub fn assemble(spec: &FlowsheetSpec, file: &str) -> Result<Plant, LoadError> {
             reads: Vec::new(),
             input_ids,
             pattern: None,
+            coloring: None,
         });
     }
     let streams: Vec<StreamInfo> = links
@@ -348,6 +349,7 @@ pub fn assemble(spec: &FlowsheetSpec, file: &str) -> Result<Plant, LoadError> {
                     reads: Vec::new(),
                     input_ids,
                     pattern: None,
+                    coloring: None,
                 });
             }
             Err(errs) => diags.extend(errs.into_iter().map(|e| Diagnostic::new(e.path, e.message))),
@@ -406,6 +408,7 @@ pub fn assemble(spec: &FlowsheetSpec, file: &str) -> Result<Plant, LoadError> {
         }
         b.reads = reads;
         b.pattern = b.unit.pattern(&b.layout);
+        b.coloring = b.pattern.as_ref().map(|p| Coloring::new(p, b.n_eq, b.layout.len()));
         b.eq_offset = eq_offset;
         eq_offset += b.n_eq;
     }

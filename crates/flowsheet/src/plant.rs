@@ -7,7 +7,7 @@ use std::collections::HashMap;
 use rayon::prelude::*;
 
 use plantwide_model::stream::StreamLayout;
-use plantwide_model::{LocalLayout, Unit, UnitIo, VarKind, VarSpec};
+use plantwide_model::{Coloring, LocalLayout, Unit, UnitIo, VarKind, VarSpec};
 use plantwide_thermo::ThermoPackage;
 use plantwide_units::Dimension;
 
@@ -52,6 +52,8 @@ pub struct Block {
     pub input_ids: Vec<usize>,
     /// Declared local sparsity pattern (`None`: dense).
     pub pattern: Option<Vec<(usize, usize)>>,
+    /// Column colouring of the pattern, computed once at assembly.
+    pub coloring: Option<Coloring>,
 }
 
 /// A global variable.
@@ -235,7 +237,7 @@ impl Plant {
         let mut jac = vec![0.0; b.n_eq * n];
         let mut out = BlockJacobian { r: vec![0.0; b.n_eq], jx: Vec::new(), ju: Vec::new() };
         let io = UnitIo { local: &local, layout: &b.layout, thermo: &self.thermo, time: t };
-        b.unit.jacobian(&io, &mut out.r, &mut jac);
+        b.unit.jacobian_colored(&io, &mut out.r, &mut jac, b.coloring.as_ref());
         let n_own = b.layout.n_own();
         let mut push = |k: usize, j: usize| {
             let (row, v) = (b.eq_offset + k, jac[k * n + j]);

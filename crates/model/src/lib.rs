@@ -21,7 +21,7 @@ pub mod var;
 pub use build::{BuildCx, FieldError};
 pub use registry::{ControllerSpec, UnitSpec};
 pub use stream::{Stream, StreamLayout};
-pub use unit::{InputSpec, LocalLayout, SignalSpec, Unit, UnitIo, UnitModel};
+pub use unit::{Coloring, InputSpec, LocalLayout, SignalSpec, Unit, UnitIo, UnitModel};
 pub use var::{VarKind, VarSpec};
 
 pub use plantwide_thermo::Scalar;

@@ -199,7 +199,13 @@ pub trait Unit: Send + Sync + std::fmt::Debug {
     /// Residuals and the local Jacobian `jac[k][j] = ∂r_k/∂local_j` (row-major, `n_eq × len`; only
     /// entries of the pattern are written, the rest stay as the caller set them), exact by
     /// forward-mode dual numbers: one pass per column colour of the pattern.
-    fn jacobian(&self, io: &UnitIo<'_, f64>, r: &mut [f64], jac: &mut [f64]);
+    fn jacobian(&self, io: &UnitIo<'_, f64>, r: &mut [f64], jac: &mut [f64]) {
+        let coloring = self.pattern(io.layout).map(|p| Coloring::new(&p, r.len(), io.local.len()));
+        self.jacobian_colored(io, r, jac, coloring.as_ref());
+    }
+    /// [`Unit::jacobian`] with the colouring of the unit's pattern computed once by the caller
+    /// (`None` for a dense unit); assembly caches it per block.
+    fn jacobian_colored(&self, io: &UnitIo<'_, f64>, r: &mut [f64], jac: &mut [f64], coloring: Option<&Coloring>);
     /// See [`UnitModel::guess`].
     fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]);
 }
@@ -235,7 +241,7 @@ impl<U: UnitModel> Unit for U {
     fn pattern(&self, layout: &LocalLayout) -> Option<Vec<(usize, usize)>> {
         UnitModel::pattern(self, layout)
     }
-    fn jacobian(&self, io: &UnitIo<'_, f64>, r: &mut [f64], jac: &mut [f64]) {
+    fn jacobian_colored(&self, io: &UnitIo<'_, f64>, r: &mut [f64], jac: &mut [f64], coloring: Option<&Coloring>) {
         let n = io.local.len();
         let m = r.len();
         let mut local: Vec<Dual64> = io.local.iter().map(|&v| Dual64::from_re(v)).collect();
@@ -244,7 +250,7 @@ impl<U: UnitModel> Unit for U {
             let dio = UnitIo { local, layout: io.layout, thermo: io.thermo, time: io.time };
             self.eval(&dio, rd);
         };
-        match UnitModel::pattern(self, io.layout) {
+        match coloring {
             None => {
                 for j in 0..n {
                     local[j].eps = 1.0;
@@ -255,24 +261,19 @@ impl<U: UnitModel> Unit for U {
                     local[j].eps = 0.0;
                 }
             }
-            Some(pattern) => {
-                let (colors, n_colors) = color_columns(&pattern, m, n);
-                let mut rows_of_col: Vec<Vec<usize>> = vec![Vec::new(); n];
-                for &(k, j) in &pattern {
-                    rows_of_col[j].push(k);
-                }
-                for c in 0..n_colors {
-                    for j in 0..n {
-                        local[j].eps = if colors[j] == c { 1.0 } else { 0.0 };
+            Some(c) => {
+                for color in 0..c.n_colors {
+                    for (j, v) in local.iter_mut().enumerate() {
+                        v.eps = if c.colors[j] == color { 1.0 } else { 0.0 };
                     }
                     eval(&local, &mut rd);
-                    for j in (0..n).filter(|&j| colors[j] == c) {
-                        for &k in &rows_of_col[j] {
+                    for &j in &c.columns_of_color[color] {
+                        for &k in &c.rows_of_col[j] {
                             jac[k * n + j] = rd[k].eps;
                         }
                     }
                 }
-                if n_colors == 0 {
+                if c.n_colors == 0 {
                     local.iter_mut().for_each(|v| v.eps = 0.0);
                     eval(&local, &mut rd);
                 }
@@ -291,35 +292,56 @@ impl<U: UnitModel> Unit for U {
     }
 }
 
-/// Greedy distance-2 colouring of the columns of an `m × n` pattern: columns of one colour share
+/// A distance-2 colouring of the columns of a unit's Jacobian pattern: columns of one colour share
 /// no row, so one dual pass seeded on all of them yields each of their entries exactly.
-pub fn color_columns(pattern: &[(usize, usize)], m: usize, n: usize) -> (Vec<usize>, usize) {
-    let mut cols_of_row: Vec<Vec<usize>> = vec![Vec::new(); m];
-    let mut rows_of_col: Vec<Vec<usize>> = vec![Vec::new(); n];
-    for &(k, j) in pattern {
-        cols_of_row[k].push(j);
-        rows_of_col[j].push(k);
-    }
-    let mut color = vec![usize::MAX; n];
-    let mut n_colors = 0;
-    let mut forbidden: Vec<usize> = Vec::new();
-    for j in 0..n {
-        if rows_of_col[j].is_empty() {
-            continue;
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Coloring {
+    /// Colour of each local column (`usize::MAX` for a column in no row).
+    pub colors: Vec<usize>,
+    /// Number of colours (dual passes).
+    pub n_colors: usize,
+    /// Columns of each colour.
+    pub columns_of_color: Vec<Vec<usize>>,
+    /// Rows in which each column has a structural entry.
+    pub rows_of_col: Vec<Vec<usize>>,
+}
+
+impl Coloring {
+    /// Greedy colouring of an `m × n` pattern given as `(row, column)` entries.
+    pub fn new(pattern: &[(usize, usize)], m: usize, n: usize) -> Coloring {
+        let mut cols_of_row: Vec<Vec<usize>> = vec![Vec::new(); m];
+        let mut rows_of_col: Vec<Vec<usize>> = vec![Vec::new(); n];
+        for &(k, j) in pattern {
+            cols_of_row[k].push(j);
+            rows_of_col[j].push(k);
         }
-        forbidden.clear();
-        for &k in &rows_of_col[j] {
-            for &j2 in &cols_of_row[k] {
-                if color[j2] != usize::MAX {
-                    forbidden.push(color[j2]);
-                }
+        for v in cols_of_row.iter_mut().chain(rows_of_col.iter_mut()) {
+            v.sort_unstable();
+            v.dedup();
+        }
+        let mut colors = vec![usize::MAX; n];
+        let mut n_colors = 0;
+        let mut forbidden: Vec<usize> = Vec::new();
+        for j in 0..n {
+            if rows_of_col[j].is_empty() {
+                continue;
+            }
+            forbidden.clear();
+            for &k in &rows_of_col[j] {
+                forbidden.extend(cols_of_row[k].iter().map(|&j2| colors[j2]).filter(|&c| c != usize::MAX));
+            }
+            forbidden.sort_unstable();
+            forbidden.dedup();
+            let c = (0..).find(|c| forbidden.binary_search(c).is_err()).unwrap_or(0);
+            colors[j] = c;
+            n_colors = n_colors.max(c + 1);
+        }
+        let mut columns_of_color = vec![Vec::new(); n_colors];
+        for (j, &c) in colors.iter().enumerate() {
+            if c != usize::MAX {
+                columns_of_color[c].push(j);
             }
         }
-        forbidden.sort_unstable();
-        forbidden.dedup();
-        let c = (0..).find(|c| forbidden.binary_search(c).is_err()).unwrap_or(0);
-        color[j] = c;
-        n_colors = n_colors.max(c + 1);
+        Coloring { colors, n_colors, columns_of_color, rows_of_col }
     }
-    (color, n_colors)
 }

@@ -323,7 +323,7 @@ impl System for GroupSystem<'_> {
             dense.resize(b.n_eq * n, 0.0);
             let io = UnitIo { local: &local, layout: &b.layout, thermo: &self.plant.thermo, time: 0.0 };
             let (r0, c0, n_own) = (self.layout.row0[k], self.layout.col0[k], b.layout.n_own());
-            b.unit.jacobian(&io, &mut r[r0..r0 + b.n_eq], &mut dense);
+            b.unit.jacobian_colored(&io, &mut r[r0..r0 + b.n_eq], &mut dense, b.coloring.as_ref());
             let mut push = |row: usize, j: usize| {
                 let col = if j < n_own {
                     Some(c0 + j)
