@@ -12,7 +12,8 @@ const XB: f64 = 0.0105;
 
 /// Run a sweep and return its rows as (change %, [outputs…]).
 fn sweep(file: &str, disturb: &str, outputs: &str, points: &str) -> Vec<(f64, Vec<f64>)> {
-    let csv = std::env::temp_dir().join(format!("snowball-{}-{}.csv", std::process::id(), file.replace(['/', '.'], "_")));
+    let csv =
+        std::env::temp_dir().join(format!("snowball-{}-{}.csv", std::process::id(), file.replace(['/', '.'], "_")));
     let out = Command::new(env!("CARGO_BIN_EXE_plantwide"))
         .args(["sensitivity", &common::flowsheet(file), "--disturb", disturb, "--outputs", outputs, "--points", points])
         .arg("--csv")

@@ -89,13 +89,19 @@ impl<'a> BuildCx<'a> {
             match self.components.iter().position(|c| c == name) {
                 Some(i) => {
                     if !(v.is_finite() && v >= 0.0) {
-                        self.error(&format!("{field}.{name}"), format!("mole fraction must be finite and ≥ 0 (got {v})"));
+                        self.error(
+                            &format!("{field}.{name}"),
+                            format!("mole fraction must be finite and ≥ 0 (got {v})"),
+                        );
                     }
                     z[i] = v;
                 }
                 None => self.error(
                     &format!("{field}.{name}"),
-                    format!("`{name}` is not a component of this flowsheet (components: {})", self.components.join(", ")),
+                    format!(
+                        "`{name}` is not a component of this flowsheet (components: {})",
+                        self.components.join(", ")
+                    ),
                 ),
             }
         }

@@ -19,7 +19,13 @@ pub fn binary_package() -> ThermoPackage {
 
 /// Largest mismatch between the dual-number Jacobian of `unit` at `local` and a central finite
 /// difference, relative to `max(|J_ij|, row scale)`. Steps are `1e-6·max(|x_j|, 1e-3)`.
-pub fn jacobian_error(unit: &dyn Unit, layout: &LocalLayout, thermo: &ThermoPackage, local: &[f64], n_eq: usize) -> f64 {
+pub fn jacobian_error(
+    unit: &dyn Unit,
+    layout: &LocalLayout,
+    thermo: &ThermoPackage,
+    local: &[f64],
+    n_eq: usize,
+) -> f64 {
     let n = local.len();
     let mut r = vec![0.0; n_eq];
     let mut jac = vec![0.0; n_eq * n];
@@ -38,7 +44,8 @@ pub fn jacobian_error(unit: &dyn Unit, layout: &LocalLayout, thermo: &ThermoPack
         xp[j] = local[j];
         for k in 0..n_eq {
             let fd = (rp[k] - rm[k]) / (2.0 * h);
-            let row_scale = (0..n).map(|c| (jac[k * n + c] * local[c].abs().max(1e-3)).abs()).fold(0.0, f64::max) / local[j].abs().max(1e-3);
+            let row_scale = (0..n).map(|c| (jac[k * n + c] * local[c].abs().max(1e-3)).abs()).fold(0.0, f64::max)
+                / local[j].abs().max(1e-3);
             let denom = jac[k * n + j].abs().max(row_scale).max(1e-12);
             worst = worst.max((jac[k * n + j] - fd).abs() / denom);
         }

@@ -14,7 +14,13 @@ pub mod steady;
 pub mod structure;
 pub mod system;
 
-pub use newton::{pseudo_transient_steps, solve_steady, solve_steady_observed, IterationRecord, NewtonReport, NewtonSettings, NewtonStatus};
-pub use structure::{maximum_matching, Matching};
-pub use steady::{dof_check, DofProbe, steady_state, steady_state_observed, ConvergenceFailure, DofError, PlantSystem, SteadyError, SteadyState};
+pub use newton::{
+    IterationRecord, NewtonReport, NewtonSettings, NewtonStatus, pseudo_transient_steps, solve_steady,
+    solve_steady_observed,
+};
+pub use steady::{
+    ConvergenceFailure, DofError, DofProbe, PlantSystem, SteadyError, SteadyState, dof_check, steady_state,
+    steady_state_observed,
+};
+pub use structure::{Matching, maximum_matching};
 pub use system::System;

@@ -209,7 +209,8 @@ pub fn solve_steady_observed<S: System>(
 /// differential variables have moved a little along the plant's own dynamics.
 pub fn pseudo_transient_steps<S: System>(sys: &S, x: &mut [f64], steps: usize, dt: f64) {
     let n = sys.n();
-    let mut wk = Work { sys, n, lu: SparseLu::default(), jac: Vec::new(), r: vec![0.0; n], w: vec![1.0; n], n_res: 0, n_jac: 0 };
+    let mut wk =
+        Work { sys, n, lu: SparseLu::default(), jac: Vec::new(), r: vec![0.0; n], w: vec![1.0; n], n_res: 0, n_jac: 0 };
     let mass = sys.mass();
     for _ in 0..steps {
         wk.linearize(x);

@@ -130,7 +130,11 @@ pub fn dof_check(plant: &Plant, u: &[f64], x: &[f64], probe: DofProbe) -> Result
         if let Some(idx) = null_direction(plant, u, &xp) {
             return Err(DofError::Underdetermined {
                 file,
-                explanation: explain_loose(plant, &idx, "these variables can move together without changing any equation"),
+                explanation: explain_loose(
+                    plant,
+                    &idx,
+                    "these variables can move together without changing any equation",
+                ),
             });
         }
     }

@@ -31,13 +31,7 @@ impl Dimension {
     /// A dimension from its exponents of mass (kg), length (m), time (s), temperature (K) and
     /// amount (mol).
     pub const fn new(mass: i8, length: i8, time: i8, temperature: i8, amount: i8) -> Self {
-        Dimension {
-            mass,
-            length,
-            time,
-            temperature,
-            amount,
-        }
+        Dimension { mass, length, time, temperature, amount }
     }
 
     /// Dimensionless (1): fractions, ratios, percentages.
@@ -107,22 +101,12 @@ impl Dimension {
 
     /// Whether all exponents are zero.
     pub const fn is_dimensionless(&self) -> bool {
-        self.mass == 0
-            && self.length == 0
-            && self.time == 0
-            && self.temperature == 0
-            && self.amount == 0
+        self.mass == 0 && self.length == 0 && self.time == 0 && self.temperature == 0 && self.amount == 0
     }
 
     /// The exponents in the order mass, length, time, temperature, amount.
     pub const fn exponents(&self) -> [i8; 5] {
-        [
-            self.mass,
-            self.length,
-            self.time,
-            self.temperature,
-            self.amount,
-        ]
+        [self.mass, self.length, self.time, self.temperature, self.amount]
     }
 
     const fn from_exponents(e: [i8; 5]) -> Self {
@@ -199,11 +183,7 @@ impl Dimension {
             format!("a bare number in {self}")
         });
         let last = parts.pop().unwrap_or_default();
-        if parts.is_empty() {
-            last
-        } else {
-            format!("{} or {last}", parts.join(", "))
-        }
+        if parts.is_empty() { last } else { format!("{} or {last}", parts.join(", ")) }
     }
 }
 
@@ -232,11 +212,7 @@ impl fmt::Display for Dimension {
         }
         const SYMBOLS: [&str; 5] = ["kg", "m", "s", "K", "mol"];
         let term = |s: &str, e: i8| {
-            if e == 1 {
-                s.to_owned()
-            } else {
-                format!("{s}{e}")
-            }
+            if e == 1 { s.to_owned() } else { format!("{s}{e}") }
         };
         let (mut num, mut den) = (Vec::new(), Vec::new());
         for (s, e) in SYMBOLS.iter().zip(self.exponents()) {
@@ -246,11 +222,7 @@ impl fmt::Display for Dimension {
                 den.push(term(s, -e));
             }
         }
-        let num = if num.is_empty() {
-            "1".to_owned()
-        } else {
-            num.join("*")
-        };
+        let num = if num.is_empty() { "1".to_owned() } else { num.join("*") };
         match den.len() {
             0 => write!(f, "{num}"),
             1 => write!(f, "{num}/{}", den[0]),
@@ -270,17 +242,10 @@ mod tests {
         assert_eq!(Dimension::FORCE / Dimension::AREA, Dimension::PRESSURE);
         assert_eq!(Dimension::LENGTH.pow(3), Dimension::VOLUME);
         assert_eq!(Dimension::POWER / Dimension::TEMPERATURE, Dimension::UA);
-        assert_eq!(
-            Dimension::MOLAR_FLOW / Dimension::AMOUNT,
-            Dimension::INVERSE_TIME
-        );
+        assert_eq!(Dimension::MOLAR_FLOW / Dimension::AMOUNT, Dimension::INVERSE_TIME);
         assert_eq!(Dimension::TIME.pow(-1), Dimension::INVERSE_TIME);
         assert!(Dimension::LENGTH.checked_pow(200).is_none());
-        assert!(
-            Dimension::new(127, 0, 0, 0, 0)
-                .checked_mul(Dimension::MASS)
-                .is_none()
-        );
+        assert!(Dimension::new(127, 0, 0, 0, 0).checked_mul(Dimension::MASS).is_none());
     }
 
     #[test]
@@ -301,17 +266,8 @@ mod tests {
         assert_eq!(Dimension::PRESSURE.name(), "pressure");
         assert_eq!(Dimension::ENERGY.describe(), "an energy");
         assert_eq!(Dimension::new(0, 1, -2, 0, 0).name(), "quantity in m/s2");
-        assert_eq!(
-            Dimension::MOLAR_FLOW.example_hint(),
-            "\"1 kmol/min\", \"100 lbmol/h\" or a bare number in mol/s"
-        );
-        assert_eq!(
-            Dimension::new(0, 1, -2, 0, 0).example_hint(),
-            "a bare number in m/s2"
-        );
-        assert_eq!(
-            Dimension::DIMENSIONLESS.example_hint(),
-            "\"0.5\", \"50 %\" or a bare number"
-        );
+        assert_eq!(Dimension::MOLAR_FLOW.example_hint(), "\"1 kmol/min\", \"100 lbmol/h\" or a bare number in mol/s");
+        assert_eq!(Dimension::new(0, 1, -2, 0, 0).example_hint(), "a bare number in m/s2");
+        assert_eq!(Dimension::DIMENSIONLESS.example_hint(), "\"0.5\", \"50 %\" or a bare number");
     }
 }

@@ -62,9 +62,7 @@ pub enum UnitError {
 }
 
 fn did_you_mean(suggestion: Option<&str>) -> String {
-    suggestion
-        .map(|s| format!(" (did you mean `{s}`?)"))
-        .unwrap_or_default()
+    suggestion.map(|s| format!(" (did you mean `{s}`?)")).unwrap_or_default()
 }
 
 fn affine_hint(unit: &str, linear: &str) -> String {
@@ -90,35 +88,17 @@ mod tests {
     fn messages_are_lowercase_without_period() {
         let errors = [
             UnitError::Empty,
-            UnitError::BadNumber {
-                text: "abc".into(),
-                reason: "expected a number first".into(),
-            },
-            UnitError::UnknownUnit {
-                unit: "kmols".into(),
-                text: "1 kmols".into(),
-                suggestion: Some("kmol".into()),
-            },
+            UnitError::BadNumber { text: "abc".into(), reason: "expected a number first".into() },
+            UnitError::UnknownUnit { unit: "kmols".into(), text: "1 kmols".into(), suggestion: Some("kmol".into()) },
             UnitError::WrongDimension {
                 text: "5 K".into(),
                 found: Dimension::TEMPERATURE,
                 expected: Dimension::MOLAR_FLOW,
                 example: Dimension::MOLAR_FLOW.example_hint(),
             },
-            UnitError::AffineInCompound {
-                unit: "degC".into(),
-                text: "80 degC/min".into(),
-                linear: "K".into(),
-            },
-            UnitError::AffineInCompound {
-                unit: "psig".into(),
-                text: "3 psig/s".into(),
-                linear: "psi".into(),
-            },
-            UnitError::Syntax {
-                text: "1 (m".into(),
-                message: "missing `)`".into(),
-            },
+            UnitError::AffineInCompound { unit: "degC".into(), text: "80 degC/min".into(), linear: "K".into() },
+            UnitError::AffineInCompound { unit: "psig".into(), text: "3 psig/s".into(), linear: "psi".into() },
+            UnitError::Syntax { text: "1 (m".into(), message: "missing `)`".into() },
         ];
         for e in errors {
             let m = e.to_string();
@@ -145,20 +125,10 @@ mod tests {
 
     #[test]
     fn unknown_unit_message() {
-        let e = UnitError::UnknownUnit {
-            unit: "kmols".into(),
-            text: "1 kmols/h".into(),
-            suggestion: Some("kmol".into()),
-        };
-        assert_eq!(
-            e.to_string(),
-            "unknown unit `kmols` in `1 kmols/h` (did you mean `kmol`?)"
-        );
-        let e = UnitError::UnknownUnit {
-            unit: "furlongs".into(),
-            text: "3 furlongs".into(),
-            suggestion: None,
-        };
+        let e =
+            UnitError::UnknownUnit { unit: "kmols".into(), text: "1 kmols/h".into(), suggestion: Some("kmol".into()) };
+        assert_eq!(e.to_string(), "unknown unit `kmols` in `1 kmols/h` (did you mean `kmol`?)");
+        let e = UnitError::UnknownUnit { unit: "furlongs".into(), text: "3 furlongs".into(), suggestion: None };
         assert_eq!(e.to_string(), "unknown unit `furlongs` in `3 furlongs`");
     }
 }

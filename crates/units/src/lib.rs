@@ -61,8 +61,8 @@ pub use dimension::Dimension;
 pub use error::UnitError;
 pub use named::{NamedDimension, named_dimensions};
 pub use quantity::{
-    Quantity, convert_from_si, convert_to_si, parse_difference, parse_difference_as,
-    parse_quantity, parse_quantity_as, unit_dimension,
+    Quantity, convert_from_si, convert_to_si, parse_difference, parse_difference_as, parse_quantity, parse_quantity_as,
+    unit_dimension,
 };
 pub use table::{Prefix, UnitDef, UnitKind, prefixes, units};
 pub use unit::Unit;
@@ -71,7 +71,7 @@ pub use value::QuantityValue;
 /// Exact and NIST SP 811 conversion constants used by the unit table, in SI units.
 pub mod constants {
     pub use crate::table::{
-        ATM, BTU, CALORIE, FOOT, HORSEPOWER, INCH, MM_HG, POUND, POUND_FORCE, POUND_MOLE, PSI,
-        RANKINE, STANDARD_GRAVITY, US_GALLON,
+        ATM, BTU, CALORIE, FOOT, HORSEPOWER, INCH, MM_HG, POUND, POUND_FORCE, POUND_MOLE, PSI, RANKINE,
+        STANDARD_GRAVITY, US_GALLON,
     };
 }

@@ -24,73 +24,25 @@ const fn nd(
     symbol: &'static str,
     examples: &'static [&'static str],
 ) -> NamedDimension {
-    NamedDimension {
-        dim,
-        name,
-        phrase,
-        symbol,
-        examples,
-    }
+    NamedDimension { dim, name, phrase, symbol, examples }
 }
 
 type D = Dimension;
 
 static NAMED: &[NamedDimension] = &[
-    nd(
-        D::DIMENSIONLESS,
-        "dimensionless",
-        "a dimensionless number",
-        "1",
-        &["0.5", "50 %"],
-    ),
+    nd(D::DIMENSIONLESS, "dimensionless", "a dimensionless number", "1", &["0.5", "50 %"]),
     nd(D::MASS, "mass", "a mass", "kg", &["100 kg", "10 lb"]),
     nd(D::LENGTH, "length", "a length", "m", &["4.5 ft", "2 m"]),
     nd(D::TIME, "time", "a time", "s", &["2 min", "1 h"]),
-    nd(
-        D::TEMPERATURE,
-        "temperature",
-        "a temperature",
-        "K",
-        &["350 K", "80 degC"],
-    ),
-    nd(
-        D::AMOUNT,
-        "amount of substance",
-        "an amount of substance",
-        "mol",
-        &["0.5 kmol", "10 lbmol"],
-    ),
+    nd(D::TEMPERATURE, "temperature", "a temperature", "K", &["350 K", "80 degC"]),
+    nd(D::AMOUNT, "amount of substance", "an amount of substance", "mol", &["0.5 kmol", "10 lbmol"]),
     nd(D::AREA, "area", "an area", "m2", &["10 m2", "100 ft2"]),
     nd(D::VOLUME, "volume", "a volume", "m3", &["5 m3", "100 gal"]),
-    nd(
-        D::VELOCITY,
-        "velocity",
-        "a velocity",
-        "m/s",
-        &["1.5 m/s", "3 ft/s"],
-    ),
+    nd(D::VELOCITY, "velocity", "a velocity", "m/s", &["1.5 m/s", "3 ft/s"]),
     nd(D::FORCE, "force", "a force", "N", &["10 kN", "5 lbf"]),
-    nd(
-        D::PRESSURE,
-        "pressure",
-        "a pressure",
-        "Pa",
-        &["1 atm", "30 psia", "1.2 bar"],
-    ),
-    nd(
-        D::ENERGY,
-        "energy",
-        "an energy",
-        "J",
-        &["2500 kJ", "1 MMBtu"],
-    ),
-    nd(
-        D::POWER,
-        "power (heat duty)",
-        "a power (heat duty)",
-        "W",
-        &["3 kW", "1e6 Btu/h"],
-    ),
+    nd(D::PRESSURE, "pressure", "a pressure", "Pa", &["1 atm", "30 psia", "1.2 bar"]),
+    nd(D::ENERGY, "energy", "an energy", "J", &["2500 kJ", "1 MMBtu"]),
+    nd(D::POWER, "power (heat duty)", "a power (heat duty)", "W", &["3 kW", "1e6 Btu/h"]),
     nd(
         D::INVERSE_TIME,
         "inverse time (rate constant)",
@@ -98,27 +50,9 @@ static NAMED: &[NamedDimension] = &[
         "1/s",
         &["0.1 1/min", "10 kmol/min/kmol"],
     ),
-    nd(
-        D::MOLAR_FLOW,
-        "molar flow",
-        "a molar flow",
-        "mol/s",
-        &["1 kmol/min", "100 lbmol/h"],
-    ),
-    nd(
-        D::MASS_FLOW,
-        "mass flow",
-        "a mass flow",
-        "kg/s",
-        &["1e3 kg/h", "10 lb/s"],
-    ),
-    nd(
-        D::VOLUMETRIC_FLOW,
-        "volumetric flow",
-        "a volumetric flow",
-        "m3/s",
-        &["120 gpm", "2 m3/h"],
-    ),
+    nd(D::MOLAR_FLOW, "molar flow", "a molar flow", "mol/s", &["1 kmol/min", "100 lbmol/h"]),
+    nd(D::MASS_FLOW, "mass flow", "a mass flow", "kg/s", &["1e3 kg/h", "10 lb/s"]),
+    nd(D::VOLUMETRIC_FLOW, "volumetric flow", "a volumetric flow", "m3/s", &["120 gpm", "2 m3/h"]),
     nd(
         D::MOLAR_ENERGY,
         "molar energy (molar enthalpy)",
@@ -133,13 +67,7 @@ static NAMED: &[NamedDimension] = &[
         "J/kg",
         &["2257 kJ/kg", "970 Btu/lb"],
     ),
-    nd(
-        D::HEAT_CAPACITY,
-        "heat capacity",
-        "a heat capacity",
-        "J/K",
-        &["10 kJ/K", "50 Btu/degF"],
-    ),
+    nd(D::HEAT_CAPACITY, "heat capacity", "a heat capacity", "J/K", &["10 kJ/K", "50 Btu/degF"]),
     nd(
         D::HEAT_CAPACITY_MOLAR,
         "molar heat capacity",
@@ -168,20 +96,8 @@ static NAMED: &[NamedDimension] = &[
         "W/(m2*K)",
         &["500 W/(m2*K)", "100 Btu/(h*ft2*degF)"],
     ),
-    nd(
-        D::MOLAR_VOLUME,
-        "molar volume",
-        "a molar volume",
-        "m3/mol",
-        &["2.3e-4 m3/mol", "22.4 L/mol"],
-    ),
-    nd(
-        D::MOLAR_MASS,
-        "molar mass",
-        "a molar mass",
-        "kg/mol",
-        &["18 g/mol", "44 kg/kmol"],
-    ),
+    nd(D::MOLAR_VOLUME, "molar volume", "a molar volume", "m3/mol", &["2.3e-4 m3/mol", "22.4 L/mol"]),
+    nd(D::MOLAR_MASS, "molar mass", "a molar mass", "kg/mol", &["18 g/mol", "44 kg/kmol"]),
     nd(
         D::DENSITY_MOLAR,
         "molar density (concentration)",
@@ -189,20 +105,8 @@ static NAMED: &[NamedDimension] = &[
         "mol/m3",
         &["10 kmol/m3", "0.5 mol/L"],
     ),
-    nd(
-        D::DENSITY_MASS,
-        "mass density",
-        "a mass density",
-        "kg/m3",
-        &["1000 kg/m3", "62.4 lb/ft3"],
-    ),
-    nd(
-        D::REACTION_RATE,
-        "volumetric reaction rate",
-        "a volumetric reaction rate",
-        "mol/(m3*s)",
-        &["1 kmol/(m3*h)"],
-    ),
+    nd(D::DENSITY_MASS, "mass density", "a mass density", "kg/m3", &["1000 kg/m3", "62.4 lb/ft3"]),
+    nd(D::REACTION_RATE, "volumetric reaction rate", "a volumetric reaction rate", "mol/(m3*s)", &["1 kmol/(m3*h)"]),
 ];
 
 /// All named dimensions, one entry per distinct [`Dimension`].
@@ -231,11 +135,7 @@ mod tests {
     fn phrases_contain_names() {
         for n in NAMED {
             assert!(n.phrase.contains(n.name), "{}", n.phrase);
-            assert!(
-                n.phrase.starts_with("a ") || n.phrase.starts_with("an "),
-                "{}",
-                n.phrase
-            );
+            assert!(n.phrase.starts_with("a ") || n.phrase.starts_with("an "), "{}", n.phrase);
         }
     }
 }

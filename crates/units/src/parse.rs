@@ -82,10 +82,7 @@ impl<'a> Parser<'a> {
     }
 
     fn syntax(&self, message: impl Into<String>) -> UnitError {
-        UnitError::Syntax {
-            text: self.text.to_owned(),
-            message: message.into(),
-        }
+        UnitError::Syntax { text: self.text.to_owned(), message: message.into() }
     }
 
     fn product(&mut self) -> Result<Vec<Term<'a>>, UnitError> {
@@ -153,10 +150,7 @@ impl<'a> Parser<'a> {
                 return Err(self.syntax("two exponents on one unit"));
             }
             for t in &mut terms {
-                t.exp = t
-                    .exp
-                    .checked_mul(n)
-                    .ok_or_else(|| self.syntax("exponent out of range"))?;
+                t.exp = t.exp.checked_mul(n).ok_or_else(|| self.syntax("exponent out of range"))?;
             }
         }
         Ok(terms)
@@ -170,30 +164,14 @@ impl<'a> Parser<'a> {
         }
         let word = &self.src[start..self.pos];
         if let Some(unit) = table::lookup(word) {
-            return Ok((
-                vec![Term {
-                    symbol: word,
-                    unit,
-                    exp: 1,
-                }],
-                false,
-            ));
+            return Ok((vec![Term { symbol: word, unit, exp: 1 }], false));
         }
         let base = word.trim_end_matches(|c: char| c.is_ascii_digit());
         if base != word
             && let Some(unit) = table::lookup(base)
         {
-            let exp = word[base.len()..]
-                .parse()
-                .map_err(|_| self.syntax("exponent out of range"))?;
-            return Ok((
-                vec![Term {
-                    symbol: base,
-                    unit,
-                    exp,
-                }],
-                true,
-            ));
+            let exp = word[base.len()..].parse().map_err(|_| self.syntax("exponent out of range"))?;
+            return Ok((vec![Term { symbol: base, unit, exp }], true));
         }
         let unit = if base.is_empty() { word } else { base };
         Err(UnitError::UnknownUnit {
@@ -225,13 +203,9 @@ impl<'a> Parser<'a> {
             }
             let digits = &self.src[start..self.pos];
             if digits.is_empty() {
-                return Err(
-                    self.syntax("`^` must be followed by an integer exponent, e.g. m^3 or s^-1")
-                );
+                return Err(self.syntax("`^` must be followed by an integer exponent, e.g. m^3 or s^-1"));
             }
-            let n: i32 = digits
-                .parse()
-                .map_err(|_| self.syntax("exponent out of range"))?;
+            let n: i32 = digits.parse().map_err(|_| self.syntax("exponent out of range"))?;
             return Ok(Some(if negative { -n } else { n }));
         }
         self.pos = save;
@@ -239,17 +213,12 @@ impl<'a> Parser<'a> {
         let mut n: Option<i32> = None;
         while let Some(d) = self.peek().and_then(superscript_digit) {
             self.bump();
-            let next = n
-                .unwrap_or(0)
-                .checked_mul(10)
-                .and_then(|v| v.checked_add(d as i32));
+            let next = n.unwrap_or(0).checked_mul(10).and_then(|v| v.checked_add(d as i32));
             n = Some(next.ok_or_else(|| self.syntax("exponent out of range"))?);
         }
         match n {
             Some(n) => Ok(Some(if negative { -n } else { n })),
-            None if negative => {
-                Err(self.syntax("`⁻` must be followed by superscript digits, e.g. s⁻¹"))
-            }
+            None if negative => Err(self.syntax("`⁻` must be followed by superscript digits, e.g. s⁻¹")),
             None => Ok(None),
         }
     }
@@ -258,31 +227,21 @@ impl<'a> Parser<'a> {
 /// Parses a unit expression. `text` is the whole user input, quoted in errors.
 pub(crate) fn parse_unit(expr: &str, text: &str, mode: Mode) -> Result<Unit, UnitError> {
     let src = expr.trim();
-    let syntax = |message: &str| UnitError::Syntax {
-        text: text.to_owned(),
-        message: message.to_owned(),
-    };
+    let syntax = |message: &str| UnitError::Syntax { text: text.to_owned(), message: message.to_owned() };
     if src.is_empty() {
         return Err(syntax("no unit given"));
     }
     if src == "-" {
         return Ok(Unit::new(src, 1.0, 0.0, Dimension::DIMENSIONLESS));
     }
-    let mut p = Parser {
-        src,
-        pos: 0,
-        text,
-        compound: false,
-    };
+    let mut p = Parser { src, pos: 0, text, compound: false };
     let terms = p.product()?;
     p.skip_ws();
     match p.peek() {
         None => {}
         Some(')') => return Err(syntax("unmatched `)`")),
         Some(c) if is_symbol_char(c) || c == '(' => {
-            return Err(syntax(
-                "expected `*` or `/` between units (units written side by side are not supported)",
-            ));
+            return Err(syntax("expected `*` or `/` between units (units written side by side are not supported)"));
         }
         Some(c) => return Err(syntax(&format!("unexpected `{c}`"))),
     }
@@ -345,10 +304,7 @@ mod tests {
         }
         assert!((unit("cm3").factor() - 1e-6).abs() < 1e-21);
         assert!((unit("ft^2").factor() - 0.09290304).abs() < 1e-15);
-        assert_eq!(
-            unit("(mol*K)^-1").dimension(),
-            Dimension::new(0, 0, 0, -1, -1)
-        );
+        assert_eq!(unit("(mol*K)^-1").dimension(), Dimension::new(0, 0, 0, -1, -1));
     }
 
     #[test]
@@ -358,70 +314,35 @@ mod tests {
         assert!((u.factor() - 1.0 / 60.0).abs() < 1e-15);
         let u = unit("J/(mol*K)");
         assert_eq!(u.dimension(), Dimension::HEAT_CAPACITY_MOLAR);
-        assert_eq!(
-            unit("W/m2/K").dimension(),
-            Dimension::HEAT_TRANSFER_COEFFICIENT
-        );
+        assert_eq!(unit("W/m2/K").dimension(), Dimension::HEAT_TRANSFER_COEFFICIENT);
         assert_eq!(unit("kg·m/s2").dimension(), Dimension::FORCE);
     }
 
     #[test]
     fn symbols_with_digits_inside() {
         assert_eq!(unit("inH2O").dimension(), Dimension::PRESSURE);
-        assert_eq!(
-            unit("inH2O/ft").dimension(),
-            Dimension::new(1, -2, -2, 0, 0)
-        );
+        assert_eq!(unit("inH2O/ft").dimension(), Dimension::new(1, -2, -2, 0, 0));
     }
 
     #[test]
     fn syntax_errors() {
-        for s in [
-            "(m",
-            "m)",
-            "m^",
-            "m^x",
-            "m3^2",
-            "J/mol*K",
-            "kJ/kmol K",
-            "10/min",
-            "m^99999999999",
-            "/s",
-            "m/",
-            "m⁻",
-        ] {
-            assert!(
-                matches!(err(s), UnitError::Syntax { .. }),
-                "{s}: {:?}",
-                err(s)
-            );
+        for s in ["(m", "m)", "m^", "m^x", "m3^2", "J/mol*K", "kJ/kmol K", "10/min", "m^99999999999", "/s", "m/", "m⁻"]
+        {
+            assert!(matches!(err(s), UnitError::Syntax { .. }), "{s}: {:?}", err(s));
         }
         assert!(matches!(err("m^200"), UnitError::Syntax { .. }));
-        assert!(
-            matches!(err("Tm^30"), UnitError::Syntax { .. }),
-            "1e360 overflows"
-        );
+        assert!(matches!(err("Tm^30"), UnitError::Syntax { .. }), "1e360 overflows");
     }
 
     #[test]
     fn affine_rules() {
         assert_eq!(unit("degC").offset(), 273.15);
         assert_eq!(unit("(degC)").offset(), 273.15);
-        assert_eq!(
-            parse_unit("degC", "", Mode::Difference).unwrap().offset(),
-            0.0
-        );
+        assert_eq!(parse_unit("degC", "", Mode::Difference).unwrap().offset(), 0.0);
         assert_eq!(unit("kJ/(kmol*degC)").offset(), 0.0);
         assert_eq!(unit("1/degF").offset(), 0.0);
         assert!((unit("1/degF").factor() - 1.8).abs() < 1e-12);
-        for s in [
-            "degC/min",
-            "degC^2",
-            "degC*s",
-            "psig/s",
-            "1/psig",
-            "1/(1/degC)",
-        ] {
+        for s in ["degC/min", "degC^2", "degC*s", "psig/s", "1/psig", "1/(1/degC)"] {
             assert!(matches!(err(s), UnitError::AffineInCompound { .. }), "{s}");
         }
     }

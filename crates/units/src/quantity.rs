@@ -51,12 +51,7 @@ impl FromStr for Quantity {
 }
 
 fn wrong_dimension(text: &str, found: Dimension, expected: Dimension) -> UnitError {
-    UnitError::WrongDimension {
-        text: text.to_owned(),
-        found,
-        expected,
-        example: expected.example_hint(),
-    }
+    UnitError::WrongDimension { text: text.to_owned(), found, expected, example: expected.example_hint() }
 }
 
 /// Byte length of the number literal at the start of `s`: `[+-]? digits [. digits] [e [+-] digits]`
@@ -97,25 +92,15 @@ fn split(text: &str, mode: Mode) -> Result<(f64, Option<Unit>), UnitError> {
     if t.is_empty() {
         return Err(UnitError::Empty);
     }
-    let bad = |reason: String| UnitError::BadNumber {
-        text: text.to_owned(),
-        reason,
-    };
-    let n = number_len(t)
-        .ok_or_else(|| bad("expected a number first, e.g. \"1 kmol/min\"".to_owned()))?;
+    let bad = |reason: String| UnitError::BadNumber { text: text.to_owned(), reason };
+    let n = number_len(t).ok_or_else(|| bad("expected a number first, e.g. \"1 kmol/min\"".to_owned()))?;
     let literal = &t[..n];
-    let value: f64 = literal
-        .parse()
-        .map_err(|_| bad(format!("`{literal}` is not a number")))?;
+    let value: f64 = literal.parse().map_err(|_| bad(format!("`{literal}` is not a number")))?;
     if !value.is_finite() {
         return Err(bad(format!("{literal} is not a finite number")));
     }
     let rest = t[n..].trim();
-    let unit = if rest.is_empty() {
-        None
-    } else {
-        Some(parse_unit(rest, text, mode)?)
-    };
+    let unit = if rest.is_empty() { None } else { Some(parse_unit(rest, text, mode)?) };
     Ok((value, unit))
 }
 
@@ -124,10 +109,7 @@ fn to_si(text: &str, value: f64, unit: &Unit) -> Result<f64, UnitError> {
     if si.is_finite() {
         Ok(si)
     } else {
-        Err(UnitError::BadNumber {
-            text: text.to_owned(),
-            reason: "the value is out of range in SI units".to_owned(),
-        })
+        Err(UnitError::BadNumber { text: text.to_owned(), reason: "the value is out of range in SI units".to_owned() })
     }
 }
 
@@ -218,17 +200,8 @@ mod tests {
 
     #[test]
     fn display() {
-        assert_eq!(
-            Quantity::new(12.5, Dimension::MOLAR_FLOW).to_string(),
-            "12.5 mol/s"
-        );
-        assert_eq!(
-            Quantity::new(0.5, Dimension::DIMENSIONLESS).to_string(),
-            "0.5"
-        );
-        assert_eq!(
-            format!("{:.1}", Quantity::new(351.26, Dimension::TEMPERATURE)),
-            "351.3 K"
-        );
+        assert_eq!(Quantity::new(12.5, Dimension::MOLAR_FLOW).to_string(), "12.5 mol/s");
+        assert_eq!(Quantity::new(0.5, Dimension::DIMENSIONLESS).to_string(), "0.5");
+        assert_eq!(format!("{:.1}", Quantity::new(351.26, Dimension::TEMPERATURE)), "351.3 K");
     }
 }

@@ -52,10 +52,7 @@ const ALIASES: &[(&str, &str)] = &[
 const COMMON_PREFIXES: &[&str] = &["k", "M", "G", "m", "c", "µ"];
 
 fn candidates() -> impl Iterator<Item = String> {
-    let plain = units()
-        .iter()
-        .filter(|u| u.symbol != "-")
-        .map(|u| u.symbol.to_owned());
+    let plain = units().iter().filter(|u| u.symbol != "-").map(|u| u.symbol.to_owned());
     let prefixed = units().iter().filter(|u| u.prefixable).flat_map(|u| {
         prefixes()
             .iter()
@@ -73,9 +70,7 @@ fn edit_distance(a: &str, b: &str) -> usize {
         let mut diagonal = row[0];
         row[0] = i + 1;
         for (j, &cb) in b.iter().enumerate() {
-            let next = (row[j + 1] + 1)
-                .min(row[j] + 1)
-                .min(diagonal + usize::from(ca != cb));
+            let next = (row[j + 1] + 1).min(row[j] + 1).min(diagonal + usize::from(ca != cb));
             diagonal = row[j + 1];
             row[j + 1] = next;
         }
@@ -86,10 +81,7 @@ fn edit_distance(a: &str, b: &str) -> usize {
 /// The known symbol closest to `unknown`: an alias, the same symbol in other letter case, or the
 /// nearest symbol by edit distance (at most 1 for symbols of up to 3 characters, else at most 2).
 pub(crate) fn suggest(unknown: &str) -> Option<String> {
-    if let Some((_, meant)) = ALIASES
-        .iter()
-        .find(|(alias, _)| alias.eq_ignore_ascii_case(unknown))
-    {
+    if let Some((_, meant)) = ALIASES.iter().find(|(alias, _)| alias.eq_ignore_ascii_case(unknown)) {
         return Some((*meant).to_owned());
     }
     if let Some(same) = candidates().find(|c| c.to_lowercase() == unknown.to_lowercase()) {

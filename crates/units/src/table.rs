@@ -86,64 +86,21 @@ pub const RANKINE: f64 = 5.0 / 9.0;
 type D = Dimension;
 
 const fn lin(symbol: &'static str, name: &'static str, factor: f64, dim: D) -> UnitDef {
-    UnitDef {
-        symbol,
-        name,
-        factor,
-        offset: 0.0,
-        dim,
-        prefixable: false,
-        kind: UnitKind::Linear,
-    }
+    UnitDef { symbol, name, factor, offset: 0.0, dim, prefixable: false, kind: UnitKind::Linear }
 }
 
 const fn pre(symbol: &'static str, name: &'static str, factor: f64, dim: D) -> UnitDef {
-    UnitDef {
-        symbol,
-        name,
-        factor,
-        offset: 0.0,
-        dim,
-        prefixable: true,
-        kind: UnitKind::Linear,
-    }
+    UnitDef { symbol, name, factor, offset: 0.0, dim, prefixable: true, kind: UnitKind::Linear }
 }
 
-const fn temp(
-    symbol: &'static str,
-    name: &'static str,
-    factor: f64,
-    offset: f64,
-    linear: &'static str,
-) -> UnitDef {
+const fn temp(symbol: &'static str, name: &'static str, factor: f64, offset: f64, linear: &'static str) -> UnitDef {
     let kind = UnitKind::OffsetTemperature { linear };
-    UnitDef {
-        symbol,
-        name,
-        factor,
-        offset,
-        dim: D::TEMPERATURE,
-        prefixable: false,
-        kind,
-    }
+    UnitDef { symbol, name, factor, offset, dim: D::TEMPERATURE, prefixable: false, kind }
 }
 
-const fn gauge(
-    symbol: &'static str,
-    name: &'static str,
-    factor: f64,
-    linear: &'static str,
-) -> UnitDef {
+const fn gauge(symbol: &'static str, name: &'static str, factor: f64, linear: &'static str) -> UnitDef {
     let kind = UnitKind::GaugePressure { linear };
-    UnitDef {
-        symbol,
-        name,
-        factor,
-        offset: ATM,
-        dim: D::PRESSURE,
-        prefixable: false,
-        kind,
-    }
+    UnitDef { symbol, name, factor, offset: ATM, dim: D::PRESSURE, prefixable: false, kind }
 }
 
 const DEG_F_OFFSET: f64 = 459.67 * RANKINE;
@@ -192,18 +149,8 @@ static UNITS: &[UnitDef] = &[
     pre("L", "litre", 1e-3, D::VOLUME),
     pre("l", "litre", 1e-3, D::VOLUME),
     lin("gal", "US gallon", US_GALLON, D::VOLUME),
-    lin(
-        "bbl",
-        "barrel (petroleum, 42 US gal)",
-        42.0 * US_GALLON,
-        D::VOLUME,
-    ),
-    lin(
-        "gpm",
-        "US gallon per minute",
-        US_GALLON / 60.0,
-        D::VOLUMETRIC_FLOW,
-    ),
+    lin("bbl", "barrel (petroleum, 42 US gal)", 42.0 * US_GALLON, D::VOLUME),
+    lin("gpm", "US gallon per minute", US_GALLON / 60.0, D::VOLUMETRIC_FLOW),
     // Pressure.
     pre("Pa", "pascal", 1.0, D::PRESSURE),
     pre("bar", "bar", 1e5, D::PRESSURE),
@@ -211,33 +158,13 @@ static UNITS: &[UnitDef] = &[
     gauge("barg", "bar gauge", 1e5, "bar"),
     lin("atm", "standard atmosphere", ATM, D::PRESSURE),
     lin("psi", "pound-force per square inch", PSI, D::PRESSURE),
-    lin(
-        "psia",
-        "pound-force per square inch absolute",
-        PSI,
-        D::PRESSURE,
-    ),
+    lin("psia", "pound-force per square inch absolute", PSI, D::PRESSURE),
     gauge("psig", "pound-force per square inch gauge", PSI, "psi"),
     lin("torr", "torr (1/760 atm)", ATM / 760.0, D::PRESSURE),
     lin("Torr", "torr (1/760 atm)", ATM / 760.0, D::PRESSURE),
-    lin(
-        "mmHg",
-        "millimetre of mercury (conventional)",
-        MM_HG,
-        D::PRESSURE,
-    ),
-    lin(
-        "inHg",
-        "inch of mercury (conventional)",
-        13595.1 * STANDARD_GRAVITY * INCH,
-        D::PRESSURE,
-    ),
-    lin(
-        "inH2O",
-        "inch of water (conventional)",
-        1000.0 * STANDARD_GRAVITY * INCH,
-        D::PRESSURE,
-    ),
+    lin("mmHg", "millimetre of mercury (conventional)", MM_HG, D::PRESSURE),
+    lin("inHg", "inch of mercury (conventional)", 13595.1 * STANDARD_GRAVITY * INCH, D::PRESSURE),
+    lin("inH2O", "inch of water (conventional)", 1000.0 * STANDARD_GRAVITY * INCH, D::PRESSURE),
     // Energy.
     pre("J", "joule", 1.0, D::ENERGY),
     pre("cal", "calorie (thermochemical)", CALORIE, D::ENERGY),
@@ -246,74 +173,27 @@ static UNITS: &[UnitDef] = &[
     pre("Wh", "watt-hour", 3600.0, D::ENERGY),
     // Power.
     pre("W", "watt", 1.0, D::POWER),
-    lin(
-        "hp",
-        "horsepower (mechanical, 550 ft·lbf/s)",
-        HORSEPOWER,
-        D::POWER,
-    ),
+    lin("hp", "horsepower (mechanical, 550 ft·lbf/s)", HORSEPOWER, D::POWER),
     // Force.
     pre("N", "newton", 1.0, D::FORCE),
     lin("lbf", "pound-force", POUND_FORCE, D::FORCE),
 ];
 
 static PREFIXES: &[Prefix] = &[
-    Prefix {
-        symbol: "T",
-        factor: 1e12,
-    },
-    Prefix {
-        symbol: "G",
-        factor: 1e9,
-    },
-    Prefix {
-        symbol: "M",
-        factor: 1e6,
-    },
-    Prefix {
-        symbol: "k",
-        factor: 1e3,
-    },
-    Prefix {
-        symbol: "h",
-        factor: 1e2,
-    },
-    Prefix {
-        symbol: "da",
-        factor: 1e1,
-    },
-    Prefix {
-        symbol: "d",
-        factor: 1e-1,
-    },
-    Prefix {
-        symbol: "c",
-        factor: 1e-2,
-    },
-    Prefix {
-        symbol: "m",
-        factor: 1e-3,
-    },
-    Prefix {
-        symbol: "µ",
-        factor: 1e-6,
-    },
-    Prefix {
-        symbol: "μ",
-        factor: 1e-6,
-    },
-    Prefix {
-        symbol: "u",
-        factor: 1e-6,
-    },
-    Prefix {
-        symbol: "n",
-        factor: 1e-9,
-    },
-    Prefix {
-        symbol: "p",
-        factor: 1e-12,
-    },
+    Prefix { symbol: "T", factor: 1e12 },
+    Prefix { symbol: "G", factor: 1e9 },
+    Prefix { symbol: "M", factor: 1e6 },
+    Prefix { symbol: "k", factor: 1e3 },
+    Prefix { symbol: "h", factor: 1e2 },
+    Prefix { symbol: "da", factor: 1e1 },
+    Prefix { symbol: "d", factor: 1e-1 },
+    Prefix { symbol: "c", factor: 1e-2 },
+    Prefix { symbol: "m", factor: 1e-3 },
+    Prefix { symbol: "µ", factor: 1e-6 },
+    Prefix { symbol: "μ", factor: 1e-6 },
+    Prefix { symbol: "u", factor: 1e-6 },
+    Prefix { symbol: "n", factor: 1e-9 },
+    Prefix { symbol: "p", factor: 1e-12 },
 ];
 
 /// The unit table (without prefixed forms).
@@ -350,10 +230,7 @@ pub(crate) fn lookup(symbol: &str) -> Option<Resolved> {
     }
     PREFIXES.iter().find_map(|p| {
         let def = exact(symbol.strip_prefix(p.symbol)?)?;
-        def.prefixable.then_some(Resolved {
-            def,
-            prefix: p.factor,
-        })
+        def.prefixable.then_some(Resolved { def, prefix: p.factor })
     })
 }
 
@@ -364,11 +241,7 @@ mod tests {
     #[test]
     fn symbols_unique() {
         for (i, a) in UNITS.iter().enumerate() {
-            assert!(
-                UNITS[i + 1..].iter().all(|b| b.symbol != a.symbol),
-                "duplicate {}",
-                a.symbol
-            );
+            assert!(UNITS[i + 1..].iter().all(|b| b.symbol != a.symbol), "duplicate {}", a.symbol);
         }
     }
 
@@ -380,8 +253,7 @@ mod tests {
                 if let Some(def) = u.symbol.strip_prefix(p.symbol).and_then(exact)
                     && def.prefixable
                 {
-                    let same = def.dim == u.dim
-                        && (def.factor * p.factor - u.factor).abs() <= 1e-12 * u.factor;
+                    let same = def.dim == u.dim && (def.factor * p.factor - u.factor).abs() <= 1e-12 * u.factor;
                     assert!(same, "{} is also {} + {}", u.symbol, p.symbol, def.symbol);
                 }
             }

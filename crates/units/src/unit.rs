@@ -23,12 +23,7 @@ pub struct Unit {
 
 impl Unit {
     pub(crate) fn new(expr: &str, factor: f64, offset: f64, dim: Dimension) -> Self {
-        Unit {
-            expr: expr.to_owned(),
-            factor,
-            offset,
-            dim,
-        }
+        Unit { expr: expr.to_owned(), factor, offset, dim }
     }
 
     /// Parses a unit expression for absolute values: `"degC"` alone has its offset (0 degC is

@@ -43,10 +43,7 @@ fn finite(x: f64) -> Result<f64, UnitError> {
     if x.is_finite() {
         Ok(x)
     } else {
-        Err(UnitError::BadNumber {
-            text: x.to_string(),
-            reason: format!("{x} is not a finite number"),
-        })
+        Err(UnitError::BadNumber { text: x.to_string(), reason: format!("{x} is not a finite number") })
     }
 }
 

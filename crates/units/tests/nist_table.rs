@@ -38,27 +38,9 @@ const EXPECTED: &[(&str, f64, f64, D, f64)] = &[
     ("°C", 274.15, 273.15, D::TEMPERATURE, 1e-15),
     ("℃", 274.15, 273.15, D::TEMPERATURE, 1e-15),
     // 0 °F = 459.67 °R = 255.372 222… K; 1 °F = 460.67 × 5/9 K.
-    (
-        "degF",
-        255.927_777_777_777_8,
-        255.372_222_222_222_2,
-        D::TEMPERATURE,
-        1e-14,
-    ),
-    (
-        "°F",
-        255.927_777_777_777_8,
-        255.372_222_222_222_2,
-        D::TEMPERATURE,
-        1e-14,
-    ),
-    (
-        "℉",
-        255.927_777_777_777_8,
-        255.372_222_222_222_2,
-        D::TEMPERATURE,
-        1e-14,
-    ),
+    ("degF", 255.927_777_777_777_8, 255.372_222_222_222_2, D::TEMPERATURE, 1e-14),
+    ("°F", 255.927_777_777_777_8, 255.372_222_222_222_2, D::TEMPERATURE, 1e-14),
+    ("℉", 255.927_777_777_777_8, 255.372_222_222_222_2, D::TEMPERATURE, 1e-14),
     ("degR", 0.555_555_555_555_555_6, 0.0, D::TEMPERATURE, 1e-15),
     ("°R", 0.555_555_555_555_555_6, 0.0, D::TEMPERATURE, 1e-15),
     ("R", 0.555_555_555_555_555_6, 0.0, D::TEMPERATURE, 1e-15),
@@ -78,13 +60,7 @@ const EXPECTED: &[(&str, f64, f64, D, f64)] = &[
     ("atm", 101325.0, 0.0, D::PRESSURE, 0.0),
     ("psi", 6894.757293168, 0.0, D::PRESSURE, 1e-13),
     ("psia", 6894.757293168, 0.0, D::PRESSURE, 1e-13),
-    (
-        "psig",
-        6894.757293168 + 101325.0,
-        101325.0,
-        D::PRESSURE,
-        1e-13,
-    ),
+    ("psig", 6894.757293168 + 101325.0, 101325.0, D::PRESSURE, 1e-13),
     ("torr", 133.3224, 0.0, D::PRESSURE, 1e-6),
     ("Torr", 133.3224, 0.0, D::PRESSURE, 1e-6),
     ("mmHg", 133.3224, 0.0, D::PRESSURE, 1e-6),
@@ -104,18 +80,10 @@ const EXPECTED: &[(&str, f64, f64, D, f64)] = &[
 #[test]
 fn every_table_unit_has_a_hand_written_factor() {
     for u in units() {
-        assert!(
-            EXPECTED.iter().any(|e| e.0 == u.symbol),
-            "no expected factor for `{}`",
-            u.symbol
-        );
+        assert!(EXPECTED.iter().any(|e| e.0 == u.symbol), "no expected factor for `{}`", u.symbol);
     }
     for e in EXPECTED {
-        assert!(
-            units().iter().any(|u| u.symbol == e.0),
-            "`{}` is not in the table",
-            e.0
-        );
+        assert!(units().iter().any(|u| u.symbol == e.0), "`{}` is not in the table", e.0);
     }
 }
 
@@ -190,12 +158,7 @@ fn si_prefixes() {
 
 #[test]
 fn prefixes_only_on_prefixable_units() {
-    for s in [
-        "kft", "klb", "kmin", "kK", "kdegC", "MBtu", "kpsi", "katm", "mhp", "ktonne", "kgal",
-    ] {
-        assert!(
-            parse_quantity(&format!("1 {s}")).is_err(),
-            "{s} should not parse"
-        );
+    for s in ["kft", "klb", "kmin", "kK", "kdegC", "MBtu", "kpsi", "katm", "mhp", "ktonne", "kgal"] {
+        assert!(parse_quantity(&format!("1 {s}")).is_err(), "{s} should not parse");
     }
 }

@@ -4,8 +4,7 @@ mod common;
 
 use common::assert_close;
 use plantwide_units::{
-    Dimension as D, Quantity, parse_difference, parse_difference_as, parse_quantity,
-    parse_quantity_as,
+    Dimension as D, Quantity, parse_difference, parse_difference_as, parse_quantity, parse_quantity_as,
 };
 
 #[track_caller]
@@ -13,12 +12,7 @@ fn check(text: &str, expected_si: f64, dim: D) {
     let q = parse_quantity(text).unwrap_or_else(|e| panic!("{text}: {e}"));
     assert_eq!(q.dim, dim, "{text}: dimension {} instead of {}", q.dim, dim);
     assert_close(q.value_si, expected_si, 1e-12, text);
-    assert_close(
-        parse_quantity_as(text, dim).unwrap(),
-        expected_si,
-        1e-12,
-        text,
-    );
+    assert_close(parse_quantity_as(text, dim).unwrap(), expected_si, 1e-12, text);
 }
 
 #[test]
@@ -91,30 +85,10 @@ fn differences_drop_offsets() {
     let q = parse_difference("10 degC").unwrap();
     assert_eq!(q.dim, D::TEMPERATURE);
     assert_close(q.value_si, 10.0, 1e-15, "10 degC difference");
-    assert_close(
-        parse_difference_as("18 degF", D::TEMPERATURE).unwrap(),
-        10.0,
-        1e-14,
-        "18 degF",
-    );
-    assert_close(
-        parse_difference_as("5 psig", D::PRESSURE).unwrap(),
-        5.0 * 6894.757293168,
-        1e-13,
-        "5 psig",
-    );
-    assert_close(
-        parse_difference_as("10 K", D::TEMPERATURE).unwrap(),
-        10.0,
-        0.0,
-        "10 K",
-    );
-    assert_close(
-        parse_difference_as("3", D::TEMPERATURE).unwrap(),
-        3.0,
-        0.0,
-        "bare",
-    );
+    assert_close(parse_difference_as("18 degF", D::TEMPERATURE).unwrap(), 10.0, 1e-14, "18 degF");
+    assert_close(parse_difference_as("5 psig", D::PRESSURE).unwrap(), 5.0 * 6894.757293168, 1e-13, "5 psig");
+    assert_close(parse_difference_as("10 K", D::TEMPERATURE).unwrap(), 10.0, 0.0, "10 K");
+    assert_close(parse_difference_as("3", D::TEMPERATURE).unwrap(), 3.0, 0.0, "bare");
 }
 
 #[test]
@@ -163,18 +137,8 @@ fn number_spellings() {
 
 #[test]
 fn bare_numbers_are_si_in_the_expected_dimension() {
-    assert_close(
-        parse_quantity_as("12.6", D::MOLAR_FLOW).unwrap(),
-        12.6,
-        0.0,
-        "bare flow",
-    );
-    assert_close(
-        parse_quantity_as("350", D::TEMPERATURE).unwrap(),
-        350.0,
-        0.0,
-        "bare temperature",
-    );
+    assert_close(parse_quantity_as("12.6", D::MOLAR_FLOW).unwrap(), 12.6, 0.0, "bare flow");
+    assert_close(parse_quantity_as("350", D::TEMPERATURE).unwrap(), 350.0, 0.0, "bare temperature");
     assert_eq!(parse_quantity("350").unwrap().dim, D::DIMENSIONLESS);
 }
 
@@ -183,8 +147,5 @@ fn quantity_from_str_and_display() {
     let q: Quantity = "100 lbmol/h".parse().unwrap();
     assert_eq!(q.dim, D::MOLAR_FLOW);
     assert_eq!(Quantity::new(2.5, D::MOLAR_FLOW).to_string(), "2.5 mol/s");
-    assert_eq!(
-        Quantity::new(101_325.0, D::PRESSURE).to_string(),
-        "101325 Pa"
-    );
+    assert_eq!(Quantity::new(101_325.0, D::PRESSURE).to_string(), "101325 Pa");
 }

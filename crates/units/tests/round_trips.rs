@@ -4,8 +4,8 @@ mod common;
 
 use common::assert_close;
 use plantwide_units::{
-    Dimension as D, Quantity, Unit, convert_from_si, convert_to_si, named_dimensions,
-    parse_quantity, prefixes, unit_dimension, units,
+    Dimension as D, Quantity, Unit, convert_from_si, convert_to_si, named_dimensions, parse_quantity, prefixes,
+    unit_dimension, units,
 };
 
 const VALUES: [f64; 6] = [0.0, 1.0, -40.0, 80.0, 176.0, 1.234_567e5];
@@ -18,12 +18,7 @@ fn round_trip(value: f64, unit: &str) {
     // Affine units subtract a large offset, so compare against the scale of the SI value.
     let tolerance = 1e-13 * q.value_si.abs().max(value.abs()).max(1.0);
     assert!((back - value).abs() <= tolerance, "{what}");
-    assert_close(
-        convert_to_si(value, unit).unwrap(),
-        q.value_si,
-        1e-15,
-        &what,
-    );
+    assert_close(convert_to_si(value, unit).unwrap(), q.value_si, 1e-15, &what);
     assert_close(q.in_unit(unit).unwrap(), back, 0.0, &what);
 }
 
@@ -79,52 +74,14 @@ fn compound_units() {
 
 #[test]
 fn affine_display_conversions() {
-    assert_close(
-        convert_from_si(353.15, "degC").unwrap(),
-        80.0,
-        1e-13,
-        "K to degC",
-    );
-    assert_close(
-        convert_from_si(353.15, "degF").unwrap(),
-        176.0,
-        1e-13,
-        "K to degF",
-    );
-    assert_close(
-        convert_from_si(353.15, "degR").unwrap(),
-        635.67,
-        1e-13,
-        "K to degR",
-    );
-    assert_close(
-        convert_from_si(308_167.718_795_04, "psig").unwrap(),
-        30.0,
-        1e-12,
-        "Pa to psig",
-    );
-    assert_close(
-        convert_from_si(101_325.0, "barg").unwrap(),
-        0.0,
-        1e-12,
-        "Pa to barg",
-    );
-    assert_close(
-        convert_from_si(12.599_788_055_555_556, "lbmol/h").unwrap(),
-        100.0,
-        1e-14,
-        "lbmol/h",
-    );
-    assert_close(
-        convert_from_si(1000.0 / 60.0, "kmol/min").unwrap(),
-        1.0,
-        1e-15,
-        "kmol/min",
-    );
-    assert!(
-        convert_from_si(f64::NAN, "K").unwrap().is_nan(),
-        "NaN passes through"
-    );
+    assert_close(convert_from_si(353.15, "degC").unwrap(), 80.0, 1e-13, "K to degC");
+    assert_close(convert_from_si(353.15, "degF").unwrap(), 176.0, 1e-13, "K to degF");
+    assert_close(convert_from_si(353.15, "degR").unwrap(), 635.67, 1e-13, "K to degR");
+    assert_close(convert_from_si(308_167.718_795_04, "psig").unwrap(), 30.0, 1e-12, "Pa to psig");
+    assert_close(convert_from_si(101_325.0, "barg").unwrap(), 0.0, 1e-12, "Pa to barg");
+    assert_close(convert_from_si(12.599_788_055_555_556, "lbmol/h").unwrap(), 100.0, 1e-14, "lbmol/h");
+    assert_close(convert_from_si(1000.0 / 60.0, "kmol/min").unwrap(), 1.0, 1e-15, "kmol/min");
+    assert!(convert_from_si(f64::NAN, "K").unwrap().is_nan(), "NaN passes through");
     let u = Unit::parse_difference("degC").unwrap();
     assert!(!u.is_affine());
     assert_close(u.from_si(10.0), 10.0, 0.0, "difference");
@@ -149,12 +106,7 @@ fn named_dimensions_display_as_parseable_si_units() {
 
 #[test]
 fn generic_dimensions_display_as_parseable_units() {
-    for dim in [
-        D::new(1, 1, -2, 0, -1),
-        D::new(0, 0, -2, 0, 0),
-        D::new(2, -1, 0, 1, -3),
-        D::new(0, 4, 0, 0, 0),
-    ] {
+    for dim in [D::new(1, 1, -2, 0, -1), D::new(0, 0, -2, 0, 0), D::new(2, -1, 0, 1, -3), D::new(0, 4, 0, 0, 0)] {
         let shown = dim.to_string();
         let unit = Unit::parse(&shown).unwrap_or_else(|e| panic!("{shown}: {e}"));
         assert_eq!(unit.dimension(), dim, "{shown}");

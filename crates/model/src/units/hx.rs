@@ -297,7 +297,8 @@ mod tests {
     ) -> (LocalLayout, Vec<f64>) {
         let layout = layout_of(u);
         let mut x = vec![0.0; layout.len()];
-        let (hh, hc) = (u.phase[0].enthalpy(thermo, th, 1e5, &[0.2, 0.8]), u.phase[1].enthalpy(thermo, tc, 1e5, &[0.6, 0.4]));
+        let (hh, hc) =
+            (u.phase[0].enthalpy(thermo, th, 1e5, &[0.2, 0.8]), u.phase[1].enthalpy(thermo, tc, 1e5, &[0.6, 0.4]));
         let i0 = layout.inlets_offset();
         x[i0..i0 + 12].copy_from_slice(&[fh, th, 3e5, hh, 0.2, 0.8, fc, tc, 2e5, hc, 0.6, 0.4]);
         x[layout.inputs_offset()] = ua;
