@@ -137,10 +137,14 @@ impl<'a, S: Scalar> UnitIo<'a, S> {
 pub trait UnitModel: Send + Sync + std::fmt::Debug {
     /// Type name as in flowsheet files (`"mixer"`).
     fn type_name(&self) -> &'static str;
-    /// Inlet port names, in local order.
-    fn inlet_ports(&self) -> Vec<String>;
-    /// Outlet port names, in local order.
-    fn outlet_ports(&self) -> Vec<String>;
+    /// Inlet port names, in local order (default none: controllers).
+    fn inlet_ports(&self) -> Vec<String> {
+        Vec::new()
+    }
+    /// Outlet port names, in local order (default none: controllers, sinks).
+    fn outlet_ports(&self) -> Vec<String> {
+        Vec::new()
+    }
     /// Internal (non-stream) variables, after the outlet streams in the own block.
     fn internal_vars(&self) -> Vec<VarSpec> {
         Vec::new()

@@ -99,12 +99,6 @@ impl UnitModel for Delay {
     fn type_name(&self) -> &'static str {
         "delay"
     }
-    fn inlet_ports(&self) -> Vec<String> {
-        Vec::new()
-    }
-    fn outlet_ports(&self) -> Vec<String> {
-        Vec::new()
-    }
     fn internal_vars(&self) -> Vec<VarSpec> {
         let mut v: Vec<VarSpec> =
             (1..=self.order()).map(|k| VarSpec::differential(format!("z[{k}]"), self.dim, self.scale)).collect();

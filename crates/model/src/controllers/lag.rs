@@ -79,12 +79,6 @@ impl UnitModel for Lag {
     fn type_name(&self) -> &'static str {
         "lag"
     }
-    fn inlet_ports(&self) -> Vec<String> {
-        Vec::new()
-    }
-    fn outlet_ports(&self) -> Vec<String> {
-        Vec::new()
-    }
     fn internal_vars(&self) -> Vec<VarSpec> {
         vec![VarSpec::differential("op", self.dim, self.scale)]
     }

@@ -84,6 +84,17 @@ pub trait ControllerConfig: std::fmt::Debug {
     }
 }
 
+/// `u` limited to `[lo, hi]`; the derivative follows the active branch.
+pub(crate) fn clamp<S: crate::Scalar>(u: S, lo: f64, hi: f64) -> S {
+    if u.re() < lo {
+        S::from(lo)
+    } else if u.re() > hi {
+        S::from(hi)
+    } else {
+        u
+    }
+}
+
 /// The dimension a controller gain must have: output per unit of measurement.
 pub fn gain_dimension(links: &ControllerLinks) -> Dimension {
     links.op_dim / links.pv_dim

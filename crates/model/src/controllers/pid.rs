@@ -21,7 +21,7 @@ use plantwide_units::{Dimension, QuantityValue};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
-use super::{Action, ControllerLinks, Mode, Setpoint, gain_dimension};
+use super::{Action, ControllerLinks, Mode, Setpoint, clamp, gain_dimension};
 use crate::{BuildCx, FieldError, InputSpec, Scalar, SignalSpec, UnitIo, UnitModel, VarSpec};
 
 /// Flowsheet description of a PID controller.
@@ -161,25 +161,9 @@ impl Pid {
     }
 }
 
-fn clamp<S: Scalar>(u: S, lo: f64, hi: f64) -> S {
-    if u.re() < lo {
-        S::from(lo)
-    } else if u.re() > hi {
-        S::from(hi)
-    } else {
-        u
-    }
-}
-
 impl UnitModel for Pid {
     fn type_name(&self) -> &'static str {
         "pid"
-    }
-    fn inlet_ports(&self) -> Vec<String> {
-        Vec::new()
-    }
-    fn outlet_ports(&self) -> Vec<String> {
-        Vec::new()
     }
     fn internal_vars(&self) -> Vec<VarSpec> {
         let pv_scale = self.links.pv_nominal.abs().max(1e-6);

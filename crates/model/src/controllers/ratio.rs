@@ -18,6 +18,7 @@ use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 use super::ControllerLinks;
+use super::clamp;
 use crate::{BuildCx, FieldError, InputSpec, Scalar, SignalSpec, UnitIo, UnitModel, VarSpec};
 
 /// A ratio: a value (an input `ratio` that analyses and scenarios may move) or another controller's
@@ -134,26 +135,9 @@ fn quantity_in(cx: &mut BuildCx<'_>, field: &str, value: &QuantityValue, dim: Di
     v
 }
 
-/// `u` limited to `[lo, hi]`; the derivative follows the active branch.
-fn clamp<S: Scalar>(u: S, lo: f64, hi: f64) -> S {
-    if u.re() < lo {
-        S::from(lo)
-    } else if u.re() > hi {
-        S::from(hi)
-    } else {
-        u
-    }
-}
-
 impl UnitModel for Ratio {
     fn type_name(&self) -> &'static str {
         "ratio"
-    }
-    fn inlet_ports(&self) -> Vec<String> {
-        Vec::new()
-    }
-    fn outlet_ports(&self) -> Vec<String> {
-        Vec::new()
     }
     fn internal_vars(&self) -> Vec<VarSpec> {
         let nominal = self.links.op_value.abs().max(self.bias.abs()).max(1e-6);

@@ -122,12 +122,6 @@ impl UnitModel for Selector {
     fn type_name(&self) -> &'static str {
         "selector"
     }
-    fn inlet_ports(&self) -> Vec<String> {
-        Vec::new()
-    }
-    fn outlet_ports(&self) -> Vec<String> {
-        Vec::new()
-    }
     fn internal_vars(&self) -> Vec<VarSpec> {
         vec![VarSpec::algebraic("op", self.links.op_dim, self.links.op_value.abs().max(1e-6))]
     }

@@ -30,6 +30,7 @@ use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 use super::ControllerLinks;
+use super::clamp;
 use crate::{BuildCx, FieldError, Scalar, SignalSpec, UnitIo, UnitModel, VarSpec};
 
 /// How an output moves over its part of the signal.
@@ -175,26 +176,9 @@ fn unit_dimension_of(value: &QuantityValue) -> Option<Dimension> {
     }
 }
 
-/// `u` limited to `[lo, hi]`; the derivative follows the active branch (the inner one at a bound).
-fn clamp<S: Scalar>(u: S, lo: f64, hi: f64) -> S {
-    if u.re() < lo {
-        S::from(lo)
-    } else if u.re() > hi {
-        S::from(hi)
-    } else {
-        u
-    }
-}
-
 impl UnitModel for SplitRange {
     fn type_name(&self) -> &'static str {
         "split_range"
-    }
-    fn inlet_ports(&self) -> Vec<String> {
-        Vec::new()
-    }
-    fn outlet_ports(&self) -> Vec<String> {
-        Vec::new()
     }
     fn internal_vars(&self) -> Vec<VarSpec> {
         let nominal = |k: usize| self.ranges[k][0].abs().max(self.ranges[k][1].abs()).max(1e-6);

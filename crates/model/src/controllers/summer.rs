@@ -27,6 +27,7 @@ use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 use super::ControllerLinks;
+use super::clamp;
 use crate::{BuildCx, FieldError, InputSpec, Scalar, SignalSpec, UnitIo, UnitModel, VarSpec};
 
 /// One term of a summer.
@@ -180,26 +181,9 @@ fn quantity_in(cx: &mut BuildCx<'_>, field: &str, value: &QuantityValue, dim: Di
     v
 }
 
-/// `u` limited to `[lo, hi]`; the derivative follows the active branch.
-fn clamp<S: Scalar>(u: S, lo: f64, hi: f64) -> S {
-    if u.re() < lo {
-        S::from(lo)
-    } else if u.re() > hi {
-        S::from(hi)
-    } else {
-        u
-    }
-}
-
 impl UnitModel for Summer {
     fn type_name(&self) -> &'static str {
         "summer"
-    }
-    fn inlet_ports(&self) -> Vec<String> {
-        Vec::new()
-    }
-    fn outlet_ports(&self) -> Vec<String> {
-        Vec::new()
     }
     fn internal_vars(&self) -> Vec<VarSpec> {
         let nominal = self.links.op_value.abs().max(self.bias.abs()).max(1e-6);

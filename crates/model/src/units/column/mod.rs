@@ -28,6 +28,36 @@ use crate::{BuildCx, FieldError, InputSpec, LocalLayout, Scalar, UnitIo, UnitMod
 pub use rigorous::{RigorousColumn, RigorousConfig};
 pub use simple::SimpleColumn;
 
+/// Offsets of the variables within one stage's block, shared by both fidelities:
+/// `[n_1 … n_c, x_1 … x_c, y_1 … y_c, T, M, L, V]`.
+pub(crate) struct StageIdx {
+    pub(crate) nc: usize,
+}
+
+impl StageIdx {
+    pub(crate) fn n(&self, j: usize) -> usize {
+        j
+    }
+    pub(crate) fn x(&self, j: usize) -> usize {
+        self.nc + j
+    }
+    pub(crate) fn y(&self, j: usize) -> usize {
+        2 * self.nc + j
+    }
+    pub(crate) fn t(&self) -> usize {
+        3 * self.nc
+    }
+    pub(crate) fn m(&self) -> usize {
+        3 * self.nc + 1
+    }
+    pub(crate) fn l(&self) -> usize {
+        3 * self.nc + 2
+    }
+    pub(crate) fn v(&self) -> usize {
+        3 * self.nc + 3
+    }
+}
+
 /// Fidelity of the column model.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]

@@ -79,6 +79,7 @@ mod weir;
 use plantwide_thermo::VleModel;
 use plantwide_units::Dimension;
 
+use super::StageIdx;
 use crate::stream::{F, H, P, T, Z0};
 use crate::{InputSpec, LocalLayout, Scalar, UnitIo, UnitModel, VarSpec};
 
@@ -152,34 +153,6 @@ impl RigorousColumn {
             1 => 0,
             _ => self.draws[k - 2].stage,
         }
-    }
-}
-
-/// Offsets within a stage block.
-struct StageIdx {
-    nc: usize,
-}
-impl StageIdx {
-    fn n(&self, j: usize) -> usize {
-        j
-    }
-    fn x(&self, j: usize) -> usize {
-        self.nc + j
-    }
-    fn y(&self, j: usize) -> usize {
-        2 * self.nc + j
-    }
-    fn t(&self) -> usize {
-        3 * self.nc
-    }
-    fn m(&self) -> usize {
-        3 * self.nc + 1
-    }
-    fn l(&self) -> usize {
-        3 * self.nc + 2
-    }
-    fn v(&self) -> usize {
-        3 * self.nc + 3
     }
 }
 

@@ -33,7 +33,7 @@
 
 use plantwide_units::Dimension;
 
-use super::ColumnConfig;
+use super::{ColumnConfig, StageIdx};
 
 use crate::stream::{F, H, P, T, Z0};
 use crate::{BuildCx, FieldError, InputSpec, LocalLayout, Scalar, UnitIo, UnitModel, VarSpec};
@@ -204,34 +204,6 @@ impl SimpleColumn {
     /// Offset of stage `s` (0-based) in the internal variables.
     fn stage(&self, s: usize) -> usize {
         s * self.per_stage()
-    }
-}
-
-/// Offsets within a stage block.
-struct StageIdx {
-    nc: usize,
-}
-impl StageIdx {
-    fn n(&self, j: usize) -> usize {
-        j
-    }
-    fn x(&self, j: usize) -> usize {
-        self.nc + j
-    }
-    fn y(&self, j: usize) -> usize {
-        2 * self.nc + j
-    }
-    fn t(&self) -> usize {
-        3 * self.nc
-    }
-    fn m(&self) -> usize {
-        3 * self.nc + 1
-    }
-    fn l(&self) -> usize {
-        3 * self.nc + 2
-    }
-    fn v(&self) -> usize {
-        3 * self.nc + 3
     }
 }
 

@@ -24,8 +24,9 @@
 //! with partial pivoting inside the band. Rows are scaled by `max_j |J_ij| nominal_j`; steps are
 //! clipped to the variable bounds and halved until the scaled residual falls.
 
-use super::{IN_BOTTOMS, IN_DISTILLATE, IN_REFLUX, RigorousColumn, StageIdx, UnitModel};
+use super::{IN_BOTTOMS, IN_DISTILLATE, IN_REFLUX, RigorousColumn, UnitModel};
 use crate::stream::F;
+use crate::units::column::StageIdx;
 use crate::{Unit, UnitIo, VarKind};
 
 /// Most Newton iterations on the steady equations.

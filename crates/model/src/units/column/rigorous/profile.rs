@@ -28,10 +28,11 @@
 
 use plantwide_thermo::ThermoPackage;
 
-use super::{IN_CONDENSER_DUTY, IN_REBOILER_DUTY, IN_REFLUX, RigorousColumn, StageIdx};
+use super::{IN_CONDENSER_DUTY, IN_REBOILER_DUTY, IN_REFLUX, RigorousColumn};
 use crate::UnitIo;
 use crate::stream::{F, H, P, T, Z0};
 use crate::units::Phase;
+use crate::units::column::StageIdx;
 use crate::units::outflow::normalized;
 
 /// Most sweeps of the bubble-point method.
