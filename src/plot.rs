@@ -60,7 +60,10 @@ fn draw<DB: DrawingBackend>(
         let (lo, hi) = if !lo.is_finite() {
             (0.0, 1.0)
         } else {
-            let pad = ((hi - lo) * 0.05).max(1e-9 * lo.abs().max(1e-300));
+            // A series that moves by less than 1e-6 of its size is drawn as constant in a ±1 % band
+            // (tick labels of a 1e-9 span are unreadable and mean nothing to a reader).
+            let scale = lo.abs().max(hi.abs());
+            let pad = if hi - lo < 1e-6 * scale || scale == 0.0 { 0.01 * scale.max(1e-12) } else { (hi - lo) * 0.05 };
             (lo - pad, hi + pad)
         };
         // Enough decimals to tell the ticks apart (about three significant digits of the span).
