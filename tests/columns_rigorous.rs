@@ -295,3 +295,126 @@ fn ethanol_water_next_to_the_purity_cliff() {
     assert!(ss.report.iterations <= 3);
     assert!(component_balance_error(&plant, &ss.x, &[]) < 1e-9 && energy_imbalance(&plant, &ss).abs() < 1e-8);
 }
+
+/// `Q_R + F h_F − Qc − Σ products F h`, relative to `Q_R`, for the column's outlet streams
+/// `products`.
+fn energy_imbalance_with(plant: &Plant, ss: &SteadyState, q_r: f64, products: &[&str]) -> f64 {
+    let v = |p: &str| value(plant, &ss.x, p);
+    let flow_h = |s: &str| v(&format!("{s}.F")) * v(&format!("{s}.h"));
+    (q_r + flow_h("feed") - v("column.Qc") - products.iter().map(|s| flow_h(s)).sum::<f64>()) / q_r
+}
+
+/// Largest difference between two steady states of plants with the same variables, relative to
+/// `max(|x|, 1)`.
+fn state_difference(a: &SteadyState, b: &SteadyState) -> f64 {
+    assert_eq!(a.x.len(), b.x.len());
+    a.x.iter().zip(&b.x).map(|(p, q)| (p - q).abs() / p.abs().max(1.0)).fold(0.0, f64::max)
+}
+
+/// The shipped ethanol–water column with its 1.25 MW reboiler duty replaced by steam at
+/// `m_s = Q_R / λ_s` converges to the same steady state, with `Q_R = m_s λ_s` closing the energy
+/// balance.
+#[test]
+fn steam_reboiler_reproduces_the_duty_column() {
+    let d = doc("ethanol_water.json");
+    let (_, duty) = converge(&d, "duty");
+    let (q_r, lambda) = (1.25e6, 2.1e6);
+    let mut s = d.clone();
+    let r = s["units"]["column"]["rigorous"].as_object_mut().unwrap();
+    r.remove("reboiler_duty");
+    r.insert(
+        "reboiler".into(),
+        json!({"steam_flow": format!("{} kg/h", q_r / lambda * 3600.0), "steam_latent_heat": "2100 kJ/kg"}),
+    );
+    s["inputs"]["QR"] = json!("column.steam_flow");
+    let (plant, steam) = converge(&s, "steam");
+    let m_s = steam.u[plant.input("column.steam_flow").unwrap()];
+    let diff = state_difference(&duty, &steam);
+    let energy = energy_imbalance_with(&plant, &steam, m_s * lambda, &["distillate", "bottoms"]);
+    eprintln!("steam reboiler: m_s = {m_s:.6} kg/s, steady states differ by {diff:.1e}, energy balance {energy:.1e}");
+    assert!((m_s - q_r / lambda).abs() < 1e-12 * m_s);
+    assert!(diff < 1e-10 && energy.abs() < 1e-9, "{diff} {energy}");
+}
+
+/// Water-cooled condenser on the shipped ethanol–water column: a coolant flow that removes the
+/// duty `Q_C` (0.2 % above the bubble-point drum's) reproduces the duty-specified column, and at
+/// the converged point `Qc = m c_p (T_out − T_in) = UA ΔT_lm` with `T_out` from the coolant's
+/// balance (the closed form of the effectiveness relation).
+#[test]
+fn coolant_condenser_reproduces_the_duty_column() {
+    let d = doc("ethanol_water.json");
+    let (plant, bubble) = converge(&d, "bubble-point drum");
+    let q_c = 1.002 * value(&plant, &bubble.x, "column.Qc");
+    let mut c = d.clone();
+    c["units"]["column"]["rigorous"]["condenser_duty"] = json!(q_c);
+    let (plant, duty) = converge(&c, "duty-specified drum");
+    let t_n = value(&plant, &duty.x, "column.T[32]");
+    let (t_in, ua, cp) = (303.15, 1.5e5, 4184.0);
+    // Coolant flow removing Q_C from a drum at T_N: bisection on the effectiveness relation.
+    let q = |m: f64| m * cp * (t_n - t_in) * (1.0 - (-ua / (m * cp)).exp());
+    let (mut lo, mut hi) = (1e-3f64, 1e4f64);
+    for _ in 0..200 {
+        let mid = (lo * hi).sqrt();
+        if q(mid) > q_c { hi = mid } else { lo = mid }
+    }
+    let m_c = (lo * hi).sqrt();
+    let mut w = d.clone();
+    w["units"]["column"]["rigorous"]["condenser"] =
+        json!({"coolant_flow": m_c, "coolant_T_in": "30 degC", "ua": "150 kW/K"});
+    let (plant, cooled) = converge(&w, "water-cooled drum");
+    let v = |p: &str| value(&plant, &cooled.x, p);
+    let (qc, t) = (v("column.Qc"), v("column.T[32]"));
+    let t_out = t_in + qc / (m_c * cp);
+    let lmtd = ((t - t_in) - (t - t_out)) / ((t - t_in) / (t - t_out)).ln();
+    let diff = state_difference(&duty, &cooled);
+    let energy = energy_imbalance_with(&plant, &cooled, 1.25e6, &["distillate", "bottoms"]);
+    eprintln!(
+        "coolant condenser: m_c = {m_c:.4} kg/s, T_N = {t:.4} K (bubble-point drum {:.4} K), T_out = {t_out:.4} K, \
+         Qc = {qc:.6e} W, UA ΔT_lm = {:.6e} W, vs duty-specified column {diff:.1e}, energy {energy:.1e}",
+        value(&plant, &bubble.x, "column.T[32]"),
+        ua * lmtd
+    );
+    assert!((qc - ua * lmtd).abs() < 1e-9 * qc && (qc - q_c).abs() < 1e-8 * qc);
+    assert!(diff < 1e-8 && energy.abs() < 1e-9, "{diff} {energy}");
+}
+
+/// The shipped ethanol–water column with a partial condenser and a vapour side draw from tray 5:
+/// the vapour distillate is in equilibrium with the reflux, `y_D = K(T_N, P_top, x_N) x_N` (the
+/// thermo package's K-values), at `h_V(T_N, y_D)`; the draw carries tray 5's `y` and `h_V`; the
+/// column closes its component and energy balances.
+#[test]
+fn partial_condenser_and_vapour_side_draw() {
+    let mut d = doc("ethanol_water.json");
+    let col = &mut d["units"]["column"];
+    col["rigorous"]["condenser_type"] = json!("partial");
+    col["side_draws"] = json!([{"port": "vside", "stage": 5, "flow": "10 kmol/h", "phase": "vapour"}]);
+    d["units"]["side_product"] = json!({"type": "product"});
+    d["streams"]["vapour_draw"] = json!({"from": "column.vside", "to": "side_product"});
+    let (plant, ss) = converge(&d, "partial condenser, vapour draw");
+    let v = |p: &str| value(&plant, &ss.x, p);
+    let th = &plant.thermo;
+    let comps = ["ethanol", "water"];
+    let x_n: Vec<f64> = comps.iter().map(|c| v(&format!("column.x[32][{c}]"))).collect();
+    let y_d: Vec<f64> = comps.iter().map(|c| v(&format!("distillate.x[{c}]"))).collect();
+    let mut k = [0.0; 2];
+    th.k_values(v("column.T[32]"), 101_325.0, &x_n, &mut k);
+    let eq = (0..2).map(|j| (y_d[j] - k[j] * x_n[j]).abs()).fold(0.0, f64::max);
+    let h_d = th.h_vap(v("distillate.T"), &y_d);
+    let y5: Vec<f64> = comps.iter().map(|c| v(&format!("column.y[5][{c}]"))).collect();
+    let draw = (0..2).map(|j| (v(&format!("vapour_draw.x[{}]", comps[j])) - y5[j]).abs()).fold(0.0, f64::max);
+    let h_s = th.h_vap(v("column.T[5]"), &y5);
+    let comp = component_balance_error(&plant, &ss.x, &[]);
+    let energy = energy_imbalance_with(&plant, &ss, 1.25e6, &["distillate", "bottoms", "vapour_draw"]);
+    eprintln!(
+        "partial condenser: yD = {:.6}, T_N = {:.3} K, D = {:.4} kmol/h, Qc = {:.6} MW, |y_D − K x_N| {eq:.1e}, \
+         |z_S − y_5| {draw:.1e}, component balance {comp:.1e}, energy balance {energy:.1e}",
+        y_d[0],
+        v("column.T[32]"),
+        v("distillate.F") * 3.6,
+        v("column.Qc") * 1e-6
+    );
+    assert!(eq < 1e-12 && draw < 1e-12, "{eq} {draw}");
+    assert!((v("distillate.h") - h_d).abs() < 1e-9 * h_d.abs() && (v("vapour_draw.h") - h_s).abs() < 1e-9 * h_s.abs());
+    assert!((v("vapour_draw.F") * 3.6 - 10.0).abs() < 1e-9);
+    assert!(comp < 1e-9 && energy.abs() < 1e-9, "{comp} {energy}");
+}

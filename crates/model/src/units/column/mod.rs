@@ -9,12 +9,13 @@
 //!
 //! Ports: one inlet per feed (`feeds[k].port`, default `feed`), outlets `distillate`, `bottoms` and
 //! one per side draw. Manipulated inputs declared by both models: `reflux`, `distillate`,
-//! `bottoms`, each side draw's flow, and `boilup` (simple) or `reboiler_duty` (rigorous, plus
-//! `condenser_duty` when the condenser is duty-specified).
+//! `bottoms`, each side draw's flow, and `boilup` (simple) or `reboiler_duty` / `steam_flow`
+//! (rigorous, plus `condenser_duty` or `coolant_flow` when the condenser is duty-specified or
+//! water-cooled).
 //!
 //! Fields only one model uses are optional here; building with the other model reports each of
 //! them by name (simple: `tray_holdup`, `tau_l`, `boilup`, `lambda`, `feeds[k].q`,
-//! `feeds[k].nominal_flow`; rigorous: `rigorous`).
+//! `feeds[k].nominal_flow`; rigorous: `rigorous`, `side_draws[k].phase` = `vapour`).
 
 pub mod rigorous;
 pub mod simple;
@@ -92,7 +93,18 @@ fn default_feed_port() -> String {
     "feed".into()
 }
 
-/// A liquid side draw.
+/// The phase a side draw takes from its tray.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum DrawPhase {
+    /// Part of the liquid leaving the tray (composition x, enthalpy h_L).
+    #[default]
+    Liquid,
+    /// Part of the vapour leaving the tray (composition y, enthalpy h_V; rigorous model only).
+    Vapour,
+}
+
+/// A side draw.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct SideDraw {
@@ -102,6 +114,13 @@ pub struct SideDraw {
     pub stage: usize,
     /// Draw flow (e.g. `"0.1 kmol/min"`).
     pub flow: QuantityValue,
+    /// Phase drawn: `liquid` (default) or `vapour` (rigorous model only).
+    #[serde(default, skip_serializing_if = "is_liquid")]
+    pub phase: DrawPhase,
+}
+
+fn is_liquid(p: &DrawPhase) -> bool {
+    *p == DrawPhase::Liquid
 }
 
 /// Flowsheet description of a column.
@@ -115,7 +134,7 @@ pub struct ColumnConfig {
     pub stages: usize,
     /// Feeds.
     pub feeds: Vec<ColumnFeed>,
-    /// Liquid side draws (default none).
+    /// Side draws (default none).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub side_draws: Vec<SideDraw>,
     /// Column pressure (default 1 atm); for the rigorous model the top (condenser) pressure.
@@ -145,7 +164,7 @@ pub struct ColumnConfig {
     pub bottoms: QuantityValue,
     /// Rigorous-model data: duties, efficiency, tray geometry (rigorous model only, required).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub rigorous: Option<RigorousConfig>,
+    pub rigorous: Option<Box<RigorousConfig>>,
 }
 
 impl ColumnConfig {
@@ -164,6 +183,9 @@ impl ColumnConfig {
         for (k, f) in self.feeds.iter().enumerate() {
             fields.push((format!("feeds[{k}].q"), f.q.is_some(), true, None));
             fields.push((format!("feeds[{k}].nominal_flow"), f.nominal_flow.is_some(), true, None));
+        }
+        for (k, d) in self.side_draws.iter().enumerate() {
+            fields.push((format!("side_draws[{k}].phase"), d.phase == DrawPhase::Vapour, false, None));
         }
         for (field, given, of_simple, example) in fields {
             if of_simple != simple && given {

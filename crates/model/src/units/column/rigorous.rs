@@ -3,20 +3,23 @@
 //! and a fixed tray pressure drop — Grassi's model 2a (Luyben (ed.) 1992, ch. 3).
 //!
 //! **Stages** as in [`super`]: 1 = reboiler (sump, an equilibrium stage heated by the input
-//! `reboiler_duty`), 2 … N−1 = trays from the bottom, N = total condenser with its reflux drum.
+//! `reboiler_duty`, or by steam, below), 2 … N−1 = trays from the bottom, N = condenser with its
+//! reflux drum (total, or partial with a vapour distillate).
 //! Pressures are fixed: `P_i = P + (N − i) ΔP` [Pa], `P` the top (drum) pressure and `ΔP` the
 //! pressure drop per tray (`rigorous.tray_pressure_drop`, default 0).
 //!
 //! # Variables
 //! Per stage i: `n[i][c]` [mol] component holdups (differential), `x[i][c]`, `y[i][c]` [-], `T[i]`
 //! [K], `M[i]` [mol], `L[i]`, `V[i]` [mol/s] (liquid and vapour leaving the stage); then `Qc` [W],
-//! the heat removed in the condenser. Inputs: `reflux` L_N, `reboiler_duty` Q_R [W], `distillate`
-//! D, `bottoms` B [mol/s], `condenser_duty` Q_C [W] (duty-specified condenser only) and each side
-//! draw's flow [mol/s].
+//! the heat removed in the condenser. Inputs: `reflux` L_N, `reboiler_duty` Q_R [W] (or
+//! `steam_flow` m_s [kg/s]), `distillate` D, `bottoms` B [mol/s], `condenser_duty` Q_C [W]
+//! (duty-specified condenser only) or `coolant_flow` m_c [kg/s] (water-cooled condenser only), and
+//! each side draw's flow [mol/s].
 //!
 //! # Equations (stage i; `h_L,i = h_liq(T_i, x_i)`, `h_V,i = h_vap(T_i, y_i)` [J/mol])
 //! - component balances `dn_ij/dt = L_{i+1} x_{i+1,j} + V_{i−1} y_{i−1,j} + Σ_feeds F z_j
-//!   − (L_i + S_i + D δ_iN) x_ij − V_i y_ij` (S_i liquid side draws);
+//!   − (L_i + S_i + D δ_iN) x_ij − (V_i + S^V_i) y_ij` (S_i liquid, S^V_i vapour side draws; the
+//!   `D δ_iN` term for a total condenser only);
 //! - holdup `M_i = Σ_j n_ij`, `x_ij M_i = n_ij`;
 //! - bubble point `Σ_j K_ij(T_i, P_i, x_i) x_ij = 1` (the liquid is saturated on every stage);
 //! - vapour: reboiler and drum `y_ij = K_ij x_ij`; trays, Murphree vapour efficiency E,
@@ -26,18 +29,21 @@
 //!   `v_L = v_liq(T_i, x_i)` [m³/mol], `l_w`, `h_w`, `A` the weir length, weir height and tray
 //!   area ([`Weir`]); drum `L_N = reflux`; reboiler `L_1 = B`;
 //! - energy (quasi-steady, below), giving `V_i` on the reboiler and trays and `Qc` (drum at its
-//!   bubble point) or `T_N` (duty-specified condenser, `Qc = condenser_duty`); the drum sends no
-//!   vapour on, `V_N = 0`, and its `y_N = K x_N` is the equilibrium vapour of the drum liquid.
+//!   bubble point) or `T_N` (duty-specified or water-cooled condenser); a total condenser's drum
+//!   sends no vapour on, `V_N = 0`, and its `y_N = K x_N` is the equilibrium vapour of the drum
+//!   liquid; a partial condenser's vapour is the distillate, `V_N = D`;
+//! - products: distillate, bottoms and liquid draws carry `(T_i, P_i, x_i, h_L,i)` of their stage,
+//!   a partial condenser's distillate and vapour draws `(T_i, P_i, y_i, h_V,i)`.
 //!
 //! # Energy balance and why the model is index 1
 //! The stage energy balance is
-//! `d(M_i h_L,i)/dt = Σ_in F h − (L_i + S_i + D δ_iN) h_L,i − V_i h_V,i + Q_i`
+//! `d(M_i h_L,i)/dt = Σ_in F h − (L_i + S_i + D δ_iN) h_L,i − (V_i + S^V_i) h_V,i + Q_i`
 //! with `Q_1 = Q_R`, `Q_N = −Qc`. At fixed pressure the liquid sits at its bubble point, so
 //! `h_L,i` is a function of `x_i`: `U = M h_L` is not an independent state. Model 2a neglects the
 //! specific-enthalpy accumulation, `M_i dh_L,i/dt ≈ 0`; subtracting `h_L,i` times the total
 //! balance then leaves the algebraic equation
 //!
-//! `0 = Σ_in F (h_in − h_L,i) + Q_i − V_i (h_V,i − h_L,i)`,
+//! `0 = Σ_in F (h_in − h_L,i) + Q_i − (V_i + S^V_i) (h_V,i − h_L,i)`,
 //!
 //! in which the liquid outflows drop out. Given the differential states `n`, the algebraic
 //! variables follow in order — `M, x` (holdup), `T` (bubble point), `y` (equilibrium or Murphree,
@@ -55,8 +61,30 @@
 //! reflux, the more vapour it condenses on the top tray, so the less reaches the condenser;
 //! outside the window there is no steady state.
 //!
-//! Not modelled: partial condensers (vapour distillate), steam-flow reboilers, froth density,
-//! downcomer holdup, vapour side draws.
+//! **Steam reboiler** (`rigorous.reboiler = {"steam_flow", "steam_latent_heat"}` instead of
+//! `reboiler_duty`): the input is the steam flow m_s [kg/s] (`steam_flow`), and the reboiler duty
+//! is the heat the saturated steam gives up condensing, `Q_R = m_s λ_s` [W] with λ_s [J/kg]; the
+//! column equations are otherwise unchanged, so a steam flow `Q_R / λ_s` gives the steady state of
+//! the duty-specified reboiler.
+//!
+//! **Water-cooled condenser** (`rigorous.condenser = {"coolant_flow", "coolant_T_in", "ua", "cp"}`
+//! instead of `condenser_duty`): the drum is the duty-specified one (its energy balance fixes
+//! `T_N`), with the duty taken up by the coolant, input `coolant_flow` m_c [kg/s], entering at
+//! `T_in` [K]: `Qc = m_c c_p (T_c,out − T_in) = UA ΔT_lm` against the isothermal drum at `T_N`,
+//! which solves to `Qc = m_c c_p (T_N − T_in) (1 − exp(−UA / (m_c c_p)))` [W] (UA [W/K], c_p
+//! [J/(kg K)], default 4184). The duty window above applies: too little coolant for the
+//! bubble-point duty has no steady state.
+//!
+//! **Partial condenser** (`rigorous.condenser_type = "partial"`): the drum liquid (the reflux) is
+//! at its bubble point, the distillate is its equilibrium vapour, `D = V_N` with `y_D = y_N =
+//! K(T_N, P_N, x_N) x_N` and `h_D = h_V,N`, and the drum energy balance gives
+//! `Qc = V_{N−1} h_V,N−1 − L_N h_L,N − D h_V,N + Σ F h_F` (written relative to `h_L,N` as above).
+//!
+//! **Vapour side draws** (`side_draws[k].phase = "vapour"`, trays only): the draw S^V_i is part of
+//! the vapour leaving tray i, at its `y_i` and `h_V,i`; `V_i` is what goes on to tray i + 1.
+//!
+//! Not modelled: partial condensers with a specified duty or coolant, froth density, downcomer
+//! holdup.
 //!
 //! # Initial guess
 //! The bubble-point (Wang–Henke) method solves the steady column at the current inputs `reflux`
@@ -83,13 +111,52 @@ use super::StageIdx;
 use crate::stream::{F, H, P, T, Z0};
 use crate::{InputSpec, LocalLayout, Scalar, UnitIo, UnitModel, VarSpec};
 
-pub use build::{EXAMPLE, RigorousConfig};
+pub use build::{CondenserType, CoolantCondenser, EXAMPLE, RigorousConfig, SteamReboiler};
 pub use weir::{CREST_SMOOTH, FRANCIS, Weir};
 
 #[derive(Debug, Clone)]
 struct Draw {
     stage: usize,
     flow: f64,
+    /// Drawn from the vapour leaving the tray (else from its liquid).
+    vapour: bool,
+}
+
+/// How the condenser duty is set.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Condenser {
+    /// Drum at the bubble point of its liquid; `Qc` follows from the drum energy balance.
+    BubblePoint,
+    /// `Qc` is the input `condenser_duty` [W] (this value its nominal); the drum energy balance
+    /// gives `T_N`.
+    Duty(f64),
+    /// Cooling water: `Qc = m_c c_p (T_N − T_in) (1 − exp(−UA / (m_c c_p)))`, `m_c` the input
+    /// `coolant_flow` [kg/s] (`flow` its nominal); the drum energy balance gives `T_N`.
+    Coolant {
+        /// Nominal coolant flow [kg/s].
+        flow: f64,
+        /// Coolant inlet temperature [K].
+        t_in: f64,
+        /// UA [W/K].
+        ua: f64,
+        /// Coolant heat capacity [J/(kg K)].
+        cp: f64,
+    },
+}
+
+impl Condenser {
+    /// Whether the condenser declares an input (`condenser_duty` or `coolant_flow`).
+    fn has_input(&self) -> bool {
+        !matches!(self, Condenser::BubblePoint)
+    }
+}
+
+/// Heat [W] a coolant flow `m` [kg/s] entering at `t_in` [K] with heat capacity `cp` [J/(kg K)]
+/// takes from a condensing drum at `t_hot` [K] through `ua` [W/K]: the effectiveness relation of an
+/// exchanger with an isothermal hot side, `m c_p (T_hot − T_in) (1 − exp(−UA / (m c_p)))`.
+fn coolant_duty<S: Scalar>(m: S, t_hot: S, t_in: f64, ua: f64, cp: f64) -> S {
+    let c = m * S::from(cp);
+    c * (t_hot - S::from(t_in)) * (S::from(1.0) - (S::from(-ua) / c).exp())
 }
 
 /// A distillation column, rigorous model.
@@ -109,10 +176,15 @@ pub struct RigorousColumn {
     m_reboiler: f64,
     m_tray: f64,
     reflux: f64,
+    /// Value of input 1: the reboiler duty [W], or the steam flow [kg/s] with a steam reboiler.
     reboiler_duty: f64,
+    /// Latent heat of the reboiler steam λ_s [J/kg] (steam reboiler only).
+    steam_latent_heat: Option<f64>,
     distillate: f64,
     bottoms: f64,
-    condenser_duty: Option<f64>,
+    condenser: Condenser,
+    /// Partial condenser: the distillate is the drum's vapour, `V_N = D`.
+    partial: bool,
     comp_names: Vec<String>,
 }
 
@@ -144,7 +216,22 @@ impl RigorousColumn {
     }
     /// Input index of side draw `k`.
     fn draw_input(&self, k: usize) -> usize {
-        IN_CONDENSER_DUTY + usize::from(self.condenser_duty.is_some()) + k
+        IN_CONDENSER_DUTY + usize::from(self.condenser.has_input()) + k
+    }
+    /// The reboiler duty Q_R [W] from input 1: the duty itself, or `m_s λ_s` for a steam reboiler.
+    fn q_r<S: Scalar>(&self, input: S) -> S {
+        match self.steam_latent_heat {
+            Some(lambda) => input * S::from(lambda),
+            None => input,
+        }
+    }
+    /// Whether outlet `k` is vapour: the distillate of a partial condenser, a vapour side draw.
+    fn outlet_is_vapour(&self, k: usize) -> bool {
+        match k {
+            0 => self.partial,
+            1 => false,
+            _ => self.draws[k - 2].vapour,
+        }
     }
     /// Outlet `k`'s stage: distillate from the drum, bottoms from the reboiler, draws from trays.
     fn outlet_stage(&self, k: usize) -> usize {
@@ -194,19 +281,28 @@ impl UnitModel for RigorousColumn {
             v.push(VarSpec::algebraic(format!("L[{st}]"), Dimension::MOLAR_FLOW, flow_nom).bounded(0.0, f64::INFINITY));
             v.push(VarSpec::algebraic(format!("V[{st}]"), Dimension::MOLAR_FLOW, flow_nom).bounded(0.0, f64::INFINITY));
         }
-        v.push(VarSpec::algebraic("Qc", Dimension::POWER, self.reboiler_duty.max(1.0)));
+        v.push(VarSpec::algebraic("Qc", Dimension::POWER, self.q_r(self.reboiler_duty).max(1.0)));
         v
     }
     fn inputs(&self) -> Vec<InputSpec> {
         let flow = Dimension::MOLAR_FLOW;
         let mut v = vec![
             InputSpec { name: "reflux".into(), dim: flow, value: self.reflux },
-            InputSpec { name: "reboiler_duty".into(), dim: Dimension::POWER, value: self.reboiler_duty },
+            match self.steam_latent_heat {
+                Some(_) => {
+                    InputSpec { name: "steam_flow".into(), dim: Dimension::MASS_FLOW, value: self.reboiler_duty }
+                }
+                None => InputSpec { name: "reboiler_duty".into(), dim: Dimension::POWER, value: self.reboiler_duty },
+            },
             InputSpec { name: "distillate".into(), dim: flow, value: self.distillate },
             InputSpec { name: "bottoms".into(), dim: flow, value: self.bottoms },
         ];
-        if let Some(q) = self.condenser_duty {
-            v.push(InputSpec { name: "condenser_duty".into(), dim: Dimension::POWER, value: q });
+        match self.condenser {
+            Condenser::BubblePoint => {}
+            Condenser::Duty(q) => v.push(InputSpec { name: "condenser_duty".into(), dim: Dimension::POWER, value: q }),
+            Condenser::Coolant { flow, .. } => {
+                v.push(InputSpec { name: "coolant_flow".into(), dim: Dimension::MASS_FLOW, value: flow })
+            }
         }
         for (d, p) in self.draws.iter().zip(&self.draw_ports) {
             v.push(InputSpec { name: p.clone(), dim: flow, value: d.flow });
@@ -256,7 +352,7 @@ impl UnitModel for RigorousColumn {
         let th = io.thermo;
         let st = |s: usize| io.vars(self.stage(s), self.per_stage());
         let (l_in, q_r, d_in, b_in) =
-            (io.input(IN_REFLUX), io.input(IN_REBOILER_DUTY), io.input(IN_DISTILLATE), io.input(IN_BOTTOMS));
+            (io.input(IN_REFLUX), self.q_r(io.input(IN_REBOILER_DUTY)), io.input(IN_DISTILLATE), io.input(IN_BOTTOMS));
         let qc = io.var(self.qc());
         let draw_flow: Vec<S> = (0..self.draws.len()).map(|k| io.input(self.draw_input(k))).collect();
         let h_l: Vec<S> = (0..n).map(|s| th.h_liq(st(s)[ix.t()], &st(s)[ix.x(0)..ix.x(0) + nc])).collect();
@@ -270,9 +366,21 @@ impl UnitModel for RigorousColumn {
             let (t, m, l, vap) = (v[ix.t()], v[ix.m()], v[ix.l()], v[ix.v()]);
             let x = &v[ix.x(0)..ix.x(0) + nc];
             let p = S::from(self.pressure[s]);
-            // Inflows: components, and enthalpy relative to the stage liquid.
             comp_in.iter_mut().for_each(|c| *c = S::from(0.0));
-            let mut energy = -vap * (h_v[s] - h_l[s]);
+            // Liquid and vapour leaving: to the neighbours (or bottoms), distillate, side draws.
+            let (mut liquid_out, mut vapour_out) = (l, vap);
+            if s + 1 == n && !self.partial {
+                liquid_out += d_in;
+            }
+            for (d, fl) in self.draws.iter().zip(&draw_flow).filter(|(d, _)| d.stage == s) {
+                if d.vapour {
+                    vapour_out += *fl;
+                } else {
+                    liquid_out += *fl;
+                }
+            }
+            let mut energy = -vapour_out * (h_v[s] - h_l[s]);
+            // Inflows: components, and enthalpy relative to the stage liquid.
             if s + 1 < n {
                 let up = st(s + 1);
                 comp_in.iter_mut().enumerate().for_each(|(j, c)| *c += up[ix.l()] * up[ix.x(j)]);
@@ -288,23 +396,15 @@ impl UnitModel for RigorousColumn {
                 comp_in.iter_mut().zip(feed.z()).for_each(|(c, z)| *c += feed.f() * *z);
                 energy += feed.f() * (feed.h() - h_l[s]);
             }
-            // Liquid leaving: to the stage below (or bottoms), distillate, side draws.
-            let mut liquid_out = l;
             if s + 1 == n {
-                liquid_out += d_in;
                 energy -= qc;
                 condenser_energy = energy;
             }
             if s == 0 {
                 energy += q_r;
             }
-            for (d, fl) in self.draws.iter().zip(&draw_flow) {
-                if d.stage == s {
-                    liquid_out += *fl;
-                }
-            }
             for j in 0..nc {
-                r[o + ix.n(j)] = comp_in[j] - liquid_out * x[j] - vap * v[ix.y(j)];
+                r[o + ix.n(j)] = comp_in[j] - liquid_out * x[j] - vapour_out * v[ix.y(j)];
                 r[o + ix.x(j)] = x[j] * m - v[ix.n(j)];
             }
             th.k_values(t, p, x, &mut k);
@@ -317,7 +417,7 @@ impl UnitModel for RigorousColumn {
                     v[ix.y(j)] - k[j] * x[j]
                 };
             }
-            let duty_condenser = s + 1 == n && self.condenser_duty.is_some();
+            let duty_condenser = s + 1 == n && self.condenser.has_input();
             r[o + ix.t()] = if duty_condenser {
                 energy
             } else if let VleModel::ConstantAlpha { .. } = th.vle {
@@ -334,11 +434,18 @@ impl UnitModel for RigorousColumn {
             } else {
                 l - self.weir.flow(m, th.v_liq(t, x))
             };
-            r[o + ix.v()] = if s + 1 == n { vap } else { energy };
+            r[o + ix.v()] = match (s + 1 == n, self.partial) {
+                (true, true) => vap - d_in,
+                (true, false) => vap,
+                _ => energy,
+            };
         }
-        r[internal0 + self.qc()] = match self.condenser_duty {
-            Some(_) => qc - io.input(IN_CONDENSER_DUTY),
-            None => condenser_energy,
+        r[internal0 + self.qc()] = match self.condenser {
+            Condenser::BubblePoint => condenser_energy,
+            Condenser::Duty(_) => qc - io.input(IN_CONDENSER_DUTY),
+            Condenser::Coolant { t_in, ua, cp, .. } => {
+                qc - coolant_duty(io.input(IN_CONDENSER_DUTY), st(n - 1)[ix.t()], t_in, ua, cp)
+            }
         };
         for k in 0..self.n_outlets() {
             let s = self.outlet_stage(k);
@@ -349,13 +456,14 @@ impl UnitModel for RigorousColumn {
             };
             let out = io.outlet(k);
             let v = st(s);
+            let (h, z0) = if self.outlet_is_vapour(k) { (h_v[s], ix.y(0)) } else { (h_l[s], ix.x(0)) };
             let rr = &mut r[k * slen..(k + 1) * slen];
             rr[F] = out.f() - flow;
             rr[T] = out.t() - v[ix.t()];
             rr[P] = out.p() - self.pressure[s];
-            rr[H] = out.h() - h_l[s];
+            rr[H] = out.h() - h;
             for j in 0..nc {
-                rr[Z0 + j] = out.z()[j] - v[ix.x(j)];
+                rr[Z0 + j] = out.z()[j] - v[z0 + j];
             }
         }
     }

@@ -4,24 +4,78 @@ use plantwide_units::{Dimension, QuantityValue};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
-use super::{Draw, RigorousColumn, Weir};
-use crate::units::column::ColumnConfig;
+use super::{Condenser, Draw, RigorousColumn, Weir};
+use crate::units::column::{ColumnConfig, DrawPhase};
 use crate::{BuildCx, FieldError};
 
 /// An example of the `rigorous` block, for error messages.
 pub const EXAMPLE: &str =
     r#"{"reboiler_duty": "1.2 MW", "weir_length": "0.8 m", "weir_height": "50 mm", "tray_area": "0.6 m2"}"#;
 
+/// A steam-heated reboiler: `Q_R = m_s λ_s` [W] with the steam flow m_s [kg/s] an input
+/// (`steam_flow`) and λ_s [J/kg] the latent heat the condensing steam gives up.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct SteamReboiler {
+    /// Steam flow m_s [kg/s] (input `steam_flow`; e.g. `"1800 kg/h"`).
+    pub steam_flow: QuantityValue,
+    /// Latent heat of the steam λ_s [J/kg] (e.g. `"2100 kJ/kg"`), > 0.
+    pub steam_latent_heat: QuantityValue,
+}
+
+/// A water-cooled condenser: the coolant (input `coolant_flow` m_c [kg/s]) enters at `T_in` and
+/// takes `Qc = m_c c_p (T_N − T_in) (1 − exp(−UA / (m_c c_p)))` [W] from the drum at `T_N`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct CoolantCondenser {
+    /// Coolant flow m_c [kg/s] (input `coolant_flow`; e.g. `"20 kg/s"`).
+    pub coolant_flow: QuantityValue,
+    /// Coolant inlet temperature T_in [K] (e.g. `"30 degC"`).
+    #[serde(rename = "coolant_T_in")]
+    pub coolant_t_in: QuantityValue,
+    /// Overall heat-transfer coefficient times area UA [W/K] (e.g. `"60 kW/K"`).
+    pub ua: QuantityValue,
+    /// Coolant heat capacity c_p [J/(kg K)] (default 4184, water).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cp: Option<QuantityValue>,
+}
+
+/// Condenser type.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum CondenserType {
+    /// All the vapour condenses; the distillate is liquid of the drum's composition.
+    #[default]
+    Total,
+    /// The distillate is the drum's vapour, in equilibrium with the reflux (`y_D = K x_N`).
+    Partial,
+}
+
 /// Rigorous-model data of a column (`"rigorous": {...}` with `"model": "rigorous"`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct RigorousConfig {
-    /// Reboiler duty Q_R [W] (input `reboiler_duty`; e.g. `"1.2 MW"`).
-    pub reboiler_duty: QuantityValue,
+    /// Reboiler duty Q_R [W] (input `reboiler_duty`; e.g. `"1.2 MW"`); give either this or
+    /// `reboiler`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reboiler_duty: Option<QuantityValue>,
+    /// Steam-heated reboiler, `Q_R = m_s λ_s` (input `steam_flow` [kg/s]; e.g.
+    /// `{"steam_flow": "1800 kg/h", "steam_latent_heat": "2100 kJ/kg"}`), instead of `reboiler_duty`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reboiler: Option<SteamReboiler>,
     /// Condenser duty Q_C [W] (input `condenser_duty`; e.g. `"1.1 MW"`); omit for a drum at its
     /// bubble point, whose duty is computed (variable `Qc`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub condenser_duty: Option<QuantityValue>,
+    /// Water-cooled condenser (input `coolant_flow` [kg/s]; e.g. `{"coolant_flow": "20 kg/s",
+    /// "coolant_T_in": "30 degC", "ua": "60 kW/K"}`), instead of `condenser_duty`; the drum energy
+    /// balance gives its temperature, as with `condenser_duty`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub condenser: Option<CoolantCondenser>,
+    /// `total` (default) or `partial` (vapour distillate in equilibrium with the reflux; the drum at
+    /// its bubble point, so neither `condenser_duty` nor `condenser`).
+    #[serde(default, skip_serializing_if = "is_total")]
+    pub condenser_type: CondenserType,
     /// Murphree vapour efficiency E of every tray [-], 0 < E ≤ 1 (default 1: equilibrium trays).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub murphree_efficiency: Option<f64>,
@@ -34,6 +88,10 @@ pub struct RigorousConfig {
     pub weir_height: QuantityValue,
     /// Tray active area A [m²] (e.g. `"0.6 m2"`): liquid height on the tray is `M v_L / A`.
     pub tray_area: QuantityValue,
+}
+
+fn is_total(t: &CondenserType) -> bool {
+    *t == CondenserType::Total
 }
 
 impl RigorousColumn {
@@ -50,12 +108,57 @@ impl RigorousColumn {
         let reflux = cx.non_negative("reflux", &c.reflux, flow);
         let distillate = cx.non_negative("distillate", &c.distillate, flow);
         let bottoms = cx.non_negative("bottoms", &c.bottoms, flow);
-        let (mut reboiler_duty, mut condenser_duty, mut efficiency, mut dp) = (f64::NAN, None, 1.0, 0.0);
+        let (mut reboiler_duty, mut condenser, mut efficiency, mut dp) = (f64::NAN, Condenser::BubblePoint, 1.0, 0.0);
+        let (mut steam_latent_heat, mut partial) = (None, false);
         let mut weir = Weir { length: f64::NAN, height: f64::NAN, area: f64::NAN };
         if let Some(r) = &c.rigorous {
-            reboiler_duty = cx.non_negative("rigorous.reboiler_duty", &r.reboiler_duty, Dimension::POWER);
-            condenser_duty =
-                r.condenser_duty.as_ref().map(|q| cx.non_negative("rigorous.condenser_duty", q, Dimension::POWER));
+            match (&r.reboiler_duty, &r.reboiler) {
+                (Some(q), None) => reboiler_duty = cx.non_negative("rigorous.reboiler_duty", q, Dimension::POWER),
+                (None, Some(s)) => {
+                    reboiler_duty = cx.non_negative("rigorous.reboiler.steam_flow", &s.steam_flow, Dimension::MASS_FLOW);
+                    steam_latent_heat = Some(cx.positive(
+                        "rigorous.reboiler.steam_latent_heat",
+                        &s.steam_latent_heat,
+                        Dimension::SPECIFIC_ENERGY,
+                    ));
+                }
+                (Some(_), Some(_)) => cx.error(
+                    "rigorous.reboiler",
+                    "give either `reboiler_duty` or the steam `reboiler`, not both: remove one",
+                ),
+                (None, None) => cx.error(
+                    "rigorous.reboiler_duty",
+                    r#"the rigorous model needs `reboiler_duty` (e.g. "1.2 MW") or a steam `reboiler` (e.g. {"steam_flow": "1800 kg/h", "steam_latent_heat": "2100 kJ/kg"})"#,
+                ),
+            }
+            if let Some(q) = &r.condenser_duty {
+                condenser = Condenser::Duty(cx.non_negative("rigorous.condenser_duty", q, Dimension::POWER));
+            }
+            if let Some(c) = &r.condenser {
+                if r.condenser_duty.is_some() {
+                    cx.error(
+                        "rigorous.condenser",
+                        "give either `condenser_duty` or the coolant `condenser`, not both: remove one",
+                    );
+                }
+                let cp =
+                    c.cp.as_ref()
+                        .map_or(4184.0, |v| cx.positive("rigorous.condenser.cp", v, Dimension::HEAT_CAPACITY_MASS));
+                condenser = Condenser::Coolant {
+                    flow: cx.positive("rigorous.condenser.coolant_flow", &c.coolant_flow, Dimension::MASS_FLOW),
+                    t_in: cx.positive("rigorous.condenser.coolant_T_in", &c.coolant_t_in, Dimension::TEMPERATURE),
+                    ua: cx.positive("rigorous.condenser.ua", &c.ua, Dimension::UA),
+                    cp,
+                };
+            }
+            partial = r.condenser_type == CondenserType::Partial;
+            if partial && (r.condenser_duty.is_some() || r.condenser.is_some()) {
+                cx.error(
+                    "rigorous.condenser_type",
+                    "a partial condenser keeps its drum at the bubble point, so its duty is computed: remove \
+                     `condenser_duty` / `condenser`, or make the condenser `total`",
+                );
+            }
             if let Some(e) = r.murphree_efficiency {
                 if !(e.is_finite() && e > 0.0 && e <= 1.0) {
                     cx.error(
@@ -109,7 +212,7 @@ impl RigorousColumn {
                 cx.error(&format!("side_draws[{k}].port"), format!("port name `{}` is already used", d.port));
             }
             let f = cx.non_negative(&format!("side_draws[{k}].flow"), &d.flow, flow);
-            draws.push(Draw { stage: d.stage.saturating_sub(1), flow: f });
+            draws.push(Draw { stage: d.stage.saturating_sub(1), flow: f, vapour: d.phase == DrawPhase::Vapour });
             draw_ports.push(d.port.clone());
         }
         let pressure = (0..n).map(|s| p_top + (n - 1 - s) as f64 * dp).collect();
@@ -131,9 +234,11 @@ impl RigorousColumn {
             m_tray: if m_tray.is_finite() && m_tray > 0.0 { m_tray } else { 1.0 },
             reflux,
             reboiler_duty,
+            steam_latent_heat,
             distillate,
             bottoms,
-            condenser_duty,
+            condenser,
+            partial,
             comp_names: cx.components.to_vec(),
         };
         cx.finish(column)

@@ -15,7 +15,11 @@
 //!      x_{i−1} − (L_i + S_i + D δ_iN + V_i K'_i) x_i = −Σ F z` with effective K-values `K' = y/x` of
 //!      the last sweep (they carry the Murphree efficiency), by the Thomas algorithm;
 //!    - normalised `x`, bubble-point temperatures, K-values, Murphree vapours; a duty-specified
-//!      drum takes the temperature at which `h_L(T_N, x_N) = h_V,N−1 − Q_C / V_{N−1}`.
+//!      drum takes the temperature at which `h_L(T_N, x_N) = h_V,N−1 − Q_C / V_{N−1}`, a
+//!      water-cooled one the same with `Q_C = Qc(T_N)` of the coolant (by bisection).
+//!
+//!    Vapour side draws enter the energy balance of their tray as `− S^V_i (h_V,i − h_L,i)` and
+//!    the component balances with `K'`; a partial condenser's vapour distillate is `V_N = D`.
 //!
 //!    Tray holdups invert the weir; the drum and sump sit at their nominal holdups.
 //! 3. **Newton** on the column's own equations, with a pseudo-transient fallback, finishes the
@@ -28,7 +32,7 @@
 
 use plantwide_thermo::ThermoPackage;
 
-use super::{IN_CONDENSER_DUTY, IN_REBOILER_DUTY, IN_REFLUX, RigorousColumn};
+use super::{Condenser, IN_CONDENSER_DUTY, IN_REBOILER_DUTY, IN_REFLUX, RigorousColumn, coolant_duty};
 use crate::UnitIo;
 use crate::stream::{F, H, P, T, Z0};
 use crate::units::Phase;
@@ -60,14 +64,18 @@ pub(super) struct Specs {
     pub p: Vec<f64>,
     /// Feeds.
     pub feeds: Vec<FeedIn>,
-    /// Side draws (stage, flow [mol/s]).
-    pub draws: Vec<(usize, f64)>,
+    /// Side draws (stage, flow [mol/s], drawn from the vapour).
+    pub draws: Vec<(usize, f64, bool)>,
+    /// Partial condenser (vapour distillate, `V_N = D`).
+    pub partial: bool,
     /// Reflux [mol/s].
     pub reflux: f64,
     /// Reboiler duty [W].
     pub q_r: f64,
     /// Condenser duty [W] of a duty-specified drum.
     pub q_c: Option<f64>,
+    /// Coolant of a water-cooled drum: flow [kg/s], inlet temperature [K], UA [W/K], c_p [J/(kg K)].
+    pub coolant: Option<(f64, f64, f64, f64)>,
     /// Murphree efficiency of the trays.
     pub efficiency: f64,
 }
@@ -109,10 +117,23 @@ pub(super) fn guess(col: &RigorousColumn, io: &UnitIo<'_, f64>, own: &mut [f64])
     let specs = Specs {
         p: col.pressure.clone(),
         feeds,
-        draws: col.draws.iter().enumerate().map(|(k, d)| (d.stage, io.input(col.draw_input(k)).max(0.0))).collect(),
+        draws: col
+            .draws
+            .iter()
+            .enumerate()
+            .map(|(k, d)| (d.stage, io.input(col.draw_input(k)).max(0.0), d.vapour))
+            .collect(),
+        partial: col.partial,
         reflux: io.input(IN_REFLUX).max(0.0),
-        q_r: io.input(IN_REBOILER_DUTY).max(0.0),
-        q_c: col.condenser_duty.map(|_| io.input(IN_CONDENSER_DUTY)),
+        q_r: col.q_r(io.input(IN_REBOILER_DUTY)).max(0.0),
+        q_c: match col.condenser {
+            Condenser::Duty(_) => Some(io.input(IN_CONDENSER_DUTY)),
+            _ => None,
+        },
+        coolant: match col.condenser {
+            Condenser::Coolant { t_in, ua, cp, .. } => Some((io.input(IN_CONDENSER_DUTY).max(0.0), t_in, ua, cp)),
+            _ => None,
+        },
         efficiency: col.efficiency,
     };
     let prof = bubble_point_profile(th, &specs, cmo_distillate(th, &specs));
@@ -157,10 +178,13 @@ fn write_own(col: &RigorousColumn, io: &UnitIo<'_, f64>, specs: &Specs, prof: &P
         own[o + ix.l()] = prof.l[s];
         own[o + ix.v()] = prof.v[s];
     }
-    own[internal0 + col.qc()] = specs.q_c.unwrap_or_else(|| {
+    let h_v_drum = th.h_vap(prof.t[n - 1], &prof.y[n - 1]);
+    let coolant = specs.coolant.map(|(m, t_in, ua, cp)| coolant_duty(m, prof.t[n - 1], t_in, ua, cp));
+    own[internal0 + col.qc()] = specs.q_c.or(coolant).unwrap_or_else(|| {
         let top = n - 2;
         let feed_heat: f64 = specs.feeds.iter().filter(|f| f.stage == n - 1).map(|f| f.f * (f.h - h_l[n - 1])).sum();
         prof.v[top] * (th.h_vap(prof.t[top], &prof.y[top]) - h_l[n - 1]) + feed_heat
+            - prof.v[n - 1] * (h_v_drum - h_l[n - 1])
     });
     for k in 0..col.n_outlets() {
         let s = col.outlet_stage(k);
@@ -169,12 +193,14 @@ fn write_own(col: &RigorousColumn, io: &UnitIo<'_, f64>, specs: &Specs, prof: &P
             1 => prof.l[0],
             _ => specs.draws[k - 2].1,
         };
+        let (h, z) =
+            if col.outlet_is_vapour(k) { (th.h_vap(prof.t[s], &prof.y[s]), &prof.y[s]) } else { (h_l[s], &prof.x[s]) };
         let rr = &mut own[k * slen..(k + 1) * slen];
         rr[F] = flow;
         rr[T] = prof.t[s];
         rr[P] = col.pressure[s];
-        rr[H] = h_l[s];
-        rr[Z0..Z0 + nc].copy_from_slice(&prof.x[s]);
+        rr[H] = h;
+        rr[Z0..Z0 + nc].copy_from_slice(z);
     }
 }
 
@@ -238,6 +264,7 @@ fn flows(sp: &Specs, h_l: &[f64], h_v: &[f64], d0: f64, eps: f64) -> (Vec<f64>, 
     let n = h_l.len();
     let feed_at = |s: usize| sp.feeds.iter().filter(move |f| f.stage == s);
     let draw_at = |s: usize| sp.draws.iter().filter(move |d| d.0 == s).map(|d| d.1).sum::<f64>();
+    let vapour_draw_at = |s: usize| sp.draws.iter().filter(move |d| d.0 == s && d.2).map(|d| d.1).sum::<f64>();
     // Σ_{k>s} (F_k − S_k): what enters the section above stage s besides V_s, net of side draws.
     let mut above = vec![0.0; n];
     for s in (0..n - 1).rev() {
@@ -250,6 +277,7 @@ fn flows(sp: &Specs, h_l: &[f64], h_v: &[f64], d0: f64, eps: f64) -> (Vec<f64>, 
             let g = above[s] - d;
             let mut num = g * (h_l[s + 1] - h_l[s]) + feed_at(s).map(|f| f.f * (f.h - h_l[s])).sum::<f64>();
             num += if s > 0 { v[s - 1] * (h_v[s - 1] - h_l[s]) } else { sp.q_r };
+            num -= vapour_draw_at(s) * (h_v[s] - h_l[s]);
             v[s] = (num / (h_v[s] - h_l[s + 1])).max(eps);
         }
         let d_new = (v[n - 2] + above[n - 2] - sp.reflux).max(eps);
@@ -265,6 +293,9 @@ fn flows(sp: &Specs, h_l: &[f64], h_v: &[f64], d0: f64, eps: f64) -> (Vec<f64>, 
         l[s + 1] = (v[s] + above[s] - d).max(eps);
     }
     l[n - 1] = sp.reflux;
+    if sp.partial {
+        v[n - 1] = d;
+    }
     (v, l, d)
 }
 
@@ -281,7 +312,8 @@ struct State {
 /// Bubble-point sweeps until the temperatures settle; returns the distillate.
 fn sweeps(th: &ThermoPackage, sp: &Specs, mut d: f64, eps: f64, st: &mut State) -> f64 {
     let (n, nc) = (sp.p.len(), th.n());
-    let draw_at = |s: usize| sp.draws.iter().filter(|d| d.0 == s).map(|d| d.1).sum::<f64>();
+    let draw_at =
+        |s: usize, vapour: bool| sp.draws.iter().filter(|d| d.0 == s && d.2 == vapour).map(|d| d.1).sum::<f64>();
     let (mut a, mut b, mut c, mut rhs) = (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
     for _ in 0..MAX_SWEEPS {
         let h_l: Vec<f64> = (0..n).map(|s| th.h_liq(st.t[s], &st.x[s])).collect();
@@ -295,7 +327,8 @@ fn sweeps(th: &ThermoPackage, sp: &Specs, mut d: f64, eps: f64, st: &mut State) 
         for j in 0..nc {
             for s in 0..n {
                 a[s] = if s > 0 { v[s - 1] * k_eff[s - 1][j] } else { 0.0 };
-                b[s] = -(l[s] + draw_at(s) + v[s] * k_eff[s][j] + if s + 1 == n { d } else { 0.0 });
+                let total_d = if s + 1 == n && !sp.partial { d } else { 0.0 };
+                b[s] = -(l[s] + draw_at(s, false) + (v[s] + draw_at(s, true)) * k_eff[s][j] + total_d);
                 c[s] = if s + 1 < n { l[s + 1] } else { 0.0 };
                 rhs[s] = -sp.feeds.iter().filter(|f| f.stage == s).map(|f| f.f * f.z[j]).sum::<f64>();
             }
@@ -309,6 +342,9 @@ fn sweeps(th: &ThermoPackage, sp: &Specs, mut d: f64, eps: f64, st: &mut State) 
             let h_target = h_v[n - 2] - q_c / v[n - 2];
             t_new[n - 1] = Phase::Liquid.temperature(th, h_target, sp.p[n - 1], &x_new[n - 1], t_new[n - 1]);
         }
+        if let Some(c) = sp.coolant {
+            t_new[n - 1] = coolant_drum_temperature(th, c, h_v[n - 2], v[n - 2], &x_new[n - 1], t_new[n - 1]);
+        }
         let change = st.t.iter().zip(&t_new).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
         st.x = x_new;
         st.t = t_new;
@@ -318,6 +354,38 @@ fn sweeps(th: &ThermoPackage, sp: &Specs, mut d: f64, eps: f64, st: &mut State) 
         }
     }
     d
+}
+
+/// Temperature of a water-cooled drum of liquid `x` fed the vapour flow `v` [mol/s] of molar enthalpy
+/// `h_v` (coolant `(m, T_in, UA, c_p)`): the root of `h_L(T, x) − h_v + Qc(T) / v = 0` between the
+/// coolant inlet and the bubble point `t_bubble` (both sides increase with `T`), by bisection; the
+/// bubble point when the coolant cannot condense all the vapour there.
+fn coolant_drum_temperature(
+    th: &ThermoPackage,
+    (m, t_in, ua, cp): (f64, f64, f64, f64),
+    h_v: f64,
+    v: f64,
+    x: &[f64],
+    t_bubble: f64,
+) -> f64 {
+    let f = |t: f64| th.h_liq(t, x) - h_v + coolant_duty(m, t, t_in, ua, cp) / v.max(1e-300);
+    let (mut lo, mut hi) = (t_in.min(t_bubble), t_bubble);
+    let (f_lo, f_hi) = (f(lo), f(hi));
+    if f_lo.is_nan() || f_hi.is_nan() || f_lo >= 0.0 || f_hi <= 0.0 {
+        return t_bubble;
+    }
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if f(mid) > 0.0 {
+            hi = mid
+        } else {
+            lo = mid
+        }
+        if hi - lo <= 1e-12 * hi {
+            break;
+        }
+    }
+    0.5 * (lo + hi)
 }
 
 /// The column at the reflux and reboiler duty of `sp` by the bubble-point method (step 2 of the

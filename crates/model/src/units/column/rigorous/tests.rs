@@ -87,10 +87,13 @@ fn jacobian_matches_finite_differences() {
             "",
             r#", "murphree_efficiency": 0.7, "tray_pressure_drop": "0.8 kPa""#,
             r#", "condenser_duty": QC, "murphree_efficiency": 0.5"#,
+            r#", "condenser": {"coolant_flow": "15 kg/s", "coolant_T_in": "300 K", "ua": "50 kW/K"}"#,
+            r#", "condenser_type": "partial", "murphree_efficiency": 0.6"#,
         ] {
             let json = config(&thermo, extra).replace(
                 r#""bottoms": "5 mol/s","#,
-                r#""bottoms": "5 mol/s", "side_draws": [{"port": "side", "stage": 4, "flow": "1 mol/s"}],"#,
+                r#""bottoms": "5 mol/s", "side_draws": [{"port": "side", "stage": 4, "flow": "1 mol/s"},
+                {"port": "vside", "stage": 2, "flow": "2 mol/s", "phase": "vapour"}],"#,
             );
             let u = build(&json, &thermo).unwrap();
             let (lay, base) = at_guess(&u, &thermo, &feed(&thermo));
@@ -296,4 +299,218 @@ fn variables_and_inputs() {
     let inputs: Vec<String> = UnitModel::inputs(&u).into_iter().map(|i| i.name).collect();
     assert_eq!(inputs, ["reflux", "reboiler_duty", "distillate", "bottoms", "condenser_duty"]);
     assert_eq!(UnitModel::outlet_ports(&u), ["distillate", "bottoms"]);
+}
+
+/// A steam reboiler with `m_s = Q_R / λ_s` is the duty-specified column: the same cold-start steady
+/// state (to 1e-10) and the same residuals at that state; its input is `steam_flow` in kg/s.
+#[test]
+fn steam_reboiler_reproduces_the_duty() {
+    let thermo = ethanol_water();
+    let lambda = 2.1e6;
+    let duty_json = config(&thermo, r#", "murphree_efficiency": 0.8"#);
+    let c: ColumnConfig = serde_json::from_str(&duty_json).unwrap();
+    let q_r = match &c.rigorous.as_ref().unwrap().reboiler_duty {
+        Some(plantwide_units::QuantityValue::Number(q)) => *q,
+        other => panic!("duty not a number: {other:?}"),
+    };
+    let steam_json = duty_json.replace(
+        &format!(r#""reboiler_duty": {q_r}"#),
+        &format!(
+            r#""reboiler": {{"steam_flow": "{} kg/h", "steam_latent_heat": "2100 kJ/kg"}}"#,
+            q_r / lambda * 3600.0
+        ),
+    );
+    assert_ne!(steam_json, duty_json);
+    let (duty, steam) = (build(&duty_json, &thermo).unwrap(), build(&steam_json, &thermo).unwrap());
+    let inputs: Vec<(String, f64)> = UnitModel::inputs(&steam).into_iter().map(|i| (i.name, i.value)).collect();
+    assert_eq!(inputs[1].0, "steam_flow");
+    assert!((inputs[1].1 - q_r / lambda).abs() < 1e-14 * q_r / lambda, "{inputs:?}");
+    let (lay, a) = at_guess(&duty, &thermo, &feed(&thermo));
+    let (_, b) = at_guess(&steam, &thermo, &feed(&thermo));
+    let own = lay.n_own();
+    let worst = (0..own).map(|i| (a[i] - b[i]).abs() / a[i].abs().max(1.0)).fold(0.0, f64::max);
+    eprintln!("steam vs duty reboiler: worst relative difference of the steady state {worst:.1e}");
+    assert!(worst < 1e-10, "{worst}");
+    // Residuals of both at the duty column's state, with the steam input at Q_R / λ_s.
+    let mut b_local = a.clone();
+    b_local[lay.inputs_offset() + IN_REBOILER_DUTY] = q_r / lambda;
+    let (mut ra, mut rb) = (vec![0.0; n_eq(&duty, &lay)], vec![0.0; n_eq(&steam, &lay)]);
+    duty.residual(&UnitIo { local: &a, layout: &lay, thermo: &thermo, time: 0.0 }, &mut ra);
+    steam.residual(&UnitIo { local: &b_local, layout: &lay, thermo: &thermo, time: 0.0 }, &mut rb);
+    let diff = ra.iter().zip(&rb).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
+    assert!(diff < 1e-10 * q_r, "{diff}");
+}
+
+#[test]
+fn steam_coolant_partial_and_vapour_draw_errors() {
+    let thermo = binary_package();
+    let msg = |json: &str| match build(json, &thermo) {
+        Ok(_) => String::new(),
+        Err(e) => e.iter().map(|e| e.to_string()).collect::<Vec<_>>().join("\n"),
+    };
+    let steam = r#""reboiler": {"steam_flow": "1 kg/s", "steam_latent_heat": "2100 kJ/kg"}"#;
+    let both = config(&thermo, &format!(", {steam}"));
+    assert!(msg(&both).contains("units.column.rigorous.reboiler: give either"), "{}", msg(&both));
+    let c: ColumnConfig = serde_json::from_str(&config(&thermo, "")).unwrap();
+    let Some(plantwide_units::QuantityValue::Number(q)) = c.rigorous.unwrap().reboiler_duty else { panic!() };
+    let none = config(&thermo, "").replace(&format!(r#""reboiler_duty": {q}, "#), "");
+    assert!(msg(&none).contains("units.column.rigorous.reboiler_duty: the rigorous model needs"), "{}", msg(&none));
+    let bad = config(&thermo, "").replace(&format!(r#""reboiler_duty": {q}"#), &steam.replace("kJ/kg", "kJ"));
+    assert!(msg(&bad).contains("units.column.rigorous.reboiler.steam_latent_heat"), "{}", msg(&bad));
+    // Coolant condenser, partial condenser, vapour draws.
+    let coolant = r#""condenser": {"coolant_flow": "10 kg/s", "coolant_T_in": "30 degC", "ua": "50 kW/K""#;
+    let m = msg(&config(&thermo, &format!(r#", "condenser_duty": "1 MW", {coolant}}}"#)));
+    assert!(m.contains("units.column.rigorous.condenser: give either"), "{m}");
+    let m = msg(&config(&thermo, &format!(r#", {coolant}, "cp": "4 kJ/kg"}}"#)));
+    assert!(m.contains("units.column.rigorous.condenser.cp"), "{m}");
+    let m = msg(&config(&thermo, &format!(r#", {}}}"#, coolant.replace("50 kW/K", "-5 kW/K"))));
+    assert!(m.contains("units.column.rigorous.condenser.ua: must be positive"), "{m}");
+    let m = msg(&config(&thermo, r#", "condenser_type": "partial", "condenser_duty": "1 MW""#));
+    assert!(m.contains("units.column.rigorous.condenser_type: a partial condenser"), "{m}");
+    let vapour_draw = |json: String| {
+        json.replace(
+            r#""bottoms": "5 mol/s","#,
+            r#""bottoms": "5 mol/s", "side_draws": [{"port": "v", "stage": 2, "flow": 1, "phase": "vapour"}],"#,
+        )
+    };
+    assert_eq!(msg(&vapour_draw(config(&thermo, ""))), "");
+    let m = msg(&vapour_draw(config(&thermo, "")).replace(r#""model": "rigorous""#, r#""model": "simple""#));
+    assert!(m.contains("units.column.side_draws[0].phase: the simple model does not use `side_draws[0].phase`"), "{m}");
+}
+
+/// Coolant flow [kg/s] at which `coolant_duty(m, t_hot, …) = q` (the duty rises with the flow), by
+/// bisection.
+fn coolant_flow_for(q: f64, t_hot: f64, t_in: f64, ua: f64, cp: f64) -> f64 {
+    let (mut lo, mut hi) = (1e-6f64, 1e6f64);
+    for _ in 0..300 {
+        let mid = (lo * hi).sqrt();
+        if coolant_duty(mid, t_hot, t_in, ua, cp) > q { hi = mid } else { lo = mid }
+    }
+    (lo * hi).sqrt()
+}
+
+/// A water-cooled condenser: at its cold-start steady state `Qc` obeys the effectiveness relation
+/// and, independently, `Qc = m c_p (T_out − T_in) = UA ΔT_lm` between the drum at `T_N` and the
+/// coolant; a coolant flow that removes the duty `QC` reproduces the duty-specified column.
+#[test]
+fn coolant_condenser_closed_forms() {
+    let thermo = ethanol_water();
+    let duty = build(&config(&thermo, r#", "condenser_duty": QC"#), &thermo).unwrap();
+    let Column::Rigorous(col) = &duty else { panic!("not rigorous") };
+    let (lay, a) = at_guess(&duty, &thermo, &feed(&thermo));
+    let internal0 = lay.n_outlets * lay.stream.len();
+    let ix = StageIdx { nc: 2 };
+    let (qc, t_n) = (a[internal0 + col.qc()], a[internal0 + col.stage(5) + ix.t()]);
+    let (t_in, ua, cp) = (303.15, 4.0e4, 4184.0);
+    let m = coolant_flow_for(qc, t_n, t_in, ua, cp);
+    let coolant_json = config(
+        &thermo,
+        &format!(r#", "condenser": {{"coolant_flow": {m}, "coolant_T_in": "30 degC", "ua": "40 kW/K"}}"#),
+    );
+    let coolant = build(&coolant_json, &thermo).unwrap();
+    let inputs: Vec<String> = UnitModel::inputs(&coolant).into_iter().map(|i| i.name).collect();
+    assert_eq!(inputs, ["reflux", "reboiler_duty", "distillate", "bottoms", "coolant_flow"]);
+    let (_, b) = at_guess(&coolant, &thermo, &feed(&thermo));
+    let io = UnitIo { local: &b, layout: &lay, thermo: &thermo, time: 0.0 };
+    // Every residual of the coolant column vanishes at its guess (with D, B at the guess's flows).
+    let mut local = b.clone();
+    local[lay.inputs_offset() + IN_DISTILLATE] = b[F];
+    local[lay.inputs_offset() + IN_BOTTOMS] = b[lay.stream.len() + F];
+    let mut r = vec![0.0; n_eq(&coolant, &lay)];
+    coolant.residual(&UnitIo { local: &local, layout: &lay, thermo: &thermo, time: 0.0 }, &mut r);
+    let qc_b = io.var(col.qc());
+    let t_nb = io.var(col.stage(5) + ix.t());
+    assert!(r[internal0 + col.qc()].abs() < 1e-9 * qc_b, "Qc row {}", r[internal0 + col.qc()]);
+    // Closed forms: effectiveness, and the coolant's own balance against UA ΔT_lm.
+    let c = m * cp;
+    let eff = c * (t_nb - t_in) * (1.0 - (-ua / c).exp());
+    let t_out = t_in + qc_b / c;
+    let lmtd = ((t_nb - t_in) - (t_nb - t_out)) / ((t_nb - t_in) / (t_nb - t_out)).ln();
+    eprintln!(
+        "coolant condenser: m_c {m:.4} kg/s, T_N {t_nb:.4} K, T_out {t_out:.4} K, Qc {qc_b:.6e} W, UA ΔT_lm {:.6e} W",
+        ua * lmtd
+    );
+    assert!((qc_b - eff).abs() < 1e-9 * qc_b && (qc_b - ua * lmtd).abs() < 1e-9 * qc_b);
+    // The duty-specified column's steady state.
+    let worst = (0..lay.n_own()).map(|i| (a[i] - b[i]).abs() / a[i].abs().max(1.0)).fold(0.0, f64::max);
+    eprintln!("coolant vs duty condenser: worst relative difference of the steady state {worst:.1e}");
+    assert!(worst < 1e-8, "{worst}");
+    assert!((t_nb - t_n).abs() < 1e-8 && t_nb > t_out);
+}
+
+/// Partial condensers and vapour side draws at their cold-start steady states: every residual
+/// vanishes, components and energy balance over the whole column (vapour products at `h_V`), the
+/// vapour distillate is in equilibrium with the reflux, `y_D = K(T_N, P_top, x_N) x_N`, and a
+/// vapour draw carries its tray's `y` and `h_V(T, y)`.
+#[test]
+fn partial_condenser_and_vapour_draws() {
+    let draws = |json: String, list: &str| {
+        json.replace(r#""bottoms": "5 mol/s","#, &format!(r#""bottoms": "5 mol/s", "side_draws": [{list}],"#))
+    };
+    let vapour = r#"{"port": "vside", "stage": 2, "flow": "3 mol/s", "phase": "vapour"}"#;
+    let liquid = r#"{"port": "side", "stage": 4, "flow": "1 mol/s"}"#;
+    for thermo in [binary_package(), ethanol_water()] {
+        for (partial, list) in [(true, ""), (false, vapour), (true, &format!("{vapour}, {liquid}") as &str)] {
+            let extra = if partial { r#", "condenser_type": "partial", "murphree_efficiency": 0.8"# } else { "" };
+            let u = build(&draws(config(&thermo, extra), list), &thermo).unwrap();
+            let Column::Rigorous(col) = &u else { panic!("not rigorous") };
+            let (lay, mut local) = at_guess(&u, &thermo, &feed(&thermo));
+            let slen = lay.stream.len();
+            local[lay.inputs_offset() + IN_DISTILLATE] = local[F];
+            local[lay.inputs_offset() + IN_BOTTOMS] = local[slen + F];
+            let mut r = vec![0.0; n_eq(&u, &lay)];
+            let mut jac = vec![0.0; r.len() * local.len()];
+            let io = UnitIo { local: &local, layout: &lay, thermo: &thermo, time: 0.0 };
+            u.jacobian(&io, &mut r, &mut jac);
+            let n = local.len();
+            let scaled = (0..r.len())
+                .map(|k| r[k].abs() / (0..n).map(|j| (jac[k * n + j] * local[j]).abs()).fold(1e-300, f64::max))
+                .fold(0.0, f64::max);
+            let feed = io.inlet(0);
+            let products: Vec<_> = (0..lay.n_outlets).map(|k| io.outlet(k)).collect();
+            let q_r = io.input(IN_REBOILER_DUTY);
+            let qc = io.var(col.qc());
+            let energy = (q_r + feed.f() * feed.h() - qc - products.iter().map(|p| p.f() * p.h()).sum::<f64>()) / q_r;
+            let comp = (0..2)
+                .map(|j| (feed.f() * feed.z()[j] - products.iter().map(|p| p.f() * p.z()[j]).sum::<f64>()) / feed.f())
+                .fold(0.0, |a: f64, b| a.max(b.abs()));
+            let ix = StageIdx { nc: 2 };
+            let stage_var = |s: usize, i: usize| io.var(col.stage(s - 1) + i);
+            // Independent phase checks from the thermo package.
+            let mut k = [0.0; 2];
+            let mut phase_err: f64 = 0.0;
+            let d = &products[0];
+            if partial {
+                let x_n = [stage_var(6, ix.x(0)), stage_var(6, ix.x(1))];
+                thermo.k_values(stage_var(6, ix.t()), 101_325.0, &x_n, &mut k);
+                for j in 0..2 {
+                    phase_err = phase_err.max((d.z()[j] - k[j] * x_n[j]).abs());
+                }
+                phase_err = phase_err.max((d.z()[0] + d.z()[1] - 1.0).abs());
+                let h_v = thermo.h_vap(d.t(), d.z());
+                phase_err = phase_err.max((d.h() - h_v).abs() / h_v.abs());
+                assert!((d.f() - stage_var(6, ix.v())).abs() < 1e-12 * d.f(), "V_N = D");
+            }
+            for (k, p) in products.iter().enumerate().skip(2) {
+                let (s, vap) = (col.draws[k - 2].stage + 1, col.draws[k - 2].vapour);
+                let z0 = if vap { ix.y(0) } else { ix.x(0) };
+                let z = [stage_var(s, z0), stage_var(s, z0 + 1)];
+                let h =
+                    if vap { thermo.h_vap(stage_var(s, ix.t()), &z) } else { thermo.h_liq(stage_var(s, ix.t()), &z) };
+                phase_err = phase_err.max((p.z()[0] - z[0]).abs()).max((p.z()[1] - z[1]).abs());
+                phase_err = phase_err.max((p.h() - h).abs() / h.abs());
+            }
+            eprintln!(
+                "{} partial {partial}, draws [{list}]: scaled residual {scaled:.1e}, energy {energy:.1e}, components {comp:.1e}, \
+                 phase {phase_err:.1e}, D {:.4} mol/s, yD {:.6}, T_N {:.3} K, Qc {:.4e} W",
+                vle_name(&thermo),
+                d.f(),
+                d.z()[0],
+                d.t(),
+                qc
+            );
+            assert!(scaled < 1e-9, "{scaled}");
+            assert!(energy.abs() < 1e-9 && comp < 1e-9 && phase_err < 1e-12, "{energy} {comp} {phase_err}");
+        }
+    }
 }
