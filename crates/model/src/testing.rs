@@ -52,3 +52,28 @@ pub fn jacobian_error(
     }
     worst
 }
+
+/// Local layout of a controller (no ports) with two components.
+pub fn controller_layout(u: &dyn Unit) -> LocalLayout {
+    LocalLayout {
+        stream: crate::StreamLayout { n_comp: 2 },
+        n_outlets: 0,
+        n_internal: u.internal_vars().len(),
+        n_inlets: 0,
+        n_inputs: u.inputs().len(),
+        n_signals: u.signals().len(),
+    }
+}
+
+/// A controller's residuals and guess at `local = [internal | inputs | signals]`.
+pub fn controller_eval(u: &dyn Unit, local: &[f64]) -> (Vec<f64>, Vec<f64>) {
+    let thermo = binary_package();
+    let layout = controller_layout(u);
+    assert_eq!(layout.len(), local.len());
+    let io = UnitIo { local, layout: &layout, thermo: &thermo, time: 0.0 };
+    let mut r = vec![0.0; layout.n_own()];
+    u.residual(&io, &mut r);
+    let mut own = local[..layout.n_own()].to_vec();
+    u.guess(&io, &mut own);
+    (r, own)
+}

@@ -173,8 +173,9 @@ mod tests {
     use serde_json::json;
 
     use super::*;
+    use crate::ControllerSpec;
     use crate::testing::{binary_package, jacobian_error};
-    use crate::{ControllerSpec, LocalLayout, StreamLayout};
+    use crate::testing::{controller_eval as eval, controller_layout as layout};
 
     fn links(pv_dim: Dimension, op_dim: Dimension) -> ControllerLinks {
         ControllerLinks { pv_dim, op_dim, op_value: 3.0, pv_nominal: 1.0 }
@@ -185,30 +186,6 @@ mod tests {
         let thermo = binary_package();
         let comps = vec!["light".to_string(), "heavy".to_string()];
         Ratio::build(&c, BuildCx::new(&comps, &thermo, "controllers.fr"), links)
-    }
-
-    fn layout(u: &dyn crate::Unit) -> LocalLayout {
-        LocalLayout {
-            stream: StreamLayout { n_comp: 2 },
-            n_outlets: 0,
-            n_internal: u.internal_vars().len(),
-            n_inlets: 0,
-            n_inputs: u.inputs().len(),
-            n_signals: u.signals().len(),
-        }
-    }
-
-    /// Residuals and guess at `local = [op | inputs | signals]`.
-    fn eval(u: &dyn crate::Unit, local: &[f64]) -> (Vec<f64>, Vec<f64>) {
-        let thermo = binary_package();
-        let layout = layout(u);
-        assert_eq!(layout.len(), local.len());
-        let io = UnitIo { local, layout: &layout, thermo: &thermo, time: 0.0 };
-        let mut r = vec![0.0; layout.n_own()];
-        u.residual(&io, &mut r);
-        let mut own = local[..layout.n_own()].to_vec();
-        u.guess(&io, &mut own);
-        (r, own)
     }
 
     fn jac_err(u: &dyn crate::Unit, local: &[f64]) -> f64 {

@@ -212,8 +212,9 @@ mod tests {
     use serde_json::json;
 
     use super::*;
+    use crate::ControllerSpec;
+    use crate::testing::controller_layout as layout;
     use crate::testing::{binary_package, jacobian_error};
-    use crate::{ControllerSpec, LocalLayout, StreamLayout};
 
     fn links(pv_dim: Dimension, op_dim: Dimension) -> ControllerLinks {
         ControllerLinks { pv_dim, op_dim, op_value: 0.5, pv_nominal: 1.0 }
@@ -224,17 +225,6 @@ mod tests {
         let thermo = binary_package();
         let comps = vec!["light".to_string(), "heavy".to_string()];
         SplitRange::build(&c, BuildCx::new(&comps, &thermo, "controllers.sr"), links)
-    }
-
-    fn layout(u: &dyn crate::Unit) -> LocalLayout {
-        LocalLayout {
-            stream: StreamLayout { n_comp: 2 },
-            n_outlets: 0,
-            n_internal: u.internal_vars().len(),
-            n_inlets: 0,
-            n_inputs: u.inputs().len(),
-            n_signals: u.signals().len(),
-        }
     }
 
     /// The guessed outputs at signal `s`, checked to zero the residuals.
