@@ -29,6 +29,48 @@ use crate::{BuildCx, FieldError, InputSpec, LocalLayout, Scalar, UnitIo, UnitMod
 pub use rigorous::{RigorousColumn, RigorousConfig};
 pub use simple::SimpleColumn;
 
+/// A validated side draw.
+#[derive(Debug, Clone)]
+pub(crate) struct Draw {
+    /// 0-based stage it is drawn from.
+    pub(crate) stage: usize,
+    /// Flow [mol/s] (the value of its input).
+    pub(crate) flow: f64,
+    /// Drawn from the vapour leaving the tray (else from its liquid).
+    pub(crate) vapour: bool,
+}
+
+/// Validate the side draws of `c` (a column of `n` stages whose feeds use `feed_ports`): trays
+/// 2 … N−1 only, port names unique among products, feeds and draws, flows non-negative. Returns the
+/// draws and their port names; errors are recorded on `cx` with their field paths.
+pub(crate) fn side_draws(
+    c: &ColumnConfig,
+    n: usize,
+    feed_ports: &[String],
+    cx: &mut BuildCx<'_>,
+) -> (Vec<Draw>, Vec<String>) {
+    let mut draws = Vec::new();
+    let mut draw_ports: Vec<String> = Vec::new();
+    for (k, d) in c.side_draws.iter().enumerate() {
+        if d.stage < 2 || d.stage + 1 > n {
+            cx.error(
+                &format!("side_draws[{k}].stage"),
+                format!("side draws come from trays 2 … {}; got {}", n.saturating_sub(1), d.stage),
+            );
+        }
+        if ["distillate", "bottoms"].contains(&d.port.as_str())
+            || feed_ports.contains(&d.port)
+            || draw_ports.contains(&d.port)
+        {
+            cx.error(&format!("side_draws[{k}].port"), format!("port name `{}` is already used", d.port));
+        }
+        let flow = cx.non_negative(&format!("side_draws[{k}].flow"), &d.flow, plantwide_units::Dimension::MOLAR_FLOW);
+        draws.push(Draw { stage: d.stage.saturating_sub(1), flow, vapour: d.phase == DrawPhase::Vapour });
+        draw_ports.push(d.port.clone());
+    }
+    (draws, draw_ports)
+}
+
 /// Offsets of the variables within one stage's block, shared by both fidelities:
 /// `[n_1 … n_c, x_1 … x_c, y_1 … y_c, T, M, L, V]`.
 pub(crate) struct StageIdx {

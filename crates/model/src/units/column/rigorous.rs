@@ -107,20 +107,12 @@ mod weir;
 use plantwide_thermo::VleModel;
 use plantwide_units::Dimension;
 
-use super::StageIdx;
+use super::{Draw, StageIdx};
 use crate::stream::{F, H, P, T, Z0};
 use crate::{InputSpec, LocalLayout, Scalar, UnitIo, UnitModel, VarSpec};
 
 pub use build::{CondenserType, CoolantCondenser, EXAMPLE, RigorousConfig, SteamReboiler};
 pub use weir::{CREST_SMOOTH, FRANCIS, Weir};
-
-#[derive(Debug, Clone)]
-struct Draw {
-    stage: usize,
-    flow: f64,
-    /// Drawn from the vapour leaving the tray (else from its liquid).
-    vapour: bool,
-}
 
 /// How the condenser duty is set.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -33,7 +33,7 @@
 
 use plantwide_units::Dimension;
 
-use super::{ColumnConfig, StageIdx};
+use super::{ColumnConfig, Draw, StageIdx, side_draws};
 
 use crate::stream::{F, H, P, T, Z0};
 use crate::{BuildCx, FieldError, InputSpec, LocalLayout, Scalar, UnitIo, UnitModel, VarSpec};
@@ -42,12 +42,6 @@ use crate::{BuildCx, FieldError, InputSpec, LocalLayout, Scalar, UnitIo, UnitMod
 struct Feed {
     stage: usize,
     q: Option<f64>,
-}
-
-#[derive(Debug, Clone)]
-struct Draw {
-    stage: usize,
-    flow: f64,
 }
 
 /// A distillation column, simple model.
@@ -132,25 +126,7 @@ impl SimpleColumn {
             nominal_feed.push(nom);
             feeds.push(Feed { stage: f.stage.saturating_sub(1), q: f.q });
         }
-        let mut draws = Vec::new();
-        let mut draw_ports = Vec::new();
-        for (k, d) in c.side_draws.iter().enumerate() {
-            if d.stage < 2 || d.stage + 1 > n {
-                cx.error(
-                    &format!("side_draws[{k}].stage"),
-                    format!("side draws come from trays 2 … {}; got {}", n.saturating_sub(1), d.stage),
-                );
-            }
-            if ["distillate", "bottoms"].contains(&d.port.as_str())
-                || feed_ports.contains(&d.port)
-                || draw_ports.contains(&d.port)
-            {
-                cx.error(&format!("side_draws[{k}].port"), format!("port name `{}` is already used", d.port));
-            }
-            let f = cx.non_negative(&format!("side_draws[{k}].flow"), &d.flow, flow);
-            draws.push(Draw { stage: d.stage.saturating_sub(1), flow: f });
-            draw_ports.push(d.port.clone());
-        }
+        let (draws, draw_ports) = side_draws(c, n, &feed_ports, &mut cx);
         let mut m0 = vec![tray; n];
         if n >= 1 {
             m0[0] = reb;

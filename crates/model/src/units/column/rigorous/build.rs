@@ -4,8 +4,8 @@ use plantwide_units::{Dimension, QuantityValue};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
-use super::{Condenser, Draw, RigorousColumn, Weir};
-use crate::units::column::{ColumnConfig, DrawPhase};
+use super::{Condenser, RigorousColumn, Weir};
+use crate::units::column::{ColumnConfig, side_draws};
 use crate::{BuildCx, FieldError};
 
 /// An example of the `rigorous` block, for error messages.
@@ -196,25 +196,7 @@ impl RigorousColumn {
             feed_ports.push(f.port.clone());
             feeds.push(f.stage.saturating_sub(1));
         }
-        let mut draws = Vec::new();
-        let mut draw_ports = Vec::new();
-        for (k, d) in c.side_draws.iter().enumerate() {
-            if d.stage < 2 || d.stage + 1 > n {
-                cx.error(
-                    &format!("side_draws[{k}].stage"),
-                    format!("side draws come from trays 2 … {}; got {}", n.saturating_sub(1), d.stage),
-                );
-            }
-            if ["distillate", "bottoms"].contains(&d.port.as_str())
-                || feed_ports.contains(&d.port)
-                || draw_ports.contains(&d.port)
-            {
-                cx.error(&format!("side_draws[{k}].port"), format!("port name `{}` is already used", d.port));
-            }
-            let f = cx.non_negative(&format!("side_draws[{k}].flow"), &d.flow, flow);
-            draws.push(Draw { stage: d.stage.saturating_sub(1), flow: f, vapour: d.phase == DrawPhase::Vapour });
-            draw_ports.push(d.port.clone());
-        }
+        let (draws, draw_ports) = side_draws(c, n, &feed_ports, &mut cx);
         let pressure = (0..n).map(|s| p_top + (n - 1 - s) as f64 * dp).collect();
         let n_comp = cx.thermo.n().max(1) as f64;
         let v_mean = cx.thermo.components.iter().map(|c| c.v_liq(298.15)).sum::<f64>() / n_comp;
