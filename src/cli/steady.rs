@@ -6,7 +6,6 @@ use plantwide::flowsheet::overrides::{set_field, set_input, split_assignment};
 use plantwide::flowsheet::{BlockKind, Plant, assemble, parse_spec};
 use plantwide::model::stream::{F, H, P, T, Z0};
 use plantwide::solve::sequential::{Method, Progress, Solution, StrategySettings, steady_state_by};
-use plantwide::solve::{NewtonSettings, SteadyError, SteadyState, steady_state_observed};
 
 use super::CliError;
 
@@ -39,32 +38,10 @@ pub fn load_with_overrides(file: &Path, sets: &[String]) -> Result<(Plant, Vec<f
     Ok((plant, u))
 }
 
-/// Converge with a progress spinner on stderr (hidden when stderr is not a terminal), mapping
-/// failures to exit codes.
-pub fn converge(plant: &Plant, u: &[f64]) -> Result<SteadyState, CliError> {
-    let x0 = plant.initial_guess_at(u);
-    plantwide::solve::dof_check(plant, u, &x0, plantwide::solve::DofProbe::Numerical)
-        .map_err(|e| CliError::user(e.to_string()))?;
-    let bar = indicatif::ProgressBar::new_spinner();
-    let mut observer = |r: &plantwide::solve::IterationRecord| {
-        let phase = if r.pseudo_dt.is_some() { "pseudo-transient" } else { "Newton" };
-        bar.set_message(format!("{phase} iteration {}: scaled residual {:.2e}", r.iter + 1, r.residual));
-        bar.tick();
-    };
-    let result = steady_state_observed(plant, u, None, &NewtonSettings::default(), &mut observer);
-    bar.finish_and_clear();
-    result.map_err(|e| match e {
-        SteadyError::Dof(d) => CliError::user(d.to_string()),
-        SteadyError::NotConverged(f) => {
-            let mut msg = f.to_string();
-            msg.push_str("\niteration history (scaled residual, accepted step, pseudo time step):");
-            for h in &f.report.history {
-                let dt = h.pseudo_dt.map_or("-".to_string(), |d| format!("{d:.3e} s"));
-                msg.push_str(&format!("\n  {:>4}  {:.3e}  {:.3e}  {}", h.iter + 1, h.residual, h.step, dt));
-            }
-            CliError::numerical(msg)
-        }
-    })
+/// Converge the way `plantwide steady` does by default (sequential-modular pass, then whole-plant
+/// Newton), so that every command starts from the same steady state.
+pub fn converge(plant: &Plant, u: &[f64]) -> Result<Solution, CliError> {
+    converge_by(plant, u, MethodArg::Auto)
 }
 
 /// How `--method` finds the steady state.

@@ -114,6 +114,11 @@ pub struct CstrConfig {
     /// Initial level guess [m] (default: the valve's steady level, else half the height, else 1 m).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub level: Option<QuantityValue>,
+    /// Initial temperature guess [K] (default: the energy balance without reaction). An exothermic
+    /// reactor can have several steady states; give the operating temperature (e.g. `"350 K"`) so that
+    /// Newton starts on the intended (usually the hot, temperature-controlled) branch.
+    #[serde(rename = "T_guess", default, skip_serializing_if = "Option::is_none")]
+    pub t_guess: Option<QuantityValue>,
 }
 
 #[derive(Debug, Clone)]
@@ -144,6 +149,7 @@ pub struct Cstr {
     law: OutflowLaw,
     reactions: Vec<Reaction>,
     jacket: Option<Jacket>,
+    t_guess: Option<f64>,
 }
 
 fn by_component(cx: &mut BuildCx<'_>, field: &str, map: &BTreeMap<String, f64>) -> Vec<f64> {
@@ -209,7 +215,8 @@ impl Cstr {
         if jacket.is_some() && c.duty.is_some() {
             cx.error("duty", "give either `jacket` or `duty`, not both");
         }
-        cx.finish(Cstr { holdup, pressure, duty, law, reactions, jacket })
+        let t_guess = c.t_guess.as_ref().map(|t| cx.positive("T_guess", t, Dimension::TEMPERATURE));
+        cx.finish(Cstr { holdup, pressure, duty, law, reactions, jacket, t_guess })
     }
     /// Inputs before the outflow law's: `P`, then `duty` or `coolant_flow`, `coolant_T`.
     fn n_fixed_inputs(&self) -> usize {
@@ -343,7 +350,8 @@ impl UnitModel for Cstr {
         let inlet = io.inlet(0);
         let x = normalized(inlet.z());
         let (f, op) = self.law.guess_flow(io, self.n_fixed_inputs(), inlet.f());
-        // Energy balance without reaction: F_in (h_L(T) − h_in) = UA_eff (T_c − T), or = duty.
+        // The given temperature, else the energy balance without reaction:
+        // F_in (h_L(T) − h_in) = UA_eff (T_c − T), or = duty.
         let (t, tj, q) = match &self.jacket {
             Some(j) => {
                 let (fcp, tc) = (io.input(1) * j.cp, io.input(2));
@@ -352,13 +360,17 @@ impl UnitModel for Cstr {
                 let xd: Vec<Dual64> = x.iter().map(|&v| v.into()).collect();
                 let td = Dual64::new(inlet.t(), 1.0);
                 let g = (io.thermo.h_liq(td, &xd) - inlet.h()) * inlet.f() + (td - tc) * ua_eff;
-                let t = if g.eps > 0.0 { (td.re - g.re / g.eps).clamp(0.5 * td.re, 2.0 * td.re) } else { td.re };
+                let t_balance =
+                    if g.eps > 0.0 { (td.re - g.re / g.eps).clamp(0.5 * td.re, 2.0 * td.re) } else { td.re };
+                let t = self.t_guess.unwrap_or(t_balance);
                 let tj = if fcp + j.ua > 0.0 { (fcp * tc + j.ua * t) / (fcp + j.ua) } else { t };
                 (t, tj, j.ua * (tj - t))
             }
             None => {
                 let h = if inlet.f() > 0.0 { inlet.h() + io.input(1) / inlet.f() } else { inlet.h() };
-                (Phase::Liquid.temperature(io.thermo, h, inlet.p(), &x, inlet.t()), 0.0, io.input(1))
+                let t =
+                    self.t_guess.unwrap_or_else(|| Phase::Liquid.temperature(io.thermo, h, inlet.p(), &x, inlet.t()));
+                (t, 0.0, io.input(1))
             }
         };
         let mut liq = LiquidState { p: io.input(0), level: 0.0, mw: io.thermo.mw(&x), v: io.thermo.v_liq(t, &x) };
