@@ -26,6 +26,7 @@ const CASES: &[(&str, &[&str])] = &[
     ("controller_gain_dimension.json", &["controllers.tc1.kc", "is a molar flow but a heat-transfer conductance"]),
     ("wrong_format_version.json", &["format_version", "reads format_version 1, the file has 2"]),
     ("heater_overspecified.json", &["units.h1", "exactly one of `duty`"]),
+    ("cstr_temperature_guess_dimension.json", &["units.reactor.T_guess", "a temperature is expected"]),
     (
         "uncontrolled_level.json",
         &[
