@@ -1,8 +1,11 @@
 //! Steady state `f(x) = 0` by Newton's method with a sparse LU (faer), row-scaled residuals,
 //! bound-respecting backtracking line search and, when Newton stalls from a poor start,
 //! pseudo-transient continuation (Kelley & Keyes 1998): `(M/δ − J) Δx = f`, with the pseudo time
-//! step δ grown by switched evolution relaxation `δ_{k+1} = δ_k ‖f_{k−1}‖/‖f_k‖` — the
-//! "converge dynamically" advice of Luyben's ch. 3, done implicitly.
+//! step δ grown by switched evolution relaxation with an increment, `δ_{k+1} = 1.1 δ_k ‖f_{k−1}‖/‖f_k‖`
+//! (PETSc's `TSPSEUDO` default) — the "converge dynamically" advice of Luyben's ch. 3, done
+//! implicitly. The increment matters on a plateau, where the residual stays put while the plant
+//! moves (a vessel draining at a controller's output limit): plain relaxation keeps δ constant there
+//! and marches through the transient at the first step's pace.
 //!
 //! # References
 //! - C. T. Kelley, D. E. Keyes, *Convergence analysis of pseudo-transient continuation*, SIAM J.
@@ -83,6 +86,14 @@ pub struct NewtonReport {
     pub n_jacobian_evals: usize,
 }
 
+/// Growth factor of the pseudo time step per accepted step, on top of switched evolution
+/// relaxation (PETSc `-ts_pseudo_increment`, default 1.1).
+const PTC_INCREMENT: f64 = 1.1;
+
+/// Overshoot of a bound, relative to the variable's nominal size, that is clipped rather than
+/// allowed to shorten the Newton step.
+const BOUND_SLACK: f64 = 1e-10;
+
 struct Work<'a, S: System> {
     sys: &'a S,
     n: usize,
@@ -125,16 +136,19 @@ impl<S: System> Work<'_, S> {
         self.n_res += 1;
         r.iter().zip(&self.w).map(|(a, b)| (a * b) * (a * b)).sum::<f64>() * 0.5
     }
-    /// Largest fraction τ ≤ 1 of `dx` keeping `x` inside the bounds (fraction to the boundary 0.995),
-    /// after clipping variables already at a bound.
+    /// Largest fraction τ ≤ 1 of `dx` keeping `x` inside the bounds (fraction to the boundary 0.995).
+    /// A step that would cross a bound by less than [`BOUND_SLACK`] of the variable's nominal size
+    /// does not limit τ: the variable is clipped (a trace mole fraction of 1e-40 pushed to −1e-31
+    /// must not shrink a whole-plant step to 1e-12).
     fn max_step(&self, x: &[f64], dx: &[f64]) -> f64 {
         let mut tau: f64 = 1.0;
         for i in 0..self.n {
             let (lo, hi) = self.sys.bounds(i);
             let target = x[i] + dx[i];
-            if target < lo && dx[i] < 0.0 {
+            let slack = BOUND_SLACK * self.sys.nominal(i);
+            if target < lo - slack && dx[i] < 0.0 {
                 tau = tau.min(0.995 * (x[i] - lo).max(0.0) / -dx[i]);
-            } else if target > hi && dx[i] > 0.0 {
+            } else if target > hi + slack && dx[i] > 0.0 {
                 tau = tau.min(0.995 * (hi - x[i]).max(0.0) / dx[i]);
             }
         }
@@ -292,7 +306,7 @@ fn ptc_phase<S: System>(
             return NewtonStatus::Converged;
         }
         if prev_norm.is_finite() {
-            dt = (dt * (prev_norm / norm).clamp(0.2, 10.0)).min(1e12);
+            dt = (PTC_INCREMENT * dt * (prev_norm / norm).clamp(0.2, 10.0)).min(1e12);
         }
         prev_norm = norm;
         // (M/δ − J) Δx = f  ⇔  (J − M/δ) Δx = −f.
@@ -395,6 +409,45 @@ mod tests {
         fn mass(&self) -> Vec<(usize, usize)> {
             vec![(0, 0)]
         }
+    }
+
+    /// `f = (x0² − 4, x1 + 1e-31)` with `x1 ≥ 0`: the root has `x1` a round-off below its bound.
+    /// From `x1 = 1e-42` the step to −1e-31 is clipped, not allowed to shrink the step of `x0` to
+    /// 1e-11, below the round-off of `x0` (which stalled column 2 of the two-column plant at a scaled
+    /// residual of 5e-7: the line search sees no decrease and fails).
+    struct Trace;
+    impl System for Trace {
+        fn n(&self) -> usize {
+            2
+        }
+        fn residual(&self, x: &[f64], r: &mut [f64]) {
+            r[0] = x[0] * x[0] - 4.0;
+            r[1] = x[1] + 1e-31;
+        }
+        fn jacobian(&self, x: &[f64], r: &mut [f64], jac: &mut Vec<(usize, usize, f64)>) {
+            self.residual(x, r);
+            jac.clear();
+            jac.extend([(0, 0, 2.0 * x[0]), (1, 1, 1.0)]);
+        }
+        fn nominal(&self, _i: usize) -> f64 {
+            1.0
+        }
+        fn bounds(&self, i: usize) -> (f64, f64) {
+            if i == 1 { (0.0, f64::INFINITY) } else { (f64::NEG_INFINITY, f64::INFINITY) }
+        }
+        fn mass(&self) -> Vec<(usize, usize)> {
+            vec![(0, 0), (1, 1)]
+        }
+    }
+
+    #[test]
+    fn a_trace_variable_at_its_bound_does_not_stall_newton() {
+        let mut x = [2.000001, 1e-42];
+        let settings = NewtonSettings { pseudo_transient: false, ..NewtonSettings::default() };
+        let rep = solve_steady(&Trace, &mut x, &settings);
+        assert_eq!(rep.status, NewtonStatus::Converged, "{rep:?}");
+        assert!(rep.iterations <= 3, "{} iterations", rep.iterations);
+        assert!((x[0] - 2.0).abs() < 1e-10 && x[1] == 0.0, "{x:?}");
     }
 
     #[test]
