@@ -1,7 +1,10 @@
 //! Steady-state gains the book's way (*Practical Distillation Control* ch. 6): each input moved
 //! `± h` from the base case, the plant re-converged from the base point, and central differences
 //! `G_ij = (y_i(u + h_j e_j) − y_i(u − h_j e_j)) / (2 h_j)`. The `2m` re-convergences are
-//! independent and run in parallel (rayon).
+//! independent and run in parallel (rayon). A re-convergence whose Newton iteration from the base
+//! point fails (a slow integral loop elsewhere in a recycle plant can stall pseudo-transient
+//! continuation) is repeated from scratch the way `steady` converges (sequential-modular pass, then
+//! Newton); only if that fails too is the gain refused.
 //!
 //! **Step.** `h_j = step · |u_j|` with `step` relative (default 1e-5), or `step` SI units when
 //! `u_j = 0`. Central differences err by `O(h²)`; high-purity columns are strongly curved (column
@@ -16,6 +19,7 @@
 
 use faer::Mat;
 use plantwide_flowsheet::Plant;
+use plantwide_solve::sequential::{StrategySettings, steady_state_by};
 use plantwide_solve::sparse::SparseLu;
 use plantwide_solve::{NewtonSettings, NewtonStatus, PlantSystem, solve_steady};
 use rayon::prelude::*;
@@ -73,14 +77,20 @@ fn reconverge(
     let sys = PlantSystem::new(plant, u);
     let mut x = x0.to_vec();
     let report = solve_steady(&sys, &mut x, settings);
+    let mut iterations = report.iterations;
     if report.status != NewtonStatus::Converged {
         let (eq, res) = report.worst.unwrap_or((0, f64::NAN));
-        return Err(format!(
-            "{:?} after {} iterations (worst: {}, scaled residual {res:.2e})",
+        let from_base = format!(
+            "from the base point: {:?} after {} iterations (worst: {}, scaled residual {res:.2e})",
             report.status,
             report.iterations,
             plant.equation_name(eq)
-        ));
+        );
+        let strategy = StrategySettings { newton: settings.clone(), ..StrategySettings::default() };
+        let solution =
+            steady_state_by(plant, u, &strategy, &mut |_| {}).map_err(|e| format!("{from_base}; from scratch: {e}"))?;
+        x = solution.x;
+        iterations += solution.newton.map_or(0, |n| n.iterations);
     }
     let n = plant.n_vars();
     let (mut r, mut jx, mut ju) = (vec![0.0; n], Vec::new(), Vec::new());
@@ -96,7 +106,7 @@ fn reconverge(
             break;
         }
     }
-    Ok(Point { y: outputs.iter().map(|&k| x[k]).collect(), error, iterations: report.iterations })
+    Ok(Point { y: outputs.iter().map(|&k| x[k]).collect(), error, iterations })
 }
 
 /// Gains `dy/du` of `outputs` (variable indices) to `inputs` (free input indices) at the converged
