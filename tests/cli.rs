@@ -80,6 +80,28 @@ fn no_steady_state_is_a_numerical_failure_naming_the_worst_equation() {
     );
 }
 
+/// A PI level controller whose output sits at its upper limit at the cold-start guess (level guessed
+/// 0.8 m above a 0.2 m setpoint with Kc = 500 mol/s/m: the unclamped output is 450 mol/s, the limit
+/// 60). Clamped, the outflow no longer depends on the level and the Jacobian is singular there,
+/// but the plant is well posed: the degrees-of-freedom probe must not call it "not determined", and
+/// the steady state has the level on its setpoint and the outflow equal to the inflow.
+#[test]
+fn a_controller_at_its_limit_at_the_guess_is_not_called_undetermined() {
+    let mut spec: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(common::flowsheet("surge_tank_pi.json")).unwrap()).unwrap();
+    let lc = &mut spec["controllers"]["lc"];
+    lc["op_max"] = "60 mol/s".into();
+    lc["kc"] = "500 mol/s/m".into();
+    lc["sp"] = "0.2 m".into();
+    let path = std::env::temp_dir().join(format!("plantwide_saturated_guess_{}.json", std::process::id()));
+    std::fs::write(&path, serde_json::to_string(&spec).unwrap()).unwrap();
+    let out = steady_json(&[path.to_str().unwrap()]);
+    std::fs::remove_file(&path).unwrap();
+    let v = &out["values"];
+    assert!((v["tank.level"].as_f64().unwrap() - 0.2).abs() < 1e-9, "{v}");
+    assert!((v["lc.op"].as_f64().unwrap() - 50.0).abs() < 1e-9, "{v}");
+}
+
 #[test]
 fn components_lists_the_library() {
     let out = plantwide(&["components"]);

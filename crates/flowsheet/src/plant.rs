@@ -176,6 +176,19 @@ impl Plant {
         }));
     }
 
+    /// Names of the controllers whose output sits at one of its limits at `(x, u)`.
+    pub fn controllers_at_limits(&self, x: &[f64], u: &[f64]) -> Vec<&str> {
+        let mut local = Vec::new();
+        self.blocks
+            .iter()
+            .filter(|b| {
+                self.gather(b, x, u, &mut local);
+                b.unit.at_output_limit(&UnitIo { local: &local, layout: &b.layout, thermo: &self.thermo, time: 0.0 })
+            })
+            .map(|b| b.name.as_str())
+            .collect()
+    }
+
     /// Residuals `f(x, u)` at time `t` into `r` (length `n_eqs`).
     pub fn residual(&self, x: &[f64], u: &[f64], t: f64, r: &mut [f64]) {
         let mut local = Vec::new();

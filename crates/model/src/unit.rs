@@ -176,6 +176,12 @@ pub trait UnitModel: Send + Sync + std::fmt::Debug {
     /// Initial guess of the own variables from the inlets and inputs in `local` (its own block holds
     /// whatever was there before: defaults or a previous solution).
     fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]);
+    /// Whether an output of this controller sits at one of its limits at `io` (default: never).
+    /// A limited output no longer depends on its measurement, so the Jacobian can be singular there
+    /// although the plant is well posed: the numerical degrees-of-freedom probe does not judge it.
+    fn at_output_limit(&self, _io: &UnitIo<'_, f64>) -> bool {
+        false
+    }
 }
 
 /// Object-safe view of a [`UnitModel`], used by assembly and solvers.
@@ -212,6 +218,8 @@ pub trait Unit: Send + Sync + std::fmt::Debug {
     fn jacobian_colored(&self, io: &UnitIo<'_, f64>, r: &mut [f64], jac: &mut [f64], coloring: Option<&Coloring>);
     /// See [`UnitModel::guess`].
     fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]);
+    /// See [`UnitModel::at_output_limit`].
+    fn at_output_limit(&self, io: &UnitIo<'_, f64>) -> bool;
 }
 
 impl<U: UnitModel> Unit for U {
@@ -293,6 +301,9 @@ impl<U: UnitModel> Unit for U {
     }
     fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]) {
         UnitModel::guess(self, io, own);
+    }
+    fn at_output_limit(&self, io: &UnitIo<'_, f64>) -> bool {
+        UnitModel::at_output_limit(self, io)
     }
 }
 

@@ -117,9 +117,14 @@ impl Ratio {
         }
     }
 
-    fn output<S: Scalar>(&self, io: &UnitIo<'_, S>) -> S {
+    /// The output before its limits, `ratio · wild + bias`.
+    fn unclamped<S: Scalar>(&self, io: &UnitIo<'_, S>) -> S {
         let (ratio, bias) = self.ratio_and_bias(io);
-        clamp(ratio * io.signal(0) + bias, self.op_min, self.op_max)
+        ratio * io.signal(0) + bias
+    }
+
+    fn output<S: Scalar>(&self, io: &UnitIo<'_, S>) -> S {
+        clamp(self.unclamped(io), self.op_min, self.op_max)
     }
 }
 
@@ -160,6 +165,10 @@ impl UnitModel for Ratio {
     }
     fn eval<S: Scalar>(&self, io: &UnitIo<'_, S>, r: &mut [S]) {
         r[0] = io.var(0) - self.output(io);
+    }
+    fn at_output_limit(&self, io: &UnitIo<'_, f64>) -> bool {
+        let u = self.unclamped(io);
+        u < self.op_min || u > self.op_max
     }
     fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]) {
         let op = self.output(io);

@@ -112,12 +112,17 @@ impl Summer {
         cx.finish(Summer { paths, gains, references, bias, op_min, op_max, links: links.clone() })
     }
 
-    fn output<S: Scalar>(&self, io: &UnitIo<'_, S>) -> S {
+    /// The output before its limits, `bias + Σ g_k (s_k − s_ref,k)`.
+    fn unclamped<S: Scalar>(&self, io: &UnitIo<'_, S>) -> S {
         let mut u = io.input(0);
         for (k, (&g, &s_ref)) in self.gains.iter().zip(&self.references).enumerate() {
             u += (io.signal(k) - s_ref) * g;
         }
-        clamp(u, self.op_min, self.op_max)
+        u
+    }
+
+    fn output<S: Scalar>(&self, io: &UnitIo<'_, S>) -> S {
+        clamp(self.unclamped(io), self.op_min, self.op_max)
     }
 }
 
@@ -201,6 +206,10 @@ impl UnitModel for Summer {
     }
     fn eval<S: Scalar>(&self, io: &UnitIo<'_, S>, r: &mut [S]) {
         r[0] = io.var(0) - self.output(io);
+    }
+    fn at_output_limit(&self, io: &UnitIo<'_, f64>) -> bool {
+        let u = self.unclamped(io);
+        u < self.op_min || u > self.op_max
     }
     fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]) {
         let op = self.output(io);
