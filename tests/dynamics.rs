@@ -71,7 +71,7 @@ fn tank_closed_form(t: f64, v: f64, kc: f64, tau_i: Option<f64>, df: f64) -> (f6
 const TANK_STEP: &str = r#"{"format_version": 1, "duration": "2500 s",
     "integrator": {"rtol": 1e-10, "atol": 1e-12},
     "events": [{"type": "step", "at": "100 s", "path": "F_in", "to": "60 mol/s"}],
-    "record": {"interval": "5 s", "time_unit": "s", "paths": ["tank.level", "out.F", "tank.M"]}}"#;
+    "record": {"interval": "5 s", "time_unit": "s", "paths": ["tank.level", "out.F", "tank.M", "tank.outflow"]}}"#;
 
 fn check_tank(fields: &[(&str, &str)], tau_i: Option<f64>) {
     let (plant, x0, res) = run("surge_tank_pi.json", fields, TANK_STEP);
@@ -79,6 +79,11 @@ fn check_tank(fields: &[(&str, &str)], tau_i: Option<f64>) {
     // Level per mole from the model's own liquid volume at the (constant) tank temperature.
     let v = common::value(&plant, &x0, "tank.level") / common::value(&plant, &x0, "tank.M");
     let (level, out) = (column(&res, "tank.level"), column(&res, "out.F"));
+    // The pump's flow setpoint, an input driven by the level controller, is recorded as the
+    // controller's output: the flow the tank delivers, not the flowsheet's initial value.
+    let setpoint = column(&res, "tank.outflow");
+    let err_sp = setpoint.iter().zip(&out).map(|(s, f)| (s - f).abs()).fold(0.0, f64::max);
+    assert!(err_sp < 1e-9 * 50.0, "recorded tank.outflow differs from out.F by {err_sp} mol/s");
     let (mut err_h, mut err_f): (f64, f64) = (0.0, 0.0);
     for (i, &t) in res.times.iter().enumerate() {
         let (h, f) = if t < t_s || (t == t_s && i + 1 < res.times.len() && res.times[i + 1] == t_s) {

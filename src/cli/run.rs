@@ -91,14 +91,38 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
         }
     });
     bar.finish_and_clear();
-    let res = result.map_err(|e| match e {
-        SimError::Integration { .. } => CliError::numerical(e.to_string()),
-        SimError::Snapshot { .. } => CliError::user(e.to_string()),
-    })?;
+    let title = if sc.name.is_empty() { plant.name.clone() } else { format!("{}: {}", plant.name, sc.name) };
+    let res = match result {
+        Ok(res) => res,
+        Err(SimError::Integration { ref partial, .. }) => {
+            // The trends up to the failure show what led to it (a vessel draining, a loop saturating).
+            let written = write_trends_files(args, partial, &title, &sc.time_unit, time_factor);
+            let at = format!("{:.6} {}", partial.t * time_factor, sc.time_unit);
+            let message = result.err().map_or_else(String::new, |e| e.to_string());
+            return Err(CliError::numerical(match written {
+                Ok(()) => format!("{message}; the trends up to t = {at} are in {}", args.csv.display()),
+                Err(e) => format!("{message}; {}", e.message),
+            }));
+        }
+        Err(e @ SimError::Snapshot { .. }) => return Err(CliError::user(e.to_string())),
+    };
     if let Some(e) = write_error {
         return Err(e);
     }
-    write_csv(&args.csv, &res, &sc.time_unit, time_factor)?;
+    write_trends_files(args, &res, &title, &sc.time_unit, time_factor)?;
+    let wall = started.elapsed().as_secs_f64();
+    print_summary(&res, args.json, wall, time_factor, &sc.time_unit)
+}
+
+/// The CSV file and, if asked for, the plot of the recorded trends.
+fn write_trends_files(
+    args: &RunArgs,
+    res: &SimulationResult,
+    title: &str,
+    time_unit: &str,
+    time_factor: f64,
+) -> Result<(), CliError> {
+    write_csv(&args.csv, res, time_unit, time_factor)?;
     if let Some(p) = &args.plot {
         let times: Vec<f64> = res.times.iter().map(|t| t * time_factor).collect();
         let trends: Vec<Trend> = (0..res.columns.len())
@@ -107,11 +131,9 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
                 values: res.rows.iter().map(|r| to_unit(r[k], &res.columns[k].unit)).collect(),
             })
             .collect();
-        let title = if sc.name.is_empty() { plant.name.clone() } else { format!("{}: {}", plant.name, sc.name) };
-        write_trends(p, &title, &format!("time [{}]", sc.time_unit), &times, &trends).map_err(CliError::user)?;
+        write_trends(p, title, &format!("time [{time_unit}]"), &times, &trends).map_err(CliError::user)?;
     }
-    let wall = started.elapsed().as_secs_f64();
-    print_summary(&res, args.json, wall, time_factor, &sc.time_unit)
+    Ok(())
 }
 
 fn to_unit(v: f64, unit: &str) -> f64 {

@@ -236,6 +236,8 @@ pub enum SimError {
         source: DaeError,
         /// The equation and variable concerned, when known.
         detail: String,
+        /// What was recorded up to the failure (the trends that lead to it).
+        partial: Box<SimulationResult>,
     },
     /// A snapshot does not fit this plant.
     #[error("{file}: the snapshot does not fit this plant: {reason}")]
@@ -258,8 +260,8 @@ pub struct Column {
     pub si_unit: String,
 }
 
-/// A finished run.
-#[derive(Debug, Clone)]
+/// A finished run (or, in [`SimError::Integration`], the part of it before the failure).
+#[derive(Debug, Clone, PartialEq)]
 pub struct SimulationResult {
     /// Recorded columns.
     pub columns: Vec<Column>,
@@ -303,7 +305,7 @@ pub fn simulate(
             }
             _ => String::new(),
         };
-        return Err(SimError::Integration { file, source, detail });
+        return Err(SimError::Integration { file, source, detail, partial: Box::new(d.finish()) });
     }
     Ok(d.finish())
 }
@@ -515,7 +517,7 @@ impl<'p> Driver<'p> {
     }
 
     fn push_row(&mut self, t: f64, x: &[f64]) {
-        let (row, refs) = row_at(self.sc, &self.refs, &self.st.waveforms, self.plant.n_vars(), t, x);
+        let (row, refs) = row_at(self.plant, self.sc, &self.refs, &self.st.waveforms, t, x);
         self.times.push(t);
         self.rows.push(row);
         self.ref_rows.push(refs);
@@ -663,7 +665,7 @@ impl<'p> Driver<'p> {
                     } else {
                         self.bdf.interpolate(tr, &mut xi);
                     }
-                    let (row, refs) = row_at(self.sc, &self.refs, &self.st.waveforms, self.plant.n_vars(), tr, &xi);
+                    let (row, refs) = row_at(self.plant, self.sc, &self.refs, &self.st.waveforms, tr, &xi);
                     self.times.push(tr);
                     self.rows.push(row);
                     self.ref_rows.push(refs);
@@ -726,12 +728,13 @@ impl<'p> Driver<'p> {
     }
 }
 
-/// One recorded row at `t` from the state `x`, and the references.
+/// One recorded row at `t` from the state `x`, and the references. An input driven by a
+/// controller is recorded as the controller's output, the value the plant receives.
 fn row_at(
+    plant: &Plant,
     sc: &Scenario,
     refs: &[Option<usize>],
     waves: &[Waveform],
-    n_plant: usize,
     t: f64,
     x: &[f64],
 ) -> (Vec<f64>, Vec<f64>) {
@@ -740,10 +743,10 @@ fn row_at(
         .iter()
         .map(|r| match r.source {
             Read::Var(v) => x[v],
-            Read::Input(i) => waves[i].at(t),
+            Read::Input(i) => plant.inputs[i].driven_by.map_or_else(|| waves[i].at(t), |v| x[v]),
         })
         .collect();
-    row.extend_from_slice(&x[n_plant..]);
+    row.extend_from_slice(&x[plant.n_vars()..]);
     (row, refs.iter().map(|r| r.map_or(f64::NAN, |i| waves[i].at(t))).collect())
 }
 
