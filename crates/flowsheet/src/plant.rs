@@ -176,19 +176,6 @@ impl Plant {
         }));
     }
 
-    /// Names of the controllers whose output sits at one of its limits at `(x, u)`.
-    pub fn controllers_at_limits(&self, x: &[f64], u: &[f64]) -> Vec<&str> {
-        let mut local = Vec::new();
-        self.blocks
-            .iter()
-            .filter(|b| {
-                self.gather(b, x, u, &mut local);
-                b.unit.at_output_limit(&UnitIo { local: &local, layout: &b.layout, thermo: &self.thermo, time: 0.0 })
-            })
-            .map(|b| b.name.as_str())
-            .collect()
-    }
-
     /// Residuals `f(x, u)` at time `t` into `r` (length `n_eqs`).
     pub fn residual(&self, x: &[f64], u: &[f64], t: f64, r: &mut [f64]) {
         let mut local = Vec::new();
@@ -233,24 +220,59 @@ impl Plant {
         jx.clear();
         ju.clear();
         let parts: Vec<BlockJacobian> = match par {
-            Parallelism::Sequential => self.blocks.iter().map(|b| self.block_jacobian(b, x, u, t)).collect(),
-            Parallelism::Rayon => self.blocks.par_iter().map(|b| self.block_jacobian(b, x, u, t)).collect(),
+            Parallelism::Sequential => self.blocks.iter().map(|b| self.block_jacobian(b, &*b.unit, x, u, t)).collect(),
+            Parallelism::Rayon => self.blocks.par_iter().map(|b| self.block_jacobian(b, &*b.unit, x, u, t)).collect(),
         };
-        for (b, part) in self.blocks.iter().zip(parts) {
+        Self::merge(&self.blocks, parts, r, jx, ju);
+    }
+
+    /// [`Plant::jacobian`] with the controllers' output limits removed: the plant with its controllers
+    /// in their linear range, where a well-posed plant's Jacobian is regular (a clamped output no
+    /// longer depends on its measurement). For the degrees-of-freedom probe.
+    pub fn jacobian_without_limits(
+        &self,
+        x: &[f64],
+        u: &[f64],
+        r: &mut [f64],
+        jx: &mut Vec<(usize, usize, f64)>,
+        ju: &mut Vec<(usize, usize, f64)>,
+    ) {
+        jx.clear();
+        ju.clear();
+        let parts = self
+            .blocks
+            .iter()
+            .map(|b| match b.unit.without_limits() {
+                Some(relaxed) => self.block_jacobian(b, &*relaxed, x, u, 0.0),
+                None => self.block_jacobian(b, &*b.unit, x, u, 0.0),
+            })
+            .collect();
+        Self::merge(&self.blocks, parts, r, jx, ju);
+    }
+
+    fn merge(
+        blocks: &[Block],
+        parts: Vec<BlockJacobian>,
+        r: &mut [f64],
+        jx: &mut Vec<(usize, usize, f64)>,
+        ju: &mut Vec<(usize, usize, f64)>,
+    ) {
+        for (b, part) in blocks.iter().zip(parts) {
             r[b.eq_offset..b.eq_offset + b.n_eq].copy_from_slice(&part.r);
             jx.extend(part.jx);
             ju.extend(part.ju);
         }
     }
 
-    fn block_jacobian(&self, b: &Block, x: &[f64], u: &[f64], t: f64) -> BlockJacobian {
+    /// Residuals and Jacobian entries of block `b` evaluated by `unit` (its own, or a variant of it).
+    fn block_jacobian(&self, b: &Block, unit: &dyn Unit, x: &[f64], u: &[f64], t: f64) -> BlockJacobian {
         let mut local = Vec::new();
         self.gather(b, x, u, &mut local);
         let n = local.len();
         let mut jac = vec![0.0; b.n_eq * n];
         let mut out = BlockJacobian { r: vec![0.0; b.n_eq], jx: Vec::new(), ju: Vec::new() };
         let io = UnitIo { local: &local, layout: &b.layout, thermo: &self.thermo, time: t };
-        b.unit.jacobian_colored(&io, &mut out.r, &mut jac, b.coloring.as_ref());
+        unit.jacobian_colored(&io, &mut out.r, &mut jac, b.coloring.as_ref());
         let n_own = b.layout.n_own();
         let mut push = |k: usize, j: usize| {
             let (row, v) = (b.eq_offset + k, jac[k * n + j]);

@@ -176,11 +176,15 @@ pub trait UnitModel: Send + Sync + std::fmt::Debug {
     /// Initial guess of the own variables from the inlets and inputs in `local` (its own block holds
     /// whatever was there before: defaults or a previous solution).
     fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]);
-    /// Whether an output of this controller sits at one of its limits at `io` (default: never).
-    /// A limited output no longer depends on its measurement, so the Jacobian can be singular there
-    /// although the plant is well posed: the numerical degrees-of-freedom probe does not judge it.
-    fn at_output_limit(&self, _io: &UnitIo<'_, f64>) -> bool {
-        false
+    /// This controller with its output limits removed, if it has any (default: none). A clamped
+    /// output no longer depends on its measurement, so the Jacobian of a well-posed plant can be
+    /// singular where a limit is active: the numerical degrees-of-freedom probe judges the plant
+    /// with its controllers in their linear range.
+    fn without_limits(&self) -> Option<Self>
+    where
+        Self: Sized,
+    {
+        None
     }
 }
 
@@ -218,11 +222,11 @@ pub trait Unit: Send + Sync + std::fmt::Debug {
     fn jacobian_colored(&self, io: &UnitIo<'_, f64>, r: &mut [f64], jac: &mut [f64], coloring: Option<&Coloring>);
     /// See [`UnitModel::guess`].
     fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]);
-    /// See [`UnitModel::at_output_limit`].
-    fn at_output_limit(&self, io: &UnitIo<'_, f64>) -> bool;
+    /// See [`UnitModel::without_limits`].
+    fn without_limits(&self) -> Option<Box<dyn Unit>>;
 }
 
-impl<U: UnitModel> Unit for U {
+impl<U: UnitModel + 'static> Unit for U {
     fn type_name(&self) -> &'static str {
         UnitModel::type_name(self)
     }
@@ -302,8 +306,8 @@ impl<U: UnitModel> Unit for U {
     fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]) {
         UnitModel::guess(self, io, own);
     }
-    fn at_output_limit(&self, io: &UnitIo<'_, f64>) -> bool {
-        UnitModel::at_output_limit(self, io)
+    fn without_limits(&self) -> Option<Box<dyn Unit>> {
+        UnitModel::without_limits(self).map(|u| Box::new(u) as Box<dyn Unit>)
     }
 }
 

@@ -123,15 +123,12 @@ pub fn dof_check(plant: &Plant, u: &[f64], x: &[f64], probe: DofProbe) -> Result
         // by accident (a component absent from a loop's measurement at a linear profile). Only a
         // null direction found at the guess and again after a few pseudo-transient steps (which
         // satisfy the algebraic equations and move the inventories along the plant's dynamics) is
-        // reported. A controller output at a limit no longer depends on its measurement, which
-        // makes the Jacobian singular at a well-posed plant (a level loop saturated at a cold
-        // start): the probe does not judge such a point.
+        // reported. The probe removes the controllers' output limits: a clamped output no longer
+        // depends on its measurement, which makes a well-posed plant singular (a level loop
+        // saturated at a cold start).
         let Some(_) = null_direction(plant, u, x) else { return Ok(()) };
         let mut xp = x.to_vec();
         crate::pseudo_transient_steps(&PlantSystem::new(plant, u), &mut xp, 3, 10.0);
-        if !plant.controllers_at_limits(&xp, u).is_empty() {
-            return Ok(());
-        }
         if let Some(idx) = null_direction(plant, u, &xp) {
             return Err(DofError::Underdetermined {
                 file,
@@ -152,7 +149,7 @@ fn null_direction(plant: &Plant, u: &[f64], x: &[f64]) -> Option<Vec<usize>> {
     let n = plant.n_vars();
     let mut r = vec![0.0; n];
     let (mut jx, mut ju) = (Vec::new(), Vec::new());
-    plant.jacobian(x, u, 0.0, &mut r, &mut jx, &mut ju);
+    plant.jacobian_without_limits(x, u, &mut r, &mut jx, &mut ju);
     // Scale columns by their nominal values and rows by their largest entry.
     let mut a = Mat::<f64>::zeros(n, n);
     for &(i, j, v) in &jx {

@@ -151,30 +151,6 @@ impl Pid {
         io.input(usize::from(self.remote_sp.is_none()) + 1).re() >= 0.5
     }
 
-    /// The integral state with `τ_I`, and the filtered error with `τ_f` and `τ_D`, where present.
-    #[allow(clippy::type_complexity)]
-    fn states<S: Scalar>(&self, io: &UnitIo<'_, S>) -> (Option<(S, f64)>, Option<(S, f64, f64)>) {
-        let mut k = 0;
-        let integral = self.tau_i.map(|ti| {
-            k += 1;
-            (io.var(0), ti)
-        });
-        let derivative = self.tau_d.map(|td| (io.var(k), td / self.filter_ratio, td));
-        (integral, derivative)
-    }
-
-    /// The output before its limits, `u = bias + Kc (e + I/τ_I + D)`.
-    fn unclamped<S: Scalar>(&self, e: S, integral: Option<(S, f64)>, derivative: Option<(S, f64, f64)>) -> S {
-        let mut u = e;
-        if let Some((i, ti)) = integral {
-            u += i / ti;
-        }
-        if let Some((xf, tf, td)) = derivative {
-            u += (e - xf) * (td / tf);
-        }
-        u * self.kc + self.bias
-    }
-
     fn error<S: Scalar>(&self, io: &UnitIo<'_, S>) -> S {
         let pv = io.signal(0);
         let sp = if self.remote_sp.is_some() { io.signal(1) } else { io.input(0) };
@@ -224,8 +200,25 @@ impl UnitModel for Pid {
         let op = io.var(n_diff);
         let op_manual = io.input(usize::from(self.remote_sp.is_none()));
         let auto = self.is_auto(io);
-        let (integral, derivative) = self.states(io);
-        let u = self.unclamped(e, integral, derivative);
+        let mut k = 0;
+        let integral = self.tau_i.map(|ti| {
+            let i = io.var(k);
+            k += 1;
+            (i, ti)
+        });
+        let derivative = self.tau_d.map(|td| {
+            let xf = io.var(k);
+            let tf = td / self.filter_ratio;
+            (xf, tf, td)
+        });
+        let mut u = e;
+        if let Some((i, ti)) = integral {
+            u += i / ti;
+        }
+        if let Some((xf, tf, td)) = derivative {
+            u += (e - xf) * (td / tf);
+        }
+        let u = u * self.kc + self.bias;
         let mut k = 0;
         if let Some((i, ti)) = integral {
             r[k] = if auto { e + (op - u) / self.kc } else { (op_manual - self.bias) / self.kc - e - i / ti };
@@ -236,10 +229,9 @@ impl UnitModel for Pid {
         }
         r[n_diff] = if auto { op - clamp(u, self.op_min, self.op_max) } else { op - op_manual };
     }
-    fn at_output_limit(&self, io: &UnitIo<'_, f64>) -> bool {
-        let (integral, derivative) = self.states(io);
-        let u = self.unclamped(self.error(io), integral, derivative);
-        self.is_auto(io) && (u < self.op_min || u > self.op_max)
+    fn without_limits(&self) -> Option<Self> {
+        let limited = self.op_min > f64::NEG_INFINITY || self.op_max < f64::INFINITY;
+        limited.then(|| Pid { op_min: f64::NEG_INFINITY, op_max: f64::INFINITY, ..self.clone() })
     }
     fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]) {
         let e = self.error(io);

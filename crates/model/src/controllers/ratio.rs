@@ -117,14 +117,9 @@ impl Ratio {
         }
     }
 
-    /// The output before its limits, `ratio · wild + bias`.
-    fn unclamped<S: Scalar>(&self, io: &UnitIo<'_, S>) -> S {
-        let (ratio, bias) = self.ratio_and_bias(io);
-        ratio * io.signal(0) + bias
-    }
-
     fn output<S: Scalar>(&self, io: &UnitIo<'_, S>) -> S {
-        clamp(self.unclamped(io), self.op_min, self.op_max)
+        let (ratio, bias) = self.ratio_and_bias(io);
+        clamp(ratio * io.signal(0) + bias, self.op_min, self.op_max)
     }
 }
 
@@ -166,9 +161,9 @@ impl UnitModel for Ratio {
     fn eval<S: Scalar>(&self, io: &UnitIo<'_, S>, r: &mut [S]) {
         r[0] = io.var(0) - self.output(io);
     }
-    fn at_output_limit(&self, io: &UnitIo<'_, f64>) -> bool {
-        let u = self.unclamped(io);
-        u < self.op_min || u > self.op_max
+    fn without_limits(&self) -> Option<Self> {
+        let limited = self.op_min > f64::NEG_INFINITY || self.op_max < f64::INFINITY;
+        limited.then(|| Ratio { op_min: f64::NEG_INFINITY, op_max: f64::INFINITY, ..self.clone() })
     }
     fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]) {
         let op = self.output(io);

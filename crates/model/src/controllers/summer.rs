@@ -112,17 +112,12 @@ impl Summer {
         cx.finish(Summer { paths, gains, references, bias, op_min, op_max, links: links.clone() })
     }
 
-    /// The output before its limits, `bias + Σ g_k (s_k − s_ref,k)`.
-    fn unclamped<S: Scalar>(&self, io: &UnitIo<'_, S>) -> S {
+    fn output<S: Scalar>(&self, io: &UnitIo<'_, S>) -> S {
         let mut u = io.input(0);
         for (k, (&g, &s_ref)) in self.gains.iter().zip(&self.references).enumerate() {
             u += (io.signal(k) - s_ref) * g;
         }
-        u
-    }
-
-    fn output<S: Scalar>(&self, io: &UnitIo<'_, S>) -> S {
-        clamp(self.unclamped(io), self.op_min, self.op_max)
+        clamp(u, self.op_min, self.op_max)
     }
 }
 
@@ -207,9 +202,9 @@ impl UnitModel for Summer {
     fn eval<S: Scalar>(&self, io: &UnitIo<'_, S>, r: &mut [S]) {
         r[0] = io.var(0) - self.output(io);
     }
-    fn at_output_limit(&self, io: &UnitIo<'_, f64>) -> bool {
-        let u = self.unclamped(io);
-        u < self.op_min || u > self.op_max
+    fn without_limits(&self) -> Option<Self> {
+        let limited = self.op_min > f64::NEG_INFINITY || self.op_max < f64::INFINITY;
+        limited.then(|| Summer { op_min: f64::NEG_INFINITY, op_max: f64::INFINITY, ..self.clone() })
     }
     fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]) {
         let op = self.output(io);
