@@ -2,9 +2,15 @@
 //! `tools/two_column_study.py` (the same script that writes `docs/two_column_plant.md`), with its
 //! conservation and its conclusions pinned.
 
+mod common;
+
 use std::path::Path;
 use std::process::Command;
 
+use plantwide::flowsheet::load_file;
+use plantwide::flowsheet::scenario::{parse_scenario, resolve};
+use plantwide::solve::dynamic::{Start, simulate};
+use plantwide::solve::sequential::{StrategySettings, steady_state_by};
 use serde_json::Value;
 
 fn num(v: &Value, path: &str) -> f64 {
@@ -48,7 +54,7 @@ fn two_column_study_runs_and_reaches_its_conclusions() {
     close(&r, "base.residence_min", 19.81, 1e-3);
 
     // Column structures: LV interactive on both columns, LB decoupled; the book's perturbation
-    // gains agree with the linearization where they re-converge.
+    // gains re-converge for every structure and agree with the linearization.
     close(&r, "column1.LV.rga11", 5.2216, 1e-3);
     close(&r, "column1.LV.niederlinski", 0.19151, 1e-3);
     close(&r, "column1.DV.rga11", 1.2401, 1e-3);
@@ -56,9 +62,17 @@ fn two_column_study_runs_and_reaches_its_conclusions() {
     close(&r, "column2.LV.rga11", 11.98, 1e-2);
     close(&r, "column2.LB.rga11", 0.9762, 1e-3);
     close(&r, "column2.DV.rga11", 0.02403, 1e-2);
-    for s in ["column1.LV", "column1.DV", "column2.LB"] {
-        let d = num(&r, &format!("{s}.perturb_vs_linear"));
-        assert!(d < 1e-3, "{s}: perturbation and linearization differ by {d:e}");
+    for col in ["column1", "column2"] {
+        for st in ["LV", "DV", "LB"] {
+            let d = num(&r, &format!("{col}.{st}.perturb_vs_linear"));
+            assert!(d < 1e-3, "{col} {st}: perturbation and linearization differ by {d:e}");
+        }
+    }
+    // What remains is the central difference's O(h²) curvature: a tenth of the step, a hundredth of it.
+    let curv = |h: &str| num(&r, &format!("column2.LV_curvature.{h}"));
+    for (big, small) in [("1e-4", "1e-5"), ("1e-5", "1e-6")] {
+        let ratio = curv(big) / curv(small);
+        assert!((80.0..125.0).contains(&ratio), "step {big} → {small}: difference falls by {ratio}");
     }
     assert!(r["column2"]["DB_error"].as_str().is_some_and(|e| e.contains("not determined")));
     assert_eq!(r["sensors_column1"], serde_json::json!([21, 11]));
@@ -68,6 +82,9 @@ fn two_column_study_runs_and_reaches_its_conclusions() {
     close(&r, "production.P1.product", 0.99922, 1e-3);
     close(&r, "production.P1.recycle_per_product", 4.615, 1e-3);
     assert!(num(&r, "production.P2.product").abs() < 0.02);
+    // P3 (effluent flow fixed, fresh A on the reactor level) reaches P1's steady states.
+    close(&r, "production.P3.product", 0.17814, 1e-3);
+    close(&r, "production.P3.recycle_per_product", num(&r, "production.P1.recycle_per_product"), 1e-3);
 
     // Figure 6-6: the bottoms impurity over ±10 % of each disturbance; the feed rate moves it most.
     let band = |d: &str| -> (f64, f64) {
@@ -95,6 +112,12 @@ fn two_column_study_runs_and_reaches_its_conclusions() {
     // start an excursion only with the temperature loop in manual.
     assert!(num(&r, "safety.peak_no_action") > 390.0, "{}", r["safety"]);
     assert!(num(&r, "safety.peak_trip") < 362.0, "{}", r["safety"]);
+    // Maximum cooling with the feeds kept stops the excursion but quenches the reactor, and the
+    // unreacted A and B drive the recycle to the distillate valve's limit and column 1's reflux to ~0.
+    assert!(num(&r, "safety.peak_cooling_only") < 362.0, "{}", r["safety"]);
+    assert!(num(&r, "safety.min_cooling_only") < 320.0, "{}", r["safety"]);
+    close(&r, "safety.cooling_only_recycle_max", 400.0, 1e-6);
+    assert!(num(&r, "safety.cooling_only_reflux_end") < 10.0, "{}", r["safety"]);
     let rec = &r["safety"]["recycle"];
     for k in ["recycle_flow_auto", "recycle_composition_auto"] {
         assert!(rec[k]["peak"].as_f64().expect("peak") < 351.0, "{k}: {}", rec[k]);
@@ -108,4 +131,60 @@ fn two_column_study_runs_and_reaches_its_conclusions() {
     let rec_dev = |k: &str| dy[k]["recycle_max_dev_kmol_h"].as_f64().expect("recycle").abs();
     assert!(rec_dev("DV_production") > rec_dev("LB_production"));
     let _ = std::fs::remove_dir_all(&out);
+}
+
+/// One hour of the plant after a +10 % production step and a column-1 feed-temperature step (both
+/// columns, the reactor and the recycle all move): the A atoms (A + R) and B atoms (B + R + 2 S)
+/// held in the reactor and on every stage, drum and sump change by exactly what the boundary
+/// streams brought in and took out (`record.totals`), while A + B → R and 2 B → S run.
+#[test]
+fn two_column_plant_conserves_atoms_through_an_upset() {
+    let mut plant = load_file(Path::new(&common::flowsheet("two_column_plant.json"))).unwrap_or_else(|e| panic!("{e}"));
+    let u = plant.input_values();
+    let x0 = steady_state_by(&plant, &u, &StrategySettings::default(), &mut |_| {}).unwrap_or_else(|e| panic!("{e}")).x;
+    let scenario = r#"{"format_version": 1, "duration": "1 h",
+        "events": [{"type": "step", "at": "5 min", "path": "production_rate", "by": "10 kmol/h"},
+                   {"type": "step", "at": "10 min", "path": "feed_cooler.T_out", "by": "5 K"}],
+        "record": {"interval": "1 min", "paths": ["effluent.T"], "totals": ["feed_A", "feed_B", "product", "heavies"]}}"#;
+    let sc = resolve(&parse_scenario(scenario, "upset.json").unwrap(), &plant, "upset.json").unwrap();
+    let res = simulate(&mut plant, &sc, Start::Steady(&x0), "test", &mut |_| {}).unwrap_or_else(|e| panic!("{e}"));
+    let comps = ["A", "B", "R", "S"];
+    // Moles of each component held in the plant.
+    let held = |x: &[f64]| -> Vec<f64> {
+        comps
+            .iter()
+            .map(|c| {
+                let columns: f64 = ["column1", "column2"]
+                    .iter()
+                    .flat_map(|col| (1..=32).map(move |s| format!("{col}.n[{s}][{c}]")))
+                    .map(|p| common::value(&plant, x, &p))
+                    .sum();
+                columns + common::value(&plant, x, &format!("reactor.N[{c}]"))
+            })
+            .collect()
+    };
+    let total = |stream: &str, c: &str| {
+        let k = res.columns.iter().position(|col| col.path == format!("{stream}.total[{c}]")).expect("total");
+        res.rows.last().expect("rows")[k]
+    };
+    let net: Vec<f64> = comps
+        .iter()
+        .map(|c| total("feed_A", c) + total("feed_B", c) - total("product", c) - total("heavies", c))
+        .collect();
+    let (h0, h1) = (held(&x0), held(&res.x));
+    let change: Vec<f64> = (0..4).map(|j| h1[j] - h0[j]).collect();
+    // Atoms: A in A and R; B in B, R and twice in S.
+    let atoms = |v: &[f64]| [v[0] + v[2], v[1] + v[2] + 2.0 * v[3]];
+    let (held_change, brought) = (atoms(&change), atoms(&net));
+    let fed = [total("feed_A", "A"), total("feed_B", "B")];
+    let reacted = change[2] - net[2];
+    assert!(reacted > 0.1 * fed[0], "R made in the hour: {reacted} mol of {} mol of A fed", fed[0]);
+    for (k, name) in ["A atoms", "B atoms"].iter().enumerate() {
+        let gap = (held_change[k] - brought[k]).abs() / fed[k];
+        eprintln!(
+            "{name}: Δheld {:.6} mol, ∫(in − out) {:.6} mol, fed {:.1} mol: gap {gap:.1e}",
+            held_change[k], brought[k], fed[k]
+        );
+        assert!(gap < 1e-8, "{name}: held changed by {} mol, the boundary brought {} mol", held_change[k], brought[k]);
+    }
 }
