@@ -94,17 +94,17 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
     let title = if sc.name.is_empty() { plant.name.clone() } else { format!("{}: {}", plant.name, sc.name) };
     let res = match result {
         Ok(res) => res,
-        Err(SimError::Integration { ref partial, .. }) => {
+        Err(e @ SimError::Snapshot { .. }) => return Err(CliError::user(e.to_string())),
+        Err(e) => {
             // The trends up to the failure show what led to it (a vessel draining, a loop saturating).
+            let SimError::Integration { partial, .. } = &e else { return Err(CliError::numerical(e.to_string())) };
             let written = write_trends_files(args, partial, &title, &sc.time_unit, time_factor);
             let at = format!("{:.6} {}", partial.t * time_factor, sc.time_unit);
-            let message = result.err().map_or_else(String::new, |e| e.to_string());
             return Err(CliError::numerical(match written {
-                Ok(()) => format!("{message}; the trends up to t = {at} are in {}", args.csv.display()),
-                Err(e) => format!("{message}; {}", e.message),
+                Ok(()) => format!("{e}; the trends up to t = {at} are in {}", args.csv.display()),
+                Err(w) => format!("{e}; {}", w.message),
             }));
         }
-        Err(e @ SimError::Snapshot { .. }) => return Err(CliError::user(e.to_string())),
     };
     if let Some(e) = write_error {
         return Err(e);

@@ -242,9 +242,9 @@ impl Plant {
         let parts = self
             .blocks
             .iter()
-            .map(|b| match b.unit.without_limits() {
-                Some(relaxed) => self.block_jacobian(b, &*relaxed, x, u, 0.0),
-                None => self.block_jacobian(b, &*b.unit, x, u, 0.0),
+            .map(|b| {
+                let relaxed = b.unit.without_limits();
+                self.block_jacobian(b, relaxed.as_deref().unwrap_or(&*b.unit), x, u, 0.0)
             })
             .collect();
         Self::merge(&self.blocks, parts, r, jx, ju);
