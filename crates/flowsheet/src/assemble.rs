@@ -8,6 +8,8 @@ use plantwide_model::controllers::ControllerLinks;
 use plantwide_model::stream::StreamLayout;
 use plantwide_model::{BuildCx, Coloring, LocalLayout, Unit};
 
+use plantwide_model::limits::Limits;
+
 use crate::components::thermo_package;
 use crate::error::{Diagnostic, LoadError, did_you_mean};
 use crate::parse::parse_spec;
@@ -16,10 +18,8 @@ use crate::spec::FlowsheetSpec;
 
 /// Read, validate and assemble the flowsheet file at `path`.
 pub fn load_file(path: &Path) -> Result<Plant, LoadError> {
-    let file = path.display().to_string();
-    let text =
-        std::fs::read_to_string(path).map_err(|e| LoadError::Io { file: file.clone(), reason: e.to_string() })?;
-    load_str(&text, &file)
+    let text = crate::parse::read_text(path)?;
+    load_str(&text, &path.display().to_string())
 }
 
 /// Validate and assemble flowsheet text; `file` names it in messages.
@@ -45,6 +45,15 @@ pub fn assemble(spec: &FlowsheetSpec, file: &str) -> Result<Plant, LoadError> {
     let stream_layout = StreamLayout { n_comp: components.len() };
 
     // Names: units and controllers share one name space; names must be usable in paths.
+    let name_len = plantwide_model::limits::Limits::get().name_len();
+    for name in spec.units.keys().chain(spec.controllers.keys()).chain(spec.streams.keys()) {
+        if let Some(msg) = name_len.check(name.chars().count(), "the length of this name") {
+            diags.push(Diagnostic::new(plantwide_model::limits::clip(name), msg));
+        }
+    }
+    if !diags.is_empty() {
+        return Err(invalid(diags));
+    }
     for name in spec.units.keys().chain(spec.controllers.keys()) {
         if name.is_empty() || name.contains(['.', '[', ']', '@', ',', '=', ' ']) {
             diags.push(Diagnostic::new(name.clone(), "names may not be empty or contain '.', '[', ']', '@', ',', '=' or spaces (they appear in variable paths)"));
@@ -381,9 +390,18 @@ pub fn assemble(spec: &FlowsheetSpec, file: &str) -> Result<Plant, LoadError> {
         }
     }
 
+    check_inputs(&blocks, &inputs, &mut diags);
+    if let Some(msg) = Limits::get().variables().check(vars.len(), "the number of variables of the plant") {
+        diags.push(Diagnostic::new("units", msg));
+    }
+
     // Reads of every block, and equation offsets.
     let mut eq_offset = 0;
     for (bi, b) in blocks.iter_mut().enumerate() {
+        if let Some(msg) = block_size(b) {
+            diags.push(Diagnostic::new(section_path(b), msg));
+            continue;
+        }
         let mut reads = Vec::new();
         if b.kind == BlockKind::Unit {
             for k in 0..b.layout.n_inlets {
@@ -428,5 +446,39 @@ pub fn assemble(spec: &FlowsheetSpec, file: &str) -> Result<Plant, LoadError> {
         aliases,
         var_index,
         input_index,
+    })
+}
+
+/// `units.<name>` or `controllers.<name>`: where block `b` is described in the file.
+fn section_path(b: &Block) -> String {
+    match b.kind {
+        BlockKind::Unit => format!("units.{}", b.name),
+        BlockKind::Controller => format!("controllers.{}", b.name),
+    }
+}
+
+/// Every input value of the file within its physical range ([`plantwide_model::limits::check_input`],
+/// the check `--set` and scenario events go through too).
+fn check_inputs(blocks: &[Block], inputs: &[InputInfo], diags: &mut Vec<Diagnostic>) {
+    for info in inputs {
+        let b = &blocks[info.block];
+        let name = info.path.strip_prefix(&format!("{}.", b.name)).unwrap_or(&info.path);
+        if let Err(why) = plantwide_model::limits::check_input(name, info.dim, info.value) {
+            diags.push(Diagnostic::new(format!("{}.{name}", section_path(b)), why));
+        }
+    }
+}
+
+/// Why block `b`'s Jacobian block is too large to evaluate, if it is: it is held dense, equations ×
+/// local variables.
+fn block_size(b: &Block) -> Option<String> {
+    let entries = b.n_eq.saturating_mul(b.layout.len());
+    Limits::get().block_entries().check(entries, "the size of its Jacobian block").map(|msg| {
+        format!(
+            "{} equations × {} local variables ({:.1} GB): {msg}; fewer stages or components make it smaller",
+            b.n_eq,
+            b.layout.len(),
+            entries as f64 * 8e-9
+        )
     })
 }

@@ -3,6 +3,8 @@
 use plantwide_thermo::{Component, Library, ThermoPackage, VleModel};
 use plantwide_units::{Dimension, QuantityValue};
 
+use plantwide_model::limits::{Limits, clip};
+
 use crate::error::{Diagnostic, did_you_mean};
 use crate::spec::{ComponentSpec, ThermoSpec, VleChoice};
 
@@ -22,8 +24,18 @@ pub fn thermo_package(
     let mut comps = Vec::new();
     let mut alphas = Vec::new();
     let n0 = diags.len();
+    let limits = Limits::get();
+    if let Some(msg) = limits.components().check(components.len(), "the number of components") {
+        diags.push(Diagnostic::new("components", msg));
+        return None;
+    }
     for (i, spec) in components.iter().enumerate() {
         let path = format!("components[{i}]");
+        let name = spec.name();
+        if let Some(msg) = limits.name_len().check(name.chars().count(), "the length of this component name") {
+            diags.push(Diagnostic::new(path, format!("`{}`: {msg}", clip(name))));
+            continue;
+        }
         match spec {
             ComponentSpec::Library(name) => match library.component(name) {
                 Ok(c) => {
@@ -33,16 +45,26 @@ pub fn thermo_package(
                 Err(_) => diags.push(Diagnostic::new(
                     path,
                     format!(
-                        "unknown component `{name}`{}; `plantwide components` lists the library, or define it inline with \"hypothetical\"",
+                        "unknown component `{}`{}; `plantwide components` lists the library, or define it inline with \"hypothetical\"",
+                        clip(name),
                         did_you_mean(name, library.components.iter().map(|c| c.name.as_str()))
                     ),
                 )),
             },
             ComponentSpec::Hypothetical { name, hypothetical: h } => {
-                let mut q = |field: &str, v: Option<&QuantityValue>, dim: Dimension, default: f64| -> f64 {
+                // Positive and below a plausibility bound (SI): molar mass ≤ 10 kg/mol, heat of
+                // vaporization ≤ 10 MJ/mol, heat capacity ≤ 100 kJ/(mol·K), liquid volume ≤ 1 m³/mol.
+                let mut q = |field: &str, v: Option<&QuantityValue>, dim: Dimension, default: f64, max: f64| -> f64 {
                     let Some(v) = v else { return default };
                     match v.to_si(dim) {
-                        Ok(x) if x.is_finite() && x > 0.0 => x,
+                        Ok(x) if x.is_finite() && x > 0.0 && x <= max => x,
+                        Ok(x) if x > max => {
+                            diags.push(Diagnostic::new(
+                                format!("{path}.hypothetical.{field}"),
+                                format!("{x:e} {dim} is beyond the plausible {max:e} {dim}"),
+                            ));
+                            default
+                        }
                         Ok(x) => {
                             diags.push(Diagnostic::new(format!("{path}.hypothetical.{field}"), format!("must be positive (got {x})")));
                             default
@@ -53,12 +75,12 @@ pub fn thermo_package(
                         }
                     }
                 };
-                let mw = q("mw", Some(&h.mw), Dimension::MOLAR_MASS, 0.05);
-                let hvap = q("hvap", Some(&h.hvap), Dimension::MOLAR_ENERGY, 3e4);
-                let t_ref = q("t_ref", h.t_ref.as_ref(), Dimension::TEMPERATURE, 350.0);
-                let cp = q("cp", h.cp.as_ref(), Dimension::HEAT_CAPACITY_MOLAR, 150.0);
-                let v = q("v_liq", h.v_liq.as_ref(), Dimension::MOLAR_VOLUME, 1e-4);
-                if !(h.alpha.is_finite() && h.alpha > 0.0) {
+                let mw = q("mw", Some(&h.mw), Dimension::MOLAR_MASS, 0.05, 10.0);
+                let hvap = q("hvap", Some(&h.hvap), Dimension::MOLAR_ENERGY, 3e4, 1e7);
+                let t_ref = q("t_ref", h.t_ref.as_ref(), Dimension::TEMPERATURE, 350.0, 5000.0);
+                let cp = q("cp", h.cp.as_ref(), Dimension::HEAT_CAPACITY_MOLAR, 150.0, 1e5);
+                let v = q("v_liq", h.v_liq.as_ref(), Dimension::MOLAR_VOLUME, 1e-4, 1.0);
+                if !(h.alpha.is_finite() && h.alpha > 0.0 && h.alpha <= 1e6) {
                     diags.push(Diagnostic::new(format!("{path}.hypothetical.alpha"), format!("relative volatility must be positive (got {})", h.alpha)));
                 }
                 comps.push(Component::hypothetical(name, h.alpha, mw, hvap, t_ref, cp, v));

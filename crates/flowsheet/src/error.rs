@@ -28,6 +28,20 @@ pub enum LoadError {
         /// Operating-system reason.
         reason: String,
     },
+    /// The file is not valid UTF-8.
+    #[error("{file}:{line}:{column}: not UTF-8 text: byte 0x{byte:02x} at offset {offset} (save the file as UTF-8)")]
+    Encoding {
+        /// File path.
+        file: String,
+        /// Byte offset of the first invalid byte.
+        offset: usize,
+        /// 1-based line of it.
+        line: usize,
+        /// 1-based column (in characters) of it.
+        column: usize,
+        /// The invalid byte.
+        byte: u8,
+    },
     /// The file is not valid JSON.
     #[error("{file}:{line}:{column}: malformed JSON: {reason}")]
     Syntax {
@@ -64,15 +78,23 @@ fn render(file: &str, diagnostics: &[Diagnostic]) -> String {
 }
 
 /// The closest of `candidates` to `word` by edit distance, if it is close enough to be a likely typo.
+/// Words longer than [`SUGGEST_MAX_LEN`] get no suggestion, which bounds the cost (a 10 MB name
+/// against a library of names would take seconds).
 pub fn suggest<'a>(word: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
+    if word.len() > SUGGEST_MAX_LEN {
+        return None;
+    }
     let w = word.to_lowercase();
     candidates
         .into_iter()
         .map(|c| (edit_distance(&w, &c.to_lowercase()), c))
-        .filter(|(d, c)| *d <= 2.max(c.len() / 3))
+        .filter(|(d, c)| c.len() <= SUGGEST_MAX_LEN && *d <= 2.max(c.len() / 3))
         .min_by_key(|(d, _)| *d)
         .map(|(_, c)| c)
 }
+
+/// Longest word (bytes) for which [`suggest`] searches; no real name is longer.
+pub const SUGGEST_MAX_LEN: usize = 64;
 
 fn edit_distance(a: &str, b: &str) -> usize {
     let b: Vec<char> = b.chars().collect();

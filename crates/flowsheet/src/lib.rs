@@ -17,6 +17,6 @@ pub mod tears;
 
 pub use assemble::{assemble, load_file, load_str};
 pub use error::{Diagnostic, LoadError};
-pub use parse::parse_spec;
+pub use parse::{parse_spec, read_text};
 pub use plant::{Block, BlockKind, InputInfo, Parallelism, Plant, Read, StreamInfo, VarInfo};
 pub use spec::FlowsheetSpec;

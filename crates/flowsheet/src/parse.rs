@@ -1,9 +1,13 @@
 //! Reading a flowsheet file into a [`FlowsheetSpec`], section by section so that every structural
 //! problem is reported at once with its JSON path.
 
+use std::collections::HashSet;
+use std::path::Path;
+
 use indexmap::IndexMap;
+use plantwide_model::limits::{Limits, clip};
 use plantwide_model::{ControllerSpec, UnitSpec};
-use serde::de::DeserializeOwned;
+use serde::de::{DeserializeOwned, DeserializeSeed, MapAccess, SeqAccess, Visitor};
 use serde_json::Value;
 
 use crate::error::{Diagnostic, LoadError, did_you_mean};
@@ -11,6 +15,27 @@ use crate::spec::{ComponentSpec, FORMAT_VERSION, FlowsheetSpec, StreamSpec, Ther
 
 const TOP_LEVEL: &[&str] =
     &["format_version", "name", "description", "components", "thermo", "units", "streams", "controllers", "inputs"];
+
+/// Read a flowsheet or scenario file as text: at most [`Limits::max_file_bytes`] bytes, valid UTF-8
+/// (an invalid byte is reported with its offset, line and column).
+pub fn read_text(path: &Path) -> Result<String, LoadError> {
+    let file = path.display().to_string();
+    let io = |e: std::io::Error| LoadError::Io { file: file.clone(), reason: e.to_string() };
+    let limit = Limits::get().file_bytes();
+    let len = std::fs::metadata(path).map_err(io)?.len();
+    if let Some(msg) = limit.check(usize::try_from(len).unwrap_or(usize::MAX), "the file size in bytes") {
+        return Err(LoadError::Io { file, reason: msg });
+    }
+    let bytes = std::fs::read(path).map_err(io)?;
+    String::from_utf8(bytes).map_err(|e| {
+        let offset = e.utf8_error().valid_up_to();
+        let good = &e.as_bytes()[..offset];
+        let line = good.iter().filter(|&&b| b == b'\n').count() + 1;
+        let line_start = good.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
+        let column = String::from_utf8_lossy(&good[line_start..]).chars().count() + 1;
+        LoadError::Encoding { file, offset, line, column, byte: e.as_bytes()[offset] }
+    })
+}
 
 /// Parse the text of a flowsheet file named `file` (the name is only used in messages).
 pub fn parse_spec(text: &str, file: &str) -> Result<FlowsheetSpec, LoadError> {
@@ -20,7 +45,15 @@ pub fn parse_spec(text: &str, file: &str) -> Result<FlowsheetSpec, LoadError> {
         column: e.column(),
         reason: strip_position(&e.to_string()),
     })?;
-    let mut diags = Vec::new();
+    let mut diags: Vec<Diagnostic> = duplicate_keys(text)
+        .into_iter()
+        .map(|path| {
+            Diagnostic::new(
+                path,
+                "this key appears twice in the same object (JSON readers keep only one): remove or rename one",
+            )
+        })
+        .collect();
     let Some(obj) = root.as_object() else {
         return Err(LoadError::Invalid {
             file: file.into(),
@@ -53,15 +86,20 @@ pub fn parse_spec(text: &str, file: &str) -> Result<FlowsheetSpec, LoadError> {
     let description: String = field(obj, "description", &mut diags, false).unwrap_or_default();
     let components = components(obj.get("components"), &mut diags);
     let thermo: Option<ThermoSpec> = field(obj, "thermo", &mut diags, true);
-    let units = tagged_map::<UnitSpec>(obj.get("units"), "units", UnitSpec::TYPES, "unit", true, &mut diags);
-    let controllers = tagged_map::<ControllerSpec>(
+    let units =
+        tagged_map(obj.get("units"), "units", (UnitSpec::TYPES, UnitSpec::from_tagged), "unit", true, &mut diags);
+    let controllers = tagged_map(
         obj.get("controllers"),
         "controllers",
-        ControllerSpec::TYPES,
+        (ControllerSpec::TYPES, ControllerSpec::from_tagged),
         "controller",
         false,
         &mut diags,
     );
+    let n_blocks = units.len() + controllers.len();
+    if let Some(msg) = Limits::get().units().check(n_blocks, "the number of units and controllers") {
+        diags.push(Diagnostic::new("units", msg));
+    }
     let streams = plain_map::<StreamSpec>(obj.get("streams"), "streams", true, &mut diags);
     let inputs = plain_map::<String>(obj.get("inputs"), "inputs", false, &mut diags);
     match thermo {
@@ -104,6 +142,11 @@ fn typed<T: DeserializeOwned>(value: &Value, base: &str, diags: &mut Vec<Diagnos
 fn explain(msg: &str) -> String {
     if msg.starts_with("data did not match any variant of untagged enum QuantityValue") {
         return "expected a quantity: a number in SI units or a string with units such as \"1 kmol/min\"".into();
+    }
+    for int in ["usize", "u32", "u64", "u8"] {
+        if let Some(head) = msg.strip_suffix(&format!("expected {int}")) {
+            return format!("{head}expected a whole number ≥ 0");
+        }
     }
     if let Some(rest) = msg.strip_prefix("missing field ") {
         return format!("missing required field {rest}");
@@ -191,10 +234,13 @@ fn plain_map<T: DeserializeOwned>(
     out
 }
 
-fn tagged_map<T: DeserializeOwned>(
+/// The type names of a registry and its deserializer of one tagged description.
+type Registry<T> = (&'static [&'static str], fn(&str, &Value) -> Result<T, (String, String)>);
+
+fn tagged_map<T>(
     value: Option<&Value>,
     section: &str,
-    types: &[&str],
+    (types, from_tagged): Registry<T>,
     what: &str,
     required: bool,
     diags: &mut Vec<Diagnostic>,
@@ -214,20 +260,93 @@ fn tagged_map<T: DeserializeOwned>(
                     Some(t) if !types.contains(&t) => diags.push(Diagnostic::new(
                         format!("{path}.type"),
                         format!(
-                            "unknown {what} type `{t}`{}; known types: {}",
+                            "unknown {what} type `{}`{}; known types: {}",
+                            clip(t),
                             did_you_mean(t, types.iter().copied()),
                             types.join(", ")
                         ),
                     )),
-                    Some(_) => {
-                        if let Some(spec) = typed(v, &path, diags) {
+                    Some(t) => match from_tagged(t, v) {
+                        Ok(spec) => {
                             out.insert(name.clone(), spec);
                         }
-                    }
+                        Err((inner, msg)) => {
+                            let path = if inner.is_empty() { path } else { format!("{path}.{inner}") };
+                            diags.push(Diagnostic::new(path, explain(&msg)));
+                        }
+                    },
                 }
             }
         }
         Some(_) => diags.push(Diagnostic::new(section, "must be an object keyed by name")),
     }
     out
+}
+
+/// JSON paths of keys that appear twice in one object (at most 20). serde_json, like most JSON
+/// readers, silently keeps one of them, which would drop a whole unit definition unseen.
+fn duplicate_keys(text: &str) -> Vec<String> {
+    let mut found = Vec::new();
+    let mut de = serde_json::Deserializer::from_str(text);
+    // The text already parsed as JSON; a failure here only ends the search early.
+    let _ = Walk { path: String::new(), found: &mut found }.deserialize(&mut de);
+    found
+}
+
+/// A walk over a JSON document that records duplicate keys with their paths.
+struct Walk<'a> {
+    path: String,
+    found: &'a mut Vec<String>,
+}
+
+impl<'de> DeserializeSeed<'de> for Walk<'_> {
+    type Value = ();
+    fn deserialize<D: serde::Deserializer<'de>>(self, d: D) -> Result<(), D::Error> {
+        d.deserialize_any(self)
+    }
+}
+
+impl<'de> Visitor<'de> for Walk<'_> {
+    type Value = ();
+    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str("any JSON value")
+    }
+    fn visit_bool<E>(self, _: bool) -> Result<(), E> {
+        Ok(())
+    }
+    fn visit_i64<E>(self, _: i64) -> Result<(), E> {
+        Ok(())
+    }
+    fn visit_u64<E>(self, _: u64) -> Result<(), E> {
+        Ok(())
+    }
+    fn visit_f64<E>(self, _: f64) -> Result<(), E> {
+        Ok(())
+    }
+    fn visit_str<E>(self, _: &str) -> Result<(), E> {
+        Ok(())
+    }
+    fn visit_unit<E>(self) -> Result<(), E> {
+        Ok(())
+    }
+    fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<(), A::Error> {
+        let Walk { path, found } = self;
+        let mut i = 0;
+        while seq.next_element_seed(Walk { path: format!("{path}[{i}]"), found: &mut *found })?.is_some() {
+            i += 1;
+        }
+        Ok(())
+    }
+    fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<(), A::Error> {
+        let Walk { path, found } = self;
+        let mut seen = HashSet::new();
+        while let Some(key) = map.next_key::<String>()? {
+            let child = if path.is_empty() { key.clone() } else { format!("{path}.{key}") };
+            if !seen.insert(key) && found.len() < 20 {
+                found.push(child.clone());
+            }
+            map.next_value_seed(Walk { path: child, found: &mut *found })?;
+        }
+        Ok(())
+    }
 }

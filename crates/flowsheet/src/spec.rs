@@ -62,6 +62,17 @@ pub enum ComponentSpec {
     Inline(Box<Component>),
 }
 
+impl ComponentSpec {
+    /// The component's name.
+    pub fn name(&self) -> &str {
+        match self {
+            ComponentSpec::Library(n) => n,
+            ComponentSpec::Hypothetical { name, .. } => name,
+            ComponentSpec::Inline(c) => &c.name,
+        }
+    }
+}
+
 /// A hypothetical component for constant-relative-volatility studies. Components that share `hvap`
 /// and `t_ref` have exactly the relative volatility given by the ratio of their `alpha`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]

@@ -47,7 +47,15 @@ impl<'a> BuildCx<'a> {
     /// Convert a quantity to SI, recording a dimension or parse error (returns NaN on error).
     pub fn quantity(&mut self, field: &str, value: &QuantityValue, dim: Dimension) -> f64 {
         match value.to_si(dim) {
-            Ok(v) if v.is_finite() => v,
+            Ok(v) if v.is_finite() && v.abs() <= crate::limits::max_magnitude(dim) => v,
+            Ok(v) if v.is_finite() => {
+                let max = crate::limits::max_magnitude(dim);
+                self.error(
+                    field,
+                    format!("`{value}` is {v:e} {dim}, beyond the ±{max:e} {dim} in which the models hold"),
+                );
+                f64::NAN
+            }
             Ok(v) => {
                 self.error(field, format!("value {v} is not finite"));
                 f64::NAN
@@ -73,6 +81,17 @@ impl<'a> BuildCx<'a> {
             self.error(field, format!("must be positive (got `{value}`)"));
         }
         v
+    }
+    /// A count (`stages`, `inlets`) within `limit`; records an error naming the field and the
+    /// environment variable that raises the limit.
+    pub fn count(&mut self, field: &str, n: usize, limit: crate::limits::Limit) -> bool {
+        match limit.check(n, &format!("`{field}`")) {
+            Some(msg) => {
+                self.error(field, msg);
+                false
+            }
+            None => true,
+        }
     }
     /// A plain fraction in `[lo, hi]`.
     pub fn in_range(&mut self, field: &str, v: f64, lo: f64, hi: f64) -> f64 {

@@ -11,6 +11,7 @@
 
 pub mod build;
 pub mod controllers;
+pub mod limits;
 pub mod registry;
 pub mod stream;
 pub mod testing;
@@ -21,7 +22,7 @@ pub mod var;
 pub use build::{BuildCx, FieldError};
 pub use registry::{ControllerSpec, UnitSpec};
 pub use stream::{Stream, StreamLayout};
-pub use unit::{Coloring, InputSpec, LocalLayout, SignalSpec, Unit, UnitIo, UnitModel};
+pub use unit::{Coloring, InputSpec, LocalLayout, Saturation, SignalSpec, Unit, UnitIo, UnitModel};
 pub use var::{VarKind, VarSpec};
 
 pub use plantwide_thermo::Scalar;

@@ -40,6 +40,24 @@ macro_rules! registry {
                 match self { $($name::$variant(c) => c,)* }
             }
 
+            /// Deserialize the description of `"type": tag` from `value` (the `type` key is
+            /// ignored); on failure, the JSON path below `value` of the first problem and its
+            /// message (serde's internally tagged enums lose that path).
+            pub fn from_tagged(tag: &str, value: &serde_json::Value) -> Result<Self, (String, String)> {
+                let mut body = value.clone();
+                if let Some(o) = body.as_object_mut() {
+                    o.remove("type");
+                }
+                let path_error = |e: serde_path_to_error::Error<serde_json::Error>| {
+                    let path = e.path().to_string();
+                    (if path == "." { String::new() } else { path }, e.into_inner().to_string())
+                };
+                match tag {
+                    $($tag => serde_path_to_error::deserialize::<_, $cfg>(&body).map($name::$variant).map_err(path_error),)*
+                    _ => Err(("type".into(), format!("unknown type `{tag}`"))),
+                }
+            }
+
             /// Build the unit model, or every error found in the description.
             pub fn build(&self, cx: BuildCx<'_>, links: $cx) -> Result<Box<dyn Unit>, Vec<FieldError>> {
                 match self {

@@ -87,10 +87,21 @@ fn number_len(s: &str) -> Option<usize> {
 }
 
 /// The number as written and its unit (`None` for a bare number).
+/// Longest quantity text read (bytes): far above any real quantity, and it bounds the cost of
+/// parsing and of the "did you mean" search.
+pub const MAX_QUANTITY_LEN: usize = 200;
+
 fn split(text: &str, mode: Mode) -> Result<(f64, Option<Unit>), UnitError> {
     let t = text.trim();
     if t.is_empty() {
         return Err(UnitError::Empty);
+    }
+    if t.len() > MAX_QUANTITY_LEN {
+        let head: String = t.chars().take(24).collect();
+        return Err(UnitError::BadNumber {
+            text: format!("{head}…"),
+            reason: format!("{} characters is not a quantity (at most {MAX_QUANTITY_LEN})", t.len()),
+        });
     }
     let bad = |reason: String| UnitError::BadNumber { text: text.to_owned(), reason };
     let n = number_len(t).ok_or_else(|| bad("expected a number first, e.g. \"1 kmol/min\"".to_owned()))?;

@@ -81,6 +81,9 @@ fn edit_distance(a: &str, b: &str) -> usize {
 /// The known symbol closest to `unknown`: an alias, the same symbol in other letter case, or the
 /// nearest symbol by edit distance (at most 1 for symbols of up to 3 characters, else at most 2).
 pub(crate) fn suggest(unknown: &str) -> Option<String> {
+    if unknown.len() > 32 {
+        return None;
+    }
     if let Some((_, meant)) = ALIASES.iter().find(|(alias, _)| alias.eq_ignore_ascii_case(unknown)) {
         return Some((*meant).to_owned());
     }

@@ -51,6 +51,9 @@ impl Mixer {
         if config.inlets < 1 {
             cx.error("inlets", "a mixer needs at least one inlet");
         }
+        if !cx.count("inlets", config.inlets, crate::limits::Limits::get().inlets()) {
+            return Err(cx.errors);
+        }
         let pressure = config.pressure.as_ref().map(|p| cx.positive("P", p, Dimension::PRESSURE));
         cx.finish(Mixer { n_in: config.inlets, phase: config.phase, pressure })
     }

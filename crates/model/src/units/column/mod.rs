@@ -251,6 +251,9 @@ pub enum Column {
 impl Column {
     /// Build from the flowsheet description.
     pub fn build(c: &ColumnConfig, mut cx: BuildCx<'_>, _links: ()) -> Result<Column, Vec<FieldError>> {
+        if !cx.count("stages", c.stages, crate::limits::Limits::get().stages()) {
+            return Err(cx.errors);
+        }
         c.check_model_fields(&mut cx);
         match c.model {
             ColumnModel::Simple => SimpleColumn::build(c, cx).map(Column::Simple),

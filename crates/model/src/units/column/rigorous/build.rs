@@ -197,6 +197,15 @@ impl RigorousColumn {
             feeds.push(f.stage.saturating_sub(1));
         }
         let (draws, draw_ports) = side_draws(c, n, &feed_ports, &mut cx);
+        let p_bottom = p_top + n.saturating_sub(1) as f64 * dp;
+        if p_bottom > crate::limits::max_magnitude(Dimension::PRESSURE) {
+            cx.error(
+                "rigorous.tray_pressure_drop",
+                format!(
+                    "{dp:e} Pa per tray over {n} stages puts the reboiler at {p_bottom:e} Pa, beyond the 1e9 Pa in which the models hold"
+                ),
+            );
+        }
         let pressure = (0..n).map(|s| p_top + (n - 1 - s) as f64 * dp).collect();
         let n_comp = cx.thermo.n().max(1) as f64;
         let v_mean = cx.thermo.components.iter().map(|c| c.v_liq(298.15)).sum::<f64>() / n_comp;

@@ -1,0 +1,250 @@
+//! Resource limits and the physical range of input values: the one place that bounds what a
+//! flowsheet file, a `--set` override or a scenario event can ask for.
+//!
+//! **Resource limits** stop a file from asking for an allocation or a run time without bound (a
+//! column of 10⁹ stages, a mixer of 10⁹ inlets, a 10 MB name). Each has a default chosen far above
+//! any real plant and can be raised for one process by an environment variable
+//! (`PLANTWIDE_MAX_STAGES=5000 plantwide steady big.json`); the error message names the variable.
+//!
+//! **Physical ranges** are the ranges in which the models are valid: absolute temperatures in
+//! 1 … 5000 K and pressures in 1 Pa … 1 GPa (the bounds of every stream's `T` and `P`), flows,
+//! holdups, levels, volumes and times ≥ 0, mole fractions in [0, 1]. A value outside them can have
+//! no steady state, so it is rejected where it enters rather than blamed on the solver later.
+
+use std::sync::OnceLock;
+
+use plantwide_units::Dimension;
+
+/// Resource limits (see the module documentation); read once per process from the environment.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Limits {
+    /// Most stages of one column (`PLANTWIDE_MAX_STAGES`, default 1000).
+    pub max_stages: usize,
+    /// Most inlets of one mixer (`PLANTWIDE_MAX_INLETS`, default 1000).
+    pub max_inlets: usize,
+    /// Most components of a flowsheet (`PLANTWIDE_MAX_COMPONENTS`, default 200).
+    pub max_components: usize,
+    /// Most units plus controllers of a flowsheet (`PLANTWIDE_MAX_UNITS`, default 20000).
+    pub max_units: usize,
+    /// Most characters of a name or path (`PLANTWIDE_MAX_NAME_LEN`, default 256).
+    pub max_name_len: usize,
+    /// Largest flowsheet or scenario file in bytes (`PLANTWIDE_MAX_FILE_BYTES`, default 64 MiB).
+    pub max_file_bytes: usize,
+    /// Most variables of an assembled plant (`PLANTWIDE_MAX_VARIABLES`, default 2 000 000).
+    pub max_variables: usize,
+    /// Most entries (equations × local variables) of one unit's Jacobian block
+    /// (`PLANTWIDE_MAX_BLOCK_ENTRIES`, default 40 000 000, i.e. 320 MB of f64).
+    pub max_block_entries: usize,
+}
+
+impl Default for Limits {
+    fn default() -> Self {
+        Limits {
+            max_stages: 1000,
+            max_inlets: 1000,
+            max_components: 200,
+            max_units: 20_000,
+            max_name_len: 256,
+            max_file_bytes: 64 << 20,
+            max_variables: 2_000_000,
+            max_block_entries: 40_000_000,
+        }
+    }
+}
+
+/// One limit: its value and the environment variable that raises it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Limit {
+    /// The largest allowed value.
+    pub max: usize,
+    /// The environment variable that sets it.
+    pub var: &'static str,
+}
+
+impl Limit {
+    /// `None` if `n` is within the limit, else the message "`what` is `n`; at most `max` …".
+    pub fn check(&self, n: usize, what: &str) -> Option<String> {
+        (n > self.max).then(|| {
+            format!(
+                "{what} is {n}, above the limit of {} (set the environment variable {} to raise it)",
+                self.max, self.var
+            )
+        })
+    }
+}
+
+impl Limits {
+    /// The limits in force: the defaults, each overridden by its environment variable when that holds
+    /// a positive integer.
+    pub fn get() -> &'static Limits {
+        static LIMITS: OnceLock<Limits> = OnceLock::new();
+        LIMITS.get_or_init(Limits::from_env)
+    }
+
+    fn from_env() -> Limits {
+        let mut l = Limits::default();
+        for (var, slot) in [
+            ("PLANTWIDE_MAX_STAGES", &mut l.max_stages),
+            ("PLANTWIDE_MAX_INLETS", &mut l.max_inlets),
+            ("PLANTWIDE_MAX_COMPONENTS", &mut l.max_components),
+            ("PLANTWIDE_MAX_UNITS", &mut l.max_units),
+            ("PLANTWIDE_MAX_NAME_LEN", &mut l.max_name_len),
+            ("PLANTWIDE_MAX_FILE_BYTES", &mut l.max_file_bytes),
+            ("PLANTWIDE_MAX_VARIABLES", &mut l.max_variables),
+            ("PLANTWIDE_MAX_BLOCK_ENTRIES", &mut l.max_block_entries),
+        ] {
+            if let Some(v) = std::env::var(var).ok().and_then(|s| s.trim().parse::<usize>().ok()).filter(|&v| v > 0) {
+                *slot = v;
+            }
+        }
+        l
+    }
+
+    /// Stages of one column.
+    pub fn stages(&self) -> Limit {
+        Limit { max: self.max_stages, var: "PLANTWIDE_MAX_STAGES" }
+    }
+    /// Inlets of one mixer.
+    pub fn inlets(&self) -> Limit {
+        Limit { max: self.max_inlets, var: "PLANTWIDE_MAX_INLETS" }
+    }
+    /// Components of a flowsheet.
+    pub fn components(&self) -> Limit {
+        Limit { max: self.max_components, var: "PLANTWIDE_MAX_COMPONENTS" }
+    }
+    /// Units plus controllers.
+    pub fn units(&self) -> Limit {
+        Limit { max: self.max_units, var: "PLANTWIDE_MAX_UNITS" }
+    }
+    /// Characters of a name.
+    pub fn name_len(&self) -> Limit {
+        Limit { max: self.max_name_len, var: "PLANTWIDE_MAX_NAME_LEN" }
+    }
+    /// Bytes of a file.
+    pub fn file_bytes(&self) -> Limit {
+        Limit { max: self.max_file_bytes, var: "PLANTWIDE_MAX_FILE_BYTES" }
+    }
+    /// Variables of a plant.
+    pub fn variables(&self) -> Limit {
+        Limit { max: self.max_variables, var: "PLANTWIDE_MAX_VARIABLES" }
+    }
+    /// Entries of one unit's Jacobian block.
+    pub fn block_entries(&self) -> Limit {
+        Limit { max: self.max_block_entries, var: "PLANTWIDE_MAX_BLOCK_ENTRIES" }
+    }
+}
+
+/// `s` for a message: at most 60 characters, elided in the middle (a 10 MB name is not echoed).
+pub fn clip(s: &str) -> String {
+    const KEEP: usize = 28;
+    if s.chars().count() <= 2 * KEEP + 4 {
+        return s.to_string();
+    }
+    let head: String = s.chars().take(KEEP).collect();
+    let tail: String = s.chars().rev().take(KEEP).collect::<Vec<_>>().into_iter().rev().collect();
+    format!("{head}…{tail} ({} characters)", s.chars().count())
+}
+
+/// Largest magnitude a quantity of dimension `dim` may have anywhere in a flowsheet (SI): the range
+/// of the models (temperatures up to 5000 K, pressures up to 1 GPa, flows up to 10⁹ mol/s, holdups
+/// up to 10¹⁵ mol), and 10³⁰ for everything else so that products of values stay finite.
+pub fn max_magnitude(dim: Dimension) -> f64 {
+    if dim == Dimension::TEMPERATURE {
+        5000.0
+    } else if dim == Dimension::PRESSURE || dim == Dimension::MOLAR_FLOW {
+        1e9
+    } else if dim == Dimension::AMOUNT {
+        1e15
+    } else {
+        1e30
+    }
+}
+
+/// The physical range `[lo, hi]` of an input value of dimension `dim` named `name` (SI), within
+/// which the models are valid (see the module documentation).
+pub fn input_range(name: &str, dim: Dimension) -> (f64, f64) {
+    let hi = max_magnitude(dim);
+    if name.starts_with("z[") || name.starts_with("split[") || name == "auto" || name == "opening" {
+        (0.0, 1.0)
+    } else if name == "bias" || name == "ratio" || name.starts_with("dp") {
+        (-hi, hi)
+    } else if dim == Dimension::TEMPERATURE || dim == Dimension::PRESSURE {
+        (1.0, hi)
+    } else if [
+        Dimension::MOLAR_FLOW,
+        Dimension::MASS_FLOW,
+        Dimension::VOLUMETRIC_FLOW,
+        Dimension::AMOUNT,
+        Dimension::MASS,
+        Dimension::LENGTH,
+        Dimension::AREA,
+        Dimension::VOLUME,
+        Dimension::TIME,
+        Dimension::UA,
+    ]
+    .contains(&dim)
+    {
+        (0.0, hi)
+    } else {
+        (-hi, hi)
+    }
+}
+
+/// Check an input value against [`input_range`]: `Err` says what is wrong and the range.
+pub fn check_input(name: &str, dim: Dimension, value: f64) -> Result<(), String> {
+    let (lo, hi) = input_range(name, dim);
+    if !value.is_finite() {
+        return Err(format!("{value} is not a finite number"));
+    }
+    if value < lo || value > hi {
+        let unit = if dim.is_dimensionless() { String::new() } else { format!(" {dim}") };
+        let what = if lo == 0.0 && value < 0.0 { "must not be negative: " } else { "" };
+        let (v, lo, hi) = (number(value), number(lo), number(hi));
+        return Err(format!("{what}{v}{unit} is outside the range {lo} … {hi}{unit} in which the models hold"));
+    }
+    Ok(())
+}
+
+/// A number for a message: plain between 1e-3 and 1e6 (at most 6 significant digits), else in
+/// exponent form.
+pub fn number(v: f64) -> String {
+    if v == 0.0 || (v.abs() >= 1e-3 && v.abs() < 1e6) {
+        let s = format!("{v:.6}");
+        let s = s.trim_end_matches('0').trim_end_matches('.');
+        if v.fract() == 0.0 { format!("{v}") } else { s.to_string() }
+    } else {
+        format!("{v:e}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn inputs_outside_their_physical_range_are_named() {
+        assert!(check_input("F", Dimension::MOLAR_FLOW, -1.0).unwrap_err().contains("must not be negative"));
+        assert!(check_input("T", Dimension::TEMPERATURE, 1e-300).is_err());
+        assert!(check_input("sp", Dimension::TEMPERATURE, -1e308).is_err());
+        assert!(check_input("z[light]", Dimension::DIMENSIONLESS, 1.5).is_err());
+        assert!(check_input("reflux", Dimension::MOLAR_FLOW, 1e308).is_err());
+        assert!(check_input("duty", Dimension::POWER, f64::NAN).is_err());
+        assert!(check_input("duty", Dimension::POWER, -1e6).is_ok());
+        assert!(check_input("P", Dimension::PRESSURE, 101_325.0).is_ok());
+    }
+
+    #[test]
+    fn a_huge_name_is_clipped_in_messages() {
+        let long = "A".repeat(10_000_000);
+        let c = clip(&long);
+        assert!(c.len() < 100 && c.contains("10000000 characters"), "{c}");
+        assert_eq!(clip("benzene"), "benzene");
+    }
+
+    #[test]
+    fn a_limit_names_its_environment_variable() {
+        let msg = Limits::default().stages().check(5000, "`stages`").expect("over the limit");
+        assert!(msg.contains("PLANTWIDE_MAX_STAGES") && msg.contains("1000"), "{msg}");
+        assert_eq!(Limits::default().stages().check(1000, "`stages`"), None);
+    }
+}
