@@ -2,8 +2,7 @@
 
 use std::path::Path;
 
-use plantwide::flowsheet::overrides::{set_field, set_input, split_assignment};
-use plantwide::flowsheet::{BlockKind, Plant, assemble, parse_spec};
+use plantwide::flowsheet::{BlockKind, Plant};
 use plantwide::model::stream::{F, H, P, T, Z0};
 use plantwide::solve::sequential::{Method, Progress, Solution, StrategySettings, steady_state_by};
 
@@ -11,31 +10,7 @@ use super::CliError;
 
 /// Load `file`, apply `--set` overrides, return the plant and its input vector.
 pub fn load_with_overrides(file: &Path, sets: &[String]) -> Result<(Plant, Vec<f64>), CliError> {
-    let name = file.display().to_string();
-    let text =
-        std::fs::read_to_string(file).map_err(|e| CliError::user(format!("{name}: cannot read the file: {e}")))?;
-    let mut spec = parse_spec(&text, &name).map_err(|e| CliError::user(e.to_string()))?;
-    let mut plant = assemble(&spec, &name).map_err(|e| CliError::user(e.to_string()))?;
-    let mut assignments = Vec::new();
-    let mut reassemble = false;
-    for s in sets {
-        let (path, value) = split_assignment(s).map_err(CliError::user)?;
-        let mut u = plant.input_values();
-        if set_input(&plant, &mut u, path, value).map_err(CliError::user)? {
-            assignments.push((path.to_string(), value.to_string()));
-        } else {
-            set_field(&mut spec, path, value).map_err(CliError::user)?;
-            reassemble = true;
-        }
-    }
-    if reassemble {
-        plant = assemble(&spec, &name).map_err(|e| CliError::user(e.to_string()))?;
-    }
-    let mut u = plant.input_values();
-    for (path, value) in &assignments {
-        set_input(&plant, &mut u, path, value).map_err(CliError::user)?;
-    }
-    Ok((plant, u))
+    plantwide::flowsheet::overrides::load_with(file, sets).map_err(|e| CliError::user(e.to_string()))
 }
 
 /// Converge the way `plantwide steady` does by default (sequential-modular pass, then whole-plant
@@ -111,6 +86,7 @@ pub fn run(file: &Path, json: bool, sets: &[String], method: MethodArg) -> Resul
             "iterations": iterations,
             "residual": residual,
             "sequential_modular": sol.sm,
+            "warnings": sol.warnings,
             "values": values,
         });
         outln!("{}", serde_json::to_string_pretty(&out).map_err(|e| CliError::user(e.to_string()))?);
@@ -132,6 +108,9 @@ pub fn run(file: &Path, json: bool, sets: &[String], method: MethodArg) -> Resul
             "steady state of `{}`: converged in {iterations} iterations, scaled residual {residual:.2e}\n",
             plant.name
         ),
+    }
+    for w in &sol.warnings {
+        outln!("warning: {}\n", w.message);
     }
     let comps = &plant.components;
     out!("{:<14} {:>12} {:>9} {:>10} {:>11}", "stream", "F kmol/h", "T K", "P kPa", "h kJ/mol");

@@ -35,8 +35,81 @@ pub fn set_input(plant: &Plant, u: &mut [f64], path: &str, value: &str) -> Resul
             "--set {path}: this input is driven by a controller; set the controller's setpoint (`<ctrl>.sp`) instead"
         ));
     }
-    u[i] = parse_quantity_as(value, info.dim).map_err(|e| format!("--set {path}: {e}"))?;
+    let v = parse_quantity_as(value, info.dim).map_err(|e| format!("--set {path}: {e}"))?;
+    check_input_value(plant, i, v).map_err(|e| format!("--set {path}={value}: {e}"))?;
+    u[i] = v;
     Ok(true)
+}
+
+/// Check value `v` (SI) of input `i` against its physical range: the one check that file values,
+/// `--set` overrides and scenario events all pass ([`plantwide_model::limits::check_input`]).
+pub fn check_input_value(plant: &Plant, i: usize, v: f64) -> Result<(), String> {
+    let info = &plant.inputs[i];
+    let block = &plant.blocks[info.block].name;
+    let name = info.path.strip_prefix(&format!("{block}.")).unwrap_or(&info.path);
+    plantwide_model::limits::check_input(name, info.dim, v)
+}
+
+/// Read the flowsheet at `path` and apply `--set PATH=VALUE` overrides: an input (validated like
+/// the file's values) or a field of a unit or controller description (the description is then
+/// validated and assembled again). Returns the plant and its input vector.
+pub fn load_with(path: &std::path::Path, sets: &[String]) -> Result<(Plant, Vec<f64>), OverrideError> {
+    let name = path.display().to_string();
+    let text = crate::parse::read_text(path)?;
+    let mut spec = crate::parse::parse_spec(&text, &name)?;
+    let mut plant = crate::assemble(&spec, &name)?;
+    let mut assignments = Vec::new();
+    let mut reassemble = false;
+    for s in sets {
+        let (path, value) = split_assignment(s).map_err(OverrideError::Bad)?;
+        let mut u = plant.input_values();
+        if set_input(&plant, &mut u, path, value).map_err(OverrideError::Bad)? {
+            assignments.push((path.to_string(), value.to_string()));
+        } else {
+            set_field(&mut spec, path, value).map_err(OverrideError::Bad)?;
+            reassemble = true;
+        }
+    }
+    if reassemble {
+        plant = crate::assemble(&spec, &name)?;
+    }
+    let mut u = plant.input_values();
+    for (path, value) in &assignments {
+        set_input(&plant, &mut u, path, value).map_err(OverrideError::Bad)?;
+    }
+    check_compositions(&plant, &u).map_err(OverrideError::Bad)?;
+    Ok((plant, u))
+}
+
+/// The mole-fraction inputs `z[c]` of each unit (a feed's composition but its last component,
+/// which makes up the balance) must not sum above 1: the last fraction would be negative.
+pub fn check_compositions(plant: &Plant, u: &[f64]) -> Result<(), String> {
+    for (bi, b) in plant.blocks.iter().enumerate() {
+        let z: Vec<usize> = (0..plant.inputs.len())
+            .filter(|&i| plant.inputs[i].block == bi && plant.inputs[i].path.starts_with(&format!("{}.z[", b.name)))
+            .collect();
+        let sum: f64 = z.iter().map(|&i| u[i]).sum();
+        if sum > 1.0 + 1e-9 {
+            let parts: Vec<String> = z.iter().map(|&i| format!("{} = {}", plant.inputs[i].path, u[i])).collect();
+            return Err(format!(
+                "{}: mole fractions sum to {sum} > 1, leaving a negative fraction for the last component; set them so that they sum to at most 1 ({})",
+                b.name,
+                parts.join(", ")
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Why a flowsheet with overrides could not be loaded.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum OverrideError {
+    /// The file, or the description after a field override, is invalid.
+    #[error(transparent)]
+    Load(#[from] crate::LoadError),
+    /// An override cannot be applied (the message names it).
+    #[error("{0}")]
+    Bad(String),
 }
 
 /// Apply an assignment to a unit or controller field of the flowsheet description
