@@ -176,6 +176,16 @@ pub trait UnitModel: Send + Sync + std::fmt::Debug {
     /// Initial guess of the own variables from the inlets and inputs in `local` (its own block holds
     /// whatever was there before: defaults or a previous solution).
     fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]);
+    /// True if the unit converts components into one another (reactions): its steady-state
+    /// certificate then checks mass instead of moles of each component (default false).
+    fn reacts(&self) -> bool {
+        false
+    }
+    /// A controller whose output rests on a limit while its measurement is off its setpoint, at the
+    /// point `io` (default: never).
+    fn saturation(&self, _io: &UnitIo<'_, f64>) -> Option<Saturation> {
+        None
+    }
     /// This controller with its output limits removed, if it has any (default: none). A clamped
     /// output no longer depends on its measurement, so the Jacobian of a well-posed plant can be
     /// singular where a limit is active: the numerical degrees-of-freedom probe judges the plant
@@ -224,11 +234,32 @@ pub trait Unit: Send + Sync + std::fmt::Debug {
     fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]);
     /// See [`UnitModel::without_limits`].
     fn without_limits(&self) -> Option<Box<dyn Unit>>;
+    /// See [`UnitModel::reacts`].
+    fn reacts(&self) -> bool;
+    /// See [`UnitModel::saturation`].
+    fn saturation(&self, io: &UnitIo<'_, f64>) -> Option<Saturation>;
+}
+
+/// A controller output held at a limit with the measurement off its setpoint.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Saturation {
+    /// The limit reached: `"op_min"` or `"op_max"`.
+    pub limit: &'static str,
+    /// Its value (SI, the output's dimension).
+    pub value: f64,
+    /// Measurement minus setpoint (SI, the measurement's dimension).
+    pub offset: f64,
 }
 
 impl<U: UnitModel + 'static> Unit for U {
     fn type_name(&self) -> &'static str {
         UnitModel::type_name(self)
+    }
+    fn reacts(&self) -> bool {
+        UnitModel::reacts(self)
+    }
+    fn saturation(&self, io: &UnitIo<'_, f64>) -> Option<Saturation> {
+        UnitModel::saturation(self, io)
     }
     fn inlet_ports(&self) -> Vec<String> {
         UnitModel::inlet_ports(self)

@@ -26,12 +26,23 @@ pub struct VarSpec {
     pub lower: f64,
     /// Upper bound honoured by Newton (SI).
     pub upper: f64,
+    /// A total holdup (moles of a stage, a drum, a vessel): at a steady state it must not rest on
+    /// its lower bound, where the equations that divide by it degenerate.
+    pub inventory: bool,
 }
 
 impl VarSpec {
     /// An unbounded variable.
     pub fn new(name: impl Into<String>, kind: VarKind, dim: Dimension, nominal: f64) -> VarSpec {
-        VarSpec { name: name.into(), kind, dim, nominal, lower: f64::NEG_INFINITY, upper: f64::INFINITY }
+        VarSpec {
+            name: name.into(),
+            kind,
+            dim,
+            nominal,
+            lower: f64::NEG_INFINITY,
+            upper: f64::INFINITY,
+            inventory: false,
+        }
     }
     /// A differential variable.
     pub fn differential(name: impl Into<String>, dim: Dimension, nominal: f64) -> VarSpec {
@@ -40,6 +51,11 @@ impl VarSpec {
     /// An algebraic variable.
     pub fn algebraic(name: impl Into<String>, dim: Dimension, nominal: f64) -> VarSpec {
         VarSpec::new(name, VarKind::Algebraic, dim, nominal)
+    }
+    /// The same variable marked as a total holdup (see [`VarSpec::inventory`]).
+    pub fn inventory(mut self) -> VarSpec {
+        self.inventory = true;
+        self
     }
     /// The same variable with bounds `[lower, upper]`.
     pub fn bounded(mut self, lower: f64, upper: f64) -> VarSpec {

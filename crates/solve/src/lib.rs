@@ -5,6 +5,7 @@
 //! **Architecture Invariant:** solvers see a [`System`] (residual, Jacobian triplets, bounds,
 //! nominal magnitudes, mass-matrix pattern), never a unit, a stream or a file.
 
+pub mod certify;
 pub mod dae;
 pub mod dynamic;
 pub mod newton;
@@ -14,6 +15,7 @@ pub mod steady;
 pub mod structure;
 pub mod system;
 
+pub use certify::{CertificateFailure, Warning, certify, certify_to};
 pub use newton::{
     IterationRecord, NewtonReport, NewtonSettings, NewtonStatus, pseudo_transient_steps, solve_steady,
     solve_steady_observed,

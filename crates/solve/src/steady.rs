@@ -4,6 +4,7 @@ use faer::Mat;
 use plantwide_flowsheet::Plant;
 use plantwide_model::VarKind;
 
+use crate::certify::{CertificateFailure, Warning, certify};
 use crate::{NewtonReport, NewtonSettings, NewtonStatus, System, maximum_matching, solve_steady_observed};
 
 /// The plant at fixed inputs `u`, seen as a nonlinear system.
@@ -210,6 +211,8 @@ pub struct SteadyState {
     pub u: Vec<f64>,
     /// Newton report.
     pub report: NewtonReport,
+    /// Controllers that hold their output at a limit with the measurement off setpoint.
+    pub warnings: Vec<Warning>,
 }
 
 /// Why a steady state could not be found.
@@ -221,6 +224,9 @@ pub enum SteadyError {
     /// Newton did not converge.
     #[error(transparent)]
     NotConverged(Box<ConvergenceFailure>),
+    /// Newton converged to a point that fails the steady-state certificate.
+    #[error(transparent)]
+    Certificate(Box<CertificateFailure>),
 }
 
 /// A steady-state solve that did not converge: where and how it failed.
@@ -277,7 +283,8 @@ pub fn steady_state_observed(
     let sys = PlantSystem::new(plant, u);
     let report = solve_steady_observed(&sys, &mut x, settings, observer);
     if report.status == NewtonStatus::Converged {
-        return Ok(SteadyState { x, u: u.to_vec(), report });
+        let warnings = certify(plant, &x, u).map_err(|e| SteadyError::Certificate(Box::new(e)))?;
+        return Ok(SteadyState { x, u: u.to_vec(), report, warnings });
     }
     dof_check(plant, u, &x_start, DofProbe::Numerical)?;
     let (eq, worst) = report.worst.unwrap_or((0, f64::NAN));

@@ -233,6 +233,29 @@ impl UnitModel for Pid {
         let limited = self.op_min > f64::NEG_INFINITY || self.op_max < f64::INFINITY;
         limited.then(|| Pid { op_min: f64::NEG_INFINITY, op_max: f64::INFINITY, ..self.clone() })
     }
+    /// In auto with the output within 1e-9 (relative) of a limit and the error beyond 1e-6 of the
+    /// measurement's scale: the loop has lost control of its measurement.
+    fn saturation(&self, io: &UnitIo<'_, f64>) -> Option<crate::Saturation> {
+        if !self.is_auto(io) {
+            return None;
+        }
+        let op = io.var(self.n_diff());
+        let at = |lim: f64| lim.is_finite() && (op - lim).abs() <= 1e-9 * lim.abs().max(self.bias.abs()).max(1e-12);
+        let limit = if at(self.op_max) {
+            ("op_max", self.op_max)
+        } else if at(self.op_min) {
+            ("op_min", self.op_min)
+        } else {
+            return None;
+        };
+        let e = self.error(io);
+        let offset = match self.action {
+            Action::Reverse => -e,
+            Action::Direct => e,
+        };
+        let scale = self.links.pv_nominal.abs().max(io.signal(0).abs()).max(1e-12);
+        (offset.abs() > 1e-6 * scale).then_some(crate::Saturation { limit: limit.0, value: limit.1, offset })
+    }
     fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]) {
         let e = self.error(io);
         let mut k = 0;

@@ -279,6 +279,9 @@ impl UnitModel for Cstr {
     fn type_name(&self) -> &'static str {
         "cstr"
     }
+    fn reacts(&self) -> bool {
+        true
+    }
     fn inlet_ports(&self) -> Vec<String> {
         vec!["in".into()]
     }

@@ -278,7 +278,7 @@ impl Holdup {
     /// `M` [mol], `level` [m], `V` [m³], algebraic.
     pub fn volume_vars(&self) -> Vec<VarSpec> {
         vec![
-            VarSpec::algebraic("M", Dimension::AMOUNT, self.m_nominal).bounded(0.0, f64::INFINITY),
+            VarSpec::algebraic("M", Dimension::AMOUNT, self.m_nominal).bounded(0.0, f64::INFINITY).inventory(),
             VarSpec::algebraic("level", Dimension::LENGTH, self.level).bounded(0.0, f64::INFINITY),
             VarSpec::algebraic("V", Dimension::VOLUME, self.level * self.area).bounded(0.0, f64::INFINITY),
         ]

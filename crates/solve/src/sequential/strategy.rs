@@ -4,8 +4,10 @@
 use plantwide_flowsheet::Plant;
 use serde::{Deserialize, Serialize};
 
+use crate::certify::certify_to;
+
 use super::{PassRecord, SmError, SmReport, SmSettings, plan, solve_sequential_observed};
-use crate::{IterationRecord, NewtonReport, NewtonSettings, SteadyError, steady_state_observed};
+use crate::{IterationRecord, NewtonReport, NewtonSettings, SteadyError, Warning, steady_state_observed};
 
 /// How to find the steady state.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -67,6 +69,8 @@ pub struct Solution {
     pub sm_failure: Option<String>,
     /// The whole-plant Newton report, if Newton ran.
     pub newton: Option<NewtonReport>,
+    /// Controllers that hold their output at a limit with the measurement off setpoint.
+    pub warnings: Vec<Warning>,
 }
 
 /// Why no steady state was found.
@@ -100,17 +104,34 @@ pub fn steady_state_by(
     match settings.method {
         Method::Eo => {
             let ss = eo(None, observer)?;
-            Ok(Solution { x: ss.x, u: ss.u, sm: None, sm_failure: None, newton: Some(ss.report) })
+            Ok(Solution {
+                x: ss.x,
+                u: ss.u,
+                sm: None,
+                sm_failure: None,
+                newton: Some(ss.report),
+                warnings: ss.warnings,
+            })
         }
         Method::Sm => {
             let sol = solve_sequential_observed(plant, u, None, &settings.sm, &mut |p| observer(Progress::Pass(p)))?;
-            Ok(Solution { x: sol.x, u: sol.u, sm: Some(sol.report), sm_failure: None, newton: None })
+            let tol = (10.0 * settings.sm.tol).max(crate::certify::TOL);
+            let warnings = certify_to(plant, &sol.x, &sol.u, tol).map_err(|e| SteadyError::Certificate(Box::new(e)))?;
+            Ok(Solution { x: sol.x, u: sol.u, sm: Some(sol.report), sm_failure: None, newton: None, warnings })
         }
         Method::Auto => {
             let x0 = plant.initial_guess_at(u);
             if plan(plant, u, &x0).recycles().next().is_none() {
                 let ss = eo(Some(&x0), observer)?;
-                return Ok(Solution { x: ss.x, u: ss.u, sm: None, sm_failure: None, newton: Some(ss.report) });
+                let warnings = ss.warnings;
+                return Ok(Solution {
+                    x: ss.x,
+                    u: ss.u,
+                    sm: None,
+                    sm_failure: None,
+                    newton: Some(ss.report),
+                    warnings,
+                });
             }
             let loose = SmSettings { tol: settings.auto_tol, ..settings.sm.clone() };
             let (start, sm, sm_failure) =
@@ -125,7 +146,7 @@ pub fn steady_state_by(
                 Err(first) if sm_failure.is_none() => eo(Some(&x0), observer).map_err(|_| first)?,
                 Err(e) => return Err(e.into()),
             };
-            Ok(Solution { x: ss.x, u: ss.u, sm, sm_failure, newton: Some(ss.report) })
+            Ok(Solution { x: ss.x, u: ss.u, sm, sm_failure, newton: Some(ss.report), warnings: ss.warnings })
         }
     }
 }

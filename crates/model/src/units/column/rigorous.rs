@@ -269,7 +269,11 @@ impl UnitModel for RigorousColumn {
                 v.push(VarSpec::algebraic(format!("y[{st}][{c}]"), Dimension::DIMENSIONLESS, 1.0).bounded(0.0, 1.0));
             }
             v.push(VarSpec::algebraic(format!("T[{st}]"), Dimension::TEMPERATURE, 350.0).bounded(1.0, 5000.0));
-            v.push(VarSpec::algebraic(format!("M[{st}]"), Dimension::AMOUNT, m0).bounded(1e-12 * m0, f64::INFINITY));
+            v.push(
+                VarSpec::algebraic(format!("M[{st}]"), Dimension::AMOUNT, m0)
+                    .bounded(1e-12 * m0, f64::INFINITY)
+                    .inventory(),
+            );
             v.push(VarSpec::algebraic(format!("L[{st}]"), Dimension::MOLAR_FLOW, flow_nom).bounded(0.0, f64::INFINITY));
             v.push(VarSpec::algebraic(format!("V[{st}]"), Dimension::MOLAR_FLOW, flow_nom).bounded(0.0, f64::INFINITY));
         }
