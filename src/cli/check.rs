@@ -75,14 +75,25 @@ pub fn run(file: &Path) -> Result<(), CliError> {
     }
     let u = plant.input_values();
     let x = plant.initial_guess();
-    dof_check(&plant, &u, &x, DofProbe::Numerical).map_err(|e| CliError::user(e.to_string()))?;
+    // The numerical probe judges one point: a singular Jacobian at the cold-start guess (a dry tray,
+    // a closed valve) proves nothing until the plant also fails to converge from there.
+    let numerical = match dof_check(&plant, &u, &x, DofProbe::Numerical) {
+        Ok(()) => plant.n_vars() <= plantwide::solve::steady::DENSE_PROBE_LIMIT,
+        Err(e @ plantwide::solve::DofError::Count { .. }) => return Err(CliError::user(e.to_string())),
+        Err(e) => match super::steady::converge(&plant, &u) {
+            Ok(_) => {
+                outln!(
+                    "note: the Jacobian is singular at the cold-start guess ({}), but the plant converges from there: a property of the guess, not of the plant",
+                    e.to_string().rsplit_once("the steady state is not determined: ").map_or("", |(_, why)| why)
+                );
+                false
+            }
+            Err(_) => return Err(CliError::user(e.to_string())),
+        },
+    };
     outln!(
         "degrees of freedom: 0 — square, structurally nonsingular{}",
-        if plant.n_vars() <= plantwide::solve::steady::DENSE_PROBE_LIMIT {
-            ", numerically nonsingular at the initial guess"
-        } else {
-            ""
-        }
+        if numerical { ", numerically nonsingular at the initial guess" } else { "" }
     );
     plantwide::solve::sequential::plan(&plant, &u, &x).describe(&plant).iter().for_each(|l| outln!("{l}"));
     Ok(())

@@ -4,7 +4,7 @@ use std::path::Path;
 
 use plantwide::flowsheet::{BlockKind, Plant};
 use plantwide::model::stream::{F, H, P, T, Z0};
-use plantwide::solve::sequential::{Method, Progress, Solution, StrategySettings, steady_state_by};
+use plantwide::solve::sequential::{Method, Progress, Solution, StrategySettings, steady_state_checked};
 
 use super::CliError;
 
@@ -34,9 +34,6 @@ pub enum MethodArg {
 /// Converge by `method` with a progress spinner on stderr (hidden when stderr is not a terminal),
 /// mapping failures to exit codes.
 pub fn converge_by(plant: &Plant, u: &[f64], method: MethodArg) -> Result<Solution, CliError> {
-    let x0 = plant.initial_guess_at(u);
-    plantwide::solve::dof_check(plant, u, &x0, plantwide::solve::DofProbe::Numerical)
-        .map_err(|e| CliError::user(e.to_string()))?;
     let method = match method {
         MethodArg::Eo => Method::Eo,
         MethodArg::Sm => Method::Sm,
@@ -56,7 +53,7 @@ pub fn converge_by(plant: &Plant, u: &[f64], method: MethodArg) -> Result<Soluti
         bar.tick();
     };
     let settings = StrategySettings { method, ..StrategySettings::default() };
-    let result = steady_state_by(plant, u, &settings, &mut observer);
+    let result = steady_state_checked(plant, u, &settings, &mut observer);
     bar.finish_and_clear();
     result
         .map_err(|e| if e.is_user_error() { CliError::user(e.to_string()) } else { CliError::numerical(e.to_string()) })

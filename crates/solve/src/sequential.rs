@@ -50,7 +50,7 @@ pub use accel::Accelerator;
 pub use groups::{SolveGroup, solve_groups};
 pub use plan::{SequentialPlan, plan};
 pub use report::{PassRecord, SccReport, SmReport};
-pub use strategy::{Method, Progress, Solution, SolveError, StrategySettings, steady_state_by};
+pub use strategy::{Method, Progress, Solution, SolveError, StrategySettings, steady_state_by, steady_state_checked};
 
 use crate::{DofError, DofProbe, NewtonSettings, NewtonStatus, dof_check, solve_steady};
 use accel::{TearIteration, WegsteinBounds};

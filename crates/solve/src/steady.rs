@@ -70,13 +70,46 @@ pub enum DofError {
         hint: String,
     },
     /// Some variables are not determined (structurally or numerically).
-    #[error("{file}: the steady state is not determined: {explanation}")]
+    #[error("{file}: the steady state is not determined: {explanation}{}", newton_note(.newton))]
     Underdetermined {
         /// Flowsheet file.
         file: String,
         /// Which variables are loose and what would fix it.
         explanation: String,
+        /// How Newton ended, when the numerical probe explains a failed Newton: a singular
+        /// Jacobian at one point is a diagnosis, confirmed by the failure, not a proof.
+        newton: Option<String>,
     },
+}
+
+fn newton_note(newton: &Option<String>) -> String {
+    newton.as_ref().map_or(String::new(), |n| {
+        format!(
+            " (a diagnosis from the Jacobian at the starting point and after 3 pseudo-transient steps, made because Newton failed: {n})"
+        )
+    })
+}
+
+/// `Status after n iterations, scaled residual r; history: 1: r1, 2: r2, …` with the first three and
+/// the last five iterations.
+pub fn history_summary(report: &NewtonReport) -> String {
+    let h = &report.history;
+    let fmt = |r: &crate::IterationRecord| {
+        let ptc = if r.pseudo_dt.is_some() { " (pseudo-transient)" } else { "" };
+        format!("{}: {:.2e}{ptc}", r.iter + 1, r.residual)
+    };
+    let mut items: Vec<String> = h.iter().take(3).map(fmt).collect();
+    if h.len() > 8 {
+        items.push("…".into());
+    }
+    items.extend(h.iter().skip(h.len().saturating_sub(5).max(3)).map(fmt));
+    format!(
+        "{:?} after {} iterations, scaled residual {:.3e}; history (iteration: scaled residual) {}",
+        report.status,
+        report.iterations,
+        report.residual,
+        items.join(", ")
+    )
 }
 
 /// Largest plant for which the numerical null-space probe (a dense SVD) is run.
@@ -117,6 +150,7 @@ pub fn dof_check(plant: &Plant, u: &[f64], x: &[f64], probe: DofProbe) -> Result
         return Err(DofError::Underdetermined {
             file,
             explanation: explain_loose(plant, &loose, "no equation is left to determine"),
+            newton: None,
         });
     }
     if probe == DofProbe::Numerical && n_vars <= DENSE_PROBE_LIMIT && n_vars > 0 {
@@ -138,6 +172,7 @@ pub fn dof_check(plant: &Plant, u: &[f64], x: &[f64], probe: DofProbe) -> Result
                     &idx,
                     "these variables can move together without changing any equation",
                 ),
+                newton: None,
             });
         }
     }
@@ -232,7 +267,7 @@ pub enum SteadyError {
 /// A steady-state solve that did not converge: where and how it failed.
 #[derive(Debug, Clone, thiserror::Error)]
 #[error(
-    "{file}: steady state not found ({status:?} after {iterations} iterations, scaled residual {residual:.3e}); worst equation: {equation} (variable {variable}, scaled residual {worst:.3e})"
+    "{file}: steady state not found ({status:?} after {iterations} iterations, scaled residual {residual:.3e}); worst equation: {equation} (variable {variable}, scaled residual {worst:.3e}); {}", history_summary(.report)
 )]
 pub struct ConvergenceFailure {
     /// Flowsheet file.
@@ -286,7 +321,12 @@ pub fn steady_state_observed(
         let warnings = certify(plant, &x, u).map_err(|e| SteadyError::Certificate(Box::new(e)))?;
         return Ok(SteadyState { x, u: u.to_vec(), report, warnings });
     }
-    dof_check(plant, u, &x_start, DofProbe::Numerical)?;
+    if let Err(mut e) = dof_check(plant, u, &x_start, DofProbe::Numerical) {
+        if let DofError::Underdetermined { newton, .. } = &mut e {
+            *newton = Some(history_summary(&report));
+        }
+        return Err(e.into());
+    }
     let (eq, worst) = report.worst.unwrap_or((0, f64::NAN));
     let equation = plant.equation_name(eq);
     let variable = plant.equation_variable(eq).map(|j| plant.vars[j].path.clone()).unwrap_or_else(|| "-".into());

@@ -5,6 +5,7 @@ use plantwide_flowsheet::Plant;
 use serde::{Deserialize, Serialize};
 
 use crate::certify::certify_to;
+use crate::{DofError, DofProbe, dof_check};
 
 use super::{PassRecord, SmError, SmReport, SmSettings, plan, solve_sequential_observed};
 use crate::{IterationRecord, NewtonReport, NewtonSettings, SteadyError, Warning, steady_state_observed};
@@ -149,4 +150,33 @@ pub fn steady_state_by(
             Ok(Solution { x: ss.x, u: ss.u, sm, sm_failure, newton: Some(ss.report), warnings: ss.warnings })
         }
     }
+}
+
+/// [`steady_state_by`] with the numerical degrees-of-freedom probe: a steady state is reported only
+/// where the plant's Jacobian is nonsingular, i.e. where it is an isolated solution. The probe runs
+/// at the cold-start guess; a null direction there (an uncontrolled level, or only a dry tray of the
+/// guess) is confirmed or refuted at the converged point, so that an accidental singularity of the
+/// guess neither stops a plant that converges nor lets a plant with a free inventory report one of
+/// its infinitely many steady states.
+pub fn steady_state_checked(
+    plant: &Plant,
+    u: &[f64],
+    settings: &StrategySettings,
+    observer: &mut dyn FnMut(Progress<'_>),
+) -> Result<Solution, SolveError> {
+    let x0 = plant.initial_guess_at(u);
+    let at_guess = dof_check(plant, u, &x0, DofProbe::Numerical);
+    if let Err(e @ DofError::Count { .. }) = at_guess {
+        return Err(SteadyError::Dof(e).into());
+    }
+    let singular_at_guess = at_guess.is_err();
+    let sol = match steady_state_by(plant, u, settings, observer) {
+        Ok(sol) => sol,
+        Err(e @ SolveError::Eo(SteadyError::Dof(_))) => return Err(e),
+        Err(e) => return Err(at_guess.map_or_else(|dof| SteadyError::Dof(dof).into(), |()| e)),
+    };
+    if singular_at_guess {
+        dof_check(plant, u, &sol.x, DofProbe::Numerical).map_err(SteadyError::Dof)?;
+    }
+    Ok(sol)
 }
