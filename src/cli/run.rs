@@ -7,7 +7,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use plantwide::flowsheet::scenario::{parse_scenario, resolve};
+use plantwide::flowsheet::scenario::{Limits, parse_scenario, resolve_with};
 use plantwide::plot::{Trend, write_trends};
 use plantwide::solve::dynamic::{Progress, SimError, SimulationResult, Snapshot, Start, simulate};
 use plantwide::units::convert_from_si;
@@ -55,7 +55,8 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
     let scen_name = args.scenario.display().to_string();
     let spec =
         parse_scenario(&read(&args.scenario, "scenario")?, &scen_name).map_err(|e| CliError::user(e.to_string()))?;
-    let sc = resolve(&spec, &plant, &scen_name).map_err(|e| CliError::user(e.to_string()))?;
+    let limits = Limits::from_env().map_err(|e| CliError::user(e.to_string()))?;
+    let sc = resolve_with(&spec, &plant, &scen_name, &limits).map_err(|e| CliError::user(e.to_string()))?;
     let snapshot: Option<Snapshot> = match &args.resume {
         Some(p) => Some(
             serde_json::from_str(&read(p, "snapshot")?)
