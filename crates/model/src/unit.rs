@@ -176,6 +176,17 @@ pub trait UnitModel: Send + Sync + std::fmt::Debug {
     /// Initial guess of the own variables from the inlets and inputs in `local` (its own block holds
     /// whatever was there before: defaults or a previous solution).
     fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]);
+    /// Component amounts `n_c` [mol] held by the unit at the local vector `io.local`, one per
+    /// component; `None` (the default) for a unit that holds no material. The dynamic driver
+    /// checks the plant's balance with it: `Σ_units Δn_c = ∫ (Σ_feeds F z_c − Σ_products F z_c) dt`.
+    fn holdup(&self, _io: &UnitIo<'_, f64>) -> Option<Vec<f64>> {
+        None
+    }
+    /// Whether the unit turns components into one another (reactions; default false). A plant with
+    /// such a unit conserves mass `Σ_c MW_c n_c` [kg], not moles per component.
+    fn reacts(&self) -> bool {
+        false
+    }
     /// This controller with its output limits removed, if it has any (default: none). A clamped
     /// output no longer depends on its measurement, so the Jacobian of a well-posed plant can be
     /// singular where a limit is active: the numerical degrees-of-freedom probe judges the plant
@@ -224,6 +235,10 @@ pub trait Unit: Send + Sync + std::fmt::Debug {
     fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]);
     /// See [`UnitModel::without_limits`].
     fn without_limits(&self) -> Option<Box<dyn Unit>>;
+    /// See [`UnitModel::holdup`].
+    fn holdup(&self, io: &UnitIo<'_, f64>) -> Option<Vec<f64>>;
+    /// See [`UnitModel::reacts`].
+    fn reacts(&self) -> bool;
 }
 
 impl<U: UnitModel + 'static> Unit for U {
@@ -308,6 +323,12 @@ impl<U: UnitModel + 'static> Unit for U {
     }
     fn without_limits(&self) -> Option<Box<dyn Unit>> {
         UnitModel::without_limits(self).map(|u| Box::new(u) as Box<dyn Unit>)
+    }
+    fn holdup(&self, io: &UnitIo<'_, f64>) -> Option<Vec<f64>> {
+        UnitModel::holdup(self, io)
+    }
+    fn reacts(&self) -> bool {
+        UnitModel::reacts(self)
     }
 }
 
