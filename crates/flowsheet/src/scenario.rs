@@ -531,46 +531,7 @@ pub fn resolve_with(spec: &ScenarioSpec, plant: &Plant, file: &str, limits: &Lim
             format!("`{time_unit}` is not a unit of time (e.g. \"s\", \"min\", \"h\")"),
         ));
     }
-    let mut record = Vec::new();
-    let paths: Vec<(String, Option<String>)> = if rec.paths.is_empty() {
-        default_paths(plant, &events)
-    } else {
-        rec.paths
-            .iter()
-            .map(|p| match p {
-                RecordPathSpec::Path(p) => (p.clone(), None),
-                RecordPathSpec::WithUnit { path, unit } => (path.clone(), Some(unit.clone())),
-            })
-            .collect()
-    };
-    for (k, (path, unit)) in paths.iter().enumerate() {
-        let field = format!("record.paths[{k}]");
-        let (source, dim) = match (plant.var(path), resolve_input(plant, path)) {
-            (Some(v), _) => (Read::Var(v), plant.vars[v].spec.dim),
-            (None, Some(i)) => (Read::Input(i), plant.inputs[i].dim),
-            (None, None) => {
-                let names =
-                    plant.vars.iter().map(|v| v.path.as_str()).chain(plant.inputs.iter().map(|i| i.path.as_str()));
-                cx.diags.push(Diagnostic::new(
-                    field,
-                    format!("no variable or input `{path}`{}", did_you_mean(path, names)),
-                ));
-                continue;
-            }
-        };
-        let unit = match unit {
-            Some(u) if unit_dimension(u).ok() == Some(dim) && convert_from_si(1.0, u).is_ok() => u.clone(),
-            Some(u) => {
-                cx.diags.push(Diagnostic::new(
-                    format!("{field}.unit"),
-                    format!("`{u}` is not a unit of {} (SI: {dim})", dim.describe()),
-                ));
-                continue;
-            }
-            None => dim.to_string(),
-        };
-        record.push(Recorded { path: path.clone(), source, unit, dim });
-    }
+    let record = recorded(&mut cx, rec, &events);
     let mut totals = Vec::new();
     for (k, name) in rec.totals.iter().enumerate() {
         match plant.streams.iter().position(|s| s.name == *name) {
@@ -606,6 +567,56 @@ pub fn resolve_with(spec: &ScenarioSpec, plant: &Plant, file: &str, limits: &Lim
         totals,
         snapshots,
     })
+}
+
+/// The recorded quantities: `rec.paths`, or by default every controller's measurement and output
+/// and every input an event moves.
+fn recorded(cx: &mut Cx<'_>, rec: &RecordSpec, events: &[Event]) -> Vec<Recorded> {
+    let mut record = Vec::new();
+    let paths: Vec<(String, Option<String>)> = if rec.paths.is_empty() {
+        default_paths(cx.plant, events)
+    } else {
+        rec.paths
+            .iter()
+            .map(|p| match p {
+                RecordPathSpec::Path(p) => (p.clone(), None),
+                RecordPathSpec::WithUnit { path, unit } => (path.clone(), Some(unit.clone())),
+            })
+            .collect()
+    };
+    for (k, (path, unit)) in paths.iter().enumerate() {
+        let field = format!("record.paths[{k}]");
+        let (source, dim) = match (cx.plant.var(path), resolve_input(cx.plant, path)) {
+            (Some(v), _) => (Read::Var(v), cx.plant.vars[v].spec.dim),
+            (None, Some(i)) => (Read::Input(i), cx.plant.inputs[i].dim),
+            (None, None) => {
+                let names = cx
+                    .plant
+                    .vars
+                    .iter()
+                    .map(|v| v.path.as_str())
+                    .chain(cx.plant.inputs.iter().map(|i| i.path.as_str()));
+                cx.diags.push(Diagnostic::new(
+                    field,
+                    format!("no variable or input `{path}`{}", did_you_mean(path, names)),
+                ));
+                continue;
+            }
+        };
+        let unit = match unit {
+            Some(u) if unit_dimension(u).ok() == Some(dim) && convert_from_si(1.0, u).is_ok() => u.clone(),
+            Some(u) => {
+                cx.diags.push(Diagnostic::new(
+                    format!("{field}.unit"),
+                    format!("`{u}` is not a unit of {} (SI: {dim})", dim.describe()),
+                ));
+                continue;
+            }
+            None => dim.to_string(),
+        };
+        record.push(Recorded { path: path.clone(), source, unit, dim });
+    }
+    record
 }
 
 /// The recorded rows (`⌊duration / interval⌋ + 1` plus two per event) and values (rows ×

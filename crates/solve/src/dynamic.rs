@@ -738,10 +738,8 @@ impl<'p> Driver<'p> {
         let (mut fed, mut removed) = (vec![0.0; nc], vec![0.0; nc]);
         for &(k, sign) in &self.boundary {
             let side = if sign > 0.0 { &mut fed } else { &mut removed };
-            for c in 0..nc {
-                let i = np + k * nc + c;
-                side[c] += x1[i] - self.x0[i];
-            }
+            let q = np + k * nc..np + (k + 1) * nc;
+            side.iter_mut().zip(x1[q.clone()].iter().zip(&self.x0[q])).for_each(|(v, (q1, q0))| *v += q1 - q0);
         }
         let mw: Vec<f64> = plant.thermo.components.iter().map(|c| c.mw).collect();
         let mw = conservation::reacts(plant).then_some(mw.as_slice());

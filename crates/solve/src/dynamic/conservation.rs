@@ -123,7 +123,7 @@ impl Conservation {
     /// # Errors
     /// [`ConservationError`] naming the component (or `mass`) and the figures.
     pub fn check(&self, tol: f64) -> Result<(), ConservationError> {
-        match self.balances.iter().find(|b| !(b.relative_error <= tol)) {
+        match self.balances.iter().find(|b| b.relative_error.is_nan() || b.relative_error > tol) {
             None => Ok(()),
             Some(b) => Err(ConservationError {
                 name: b.name.clone(),
