@@ -190,6 +190,57 @@ fn column_a_conserves_component_inventories() {
     }
 }
 
+/// The end-of-run check (`SimulationResult::conservation`): on every shipped scenario the units'
+/// holdups change by what the boundary streams brought in and took out, to round-off (the
+/// invariant is linear, so BDF and its Newton iteration keep it; measured 7e-16 … 3e-14), and
+/// its boundary integrals are the ones `record.totals` integrates.
+#[test]
+fn shipped_scenarios_conserve_moles_to_round_off() {
+    for (fs, sc) in [
+        ("column_a.json", "column_a_feed_step.json"),
+        ("surge_tank_pi.json", "surge_tank_inflow_step.json"),
+        ("surge_tank_pi.json", "surge_tank_upsets.json"),
+    ] {
+        let text = std::fs::read_to_string(flowsheet(&format!("scenarios/{sc}"))).unwrap();
+        let (_, _, res) = run(fs, &[], &text);
+        let c = &res.conservation;
+        eprintln!("{sc}: {} basis, largest relative error {:.1e}", c.basis, c.worst());
+        assert_eq!(c.basis, "moles");
+        assert!(c.worst() < 1e-12, "{sc}: {c:?}");
+        assert!(c.balances.iter().all(|b| b.fed > 0.0 && b.removed > 0.0), "{sc}: {c:?}");
+    }
+    // The boundary integrals equal the recorded totals of the same streams.
+    let (_, _, res) = run("column_a.json", &[], COLUMN_A_STEP);
+    for (b, c) in res.conservation.balances.iter().zip(["light", "heavy"]) {
+        let last = |s: &str| *column(&res, &format!("{s}.total[{c}]")).last().unwrap();
+        assert_eq!(b.name, c);
+        assert!((b.fed - last("feed")).abs() <= 1e-12 * b.fed, "{b:?}");
+        assert!((b.removed - last("distillate") - last("bottoms")).abs() <= 1e-12 * b.removed, "{b:?}");
+    }
+}
+
+/// Plants with a CSTR (A → B in the jacketed reactor; A → B with a column and recycle) are
+/// checked on mass, which the reactions conserve, while the moles of A are consumed.
+#[test]
+fn reactor_plants_conserve_mass_to_round_off() {
+    for (fs, feed) in [("cstr_multiplicity.json", "fresh.F"), ("reactor_column_recycle.json", "fresh.F")] {
+        let scenario = format!(
+            r#"{{"format_version": 1, "duration": "2 h",
+            "events": [{{"type": "step", "at": "5 min", "path": "{feed}", "by": "1 kmol/h"}}],
+            "record": {{"totals": ["feed"]}}}}"#
+        );
+        let (plant, x0, res) = run(fs, &[], &scenario);
+        let c = &res.conservation;
+        eprintln!("{fs}: {} basis, relative error {:.1e}, {:?}", c.basis, c.worst(), c.balances[0]);
+        assert_eq!((c.basis, c.balances.len(), c.balances[0].unit), ("mass", 1, "kg"));
+        assert!(c.worst() < 1e-12, "{fs}: {c:?}");
+        // A is fed and reacts: its moles are not conserved.
+        let a_fed = *column(&res, "feed.total[A]").last().unwrap();
+        let a_held = |x: &[f64]| common::value(&plant, x, "reactor.N[A]");
+        assert!(a_fed > a_held(&res.x) - a_held(&x0) + 1.0, "{fs}: A reacted");
+    }
+}
+
 /// Snapshot at 700 min → JSON → resume: the same trajectory as the uninterrupted run (bit for
 /// bit: the snapshot holds the BDF history and Jacobian). A resume with a retuned level loop
 /// (changed fingerprint) restarts from the same state and settles on the same compositions.
@@ -468,6 +519,10 @@ fn cli_run_writes_csv_summary_plot_and_resumes_from_its_snapshot() {
     assert_eq!(level["reference"], "setpoint");
     assert!(level["iae"].as_f64().unwrap() > 0.0 && level["max_deviation"].as_f64().unwrap() > 0.0);
     assert!((summary["final_values"]["out.F"].as_f64().unwrap() - 60.0).abs() < 1e-3);
+    let conservation = &summary["conservation"];
+    assert_eq!(conservation["basis"], "moles");
+    assert!(conservation["max_relative_error"].as_f64().unwrap() < 1e-12, "{conservation}");
+    assert_eq!(conservation["balances"][0]["name"], "water");
     let full = std::fs::read_to_string(dir.join("full.csv")).unwrap();
     assert_eq!(full.lines().next().unwrap(), "time [s],tank.level [m],out.F [mol/s],lc.sp [m]");
     assert!(std::fs::read_to_string(dir.join("trend.svg")).unwrap().contains("tank.level [m]"));

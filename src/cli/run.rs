@@ -7,9 +7,11 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use plantwide::flowsheet::scenario::{parse_scenario, resolve};
+use plantwide::flowsheet::scenario::{Limits, parse_scenario, resolve_with};
 use plantwide::plot::{Trend, write_trends};
-use plantwide::solve::dynamic::{Progress, SimError, SimulationResult, Snapshot, Start, simulate};
+use plantwide::solve::dynamic::{
+    CONSERVATION_TOL, Conservation, Progress, SimError, SimulationResult, Snapshot, Start, simulate,
+};
 use plantwide::units::convert_from_si;
 
 use super::CliError;
@@ -55,7 +57,8 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
     let scen_name = args.scenario.display().to_string();
     let spec =
         parse_scenario(&read(&args.scenario, "scenario")?, &scen_name).map_err(|e| CliError::user(e.to_string()))?;
-    let sc = resolve(&spec, &plant, &scen_name).map_err(|e| CliError::user(e.to_string()))?;
+    let limits = Limits::from_env().map_err(|e| CliError::user(e.to_string()))?;
+    let sc = resolve_with(&spec, &plant, &scen_name, &limits).map_err(|e| CliError::user(e.to_string()))?;
     let snapshot: Option<Snapshot> = match &args.resume {
         Some(p) => Some(
             serde_json::from_str(&read(p, "snapshot")?)
@@ -95,6 +98,15 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
     let res = match result {
         Ok(res) => res,
         Err(e @ SimError::Snapshot { .. }) => return Err(CliError::user(e.to_string())),
+        Err(SimError::Conservation { file, source, result }) => {
+            // The whole run is there: write and summarize it, then fail on the balance.
+            write_trends_files(args, &result, &title, &sc.time_unit, time_factor)?;
+            print_summary(&result, args.json, started.elapsed().as_secs_f64(), time_factor, &sc.time_unit)?;
+            return Err(CliError::numerical(format!(
+                "{file}: {source}; the integration is not to be trusted (trends in {})",
+                args.csv.display()
+            )));
+        }
         Err(e) => {
             // The trends up to the failure show what led to it (a vessel draining, a loop saturating).
             let SimError::Integration { partial, .. } = &e else { return Err(CliError::numerical(e.to_string())) };
@@ -179,6 +191,12 @@ fn print_summary(
             "events": res.events.iter().map(|(t, o)| serde_json::json!({"t": t, "event": o})).collect::<Vec<_>>(),
             "final_values": finals,
             "paths": summary,
+            "conservation": {
+                "basis": res.conservation.basis,
+                "tolerance": CONSERVATION_TOL,
+                "max_relative_error": res.conservation.worst(),
+                "balances": res.conservation.balances,
+            },
         });
         outln!("{}", serde_json::to_string_pretty(&out).map_err(|e| CliError::user(e.to_string()))?);
         return Ok(());
@@ -219,5 +237,27 @@ fn print_summary(
             settling
         );
     }
+    print_conservation(&res.conservation);
     Ok(())
+}
+
+/// One line per balance: `Δ held` against `∫(in − out)`, and the relative error.
+fn print_conservation(c: &Conservation) {
+    let worst = c.worst();
+    let verdict = if c.check(CONSERVATION_TOL).is_ok() { "ok" } else { "FAILED" };
+    outln!(
+        "conservation ({}): largest relative error {worst:.2e} (tolerance {CONSERVATION_TOL:.0e}): {verdict}",
+        c.basis
+    );
+    for b in &c.balances {
+        outln!(
+            "  {:<20} Δheld {:>14.6e} {u}, fed {:>14.6e} {u}, removed {:>14.6e} {u}: relative error {:.2e}",
+            b.name,
+            b.held[1] - b.held[0],
+            b.fed,
+            b.removed,
+            b.relative_error,
+            u = b.unit
+        );
+    }
 }

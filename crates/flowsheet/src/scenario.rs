@@ -6,7 +6,11 @@
 //! [`parse_scenario`] reads the file into a [`ScenarioSpec`] (every problem reported with its JSON
 //! path); [`resolve`] checks it against a [`Plant`] (paths, dimensions) and converts every quantity
 //! to SI, giving a [`Scenario`]. Times are from the start of the run, which is the converged
-//! steady state unless a snapshot is resumed.
+//! steady state unless a snapshot is resumed. Every value must be finite, every time `≥ 0`, every
+//! duration, period and interval `> 0`, and what the file asks for (recorded rows and values,
+//! events, controller scans and analyzer samples) must stay within [`Limits`], each of which an
+//! environment variable raises (`PLANTWIDE_MAX_RECORD_ROWS`, `PLANTWIDE_MAX_RECORD_VALUES`,
+//! `PLANTWIDE_MAX_EVENTS`, `PLANTWIDE_MAX_SAMPLES`).
 //!
 //! ```json
 //! {"format_version": 1, "duration": "2000 min",
@@ -23,6 +27,9 @@ use serde::{Deserialize, Serialize};
 use crate::error::{Diagnostic, LoadError, did_you_mean};
 use crate::overrides::resolve_input;
 use crate::plant::{BlockKind, Plant, Read};
+
+mod limits;
+pub use limits::{Limits, LimitsError};
 
 /// The scenario format version this build reads.
 pub const SCENARIO_FORMAT_VERSION: u32 = 1;
@@ -45,7 +52,12 @@ pub struct ScenarioSpec {
     /// nominal value, no step limit).
     #[serde(default)]
     pub integrator: IntegratorSpec,
-    /// Events, in any order.
+    /// Events, in any order, each at `0 ≤ at ≤ duration`. Two events at the same time must act
+    /// on different targets (inputs, or the modes of different controllers); they are then
+    /// applied in file order, each seeing the inputs the earlier ones left. Two at the same time
+    /// on one target are an error (which one wins would be an accident of order), and so is the
+    /// end of a ramp, pulse or sinusoid at the time of another event on its input. A ramp, pulse
+    /// or sinusoid still running at the end of the run is cut by it.
     #[serde(default)]
     pub events: Vec<EventSpec>,
     /// DCS scan interval by controller name: the controller's output is held between scans.
@@ -369,10 +381,26 @@ struct Cx<'a> {
 
 impl Cx<'_> {
     fn quantity(&mut self, path: &str, q: &QuantityValue, dim: Dimension) -> f64 {
-        q.to_si(dim).unwrap_or_else(|e| {
-            self.diags.push(Diagnostic::new(path, e.to_string()));
-            f64::NAN
-        })
+        let v = q.to_si(dim);
+        self.finite(path, q, v)
+    }
+    /// A difference (`by`, `amplitude`: no offset of a temperature scale).
+    fn difference(&mut self, path: &str, q: &QuantityValue, dim: Dimension) -> f64 {
+        let v = q.to_si_difference(dim);
+        self.finite(path, q, v)
+    }
+    fn finite<E: std::fmt::Display>(&mut self, path: &str, q: &QuantityValue, v: Result<f64, E>) -> f64 {
+        match v {
+            Ok(v) if v.is_finite() => v,
+            Ok(_) => {
+                self.diags.push(Diagnostic::new(path, format!("must be a finite number (got {q})")));
+                f64::NAN
+            }
+            Err(e) => {
+                self.diags.push(Diagnostic::new(path, e.to_string()));
+                f64::NAN
+            }
+        }
     }
     fn time(&mut self, path: &str, q: &QuantityValue, positive: bool) -> f64 {
         let t = self.quantity(path, q, Dimension::TIME);
@@ -411,17 +439,27 @@ impl Cx<'_> {
         let dim = self.plant.inputs[input?].dim;
         match (to, by) {
             (Some(v), None) => Some(Change::To(self.quantity(&format!("{base}.to"), v, dim))),
-            (None, Some(d)) => {
-                let v = d.to_si_difference(dim).unwrap_or_else(|e| {
-                    self.diags.push(Diagnostic::new(format!("{base}.by"), e.to_string()));
-                    f64::NAN
-                });
-                Some(Change::By(v))
-            }
+            (None, Some(d)) => Some(Change::By(self.difference(&format!("{base}.by"), d, dim))),
             _ => {
                 self.diags.push(Diagnostic::new(base, "give exactly one of `to` (new value) and `by` (change)"));
                 None
             }
+        }
+    }
+    /// A sampling period `period` [s] must give at most `limits.max_samples` samples over the run.
+    fn samples(&mut self, field: &str, what: &str, period: f64, duration: f64, limits: &Limits) {
+        let n = duration / period;
+        if n.is_finite() && n > limits.max_samples as f64 {
+            self.diags.push(Diagnostic::new(
+                field,
+                format!(
+                    "one every {} s over the run's duration of {} s is {n:.3e} {what}, more than the limit of {} ({} raises it): give a longer period",
+                    secs(period),
+                    secs(duration),
+                    limits.max_samples,
+                    Limits::MAX_SAMPLES
+                ),
+            ));
         }
     }
     fn controller(&mut self, name: &str, field: &str) -> Option<usize> {
@@ -434,8 +472,20 @@ impl Cx<'_> {
     }
 }
 
-/// Check `spec` against `plant` and convert it to SI; `file` names the scenario in messages.
+/// [`resolve_with`] under the default [`Limits`].
 pub fn resolve(spec: &ScenarioSpec, plant: &Plant, file: &str) -> Result<Scenario, LoadError> {
+    resolve_with(spec, plant, file, &Limits::default())
+}
+
+/// Check `spec` against `plant` and `limits` and convert it to SI; `file` names the scenario in
+/// messages.
+///
+/// # Errors
+/// [`LoadError::Invalid`] with every problem under its JSON path: unknown paths, wrong
+/// dimensions, non-finite values, negative times, zero or negative durations and intervals,
+/// events after the end of the run or colliding with another on the same target, and requests
+/// beyond `limits`.
+pub fn resolve_with(spec: &ScenarioSpec, plant: &Plant, file: &str, limits: &Limits) -> Result<Scenario, LoadError> {
     let mut cx = Cx { plant, diags: Vec::new() };
     let duration = cx.time("duration", &spec.duration, true);
     let int = &spec.integrator;
@@ -448,16 +498,12 @@ pub fn resolve(spec: &ScenarioSpec, plant: &Plant, file: &str) -> Result<Scenari
     }
     let max_step = int.max_step.as_ref().map_or(f64::INFINITY, |q| cx.time("integrator.max_step", q, true));
     let first_step = int.first_step.as_ref().map(|q| cx.time("integrator.first_step", q, true));
-    let mut events = Vec::new();
-    for (k, e) in spec.events.iter().enumerate() {
-        events.extend(event(&mut cx, &format!("events[{k}]"), e));
-    }
-    events.retain(|e: &Event| e.t.is_finite());
-    events.sort_by(|a, b| a.t.total_cmp(&b.t));
+    let events = events_of(&mut cx, &spec.events, duration, limits);
     let mut sampling = Vec::new();
     for (name, q) in &spec.sampling {
         let field = format!("sampling.{name}");
         let scan = cx.time(&field, q, true);
+        cx.samples(&field, "scans", scan, duration, limits);
         if let Some(b) = cx.controller(name, &field) {
             sampling.push((b, scan));
         }
@@ -466,6 +512,7 @@ pub fn resolve(spec: &ScenarioSpec, plant: &Plant, file: &str) -> Result<Scenari
     for (name, a) in &spec.analyzers {
         let field = format!("analyzers.{name}");
         let ts = cx.time(&format!("{field}.sample_time"), &a.sample_time, true);
+        cx.samples(&format!("{field}.sample_time"), "samples", ts, duration, limits);
         let td = a.dead_time.as_ref().map_or(0.0, |q| cx.time(&format!("{field}.dead_time"), q, false));
         if let Some(b) = cx.controller(name, &field) {
             if plant.blocks[b].layout.n_signals == 0 {
@@ -484,9 +531,50 @@ pub fn resolve(spec: &ScenarioSpec, plant: &Plant, file: &str) -> Result<Scenari
             format!("`{time_unit}` is not a unit of time (e.g. \"s\", \"min\", \"h\")"),
         ));
     }
+    let record = recorded(&mut cx, rec, &events);
+    let mut totals = Vec::new();
+    for (k, name) in rec.totals.iter().enumerate() {
+        match plant.streams.iter().position(|s| s.name == *name) {
+            Some(s) => totals.push(s),
+            None => cx.diags.push(Diagnostic::new(
+                format!("record.totals[{k}]"),
+                format!("no stream `{name}`{}", did_you_mean(name, plant.streams.iter().map(|s| s.name.as_str()))),
+            )),
+        }
+    }
+    let mut snapshots = Vec::new();
+    for (k, s) in spec.snapshots.iter().enumerate() {
+        snapshots.push((cx.time(&format!("snapshots[{k}].at"), &s.at, false), s.file.clone()));
+    }
+    let n_columns = record.len() + totals.len() * plant.components.len();
+    record_budget(&mut cx, (duration, interval), events.len(), n_columns, limits);
+    if !cx.diags.is_empty() {
+        return Err(LoadError::Invalid { file: file.into(), diagnostics: cx.diags });
+    }
+    Ok(Scenario {
+        name: spec.name.clone(),
+        duration,
+        rtol,
+        atol,
+        max_step,
+        first_step,
+        events,
+        sampling,
+        analyzers,
+        interval,
+        time_unit,
+        record,
+        totals,
+        snapshots,
+    })
+}
+
+/// The recorded quantities: `rec.paths`, or by default every controller's measurement and output
+/// and every input an event moves.
+fn recorded(cx: &mut Cx<'_>, rec: &RecordSpec, events: &[Event]) -> Vec<Recorded> {
     let mut record = Vec::new();
     let paths: Vec<(String, Option<String>)> = if rec.paths.is_empty() {
-        default_paths(plant, &events)
+        default_paths(cx.plant, events)
     } else {
         rec.paths
             .iter()
@@ -498,12 +586,16 @@ pub fn resolve(spec: &ScenarioSpec, plant: &Plant, file: &str) -> Result<Scenari
     };
     for (k, (path, unit)) in paths.iter().enumerate() {
         let field = format!("record.paths[{k}]");
-        let (source, dim) = match (plant.var(path), resolve_input(plant, path)) {
-            (Some(v), _) => (Read::Var(v), plant.vars[v].spec.dim),
-            (None, Some(i)) => (Read::Input(i), plant.inputs[i].dim),
+        let (source, dim) = match (cx.plant.var(path), resolve_input(cx.plant, path)) {
+            (Some(v), _) => (Read::Var(v), cx.plant.vars[v].spec.dim),
+            (None, Some(i)) => (Read::Input(i), cx.plant.inputs[i].dim),
             (None, None) => {
-                let names =
-                    plant.vars.iter().map(|v| v.path.as_str()).chain(plant.inputs.iter().map(|i| i.path.as_str()));
+                let names = cx
+                    .plant
+                    .vars
+                    .iter()
+                    .map(|v| v.path.as_str())
+                    .chain(cx.plant.inputs.iter().map(|i| i.path.as_str()));
                 cx.diags.push(Diagnostic::new(
                     field,
                     format!("no variable or input `{path}`{}", did_you_mean(path, names)),
@@ -524,39 +616,133 @@ pub fn resolve(spec: &ScenarioSpec, plant: &Plant, file: &str) -> Result<Scenari
         };
         record.push(Recorded { path: path.clone(), source, unit, dim });
     }
-    let mut totals = Vec::new();
-    for (k, name) in rec.totals.iter().enumerate() {
-        match plant.streams.iter().position(|s| s.name == *name) {
-            Some(s) => totals.push(s),
-            None => cx.diags.push(Diagnostic::new(
-                format!("record.totals[{k}]"),
-                format!("no stream `{name}`{}", did_you_mean(name, plant.streams.iter().map(|s| s.name.as_str()))),
-            )),
+    record
+}
+
+/// The recorded rows (`⌊duration / interval⌋ + 1` plus two per event) and values (rows ×
+/// `n_columns`) must stay within `limits`; `times = (duration, interval)` [s].
+fn record_budget(cx: &mut Cx<'_>, times: (f64, f64), n_events: usize, n_columns: usize, limits: &Limits) {
+    let (duration, interval) = times;
+    let rows = (duration / interval).floor() + 1.0 + 2.0 * n_events as f64;
+    if !rows.is_finite() {
+        return; // duration or interval already reported
+    }
+    let raise = |var: &str| format!("{var} raises it");
+    if rows > limits.max_record_rows as f64 {
+        cx.diags.push(Diagnostic::new(
+            "record.interval",
+            format!(
+                "one row every {} s over the run's duration of {} s is {rows:.3e} rows, more than the limit of {} ({}): give a longer interval",
+                secs(interval),
+                secs(duration),
+                limits.max_record_rows,
+                raise(Limits::MAX_RECORD_ROWS)
+            ),
+        ));
+    } else if rows * n_columns as f64 > limits.max_record_values as f64 {
+        cx.diags.push(Diagnostic::new(
+            "record.paths",
+            format!(
+                "{rows} rows × {n_columns} columns is {:.3e} recorded values, more than the limit of {} ({}): record fewer paths or give a longer interval",
+                rows * n_columns as f64,
+                limits.max_record_values,
+                raise(Limits::MAX_RECORD_VALUES)
+            ),
+        ));
+    }
+}
+
+/// The scenario's events in SI, sorted by time (stably: file order at equal times). Reports an
+/// event after the end of the run, more events than `limits.max_events`, and two events at the
+/// same time on the same target (an input, or a controller's mode), whose order would decide the
+/// result; events at the same time on different targets are applied in file order.
+fn events_of(cx: &mut Cx<'_>, specs: &[EventSpec], duration: f64, limits: &Limits) -> Vec<Event> {
+    // (event, label for messages)
+    let mut events: Vec<(Event, String)> = Vec::new();
+    for (k, e) in specs.iter().enumerate() {
+        let base = format!("events[{k}]");
+        let expanded = event(cx, &base, e);
+        if let Some(first) = expanded.first()
+            && first.t > duration
+        {
+            cx.diags.push(Diagnostic::new(
+                format!("{base}.at"),
+                format!("{} s is after the end of the run (duration {} s)", secs(first.t), secs(duration)),
+            ));
+        }
+        for (j, ev) in expanded.into_iter().enumerate() {
+            let label = if j == 0 { base.clone() } else { format!("{base} (its end at {} s)", secs(ev.t)) };
+            events.push((ev, label));
         }
     }
-    let mut snapshots = Vec::new();
-    for (k, s) in spec.snapshots.iter().enumerate() {
-        snapshots.push((cx.time(&format!("snapshots[{k}].at"), &s.at, false), s.file.clone()));
+    if events.len() as u64 > limits.max_events {
+        cx.diags.push(Diagnostic::new(
+            "events",
+            format!(
+                "{} events (a ramp, a pulse or a sinusoid with a duration counts two) are more than the limit of {} ({} raises it)",
+                events.len(),
+                limits.max_events,
+                Limits::MAX_EVENTS
+            ),
+        ));
+        return Vec::new();
     }
-    if !cx.diags.is_empty() {
-        return Err(LoadError::Invalid { file: file.into(), diagnostics: cx.diags });
+    events.retain(|(e, _)| e.t.is_finite());
+    events.sort_by(|a, b| a.0.t.total_cmp(&b.0.t));
+    for (i, (a, la)) in events.iter().enumerate() {
+        let origin = |l: &str| l.split(' ').next().unwrap_or_default().to_string();
+        for (b, lb) in events[i + 1..].iter().take_while(|(b, _)| b.t == a.t) {
+            // One event's start and end at one time: its duration is zero, reported already.
+            if target(&a.action) == target(&b.action) && origin(la) != origin(lb) {
+                let what = target_name(cx.plant, &a.action);
+                cx.diags.push(Diagnostic::new(
+                    origin(lb),
+                    format!(
+                        "{la} and {lb} both act on {what} at {} s, so their order would decide the result: merge them into one event or move one (events at the same time on different targets are applied in file order)",
+                        secs(a.t)
+                    ),
+                ));
+            }
+        }
     }
-    Ok(Scenario {
-        name: spec.name.clone(),
-        duration,
-        rtol,
-        atol,
-        max_step,
-        first_step,
-        events,
-        sampling,
-        analyzers,
-        interval,
-        time_unit,
-        record,
-        totals,
-        snapshots,
-    })
+    events.into_iter().map(|(e, _)| e).collect()
+}
+
+/// A time [s] for messages: plain in 1e-3 … 1e6, else in exponent form.
+fn secs(t: f64) -> String {
+    if t == 0.0 || (1e-3..1e6).contains(&t.abs()) { format!("{t}") } else { format!("{t:e}") }
+}
+
+/// What an action changes: an input, or a controller's mode (by its `auto` input).
+fn target(a: &Action) -> usize {
+    match *a {
+        Action::Step { input, .. }
+        | Action::Ramp { input, .. }
+        | Action::Hold { input }
+        | Action::Pulse { input, .. }
+        | Action::Sinusoid { input, .. }
+        | Action::Restore { input }
+        | Action::Stuck { input } => input,
+        Action::Mode { auto_input, .. } => auto_input,
+    }
+}
+
+fn target_name(plant: &Plant, a: &Action) -> String {
+    match *a {
+        Action::Mode { auto_input, .. } => {
+            format!("the mode of controller `{}`", plant.blocks[plant.inputs[auto_input].block].name)
+        }
+        _ => {
+            let i = target(a);
+            let mut aliases: Vec<&str> =
+                plant.aliases.iter().filter(|&(_, &j)| j == i).map(|(name, _)| name.as_str()).collect();
+            aliases.sort_unstable();
+            match aliases.first() {
+                Some(alias) => format!("`{alias}` (`{}`)", plant.inputs[i].path),
+                None => format!("`{}`", plant.inputs[i].path),
+            }
+        }
+    }
 }
 
 /// Every controller's measurement and output, and every input an event moves.
@@ -627,10 +813,7 @@ fn event(cx: &mut Cx<'_>, base: &str, e: &EventSpec) -> Vec<Event> {
             let period = cx.time(&format!("{base}.period"), period, true);
             let end = duration.as_ref().map(|d| t + cx.time(&format!("{base}.duration"), d, true));
             let Some(input) = input else { return Vec::new() };
-            let amplitude = amplitude.to_si_difference(cx.plant.inputs[input].dim).unwrap_or_else(|err| {
-                cx.diags.push(Diagnostic::new(format!("{base}.amplitude"), err.to_string()));
-                f64::NAN
-            });
+            let amplitude = cx.difference(&format!("{base}.amplitude"), amplitude, cx.plant.inputs[input].dim);
             let mut v = vec![ev(t, Action::Sinusoid { input, amplitude, period })];
             v.extend(end.map(|end| ev(end, Action::Restore { input })));
             v

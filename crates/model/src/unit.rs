@@ -176,8 +176,15 @@ pub trait UnitModel: Send + Sync + std::fmt::Debug {
     /// Initial guess of the own variables from the inlets and inputs in `local` (its own block holds
     /// whatever was there before: defaults or a previous solution).
     fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]);
-    /// True if the unit converts components into one another (reactions): its steady-state
-    /// certificate then checks mass instead of moles of each component (default false).
+    /// Component amounts `n_c` [mol] held by the unit at the local vector `io.local`, one per
+    /// component; `None` (the default) for a unit that holds no material. The dynamic driver
+    /// checks the plant's balance with it: `Σ_units Δn_c = ∫ (Σ_feeds F z_c − Σ_products F z_c) dt`.
+    fn holdup(&self, _io: &UnitIo<'_, f64>) -> Option<Vec<f64>> {
+        None
+    }
+    /// Whether the unit turns components into one another (reactions; default false). A plant with
+    /// such a unit conserves mass `Σ_c MW_c n_c` [kg], not moles per component, and the steady-state
+    /// certificate checks its mass balance.
     fn reacts(&self) -> bool {
         false
     }
@@ -234,6 +241,8 @@ pub trait Unit: Send + Sync + std::fmt::Debug {
     fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]);
     /// See [`UnitModel::without_limits`].
     fn without_limits(&self) -> Option<Box<dyn Unit>>;
+    /// See [`UnitModel::holdup`].
+    fn holdup(&self, io: &UnitIo<'_, f64>) -> Option<Vec<f64>>;
     /// See [`UnitModel::reacts`].
     fn reacts(&self) -> bool;
     /// See [`UnitModel::saturation`].
@@ -339,6 +348,9 @@ impl<U: UnitModel + 'static> Unit for U {
     }
     fn without_limits(&self) -> Option<Box<dyn Unit>> {
         UnitModel::without_limits(self).map(|u| Box::new(u) as Box<dyn Unit>)
+    }
+    fn holdup(&self, io: &UnitIo<'_, f64>) -> Option<Vec<f64>> {
+        UnitModel::holdup(self, io)
     }
 }
 

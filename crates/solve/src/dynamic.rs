@@ -11,6 +11,11 @@
 //! **Totals**: quadrature variables `q_{s,c}` with `dq/dt = F_s x_{s,c}` are integrated with the
 //! plant by the same BDF formula (excluded from error control), so that `Δ(holdup)` and
 //! `∫(in − out) dt` obey the same discrete relation and can be compared to rounding.
+//! **Conservation**: the boundary streams (outlets of `feed` units, inlets of `product` units)
+//! are integrated the same way, whether recorded or not, and at the end of the run
+//! `Δ(Σ_units holdup) = ∫(Σ_feeds − Σ_products) F z dt` is checked per component (mass for a
+//! plant with reactions) to [`CONSERVATION_TOL`] ([`conservation`]); a run that fails it is a
+//! [`SimError::Conservation`].
 //! **Recording** interpolates the BDF polynomial at every recording time; at a scenario event a
 //! row just before and one just after it are added (same time).
 //! **Snapshots** hold the plant state, the driver state and the full BDF history (difference array,
@@ -27,6 +32,9 @@ use plantwide_model::stream::{F, Z0};
 
 use crate::dae::{Bdf, BdfSettings, BdfState, BdfStats, DaeError, DaeIntegrator, DaeSystem};
 use crate::{PlantSystem, System};
+
+pub mod conservation;
+pub use conservation::{CONSERVATION_TOL, Conservation, ConservationError};
 
 /// Version of the snapshot format.
 pub const SNAPSHOT_VERSION: u32 = 1;
@@ -239,6 +247,17 @@ pub enum SimError {
         /// What was recorded up to the failure (the trends that lead to it).
         partial: Box<SimulationResult>,
     },
+    /// The run finished but does not conserve material (a unit's balance or holdup is wrong, or
+    /// the integration is not to be trusted).
+    #[error("{file}: {source}")]
+    Conservation {
+        /// Flowsheet file.
+        file: String,
+        /// The balance that fails.
+        source: ConservationError,
+        /// The whole run.
+        result: Box<SimulationResult>,
+    },
     /// A snapshot does not fit this plant.
     #[error("{file}: the snapshot does not fit this plant: {reason}")]
     Snapshot {
@@ -280,6 +299,8 @@ pub struct SimulationResult {
     pub t: f64,
     /// Integrator counters.
     pub stats: BdfStats,
+    /// Material balances from the start of the run (or the resumed snapshot) to `t`.
+    pub conservation: Conservation,
 }
 
 /// Run `scenario` on `plant` from `start`. The plant is rewired for sampled controllers, analyzers
@@ -307,7 +328,11 @@ pub fn simulate(
         };
         return Err(SimError::Integration { file, source, detail, partial: Box::new(d.finish()) });
     }
-    Ok(d.finish())
+    let res = d.finish();
+    match res.conservation.check(CONSERVATION_TOL) {
+        Ok(()) => Ok(res),
+        Err(source) => Err(SimError::Conservation { file, source, result: Box::new(res) }),
+    }
 }
 
 struct Driver<'p> {
@@ -329,6 +354,11 @@ struct Driver<'p> {
     restore: Option<BdfState>,
     x0: Vec<f64>,
     t0: f64,
+    /// Streams integrated as quadratures: the scenario's totals, then the boundary streams not
+    /// among them.
+    quad: Vec<usize>,
+    /// Boundary streams: (index into `quad`, +1 feed outlet / −1 product inlet).
+    boundary: Vec<(usize, f64)>,
 }
 
 /// Make input `i` read its own value instead of its controller's output; returns that output
@@ -354,7 +384,8 @@ impl<'p> Driver<'p> {
     ) -> Result<Driver<'p>, SimError> {
         let n_plant = plant.n_vars();
         let nc = plant.components.len();
-        let n_total = n_plant + sc.totals.len() * nc;
+        let (quad, boundary) = quadrature_streams(plant, &sc.totals);
+        let n_total = n_plant + quad.len() * nc;
         let x_start: Vec<f64> = match start {
             Start::Steady(x) => {
                 let mut v = x.to_vec();
@@ -364,7 +395,7 @@ impl<'p> Driver<'p> {
             Start::Snapshot(s) => {
                 let mut v = plant.initial_guess();
                 v.resize(n_total, 0.0);
-                let paths = state_paths(plant, sc);
+                let paths = state_paths(plant, &quad, sc.totals.len());
                 for (p, val) in s.paths.iter().zip(&s.integrator.d[0]) {
                     if let Some(k) = paths.iter().position(|q| q == p) {
                         v[k] = *val;
@@ -444,7 +475,9 @@ impl<'p> Driver<'p> {
                 sampled.iter_mut().for_each(|s: &mut Vec<(usize, usize)>| s.retain(|&(j, _)| j != i));
             }
             let input_paths: Vec<String> = plant.inputs.iter().map(|i| i.path.clone()).collect();
-            let same = s.fingerprint == fingerprint && s.paths == state_paths(plant, sc) && s.inputs == input_paths;
+            let same = s.fingerprint == fingerprint
+                && s.paths == state_paths(plant, &quad, sc.totals.len())
+                && s.inputs == input_paths;
             let mut driver = s.driver.clone();
             if !same {
                 // Map the input waveforms by path; everything else keeps its meaning by index.
@@ -491,6 +524,8 @@ impl<'p> Driver<'p> {
             restore,
             x0: x_start,
             t0,
+            quad,
+            boundary,
         })
     }
 
@@ -609,7 +644,7 @@ impl<'p> Driver<'p> {
     }
 
     fn run(&mut self, observer: &mut dyn FnMut(Progress<'_>)) -> Result<(), DaeError> {
-        let totals = self.sc.totals.clone();
+        let totals = self.quad.clone();
         let interval = self.sc.interval;
         let mut x = self.x0.clone();
         match self.restore.take() {
@@ -678,7 +713,7 @@ impl<'p> Driver<'p> {
                             format_version: SNAPSHOT_VERSION,
                             fingerprint: self.fingerprint.clone(),
                             t: now,
-                            paths: state_paths(self.plant, self.sc),
+                            paths: state_paths(self.plant, &self.quad, self.sc.totals.len()),
                             inputs: self.plant.inputs.iter().map(|i| i.path.clone()).collect(),
                             driver: self.st.clone(),
                             integrator: self.bdf.state().clone(),
@@ -691,7 +726,28 @@ impl<'p> Driver<'p> {
         }
     }
 
+    /// Material balances from `x0` to the integrator's state.
+    fn conservation(&self) -> Conservation {
+        let (plant, nc, np) = (&*self.plant, self.plant.components.len(), self.plant.n_vars());
+        let (t, x1) = (self.bdf.t(), self.bdf.x());
+        let u: Vec<f64> = self.st.waveforms.iter().map(|w| w.at(t)).collect();
+        let held = [
+            conservation::plant_holdup(plant, &self.x0[..np], &u, self.t0),
+            conservation::plant_holdup(plant, &x1[..np], &u, t),
+        ];
+        let (mut fed, mut removed) = (vec![0.0; nc], vec![0.0; nc]);
+        for &(k, sign) in &self.boundary {
+            let side = if sign > 0.0 { &mut fed } else { &mut removed };
+            let q = np + k * nc..np + (k + 1) * nc;
+            side.iter_mut().zip(x1[q.clone()].iter().zip(&self.x0[q])).for_each(|(v, (q1, q0))| *v += q1 - q0);
+        }
+        let mw: Vec<f64> = plant.thermo.components.iter().map(|c| c.mw).collect();
+        let mw = conservation::reacts(plant).then_some(mw.as_slice());
+        Conservation::new(&plant.components, mw, [&held[0], &held[1]], &fed, &removed)
+    }
+
     fn finish(self) -> SimulationResult {
+        let conservation = self.conservation();
         let mut columns: Vec<Column> = self
             .sc
             .record
@@ -724,6 +780,7 @@ impl<'p> Driver<'p> {
             x: self.bdf.x().to_vec(),
             t: self.bdf.t(),
             stats: self.bdf.stats(),
+            conservation,
         }
     }
 }
@@ -746,17 +803,36 @@ fn row_at(
             Read::Input(i) => plant.inputs[i].driven_by.map_or_else(|| waves[i].at(t), |v| x[v]),
         })
         .collect();
-    row.extend_from_slice(&x[plant.n_vars()..]);
+    let np = plant.n_vars();
+    row.extend_from_slice(&x[np..np + sc.totals.len() * plant.components.len()]);
     (row, refs.iter().map(|r| r.map_or(f64::NAN, |i| waves[i].at(t))).collect())
 }
 
-/// Paths of the state vector: plant variables, then `<stream>.total[<component>]`.
-fn state_paths(plant: &Plant, sc: &Scenario) -> Vec<String> {
+/// Paths of the state vector: plant variables, then `<stream>.total[<component>]` for the first
+/// `n_recorded` quadrature streams `quad` (the scenario's totals) and
+/// `<stream>.boundary_total[<component>]` for the rest.
+fn state_paths(plant: &Plant, quad: &[usize], n_recorded: usize) -> Vec<String> {
     let mut p: Vec<String> = plant.vars.iter().map(|v| v.path.clone()).collect();
-    for &s in &sc.totals {
-        p.extend(plant.components.iter().map(|c| format!("{}.total[{c}]", plant.streams[s].name)));
+    for (k, &s) in quad.iter().enumerate() {
+        let kind = if k < n_recorded { "total" } else { "boundary_total" };
+        p.extend(plant.components.iter().map(|c| format!("{}.{kind}[{c}]", plant.streams[s].name)));
     }
     p
+}
+
+/// The streams to integrate: the scenario's `totals`, then the boundary streams not among them;
+/// and the boundary streams as (index into that list, +1 feed outlet / −1 product inlet).
+fn quadrature_streams(plant: &Plant, totals: &[usize]) -> (Vec<usize>, Vec<(usize, f64)>) {
+    let mut quad = totals.to_vec();
+    let mut boundary = Vec::new();
+    for (s, sign) in conservation::boundary_streams(plant) {
+        let k = quad.iter().position(|&q| q == s).unwrap_or_else(|| {
+            quad.push(s);
+            quad.len() - 1
+        });
+        boundary.push((k, sign));
+    }
+    (quad, boundary)
 }
 
 /// The setpoint input of the controller that measures `source`, if any.

@@ -15,17 +15,18 @@ fn pow_pos<S: Scalar>(x: S, n: f64) -> S {
     (x.ln() * n).exp()
 }
 
-/// `tanh u` without overflow for duals (num-dual evaluates `sinh/cosh`, NaN beyond |u| ≈ 710).
+/// `tanh u` without overflow for duals (num-dual evaluates `sinh/cosh`, NaN beyond |u| ≈ 710):
+/// `tanh u = σ (1 − e^{−2σu}) / (1 + e^{−2σu})`, `σ = sign u`. Not recursive, so that a NaN
+/// argument (which is neither `> 0` nor `< 0`) gives NaN instead of recursing until the stack
+/// overflows.
 fn tanh_safe<S: Scalar>(u: S) -> S {
     let r = u.re();
     if r.abs() < 0.5 {
-        u.tanh()
-    } else if r > 0.0 {
-        let e = (u * -2.0).exp();
-        (S::from(1.0) - e) / (e + 1.0)
-    } else {
-        -tanh_safe(-u)
+        return u.tanh();
     }
+    let sign = if r < 0.0 { -1.0 } else { 1.0 };
+    let e = (u * (-2.0 * sign)).exp();
+    (S::from(1.0) - e) / (e + 1.0) * sign
 }
 
 /// `u / sinh u` without overflow (even in `u`; `u ≠ 0`).
@@ -211,5 +212,19 @@ impl LiquidVolume {
             }
             LiquidVolume::Constant { v } => S::from(*v),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tanh_safe_matches_tanh_and_passes_nan_through() {
+        for u in [-800.0f64, -3.0, -0.7, -0.2, 0.0, 0.3, 0.6, 5.0, 800.0] {
+            assert!((tanh_safe(u) - u.tanh()).abs() <= 1e-15, "{u}");
+        }
+        assert!(tanh_safe(f64::NAN).is_nan());
+        assert!(tanh_safe(num_dual::Dual64::new(f64::NAN, 1.0)).re.is_nan());
     }
 }

@@ -279,9 +279,6 @@ impl UnitModel for Cstr {
     fn type_name(&self) -> &'static str {
         "cstr"
     }
-    fn reacts(&self) -> bool {
-        true
-    }
     fn inlet_ports(&self) -> Vec<String> {
         vec!["in".into()]
     }
@@ -314,6 +311,12 @@ impl UnitModel for Cstr {
     }
     fn extra_equations(&self) -> isize {
         self.law.extra_equations()
+    }
+    fn holdup(&self, io: &UnitIo<'_, f64>) -> Option<Vec<f64>> {
+        Some(io.vars(0, io.n_comp()).to_vec())
+    }
+    fn reacts(&self) -> bool {
+        !self.reactions.is_empty()
     }
     fn eval<S: Scalar>(&self, io: &UnitIo<'_, S>, r: &mut [S]) {
         let (nc, len) = (io.n_comp(), io.layout.stream.len());

@@ -115,6 +115,9 @@ impl UnitModel for Flash {
     fn extra_equations(&self) -> isize {
         self.law.extra_equations()
     }
+    fn holdup(&self, io: &UnitIo<'_, f64>) -> Option<Vec<f64>> {
+        Some(io.vars(0, io.n_comp()).to_vec())
+    }
     fn eval<S: Scalar>(&self, io: &UnitIo<'_, S>, r: &mut [S]) {
         let (nc, len) = (io.n_comp(), io.layout.stream.len());
         let (vap, liq, inlet) = (io.outlet(0), io.outlet(1), io.inlet(0));

@@ -299,4 +299,7 @@ impl UnitModel for Column {
     fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]) {
         delegate!(self, guess(io, own))
     }
+    fn holdup(&self, io: &UnitIo<'_, f64>) -> Option<Vec<f64>> {
+        delegate!(self, holdup(io))
+    }
 }
