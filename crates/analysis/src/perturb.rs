@@ -342,12 +342,18 @@ struct Assessment {
     failure: Option<Failure>,
 }
 
+/// Richardson extrapolation of central differences at `h` and `h/2`: their errors are `c h²`
+/// and `c h²/4`, so `(4 D(h/2) − D(h)) / 3` cancels the `h²` term and leaves `O(h⁴)`.
+fn richardson(coarse: f64, fine: f64) -> f64 {
+    (4.0 * fine - coarse) / 3.0
+}
+
 /// Extrapolate and verify one attempt's columns (module docs: Richardson, RGA, exact gains).
 fn assess(p: &Problem, columns: &[Column], rel: &[f64], exact: Option<&Mat<f64>>) -> Assessment {
     let (n, m) = (p.outputs.len(), p.inputs.len());
     let coarse = Mat::from_fn(n, m, |i, k| columns[k].coarse[i]);
     let fine = Mat::from_fn(n, m, |i, k| columns[k].fine[i]);
-    let gain = Mat::from_fn(n, m, |i, k| (4.0 * fine[(i, k)] - coarse[(i, k)]) / 3.0);
+    let gain = Mat::from_fn(n, m, |i, k| richardson(coarse[(i, k)], fine[(i, k)]));
     // Convergence noise: at most 3 e_i / h in D(h) − D(h/2) and in the extrapolated gain.
     let allowance = |i: usize, k: usize| 3.0 * columns[k].errors[i] / (rel[k] * p.scales[k]);
     let s = &p.settings;
@@ -434,7 +440,13 @@ pub fn perturb_gains(
             continue;
         }
         let columns: Vec<Column> = columns.into_iter().flatten().collect();
-        let error_ratio = noise_check(&p, &columns, &rel)?;
+        // A step shrunk into the convergence noise cannot help: report why it was shrunk.
+        let error_ratio = match (noise_check(&p, &columns, &rel), last.take()) {
+            (Ok(r), _) => r,
+            (Err(_), Some(earlier @ AnalysisError::PerturbationUnverified { .. })) | (Err(earlier), _) => {
+                return Err(earlier);
+            }
+        };
         let mut a = assess(&p, &columns, &rel, exact.as_ref());
         a.check.attempts = attempt;
         let Some(f) = a.failure else {
@@ -497,5 +509,38 @@ fn unverified(p: &Problem, f: &Failure, step: f64, next: f64) -> AnalysisError {
         tolerance: f.tolerance,
         step,
         suggestion: next,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::measures::from_rows;
+
+    #[test]
+    fn relative_difference_measures_small_elements_against_their_row() {
+        let b = from_rows(&[vec![1.0, 1e-9], vec![2.0, -2.0]]);
+        // 1e-9 off a 1e-9 element is 100 % of it, but only 1e-9 of its row: judged as 1e-9 / FLOOR.
+        let a = from_rows(&[vec![1.0, 2e-9], vec![2.0, -2.0]]);
+        let d = relative_difference(&a, &b, &[1.0, 1.0], &|_, _| 0.0);
+        assert!((d.raw - 1e-9 / FLOOR).abs() < 1e-12, "{}", d.raw);
+        assert_eq!(d.at, (0, 1));
+        // Column scales enter the row size: input 2 in units a million times larger.
+        let d = relative_difference(&a, &b, &[1.0, 1e6], &|_, _| 0.0);
+        assert!((d.raw - 1.0).abs() < 1e-12, "{}", d.raw);
+        // What the convergence error can explain is not held against the gains.
+        let a = from_rows(&[vec![1.0 + 1e-4, 1e-9], vec![2.0, -2.0]]);
+        let d = relative_difference(&a, &b, &[1.0, 1.0], &|i, j| if (i, j) == (0, 0) { 2e-4 } else { 0.0 });
+        assert!((d.raw - 1e-4).abs() < 1e-12 && d.excess == 0.0, "{} {}", d.raw, d.excess);
+    }
+
+    #[test]
+    fn richardson_extrapolation_removes_the_h_squared_error() {
+        // D(h) = g + c h² exactly: the extrapolation (4 D(h/2) − D(h)) / 3 returns g.
+        let (g, c, e, h) = (0.8, 3e4, 5e6, 1e-3);
+        let d = |h: f64| g + c * h * h + e * h.powi(4);
+        let err = richardson(d(h), d(h / 2.0)) - g;
+        assert!((err - e * h.powi(4) * (4.0 / 16.0 - 1.0) / 3.0).abs() < 1e-12, "{err}");
+        assert!(err.abs() < 1e-3 * (d(h / 2.0) - g).abs());
     }
 }
