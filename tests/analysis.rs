@@ -197,13 +197,13 @@ fn a_bad_explicit_step_is_corrected_or_reported() {
     let outputs = select_outputs(&plant, &strings(&LV_OUTPUTS)).unwrap();
     let once = PerturbSettings { step: Some(1e-1), max_attempts: 1, ..PerturbSettings::default() };
     let e = perturb_gains(&plant, &ss.x, &ss.u, &indices(&inputs), &indices(&outputs), &once).unwrap_err();
-    assert!(matches!(e, AnalysisError::PerturbationUnverified { .. } | AnalysisError::NotConverged(_)), "{e:?}");
+    assert!(matches!(e, AnalysisError::PerturbationUnverified(_) | AnalysisError::NotConverged(_)), "{e:?}");
     assert!(!e.is_user_error(), "a numerical failure (exit 2)");
     let text = e.to_string();
     assert!(text.contains("--step"), "{text}");
-    if let AnalysisError::PerturbationUnverified { input, output, first, second, .. } = &e {
-        assert!(input.starts_with("column.") && output.ends_with("x[light]"), "{text}");
-        assert!(first.is_finite() && second.is_finite() && first != second, "{text}");
+    if let AnalysisError::PerturbationUnverified(u) = &e {
+        assert!(u.input.starts_with("column.") && u.output.ends_with("x[light]"), "{text}");
+        assert!(u.first.is_finite() && u.second.is_finite() && u.first != u.second, "{text}");
     }
 }
 

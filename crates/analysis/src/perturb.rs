@@ -47,7 +47,7 @@ use plantwide_solve::{NewtonSettings, NewtonStatus, PlantSystem, solve_steady};
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::error::AnalysisError;
+use crate::error::{AnalysisError, Unverified};
 use crate::linear::Linearization;
 use crate::measures::rga;
 
@@ -443,7 +443,7 @@ pub fn perturb_gains(
         // A step shrunk into the convergence noise cannot help: report why it was shrunk.
         let error_ratio = match (noise_check(&p, &columns, &rel), last.take()) {
             (Ok(r), _) => r,
-            (Err(_), Some(earlier @ AnalysisError::PerturbationUnverified { .. })) | (Err(earlier), _) => {
+            (Err(_), Some(earlier @ AnalysisError::PerturbationUnverified(_))) | (Err(earlier), _) => {
                 return Err(earlier);
             }
         };
@@ -497,7 +497,7 @@ fn noise_check(p: &Problem, columns: &[Column], rel: &[f64]) -> Result<f64, Anal
 
 /// The typed error for a check that failed at the last step tried.
 fn unverified(p: &Problem, f: &Failure, step: f64, next: f64) -> AnalysisError {
-    AnalysisError::PerturbationUnverified {
+    AnalysisError::PerturbationUnverified(Box::new(Unverified {
         file: p.plant.file.clone(),
         quantity: f.quantity,
         output: p.plant.vars[p.outputs[f.output]].path.clone(),
@@ -509,7 +509,7 @@ fn unverified(p: &Problem, f: &Failure, step: f64, next: f64) -> AnalysisError {
         tolerance: f.tolerance,
         step,
         suggestion: next,
-    }
+    }))
 }
 
 #[cfg(test)]
