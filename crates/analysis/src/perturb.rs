@@ -431,12 +431,15 @@ pub fn perturb_gains(
         let columns: Vec<Result<Column, String>> =
             (0..inputs.len()).into_par_iter().map(|k| p.column(k, rel[k] * p.scales[k])).collect();
         iterations += columns.iter().flatten().map(|c| c.iterations).sum::<usize>();
-        if let Some((k, e)) = columns.iter().enumerate().find_map(|(k, c)| c.as_ref().err().map(|e| (k, e))) {
+        // A move too large to re-converge: a tenth of the step for that input, and try again.
+        let failed: Vec<(usize, &String)> =
+            columns.iter().enumerate().filter_map(|(k, c)| c.as_ref().err().map(|e| (k, e))).collect();
+        if let Some((_, e)) = failed.first() {
             last = Some(AnalysisError::NotConverged(format!(
                 "{}: the plant did not re-converge: {e}; try a smaller --step",
                 plant.file
             )));
-            rel[k] = (rel[k] / 10.0).max(MIN_STEP);
+            failed.iter().for_each(|&(k, _)| rel[k] = (rel[k] / 10.0).max(MIN_STEP));
             continue;
         }
         let columns: Vec<Column> = columns.into_iter().flatten().collect();
@@ -460,8 +463,8 @@ pub fn perturb_gains(
             });
         };
         // The h² law: the step that would bring the difference to a quarter of the tolerance,
-        // at least a quarter of the step, at most a thousandth, never below the round-off
-        // floor, and within the linear range of the current estimate.
+        // shrinking by a factor between 4 and 1000, never below the round-off floor, and
+        // within the linear range of the current estimate.
         let shrink = (0.5 * (f.tolerance / f.difference).sqrt()).clamp(1e-3, 0.25);
         let smaller: Vec<f64> = rel.iter().map(|r| (r * shrink).max(MIN_STEP)).collect();
         let stuck = smaller == rel;
