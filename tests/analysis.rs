@@ -7,6 +7,7 @@ mod common;
 use std::process::Command;
 
 use common::{converge, flowsheet, value};
+use plantwide::analysis::AnalysisError;
 use plantwide::analysis::faer::linalg::solvers::Solve;
 use plantwide::analysis::faer::{Mat, c64};
 use plantwide::analysis::linear::Linearization;
@@ -72,6 +73,138 @@ fn column_a_gains_by_linearization_and_by_perturbation_agree() {
     assert!(max_rel_diff(&g_lin, &published) < 0.03, "{g_lin:?}");
     let l11 = rga(g_lin.as_ref()).unwrap()[(0, 0)];
     assert!((l11 - 35.1).abs() < 0.05 * 35.1, "λ11 = {l11}");
+}
+
+/// A shipped (or test) column, its two inputs and its two end-quality outputs.
+struct ColumnCase {
+    file: &'static str,
+    inputs: [&'static str; 2],
+    outputs: [&'static str; 2],
+}
+
+const COLUMNS: [ColumnCase; 5] = [
+    ColumnCase { file: "flowsheets/column_a.json", inputs: LV_INPUTS, outputs: LV_OUTPUTS },
+    // Column A with α = 2, L = 2.0, V = 2.5 kmol/min: yD ≈ 0.99993, λ11 ≈ 3684 (issue 13). The
+    // old fixed step 1e-5 gave gains 2.8 % off and λ11 ≈ −68.
+    ColumnCase { file: "tests/data/column_a_alpha2.json", inputs: LV_INPUTS, outputs: LV_OUTPUTS },
+    ColumnCase { file: "flowsheets/example_4_1.json", inputs: LV_INPUTS, outputs: LV_OUTPUTS },
+    ColumnCase {
+        file: "flowsheets/btx_column.json",
+        inputs: ["column.reflux@kmol/h", "column.reboiler_duty@MW"],
+        outputs: ["distillate.x[toluene]", "bottoms.x[benzene]"],
+    },
+    ColumnCase {
+        file: "flowsheets/ethanol_water.json",
+        inputs: ["column.reflux@kmol/h", "column.reboiler_duty@MW"],
+        outputs: ["distillate.x[ethanol]", "bottoms.x[ethanol]"],
+    },
+];
+
+/// The check every column must pass: perturbation gains with the default settings agree with
+/// the exact linearization (an independent route: exact Jacobians, one sparse LU) to 0.5 %
+/// element by element, and so does λ11, sign and magnitude. Returns the linear λ11.
+fn perturbation_agrees_with_linearization(case: &ColumnCase) -> f64 {
+    let path = format!("{}/{}", env!("CARGO_MANIFEST_DIR"), case.file);
+    let plant = plantwide::flowsheet::load_file(std::path::Path::new(&path)).unwrap_or_else(|e| panic!("{e}"));
+    let ss = steady_state(&plant, &plant.input_values(), None, &NewtonSettings::default()).unwrap();
+    let inputs = select_inputs(&plant, &strings(&case.inputs)).unwrap();
+    let outputs = select_outputs(&plant, &strings(&case.outputs)).unwrap();
+    let (ii, oo) = (indices(&inputs), indices(&outputs));
+    let g_lin = Linearization::new(&plant, &ss.x, &ss.u).steady_gain(&ii, &oo).unwrap();
+    let p = perturb_gains(&plant, &ss.x, &ss.u, &ii, &oo, &PerturbSettings::default())
+        .unwrap_or_else(|e| panic!("{}: {e}", case.file));
+    let d = max_rel_diff(&p.gain, &g_lin);
+    assert!(d < 5e-3, "{}: perturbation {:?} vs linearization {g_lin:?}: {d:e}", case.file, p.gain);
+    let (l_lin, l_pert) = (rga(g_lin.as_ref()).unwrap()[(0, 0)], rga(p.gain.as_ref()).unwrap()[(0, 0)]);
+    assert!((l_pert - l_lin).abs() < 5e-3 * l_lin.abs(), "{}: λ11 {l_pert} vs {l_lin}", case.file);
+    // The figures reported are the ones the returned gains passed.
+    assert!(p.check.max_relative_difference <= PerturbSettings::default().tolerance, "{}: {:?}", case.file, p.check);
+    assert!(p.check.linear_relative_difference.is_some_and(|d| d <= 1e-3), "{}: {:?}", case.file, p.check);
+    l_lin
+}
+
+#[test]
+fn perturbation_gains_verify_themselves_on_every_shipped_column() {
+    let lambdas: Vec<f64> = COLUMNS.iter().map(perturbation_agrees_with_linearization).collect();
+    // The α = 2 column is the hard case: a nearly singular gain with a large positive λ11.
+    assert!(lambdas[1] > 1000.0, "λ11 of the α = 2 column: {}", lambdas[1]);
+}
+
+/// The two-column plant's columns inside the whole plant (quality loops open), as the chapter-6
+/// study analyses them; the study itself (`tests/two_column_study.rs`) covers all six structures.
+#[test]
+fn perturbation_gains_verify_themselves_on_the_two_column_plant() {
+    let cases = [
+        ColumnCase {
+            file: "docs/two_column_plant/inputs/column1_LV_open.json",
+            inputs: ["column1.reflux@kmol/h", "column1.boilup@kmol/h"],
+            outputs: ["column1.T[21]", "column1.T[11]"],
+        },
+        ColumnCase {
+            file: "docs/two_column_plant/inputs/column2_LV_open.json",
+            inputs: ["column2.reflux@kmol/h", "column2.boilup@kmol/h"],
+            outputs: ["product.x[S]", "column2.T[6]"],
+        },
+    ];
+    for case in &cases {
+        perturbation_agrees_with_linearization(case);
+    }
+}
+
+/// A deliberately bad explicit step (1e-1 on the α = 2 column: L ± 0.2 kmol/min, a hundred times
+/// the distillate impurity's room) is corrected (the step shrunk until h and h/2 agree) or
+/// reported; never returned as if it were right.
+#[test]
+fn a_bad_explicit_step_is_corrected_or_reported() {
+    let path = format!("{}/tests/data/column_a_alpha2.json", env!("CARGO_MANIFEST_DIR"));
+    let base = [
+        "gains",
+        path.as_str(),
+        "--inputs",
+        "column.reflux@kmol/min,column.boilup@kmol/min",
+        "--outputs",
+        "distillate.x[light],bottoms.x[light]",
+        "--json",
+    ];
+    let lin = plantwide(&base);
+    assert!(lin.status.success(), "{}", String::from_utf8_lossy(&lin.stderr));
+    let lin: serde_json::Value = serde_json::from_slice(&lin.stdout).unwrap();
+    let l_lin = lin["rga"][0][0].as_f64().unwrap();
+    let out = plantwide(&[&base[..], &["--method", "perturb", "--step", "1e-1"]].concat());
+    match out.status.code() {
+        Some(0) => {
+            let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+            for (i, j) in [(0, 0), (0, 1), (1, 0), (1, 1)] {
+                let (a, b) = (v["gain"][i][j].as_f64().unwrap(), lin["gain"][i][j].as_f64().unwrap());
+                assert!((a - b).abs() < 5e-3 * b.abs(), "G{i}{j}: {a} vs {b}");
+            }
+            let l = v["rga"][0][0].as_f64().unwrap();
+            assert!((l - l_lin).abs() < 5e-3 * l_lin, "λ11 {l} vs {l_lin}");
+            assert!(v["perturbation"]["step"].as_f64().unwrap() < 1e-3, "{}", v["perturbation"]);
+            assert!(v["perturbation"]["attempts"].as_u64().unwrap() > 1, "{}", v["perturbation"]);
+        }
+        code => {
+            let stderr = String::from_utf8_lossy(&out.stderr);
+            assert_eq!(code, Some(2), "{stderr}");
+            assert!(stderr.contains("--step"), "{stderr}");
+        }
+    }
+    // With no room to shrink the step, the same request is refused with a typed error that names
+    // the pair, the two estimates and what to try.
+    let plant = plantwide::flowsheet::load_file(std::path::Path::new(&path)).unwrap();
+    let ss = steady_state(&plant, &plant.input_values(), None, &NewtonSettings::default()).unwrap();
+    let inputs = select_inputs(&plant, &strings(&LV_INPUTS)).unwrap();
+    let outputs = select_outputs(&plant, &strings(&LV_OUTPUTS)).unwrap();
+    let once = PerturbSettings { step: Some(1e-1), max_attempts: 1, ..PerturbSettings::default() };
+    let e = perturb_gains(&plant, &ss.x, &ss.u, &indices(&inputs), &indices(&outputs), &once).unwrap_err();
+    assert!(matches!(e, AnalysisError::PerturbationUnverified(_) | AnalysisError::NotConverged(_)), "{e:?}");
+    assert!(!e.is_user_error(), "a numerical failure (exit 2)");
+    let text = e.to_string();
+    assert!(text.contains("--step"), "{text}");
+    if let AnalysisError::PerturbationUnverified(u) = &e {
+        assert!(u.input.starts_with("column.") && u.output.ends_with("x[light]"), "{text}");
+        assert!(u.first.is_finite() && u.second.is_finite() && u.first != u.second, "{text}");
+    }
 }
 
 /// Three routes to G(0) on the full column must agree to round-off: −C J⁻¹ B, D − C A⁻¹ B of the
@@ -244,10 +377,16 @@ fn gains_json_has_exactly_the_documented_shape() {
         let keys: Vec<&str> = v.as_object().unwrap().keys().map(String::as_str).collect();
         let mut sorted = keys.clone();
         sorted.sort_unstable();
-        assert_eq!(
-            sorted,
-            ["condition_number", "gain", "inputs", "method", "niederlinski", "outputs", "rga", "singular_values"]
-        );
+        let mut documented =
+            vec!["condition_number", "gain", "inputs", "method", "niederlinski", "outputs", "rga", "singular_values"];
+        if method == "perturb" {
+            // The one key added for perturbation gains: how they were verified.
+            documented.insert(6, "perturbation");
+            assert_eq!(v["perturbation"]["check"], "richardson");
+            assert!(v["perturbation"]["step"].as_f64().unwrap() > 0.0);
+            assert!(v["perturbation"]["max_relative_difference"].as_f64().unwrap() < 1e-3);
+        }
+        assert_eq!(sorted, documented);
         assert_eq!(v["method"], method);
         assert_eq!(v["inputs"][0]["path"], "column.reflux");
         assert_eq!(v["inputs"][0]["unit"], "kmol/min");

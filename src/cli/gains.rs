@@ -9,7 +9,7 @@ use plantwide::analysis::faer::{Mat, c64};
 use plantwide::analysis::linear::Linearization;
 use plantwide::analysis::measures::{rga_complex, rows};
 use plantwide::analysis::perturb::{PerturbSettings, perturb_gains};
-use plantwide::analysis::report::{GainReport, ReportOptions};
+use plantwide::analysis::report::{GainJson, GainReport, ReportOptions};
 use plantwide::analysis::select::{Signal, SignalLabel, parse_block, parse_pairing, select_inputs, select_outputs};
 use plantwide::analysis::sensors::select_temperature_sensors;
 use plantwide::analysis::tf::TfModel;
@@ -54,7 +54,9 @@ pub struct GainsArgs {
     /// How the gains are obtained.
     #[arg(long, value_enum, default_value_t = Method::Linear)]
     method: Method,
-    /// Relative step of `--method perturb` (default 1e-5).
+    /// Relative step of `--method perturb`'s first attempt (default: chosen from the scales of
+    /// the inputs and outputs); the gains are verified at h and h/2 and the step shrunk until
+    /// they agree.
     #[arg(long)]
     step: Option<f64>,
     /// Expected range of each input, for scaling (quantities, or numbers in the display units).
@@ -70,7 +72,8 @@ pub struct GainsArgs {
     /// Time unit of `--frequencies` (default s).
     #[arg(long, default_value = "s")]
     time_unit: String,
-    /// Print exactly `{"method","inputs","outputs","gain","rga","singular_values","condition_number","niederlinski"}`.
+    /// Print exactly `{"method","inputs","outputs","gain","rga","singular_values","condition_number","niederlinski"}`,
+    /// and for `--method perturb` also `"perturbation": {"step","steps","check","max_relative_difference",…}`.
     #[arg(long)]
     json: bool,
     /// Override an input or a unit parameter first, e.g. `--set feed_source.F=1.01kmol/min`.
@@ -152,6 +155,7 @@ pub fn run(a: &GainsArgs) -> Result<(), CliError> {
     let (ii, oo): (Vec<usize>, Vec<usize>) =
         (inputs.iter().map(|s| s.index).collect(), outputs.iter().map(|s| s.index).collect());
     let lin = Linearization::new(&plant, &ss.x, &ss.u);
+    let mut check = None;
     let (si, method, note) = match a.method {
         Method::Linear => (
             lin.steady_gain(&ii, &oo).map_err(analysis_error)?,
@@ -159,15 +163,19 @@ pub fn run(a: &GainsArgs) -> Result<(), CliError> {
             "linearization at the steady state, G(0) = −C J⁻¹ B".to_string(),
         ),
         Method::Perturb => {
-            let settings = PerturbSettings {
-                step: a.step.unwrap_or(PerturbSettings::default().step),
-                ..PerturbSettings::default()
-            };
+            let settings = PerturbSettings { step: a.step, ..PerturbSettings::default() };
             let p = perturb_gains(&plant, &ss.x, &ss.u, &ii, &oo, &settings).map_err(analysis_error)?;
+            let c = &p.check;
             let note = format!(
-                "perturbation: each input ± {:.0e} relative, re-converged, central differences ({} Newton iterations; convergence error ≤ {:.1e} of the effect)",
-                settings.step, p.newton_iterations, p.error_ratio
+                "perturbation: each input ± h and ± h/2 (relative h ≤ {:.1e}), re-converged, central differences extrapolated (Richardson); h vs h/2 differ by ≤ {:.1e}{} ({} attempt(s), {} Newton iterations; convergence error ≤ {:.1e} of the effect)",
+                c.step,
+                c.max_relative_difference,
+                c.linear_relative_difference.map_or(String::new(), |d| format!(", linearization by {d:.1e}")),
+                c.attempts,
+                p.newton_iterations,
+                p.error_ratio
             );
+            check = Some(p.check);
             (p.gain, "perturb", note)
         }
     };
@@ -175,7 +183,8 @@ pub fn run(a: &GainsArgs) -> Result<(), CliError> {
     let labels = |s: &[Signal]| s.iter().map(Signal::label).collect::<Vec<_>>();
     let report = GainReport::new(method, labels(&inputs), labels(&outputs), gain, &opts).map_err(analysis_error)?;
     if a.json {
-        outln!("{}", serde_json::to_string_pretty(&report.json()).map_err(|e| CliError::user(e.to_string()))?);
+        let json = GainJson { perturbation: check.as_ref(), ..report.json() };
+        outln!("{}", serde_json::to_string_pretty(&json).map_err(|e| CliError::user(e.to_string()))?);
         return Ok(());
     }
     outln!("steady-state gains of `{}` ({note})\n", plant.name);

@@ -24,9 +24,44 @@ pub enum AnalysisError {
     /// A perturbed or swept plant did not re-converge.
     #[error("{0}")]
     NotConverged(String),
+    /// Perturbation gains that failed their check (step halving, RGA, exact linearization) at
+    /// every step tried: never returned as if they were right.
+    #[error("{0}")]
+    PerturbationUnverified(Box<Unverified>),
     /// A plot could not be drawn.
     #[error("plot: {0}")]
     Plot(String),
+}
+
+/// Why perturbation gains were refused: the pair, the check, the two estimates and what to try
+/// (boxed in [`AnalysisError::PerturbationUnverified`] to keep the error small).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error(
+    "{file}: the perturbation {quantity} of `{output}` to `{input}` did not verify ({check}): {first:.6e} vs {second:.6e} differ by {difference:.1e} relative (tolerance {tolerance:.0e}) at relative step {step:.1e}; try --step {suggestion:.0e} or --method linear"
+)]
+pub struct Unverified {
+    /// Flowsheet file.
+    pub file: String,
+    /// `gain` or `relative gain`.
+    pub quantity: &'static str,
+    /// Output path.
+    pub output: String,
+    /// Input path.
+    pub input: String,
+    /// Which comparison failed (`central differences at h and h/2`, …).
+    pub check: &'static str,
+    /// The first estimate (at `h`, or the perturbation's).
+    pub first: f64,
+    /// The second estimate (at `h/2`, or the exact linearization's).
+    pub second: f64,
+    /// Their relative difference.
+    pub difference: f64,
+    /// The tolerance it exceeds.
+    pub tolerance: f64,
+    /// Largest relative step of the last attempt.
+    pub step: f64,
+    /// A smaller relative step to try.
+    pub suggestion: f64,
 }
 
 impl AnalysisError {

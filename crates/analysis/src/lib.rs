@@ -4,8 +4,8 @@
 //!
 //! - [`linear`]: Jacobians at a steady state → `G(0) = −C J⁻¹ B`, state space `A, B, C, D` with
 //!   the algebraic variables eliminated, eigenvalues, `G(jω)`.
-//! - [`perturb`]: the book's gains — each input moved ± h, the plant re-converged, central
-//!   differences.
+//! - [`perturb`]: the book's gains — each input moved ± h and ± h/2, the plant re-converged,
+//!   central differences extrapolated (Richardson) and verified, never returned unverified.
 //! - [`measures`], [`min_cond`]: RGA, RGA number, SVD, condition number and its minimized value,
 //!   Niederlinski index, block relative gain, scaling, Morari resiliency index.
 //! - [`tf`]: transfer-function matrix files (gain, lags, leads, dead time per element).

@@ -1,16 +1,38 @@
 //! Steady-state gains the book's way (*Practical Distillation Control* ch. 6): each input moved
 //! `± h` from the base case, the plant re-converged from the base point, and central differences
-//! `G_ij = (y_i(u + h_j e_j) − y_i(u − h_j e_j)) / (2 h_j)`. The `2m` re-convergences are
+//! `G_ij = (y_i(u + h_j e_j) − y_i(u − h_j e_j)) / (2 h_j)`, with the step chosen from the
+//! variables' scales and every gain verified before it is returned. The re-convergences are
 //! independent and run in parallel (rayon). A re-convergence whose Newton iteration from the base
 //! point fails (a slow integral loop elsewhere in a recycle plant can stall pseudo-transient
 //! continuation) is repeated from scratch the way `steady` converges (sequential-modular pass, then
-//! Newton); only if that fails too is the gain refused.
+//! Newton).
 //!
-//! **Step.** `h_j = step · |u_j|` with `step` relative (default 1e-5), or `step` SI units when
-//! `u_j = 0`. Central differences err by `O(h²)`; high-purity columns are strongly curved (column
-//! A: the error is about `1e4 · step²` relative, 1.5e-6 at the default step, 1.5e-4 at 1e-4).
+//! **Step.** Central differences err by `h² y‴/6`; a high-purity column is so strongly curved
+//! that a fixed relative step can be wrong by percents (column A with α = 2, `yD ≈ 0.99993`: 2.8 %
+//! at `h/u = 1e-5`, and a negative RGA where the exact one is 3684). The curvature of an output is
+//! set by its room: a mole fraction near 1 cannot move by more than its impurity `1 − y`. So the
+//! default step of input `j` is the relative step 1e-5 of `|u_j|`, cut so that no output moves by
+//! more than `linear_range` (1e-3) of its room `min(y − lower, upper − y)` at the exact gain
+//! (when the Jacobian can be factored), and raised so that some output moves by at least 1e-9 of
+//! its nominal size, far above what the polished re-convergence leaves (below). This is the
+//! scale-based choice of Dennis & Schnabel (*Numerical Methods for Unconstrained Optimization*,
+//! 1983, §5.4–5.6) and Gill, Murray & Wright (*Practical Optimization*, 1981, §8.6): the step
+//! balances truncation (`∝ h²`) against the noise of the function values (`∝ 1/h`), here with
+//! the noise made tiny by polishing and the truncation bounded through the output's room.
 //!
-//! **Accuracy check.** After Newton converges at a perturbed point, Newton corrections
+//! **Verification.** Each input is moved by `h` and by `h/2` (four re-convergences). Richardson
+//! extrapolation (Richardson 1911; Dahlquist & Björck, *Numerical Methods*, §7.2) gives the
+//! returned gain `(4 D(h/2) − D(h)) / 3`, accurate to `O(h⁴)`, and the difference `D(h) − D(h/2)
+//! ≈ ¾ c h²` measures the error that is left; it must stay below `tolerance` (1e-3) element by
+//! element, and for a square gain the RGA of `D(h)` and `D(h/2)` must agree to `rga_tolerance`
+//! (1e-2): a nearly singular gain (λ₁₁ in the thousands) amplifies element errors by λ₁₁. Where
+//! the exact linearization `−C J⁻¹ B` exists, the gains and their RGA must agree with it to
+//! `linear_tolerance` (1e-3) and `rga_tolerance`. A failed check (or a re-convergence that fails)
+//! shrinks the step by the factor the `h²` error law asks for and tries again (up to
+//! `max_attempts`, default 5); if it still fails, [`AnalysisError::PerturbationUnverified`] names
+//! the input/output pair, the two estimates and what to try. Never a silently wrong gain.
+//!
+//! **Convergence accuracy.** After Newton converges at a perturbed point, Newton corrections
 //! `δ = −J⁻¹ f` are applied (up to four, until `|δ_y|` is below `accuracy · step` times the
 //! outputs' nominal size); the last `|δ_y|` bounds what the convergence left in the outputs (the
 //! error after it is of order `|δ_y|²`). It must stay below `accuracy · max_i |Δy_i|` (default
@@ -23,14 +45,41 @@ use plantwide_solve::sequential::{StrategySettings, steady_state_by};
 use plantwide_solve::sparse::SparseLu;
 use plantwide_solve::{NewtonSettings, NewtonStatus, PlantSystem, solve_steady};
 use rayon::prelude::*;
+use serde::Serialize;
 
-use crate::error::AnalysisError;
+use crate::error::{AnalysisError, Unverified};
+use crate::linear::Linearization;
+use crate::measures::rga;
+
+/// Relative step of the first attempt when none is given: `h_j = 1e-5 · |u_j|`.
+pub const DEFAULT_STEP: f64 = 1e-5;
+/// Smallest relative step tried: below it the output changes drown in round-off.
+const MIN_STEP: f64 = 1e-11;
+/// The automatic step moves some output by at least this fraction of its nominal size.
+const MIN_EFFECT: f64 = 1e-9;
+/// A gain smaller than this fraction of the largest in its row (inputs scaled by `|u_j|`) is
+/// compared against that fraction instead of against itself.
+const FLOOR: f64 = 1e-6;
 
 /// Settings of the perturbation gains.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PerturbSettings {
-    /// Relative step `h_j / |u_j|` (default 1e-5; `h_j = step` SI units when `u_j = 0`).
-    pub step: f64,
+    /// Relative step `h_j / |u_j|` of the first attempt (`h_j = step` SI units when `u_j = 0`);
+    /// `None` (default) chooses it from the scales (module docs). Verification may shrink it.
+    pub step: Option<f64>,
+    /// Largest change of an output, as a fraction of its room to its nearest bound, that the
+    /// automatic step allows (default 1e-3).
+    pub linear_range: f64,
+    /// Largest relative difference of the gains at `h` and `h/2` (default 1e-3).
+    pub tolerance: f64,
+    /// Largest relative difference of the RGA at `h` and `h/2`, and of the RGA against the
+    /// exact linearization's (default 1e-2).
+    pub rga_tolerance: f64,
+    /// Largest relative difference of the returned gains against the exact linearization
+    /// (default 1e-3).
+    pub linear_tolerance: f64,
+    /// Attempts, each with a smaller step, before the gains are refused (default 5).
+    pub max_attempts: usize,
     /// Largest allowed ratio of the convergence error in an output to the largest output change
     /// caused by the step (default 1e-6).
     pub accuracy: f64,
@@ -40,28 +89,66 @@ pub struct PerturbSettings {
 
 impl Default for PerturbSettings {
     fn default() -> Self {
-        PerturbSettings { step: 1e-5, accuracy: 1e-6, newton: NewtonSettings::default() }
+        PerturbSettings {
+            step: None,
+            linear_range: 1e-3,
+            tolerance: 1e-3,
+            rga_tolerance: 1e-2,
+            linear_tolerance: 1e-3,
+            max_attempts: 5,
+            accuracy: 1e-6,
+            newton: NewtonSettings::default(),
+        }
     }
+}
+
+/// How the returned gains were verified (serialized as `"perturbation"` by `gains --json`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PerturbCheck {
+    /// Largest relative step `h_j / |u_j|` of the accepted attempt (the larger of `h`, `h/2`).
+    pub step: f64,
+    /// Relative step of each input in the accepted attempt.
+    pub steps: Vec<f64>,
+    /// The check: `richardson` (central differences at `h` and `h/2`).
+    pub check: &'static str,
+    /// Largest relative difference of the gains at `h` and `h/2`, element by element.
+    pub max_relative_difference: f64,
+    /// Largest relative difference of the RGA at `h` and `h/2` (square, regular gains only).
+    pub rga_relative_difference: Option<f64>,
+    /// Largest relative difference of the returned gains against the exact linearization (when
+    /// the Jacobian could be factored).
+    pub linear_relative_difference: Option<f64>,
+    /// Attempts made (1 when the first step verified).
+    pub attempts: usize,
 }
 
 /// Gains by perturbation, in SI units.
 #[derive(Debug, Clone)]
 pub struct PerturbGains {
-    /// `dy_i/du_j` (outputs × inputs), SI.
+    /// `dy_i/du_j` (outputs × inputs), SI: the Richardson extrapolation of the accepted attempt.
     pub gain: Mat<f64>,
-    /// Absolute steps `h_j` (SI).
+    /// Absolute steps `h_j` of the accepted attempt (SI).
     pub steps: Vec<f64>,
     /// Largest ratio of estimated convergence error to output change, over all inputs.
     pub error_ratio: f64,
-    /// Newton iterations over all re-convergences.
+    /// Newton iterations over all re-convergences of all attempts.
     pub newton_iterations: usize,
+    /// How the gains were verified.
+    pub check: PerturbCheck,
 }
 
-/// Outputs at one perturbed point and the largest estimated convergence error in them.
+/// Outputs at one perturbed point and the estimated convergence error in each.
 struct Point {
     y: Vec<f64>,
-    error: f64,
+    errors: Vec<f64>,
     iterations: usize,
+}
+
+impl Point {
+    /// The largest estimated convergence error over the outputs.
+    fn error(&self) -> f64 {
+        self.errors.iter().copied().fold(0.0, f64::max)
+    }
 }
 
 /// Re-converge at inputs `u` from `x0`, then polish with Newton corrections until `error_goal`
@@ -95,22 +182,230 @@ fn reconverge(
     let n = plant.n_vars();
     let (mut r, mut jx, mut ju) = (vec![0.0; n], Vec::new(), Vec::new());
     let mut lu = SparseLu::default();
-    let mut error = f64::INFINITY;
+    let mut errors = vec![f64::INFINITY; outputs.len()];
     for _ in 0..4 {
         plant.jacobian(&x, u, 0.0, &mut r, &mut jx, &mut ju);
         let mut dx: Vec<f64> = r.iter().map(|v| -v).collect();
         lu.solve(n, &jx, &mut dx).map_err(|e| e.to_string())?;
-        error = outputs.iter().map(|&k| dx[k].abs()).fold(0.0, f64::max);
+        errors = outputs.iter().map(|&k| dx[k].abs()).collect();
         x.iter_mut().zip(&dx).for_each(|(a, b)| *a += b);
-        if error <= error_goal {
+        if errors.iter().all(|e| *e <= error_goal) {
             break;
         }
     }
-    Ok(Point { y: outputs.iter().map(|&k| x[k]).collect(), error, iterations })
+    Ok(Point { y: outputs.iter().map(|&k| x[k]).collect(), errors, iterations })
+}
+
+/// Central differences of one input at `h` and `h/2` (four re-convergences, in parallel).
+struct Column {
+    /// `D(h)`, one entry per output.
+    coarse: Vec<f64>,
+    /// `D(h/2)`.
+    fine: Vec<f64>,
+    /// Convergence error left in each output, the largest over the four points.
+    errors: Vec<f64>,
+    /// The largest of `errors`.
+    error: f64,
+    /// Largest output change `|y(u + h/2) − y(u − h/2)| / 2`.
+    effect: f64,
+    iterations: usize,
+}
+
+/// What the caller of [`perturb_gains`] asked for, and the base point.
+struct Problem<'a> {
+    plant: &'a Plant,
+    x0: &'a [f64],
+    u0: &'a [f64],
+    inputs: &'a [usize],
+    outputs: &'a [usize],
+    settings: &'a PerturbSettings,
+    /// `|u_j|`, or 1 where `u_j = 0`: absolute step = relative step × scale.
+    scales: Vec<f64>,
+}
+
+impl Problem<'_> {
+    /// Re-converge with input `k` moved by `±h` and `±h/2`; `Err` names the failed move.
+    fn column(&self, k: usize, h: f64) -> Result<Column, String> {
+        let (plant, input) = (self.plant, self.inputs[k]);
+        // Aim at the accuracy relative to the outputs' nominal sizes times the smaller relative
+        // step; the error ratio is checked against the effect afterwards.
+        let goal = self.outputs.iter().map(|&o| plant.vars[o].spec.nominal).fold(f64::INFINITY, f64::min)
+            * (h / 2.0 / self.scales[k])
+            * self.settings.accuracy;
+        let moves = [h, -h, h / 2.0, -h / 2.0];
+        let points = moves
+            .par_iter()
+            .map(|&d| {
+                let mut u = self.u0.to_vec();
+                u[input] += d;
+                reconverge(plant, &u, self.x0, self.outputs, &self.settings.newton, goal)
+                    .map_err(|e| format!("`{}` moved by {d:+.3e} (SI): {e}", plant.inputs[input].path))
+            })
+            .collect::<Result<Vec<Point>, String>>()?;
+        let diff = |a: &Point, b: &Point, i: usize| a.y[i] - b.y[i];
+        let n = self.outputs.len();
+        Ok(Column {
+            coarse: (0..n).map(|i| diff(&points[0], &points[1], i) / (2.0 * h)).collect(),
+            fine: (0..n).map(|i| diff(&points[2], &points[3], i) / h).collect(),
+            errors: (0..n).map(|i| points.iter().map(|p| p.errors[i]).fold(0.0, f64::max)).collect(),
+            error: points.iter().map(Point::error).fold(0.0, f64::max),
+            effect: (0..n).map(|i| diff(&points[2], &points[3], i).abs() / 2.0).fold(0.0, f64::max),
+            iterations: points.iter().map(|p| p.iterations).sum(),
+        })
+    }
+
+    /// Room of each output to its nearest bound (the scale of its curvature): a mole fraction
+    /// at 0.99993 has room 7e-5. Unbounded outputs get their magnitude or nominal size.
+    fn rooms(&self) -> Vec<f64> {
+        self.outputs
+            .iter()
+            .map(|&o| {
+                let (spec, y) = (&self.plant.vars[o].spec, self.x0[o]);
+                let room = match (spec.lower.is_finite(), spec.upper.is_finite()) {
+                    (true, true) => (y - spec.lower).min(spec.upper - y),
+                    (true, false) => y - spec.lower,
+                    (false, true) => spec.upper - y,
+                    (false, false) => y.abs().max(spec.nominal),
+                };
+                room.max(1e-12 * spec.nominal)
+            })
+            .collect()
+    }
+
+    /// Relative steps that keep every output within `linear_range` of its room at gain `g`
+    /// (SI), never above `steps`, and that move some output by at least `MIN_EFFECT` of its
+    /// nominal size.
+    fn fit_steps(&self, steps: &[f64], g: &Mat<f64>) -> Vec<f64> {
+        let rooms = self.rooms();
+        (0..self.inputs.len())
+            .map(|k| {
+                let (mut cap, mut floor) = (steps[k], 0.0_f64);
+                for (i, &o) in self.outputs.iter().enumerate() {
+                    let slope = g[(i, k)].abs() * self.scales[k];
+                    if slope > 0.0 {
+                        cap = cap.min(self.settings.linear_range * rooms[i] / slope);
+                        floor = floor.max(MIN_EFFECT * self.plant.vars[o].spec.nominal / slope);
+                    }
+                }
+                cap.max(floor.min(steps[k])).max(MIN_STEP)
+            })
+            .collect()
+    }
+}
+
+/// Relative difference of `a` against `b`, element by element: the largest `|a_ij − b_ij| /
+/// size_ij` with `size_ij = max(|b_ij|, FLOOR · max_k |b_ik| s_k / s_j)` (`s`: column scales),
+/// and where it is; then the same with `allowance(i, j)`, the noise the convergence error can put
+/// in element `(i, j)`, subtracted first (what the checks judge).
+struct Difference {
+    raw: f64,
+    excess: f64,
+    at: (usize, usize),
+}
+
+fn relative_difference(a: &Mat<f64>, b: &Mat<f64>, s: &[f64], allowance: &dyn Fn(usize, usize) -> f64) -> Difference {
+    let mut d = Difference { raw: 0.0, excess: 0.0, at: (0, 0) };
+    let nan_max = |v: f64| if v.is_nan() { f64::INFINITY } else { v };
+    for i in 0..a.nrows() {
+        let row = (0..a.ncols()).map(|k| b[(i, k)].abs() * s[k]).fold(0.0, f64::max);
+        for j in 0..a.ncols() {
+            let size = b[(i, j)].abs().max(FLOOR * row / s[j]);
+            let diff = (a[(i, j)] - b[(i, j)]).abs();
+            let raw = if diff == 0.0 { 0.0 } else { nan_max(diff / size) };
+            let beyond = (diff - allowance(i, j)).max(0.0);
+            let excess = if beyond == 0.0 { 0.0 } else { nan_max(beyond / size) };
+            d.raw = d.raw.max(raw);
+            if excess > d.excess {
+                (d.excess, d.at) = (excess, (i, j));
+            }
+        }
+    }
+    d
+}
+
+/// A failed check of one attempt: which, where, the two estimates and how far apart.
+struct Failure {
+    quantity: &'static str,
+    check: &'static str,
+    output: usize,
+    input: usize,
+    first: f64,
+    second: f64,
+    difference: f64,
+    tolerance: f64,
+}
+
+/// The figures of one attempt that passed or the first check that failed.
+struct Assessment {
+    gain: Mat<f64>,
+    check: PerturbCheck,
+    failure: Option<Failure>,
+}
+
+/// Richardson extrapolation of central differences at `h` and `h/2`: their errors are `c h²`
+/// and `c h²/4`, so `(4 D(h/2) − D(h)) / 3` cancels the `h²` term and leaves `O(h⁴)`.
+fn richardson(coarse: f64, fine: f64) -> f64 {
+    (4.0 * fine - coarse) / 3.0
+}
+
+/// Extrapolate and verify one attempt's columns (module docs: Richardson, RGA, exact gains).
+fn assess(p: &Problem, columns: &[Column], rel: &[f64], exact: Option<&Mat<f64>>) -> Assessment {
+    let (n, m) = (p.outputs.len(), p.inputs.len());
+    let coarse = Mat::from_fn(n, m, |i, k| columns[k].coarse[i]);
+    let fine = Mat::from_fn(n, m, |i, k| columns[k].fine[i]);
+    let gain = Mat::from_fn(n, m, |i, k| richardson(coarse[(i, k)], fine[(i, k)]));
+    // Convergence noise: at most 3 e_i / h in D(h) − D(h/2) and in the extrapolated gain.
+    let allowance = |i: usize, k: usize| 3.0 * columns[k].errors[i] / (rel[k] * p.scales[k]);
+    let s = &p.settings;
+    let mut failures = Vec::new();
+    let mut judge = |quantity, check, a: &Mat<f64>, b: &Mat<f64>, d: Difference, tolerance: f64| {
+        if d.excess > tolerance {
+            let ((i, j), difference) = (d.at, d.excess);
+            let (first, second) = (a[(i, j)], b[(i, j)]);
+            failures.push(Failure { quantity, check, output: i, input: j, first, second, difference, tolerance });
+        }
+        d.raw
+    };
+    let d = relative_difference(&coarse, &fine, &p.scales, &allowance);
+    let richardson = judge("gain", "central differences at h and h/2", &coarse, &fine, d, s.tolerance);
+    let ones = vec![1.0; m];
+    let rga_pair = |a: &Mat<f64>, b: &Mat<f64>| match (n == m, rga(a.as_ref()), rga(b.as_ref())) {
+        (true, Ok(la), Ok(lb)) => Some((relative_difference(&la, &lb, &ones, &|_, _| 0.0), la, lb)),
+        _ => None,
+    };
+    let rga_h = rga_pair(&coarse, &fine)
+        .map(|(d, la, lb)| judge("relative gain", "RGA at h and h/2", &la, &lb, d, s.rga_tolerance));
+    let mut linear = None;
+    if let Some(g) = exact {
+        let d = relative_difference(&gain, g, &p.scales, &allowance);
+        linear = Some(judge("gain", "against the exact linearization", &gain, g, d, s.linear_tolerance));
+        if let Some((d, la, lb)) = rga_pair(&gain, g) {
+            judge("relative gain", "RGA against the exact linearization", &la, &lb, d, s.rga_tolerance);
+        }
+    }
+    let check = PerturbCheck {
+        step: rel.iter().copied().fold(0.0, f64::max),
+        steps: rel.to_vec(),
+        check: "richardson",
+        max_relative_difference: richardson,
+        rga_relative_difference: rga_h,
+        linear_relative_difference: linear,
+        attempts: 0,
+    };
+    let failure =
+        failures.into_iter().max_by(|a, b| (a.difference / a.tolerance).total_cmp(&(b.difference / b.tolerance)));
+    Assessment { gain, check, failure }
 }
 
 /// Gains `dy/du` of `outputs` (variable indices) to `inputs` (free input indices) at the converged
-/// steady state `(x0, u0)`, by central differences of re-converged steady states.
+/// steady state `(x0, u0)`, by central differences of re-converged steady states at a step chosen
+/// from the scales and verified (module docs).
+///
+/// # Errors
+/// [`AnalysisError::Request`] for a step outside `(0, 0.5)`; [`AnalysisError::NotConverged`] when
+/// a perturbed plant does not re-converge at any step tried, or when the re-converged outputs are
+/// too inaccurate for the effect of the step; [`AnalysisError::PerturbationUnverified`] when the
+/// gains fail their check at every step tried.
 pub fn perturb_gains(
     plant: &Plant,
     x0: &[f64],
@@ -119,57 +414,136 @@ pub fn perturb_gains(
     outputs: &[usize],
     settings: &PerturbSettings,
 ) -> Result<PerturbGains, AnalysisError> {
-    if !(settings.step > 0.0 && settings.step < 0.5) {
-        return Err(AnalysisError::Request(format!(
-            "the relative perturbation step must be in (0, 0.5) (got {})",
-            settings.step
-        )));
+    if let Some(step) = settings.step.filter(|s| !(*s > 0.0 && *s < 0.5)) {
+        return Err(AnalysisError::Request(format!("the relative perturbation step must be in (0, 0.5) (got {step})")));
     }
-    let steps: Vec<f64> =
-        inputs.iter().map(|&j| settings.step * if u0[j] == 0.0 { 1.0 } else { u0[j].abs() }).collect();
-    let cases: Vec<(usize, f64)> = (0..inputs.len()).flat_map(|k| [(k, 1.0), (k, -1.0)]).collect();
-    // The convergence goal needs the size of the effect, unknown before solving: aim at the
-    // accuracy relative to the outputs' nominal sizes times the relative step, then check below.
-    let goal = outputs.iter().map(|&k| plant.vars[k].spec.nominal).fold(f64::INFINITY, f64::min)
-        * settings.step
-        * settings.accuracy;
-    let points: Vec<Result<Point, AnalysisError>> = cases
-        .par_iter()
-        .map(|&(k, sign)| {
-            let mut u = u0.to_vec();
-            u[inputs[k]] += sign * steps[k];
-            reconverge(plant, &u, x0, outputs, &settings.newton, goal).map_err(|e| {
-                AnalysisError::NotConverged(format!(
-                    "{}: the plant did not re-converge with `{}` moved by {:+.3e} (SI): {e}; try a smaller --step",
-                    plant.file,
-                    plant.inputs[inputs[k]].path,
-                    sign * steps[k]
-                ))
-            })
-        })
-        .collect();
-    let points = points.into_iter().collect::<Result<Vec<Point>, AnalysisError>>()?;
-    let (m, p) = (inputs.len(), outputs.len());
-    let mut gain = Mat::<f64>::zeros(p, m);
+    let scales = inputs.iter().map(|&j| if u0[j] == 0.0 { 1.0 } else { u0[j].abs() }).collect();
+    let p = Problem { plant, x0, u0, inputs, outputs, settings, scales };
+    // The exact gains (one sparse LU) scale the automatic step and check the result.
+    let exact = Linearization::new(plant, x0, u0).steady_gain(inputs, outputs).ok();
+    let mut rel = vec![settings.step.unwrap_or(DEFAULT_STEP); inputs.len()];
+    if let (None, Some(g)) = (settings.step, &exact) {
+        rel = p.fit_steps(&rel, g);
+    }
+    let mut iterations = 0;
+    let mut last: Option<AnalysisError> = None;
+    for attempt in 1..=settings.max_attempts.max(1) {
+        let columns: Vec<Result<Column, String>> =
+            (0..inputs.len()).into_par_iter().map(|k| p.column(k, rel[k] * p.scales[k])).collect();
+        iterations += columns.iter().flatten().map(|c| c.iterations).sum::<usize>();
+        // A move too large to re-converge: a tenth of the step for that input, and try again.
+        let failed: Vec<(usize, &String)> =
+            columns.iter().enumerate().filter_map(|(k, c)| c.as_ref().err().map(|e| (k, e))).collect();
+        if let Some((_, e)) = failed.first() {
+            last = Some(AnalysisError::NotConverged(format!(
+                "{}: the plant did not re-converge: {e}; try a smaller --step",
+                plant.file
+            )));
+            failed.iter().for_each(|&(k, _)| rel[k] = (rel[k] / 10.0).max(MIN_STEP));
+            continue;
+        }
+        let columns: Vec<Column> = columns.into_iter().flatten().collect();
+        // A step shrunk into the convergence noise cannot help: report why it was shrunk.
+        let error_ratio = match (noise_check(&p, &columns, &rel), last.take()) {
+            (Ok(r), _) => r,
+            (Err(_), Some(earlier @ AnalysisError::PerturbationUnverified(_))) | (Err(earlier), _) => {
+                return Err(earlier);
+            }
+        };
+        let mut a = assess(&p, &columns, &rel, exact.as_ref());
+        a.check.attempts = attempt;
+        let Some(f) = a.failure else {
+            let steps = rel.iter().zip(&p.scales).map(|(r, s)| r * s).collect();
+            return Ok(PerturbGains {
+                gain: a.gain,
+                steps,
+                error_ratio,
+                newton_iterations: iterations,
+                check: a.check,
+            });
+        };
+        // The h² law: the step that would bring the difference to a quarter of the tolerance,
+        // shrinking by a factor between 4 and 1000, never below the round-off floor, and
+        // within the linear range of the current estimate.
+        let shrink = (0.5 * (f.tolerance / f.difference).sqrt()).clamp(1e-3, 0.25);
+        let smaller: Vec<f64> = rel.iter().map(|r| (r * shrink).max(MIN_STEP)).collect();
+        let stuck = smaller == rel;
+        rel = p.fit_steps(&smaller, &a.gain).iter().zip(&smaller).map(|(f, s)| f.min(*s)).collect();
+        last = Some(unverified(&p, &f, a.check.step, rel[f.input]));
+        if stuck {
+            break;
+        }
+    }
+    Err(last.unwrap_or_else(|| AnalysisError::NotConverged(format!("{}: no perturbation attempted", plant.file))))
+}
+
+/// The largest ratio of convergence error to output change; `Err` when it exceeds `accuracy`.
+fn noise_check(p: &Problem, columns: &[Column], rel: &[f64]) -> Result<f64, AnalysisError> {
     let mut error_ratio: f64 = 0.0;
-    for k in 0..m {
-        let (plus, minus) = (&points[2 * k], &points[2 * k + 1]);
-        let effect = (0..p).map(|i| (plus.y[i] - minus.y[i]).abs() / 2.0).fold(0.0, f64::max);
+    for (k, c) in columns.iter().enumerate() {
         // No output moves at all (not even by round-off): the gains are exactly zero.
-        let ratio = if effect == 0.0 { 0.0 } else { plus.error.max(minus.error) / effect };
-        if ratio.is_nan() || ratio > settings.accuracy {
+        let ratio = if c.effect == 0.0 { 0.0 } else { c.error / c.effect };
+        if ratio.is_nan() || ratio > p.settings.accuracy {
             return Err(AnalysisError::NotConverged(format!(
-                "{}: moving `{}` by ±{:.3e} (SI) changes the outputs by at most {effect:.3e}, but the re-converged steady states are only accurate to {:.3e}; increase --step",
-                plant.file,
-                plant.inputs[inputs[k]].path,
-                steps[k],
-                plus.error.max(minus.error)
+                "{}: moving `{}` by ±{:.3e} (SI) changes the outputs by at most {:.3e}, but the re-converged steady states are only accurate to {:.3e}; increase --step",
+                p.plant.file,
+                p.plant.inputs[p.inputs[k]].path,
+                rel[k] * p.scales[k] / 2.0,
+                c.effect,
+                c.error
             )));
         }
         error_ratio = error_ratio.max(ratio);
-        for i in 0..p {
-            gain[(i, k)] = (plus.y[i] - minus.y[i]) / (2.0 * steps[k]);
-        }
     }
-    Ok(PerturbGains { gain, steps, error_ratio, newton_iterations: points.iter().map(|p| p.iterations).sum() })
+    Ok(error_ratio)
+}
+
+/// The typed error for a check that failed at the last step tried.
+fn unverified(p: &Problem, f: &Failure, step: f64, next: f64) -> AnalysisError {
+    AnalysisError::PerturbationUnverified(Box::new(Unverified {
+        file: p.plant.file.clone(),
+        quantity: f.quantity,
+        output: p.plant.vars[p.outputs[f.output]].path.clone(),
+        input: p.plant.inputs[p.inputs[f.input]].path.clone(),
+        check: f.check,
+        first: f.first,
+        second: f.second,
+        difference: f.difference,
+        tolerance: f.tolerance,
+        step,
+        suggestion: next,
+    }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::measures::from_rows;
+
+    #[test]
+    fn relative_difference_measures_small_elements_against_their_row() {
+        let b = from_rows(&[vec![1.0, 1e-9], vec![2.0, -2.0]]);
+        // 1e-9 off a 1e-9 element is 100 % of it, but only 1e-9 of its row: judged as 1e-9 / FLOOR.
+        let a = from_rows(&[vec![1.0, 2e-9], vec![2.0, -2.0]]);
+        let d = relative_difference(&a, &b, &[1.0, 1.0], &|_, _| 0.0);
+        assert!((d.raw - 1e-9 / FLOOR).abs() < 1e-12, "{}", d.raw);
+        assert_eq!(d.at, (0, 1));
+        // Column scales enter the row size: input 2 in units a million times larger.
+        let d = relative_difference(&a, &b, &[1.0, 1e6], &|_, _| 0.0);
+        assert!((d.raw - 1.0).abs() < 1e-12, "{}", d.raw);
+        // What the convergence error can explain is not held against the gains.
+        let a = from_rows(&[vec![1.0 + 1e-4, 1e-9], vec![2.0, -2.0]]);
+        let d = relative_difference(&a, &b, &[1.0, 1.0], &|i, j| if (i, j) == (0, 0) { 2e-4 } else { 0.0 });
+        assert!((d.raw - 1e-4).abs() < 1e-12 && d.excess == 0.0, "{} {}", d.raw, d.excess);
+    }
+
+    #[test]
+    fn richardson_extrapolation_removes_the_h_squared_error() {
+        // D(h) = g + c h² exactly: the extrapolation (4 D(h/2) − D(h)) / 3 returns g.
+        let (g, c, e, h) = (0.8, 3e4, 5e6, 1e-3);
+        let d = |h: f64| g + c * h * h + e * h.powi(4);
+        let err = richardson(d(h), d(h / 2.0)) - g;
+        assert!((err - e * h.powi(4) * (4.0 / 16.0 - 1.0) / 3.0).abs() < 1e-12, "{err}");
+        assert!(err.abs() < 1e-3 * (d(h / 2.0) - g).abs());
+    }
 }

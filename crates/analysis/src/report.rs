@@ -8,6 +8,7 @@ use serde::Serialize;
 use crate::error::AnalysisError;
 use crate::measures::{self, Svd};
 use crate::min_cond::minimized_condition_number;
+use crate::perturb::PerturbCheck;
 use crate::select::{BlockSpec, SignalLabel};
 
 /// What to compute besides the always-present RGA, SVD and condition number.
@@ -133,6 +134,7 @@ impl GainReport {
             singular_values: &self.svd.singular_values,
             condition_number: self.condition_number.is_finite().then_some(self.condition_number),
             niederlinski: self.niederlinski,
+            perturbation: None,
         }
     }
 }
@@ -156,6 +158,9 @@ pub struct GainJson<'a> {
     pub condition_number: Option<f64>,
     /// Niederlinski index of the pairing (null for non-square or singular `G`).
     pub niederlinski: Option<f64>,
+    /// How perturbation gains were verified (`gains --method perturb` only; absent otherwise).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub perturbation: Option<&'a PerturbCheck>,
 }
 
 #[cfg(test)]
