@@ -705,7 +705,41 @@ fn events_of(cx: &mut Cx<'_>, specs: &[EventSpec], duration: f64, limits: &Limit
             }
         }
     }
+    check_values(cx, &events);
     events.into_iter().map(|(e, _)| e).collect()
+}
+
+/// Every value an event gives an input, followed from the flowsheet's values in time order, within
+/// the input's physical range: the check file values and `--set` pass
+/// ([`crate::overrides::check_input_value`]). A sinusoid is checked at its peaks.
+fn check_values(cx: &mut Cx<'_>, events: &[(Event, String)]) {
+    let mut u = cx.plant.input_values();
+    let mut saved: Vec<Option<f64>> = vec![None; u.len()];
+    for (e, label) in events {
+        let (input, values): (usize, Vec<f64>) = match e.action {
+            Action::Step { input, change } | Action::Ramp { input, change, .. } => (input, vec![change.apply(u[input])]),
+            Action::Pulse { input, change } => {
+                saved[input] = Some(u[input]);
+                (input, vec![change.apply(u[input])])
+            }
+            Action::Restore { input } => (input, vec![saved[input].take().unwrap_or(u[input])]),
+            Action::Sinusoid { input, amplitude, .. } => {
+                saved[input] = Some(u[input]);
+                (input, vec![u[input] - amplitude.abs(), u[input] + amplitude.abs()])
+            }
+            _ => continue,
+        };
+        for &v in &values {
+            if let Err(why) = crate::overrides::check_input_value(cx.plant, input, v) {
+                let path = &cx.plant.inputs[input].path;
+                cx.diags.push(Diagnostic::new(label.split(' ').next().unwrap_or_default(), format!("takes `{path}` to {why}")));
+                return;
+            }
+        }
+        if !matches!(e.action, Action::Sinusoid { .. }) {
+            u[input] = values[0];
+        }
+    }
 }
 
 /// A time [s] for messages: plain in 1e-3 … 1e6, else in exponent form.
