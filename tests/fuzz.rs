@@ -27,7 +27,7 @@ use std::io::Write;
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
-use fuzz::corpus::{Corpus, Mutant};
+use fuzz::corpus::{Corpus, Mode, Mutant};
 use fuzz::exec::{Dishonest, Outcome, execute};
 use fuzz::{guard, rng};
 
@@ -65,6 +65,9 @@ struct Report {
     user: usize,
     numerical: usize,
     skipped: usize,
+    longest_message: usize,
+    baseline: usize,
+    warmup: usize,
     slowest: (Duration, String),
     failures: Vec<(String, String, String)>,
 }
@@ -79,8 +82,14 @@ impl Report {
         }
         match result {
             Ok(Ok(Outcome::Ok)) => self.ok += 1,
-            Ok(Ok(Outcome::User(_))) => self.user += 1,
-            Ok(Ok(Outcome::Numerical(_))) => self.numerical += 1,
+            Ok(Ok(Outcome::User(msg))) => {
+                self.user += 1;
+                self.longest_message = self.longest_message.max(msg.len());
+            }
+            Ok(Ok(Outcome::Numerical(msg))) => {
+                self.numerical += 1;
+                self.longest_message = self.longest_message.max(msg.len());
+            }
             Ok(Err(Dishonest(why))) => self.failures.push(("dishonest".into(), m.describe(), why)),
             Err(_) => {
                 let why = std::mem::take(&mut *LAST_PANIC.lock().unwrap_or_else(|e| e.into_inner()));
@@ -93,8 +102,9 @@ impl Report {
         let rate = |(n, t): (usize, Duration)| n as f64 / t.as_secs_f64().max(1e-9);
         let [l, s, r] = self.by_mode;
         format!(
-            "fuzz: {} mutants in {:.1} s (load {} at {:.0}/s, steady {} at {:.1}/s, run {} at {:.1}/s; {} skipped): \
-             ok {}, user error {}, numerical failure {}, FAILURES {}; slowest {:.2} s ({}); peak allocation {:.1} MiB",
+            "fuzz: {} shipped runs, then {} mutants in {:.1} s (load {} at {:.0}/s, steady {} at {:.1}/s, run {} at {:.1}/s; {} skipped): \
+             ok {}, user error {}, numerical failure {}, FAILURES {}; slowest {:.2} s ({}); peak allocation {:.1} MiB above a {:.0} MiB baseline; longest message {} chars",
+            self.warmup,
             l.0 + s.0 + r.0,
             wall.as_secs_f64(),
             l.0,
@@ -110,16 +120,53 @@ impl Report {
             self.failures.len(),
             self.slowest.0.as_secs_f64(),
             self.slowest.1,
-            guard::peak() as f64 / (1 << 20) as f64
+            guard::peak() as f64 / (1 << 20) as f64,
+            self.baseline as f64 / (1 << 20) as f64,
+            self.longest_message
         )
     }
+}
+
+/// Write a replayed mutant's files under `target/` and print the equivalent command line.
+fn dump(m: &Mutant) {
+    let dir = guard::current_file().with_file_name("fuzz-replay");
+    let _ = std::fs::create_dir_all(&dir);
+    let fs = dir.join("flowsheet.json");
+    let _ = std::fs::write(&fs, &m.text);
+    let sets: String = m.sets.iter().map(|s| format!(" --set '{s}'")).collect();
+    let command = match &m.scenario {
+        Some((_, text)) => {
+            let sc = dir.join("scenario.json");
+            let _ = std::fs::write(&sc, text);
+            format!("run {}{sets} --scenario {} --csv /tmp/fuzz.csv", fs.display(), sc.display())
+        }
+        None if m.mode == Mode::Load => format!("check {}{sets}", fs.display()),
+        None => format!("steady {}{sets}", fs.display()),
+    };
+    say(&format!("fuzz replay files: plantwide {command}"));
 }
 
 /// Make and run `n` mutants from `seed` (mutant 0 has the seed itself).
 fn campaign(seed: u64, n: usize, skip: &[String]) -> Report {
     let corpus = Corpus::load();
-    let mut seeds = rng::Rng::new(seed);
     let mut report = Report::default();
+    // The shipped files must pass themselves; running them first also lets the engine's
+    // per-thread scratch settle before the memory limit starts counting.
+    let mut shipped: Vec<Mutant> = corpus.small.iter().map(|&fi| Mutant::shipped(&corpus, fi, None)).collect();
+    for s in &corpus.scenarios {
+        shipped.extend(s.flowsheets.iter().map(|&fi| Mutant::shipped(&corpus, fi, Some(s))));
+    }
+    for m in &shipped {
+        guard::begin(&m.describe());
+        let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| execute(m)));
+        guard::end();
+        if !matches!(result, Ok(Ok(Outcome::Ok))) {
+            report.failures.push(("shipped file".into(), m.describe(), format!("{result:?}")));
+        }
+    }
+    report.baseline = guard::set_baseline();
+    report.warmup = shipped.len();
+    let mut seeds = rng::Rng::new(seed);
     for i in 0..n {
         let s = if i == 0 { seed } else { seeds.next_u64() };
         let m = Mutant::new(s, &corpus);
@@ -127,6 +174,9 @@ fn campaign(seed: u64, n: usize, skip: &[String]) -> Report {
         if skip.iter().any(|w| description.contains(w.as_str())) {
             report.skipped += 1;
             continue;
+        }
+        if n == 1 {
+            dump(&m);
         }
         guard::begin(&description);
         let started = Instant::now();

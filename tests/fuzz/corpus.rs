@@ -199,6 +199,20 @@ impl Mutant {
         m
     }
 
+    /// The shipped flowsheet `fi` unchanged: steady, or run with `scenario` (the warm-up).
+    pub fn shipped(corpus: &Corpus, fi: usize, scenario: Option<&Scenario>) -> Mutant {
+        let f = &corpus.flowsheets[fi];
+        Mutant {
+            seed: 0,
+            mode: if scenario.is_some() { Mode::Run } else { Mode::Steady },
+            file: f.file.clone(),
+            text: Doc::new(f.value.clone()).render(),
+            scenario: scenario.map(|s| (s.file.clone(), Doc::new(s.value.clone()).render())),
+            sets: Vec::new(),
+            changes: Vec::new(),
+        }
+    }
+
     /// One line: seed, mode, file, changes.
     pub fn describe(&self) -> String {
         let scen = self.scenario.as_ref().map_or(String::new(), |(f, _)| format!(" --scenario {f}"));

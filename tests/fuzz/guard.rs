@@ -1,7 +1,7 @@
 //! Guards for the failures that kill the process: the mutant about to run is written to
 //! `target/fuzz-current.txt` first (an abort or a stack overflow leaves it there to replay), a
 //! watchdog thread aborts a mutant that runs over the time limit, and a counting global allocator
-//! aborts on any request, or live total, above the memory limit. Both print the mutant first.
+//! aborts on any request, or live total above the warm-up baseline, over the memory limit. Both print the mutant first.
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::io::Write;
@@ -15,6 +15,9 @@ pub const MEMORY_LIMIT: usize = 2 << 30;
 pub const TIME_LIMIT: Duration = Duration::from_secs(10);
 
 static LIVE: AtomicUsize = AtomicUsize::new(0);
+/// Live bytes after the warm-up: per-thread scratch the engine keeps for good (faer's gemm
+/// backend holds about 1 GiB of address space per thread that multiplies matrices).
+static BASELINE: AtomicUsize = AtomicUsize::new(usize::MAX / 2);
 static PEAK: AtomicUsize = AtomicUsize::new(0);
 /// Milliseconds since [`epoch`] at which the current mutant started (0: none running).
 static STARTED_MS: AtomicU64 = AtomicU64::new(0);
@@ -44,15 +47,23 @@ pub fn end() {
     STARTED_MS.store(0, Ordering::SeqCst);
 }
 
-/// Peak live heap since the start [bytes].
+/// Take the live heap now as the baseline the limit counts from; reset the peak.
+pub fn set_baseline() -> usize {
+    let live = LIVE.load(Ordering::SeqCst);
+    BASELINE.store(live, Ordering::SeqCst);
+    PEAK.store(live, Ordering::SeqCst);
+    live
+}
+
+/// Peak live heap above the baseline [bytes].
 pub fn peak() -> usize {
-    PEAK.load(Ordering::Relaxed)
+    PEAK.load(Ordering::Relaxed).saturating_sub(BASELINE.load(Ordering::Relaxed))
 }
 
 /// Print `what` and the running mutant to stderr without allocating, then abort.
-fn die(what: &str, bytes: usize) -> ! {
+fn die(what: &str, amount: usize, unit: &str) -> ! {
     let mut err = std::io::stderr();
-    let _ = writeln!(err, "\nfuzz FAILURE: {what} ({bytes} bytes)");
+    let _ = writeln!(err, "\nfuzz FAILURE: {what} ({amount} {unit})");
     match CURRENT.try_lock() {
         Ok(d) => {
             let _ = writeln!(err, "mutant: {}", d.as_str());
@@ -77,7 +88,7 @@ pub fn start_watchdog() {
             }
             let ms = (epoch().elapsed().as_millis() as u64 + 1).saturating_sub(started);
             if ms > TIME_LIMIT.as_millis() as u64 {
-                die("mutant over the time limit of 10 s, elapsed ms", ms as usize);
+                die("mutant over the time limit of 10 s", ms as usize, "ms");
             }
         }
     });
@@ -89,11 +100,12 @@ pub struct Counting;
 impl Counting {
     fn grow(&self, bytes: usize) {
         if bytes > MEMORY_LIMIT {
-            die("single allocation over 2 GiB", bytes);
+            die("single allocation over 2 GiB", bytes, "bytes");
         }
         let live = LIVE.fetch_add(bytes, Ordering::Relaxed) + bytes;
-        if live > MEMORY_LIMIT {
-            die("live heap over 2 GiB", live);
+        let above = live.saturating_sub(BASELINE.load(Ordering::Relaxed));
+        if above > MEMORY_LIMIT {
+            die("live heap over 2 GiB above the warm-up baseline", above, "bytes");
         }
         PEAK.fetch_max(live, Ordering::Relaxed);
     }
@@ -118,6 +130,9 @@ unsafe impl GlobalAlloc for Counting {
         unsafe { System.dealloc(ptr, layout) }
     }
     unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        if new_size > MEMORY_LIMIT {
+            die("single allocation over 2 GiB", new_size, "bytes");
+        }
         if new_size > layout.size() {
             self.grow(new_size - layout.size());
         } else {
