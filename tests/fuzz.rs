@@ -1,6 +1,6 @@
 //! Seeded, structure-aware mutation fuzz of the shipped flowsheets and scenarios, in process.
 //!
-//! Each mutant is made from its own seed: a shipped file, a mode (80 % load, 15 % steady, 5 %
+//! Each mutant is made from its own seed: a shipped file, a mode (84 % load, 12 % steady, 4 %
 //! run) and one to three mutations chosen by the kind and key of the JSON nodes (`tests/fuzz/`).
 //! It fails on a panic, a mutant over 10 s or 2 GiB (the process aborts after printing the
 //! mutant; a crash leaves it in `target/fuzz-current.txt`), a steady state reported converged
