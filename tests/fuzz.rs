@@ -65,7 +65,7 @@ struct Report {
     user: usize,
     numerical: usize,
     skipped: usize,
-    longest_message: usize,
+    longest_message: (usize, u64),
     baseline: usize,
     warmup: usize,
     slowest: (Duration, String),
@@ -84,11 +84,11 @@ impl Report {
             Ok(Ok(Outcome::Ok)) => self.ok += 1,
             Ok(Ok(Outcome::User(msg))) => {
                 self.user += 1;
-                self.longest_message = self.longest_message.max(msg.len());
+                self.longest_message = self.longest_message.max((msg.len(), m.seed));
             }
             Ok(Ok(Outcome::Numerical(msg))) => {
                 self.numerical += 1;
-                self.longest_message = self.longest_message.max(msg.len());
+                self.longest_message = self.longest_message.max((msg.len(), m.seed));
             }
             Ok(Err(Dishonest(why))) => self.failures.push(("dishonest".into(), m.describe(), why)),
             Err(_) => {
@@ -103,7 +103,7 @@ impl Report {
         let [l, s, r] = self.by_mode;
         format!(
             "fuzz: {} shipped runs, then {} mutants in {:.1} s (load {} at {:.0}/s, steady {} at {:.1}/s, run {} at {:.1}/s; {} skipped): \
-             ok {}, user error {}, numerical failure {}, FAILURES {}; slowest {:.2} s ({}); peak allocation {:.1} MiB above a {:.0} MiB baseline; longest message {} chars",
+             ok {}, user error {}, numerical failure {}, FAILURES {}; slowest {:.2} s ({}); peak allocation {:.1} MiB above a {:.0} MiB baseline; longest message {} chars (seed {:#x})",
             self.warmup,
             l.0 + s.0 + r.0,
             wall.as_secs_f64(),
@@ -122,7 +122,8 @@ impl Report {
             self.slowest.1,
             guard::peak() as f64 / (1 << 20) as f64,
             self.baseline as f64 / (1 << 20) as f64,
-            self.longest_message
+            self.longest_message.0,
+            self.longest_message.1
         )
     }
 }
@@ -169,7 +170,12 @@ fn campaign(seed: u64, n: usize, skip: &[String]) -> Report {
     let mut seeds = rng::Rng::new(seed);
     for i in 0..n {
         let s = if i == 0 { seed } else { seeds.next_u64() };
-        let m = Mutant::new(s, &corpus);
+        let made = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| Mutant::new(s, &corpus)));
+        let Ok(m) = made else {
+            let why = std::mem::take(&mut *LAST_PANIC.lock().unwrap_or_else(|e| e.into_inner()));
+            report.failures.push(("harness: mutator panicked".into(), format!("seed={s:#018x}"), why));
+            continue;
+        };
         let description = m.describe();
         if skip.iter().any(|w| description.contains(w.as_str())) {
             report.skipped += 1;
@@ -215,8 +221,9 @@ fn mutants_neither_crash_nor_hang_nor_claim_false_convergence() {
     let started = Instant::now();
     // The command line runs on the main thread's 8 MiB stack; so do the mutants.
     let worker = std::thread::Builder::new().stack_size(8 << 20).spawn(move || campaign(seed, n, &skip));
-    let report = worker.expect("spawn the fuzz thread").join().expect("the campaign catches every panic");
+    let report = worker.expect("spawn the fuzz thread").join();
     let _ = std::panic::take_hook();
+    let report = report.expect("the campaign catches every panic");
     say(&report.summary(started.elapsed()));
     for (kind, mutant, why) in report.failures.iter().take(50) {
         say(&format!("fuzz FAILURE ({kind}): {mutant}\n    {why}"));

@@ -171,12 +171,11 @@ impl Mutant {
         let n = if rng.chance(0.03) { 0 } else { *rng.pick(&[1, 1, 1, 1, 1, 1, 1, 2, 2, 3]) };
         if let Some(s) = scenario {
             let mut sdoc = Doc::new(s.value.clone());
-            let names = Names::of(&base.value);
             for _ in 0..n {
                 let line = if rng.chance(0.6) {
-                    targeted::scenario(&mut rng, &mut sdoc, &names)
+                    targeted::scenario(&mut rng, &mut sdoc, &base.names)
                 } else {
-                    mutate(&mut rng, &mut sdoc, &names)
+                    mutate(&mut rng, &mut sdoc, &base.names)
                 };
                 m.changes.push(format!("scenario {line}"));
             }
