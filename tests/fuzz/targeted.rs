@@ -39,7 +39,8 @@ pub fn flowsheet(rng: &mut Rng, doc: &mut Doc, names: &Names) -> String {
         ),
         1 => {
             let mut z = old.as_object().cloned().unwrap_or_default();
-            let k = rng.pick(&z.keys().cloned().collect::<Vec<_>>()).clone();
+            let keys: Vec<String> = z.keys().cloned().collect();
+            let k = if keys.is_empty() { "nosuch_component".to_string() } else { rng.pick(&keys).clone() };
             z.insert(k, json!(*rng.pick(&[1.5, -0.1, 0.0, 0.3])));
             set(doc, &site, &old, Value::Object(z), "comp_entry")
         }
@@ -59,6 +60,9 @@ pub fn flowsheet(rng: &mut Rng, doc: &mut Doc, names: &Names) -> String {
 fn duplicate_member(rng: &mut Rng, doc: &mut Doc, site: &Site, old: &Value) -> String {
     let m = old.as_object().cloned().unwrap_or_default();
     let keys: Vec<&String> = m.keys().collect();
+    if keys.is_empty() {
+        return set(doc, site, old, json!({"fuzz_unknown": {}}), "key_unknown");
+    }
     let (a, b) = (keys[rng.below(keys.len())].clone(), keys[rng.below(keys.len())].clone());
     let mut parts: Vec<String> = m.iter().map(|(k, v)| format!("{}: {v}", json!(k))).collect();
     parts.push(format!("{}: {}", json!(a), m[&b]));
