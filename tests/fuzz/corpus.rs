@@ -1,0 +1,222 @@
+//! The shipped flowsheets and scenarios the mutants start from, and the mutant a seed makes.
+
+use std::path::{Path, PathBuf};
+
+use serde_json::Value;
+
+use super::doc::Doc;
+use super::mutate::{Names, mutate};
+use super::rng::Rng;
+use super::targeted;
+use plantwide::flowsheet::scenario::{parse_scenario, resolve};
+use plantwide::flowsheet::{Plant, load_str};
+
+/// Plants up to this many variables get steady and run mutants (the rest load only).
+const STEADY_MAX_VARS: usize = 450;
+/// Run mutants simulate this fraction of the shipped scenario's duration.
+pub const RUN_FRACTION: f64 = 0.1;
+
+/// One shipped flowsheet.
+pub struct Flowsheet {
+    /// Path relative to the repository.
+    pub file: String,
+    /// Parsed JSON.
+    pub value: Value,
+    /// Its names.
+    pub names: Names,
+    /// The plant as shipped.
+    pub plant: Plant,
+}
+
+/// One shipped scenario and the flowsheets it runs on.
+pub struct Scenario {
+    /// Path relative to the repository.
+    pub file: String,
+    /// Parsed JSON, the duration cut to [`RUN_FRACTION`].
+    pub value: Value,
+    /// Indices of the (small) flowsheets it resolves against.
+    pub flowsheets: Vec<usize>,
+}
+
+/// Everything the mutants are made from.
+pub struct Corpus {
+    /// Flowsheets, sorted by file.
+    pub flowsheets: Vec<Flowsheet>,
+    /// Indices of the flowsheets small enough for steady and run mutants.
+    pub small: Vec<usize>,
+    /// Scenarios with at least one flowsheet.
+    pub scenarios: Vec<Scenario>,
+}
+
+fn json_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    let Ok(entries) = std::fs::read_dir(dir) else { return };
+    for e in entries.flatten() {
+        let p = e.path();
+        if p.is_dir() {
+            json_files(&p, out);
+        } else if p.extension().is_some_and(|x| x == "json") {
+            out.push(p);
+        }
+    }
+}
+
+impl Corpus {
+    /// Read `flowsheets/` (and its subfolders): flowsheets have `units`, scenarios `events`.
+    pub fn load() -> Corpus {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+        let mut files = Vec::new();
+        json_files(&root.join("flowsheets"), &mut files);
+        files.sort();
+        let (mut flowsheets, mut scen) = (Vec::new(), Vec::new());
+        for p in files {
+            let file = p.strip_prefix(root).unwrap_or(&p).display().to_string();
+            let text = std::fs::read_to_string(&p).expect("shipped file readable");
+            let Ok(value) = serde_json::from_str::<Value>(&text) else { continue };
+            if value.get("units").is_some() {
+                let plant = load_str(&text, &file).unwrap_or_else(|e| panic!("shipped {file} must load: {e}"));
+                flowsheets.push(Flowsheet { file, names: Names::of(&value), value, plant });
+            } else if value.get("events").is_some() {
+                scen.push((file, text, value));
+            }
+        }
+        let small: Vec<usize> =
+            (0..flowsheets.len()).filter(|&i| flowsheets[i].plant.n_vars() <= STEADY_MAX_VARS).collect();
+        let scenarios = scen
+            .into_iter()
+            .map(|(file, text, value)| {
+                let fits = |i: &usize| {
+                    parse_scenario(&text, &file).is_ok_and(|s| resolve(&s, &flowsheets[*i].plant, &file).is_ok())
+                };
+                let on: Vec<usize> = small.iter().copied().filter(fits).collect();
+                Scenario { file, value: shortened(value), flowsheets: on }
+            })
+            .filter(|s| !s.flowsheets.is_empty())
+            .collect();
+        Corpus { flowsheets, small, scenarios }
+    }
+}
+
+/// `value` with its duration cut to [`RUN_FRACTION`] (same unit).
+fn shortened(mut value: Value) -> Value {
+    let cut = value.get("duration").and_then(Value::as_str).and_then(|d| {
+        let (x, unit) = d.trim().split_once(' ')?;
+        Some(format!("{} {unit}", x.parse::<f64>().ok()? * RUN_FRACTION))
+    });
+    if let Some(d) = cut {
+        value["duration"] = Value::String(d);
+    }
+    value
+}
+
+/// What a mutant exercises.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Mode {
+    /// Parse, assemble, `--set`, structural DOF check.
+    Load,
+    /// Also the numerical DOF probe and the steady solver, its answer certified.
+    Steady,
+    /// Also a (short) scenario through the integrator.
+    Run,
+}
+
+/// One mutant: everything needed to run it, and what was changed.
+pub struct Mutant {
+    /// Its seed (`PLANTWIDE_FUZZ_SEED=<seed> PLANTWIDE_FUZZ_MUTANTS=1` replays it).
+    pub seed: u64,
+    /// What it exercises.
+    pub mode: Mode,
+    /// Flowsheet file it came from.
+    pub file: String,
+    /// Flowsheet text.
+    pub text: String,
+    /// Scenario file and text (run mutants).
+    pub scenario: Option<(String, String)>,
+    /// `--set` assignments.
+    pub sets: Vec<String>,
+    /// The changes made, one line each (`path: before -> after [class]`).
+    pub changes: Vec<String>,
+}
+
+impl Mutant {
+    /// Make the mutant of `seed`: 84 % load, 12 % steady, 4 % run; 1-3 changes (3 % none).
+    pub fn new(seed: u64, corpus: &Corpus) -> Mutant {
+        let mut rng = Rng::new(seed);
+        let r = rng.unit();
+        let mode = if r < 0.84 {
+            Mode::Load
+        } else if r < 0.96 || corpus.scenarios.is_empty() {
+            Mode::Steady
+        } else {
+            Mode::Run
+        };
+        let (fi, scenario) = match mode {
+            Mode::Load => (rng.below(corpus.flowsheets.len()), None),
+            Mode::Steady => (*rng.pick(&corpus.small), None),
+            Mode::Run => {
+                let s = rng.pick(&corpus.scenarios);
+                (*rng.pick(&s.flowsheets), Some(s))
+            }
+        };
+        let base = &corpus.flowsheets[fi];
+        let mut m = Mutant {
+            seed,
+            mode,
+            file: base.file.clone(),
+            text: String::new(),
+            scenario: None,
+            sets: Vec::new(),
+            changes: Vec::new(),
+        };
+        let mut doc = Doc::new(base.value.clone());
+        let n = if rng.chance(0.03) { 0 } else { *rng.pick(&[1, 1, 1, 1, 1, 1, 1, 2, 2, 3]) };
+        if let Some(s) = scenario {
+            let mut sdoc = Doc::new(s.value.clone());
+            for _ in 0..n {
+                let line = if rng.chance(0.6) {
+                    targeted::scenario(&mut rng, &mut sdoc, &base.names)
+                } else {
+                    mutate(&mut rng, &mut sdoc, &base.names)
+                };
+                m.changes.push(format!("scenario {line}"));
+            }
+            m.scenario = Some((s.file.clone(), sdoc.render()));
+        } else {
+            for _ in 0..n {
+                let r = rng.unit();
+                if r < 0.12 {
+                    let (a, class) = targeted::assignment(&mut rng, &base.plant, &base.value, &base.names);
+                    m.changes.push(format!("--set {a} [{class}]"));
+                    m.sets.push(a);
+                } else if r < 0.4 {
+                    m.changes.push(targeted::flowsheet(&mut rng, &mut doc, &base.names));
+                } else {
+                    m.changes.push(mutate(&mut rng, &mut doc, &base.names));
+                }
+            }
+        }
+        m.text = doc.render();
+        m
+    }
+
+    /// The shipped flowsheet `fi` unchanged: steady, or run with `scenario` (the warm-up).
+    pub fn shipped(corpus: &Corpus, fi: usize, scenario: Option<&Scenario>) -> Mutant {
+        let f = &corpus.flowsheets[fi];
+        Mutant {
+            seed: 0,
+            mode: if scenario.is_some() { Mode::Run } else { Mode::Steady },
+            file: f.file.clone(),
+            text: Doc::new(f.value.clone()).render(),
+            scenario: scenario.map(|s| (s.file.clone(), Doc::new(s.value.clone()).render())),
+            sets: Vec::new(),
+            changes: Vec::new(),
+        }
+    }
+
+    /// One line: seed, mode, file, changes.
+    pub fn describe(&self) -> String {
+        let scen = self.scenario.as_ref().map_or(String::new(), |(f, _)| format!(" --scenario {f}"));
+        let changes =
+            if self.changes.is_empty() { "unmutated [identity]".to_string() } else { self.changes.join("; ") };
+        format!("seed={:#018x} {:?} {}{scen}: {changes}", self.seed, self.mode, self.file)
+    }
+}

@@ -1,0 +1,106 @@
+//! Running one mutant in process through the library, as `plantwide check`, `steady` and `run`
+//! would, and classifying what came back.
+
+use plantwide::flowsheet::overrides::{set_field, set_input, split_assignment};
+use plantwide::flowsheet::scenario::{parse_scenario, resolve};
+use plantwide::flowsheet::{Plant, assemble, parse_spec};
+use plantwide::solve::dynamic::{SimError, Start, simulate};
+use plantwide::solve::sequential::{Solution, StrategySettings, steady_state_by};
+use plantwide::solve::{DofProbe, dof_check};
+
+use super::certificate;
+use super::corpus::{Mode, Mutant};
+
+/// What an honest engine may answer.
+#[derive(Debug)]
+pub enum Outcome {
+    /// Loaded, converged (and certified), or ran (with finite values).
+    Ok,
+    /// Rejected as a user error (exit 1).
+    User(String),
+    /// A numerical failure (exit 2).
+    Numerical(String),
+}
+
+/// A dishonest answer: `Ok` with a failed certificate.
+#[derive(Debug)]
+pub struct Dishonest(pub String);
+
+/// Run `m`.
+pub fn execute(m: &Mutant) -> Result<Outcome, Dishonest> {
+    let (mut plant, u) = match load(m) {
+        Ok(p) => p,
+        Err(e) => return Ok(Outcome::User(e)),
+    };
+    match m.mode {
+        Mode::Load => {
+            let _ = plant.recycles();
+            let x = plant.initial_guess_at(&u);
+            Ok(match dof_check(&plant, &u, &x, DofProbe::Structural) {
+                Ok(()) => Outcome::Ok,
+                Err(e) => Outcome::User(e.to_string()),
+            })
+        }
+        Mode::Steady => match steady(&plant, &u) {
+            Ok(sol) => certificate::steady(&plant, &sol.x).map(|()| Outcome::Ok).map_err(Dishonest),
+            Err(o) => Ok(o),
+        },
+        Mode::Run => {
+            plant.inputs.iter_mut().zip(&u).for_each(|(info, v)| info.value = *v);
+            run(m, &mut plant, &u)
+        }
+    }
+}
+
+/// Parse, assemble and apply the `--set` assignments as `plantwide steady` does.
+fn load(m: &Mutant) -> Result<(Plant, Vec<f64>), String> {
+    let mut spec = parse_spec(&m.text, &m.file).map_err(|e| e.to_string())?;
+    let mut plant = assemble(&spec, &m.file).map_err(|e| e.to_string())?;
+    let mut assignments = Vec::new();
+    let mut reassemble = false;
+    for s in &m.sets {
+        let (path, value) = split_assignment(s)?;
+        let mut u = plant.input_values();
+        if set_input(&plant, &mut u, path, value)? {
+            assignments.push((path.to_string(), value.to_string()));
+        } else {
+            set_field(&mut spec, path, value)?;
+            reassemble = true;
+        }
+    }
+    if reassemble {
+        plant = assemble(&spec, &m.file).map_err(|e| e.to_string())?;
+    }
+    let mut u = plant.input_values();
+    for (path, value) in &assignments {
+        set_input(&plant, &mut u, path, value)?;
+    }
+    Ok((plant, u))
+}
+
+/// The DOF check and the default strategy, as `plantwide steady` runs them.
+fn steady(plant: &Plant, u: &[f64]) -> Result<Solution, Outcome> {
+    let x0 = plant.initial_guess_at(u);
+    dof_check(plant, u, &x0, DofProbe::Numerical).map_err(|e| Outcome::User(e.to_string()))?;
+    steady_state_by(plant, u, &StrategySettings::default(), &mut |_| {})
+        .map_err(|e| if e.is_user_error() { Outcome::User(e.to_string()) } else { Outcome::Numerical(e.to_string()) })
+}
+
+/// The scenario from the certified steady state, as `plantwide run` does.
+fn run(m: &Mutant, plant: &mut Plant, u: &[f64]) -> Result<Outcome, Dishonest> {
+    let (file, text) = m.scenario.as_ref().expect("a run mutant has a scenario");
+    let sc = match parse_scenario(text, file).and_then(|s| resolve(&s, plant, file)) {
+        Ok(sc) => sc,
+        Err(e) => return Ok(Outcome::User(e.to_string())),
+    };
+    let sol = match steady(plant, u) {
+        Ok(sol) => sol,
+        Err(o) => return Ok(o),
+    };
+    certificate::steady(plant, &sol.x).map_err(Dishonest)?;
+    match simulate(plant, &sc, Start::Steady(&sol.x), "fuzz", &mut |_| {}) {
+        Ok(res) => certificate::run(&res).map(|()| Outcome::Ok).map_err(|e| Dishonest(format!("run: {e}"))),
+        Err(e @ SimError::Snapshot { .. }) => Ok(Outcome::User(e.to_string())),
+        Err(e) => Ok(Outcome::Numerical(e.to_string())),
+    }
+}

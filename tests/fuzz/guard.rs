@@ -1,0 +1,144 @@
+//! Guards for the failures that kill the process: the mutant about to run is written to
+//! `target/fuzz-current.txt` first (an abort or a stack overflow leaves it there to replay), a
+//! watchdog thread aborts a mutant that runs over the time limit, and a counting global allocator
+//! aborts on any request, or live total above the warm-up baseline, over the memory limit. Both print the mutant first.
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::io::Write;
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
+use std::time::{Duration, Instant};
+
+/// Largest single allocation, and largest live total, a mutant may ask for.
+pub const MEMORY_LIMIT: usize = 2 << 30;
+/// Wall time a mutant may take.
+pub const TIME_LIMIT: Duration = Duration::from_secs(10);
+
+static LIVE: AtomicUsize = AtomicUsize::new(0);
+/// Live bytes after the warm-up: per-thread scratch the engine keeps for good (faer's gemm
+/// backend holds about 1 GiB of address space per thread that multiplies matrices).
+static BASELINE: AtomicUsize = AtomicUsize::new(usize::MAX / 2);
+static PEAK: AtomicUsize = AtomicUsize::new(0);
+/// Milliseconds since [`epoch`] at which the current mutant started (0: none running).
+static STARTED_MS: AtomicU64 = AtomicU64::new(0);
+/// Description of the mutant running now (read without allocating by the guards).
+static CURRENT: Mutex<String> = Mutex::new(String::new());
+
+fn epoch() -> Instant {
+    static EPOCH: std::sync::OnceLock<Instant> = std::sync::OnceLock::new();
+    *EPOCH.get_or_init(Instant::now)
+}
+
+/// The file holding the mutant being run.
+pub fn current_file() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("target").join("fuzz-current.txt")
+}
+
+/// Record `description` as the running mutant (file and memory) and start its clock.
+pub fn begin(description: &str) {
+    let _ = std::fs::write(current_file(), description);
+    let text = description.to_string();
+    *CURRENT.lock().unwrap_or_else(|e| e.into_inner()) = text;
+    STARTED_MS.store(epoch().elapsed().as_millis() as u64 + 1, Ordering::SeqCst);
+}
+
+/// The mutant finished: stop its clock.
+pub fn end() {
+    STARTED_MS.store(0, Ordering::SeqCst);
+}
+
+/// Take the live heap now as the baseline the limit counts from; reset the peak.
+pub fn set_baseline() -> usize {
+    let live = LIVE.load(Ordering::SeqCst);
+    BASELINE.store(live, Ordering::SeqCst);
+    PEAK.store(live, Ordering::SeqCst);
+    live
+}
+
+/// Peak live heap above the baseline [bytes].
+pub fn peak() -> usize {
+    PEAK.load(Ordering::Relaxed).saturating_sub(BASELINE.load(Ordering::Relaxed))
+}
+
+/// Print `what` and the running mutant to stderr without allocating, then abort.
+fn die(what: &str, amount: usize, unit: &str) -> ! {
+    let mut err = std::io::stderr();
+    let _ = writeln!(err, "\nfuzz FAILURE: {what} ({amount} {unit})");
+    match CURRENT.try_lock() {
+        Ok(d) => {
+            let _ = writeln!(err, "mutant: {}", d.as_str());
+        }
+        Err(_) => {
+            let _ = writeln!(err, "mutant: see the file below");
+        }
+    }
+    let _ = writeln!(err, "(also in target/fuzz-current.txt)");
+    std::process::abort()
+}
+
+/// Start the watchdog thread.
+pub fn start_watchdog() {
+    epoch();
+    std::thread::spawn(|| {
+        loop {
+            std::thread::sleep(Duration::from_millis(100));
+            let started = STARTED_MS.load(Ordering::SeqCst);
+            if started == 0 {
+                continue;
+            }
+            let ms = (epoch().elapsed().as_millis() as u64 + 1).saturating_sub(started);
+            if ms > TIME_LIMIT.as_millis() as u64 {
+                die("mutant over the time limit of 10 s", ms as usize, "ms");
+            }
+        }
+    });
+}
+
+/// [`System`] with a count of live bytes, a peak, and the memory limit.
+pub struct Counting;
+
+impl Counting {
+    fn grow(&self, bytes: usize) {
+        if bytes > MEMORY_LIMIT {
+            die("single allocation over 2 GiB", bytes, "bytes");
+        }
+        let live = LIVE.fetch_add(bytes, Ordering::Relaxed) + bytes;
+        let above = live.saturating_sub(BASELINE.load(Ordering::Relaxed));
+        if above > MEMORY_LIMIT {
+            die("live heap over 2 GiB above the warm-up baseline", above, "bytes");
+        }
+        PEAK.fetch_max(live, Ordering::Relaxed);
+    }
+}
+
+// SAFETY: every call is forwarded to `System` with the same arguments; the bookkeeping around it
+// only reads and writes atomics.
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        self.grow(layout.size());
+        // SAFETY: forwarded unchanged.
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
+        self.grow(layout.size());
+        // SAFETY: forwarded unchanged.
+        unsafe { System.alloc_zeroed(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        LIVE.fetch_sub(layout.size(), Ordering::Relaxed);
+        // SAFETY: forwarded unchanged.
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        if new_size > MEMORY_LIMIT {
+            die("single allocation over 2 GiB", new_size, "bytes");
+        }
+        if new_size > layout.size() {
+            self.grow(new_size - layout.size());
+        } else {
+            LIVE.fetch_sub(layout.size() - new_size, Ordering::Relaxed);
+        }
+        // SAFETY: forwarded unchanged.
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
