@@ -80,6 +80,15 @@ impl Report {
         if took > self.slowest.0 {
             self.slowest = (took, m.describe());
         }
+        if took > guard::TIME_LIMIT {
+            self.failures.push(("over the time limit".into(), m.describe(), format!("{took:?}")));
+        }
+        if let Ok(Ok(Outcome::User(msg) | Outcome::Numerical(msg))) = &result
+            && msg.len() > MAX_MESSAGE
+        {
+            let head: String = msg.chars().take(300).collect();
+            self.failures.push(("message too long".into(), m.describe(), format!("{} bytes: {head}…", msg.len())));
+        }
         match result {
             Ok(Ok(Outcome::Ok)) => self.ok += 1,
             Ok(Ok(Outcome::User(msg))) => {
@@ -195,6 +204,10 @@ fn campaign(seed: u64, n: usize, skip: &[String]) -> Report {
     }
     report
 }
+
+/// Longest error message a person can be expected to read (bytes): every problem is named, but a
+/// message must not echo a huge input or list a million problems.
+const MAX_MESSAGE: usize = 20_000;
 
 #[test]
 fn mutants_neither_crash_nor_hang_nor_claim_false_convergence() {

@@ -103,6 +103,15 @@ fn shortened(mut value: Value) -> Value {
         Some(format!("{} {unit}", x.parse::<f64>().ok()? * RUN_FRACTION))
     });
     if let Some(d) = cut {
+        // Events after the shortened end would be refused (an event after the end of a run is an
+        // error); keep those within it.
+        let secs = |q: &Value| {
+            q.as_str().and_then(|t| plantwide::units::parse_quantity_as(t, plantwide::units::Dimension::TIME).ok())
+        };
+        let end = secs(&Value::String(d.clone())).unwrap_or(f64::INFINITY);
+        if let Some(Value::Array(events)) = value.get_mut("events") {
+            events.retain(|e| e.get("at").and_then(secs).is_none_or(|t| t <= end));
+        }
         value["duration"] = Value::String(d);
     }
     value

@@ -67,7 +67,12 @@ pub enum LoadError {
 fn render(file: &str, diagnostics: &[Diagnostic]) -> String {
     let n = diagnostics.len();
     let mut s = format!("{file}: {n} problem{} found", if n == 1 { "" } else { "s" });
-    for d in diagnostics {
+    // Every problem is kept in the error value; the text shows the first MAX_SHOWN.
+    const MAX_SHOWN: usize = 50;
+    if n > MAX_SHOWN {
+        s.push_str(&format!(" (the first {MAX_SHOWN} shown)"));
+    }
+    for d in diagnostics.iter().take(MAX_SHOWN) {
         if d.path.is_empty() {
             s.push_str(&format!("\n  - {}", d.message));
         } else {

@@ -21,6 +21,10 @@ pub fn resolve_input(plant: &Plant, path: &str) -> Option<usize> {
 
 /// Split `PATH=VALUE`.
 pub fn split_assignment(text: &str) -> Result<(&str, &str), String> {
+    let limit = plantwide_model::limits::Limits::get().string_len();
+    if let Some(msg) = limit.check(text.chars().count(), "the length of this assignment") {
+        return Err(format!("--set `{}`: {msg}", plantwide_model::limits::clip(text)));
+    }
     text.split_once('=')
         .map(|(p, v)| (p.trim(), v.trim()))
         .ok_or_else(|| format!("`{text}`: expected PATH=VALUE, e.g. feed.F=1.01kmol/min"))

@@ -45,15 +45,11 @@ pub fn parse_spec(text: &str, file: &str) -> Result<FlowsheetSpec, LoadError> {
         column: e.column(),
         reason: strip_position(&e.to_string()),
     })?;
-    let mut diags: Vec<Diagnostic> = duplicate_keys(text)
-        .into_iter()
-        .map(|path| {
-            Diagnostic::new(
-                path,
-                "this key appears twice in the same object (JSON readers keep only one): remove or rename one",
-            )
-        })
-        .collect();
+    let mut diags = walk_diagnostics(text);
+    if !diags.is_empty() {
+        // A duplicate key or an overlong string: what serde would say next would quote them.
+        return Err(LoadError::Invalid { file: file.into(), diagnostics: diags });
+    }
     let Some(obj) = root.as_object() else {
         return Err(LoadError::Invalid {
             file: file.into(),
@@ -283,9 +279,11 @@ fn tagged_map<T>(
     out
 }
 
-/// JSON paths of keys that appear twice in one object (at most 20). serde_json, like most JSON
-/// readers, silently keeps one of them, which would drop a whole unit definition unseen.
-fn duplicate_keys(text: &str) -> Vec<String> {
+/// Problems only the raw text shows (at most 20): keys that appear twice in one object —
+/// serde_json, like most JSON readers, silently keeps one of them, which would drop a whole unit
+/// definition unseen — and strings or keys longer than [`Limits::max_string_len`], which no field
+/// needs and which would make every message and search that quotes them slow.
+pub fn walk_diagnostics(text: &str) -> Vec<Diagnostic> {
     let mut found = Vec::new();
     let mut de = serde_json::Deserializer::from_str(text);
     // The text already parsed as JSON; a failure here only ends the search early.
@@ -293,10 +291,21 @@ fn duplicate_keys(text: &str) -> Vec<String> {
     found
 }
 
-/// A walk over a JSON document that records duplicate keys with their paths.
+/// A walk over a JSON document that records duplicate keys and overlong strings with their paths.
 struct Walk<'a> {
     path: String,
-    found: &'a mut Vec<String>,
+    found: &'a mut Vec<Diagnostic>,
+}
+
+impl Walk<'_> {
+    fn long(&mut self, s: &str) {
+        let limit = Limits::get().string_len();
+        if let Some(msg) = limit.check(s.chars().count(), "the length of this string")
+            && self.found.len() < 20
+        {
+            self.found.push(Diagnostic::new(clip(&self.path), format!("`{}`: {msg}", clip(s))));
+        }
+    }
 }
 
 impl<'de> DeserializeSeed<'de> for Walk<'_> {
@@ -323,7 +332,8 @@ impl<'de> Visitor<'de> for Walk<'_> {
     fn visit_f64<E>(self, _: f64) -> Result<(), E> {
         Ok(())
     }
-    fn visit_str<E>(self, _: &str) -> Result<(), E> {
+    fn visit_str<E>(mut self, v: &str) -> Result<(), E> {
+        self.long(v);
         Ok(())
     }
     fn visit_unit<E>(self) -> Result<(), E> {
@@ -341,9 +351,13 @@ impl<'de> Visitor<'de> for Walk<'_> {
         let Walk { path, found } = self;
         let mut seen = HashSet::new();
         while let Some(key) = map.next_key::<String>()? {
-            let child = if path.is_empty() { key.clone() } else { format!("{path}.{key}") };
+            let child = if path.is_empty() { key.clone() } else { format!("{path}.{}", clip(&key)) };
+            Walk { path: child.clone(), found: &mut *found }.long(&key);
             if !seen.insert(key) && found.len() < 20 {
-                found.push(child.clone());
+                found.push(Diagnostic::new(
+                    child.clone(),
+                    "this key appears twice in the same object (JSON readers keep only one): remove or rename one",
+                ));
             }
             map.next_value_seed(Walk { path: child, found: &mut *found })?;
         }

@@ -493,7 +493,10 @@ pub fn resolve_with(spec: &ScenarioSpec, plant: &Plant, file: &str, limits: &Lim
     let atol = int.atol.unwrap_or(1e-8);
     for (name, v) in [("integrator.rtol", rtol), ("integrator.atol", atol)] {
         if !(v.is_finite() && v > 0.0 && v < 1.0) {
-            cx.diags.push(Diagnostic::new(name, format!("must be a number between 0 and 1 (got {v})")));
+            cx.diags.push(Diagnostic::new(
+                name,
+                format!("must be a number between 0 and 1 (got {})", plantwide_model::limits::number(v)),
+            ));
         }
     }
     let max_step = int.max_step.as_ref().map_or(f64::INFINITY, |q| cx.time("integrator.max_step", q, true));
@@ -659,6 +662,18 @@ fn record_budget(cx: &mut Cx<'_>, times: (f64, f64), n_events: usize, n_columns:
 fn events_of(cx: &mut Cx<'_>, specs: &[EventSpec], duration: f64, limits: &Limits) -> Vec<Event> {
     // (event, label for messages)
     let mut events: Vec<(Event, String)> = Vec::new();
+    if specs.len() as u64 > limits.max_events {
+        cx.diags.push(Diagnostic::new(
+            "events",
+            format!(
+                "{} events are more than the limit of {} ({} raises it)",
+                specs.len(),
+                limits.max_events,
+                Limits::MAX_EVENTS
+            ),
+        ));
+        return Vec::new();
+    }
     for (k, e) in specs.iter().enumerate() {
         let base = format!("events[{k}]");
         let expanded = event(cx, &base, e);
@@ -717,7 +732,9 @@ fn check_values(cx: &mut Cx<'_>, events: &[(Event, String)]) {
     let mut saved: Vec<Option<f64>> = vec![None; u.len()];
     for (e, label) in events {
         let (input, values): (usize, Vec<f64>) = match e.action {
-            Action::Step { input, change } | Action::Ramp { input, change, .. } => (input, vec![change.apply(u[input])]),
+            Action::Step { input, change } | Action::Ramp { input, change, .. } => {
+                (input, vec![change.apply(u[input])])
+            }
             Action::Pulse { input, change } => {
                 saved[input] = Some(u[input]);
                 (input, vec![change.apply(u[input])])
@@ -732,7 +749,10 @@ fn check_values(cx: &mut Cx<'_>, events: &[(Event, String)]) {
         for &v in &values {
             if let Err(why) = crate::overrides::check_input_value(cx.plant, input, v) {
                 let path = &cx.plant.inputs[input].path;
-                cx.diags.push(Diagnostic::new(label.split(' ').next().unwrap_or_default(), format!("takes `{path}` to {why}")));
+                cx.diags.push(Diagnostic::new(
+                    label.split(' ').next().unwrap_or_default(),
+                    format!("takes `{path}` to {why}"),
+                ));
                 return;
             }
         }

@@ -26,8 +26,13 @@ pub struct Limits {
     pub max_components: usize,
     /// Most units plus controllers of a flowsheet (`PLANTWIDE_MAX_UNITS`, default 20000).
     pub max_units: usize,
-    /// Most characters of a name or path (`PLANTWIDE_MAX_NAME_LEN`, default 256).
+    /// Most characters of a name (`PLANTWIDE_MAX_NAME_LEN`, default 256).
     pub max_name_len: usize,
+    /// Most characters of any string or key of a file: paths, descriptions
+    /// (`PLANTWIDE_MAX_STRING_LEN`, default 4096).
+    pub max_string_len: usize,
+    /// Most reactions of one reactor (`PLANTWIDE_MAX_REACTIONS`, default 100).
+    pub max_reactions: usize,
     /// Largest flowsheet or scenario file in bytes (`PLANTWIDE_MAX_FILE_BYTES`, default 64 MiB).
     pub max_file_bytes: usize,
     /// Most variables of an assembled plant (`PLANTWIDE_MAX_VARIABLES`, default 2 000 000).
@@ -45,6 +50,8 @@ impl Default for Limits {
             max_components: 200,
             max_units: 20_000,
             max_name_len: 256,
+            max_string_len: 4096,
+            max_reactions: 100,
             max_file_bytes: 64 << 20,
             max_variables: 2_000_000,
             max_block_entries: 40_000_000,
@@ -89,6 +96,8 @@ impl Limits {
             ("PLANTWIDE_MAX_COMPONENTS", &mut l.max_components),
             ("PLANTWIDE_MAX_UNITS", &mut l.max_units),
             ("PLANTWIDE_MAX_NAME_LEN", &mut l.max_name_len),
+            ("PLANTWIDE_MAX_STRING_LEN", &mut l.max_string_len),
+            ("PLANTWIDE_MAX_REACTIONS", &mut l.max_reactions),
             ("PLANTWIDE_MAX_FILE_BYTES", &mut l.max_file_bytes),
             ("PLANTWIDE_MAX_VARIABLES", &mut l.max_variables),
             ("PLANTWIDE_MAX_BLOCK_ENTRIES", &mut l.max_block_entries),
@@ -119,6 +128,14 @@ impl Limits {
     /// Characters of a name.
     pub fn name_len(&self) -> Limit {
         Limit { max: self.max_name_len, var: "PLANTWIDE_MAX_NAME_LEN" }
+    }
+    /// Characters of any string of a file.
+    pub fn string_len(&self) -> Limit {
+        Limit { max: self.max_string_len, var: "PLANTWIDE_MAX_STRING_LEN" }
+    }
+    /// Reactions of one reactor.
+    pub fn reactions(&self) -> Limit {
+        Limit { max: self.max_reactions, var: "PLANTWIDE_MAX_REACTIONS" }
     }
     /// Bytes of a file.
     pub fn file_bytes(&self) -> Limit {
@@ -166,6 +183,8 @@ pub fn input_range(name: &str, dim: Dimension) -> (f64, f64) {
     let hi = max_magnitude(dim);
     if name.starts_with("z[") || name.starts_with("split[") || name == "auto" || name == "opening" {
         (0.0, 1.0)
+    } else if name == "reboiler_duty" {
+        (0.0, hi)
     } else if name == "bias" || name == "ratio" || name.starts_with("dp") {
         (-hi, hi)
     } else if dim == Dimension::TEMPERATURE || dim == Dimension::PRESSURE {

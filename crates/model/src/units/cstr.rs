@@ -172,6 +172,18 @@ fn build_reaction(cx: &mut BuildCx<'_>, f: &str, c: &ReactionConfig) -> Reaction
     if nu.iter().all(|v| *v == 0.0) {
         cx.error(&format!("{f}.stoichiometry"), "give at least one non-zero coefficient (negative for reactants)");
     }
+    // Σ_i ν_i·MW_i = 0: a reaction creates no mass (to 1e-6 of its largest term).
+    let terms: Vec<f64> = nu.iter().zip(&cx.thermo.components).map(|(v, c)| v * c.mw).collect();
+    let (net, big) = (terms.iter().sum::<f64>(), terms.iter().fold(0.0_f64, |a, t| a.max(t.abs())));
+    if net.abs() > 1e-6 * big {
+        cx.error(
+            &format!("{f}.stoichiometry"),
+            format!(
+                "the reaction does not conserve mass: Σ ν·MW = {net:.6e} kg/mol (the products weigh {} of the reactants); adjust the coefficients or the components' molar masses",
+                crate::limits::number(1.0 + net / terms.iter().filter(|t| **t < 0.0).map(|t| -t).sum::<f64>().max(1e-300))
+            ),
+        );
+    }
     let orders = match &c.orders {
         Some(o) => by_component(cx, &format!("{f}.orders"), o),
         None => nu.iter().map(|v| (-v).max(0.0)).collect(),
@@ -197,6 +209,9 @@ impl Cstr {
         let holdup = Holdup::build(&mut cx, c.diameter.as_ref(), c.area.as_ref(), c.height.as_ref(), c.level.as_ref());
         let pressure = c.pressure.as_ref().map_or(ATM, |p| cx.positive("P", p, Dimension::PRESSURE));
         let law = OutflowLaw::build(&c.outflow, &mut cx, "outflow");
+        if !cx.count("reactions", c.reactions.len(), crate::limits::Limits::get().reactions()) {
+            return Err(cx.errors);
+        }
         let reactions = c
             .reactions
             .iter()
@@ -405,12 +420,20 @@ impl UnitModel for Cstr {
 mod tests {
     use super::super::outflow::test_support::{Lcg, at_guess, build_unit, solve_own};
     use super::*;
-    use crate::testing::{binary_package, jacobian_error};
+    use crate::testing::jacobian_error;
+
+    /// The binary test package with `heavy` an isomer of `light` (both 50 g/mol), so that the test
+    /// reactions conserve mass.
+    fn binary_package() -> plantwide_thermo::ThermoPackage {
+        let mut p = crate::testing::binary_package();
+        p.components[1].mw = p.components[0].mw;
+        p
+    }
 
     const ISO: &str = r#"{"area": 1, "outflow": {"type": "valve", "cv": 5e-4, "opening": 0.8},
         "reactions": [{"stoichiometry": {"light": -1, "heavy": 1}, "k0": "0.3 1/min", "dh": "-40 kJ/mol"}], "duty": "-300 kW"}"#;
     const JACKET: &str = r#"{"diameter": "1.2 m", "height": "2 m", "outflow": {"type": "valve", "cv": 5e-4, "opening": 0.6, "characteristic": "equal_percentage"},
-        "reactions": [{"stoichiometry": {"light": -2, "heavy": 1}, "k0": 0.2, "ea": "40 kJ/mol", "dh": "-30 kJ/mol"},
+        "reactions": [{"stoichiometry": {"light": -2, "heavy": 2}, "k0": 0.2, "ea": "40 kJ/mol", "dh": "-30 kJ/mol"},
                       {"stoichiometry": {"heavy": -1, "light": 1}, "orders": {"heavy": 1.5}, "k0": 5e2, "ea": "50 kJ/mol", "dh": "10 kJ/mol"}],
         "jacket": {"ua": "40 kW/K", "volume": "0.3 m3", "coolant_flow": "4 kg/s", "coolant_T": "30 degC"}}"#;
     const FLOW: &str = r#"{"area": 1, "outflow": {"type": "flow", "flow": 8}, "reactions": [{"stoichiometry": {"light": -1, "heavy": 1}, "k0": 1e-3}]}"#;
@@ -482,6 +505,17 @@ mod tests {
                 assert!((x - exact).abs() < 1e-9, "{x} vs {exact}");
             }
         }
+    }
+
+    #[test]
+    fn a_reaction_that_creates_mass_is_refused() {
+        // light (50 g/mol) → heavy (80 g/mol): the products would weigh 1.6 times the reactants.
+        let thermo = crate::testing::binary_package();
+        let names = ["light".to_string(), "heavy".to_string()];
+        let c: CstrConfig = serde_json::from_str(ISO).unwrap();
+        let errs = Cstr::build(&c, BuildCx::new(&names, &thermo, "units.r"), ()).unwrap_err();
+        assert_eq!(errs[0].path, "units.r.reactions[0].stoichiometry");
+        assert!(errs[0].message.contains("does not conserve mass") && errs[0].message.contains("1.6 of"), "{errs:?}");
     }
 
     #[test]

@@ -177,6 +177,20 @@ impl RigorousColumn {
                 height: cx.non_negative("rigorous.weir_height", &r.weir_height, Dimension::LENGTH),
                 area: cx.positive("rigorous.tray_area", &r.tray_area, Dimension::AREA),
             };
+            // Tray geometry of real columns: weirs of a few cm (Francis formula's range), trays of
+            // at most a few hundred m²; outside it the hydraulics have no meaning.
+            for (field, v, max, unit) in [
+                ("rigorous.weir_height", weir.height, 1.0, "m"),
+                ("rigorous.weir_length", weir.length, 100.0, "m"),
+                ("rigorous.tray_area", weir.area, 1000.0, "m²"),
+            ] {
+                if v > max {
+                    cx.error(
+                        field,
+                        format!("{} {unit} is beyond the {max} {unit} of any real tray", crate::limits::number(v)),
+                    );
+                }
+            }
         }
         if c.feeds.is_empty() {
             cx.error("feeds", "give at least one feed, e.g. [{\"port\": \"feed\", \"stage\": 10}]");
