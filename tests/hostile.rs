@@ -108,7 +108,7 @@ fn a_huge_unknown_component_name_is_answered_fast_and_not_echoed() {
     assert_eq!(out.status.code(), Some(1));
     assert!(took < Duration::from_secs(5), "{took:?}");
     assert!(
-        stderr.len() < 2000 && stderr.contains("components[0]") && stderr.contains("PLANTWIDE_MAX_NAME_LEN"),
+        stderr.len() < 2000 && stderr.contains("components[0]") && stderr.contains("PLANTWIDE_MAX_STRING_LEN"),
         "{}",
         &stderr[..stderr.len().min(500)]
     );
@@ -216,4 +216,17 @@ fn a_singular_guess_is_not_called_an_uncontrolled_inventory() {
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
     assert_eq!(v["warnings"][0]["path"], "lp_xB.op");
     assert_eq!(v["warnings"][0]["limit"], "op_min");
+}
+
+/// A record interval of 1e-300 s over 1e12 s asks for infinitely many rows (the quotient overflows):
+/// refused like any other request above the row limit (it grew the heap past 2 GiB in the fuzzer).
+#[test]
+fn a_record_request_that_overflows_is_refused() {
+    let plant = load_file(std::path::Path::new(&common::flowsheet("surge_tank_pi.json"))).unwrap();
+    let text = r#"{"format_version": 1, "duration": "1e12 s", "events": [],
+        "record": {"interval": "1e-300 s", "paths": ["tank.level"]}}"#;
+    let spec = plantwide::flowsheet::scenario::parse_scenario(text, "s.json").unwrap();
+    let e = plantwide::flowsheet::scenario::resolve(&spec, &plant, "s.json").expect_err("refused");
+    let msg = e.to_string();
+    assert!(msg.contains("record.interval") && msg.contains("PLANTWIDE_MAX_RECORD_ROWS"), "{msg}");
 }

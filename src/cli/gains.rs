@@ -209,8 +209,7 @@ pub fn display_gain(si: &Mat<f64>, inputs: &[Signal], outputs: &[Signal]) -> Mat
 
 fn run_tf(a: &GainsArgs, file: &Path) -> Result<(), CliError> {
     let name = file.display().to_string();
-    let text =
-        std::fs::read_to_string(file).map_err(|e| CliError::user(format!("{name}: cannot read the file: {e}")))?;
+    let text = plantwide::flowsheet::read_text(file).map_err(|e| CliError::user(e.to_string()))?;
     let model = TfModel::parse(&text, &name).map_err(analysis_error)?;
     if a.method == Method::Perturb {
         return Err(CliError::user(

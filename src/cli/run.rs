@@ -45,23 +45,21 @@ fn fingerprint(text: &str, sets: &[String]) -> String {
     format!("{h:016x}")
 }
 
-fn read(path: &Path, what: &str) -> Result<String, CliError> {
-    std::fs::read_to_string(path)
-        .map_err(|e| CliError::user(format!("{}: cannot read the {what}: {e}", path.display())))
+fn read(path: &Path) -> Result<String, CliError> {
+    plantwide::flowsheet::read_text(path).map_err(|e| CliError::user(e.to_string()))
 }
 
 pub fn run(args: &RunArgs) -> Result<(), CliError> {
-    let flowsheet_text = read(&args.file, "flowsheet")?;
+    let flowsheet_text = read(&args.file)?;
     let (mut plant, u) = load_with_overrides(&args.file, &args.set)?;
     plant.inputs.iter_mut().zip(&u).for_each(|(info, v)| info.value = *v);
     let scen_name = args.scenario.display().to_string();
-    let spec =
-        parse_scenario(&read(&args.scenario, "scenario")?, &scen_name).map_err(|e| CliError::user(e.to_string()))?;
+    let spec = parse_scenario(&read(&args.scenario)?, &scen_name).map_err(|e| CliError::user(e.to_string()))?;
     let limits = Limits::from_env().map_err(|e| CliError::user(e.to_string()))?;
     let sc = resolve_with(&spec, &plant, &scen_name, &limits).map_err(|e| CliError::user(e.to_string()))?;
     let snapshot: Option<Snapshot> = match &args.resume {
         Some(p) => Some(
-            serde_json::from_str(&read(p, "snapshot")?)
+            serde_json::from_str(&read(p)?)
                 .map_err(|e| CliError::user(format!("{}: not a snapshot file: {e}", p.display())))?,
         ),
         None => None,

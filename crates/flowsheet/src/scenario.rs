@@ -340,6 +340,10 @@ pub struct Scenario {
 
 /// Parse scenario text; `file` names it in messages.
 pub fn parse_scenario(text: &str, file: &str) -> Result<ScenarioSpec, LoadError> {
+    let walk = crate::parse::walk_diagnostics(text);
+    if !walk.is_empty() {
+        return Err(LoadError::Invalid { file: file.into(), diagnostics: walk });
+    }
     let mut de = serde_json::Deserializer::from_str(text);
     let spec: ScenarioSpec = serde_path_to_error::deserialize(&mut de).map_err(|e| {
         let path = e.path().to_string();
@@ -449,7 +453,7 @@ impl Cx<'_> {
     /// A sampling period `period` [s] must give at most `limits.max_samples` samples over the run.
     fn samples(&mut self, field: &str, what: &str, period: f64, duration: f64, limits: &Limits) {
         let n = duration / period;
-        if n.is_finite() && n > limits.max_samples as f64 {
+        if !n.is_nan() && n > limits.max_samples as f64 {
             self.diags.push(Diagnostic::new(
                 field,
                 format!(
@@ -627,7 +631,7 @@ fn recorded(cx: &mut Cx<'_>, rec: &RecordSpec, events: &[Event]) -> Vec<Recorded
 fn record_budget(cx: &mut Cx<'_>, times: (f64, f64), n_events: usize, n_columns: usize, limits: &Limits) {
     let (duration, interval) = times;
     let rows = (duration / interval).floor() + 1.0 + 2.0 * n_events as f64;
-    if !rows.is_finite() {
+    if rows.is_nan() {
         return; // duration or interval already reported
     }
     let raise = |var: &str| format!("{var} raises it");
