@@ -87,6 +87,22 @@ pub fn thermo_package(
                 alphas.push(Some(h.alpha));
             }
             ComponentSpec::Inline(c) => {
+                // The scalar data of an inline component within physical ranges (SI); the
+                // correlations are checked where they are evaluated.
+                for (field, v, lo, hi) in [
+                    ("mw", Some(c.mw), 1e-3, 10.0),
+                    ("tb", Some(c.tb), 1.0, 5000.0),
+                    ("tc", c.tc, 1.0, 1e4),
+                    ("pc", c.pc, 1.0, 1e10),
+                    ("omega", c.omega, -1.0, 5.0),
+                ] {
+                    if let Some(v) = v.filter(|v| !(v.is_finite() && *v >= lo && *v <= hi)) {
+                        diags.push(Diagnostic::new(
+                            format!("{path}.{field}"),
+                            format!("{v:e} is outside the physical range {lo:e} … {hi:e} (SI)"),
+                        ));
+                    }
+                }
                 comps.push((**c).clone());
                 alphas.push(None);
             }

@@ -90,8 +90,8 @@ fn newton_note(newton: &Option<String>) -> String {
     })
 }
 
-/// `Status after n iterations, scaled residual r; history: 1: r1, 2: r2, …` with the first three and
-/// the last five iterations.
+/// `history (iteration: scaled residual) 1: r1, 2: r2, …` with the first three and the last five
+/// iterations.
 pub fn history_summary(report: &NewtonReport) -> String {
     let h = &report.history;
     let fmt = |r: &crate::IterationRecord| {
@@ -103,13 +103,7 @@ pub fn history_summary(report: &NewtonReport) -> String {
         items.push("…".into());
     }
     items.extend(h.iter().skip(h.len().saturating_sub(5).max(3)).map(fmt));
-    format!(
-        "{:?} after {} iterations, scaled residual {:.3e}; history (iteration: scaled residual) {}",
-        report.status,
-        report.iterations,
-        report.residual,
-        items.join(", ")
-    )
+    format!("history (iteration: scaled residual) {}", items.join(", "))
 }
 
 /// Largest plant for which the numerical null-space probe (a dense SVD) is run.
@@ -323,7 +317,13 @@ pub fn steady_state_observed(
     }
     if let Err(mut e) = dof_check(plant, u, &x_start, DofProbe::Numerical) {
         if let DofError::Underdetermined { newton, .. } = &mut e {
-            *newton = Some(history_summary(&report));
+            *newton = Some(format!(
+                "{:?} after {} iterations, scaled residual {:.3e}; {}",
+                report.status,
+                report.iterations,
+                report.residual,
+                history_summary(&report)
+            ));
         }
         return Err(e.into());
     }
