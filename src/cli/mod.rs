@@ -125,6 +125,8 @@ impl CliError {
 
 /// Run a parsed command line.
 pub fn run(cli: Cli) -> Result<(), CliError> {
+    // A limit set in the environment but not a number is a user error, said before any work.
+    plantwide::model::limits::Limits::from_env().map_err(|e| CliError::user(e.to_string()))?;
     match cli.command {
         Command::Check { file } => check::run(&file),
         Command::Components { json } => components::run(json),

@@ -28,8 +28,7 @@ use crate::error::{Diagnostic, LoadError, did_you_mean};
 use crate::overrides::resolve_input;
 use crate::plant::{BlockKind, Plant, Read};
 
-mod limits;
-pub use limits::{Limits, LimitsError};
+pub use plantwide_model::limits::{Limits, LimitsError};
 
 /// The scenario format version this build reads.
 pub const SCENARIO_FORMAT_VERSION: u32 = 1;
@@ -666,7 +665,7 @@ fn record_budget(cx: &mut Cx<'_>, times: (f64, f64), n_events: usize, n_columns:
 fn events_of(cx: &mut Cx<'_>, specs: &[EventSpec], duration: f64, limits: &Limits) -> Vec<Event> {
     // (event, label for messages)
     let mut events: Vec<(Event, String)> = Vec::new();
-    if specs.len() as u64 > limits.max_events {
+    if specs.len() > limits.max_events {
         cx.diags.push(Diagnostic::new(
             "events",
             format!(
@@ -694,7 +693,7 @@ fn events_of(cx: &mut Cx<'_>, specs: &[EventSpec], duration: f64, limits: &Limit
             events.push((ev, label));
         }
     }
-    if events.len() as u64 > limits.max_events {
+    if events.len() > limits.max_events {
         cx.diags.push(Diagnostic::new(
             "events",
             format!(

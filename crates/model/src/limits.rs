@@ -2,7 +2,7 @@
 //! flowsheet file, a `--set` override or a scenario event can ask for.
 //!
 //! **Resource limits** stop a file from asking for an allocation or a run time without bound (a
-//! column of 10⁹ stages, a mixer of 10⁹ inlets, a 10 MB name). Each has a default chosen far above
+//! column of 10⁹ stages, a mixer of 10⁹ inlets, a 10 MB name, a run recording 10¹¹ rows). Each has a default chosen far above
 //! any real plant and can be raised for one process by an environment variable
 //! (`PLANTWIDE_MAX_STAGES=5000 plantwide steady big.json`); the error message names the variable.
 //!
@@ -40,6 +40,19 @@ pub struct Limits {
     /// Most entries (equations × local variables) of one unit's Jacobian block
     /// (`PLANTWIDE_MAX_BLOCK_ENTRIES`, default 40 000 000, i.e. 320 MB of f64).
     pub max_block_entries: usize,
+    /// Most recorded rows of a run, `⌊duration / record.interval⌋ + 1` plus two per event
+    /// (`PLANTWIDE_MAX_RECORD_ROWS`, default 1 000 000).
+    pub max_record_rows: usize,
+    /// Most recorded values, rows × columns (recorded paths plus one column per component of every
+    /// `record.totals` stream), 8 bytes each (`PLANTWIDE_MAX_RECORD_VALUES`, default 20 000 000).
+    pub max_record_values: usize,
+    /// Most scenario events after expansion: a ramp, a pulse and a sinusoid with a `duration` count
+    /// two (start and end) (`PLANTWIDE_MAX_EVENTS`, default 10 000).
+    pub max_events: usize,
+    /// Most discrete times of one sampled controller (`duration / scan interval`) or one analyzer
+    /// (`duration / sample_time`); each one stops the integrator (`PLANTWIDE_MAX_SAMPLES`, default
+    /// 100 000).
+    pub max_samples: usize,
 }
 
 impl Default for Limits {
@@ -55,6 +68,10 @@ impl Default for Limits {
             max_file_bytes: 64 << 20,
             max_variables: 2_000_000,
             max_block_entries: 40_000_000,
+            max_record_rows: 1_000_000,
+            max_record_values: 20_000_000,
+            max_events: 10_000,
+            max_samples: 100_000,
         }
     }
 }
@@ -80,17 +97,48 @@ impl Limit {
     }
 }
 
+/// An environment variable that does not hold a limit.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("environment variable {var}: `{value}` is not a limit (give a positive whole number, e.g. 1000000 or 1e7)")]
+pub struct LimitsError {
+    /// Variable name.
+    pub var: &'static str,
+    /// Its value.
+    pub value: String,
+}
+
 impl Limits {
-    /// The limits in force: the defaults, each overridden by its environment variable when that holds
-    /// a positive integer.
+    /// Environment variable of [`Limits::max_record_rows`].
+    pub const MAX_RECORD_ROWS: &'static str = "PLANTWIDE_MAX_RECORD_ROWS";
+    /// Environment variable of [`Limits::max_record_values`].
+    pub const MAX_RECORD_VALUES: &'static str = "PLANTWIDE_MAX_RECORD_VALUES";
+    /// Environment variable of [`Limits::max_events`].
+    pub const MAX_EVENTS: &'static str = "PLANTWIDE_MAX_EVENTS";
+    /// Environment variable of [`Limits::max_samples`].
+    pub const MAX_SAMPLES: &'static str = "PLANTWIDE_MAX_SAMPLES";
+
+    /// The limits in force, read once per process: [`Limits::from_env`], or the defaults where the
+    /// environment holds a bad value (the CLI reports that at its start with [`Limits::from_env`]).
     pub fn get() -> &'static Limits {
         static LIMITS: OnceLock<Limits> = OnceLock::new();
-        LIMITS.get_or_init(Limits::from_env)
+        LIMITS.get_or_init(|| Limits::from_env().unwrap_or_default())
     }
 
-    fn from_env() -> Limits {
+    /// The defaults, each replaced by its environment variable when that is set.
+    ///
+    /// # Errors
+    /// A variable that is set but not a positive whole number.
+    pub fn from_env() -> Result<Limits, LimitsError> {
+        Limits::from_lookup(|var| std::env::var(var).ok())
+    }
+
+    /// The defaults, each replaced by `lookup(variable name)` when that is `Some`.
+    ///
+    /// # Errors
+    /// A value that is not a positive whole number.
+    pub fn from_lookup(lookup: impl Fn(&str) -> Option<String>) -> Result<Limits, LimitsError> {
         let mut l = Limits::default();
-        for (var, slot) in [
+        for (var, field) in [
             ("PLANTWIDE_MAX_STAGES", &mut l.max_stages),
             ("PLANTWIDE_MAX_INLETS", &mut l.max_inlets),
             ("PLANTWIDE_MAX_COMPONENTS", &mut l.max_components),
@@ -101,12 +149,16 @@ impl Limits {
             ("PLANTWIDE_MAX_FILE_BYTES", &mut l.max_file_bytes),
             ("PLANTWIDE_MAX_VARIABLES", &mut l.max_variables),
             ("PLANTWIDE_MAX_BLOCK_ENTRIES", &mut l.max_block_entries),
+            (Limits::MAX_RECORD_ROWS, &mut l.max_record_rows),
+            (Limits::MAX_RECORD_VALUES, &mut l.max_record_values),
+            (Limits::MAX_EVENTS, &mut l.max_events),
+            (Limits::MAX_SAMPLES, &mut l.max_samples),
         ] {
-            if let Some(v) = std::env::var(var).ok().and_then(|s| s.trim().parse::<usize>().ok()).filter(|&v| v > 0) {
-                *slot = v;
+            if let Some(value) = lookup(var) {
+                *field = parse_count(&value).ok_or(LimitsError { var, value })?;
             }
         }
-        l
+        Ok(l)
     }
 
     /// Stages of one column.
@@ -149,6 +201,16 @@ impl Limits {
     pub fn block_entries(&self) -> Limit {
         Limit { max: self.max_block_entries, var: "PLANTWIDE_MAX_BLOCK_ENTRIES" }
     }
+}
+
+/// A positive whole number, written as an integer or in exponent form (`1e7`).
+fn parse_count(s: &str) -> Option<usize> {
+    let s = s.trim();
+    if let Ok(n) = s.parse::<usize>() {
+        return (n > 0).then_some(n);
+    }
+    let v: f64 = s.parse().ok()?;
+    (v.is_finite() && v >= 1.0 && v.fract() == 0.0 && v < usize::MAX as f64).then_some(v as usize)
 }
 
 /// `s` for a message: at most 60 characters, elided in the middle (a 10 MB name is not echoed).
@@ -258,6 +320,19 @@ mod tests {
         let c = clip(&long);
         assert!(c.len() < 100 && c.contains("10000000 characters"), "{c}");
         assert_eq!(clip("benzene"), "benzene");
+    }
+
+    #[test]
+    fn environment_overrides_defaults_and_rejects_nonsense() {
+        let l = Limits::from_lookup(|v| (v == Limits::MAX_RECORD_ROWS).then(|| "2e7".to_string())).unwrap();
+        assert_eq!(l, Limits { max_record_rows: 20_000_000, ..Limits::default() });
+        let l = Limits::from_lookup(|v| (v == "PLANTWIDE_MAX_STAGES").then(|| "5000".to_string())).unwrap();
+        assert_eq!(l.max_stages, 5000);
+        for bad in ["0", "-5", "1.5", "lots", "1e400", ""] {
+            let e = Limits::from_lookup(|v| (v == Limits::MAX_SAMPLES).then(|| bad.to_string())).unwrap_err();
+            assert_eq!(e.var, Limits::MAX_SAMPLES, "{bad}");
+            assert!(e.to_string().contains("PLANTWIDE_MAX_SAMPLES"), "{e}");
+        }
     }
 
     #[test]
