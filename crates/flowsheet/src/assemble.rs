@@ -433,7 +433,7 @@ pub fn assemble(spec: &FlowsheetSpec, file: &str) -> Result<Plant, LoadError> {
     if !diags.is_empty() {
         return Err(invalid(diags));
     }
-    Ok(Plant {
+    let plant = Plant {
         file: file.to_string(),
         name: spec.name.clone(),
         components,
@@ -446,7 +446,10 @@ pub fn assemble(spec: &FlowsheetSpec, file: &str) -> Result<Plant, LoadError> {
         aliases,
         var_index,
         input_index,
-    })
+    };
+    crate::overrides::check_unit_inputs(&plant, &plant.input_values())
+        .map_err(|(path, why)| invalid(vec![Diagnostic::new(path, why)]))?;
+    Ok(plant)
 }
 
 /// `units.<name>` or `controllers.<name>`: where block `b` is described in the file.

@@ -82,7 +82,24 @@ pub fn load_with(path: &std::path::Path, sets: &[String]) -> Result<(Plant, Vec<
         set_input(&plant, &mut u, path, value).map_err(OverrideError::Bad)?;
     }
     check_compositions(&plant, &u).map_err(OverrideError::Bad)?;
+    if !sets.is_empty() {
+        check_unit_inputs(&plant, &u)
+            .map_err(|(path, why)| OverrideError::Bad(format!("with --set, {path}: {why}")))?;
+    }
     Ok((plant, u))
+}
+
+/// Each unit's own check of its input values ([`plantwide_model::UnitModel::check_inputs`]) at `u`:
+/// `Err((JSON path of the input, why))`.
+pub fn check_unit_inputs(plant: &Plant, u: &[f64]) -> Result<(), (String, String)> {
+    for b in &plant.blocks {
+        let values: Vec<f64> = b.input_ids.iter().map(|&i| u[i]).collect();
+        let section = if b.kind == crate::BlockKind::Unit { "units" } else { "controllers" };
+        b.unit
+            .check_inputs(&plant.thermo, &values)
+            .map_err(|(name, why)| (format!("{section}.{}.{name}", b.name), why))?;
+    }
+    Ok(())
 }
 
 /// The mole-fraction inputs `z[c]` of each unit (a feed's composition but its last component,

@@ -193,6 +193,12 @@ pub trait UnitModel: Send + Sync + std::fmt::Debug {
     fn saturation(&self, _io: &UnitIo<'_, f64>) -> Option<Saturation> {
         None
     }
+    /// Check the unit's input values (SI, in [`UnitModel::inputs`] order) for what only the unit
+    /// knows, beyond each value's physical range: `Err((input name, why))`. Run on the file's values
+    /// and after `--set` (default: nothing to check).
+    fn check_inputs(&self, _thermo: &ThermoPackage, _inputs: &[f64]) -> Result<(), (String, String)> {
+        Ok(())
+    }
     /// This controller with its output limits removed, if it has any (default: none). A clamped
     /// output no longer depends on its measurement, so the Jacobian of a well-posed plant can be
     /// singular where a limit is active: the numerical degrees-of-freedom probe judges the plant
@@ -247,6 +253,8 @@ pub trait Unit: Send + Sync + std::fmt::Debug {
     fn reacts(&self) -> bool;
     /// See [`UnitModel::saturation`].
     fn saturation(&self, io: &UnitIo<'_, f64>) -> Option<Saturation>;
+    /// See [`UnitModel::check_inputs`].
+    fn check_inputs(&self, thermo: &ThermoPackage, inputs: &[f64]) -> Result<(), (String, String)>;
 }
 
 /// A controller output held at a limit with the measurement off its setpoint.
@@ -269,6 +277,9 @@ impl<U: UnitModel + 'static> Unit for U {
     }
     fn saturation(&self, io: &UnitIo<'_, f64>) -> Option<Saturation> {
         UnitModel::saturation(self, io)
+    }
+    fn check_inputs(&self, thermo: &ThermoPackage, inputs: &[f64]) -> Result<(), (String, String)> {
+        UnitModel::check_inputs(self, thermo, inputs)
     }
     fn inlet_ports(&self) -> Vec<String> {
         UnitModel::inlet_ports(self)

@@ -67,6 +67,20 @@ pub enum VapourPressure {
     ClausiusClapeyron { p_ref: f64, t_ref: f64, hvap: f64 },
 }
 
+impl VapourPressure {
+    /// Lowest temperature [K] of the correlation's data (its triple-point region for the DIPPR and
+    /// Antoine forms; `None` for the Clausius–Clapeyron form of hypothetical components): below it
+    /// the correlation is an extrapolation to where no liquid exists.
+    pub fn t_min(&self) -> Option<f64> {
+        match self {
+            VapourPressure::Dippr101 { tmin, .. }
+            | VapourPressure::ExtendedAntoine { tmin, .. }
+            | VapourPressure::Antoine { tmin, .. } => Some(*tmin),
+            VapourPressure::ClausiusClapeyron { .. } => None,
+        }
+    }
+}
+
 /// Ideal-gas heat capacity [J/(mol·K)].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(tag = "form", rename_all = "snake_case", deny_unknown_fields)]

@@ -13,6 +13,8 @@ use plantwide_units::{Dimension, QuantityValue};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
+use plantwide_thermo::ThermoPackage;
+
 use super::Phase;
 use crate::stream::{F, H, P, T, Z0};
 use crate::{BuildCx, FieldError, InputSpec, Scalar, UnitIo, UnitModel};
@@ -115,6 +117,31 @@ impl UnitModel for Feed {
             v.push(InputSpec { name: format!("z[{name}]"), dim: Dimension::DIMENSIONLESS, value: z });
         }
         v
+    }
+    /// A saturated-liquid feed must boil within its components' vapour-pressure data: below the
+    /// lowest temperature of a present component's correlation (its triple-point region) there is
+    /// no liquid, and the bubble point would be an extrapolation (a feed at 1.3 Pa instead of
+    /// 1.3 atm).
+    fn check_inputs(&self, thermo: &ThermoPackage, inputs: &[f64]) -> Result<(), (String, String)> {
+        if self.has_t_input() {
+            return Ok(());
+        }
+        let p = inputs[1];
+        let mut z: Vec<f64> = inputs[2..].to_vec();
+        z.push(1.0 - z.iter().sum::<f64>());
+        let t = thermo.bubble_t(p, &z).map_err(|e| ("P".to_string(), format!("no bubble point at {p} Pa: {e}")))?.t;
+        for (c, _) in thermo.components.iter().zip(&z).filter(|(_, zi)| **zi > 0.0) {
+            if let Some(t_min) = c.psat.t_min().filter(|&t_min| t < t_min) {
+                return Err((
+                    "P".into(),
+                    format!(
+                        "at {p} Pa this saturated liquid would boil at {t:.1} K, below {t_min:.1} K where the vapour-pressure data of {} begin (no liquid exists there): raise the pressure",
+                        c.name
+                    ),
+                ));
+            }
+        }
+        Ok(())
     }
     fn eval<S: Scalar>(&self, io: &UnitIo<'_, S>, r: &mut [S]) {
         let out = io.outlet(0);
