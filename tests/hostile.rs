@@ -75,7 +75,7 @@ fn structural_mistakes_are_named_with_their_full_path() {
     expect(
         &["check", &case("btx_tray_dp_1p8e19_misleading_msg.json")],
         1,
-        &["units.column.rigorous.tray_pressure_drop", "1e9 Pa"],
+        &["units.column.rigorous.tray_pressure_drop", "1.8446744073709552e19 Pa is beyond the ±1e9 Pa"],
     );
     expect(
         &["check", &case("example_4_1_negative_level_sp_dishonest.json")],
@@ -236,4 +236,50 @@ fn a_record_request_that_overflows_is_refused() {
     let e = plantwide::flowsheet::scenario::resolve(&spec, &plant, "s.json").expect_err("refused");
     let msg = e.to_string();
     assert!(msg.contains("record.interval") && msg.contains("PLANTWIDE_MAX_RECORD_ROWS"), "{msg}");
+}
+
+/// Values the fuzzer found silently accepted in a file, each refused naming its field.
+#[test]
+fn implausible_file_values_are_refused_naming_the_field() {
+    let text = std::fs::read_to_string(common::flowsheet("column_a.json")).unwrap();
+    let base: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let dir = std::env::temp_dir().join(format!("plantwide-hostile-values-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let cases: [(&str, fn(&mut serde_json::Value), &[&str]); 4] = [
+        (
+            "temperature_sp",
+            |d| {
+                d["controllers"]["t"] = serde_json::json!({"type": "pid", "pv": "column.T[10]", "output": "column.reflux",
+                    "sp": -1e308, "kc": 1.0, "tau_i": "10 min"});
+                d["controllers"]["condenser_level"]["output"] = serde_json::json!("column.distillate");
+            },
+            &["controllers.t.sp", "-1e308 K is beyond the ±5000 K"],
+        ),
+        (
+            "op_limits_reversed",
+            |d| {
+                d["controllers"]["condenser_level"]["op_min"] = serde_json::json!("2 kmol/min");
+                d["controllers"]["condenser_level"]["op_max"] = serde_json::json!("1 kmol/min");
+            },
+            &["controllers.condenser_level.op_max", "must exceed op_min"],
+        ),
+        (
+            "molar_mass",
+            |d| d["components"][0]["hypothetical"]["mw"] = serde_json::json!(9e18),
+            &["components[0].hypothetical.mw", "beyond the plausible"],
+        ),
+        (
+            "tiny_temperature_guess",
+            |d| d["units"]["feed_source"]["P"] = serde_json::json!(1e-300),
+            &["units.feed_source.P"],
+        ),
+    ];
+    for (name, mutate, fragments) in cases {
+        let mut doc = base.clone();
+        mutate(&mut doc);
+        let path = dir.join(format!("{name}.json"));
+        std::fs::write(&path, doc.to_string()).unwrap();
+        expect(&["check", path.to_str().unwrap()], 1, fragments);
+    }
+    std::fs::remove_dir_all(&dir).ok();
 }

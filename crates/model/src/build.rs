@@ -49,11 +49,8 @@ impl<'a> BuildCx<'a> {
         match value.to_si(dim) {
             Ok(v) if v.is_finite() && v.abs() <= crate::limits::max_magnitude(dim) => v,
             Ok(v) if v.is_finite() => {
-                let max = crate::limits::max_magnitude(dim);
-                self.error(
-                    field,
-                    format!("`{value}` is {v:e} {dim}, beyond the ±{max:e} {dim} in which the models hold"),
-                );
+                let (v, max) = (crate::limits::number(v), crate::limits::number(crate::limits::max_magnitude(dim)));
+                self.error(field, format!("{v} {dim} is beyond the ±{max} {dim} in which the models hold"));
                 f64::NAN
             }
             Ok(v) => {

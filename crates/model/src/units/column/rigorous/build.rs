@@ -177,20 +177,6 @@ impl RigorousColumn {
                 height: cx.non_negative("rigorous.weir_height", &r.weir_height, Dimension::LENGTH),
                 area: cx.positive("rigorous.tray_area", &r.tray_area, Dimension::AREA),
             };
-            // Tray geometry of real columns: weirs of a few cm (Francis formula's range), trays of
-            // at most a few hundred m²; outside it the hydraulics have no meaning.
-            for (field, v, max, unit) in [
-                ("rigorous.weir_height", weir.height, 1.0, "m"),
-                ("rigorous.weir_length", weir.length, 100.0, "m"),
-                ("rigorous.tray_area", weir.area, 1000.0, "m²"),
-            ] {
-                if v > max {
-                    cx.error(
-                        field,
-                        format!("{} {unit} is beyond the {max} {unit} of any real tray", crate::limits::number(v)),
-                    );
-                }
-            }
         }
         if c.feeds.is_empty() {
             cx.error("feeds", "give at least one feed, e.g. [{\"port\": \"feed\", \"stage\": 10}]");
@@ -211,15 +197,7 @@ impl RigorousColumn {
             feeds.push(f.stage.saturating_sub(1));
         }
         let (draws, draw_ports) = side_draws(c, n, &feed_ports, &mut cx);
-        let p_bottom = p_top + n.saturating_sub(1) as f64 * dp;
-        if p_bottom > crate::limits::max_magnitude(Dimension::PRESSURE) {
-            cx.error(
-                "rigorous.tray_pressure_drop",
-                format!(
-                    "{dp:e} Pa per tray over {n} stages puts the reboiler at {p_bottom:e} Pa, beyond the 1e9 Pa in which the models hold"
-                ),
-            );
-        }
+        check_ranges(&mut cx, &weir, (p_top, dp), n);
         let pressure = (0..n).map(|s| p_top + (n - 1 - s) as f64 * dp).collect();
         let n_comp = cx.thermo.n().max(1) as f64;
         let v_mean = cx.thermo.components.iter().map(|c| c.v_liq(298.15)).sum::<f64>() / n_comp;
@@ -247,5 +225,29 @@ impl RigorousColumn {
             comp_names: cx.components.to_vec(),
         };
         cx.finish(column)
+    }
+}
+
+/// Tray geometry and pressures within the range of real columns: weirs of a few cm (the Francis
+/// formula's range), trays of at most a few hundred m², the reboiler below 1 GPa; outside it the
+/// hydraulics and the property models have no meaning.
+fn check_ranges(cx: &mut BuildCx<'_>, weir: &Weir, (p_top, dp): (f64, f64), n: usize) {
+    for (field, v, max, unit) in [
+        ("rigorous.weir_height", weir.height, 1.0, "m"),
+        ("rigorous.weir_length", weir.length, 100.0, "m"),
+        ("rigorous.tray_area", weir.area, 1000.0, "m²"),
+    ] {
+        if v > max {
+            cx.error(field, format!("{} {unit} is beyond the {max} {unit} of any real tray", crate::limits::number(v)));
+        }
+    }
+    let p_bottom = p_top + n.saturating_sub(1) as f64 * dp;
+    if p_bottom > crate::limits::max_magnitude(Dimension::PRESSURE) {
+        cx.error(
+            "rigorous.tray_pressure_drop",
+            format!(
+                "{dp:e} Pa per tray over {n} stages puts the reboiler at {p_bottom:e} Pa, beyond the 1e9 Pa in which the models hold"
+            ),
+        );
     }
 }
