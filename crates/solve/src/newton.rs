@@ -52,7 +52,15 @@ pub enum NewtonStatus {
     LineSearchFailed,
     /// The Jacobian is singular.
     Singular,
+    /// Pseudo-transient continuation made no progress: its best residual did not fall by 1 % over
+    /// [`PTC_STALL_WINDOW`] iterations, while its pseudo time step grew ×1.1 per step (ten-thousand-
+    /// fold over the window), so neither the transient nor the Newton limit of it is approaching a
+    /// steady state.
+    Stalled,
 }
+
+/// Iterations without a 1 % improvement after which pseudo-transient continuation gives up.
+pub const PTC_STALL_WINDOW: usize = 100;
 
 /// One iteration of the history.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -296,7 +304,8 @@ fn ptc_phase<S: System>(
     let mut dt = st.ptc_dt0;
     let mut prev_norm = f64::NAN;
     let mut failures = 0;
-    for _ in 0..st.max_ptc_iter {
+    let (mut best, mut best_at) = (f64::INFINITY, 0);
+    for k in 0..st.max_ptc_iter {
         wk.linearize(x);
         let (norm, _) = wk.scaled_norm(&wk.r);
         if !norm.is_finite() {
@@ -304,6 +313,11 @@ fn ptc_phase<S: System>(
         }
         if norm <= st.tol.max(1e-6) {
             return NewtonStatus::Converged;
+        }
+        if norm < 0.99 * best {
+            (best, best_at) = (norm, k);
+        } else if k - best_at >= PTC_STALL_WINDOW {
+            return NewtonStatus::Stalled;
         }
         if prev_norm.is_finite() {
             dt = (PTC_INCREMENT * dt * (prev_norm / norm).clamp(0.2, 10.0)).min(1e12);

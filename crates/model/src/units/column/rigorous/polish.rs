@@ -27,7 +27,7 @@
 use super::{IN_BOTTOMS, IN_DISTILLATE, IN_REFLUX, RigorousColumn, UnitModel};
 use crate::stream::F;
 use crate::units::column::StageIdx;
-use crate::{Unit, UnitIo, VarKind};
+use crate::{Coloring, Unit, UnitIo, VarKind};
 
 /// Most Newton iterations on the steady equations.
 const MAX_NEWTON: usize = 30;
@@ -39,6 +39,8 @@ const MAX_STEP_NEWTON: usize = 10;
 const STEP_TOL: f64 = 1e-8;
 /// Most pseudo-time steps.
 const MAX_STEPS: usize = 200;
+/// Shortest implicit-Euler step [s] of the transient march before it gives up.
+const MIN_STEP: f64 = 1e-4;
 /// Scaled residual at which Newton stops.
 const TOL: f64 = 1e-12;
 
@@ -62,6 +64,8 @@ struct System<'a> {
     nominal: Vec<f64>,
     bounds: Vec<(f64, f64)>,
     differential: Vec<bool>,
+    /// Column colouring of the column's Jacobian pattern, computed once.
+    coloring: Option<Coloring>,
 }
 
 const SUMP_LAW: usize = usize::MAX - 1;
@@ -111,6 +115,7 @@ impl<'a> System<'a> {
             nominal,
             bounds,
             differential,
+            coloring: UnitModel::pattern(col, lay).map(|p| Coloring::new(&p, n_own, len)),
         }
     }
     fn io<'b>(&'b self, local: &'b [f64]) -> UnitIo<'b, f64> {
@@ -145,7 +150,7 @@ impl<'a> System<'a> {
         for it in 0..max_iter {
             if it == 0 || dt.is_none() {
                 jac.iter_mut().for_each(|v| *v = 0.0);
-                self.col.jacobian(&self.io(local), &mut r[..n_own], &mut jac);
+                self.col.jacobian_colored(&self.io(local), &mut r[..n_own], &mut jac, self.coloring.as_ref());
                 for (i, wi) in w.iter_mut().enumerate().take(n_own) {
                     let s = (0..len).map(|c| (jac[i * len + c] * self.nominal[c]).abs()).fold(0.0, f64::max);
                     *wi = if s > 0.0 && s.is_finite() { 1.0 / s } else { 1.0 };
@@ -256,6 +261,11 @@ pub(super) fn polish(col: &RigorousColumn, io: &UnitIo<'_, f64>, own: &mut [f64]
                 None => {
                     local.copy_from_slice(&old);
                     dt *= 0.3;
+                    // Eleven failed steps in a row from 10 s: the march cannot advance (an
+                    // infeasible column: no boilup, a dry sump); stop rather than shrink forever.
+                    if dt < MIN_STEP {
+                        break;
+                    }
                 }
             }
         }
