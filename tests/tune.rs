@@ -20,7 +20,9 @@ fn blt_json_on_wood_berry_in_minutes() {
     assert!((v["detuning_factor"].as_f64().unwrap() - 2.55).abs() < 0.006);
     let l = &v["loops"];
     assert!((l[0]["kc"].as_f64().unwrap() - 0.375).abs() < 5e-4 && (l[1]["kc"].as_f64().unwrap() + 0.075).abs() < 5e-4);
-    assert!((l[0]["tau_i"].as_f64().unwrap() - 8.29).abs() < 5e-3 && (l[1]["tau_i"].as_f64().unwrap() - 23.6).abs() < 0.05);
+    assert!(
+        (l[0]["tau_i"].as_f64().unwrap() - 8.29).abs() < 5e-3 && (l[1]["tau_i"].as_f64().unwrap() - 23.6).abs() < 0.05
+    );
     // The default time unit is the second; ZN carries no detuning factor.
     let out = plantwide(&["tune", "--tf", &wb, "--method", "zn", "--json"]);
     let z: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();

@@ -120,7 +120,9 @@ pub fn diagonal_ultimates(model: &TfModel) -> Result<Vec<Ultimate>, TuneError> {
                 input: model.inputs[i].name.clone(),
                 detail,
             };
-            let Some(e) = model.element(i, i) else { return Err(no_crossover(", the element is missing (zero)".into())) };
+            let Some(e) = model.element(i, i) else {
+                return Err(no_crossover(", the element is missing (zero)".into()));
+            };
             element_ultimate(e).ok_or_else(|| {
                 let detail = match (e.lags.len(), e.leads.len(), e.dead_time > 0.0) {
                     (_, _, _) if e.gain == 0.0 => ", the element's gain is zero".to_string(),

@@ -57,7 +57,10 @@ fn wood_berry_ultimate_values_match_the_foptd_closed_form() {
     }
     let tl = single_loop(&wood_berry(), PiRule::TyreusLuyben).unwrap();
     assert_eq!(tl.method, TuneMethod::TyreusLuyben);
-    assert!((tl.loops[0].kc - tl.loops[0].ku / 3.2).abs() < 1e-14 && (tl.loops[0].tau_i - 2.2 * tl.loops[0].pu).abs() < 1e-9);
+    assert!(
+        (tl.loops[0].kc - tl.loops[0].ku / 3.2).abs() < 1e-14
+            && (tl.loops[0].tau_i - 2.2 * tl.loops[0].pu).abs() < 1e-9
+    );
 }
 
 #[test]

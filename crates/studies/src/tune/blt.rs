@@ -22,7 +22,7 @@ use faer::{Mat, c64};
 use plantwide_analysis::tf::TfModel;
 
 use super::ultimate::Ultimate;
-use super::{LoopTuning, PiRule, Tuning, TuneMethod, diagonal_ultimates};
+use super::{LoopTuning, PiRule, TuneMethod, Tuning, diagonal_ultimates};
 use crate::TuneError;
 use crate::numeric::{golden_max, root_bracketed};
 
@@ -137,7 +137,7 @@ pub fn blt(model: &TfModel, settings: &BltSettings) -> Result<Tuning, TuneError>
     let sv = model.gain().singular_values().map_err(|e| TuneError::Numerical(format!("SVD of G(0): {e:?}")))?;
     let (s_max, s_min) = (sv.iter().cloned().fold(0.0, f64::max), sv.iter().cloned().fold(f64::INFINITY, f64::min));
     let ratio = if s_max > 0.0 { s_min / s_max } else { 0.0 };
-    if !(ratio >= 1e-10) {
+    if ratio.is_nan() || ratio < 1e-10 {
         return Err(TuneError::SingularGain { model: model.name.clone(), ratio });
     }
     let ultimates: Vec<Ultimate> = diagonal_ultimates(model)?;
@@ -157,5 +157,11 @@ pub fn blt(model: &TfModel, settings: &BltSettings) -> Result<Tuning, TuneError>
             tau_i: zn[i].1 * f,
         })
         .collect();
-    Ok(Tuning { method: TuneMethod::Blt, detuning_factor: Some(f), loops, max_lcm_db: Some(db), peak_omega: Some(w_peak) })
+    Ok(Tuning {
+        method: TuneMethod::Blt,
+        detuning_factor: Some(f),
+        loops,
+        max_lcm_db: Some(db),
+        peak_omega: Some(w_peak),
+    })
 }

@@ -67,7 +67,8 @@ pub fn ultimate(g: impl Fn(f64) -> c64, omega_lo: f64, omega_hi: f64) -> Option<
 /// The frequency range searched for an element's crossover: from 1e-3 over its slowest time
 /// constant (lag, lead or dead time) to 1e4 over its fastest \[rad/s\]; `None` for a pure gain.
 pub fn element_frequency_range(e: &Element) -> Option<(f64, f64)> {
-    let times: Vec<f64> = e.lags.iter().chain(&e.leads).map(|t| t.abs()).chain([e.dead_time]).filter(|t| *t > 0.0).collect();
+    let times: Vec<f64> =
+        e.lags.iter().chain(&e.leads).map(|t| t.abs()).chain([e.dead_time]).filter(|t| *t > 0.0).collect();
     let slow = times.iter().cloned().fold(0.0, f64::max);
     let fast = times.iter().cloned().fold(f64::INFINITY, f64::min);
     (slow > 0.0).then(|| (1e-3 / slow, 1e4 / fast))
@@ -114,7 +115,8 @@ mod tests {
         // 1e-3/50 rad/s and must not alias.
         let e = Element { gain: 2.0, lags: vec![0.01], leads: vec![], dead_time: 50.0 };
         let u = element_ultimate(&e).unwrap();
-        let exact = crate::numeric::root_bracketed(|w| -50.0 * w - (0.01 * w).atan() + std::f64::consts::PI, 1e-6, 1.0, 1e-15);
+        let exact =
+            crate::numeric::root_bracketed(|w| -50.0 * w - (0.01 * w).atan() + std::f64::consts::PI, 1e-6, 1.0, 1e-15);
         assert!((u.omega_u - exact).abs() < 1e-12 * exact, "{u:?} vs {exact}");
     }
 }
