@@ -88,7 +88,7 @@ pub fn max_log_modulus(
 
 /// The detuning factor F ≥ 1 of the ZN settings `(K_ZN,i, τ_ZN,i)` that makes the biggest log
 /// modulus equal `target_db`: `(F, ω_peak, L_cm,max)`; F = 1 when the ZN settings already stay
-/// below the target.
+/// below the target. The peak is sought over `[omega_range.0 / F, omega_range.1]` \[rad/s\].
 ///
 /// # Errors
 /// [`TuneError::Numerical`] when even F = `max_detuning` leaves the peak above the target.
@@ -102,7 +102,8 @@ pub fn blt_detuning(
     let peak = |f: f64| {
         let kc: Vec<f64> = zn.iter().map(|(k, _)| k / f).collect();
         let ti: Vec<f64> = zn.iter().map(|(_, t)| t * f).collect();
-        max_log_modulus(g, &kc, &ti, omega_range, settings.points_per_decade)
+        // Detuning slows the loops: the lower end of the range moves down with F.
+        max_log_modulus(g, &kc, &ti, (omega_range.0 / f, omega_range.1), settings.points_per_decade)
     };
     let at_one = peak(1.0);
     if at_one.1 <= target_db {
@@ -164,4 +165,28 @@ pub fn blt(model: &TfModel, settings: &BltSettings) -> Result<Tuning, TuneError>
         max_lcm_db: Some(db),
         peak_omega: Some(w_peak),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn one_loop_blt_is_the_classical_2_db_closed_loop_peak() {
+        // g = 2 e^(−s)/(10 s + 1): for n = 1, W/(1 + W) = g c/(1 + g c), the closed-loop response.
+        let gs = |w: f64| c64::new(0.0, -w).exp() * 2.0 / c64::new(1.0, 10.0 * w);
+        let g = |w: f64| Mat::from_fn(1, 1, |_, _| gs(w));
+        let u = crate::tune::ultimate(gs, 1e-4, 1e3).unwrap();
+        let zn = [PiRule::ZieglerNichols.settings(&u)];
+        let range = (1e-4 * u.omega_u, 10.0 * u.omega_u);
+        let (f, _, db) = blt_detuning(&g, &zn, range, 2.0, &BltSettings::default()).unwrap();
+        assert!(f > 1.0 && (db - 2.0).abs() < 1e-9, "F = {f}, peak = {db}");
+        let (kc, ti) = (zn[0].0 / f, zn[0].1 * f);
+        let closed = |w: f64| {
+            let l = gs(w) * c64::new(kc, -kc / (w * ti));
+            20.0 * (l / (l + 1.0)).norm().log10()
+        };
+        let peak = (0..20_000).map(|k| closed(1e-3 * 1e4f64.powf(k as f64 / 20_000.0))).fold(f64::MIN, f64::max);
+        assert!(peak <= 2.0 + 1e-9 && peak > 2.0 - 1e-4, "grid peak {peak}");
+    }
 }
