@@ -42,6 +42,12 @@ pub enum TuneError {
         /// What the element is (e.g. ", a first-order lag without dead time").
         detail: String,
     },
+    /// A relay test did not settle into a cycle.
+    #[error("relay test: no limit cycle: {why}")]
+    NoCycle {
+        /// Why, and what to change.
+        why: String,
+    },
     /// A numerical search failed.
     #[error("{0}")]
     Numerical(String),

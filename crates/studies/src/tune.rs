@@ -4,6 +4,8 @@
 //! - [`PiRule`]: Ziegler–Nichols PI, `K_c = K_u/2.2`, `τ_I = P_u/1.2` (Ziegler & Nichols 1942), and
 //!   Tyreus–Luyben PI, `K_c = K_u/3.2`, `τ_I = 2.2 P_u` (Tyreus & Luyben 1992, Ind. Eng. Chem. Res.
 //!   31, 2625).
+//! - [`relay`]: relay-feedback (ATV) test on a linear element, `K_u ≈ 4h/(πa)` (Åström &
+//!   Hägglund 1984).
 //! - [`blt`]: Luyben's biggest-log-modulus tuning of n diagonal PI loops (Luyben 1986, Ind. Eng.
 //!   Chem. Process Des. Dev. 25, 654).
 //!
@@ -11,12 +13,14 @@
 //! [`Tuning::in_time_unit`] converts them; gains are in the model's units (input per output).
 
 pub mod blt;
+pub mod relay;
 pub mod ultimate;
 
 use plantwide_analysis::tf::TfModel;
 use serde::Serialize;
 
 pub use blt::{BltSettings, blt, blt_detuning, max_log_modulus};
+pub use relay::{RelayReport, RelaySettings, relay_test};
 pub use ultimate::{Ultimate, element_ultimate, ultimate};
 
 use crate::TuneError;
