@@ -1,7 +1,7 @@
 //! plantwide: plantwide process-control studies from one model of the plant.
 //!
 //! This facade re-exports the layers: [`thermo`] ← [`model`] ← [`flowsheet`] ← [`solve`] ←
-//! [`analysis`]. The `plantwide` binary (src/main.rs) is the only code that touches files and the
+//! [`analysis`] ← [`studies`]. The `plantwide` binary (src/main.rs) is the only code that touches files and the
 //! terminal.
 
 pub mod plot;
@@ -10,5 +10,6 @@ pub use plantwide_analysis as analysis;
 pub use plantwide_flowsheet as flowsheet;
 pub use plantwide_model as model;
 pub use plantwide_solve as solve;
+pub use plantwide_studies as studies;
 pub use plantwide_thermo as thermo;
 pub use plantwide_units as units;

@@ -26,6 +26,7 @@ mod linearize;
 mod run;
 mod sensitivity;
 mod steady;
+mod tune;
 
 use std::path::PathBuf;
 
@@ -103,6 +104,9 @@ enum Command {
     Sensitivity(sensitivity::SensitivityArgs),
     /// Tray-temperature sensor selection for a column (SVD, sensitivity and slope criteria).
     Sensors(gains::SensorsArgs),
+    /// PI tuning of the diagonal loops of a transfer-function model: ultimate gains and periods,
+    /// Ziegler–Nichols, Tyreus–Luyben, or Luyben's BLT detuning for interaction.
+    Tune(tune::TuneArgs),
 }
 
 /// A failed command: message and exit code.
@@ -138,6 +142,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Linearize(a) => linearize::run(&a),
         Command::Sensitivity(a) => sensitivity::run(&a),
         Command::Sensors(a) => gains::run_sensors(&a),
+        Command::Tune(a) => tune::run(&a),
         Command::Schema => {
             let schema = schemars::schema_for!(plantwide::flowsheet::FlowsheetSpec);
             let text = serde_json::to_string_pretty(&schema).map_err(|e| CliError::user(e.to_string()))?;

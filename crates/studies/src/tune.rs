@@ -1,0 +1,170 @@
+//! Controller tuning from a transfer-function model (issue 16, first part).
+//!
+//! - [`ultimate`]: ultimate gain `K_u` and period `P_u` of a SISO element from `g(jω)`.
+//! - [`PiRule`]: Ziegler–Nichols PI, `K_c = K_u/2.2`, `τ_I = P_u/1.2` (Ziegler & Nichols 1942), and
+//!   Tyreus–Luyben PI, `K_c = K_u/3.2`, `τ_I = 2.2 P_u` (Tyreus & Luyben 1992, Ind. Eng. Chem. Res.
+//!   31, 2625).
+//! - [`relay`]: relay-feedback (ATV) test on a linear element, `K_u ≈ 4h/(πa)` (Åström &
+//!   Hägglund 1984).
+//! - [`blt`]: Luyben's biggest-log-modulus tuning of n diagonal PI loops (Luyben 1986, Ind. Eng.
+//!   Chem. Process Des. Dev. 25, 654).
+//!
+//! The PI controller is `c(s) = K_c (1 + 1/(τ_I s))`. Results are in SI (times in seconds) until
+//! [`Tuning::in_time_unit`] converts them; gains are in the model's units (input per output).
+
+pub mod blt;
+pub mod relay;
+pub mod ultimate;
+
+use plantwide_analysis::tf::TfModel;
+use serde::Serialize;
+
+pub use blt::{BltSettings, blt, blt_detuning, max_log_modulus};
+pub use relay::{RelayReport, RelaySettings, relay_test};
+pub use ultimate::{Ultimate, element_ultimate, ultimate};
+
+use crate::TuneError;
+
+/// A PI tuning rule applied to the ultimate gain and period.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PiRule {
+    /// Ziegler–Nichols: `K_c = K_u/2.2`, `τ_I = P_u/1.2`.
+    ZieglerNichols,
+    /// Tyreus–Luyben: `K_c = K_u/3.2`, `τ_I = 2.2 P_u`.
+    TyreusLuyben,
+}
+
+impl PiRule {
+    /// `(K_c, τ_I)` from the ultimate gain and period.
+    pub fn settings(self, u: &Ultimate) -> (f64, f64) {
+        match self {
+            PiRule::ZieglerNichols => (u.ku / 2.2, u.pu / 1.2),
+            PiRule::TyreusLuyben => (u.ku / 3.2, 2.2 * u.pu),
+        }
+    }
+}
+
+/// Which method produced a [`Tuning`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum TuneMethod {
+    /// Luyben's BLT: ZN settings detuned by one factor F.
+    #[serde(rename = "blt")]
+    Blt,
+    /// Ziegler–Nichols PI of each loop alone.
+    #[serde(rename = "zn")]
+    ZieglerNichols,
+    /// Tyreus–Luyben PI of each loop alone.
+    #[serde(rename = "tl")]
+    TyreusLuyben,
+}
+
+/// The settings of one loop.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LoopTuning {
+    /// Controlled output.
+    pub output: String,
+    /// Manipulated input.
+    pub input: String,
+    /// Ultimate gain of the paired element (input units per output unit).
+    pub ku: f64,
+    /// Ultimate period \[s, or the unit of [`Tuning::in_time_unit`]\].
+    pub pu: f64,
+    /// Controller gain (input units per output unit).
+    pub kc: f64,
+    /// Reset (integral) time \[s, or the unit of [`Tuning::in_time_unit`]\].
+    pub tau_i: f64,
+}
+
+/// Tuning of a set of loops; serializes to
+/// `{"method", "detuning_factor" (BLT only), "loops": [{"output", "input", "ku", "pu", "kc", "tau_i"}]}`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Tuning {
+    /// Method.
+    pub method: TuneMethod,
+    /// BLT detuning factor F ≥ 1 (`None` for a single-loop rule).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub detuning_factor: Option<f64>,
+    /// One entry per loop, in the model's output order.
+    pub loops: Vec<LoopTuning>,
+    /// BLT: the biggest log modulus reached at F \[dB\] (not serialized).
+    #[serde(skip)]
+    pub max_lcm_db: Option<f64>,
+    /// BLT: the frequency of that peak \[rad/s\] (not serialized).
+    #[serde(skip)]
+    pub peak_omega: Option<f64>,
+}
+
+impl Tuning {
+    /// The same tuning with times (`pu`, `tau_i`, the peak frequency) in a unit of `seconds` s.
+    pub fn in_time_unit(mut self, seconds: f64) -> Tuning {
+        for l in &mut self.loops {
+            l.pu /= seconds;
+            l.tau_i /= seconds;
+        }
+        self.peak_omega = self.peak_omega.map(|w| w * seconds);
+        self
+    }
+}
+
+/// The ultimate gain and period of each diagonal element `g_ii` of a square model, named.
+///
+/// # Errors
+/// [`TuneError::NotSquare`]; [`TuneError::NoPhaseCrossover`] naming the first diagonal element
+/// (missing, pure gain, or of too low an order without dead time) that has no ultimate gain.
+pub fn diagonal_ultimates(model: &TfModel) -> Result<Vec<Ultimate>, TuneError> {
+    let (n_outputs, n_inputs) = (model.outputs.len(), model.inputs.len());
+    if n_outputs != n_inputs {
+        return Err(TuneError::NotSquare { model: model.name.clone(), n_outputs, n_inputs });
+    }
+    (0..n_outputs)
+        .map(|i| {
+            let no_crossover = |detail: String| TuneError::NoPhaseCrossover {
+                output: model.outputs[i].name.clone(),
+                input: model.inputs[i].name.clone(),
+                detail,
+            };
+            let Some(e) = model.element(i, i) else {
+                return Err(no_crossover(", the element is missing (zero)".into()));
+            };
+            element_ultimate(e).ok_or_else(|| {
+                let detail = match (e.lags.len(), e.leads.len(), e.dead_time > 0.0) {
+                    (_, _, _) if e.gain == 0.0 => ", the element's gain is zero".to_string(),
+                    (0, 0, false) => ", a pure gain".to_string(),
+                    (n, 0, false) if n <= 2 => format!(", a lag of order {n} without dead time"),
+                    _ => String::new(),
+                };
+                no_crossover(detail)
+            })
+        })
+        .collect()
+}
+
+/// Ziegler–Nichols or Tyreus–Luyben PI settings of each diagonal loop of a square model, each
+/// tuned alone (no detuning for interaction).
+///
+/// # Errors
+/// As [`diagonal_ultimates`].
+pub fn single_loop(model: &TfModel, rule: PiRule) -> Result<Tuning, TuneError> {
+    let ultimates = diagonal_ultimates(model)?;
+    let method = match rule {
+        PiRule::ZieglerNichols => TuneMethod::ZieglerNichols,
+        PiRule::TyreusLuyben => TuneMethod::TyreusLuyben,
+    };
+    let loops = ultimates
+        .iter()
+        .enumerate()
+        .map(|(i, u)| {
+            let (kc, tau_i) = rule.settings(u);
+            LoopTuning {
+                output: model.outputs[i].name.clone(),
+                input: model.inputs[i].name.clone(),
+                ku: u.ku,
+                pu: u.pu,
+                kc,
+                tau_i,
+            }
+        })
+        .collect();
+    Ok(Tuning { method, detuning_factor: None, loops, max_lcm_db: None, peak_omega: None })
+}

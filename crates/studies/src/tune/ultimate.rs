@@ -1,0 +1,122 @@
+//! Ultimate gain and period of a SISO element from its frequency response.
+//!
+//! The ultimate frequency ω_u is the first (lowest) phase crossover, where the unwrapped phase of
+//! `g(jω)` reaches −π; the ultimate gain is the proportional gain that puts the loop on the edge
+//! of stability, `K_u = 1/|g(jω_u)|`, and the ultimate period `P_u = 2π/ω_u`
+//! (Ziegler & Nichols 1942; Seborg, Edgar, Mellichamp, *Process Dynamics and Control*, ch. 12).
+//! A process with a negative gain is handled as `−g`: its ultimate gain carries the sign of the
+//! process gain, as its controller's gain does.
+
+use faer::c64;
+use plantwide_analysis::tf::Element;
+use serde::Serialize;
+
+use crate::numeric::root_bracketed;
+
+/// Ultimate gain and frequency of a loop.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Ultimate {
+    /// Ultimate gain `K_u` (input units per output unit), with the sign of the process gain.
+    pub ku: f64,
+    /// Ultimate (phase-crossover) frequency ω_u \[rad/s\].
+    pub omega_u: f64,
+    /// Ultimate period `P_u = 2π/ω_u` \[s\].
+    pub pu: f64,
+}
+
+/// Largest phase change allowed between two frequencies of the march (keeps the unwrapping exact).
+const MAX_PHASE_STEP: f64 = std::f64::consts::PI / 16.0;
+
+/// The first phase crossover of `g` between `omega_lo` and `omega_hi` \[rad/s\], or `None`.
+///
+/// The phase is unwrapped by marching up a log-spaced grid (ratio ≤ 1.02, shrunk so that no step
+/// turns the phase by more than π/16, so dead time cannot alias), starting from `arg(±g(jω_lo))`,
+/// the sign chosen so that the low-frequency phase lies in (−π/2, π/2]. The crossover is bracketed
+/// on that grid and solved to a relative width of 1e-12 in ω.
+pub fn ultimate(g: impl Fn(f64) -> c64, omega_lo: f64, omega_hi: f64) -> Option<Ultimate> {
+    let g_lo = g(omega_lo);
+    if !(g_lo.norm() > 0.0 && g_lo.norm().is_finite()) {
+        return None;
+    }
+    let sign = if g_lo.re >= 0.0 { 1.0 } else { -1.0 };
+    let h = |w: f64| g(w) * sign;
+    let pi = std::f64::consts::PI;
+    let (mut w, mut hw, mut phase) = (omega_lo, h(omega_lo), h(omega_lo).arg());
+    let mut ratio: f64 = 1.02;
+    while w < omega_hi {
+        let w_next = (w * ratio).min(omega_hi);
+        let h_next = h(w_next);
+        let step = (h_next / hw).arg();
+        if step.abs() > MAX_PHASE_STEP && ratio > 1.0 + 1e-9 {
+            ratio = 1.0 + 0.5 * (ratio - 1.0);
+            continue;
+        }
+        let phase_next = phase + step;
+        if phase > -pi && phase_next <= -pi {
+            let (w0, h0, p0) = (w, hw, phase);
+            let wu = root_bracketed(|x| p0 + (h(x) / h0).arg() + pi, w0, w_next, 1e-12);
+            let ku = sign / h(wu).norm();
+            return Some(Ultimate { ku, omega_u: wu, pu: 2.0 * pi / wu });
+        }
+        (w, hw, phase) = (w_next, h_next, phase_next);
+        ratio = (1.0 + 2.0 * (ratio - 1.0)).min(1.02);
+    }
+    None
+}
+
+/// The frequency range searched for an element's crossover: from 1e-3 over its slowest time
+/// constant (lag, lead or dead time) to 1e4 over its fastest \[rad/s\]; `None` for a pure gain.
+pub fn element_frequency_range(e: &Element) -> Option<(f64, f64)> {
+    let times: Vec<f64> =
+        e.lags.iter().chain(&e.leads).map(|t| t.abs()).chain([e.dead_time]).filter(|t| *t > 0.0).collect();
+    let slow = times.iter().cloned().fold(0.0, f64::max);
+    let fast = times.iter().cloned().fold(f64::INFINITY, f64::min);
+    (slow > 0.0).then(|| (1e-3 / slow, 1e4 / fast))
+}
+
+/// The ultimate gain and frequency of one transfer-function element, or `None` when its phase
+/// never reaches −180° (e.g. a first- or second-order lag without dead time).
+pub fn element_ultimate(e: &Element) -> Option<Ultimate> {
+    let (lo, hi) = element_frequency_range(e)?;
+    if e.gain == 0.0 {
+        return None;
+    }
+    ultimate(|w| e.response(w), lo, hi)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn third_order_lag_crosses_at_sqrt3_over_tau() {
+        // g = 1/(τs+1)³: phase −3 atan(τω) = −π at τω = √3, |g| = 1/8 there, so K_u = 8.
+        let e = Element { gain: 1.0, lags: vec![2.0; 3], leads: vec![], dead_time: 0.0 };
+        let u = element_ultimate(&e).unwrap();
+        assert!((u.omega_u - 3f64.sqrt() / 2.0).abs() < 1e-12, "{u:?}");
+        assert!((u.ku - 8.0).abs() < 1e-10, "{u:?}");
+        let neg = Element { gain: -0.5, ..e };
+        assert!((element_ultimate(&neg).unwrap().ku + 16.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn lags_without_dead_time_of_order_below_three_do_not_cross() {
+        let first = Element { gain: 3.0, lags: vec![10.0], leads: vec![], dead_time: 0.0 };
+        assert_eq!(element_ultimate(&first), None);
+        let second = Element { lags: vec![10.0, 4.0], ..first.clone() };
+        assert_eq!(element_ultimate(&second), None);
+        let gain_only = Element { lags: vec![], ..first };
+        assert_eq!(element_ultimate(&gain_only), None);
+    }
+
+    #[test]
+    fn long_dead_time_is_unwrapped() {
+        // Pure dead time θ = 50 s behind a fast lag: ω_u just below π/θ; the march starts at
+        // 1e-3/50 rad/s and must not alias.
+        let e = Element { gain: 2.0, lags: vec![0.01], leads: vec![], dead_time: 50.0 };
+        let u = element_ultimate(&e).unwrap();
+        let exact =
+            crate::numeric::root_bracketed(|w| -50.0 * w - (0.01 * w).atan() + std::f64::consts::PI, 1e-6, 1.0, 1e-15);
+        assert!((u.omega_u - exact).abs() < 1e-12 * exact, "{u:?} vs {exact}");
+    }
+}
