@@ -665,16 +665,8 @@ fn record_budget(cx: &mut Cx<'_>, times: (f64, f64), n_events: usize, n_columns:
 fn events_of(cx: &mut Cx<'_>, specs: &[EventSpec], duration: f64, limits: &Limits) -> Vec<Event> {
     // (event, label for messages)
     let mut events: Vec<(Event, String)> = Vec::new();
-    if specs.len() > limits.max_events {
-        cx.diags.push(Diagnostic::new(
-            "events",
-            format!(
-                "{} events are more than the limit of {} ({} raises it)",
-                specs.len(),
-                limits.max_events,
-                Limits::MAX_EVENTS
-            ),
-        ));
+    // Counted before expansion too, so that a flood of events is not expanded and checked first.
+    if too_many_events(cx, specs.len(), limits) {
         return Vec::new();
     }
     for (k, e) in specs.iter().enumerate() {
@@ -693,16 +685,7 @@ fn events_of(cx: &mut Cx<'_>, specs: &[EventSpec], duration: f64, limits: &Limit
             events.push((ev, label));
         }
     }
-    if events.len() > limits.max_events {
-        cx.diags.push(Diagnostic::new(
-            "events",
-            format!(
-                "{} events (a ramp, a pulse or a sinusoid with a duration counts two) are more than the limit of {} ({} raises it)",
-                events.len(),
-                limits.max_events,
-                Limits::MAX_EVENTS
-            ),
-        ));
+    if too_many_events(cx, events.len(), limits) {
         return Vec::new();
     }
     events.retain(|(e, _)| e.t.is_finite());
@@ -763,6 +746,22 @@ fn check_values(cx: &mut Cx<'_>, events: &[(Event, String)]) {
             u[input] = values[0];
         }
     }
+}
+
+/// Report `n` events above [`Limits::max_events`] (a ramp, a pulse or a timed sinusoid counts two).
+fn too_many_events(cx: &mut Cx<'_>, n: usize, limits: &Limits) -> bool {
+    let over = n > limits.max_events;
+    if over {
+        cx.diags.push(Diagnostic::new(
+            "events",
+            format!(
+                "{n} events (a ramp, a pulse or a sinusoid with a duration counts two) are more than the limit of {} ({} raises it)",
+                limits.max_events,
+                Limits::MAX_EVENTS
+            ),
+        ));
+    }
+    over
 }
 
 /// A time [s] for messages: plain in 1e-3 … 1e6, else in exponent form.

@@ -165,6 +165,21 @@ fn is_liquid(p: &DrawPhase) -> bool {
     *p == DrawPhase::Liquid
 }
 
+/// Component holdups [mol] of a column: the `n[s][c]` variables, which start at internal variable
+/// `stage_at(s)` of stage `s`, summed over its `n_stages` stages.
+pub(crate) fn summed_holdups(
+    io: &UnitIo<'_, f64>,
+    n_stages: usize,
+    nc: usize,
+    stage_at: impl Fn(usize) -> usize,
+) -> Vec<f64> {
+    let mut n = vec![0.0; nc];
+    for s in 0..n_stages {
+        io.vars(stage_at(s), nc).iter().zip(&mut n).for_each(|(v, t)| *t += v);
+    }
+    n
+}
+
 /// Flowsheet description of a column.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]

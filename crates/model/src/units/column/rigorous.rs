@@ -306,12 +306,7 @@ impl UnitModel for RigorousColumn {
         v
     }
     fn holdup(&self, io: &UnitIo<'_, f64>) -> Option<Vec<f64>> {
-        let nc = self.nc();
-        let mut n = vec![0.0; nc];
-        for s in 0..self.n_stages {
-            io.vars(self.stage(s), nc).iter().zip(&mut n).for_each(|(v, t)| *t += v);
-        }
-        Some(n)
+        Some(super::summed_holdups(io, self.n_stages, self.nc(), |s| self.stage(s)))
     }
     fn pattern(&self, layout: &LocalLayout) -> Option<Vec<(usize, usize)>> {
         let slen = layout.stream.len();
