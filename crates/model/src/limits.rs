@@ -7,7 +7,8 @@
 //! (`PLANTWIDE_MAX_STAGES=5000 plantwide steady big.json`); the error message names the variable.
 //!
 //! **Physical ranges** are the ranges in which the models are valid: absolute temperatures in
-//! 1 … 5000 K and pressures in 1 Pa … 1 GPa (the bounds of every stream's `T` and `P`), flows,
+//! 1 … 5000 K and pressures in 1 Pa … 1 GPa (the bounds of every stream's `T` and `P`), flows up
+//! to 10⁶ mol/s,
 //! holdups, levels, volumes and times ≥ 0, mole fractions in [0, 1]. A value outside them can have
 //! no steady state, so it is rejected where it enters rather than blamed on the solver later.
 
@@ -225,13 +226,16 @@ pub fn clip(s: &str) -> String {
 }
 
 /// Largest magnitude a quantity of dimension `dim` may have anywhere in a flowsheet (SI): the range
-/// of the models (temperatures up to 5000 K, pressures up to 1 GPa, flows up to 10⁹ mol/s, holdups
+/// of the models (temperatures up to 5000 K, pressures up to 1 GPa, flows up to 10⁶ mol/s — 3.6·10⁶
+/// kmol/h, a hundred times the largest process streams —, holdups
 /// up to 10¹⁵ mol), and 10³⁰ for everything else so that products of values stay finite.
 pub fn max_magnitude(dim: Dimension) -> f64 {
     if dim == Dimension::TEMPERATURE {
         5000.0
-    } else if dim == Dimension::PRESSURE || dim == Dimension::MOLAR_FLOW {
+    } else if dim == Dimension::PRESSURE {
         1e9
+    } else if dim == Dimension::MOLAR_FLOW {
+        1e6
     } else if dim == Dimension::AMOUNT {
         1e15
     } else {

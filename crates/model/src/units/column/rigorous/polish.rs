@@ -39,6 +39,9 @@ const MAX_STEP_NEWTON: usize = 10;
 const STEP_TOL: f64 = 1e-8;
 /// Most pseudo-time steps.
 const MAX_STEPS: usize = 200;
+/// Most Newton iterations of the whole transient march (the shipped columns and the unit tests need
+/// at most ~110); a march that needs more is not converging (a bottoms flow of 10⁹ kmol/h).
+const MAX_MARCH_NEWTON: usize = 400;
 /// Shortest implicit-Euler step [s] of the transient march before it gives up.
 const MIN_STEP: f64 = 1e-4;
 /// Scaled residual at which Newton stops.
@@ -240,9 +243,15 @@ pub(super) fn polish(col: &RigorousColumn, io: &UnitIo<'_, f64>, own: &mut [f64]
     if !solved && transient {
         local.copy_from_slice(&start);
         let mut dt = 10.0;
+        let mut spent = 0;
         for _ in 0..MAX_STEPS {
+            if spent > MAX_MARCH_NEWTON {
+                break;
+            }
             let old = local.clone();
-            match sys.newton(&mut local, Some(dt), &old, MAX_STEP_NEWTON) {
+            let step = sys.newton(&mut local, Some(dt), &old, MAX_STEP_NEWTON);
+            spent += step.map_or(MAX_STEP_NEWTON, |it| it + 1);
+            match step {
                 Some(iters) => {
                     dt *= match iters {
                         0..=3 => 4.0,
@@ -251,6 +260,7 @@ pub(super) fn polish(col: &RigorousColumn, io: &UnitIo<'_, f64>, own: &mut [f64]
                     };
                     if dt > 1e6 {
                         let before = local.clone();
+                        spent += MAX_NEWTON;
                         if sys.newton(&mut local, None, &[], MAX_NEWTON).is_some() {
                             solved = true;
                             break;
