@@ -238,6 +238,9 @@ fn a_record_request_that_overflows_is_refused() {
     assert!(msg.contains("record.interval") && msg.contains("PLANTWIDE_MAX_RECORD_ROWS"), "{msg}");
 }
 
+/// A named change to a flowsheet document and the fragments its error must contain.
+type Mutation = (&'static str, fn(&mut serde_json::Value), &'static [&'static str]);
+
 /// Values the fuzzer found silently accepted in a file, each refused naming its field.
 #[test]
 fn implausible_file_values_are_refused_naming_the_field() {
@@ -245,7 +248,7 @@ fn implausible_file_values_are_refused_naming_the_field() {
     let base: serde_json::Value = serde_json::from_str(&text).unwrap();
     let dir = std::env::temp_dir().join(format!("plantwide-hostile-values-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let cases: [(&str, fn(&mut serde_json::Value), &[&str]); 4] = [
+    let cases: [Mutation; 4] = [
         (
             "temperature_sp",
             |d| {
