@@ -10,7 +10,11 @@ use super::CliError;
 
 /// Load `file`, apply `--set` overrides, return the plant and its input vector.
 pub fn load_with_overrides(file: &Path, sets: &[String]) -> Result<(Plant, Vec<f64>), CliError> {
-    plantwide::flowsheet::overrides::load_with(file, sets).map_err(|e| CliError::user(e.to_string()))
+    let user = |e: plantwide::flowsheet::OverrideError| CliError::user(e.to_string());
+    let overrides = sets.iter().map(|s| s.parse()).collect::<Result<Vec<_>, _>>().map_err(user)?;
+    let plant = plantwide::flowsheet::load_with(file, &overrides).map_err(user)?;
+    let u = plant.input_values();
+    Ok((plant, u))
 }
 
 /// Converge the way `plantwide steady` does by default (sequential-modular pass, then whole-plant

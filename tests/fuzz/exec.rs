@@ -1,9 +1,9 @@
 //! Running one mutant in process through the library, as `plantwide check`, `steady` and `run`
 //! would, and classifying what came back.
 
-use plantwide::flowsheet::overrides::{set_field, set_input, split_assignment};
+use plantwide::flowsheet::Plant;
 use plantwide::flowsheet::scenario::{parse_scenario, resolve};
-use plantwide::flowsheet::{Plant, assemble, parse_spec};
+use plantwide::flowsheet::{Override, load_str_with};
 use plantwide::solve::dynamic::{SimError, Start, simulate};
 use plantwide::solve::sequential::{Solution, StrategySettings, steady_state_by};
 use plantwide::solve::{DofProbe, dof_check};
@@ -54,27 +54,10 @@ pub fn execute(m: &Mutant) -> Result<Outcome, Dishonest> {
 
 /// Parse, assemble and apply the `--set` assignments as `plantwide steady` does.
 fn load(m: &Mutant) -> Result<(Plant, Vec<f64>), String> {
-    let mut spec = parse_spec(&m.text, &m.file).map_err(|e| e.to_string())?;
-    let mut plant = assemble(&spec, &m.file).map_err(|e| e.to_string())?;
-    let mut assignments = Vec::new();
-    let mut reassemble = false;
-    for s in &m.sets {
-        let (path, value) = split_assignment(s)?;
-        let mut u = plant.input_values();
-        if set_input(&plant, &mut u, path, value)? {
-            assignments.push((path.to_string(), value.to_string()));
-        } else {
-            set_field(&mut spec, path, value)?;
-            reassemble = true;
-        }
-    }
-    if reassemble {
-        plant = assemble(&spec, &m.file).map_err(|e| e.to_string())?;
-    }
-    let mut u = plant.input_values();
-    for (path, value) in &assignments {
-        set_input(&plant, &mut u, path, value)?;
-    }
+    let overrides =
+        m.sets.iter().map(|s| s.parse()).collect::<Result<Vec<Override>, _>>().map_err(|e| e.to_string())?;
+    let plant = load_str_with(&m.text, &m.file, &overrides).map_err(|e| e.to_string())?;
+    let u = plant.input_values();
     Ok((plant, u))
 }
 

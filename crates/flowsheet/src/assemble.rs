@@ -225,7 +225,7 @@ pub fn assemble(spec: &FlowsheetSpec, file: &str) -> Result<Plant, LoadError> {
         blocks.push(Block {
             name,
             kind: BlockKind::Unit,
-            unit,
+            unit: unit.into(),
             layout,
             own_offset,
             eq_offset: 0,
@@ -350,7 +350,7 @@ pub fn assemble(spec: &FlowsheetSpec, file: &str) -> Result<Plant, LoadError> {
                 blocks.push(Block {
                     name: cname.clone(),
                     kind: BlockKind::Controller,
-                    unit,
+                    unit: unit.into(),
                     layout,
                     own_offset,
                     eq_offset: 0,
@@ -446,6 +446,7 @@ pub fn assemble(spec: &FlowsheetSpec, file: &str) -> Result<Plant, LoadError> {
         aliases,
         var_index,
         input_index,
+        spec: spec.clone(),
     };
     crate::overrides::check_unit_inputs(&plant, &plant.input_values())
         .map_err(|(path, why)| invalid(vec![Diagnostic::new(path, why)]))?;

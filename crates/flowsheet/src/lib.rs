@@ -14,9 +14,12 @@ pub mod plant;
 pub mod scenario;
 pub mod spec;
 pub mod tears;
+pub mod wiring;
 
 pub use assemble::{assemble, load_file, load_str};
 pub use error::{Diagnostic, LoadError};
+pub use overrides::{Override, OverrideError, load_str_with, load_with};
 pub use parse::{parse_spec, read_text};
 pub use plant::{Block, BlockKind, InputInfo, Parallelism, Plant, Read, StreamInfo, VarInfo};
 pub use spec::FlowsheetSpec;
+pub use wiring::WiringError;

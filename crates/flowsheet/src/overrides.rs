@@ -19,28 +19,64 @@ pub fn resolve_input(plant: &Plant, path: &str) -> Option<usize> {
     plant.input(&format!("{}.{rest}", plant.blocks[s.from.0].name))
 }
 
+/// One `--set PATH=VALUE` assignment: an input (its value with units) or a field of a unit or
+/// controller description (a quantity string or a JSON literal).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Override {
+    /// `unit.input`, an alias, `stream.X` or `unit.field`.
+    pub path: String,
+    /// The value as written.
+    pub value: String,
+}
+
+impl Override {
+    /// An assignment of `value` to `path`.
+    pub fn new(path: impl Into<String>, value: impl Into<String>) -> Override {
+        Override { path: path.into(), value: value.into() }
+    }
+
+    /// Parse `PATH=VALUE`.
+    pub fn parse(text: &str) -> Result<Override, OverrideError> {
+        let (p, v) = split_assignment(text)?;
+        Ok(Override::new(p, v))
+    }
+}
+
+impl std::str::FromStr for Override {
+    type Err = OverrideError;
+    fn from_str(s: &str) -> Result<Override, OverrideError> {
+        Override::parse(s)
+    }
+}
+
 /// Split `PATH=VALUE`.
-pub fn split_assignment(text: &str) -> Result<(&str, &str), String> {
+pub fn split_assignment(text: &str) -> Result<(&str, &str), OverrideError> {
     let limit = plantwide_model::limits::Limits::get().string_len();
     if let Some(msg) = limit.check(text.chars().count(), "the length of this assignment") {
-        return Err(format!("--set `{}`: {msg}", plantwide_model::limits::clip(text)));
+        return Err(OverrideError::TooLong { text: plantwide_model::limits::clip(text), why: msg });
     }
     text.split_once('=')
         .map(|(p, v)| (p.trim(), v.trim()))
-        .ok_or_else(|| format!("`{text}`: expected PATH=VALUE, e.g. feed.F=1.01kmol/min"))
+        .ok_or_else(|| OverrideError::Syntax { text: text.to_string() })
 }
 
-/// Apply one assignment to the input vector `u` if `path` names an input.
-pub fn set_input(plant: &Plant, u: &mut [f64], path: &str, value: &str) -> Result<bool, String> {
+/// Apply one assignment to the input vector `u` if `path` names an input (`Ok(false)` if it does not).
+pub fn set_input(plant: &Plant, u: &mut [f64], path: &str, value: &str) -> Result<bool, OverrideError> {
     let Some(i) = resolve_input(plant, path) else { return Ok(false) };
     let info = &plant.inputs[i];
     if info.driven_by.is_some() {
-        return Err(format!(
-            "--set {path}: this input is driven by a controller; set the controller's setpoint (`<ctrl>.sp`) instead"
-        ));
+        return Err(OverrideError::Driven { path: path.to_string() });
     }
-    let v = parse_quantity_as(value, info.dim).map_err(|e| format!("--set {path}: {e}"))?;
-    check_input_value(plant, i, v).map_err(|e| format!("--set {path}={value}: {e}"))?;
+    let v = parse_quantity_as(value, info.dim).map_err(|e| OverrideError::Value {
+        path: path.to_string(),
+        value: None,
+        why: e.to_string(),
+    })?;
+    check_input_value(plant, i, v).map_err(|why| OverrideError::Value {
+        path: path.to_string(),
+        value: Some(value.to_string()),
+        why,
+    })?;
     u[i] = v;
     Ok(true)
 }
@@ -54,39 +90,38 @@ pub fn check_input_value(plant: &Plant, i: usize, v: f64) -> Result<(), String> 
     plantwide_model::limits::check_input(name, info.dim, v)
 }
 
-/// Read the flowsheet at `path` and apply `--set PATH=VALUE` overrides: an input (validated like
-/// the file's values) or a field of a unit or controller description (the description is then
-/// validated and assembled again). Returns the plant and its input vector.
-pub fn load_with(path: &std::path::Path, sets: &[String]) -> Result<(Plant, Vec<f64>), OverrideError> {
+/// Read the flowsheet at `path` and apply `overrides`: inputs (validated like the file's values)
+/// and fields of unit or controller descriptions (the description is then validated and
+/// assembled again). The plant's input values include the overrides.
+pub fn load_with(path: &std::path::Path, overrides: &[Override]) -> Result<Plant, OverrideError> {
     let name = path.display().to_string();
-    let text = crate::parse::read_text(path)?;
-    let mut spec = crate::parse::parse_spec(&text, &name)?;
-    let mut plant = crate::assemble(&spec, &name)?;
-    let mut assignments = Vec::new();
-    let mut reassemble = false;
-    for s in sets {
-        let (path, value) = split_assignment(s).map_err(OverrideError::Bad)?;
-        let mut u = plant.input_values();
-        if set_input(&plant, &mut u, path, value).map_err(OverrideError::Bad)? {
-            assignments.push((path.to_string(), value.to_string()));
-        } else {
-            set_field(&mut spec, path, value).map_err(OverrideError::Bad)?;
-            reassemble = true;
+    load_str_with(&crate::parse::read_text(path)?, &name, overrides)
+}
+
+/// [`load_with`] for flowsheet text already read (`file` names it in messages).
+pub fn load_str_with(text: &str, file: &str, overrides: &[Override]) -> Result<Plant, OverrideError> {
+    let plant = crate::load_str(text, file)?;
+    if overrides.is_empty() {
+        return Ok(plant);
+    }
+    plant.variant(overrides)
+}
+
+/// Set the input `overrides` on `plant` (every one must name an input), then check the
+/// compositions and each unit's own input checks.
+pub(crate) fn apply_inputs(plant: &mut Plant, overrides: &[Override]) -> Result<(), OverrideError> {
+    let mut u = plant.input_values();
+    for o in overrides {
+        if !set_input(plant, &mut u, &o.path, &o.value)? {
+            return Err(OverrideError::NoTarget { path: o.path.clone(), hint: String::new() });
         }
     }
-    if reassemble {
-        plant = crate::assemble(&spec, &name)?;
+    check_compositions(plant, &u)?;
+    if !overrides.is_empty() {
+        check_unit_inputs(plant, &u).map_err(|(path, why)| OverrideError::UnitInput { path, why })?;
     }
-    let mut u = plant.input_values();
-    for (path, value) in &assignments {
-        set_input(&plant, &mut u, path, value).map_err(OverrideError::Bad)?;
-    }
-    check_compositions(&plant, &u).map_err(OverrideError::Bad)?;
-    if !sets.is_empty() {
-        check_unit_inputs(&plant, &u)
-            .map_err(|(path, why)| OverrideError::Bad(format!("with --set, {path}: {why}")))?;
-    }
-    Ok((plant, u))
+    plant.set_input_values(&u);
+    Ok(())
 }
 
 /// Each unit's own check of its input values ([`plantwide_model::UnitModel::check_inputs`]) at `u`:
@@ -104,7 +139,7 @@ pub fn check_unit_inputs(plant: &Plant, u: &[f64]) -> Result<(), (String, String
 
 /// The mole-fraction inputs `z[c]` of each unit (a feed's composition but its last component,
 /// which makes up the balance) must not sum above 1: the last fraction would be negative.
-pub fn check_compositions(plant: &Plant, u: &[f64]) -> Result<(), String> {
+pub fn check_compositions(plant: &Plant, u: &[f64]) -> Result<(), OverrideError> {
     for (bi, b) in plant.blocks.iter().enumerate() {
         let z: Vec<usize> = (0..plant.inputs.len())
             .filter(|&i| plant.inputs[i].block == bi && plant.inputs[i].path.starts_with(&format!("{}.z[", b.name)))
@@ -112,11 +147,7 @@ pub fn check_compositions(plant: &Plant, u: &[f64]) -> Result<(), String> {
         let sum: f64 = z.iter().map(|&i| u[i]).sum();
         if sum > 1.0 + 1e-9 {
             let parts: Vec<String> = z.iter().map(|&i| format!("{} = {}", plant.inputs[i].path, u[i])).collect();
-            return Err(format!(
-                "{}: mole fractions sum to {sum} > 1, leaving a negative fraction for the last component; set them so that they sum to at most 1 ({})",
-                b.name,
-                parts.join(", ")
-            ));
+            return Err(OverrideError::Composition { unit: b.name.clone(), sum, parts: parts.join(", ") });
         }
     }
     Ok(())
@@ -128,37 +159,98 @@ pub enum OverrideError {
     /// The file, or the description after a field override, is invalid.
     #[error(transparent)]
     Load(#[from] crate::LoadError),
-    /// An override cannot be applied (the message names it).
-    #[error("{0}")]
-    Bad(String),
+    /// The assignment is too long.
+    #[error("--set `{text}`: {why}")]
+    TooLong {
+        /// The assignment, clipped.
+        text: String,
+        /// The limit and how to raise it.
+        why: String,
+    },
+    /// Not of the form `PATH=VALUE`.
+    #[error("`{text}`: expected PATH=VALUE, e.g. feed.F=1.01kmol/min")]
+    Syntax {
+        /// The assignment.
+        text: String,
+    },
+    /// The input is driven by a controller.
+    #[error("--set {path}: this input is driven by a controller; set the controller's setpoint (`<ctrl>.sp`) instead")]
+    Driven {
+        /// The input path.
+        path: String,
+    },
+    /// The value does not parse as the input's quantity, or is outside its physical range.
+    #[error("--set {path}{}: {why}", value.as_ref().map(|v| format!("={v}")).unwrap_or_default())]
+    Value {
+        /// The input path.
+        path: String,
+        /// The value as written (when it parsed).
+        value: Option<String>,
+        /// What is wrong and what would fix it.
+        why: String,
+    },
+    /// No input, unit or controller of that name.
+    #[error("--set {path}: no unit, controller, stream or input named `{}`{hint}", path.split('.').next().unwrap_or(path))]
+    NoTarget {
+        /// The path.
+        path: String,
+        /// A suggestion, or empty.
+        hint: String,
+    },
+    /// The path is not `unit.field`, the unit is not an object, or it has no such field.
+    #[error("--set {path}: {why}")]
+    Field {
+        /// The path.
+        path: String,
+        /// What is wrong (the fields it has, the deserialization error).
+        why: String,
+    },
+    /// A unit's mole fractions sum above 1.
+    #[error(
+        "{unit}: mole fractions sum to {sum} > 1, leaving a negative fraction for the last component; set them so that they sum to at most 1 ({parts})"
+    )]
+    Composition {
+        /// The unit.
+        unit: String,
+        /// Their sum.
+        sum: f64,
+        /// `path = value` of each.
+        parts: String,
+    },
+    /// A unit's own check of its inputs failed ([`plantwide_model::UnitModel::check_inputs`]).
+    #[error("with --set, {path}: {why}")]
+    UnitInput {
+        /// JSON path of the input.
+        path: String,
+        /// Why.
+        why: String,
+    },
 }
 
 /// Apply an assignment to a unit or controller field of the flowsheet description
 /// (`unit.field=value`): the value is stored as written (a quantity string or a JSON literal).
-pub fn set_field(spec: &mut FlowsheetSpec, path: &str, value: &str) -> Result<(), String> {
-    let (head, field) = path.split_once('.').ok_or_else(|| format!("--set {path}: expected `unit.field`"))?;
-    let mut doc = serde_json::to_value(&*spec).map_err(|e| e.to_string())?;
+pub fn set_field(spec: &mut FlowsheetSpec, path: &str, value: &str) -> Result<(), OverrideError> {
+    let field_error = |why: String| OverrideError::Field { path: path.to_string(), why };
+    let (head, field) = path.split_once('.').ok_or_else(|| field_error("expected `unit.field`".into()))?;
+    let mut doc = serde_json::to_value(&*spec).map_err(|e| field_error(e.to_string()))?;
     let section = if spec.units.contains_key(head) {
         "units"
     } else if spec.controllers.contains_key(head) {
         "controllers"
     } else {
         let names = spec.units.keys().chain(spec.controllers.keys()).map(String::as_str);
-        return Err(format!(
-            "--set {path}: no unit, controller, stream or input named `{head}`{}",
-            did_you_mean(head, names)
-        ));
+        return Err(OverrideError::NoTarget { path: path.to_string(), hint: did_you_mean(head, names) });
     };
-    let obj = doc[section][head].as_object_mut().ok_or_else(|| format!("--set {path}: `{head}` is not an object"))?;
+    let obj = doc[section][head].as_object_mut().ok_or_else(|| field_error(format!("`{head}` is not an object")))?;
     if !obj.contains_key(field) {
         let known: Vec<&str> = obj.keys().map(String::as_str).collect();
-        return Err(format!(
-            "--set {path}: `{head}` has no field `{field}` set in the file (fields: {})",
+        return Err(field_error(format!(
+            "`{head}` has no field `{field}` set in the file (fields: {})",
             known.join(", ")
-        ));
+        )));
     }
     let parsed = serde_json::from_str::<Value>(value).unwrap_or_else(|_| Value::String(value.to_string()));
     obj.insert(field.to_string(), parsed);
-    *spec = serde_json::from_value(doc).map_err(|e| format!("--set {path}: {e}"))?;
+    *spec = serde_json::from_value(doc).map_err(|e| field_error(e.to_string()))?;
     Ok(())
 }

@@ -3,6 +3,7 @@
 //! every variable and input.
 
 use std::collections::HashMap;
+use std::sync::Arc;
 
 use rayon::prelude::*;
 
@@ -10,6 +11,8 @@ use plantwide_model::stream::StreamLayout;
 use plantwide_model::{Coloring, LocalLayout, Unit, UnitIo, VarKind, VarSpec};
 use plantwide_thermo::ThermoPackage;
 use plantwide_units::Dimension;
+
+use crate::spec::FlowsheetSpec;
 
 /// Where one entry of a unit's local vector (beyond its own variables) comes from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -30,14 +33,14 @@ pub enum BlockKind {
 }
 
 /// One unit or controller in the assembled plant.
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub struct Block {
     /// Name in the flowsheet.
     pub name: String,
     /// Unit or controller.
     pub kind: BlockKind,
     /// The model.
-    pub unit: Box<dyn Unit>,
+    pub unit: Arc<dyn Unit>,
     /// Its local layout.
     pub layout: LocalLayout,
     /// First global variable it owns.
@@ -98,7 +101,7 @@ pub struct StreamInfo {
 }
 
 /// The assembled plant.
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub struct Plant {
     /// File the plant came from (for messages).
     pub file: String,
@@ -122,9 +125,60 @@ pub struct Plant {
     pub aliases: HashMap<String, usize>,
     pub(crate) var_index: HashMap<String, usize>,
     pub(crate) input_index: HashMap<String, usize>,
+    /// The description the plant was assembled from (after field overrides): structure variants
+    /// are edits of it, assembled again ([`Plant::variant`]).
+    pub(crate) spec: FlowsheetSpec,
 }
 
 impl Plant {
+    /// File the plant came from (for messages).
+    pub fn file(&self) -> &str {
+        &self.file
+    }
+    /// Name of the plant.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+    /// Component names, in the order of every composition.
+    pub fn components(&self) -> &[String] {
+        &self.components
+    }
+    /// Thermodynamic package.
+    pub fn thermo(&self) -> &ThermoPackage {
+        &self.thermo
+    }
+    /// Layout of every stream's variables.
+    pub fn stream_layout(&self) -> StreamLayout {
+        self.stream_layout
+    }
+    /// Units and controllers, units first, in file order.
+    pub fn blocks(&self) -> &[Block] {
+        &self.blocks
+    }
+    /// Global variables.
+    pub fn vars(&self) -> &[VarInfo] {
+        &self.vars
+    }
+    /// Declared inputs (manipulated variables, disturbances, setpoints; held measurements last).
+    pub fn inputs(&self) -> &[InputInfo] {
+        &self.inputs
+    }
+    /// Material streams.
+    pub fn streams(&self) -> &[StreamInfo] {
+        &self.streams
+    }
+    /// Named inputs (`alias → input index`).
+    pub fn aliases(&self) -> &HashMap<String, usize> {
+        &self.aliases
+    }
+    /// The description the plant was assembled from (after field overrides).
+    pub fn spec(&self) -> &FlowsheetSpec {
+        &self.spec
+    }
+    /// Index of the block named `name`.
+    pub fn block_index(&self, name: &str) -> Option<usize> {
+        self.blocks.iter().position(|b| b.name == name)
+    }
     /// Number of variables (= number of equations in a well-posed plant).
     pub fn n_vars(&self) -> usize {
         self.vars.len()

@@ -1,0 +1,153 @@
+//! The only code that changes how an assembled plant is wired: input values, held inputs (a loop in
+//! manual, a sampled controller between scans), held measurements (an analyzer's sample-and-hold),
+//! and structure variants (another pairing, another inventory configuration) assembled anew from
+//! an edited description.
+//!
+//! Invariants kept by every method: each block's `reads` has one entry per local input or signal;
+//! an input is `driven_by` a controller output exactly when some block reads that output variable
+//! in its place; a held measurement is an input of its own (`<ctrl>.analyzer`), appended after the
+//! declared inputs, so the indices of the declared inputs never move.
+
+use crate::overrides::{Override, OverrideError};
+use crate::plant::{BlockKind, InputInfo, Plant, Read};
+
+/// Why a plant cannot be rewired as asked.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum WiringError {
+    /// No block of that name, or it is not a controller.
+    #[error("{file}: no controller `{name}`{hint}")]
+    NoController {
+        /// Flowsheet file.
+        file: String,
+        /// The name asked for.
+        name: String,
+        /// A suggestion (`; did you mean …?`) or empty.
+        hint: String,
+    },
+    /// The controller does not read a plant variable as its measurement (it has no signal, or an
+    /// analyzer already holds it).
+    #[error(
+        "{file}: controller `{name}` does not read a plant variable as its measurement (already held by an analyzer?)"
+    )]
+    NoMeasurement {
+        /// Flowsheet file.
+        file: String,
+        /// The controller.
+        name: String,
+    },
+}
+
+impl Plant {
+    /// Set the value (SI) of input `i`: a free input's value, or the value a held input keeps.
+    pub fn set_input_value(&mut self, i: usize, value: f64) {
+        self.inputs[i].value = value;
+    }
+
+    /// Set the values (SI) of all inputs, in input order (`u.len()` = number of inputs).
+    pub fn set_input_values(&mut self, u: &[f64]) {
+        self.inputs.iter_mut().zip(u).for_each(|(info, v)| info.value = *v);
+    }
+
+    /// Index of the controller named `name`.
+    pub fn controller(&self, name: &str) -> Result<usize, WiringError> {
+        match self.block_index(name) {
+            Some(b) if self.blocks[b].kind == BlockKind::Controller => Ok(b),
+            _ => Err(WiringError::NoController {
+                file: self.file.clone(),
+                name: name.to_string(),
+                hint: crate::error::did_you_mean(
+                    name,
+                    self.blocks.iter().filter(|b| b.kind == BlockKind::Controller).map(|b| b.name.as_str()),
+                ),
+            }),
+        }
+    }
+
+    /// The inputs driven by an output variable of block `b`, in input order.
+    pub fn inputs_driven_by(&self, b: usize) -> Vec<usize> {
+        (0..self.inputs.len()).filter(|&i| self.inputs[i].driven_by.is_some_and(|v| self.vars[v].block == b)).collect()
+    }
+
+    /// The plant variable controller `b` reads as its measurement (its first signal), if it reads one.
+    pub fn measured_var(&self, b: usize) -> Option<usize> {
+        let block = &self.blocks[b];
+        if block.kind != BlockKind::Controller || block.layout.n_signals == 0 {
+            return None;
+        }
+        match block.reads.get(block.layout.n_inputs) {
+            Some(&Read::Var(v)) => Some(v),
+            _ => None,
+        }
+    }
+
+    /// Hold input `i`: every block reads the input's own value instead of the controller output
+    /// that drives it. Returns that output variable, or `None` if the input was free already.
+    pub fn hold_input(&mut self, i: usize) -> Option<usize> {
+        let op = self.inputs[i].driven_by.take()?;
+        let slen = self.stream_layout.len();
+        for b in &mut self.blocks {
+            if let Some(k) = b.input_ids.iter().position(|&id| id == i) {
+                let pos = if b.kind == BlockKind::Unit { b.layout.n_inlets * slen + k } else { k };
+                b.reads[pos] = Read::Input(i);
+            }
+        }
+        Some(op)
+    }
+
+    /// Put block `b`'s loop in manual at state `x`: every input its outputs drive is held at the
+    /// output's value in `x`. Returns the pairs (held input, output variable).
+    pub fn manual(&mut self, b: usize, x: &[f64]) -> Vec<(usize, usize)> {
+        let pairs: Vec<(usize, usize)> =
+            self.inputs_driven_by(b).into_iter().filter_map(|i| self.hold_input(i).map(|op| (i, op))).collect();
+        for &(i, op) in &pairs {
+            self.inputs[i].value = x[op];
+        }
+        pairs
+    }
+
+    /// Hold controller `b`'s measurement: a new input `<ctrl>.analyzer` with `value` is read in
+    /// place of the measured variable. Returns (the new input, the variable it stands for).
+    pub fn hold_measurement(&mut self, b: usize, value: f64) -> Result<(usize, usize), WiringError> {
+        let v = self
+            .measured_var(b)
+            .ok_or_else(|| WiringError::NoMeasurement { file: self.file.clone(), name: self.blocks[b].name.clone() })?;
+        let input = self.inputs.len();
+        let path = format!("{}.analyzer", self.blocks[b].name);
+        self.inputs.push(InputInfo {
+            path: path.clone(),
+            dim: self.vars[v].spec.dim,
+            value,
+            driven_by: None,
+            block: b,
+        });
+        self.input_index.insert(path, input);
+        let pos = self.blocks[b].layout.n_inputs;
+        self.blocks[b].reads[pos] = Read::Input(input);
+        Ok((input, v))
+    }
+
+    /// A structure variant: this plant's description with `overrides` applied (fields of units and
+    /// controllers: another measurement or manipulated input of a controller, another pairing, a
+    /// unit's parameters; and input values), assembled again. Input values of this plant carry
+    /// over by path where the variant keeps the input.
+    pub fn variant(&self, overrides: &[Override]) -> Result<Plant, OverrideError> {
+        let mut spec = self.spec.clone();
+        let mut inputs = Vec::new();
+        for o in overrides {
+            if crate::overrides::resolve_input(self, &o.path).is_some() {
+                inputs.push(o.clone());
+            } else {
+                crate::overrides::set_field(&mut spec, &o.path, &o.value)?;
+            }
+        }
+        let mut plant = crate::assemble(&spec, &self.file)?;
+        for (k, info) in plant.inputs.iter_mut().enumerate() {
+            if let Some(j) = self.input_index.get(&info.path) {
+                info.value = self.inputs[*j].value;
+            }
+            debug_assert_eq!(plant.input_index.get(&info.path), Some(&k));
+        }
+        crate::overrides::apply_inputs(&mut plant, &inputs)?;
+        Ok(plant)
+    }
+}
