@@ -4,7 +4,7 @@ use std::path::Path;
 
 use plantwide::flowsheet::{BlockKind, Plant};
 use plantwide::model::stream::{F, H, P, T, Z0};
-use plantwide::solve::sequential::{Method, Progress, Solution, StrategySettings, steady_state_checked};
+use plantwide::solve::{Method, Progress, Solution, StrategySettings, converge_observed};
 
 use super::CliError;
 
@@ -57,7 +57,8 @@ pub fn converge_by(plant: &Plant, u: &[f64], method: MethodArg) -> Result<Soluti
         bar.tick();
     };
     let settings = StrategySettings { method, ..StrategySettings::default() };
-    let result = steady_state_checked(plant, u, &settings, &mut observer);
+    debug_assert_eq!(plant.input_values(), u, "the plant carries the input values it is converged at");
+    let result = converge_observed(plant, &settings, &mut observer);
     bar.finish_and_clear();
     result
         .map_err(|e| if e.is_user_error() { CliError::user(e.to_string()) } else { CliError::numerical(e.to_string()) })

@@ -8,6 +8,7 @@
 pub mod certify;
 pub mod dae;
 pub mod dynamic;
+pub mod error;
 pub mod newton;
 pub mod sequential;
 pub mod sparse;
@@ -16,10 +17,12 @@ pub mod structure;
 pub mod system;
 
 pub use certify::{CertificateFailure, Warning, certify, certify_to};
+pub use error::Error;
 pub use newton::{
     IterationRecord, NewtonReport, NewtonSettings, NewtonStatus, pseudo_transient_steps, solve_steady,
     solve_steady_observed,
 };
+pub use sequential::{Method, Progress, Solution, SolveError, StrategySettings, converge, converge_observed};
 pub use steady::{
     ConvergenceFailure, DofError, DofProbe, PlantSystem, SteadyError, SteadyState, dof_check, steady_state,
     steady_state_observed,

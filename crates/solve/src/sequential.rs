@@ -50,7 +50,9 @@ pub use accel::Accelerator;
 pub use groups::{SolveGroup, solve_groups};
 pub use plan::{SequentialPlan, plan};
 pub use report::{PassRecord, SccReport, SmReport};
-pub use strategy::{Method, Progress, Solution, SolveError, StrategySettings, steady_state_by, steady_state_checked};
+pub use strategy::{
+    Method, Progress, Solution, SolveError, StrategySettings, converge, converge_observed, steady_state_by,
+};
 
 use crate::{DofError, DofProbe, NewtonSettings, NewtonStatus, dof_check, solve_steady};
 use accel::{TearIteration, WegsteinBounds};
@@ -97,24 +99,35 @@ impl Default for SmSettings {
 
 impl SmSettings {
     /// Check every field; the error names the field and what would fix it.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), SettingsError> {
+        let bad = |field: &'static str, got: String, fix: &'static str| Err(SettingsError { field, got, fix });
         if !(self.tol.is_finite() && self.tol > 0.0) {
-            return Err(format!("sm.tol must be a positive number (got {}), e.g. 1e-8", self.tol));
+            return bad("sm.tol", self.tol.to_string(), "a positive number, e.g. 1e-8");
         }
         if self.max_passes == 0 {
-            return Err("sm.max_passes must be at least 1".into());
+            return bad("sm.max_passes", "0".into(), "at least 1");
         }
         if !(self.q_min.is_finite() && self.q_max.is_finite() && self.q_min <= self.q_max && self.q_max < 1.0) {
-            return Err(format!(
-                "sm.q_min ≤ sm.q_max < 1 is required for Wegstein's q (got [{}, {}]); the usual bounds are [−5, 0]",
-                self.q_min, self.q_max
-            ));
+            let got = format!("[{}, {}]", self.q_min, self.q_max);
+            return bad("sm.q_min, sm.q_max", got, "q_min ≤ q_max < 1 for Wegstein's q; the usual bounds are [−5, 0]");
         }
         if !(self.local.tol.is_finite() && self.local.tol > 0.0) {
-            return Err(format!("sm.local.tol must be a positive number (got {})", self.local.tol));
+            return bad("sm.local.tol", self.local.tol.to_string(), "a positive number, e.g. 1e-10");
         }
         Ok(())
     }
+}
+
+/// A sequential-modular setting out of its range.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{field} = {got} is out of range; it must be {fix}")]
+pub struct SettingsError {
+    /// The setting (`sm.tol`).
+    pub field: &'static str,
+    /// Its value.
+    pub got: String,
+    /// What it must be.
+    pub fix: &'static str,
 }
 
 /// A local Newton that failed: which group, and its worst equation.
@@ -171,8 +184,11 @@ pub struct TearFailure {
 #[derive(Debug, Clone, thiserror::Error)]
 pub enum SmError {
     /// Bad settings.
-    #[error("{0}")]
-    Settings(String),
+    #[error(transparent)]
+    Settings(#[from] SettingsError),
+    /// A per-recycle setting names a block that is in no recycle.
+    #[error("sm.per_scc: `{0}` is not a block of any recycle; `plantwide check` lists the recycles and their blocks")]
+    NotInRecycle(String),
     /// The plant is ill-posed.
     #[error(transparent)]
     Dof(#[from] DofError),
@@ -213,7 +229,7 @@ pub fn solve_sequential_observed(
     settings: &SmSettings,
     observer: &mut dyn FnMut(&PassRecord),
 ) -> Result<SmSolution, SmError> {
-    settings.validate().map_err(SmError::Settings)?;
+    settings.validate()?;
     let mut x = x0.map_or_else(|| plant.initial_guess_at(u), <[f64]>::to_vec);
     dof_check(plant, u, &x, DofProbe::Structural)?;
     let plan = plan(plant, u, &x);
@@ -222,9 +238,7 @@ pub fn solve_sequential_observed(
             s.order.iter().any(|&v| plan.groups[plan.graph[v]].blocks.iter().any(|&b| plant.blocks[b].name == *name))
         });
         if !in_recycle {
-            return Err(SmError::Settings(format!(
-                "sm.per_scc: `{name}` is not a block of any recycle; `plantwide check` lists the recycles and their blocks"
-            )));
+            return Err(SmError::NotInRecycle(name.clone()));
         }
     }
     let layouts: Vec<GroupLayout> = plan.groups.iter().map(|g| GroupLayout::new(plant, &g.blocks)).collect();

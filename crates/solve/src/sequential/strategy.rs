@@ -88,7 +88,11 @@ pub enum SolveError {
 impl SolveError {
     /// True for an ill-posed plant or bad settings (a user error), false for a numerical failure.
     pub fn is_user_error(&self) -> bool {
-        matches!(self, SolveError::Sm(SmError::Dof(_) | SmError::Settings(_)) | SolveError::Eo(SteadyError::Dof(_)))
+        matches!(
+            self,
+            SolveError::Sm(SmError::Dof(_) | SmError::Settings(_) | SmError::NotInRecycle(_))
+                | SolveError::Eo(SteadyError::Dof(_))
+        )
     }
 }
 
@@ -135,13 +139,14 @@ pub fn steady_state_by(
                 });
             }
             let loose = SmSettings { tol: settings.auto_tol, ..settings.sm.clone() };
-            let (start, sm, sm_failure) =
-                match solve_sequential_observed(plant, u, Some(&x0), &loose, &mut |p| observer(Progress::Pass(p))) {
-                    Ok(sol) => (sol.x, Some(sol.report), None),
-                    Err(e @ (SmError::Dof(_) | SmError::Settings(_))) => return Err(e.into()),
-                    Err(SmError::NotConverged(f)) => (f.x.clone(), Some(f.report.clone()), Some(f.to_string())),
-                    Err(SmError::Local(f)) => (x0.clone(), None, Some(f.to_string())),
-                };
+            let (start, sm, sm_failure) = match solve_sequential_observed(plant, u, Some(&x0), &loose, &mut |p| {
+                observer(Progress::Pass(p))
+            }) {
+                Ok(sol) => (sol.x, Some(sol.report), None),
+                Err(e @ (SmError::Dof(_) | SmError::Settings(_) | SmError::NotInRecycle(_))) => return Err(e.into()),
+                Err(SmError::NotConverged(f)) => (f.x.clone(), Some(f.report.clone()), Some(f.to_string())),
+                Err(SmError::Local(f)) => (x0.clone(), None, Some(f.to_string())),
+            };
             let ss = match eo(Some(&start), observer) {
                 Ok(ss) => ss,
                 Err(first) if sm_failure.is_none() => eo(Some(&x0), observer).map_err(|_| first)?,
@@ -152,31 +157,38 @@ pub fn steady_state_by(
     }
 }
 
-/// [`steady_state_by`] with the numerical degrees-of-freedom probe: a steady state is reported only
-/// where the plant's Jacobian is nonsingular, i.e. where it is an isolated solution. The probe runs
-/// at the cold-start guess; a null direction there (an uncontrolled level, or only a dry tray of the
-/// guess) is confirmed or refuted at the converged point, so that an accidental singularity of the
-/// guess neither stops a plant that converges nor lets a plant with a free inventory report one of
-/// its infinitely many steady states.
-pub fn steady_state_checked(
+/// The one steady-state entry point of the library, the CLI and the tests: [`steady_state_by`] at
+/// the plant's input values with the numerical degrees-of-freedom probe, so that a steady state is
+/// reported only where the plant's Jacobian is nonsingular, i.e. where it is an isolated solution.
+/// The probe runs at the cold-start guess; a null direction there (an uncontrolled level, or only a
+/// dry tray of the guess) is confirmed or refuted at the converged point, so that an accidental
+/// singularity of the guess neither stops a plant that converges nor lets a plant with a free
+/// inventory report one of its infinitely many steady states. Every reported state passed the
+/// certificate ([`crate::certify`]).
+pub fn converge(plant: &Plant, settings: &StrategySettings) -> Result<Solution, SolveError> {
+    converge_observed(plant, settings, &mut |_| {})
+}
+
+/// [`converge`] reporting every sequential-modular pass and Newton iteration to `observer`.
+pub fn converge_observed(
     plant: &Plant,
-    u: &[f64],
     settings: &StrategySettings,
     observer: &mut dyn FnMut(Progress<'_>),
 ) -> Result<Solution, SolveError> {
-    let x0 = plant.initial_guess_at(u);
-    let at_guess = dof_check(plant, u, &x0, DofProbe::Numerical);
+    let u = plant.input_values();
+    let x0 = plant.initial_guess_at(&u);
+    let at_guess = dof_check(plant, &u, &x0, DofProbe::Numerical);
     if let Err(e @ DofError::Count { .. }) = at_guess {
         return Err(SteadyError::Dof(e).into());
     }
     let singular_at_guess = at_guess.is_err();
-    let sol = match steady_state_by(plant, u, settings, observer) {
+    let sol = match steady_state_by(plant, &u, settings, observer) {
         Ok(sol) => sol,
         Err(e @ SolveError::Eo(SteadyError::Dof(_))) => return Err(e),
         Err(e) => return Err(at_guess.map_or_else(|dof| SteadyError::Dof(dof).into(), |()| e)),
     };
     if singular_at_guess {
-        dof_check(plant, u, &sol.x, DofProbe::Numerical).map_err(SteadyError::Dof)?;
+        dof_check(plant, &u, &sol.x, DofProbe::Numerical).map_err(SteadyError::Dof)?;
     }
     Ok(sol)
 }
