@@ -3,6 +3,8 @@
 //! Entry point: [`load_file`] → [`Plant`]. Loading collects every problem it finds and reports them
 //! together, each with the file, the JSON path and what would fix it.
 
+#![warn(missing_docs)]
+
 pub mod assemble;
 pub mod components;
 pub mod error;

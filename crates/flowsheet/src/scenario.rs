@@ -259,25 +259,70 @@ impl Change {
     }
 }
 
-/// What an event does (indices are the plant's input, variable and block indices).
+/// What an event does (indices are the plant's input, variable and block indices; values SI,
+/// times in seconds).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub enum Action {
     /// Jump.
-    Step { input: usize, change: Change },
+    Step {
+        /// The input.
+        input: usize,
+        /// Its new value.
+        change: Change,
+    },
     /// Start a ramp ending at `end` [s].
-    Ramp { input: usize, change: Change, end: f64 },
+    Ramp {
+        /// The input.
+        input: usize,
+        /// Its value at `end`.
+        change: Change,
+        /// End of the ramp [s].
+        end: f64,
+    },
     /// End of a ramp: hold its final value.
-    Hold { input: usize },
+    Hold {
+        /// The input.
+        input: usize,
+    },
     /// Start of a pulse: save the value, then jump.
-    Pulse { input: usize, change: Change },
-    /// Start a sinusoid [SI, s].
-    Sinusoid { input: usize, amplitude: f64, period: f64 },
+    Pulse {
+        /// The input.
+        input: usize,
+        /// Its value during the pulse.
+        change: Change,
+    },
+    /// Start a sinusoid `u(t) = u0 + amplitude · sin(2π (t − t0) / period)`.
+    Sinusoid {
+        /// The input.
+        input: usize,
+        /// Amplitude [SI].
+        amplitude: f64,
+        /// Period [s].
+        period: f64,
+    },
     /// End of a pulse or sinusoid: back to the value before it.
-    Restore { input: usize },
+    Restore {
+        /// The input.
+        input: usize,
+    },
     /// Switch a PID: its `auto` and `op_manual` inputs, its output variable.
-    Mode { auto_input: usize, manual_input: usize, op: usize, auto: bool, output: Option<f64> },
+    Mode {
+        /// The controller's `auto` input (1 automatic, 0 manual).
+        auto_input: usize,
+        /// Its `op_manual` input.
+        manual_input: usize,
+        /// Its output variable.
+        op: usize,
+        /// Automatic after the event.
+        auto: bool,
+        /// The manual output to hold, if given (else the output at the switch: bumpless).
+        output: Option<f64>,
+    },
     /// Freeze an input.
-    Stuck { input: usize },
+    Stuck {
+        /// The input.
+        input: usize,
+    },
 }
 
 /// An event at a time.

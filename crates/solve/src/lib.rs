@@ -5,6 +5,8 @@
 //! **Architecture Invariant:** solvers see a [`System`] (residual, Jacobian triplets, bounds,
 //! nominal magnitudes, mass-matrix pattern), never a unit, a stream or a file.
 
+#![warn(missing_docs)]
+
 pub mod certify;
 pub mod dae;
 pub mod dynamic;
