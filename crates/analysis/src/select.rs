@@ -83,21 +83,22 @@ pub fn select_inputs(plant: &Plant, texts: &[String]) -> Result<Vec<Signal>, Ana
 pub fn select_input(plant: &Plant, text: &str) -> Result<Signal, AnalysisError> {
     let (path, unit) = split_unit(text);
     let Some(index) = resolve_input(plant, path) else {
-        let free: Vec<&str> = plant.inputs.iter().filter(|i| i.driven_by.is_none()).map(|i| i.path.as_str()).collect();
-        let names = free.iter().copied().chain(plant.aliases.keys().map(String::as_str));
+        let free: Vec<&str> =
+            plant.inputs().iter().filter(|i| i.driven_by.is_none()).map(|i| i.path.as_str()).collect();
+        let names = free.iter().copied().chain(plant.aliases().keys().map(String::as_str));
         return Err(request(format!(
             "{}: no input `{path}`{}; free inputs: {}",
-            plant.file,
+            plant.file(),
             did_you_mean(path, names),
             free.join(", ")
         )));
     };
-    let info = &plant.inputs[index];
+    let info = &plant.inputs()[index];
     if let Some(op) = info.driven_by {
-        let ctrl = &plant.blocks[plant.vars[op].block].name;
+        let ctrl = &plant.blocks()[plant.vars()[op].block].name;
         return Err(request(format!(
             "{}: input `{path}` is driven by controller `{ctrl}`; move its setpoint `{ctrl}.sp` instead, or choose an input no controller drives",
-            plant.file
+            plant.file()
         )));
     }
     let (unit, factor) = display_unit(path, unit, info.dim)?;
@@ -113,13 +114,14 @@ pub fn select_outputs(plant: &Plant, texts: &[String]) -> Result<Vec<Signal>, An
 pub fn select_output(plant: &Plant, text: &str) -> Result<Signal, AnalysisError> {
     let (path, unit) = split_unit(text);
     let Some(index) = plant.var(path) else {
-        let hint = did_you_mean(path, plant.vars.iter().map(|v| v.path.as_str()));
+        let hint = did_you_mean(path, plant.vars().iter().map(|v| v.path.as_str()));
         return Err(request(format!(
             "{}: no variable `{path}`{hint}; `plantwide steady {} --json` lists every variable path",
-            plant.file, plant.file
+            plant.file(),
+            plant.file()
         )));
     };
-    let (unit, factor) = display_unit(path, unit, plant.vars[index].spec.dim)?;
+    let (unit, factor) = display_unit(path, unit, plant.vars()[index].spec.dim)?;
     Ok(Signal { path: path.to_string(), unit, factor, index })
 }
 

@@ -77,7 +77,7 @@ pub fn certify(plant: &Plant, x: &[f64], u: &[f64]) -> Result<Vec<Warning>, Cert
 /// [`certify`] to the relative tolerance `tol`.
 pub fn certify_to(plant: &Plant, x: &[f64], u: &[f64], tol: f64) -> Result<Vec<Warning>, CertificateFailure> {
     let fail = |unit: &str, equation: String, relative: f64, at_bound: Vec<String>| CertificateFailure {
-        file: plant.file.clone(),
+        file: plant.file().to_string(),
         unit: unit.to_string(),
         equation,
         relative,
@@ -85,24 +85,24 @@ pub fn certify_to(plant: &Plant, x: &[f64], u: &[f64], tol: f64) -> Result<Vec<W
         at_bound,
     };
     if let Some(j) = x.iter().position(|v| !v.is_finite()) {
-        return Err(fail(&plant.vars[j].path, "its value, not finite,".into(), f64::INFINITY, Vec::new()));
+        return Err(fail(&plant.vars()[j].path, "its value, not finite,".into(), f64::INFINITY, Vec::new()));
     }
-    let nc = plant.components.len();
-    for s in &plant.streams {
+    let nc = plant.components().len();
+    for s in plant.streams() {
         let sum: f64 = x[s.offset + Z0..s.offset + Z0 + nc].iter().sum();
         if (sum - 1.0).abs() > tol {
             let at_bound = floors(plant, x, s.from.0);
             return Err(fail(&s.name, "the sum of its mole fractions − 1".into(), sum - 1.0, at_bound));
         }
     }
-    let reacting = plant.blocks.iter().any(|b| b.unit.reacts());
-    let scale = plant.streams.iter().map(|s| x[s.offset + F]).fold(0.0, f64::max).max(1e-12);
-    for (bi, b) in plant.blocks.iter().enumerate() {
+    let reacting = plant.blocks().iter().any(|b| b.unit.reacts());
+    let scale = plant.streams().iter().map(|s| x[s.offset + F]).fold(0.0, f64::max).max(1e-12);
+    for (bi, b) in plant.blocks().iter().enumerate() {
         if b.kind != BlockKind::Unit || matches!(b.unit.type_name(), "feed" | "product") {
             continue;
         }
-        let ins = plant.streams.iter().filter(|s| s.to.0 == bi).map(|s| s.offset);
-        let outs = plant.streams.iter().filter(|s| s.from.0 == bi).map(|s| s.offset);
+        let ins = plant.streams().iter().filter(|s| s.to.0 == bi).map(|s| s.offset);
+        let outs = plant.streams().iter().filter(|s| s.from.0 == bi).map(|s| s.offset);
         if let Some((equation, rel)) = imbalance(plant, x, (ins, outs), b.unit.reacts(), 1e-6 * scale, tol) {
             return Err(fail(&b.name, equation, rel, floors(plant, x, bi)));
         }
@@ -110,9 +110,9 @@ pub fn certify_to(plant: &Plant, x: &[f64], u: &[f64], tol: f64) -> Result<Vec<W
             return Err(fail(&b.name, format!("the holdup {path} − its lower bound"), 0.0, vec![path]));
         }
     }
-    let kind = |bi: usize| plant.blocks[bi].unit.type_name();
-    let feeds = plant.streams.iter().filter(|s| kind(s.from.0) == "feed").map(|s| s.offset);
-    let products = plant.streams.iter().filter(|s| kind(s.to.0) == "product").map(|s| s.offset);
+    let kind = |bi: usize| plant.blocks()[bi].unit.type_name();
+    let feeds = plant.streams().iter().filter(|s| kind(s.from.0) == "feed").map(|s| s.offset);
+    let products = plant.streams().iter().filter(|s| kind(s.to.0) == "product").map(|s| s.offset);
     if let Some((equation, rel)) = imbalance(plant, x, (feeds, products), reacting, 1e-6 * scale, tol) {
         return Err(fail("plant", format!("{equation} (feeds against products)"), rel, Vec::new()));
     }
@@ -130,8 +130,8 @@ fn imbalance(
     floor: f64,
     tol: f64,
 ) -> Option<(String, f64)> {
-    let nc = plant.components.len();
-    let mw: Vec<f64> = plant.thermo.components.iter().map(|c| c.mw).collect();
+    let nc = plant.components().len();
+    let mw: Vec<f64> = plant.thermo().components.iter().map(|c| c.mw).collect();
     let mut net = vec![0.0; nc];
     let mut through = 0.0;
     let mut add = |o: usize, sign: f64| {
@@ -150,7 +150,7 @@ fn imbalance(
         return (rel.abs() > tol).then(|| ("the mass balance (in − out)/throughput".to_string(), rel));
     }
     let (c, rel) = net.iter().map(|n| n / denom).enumerate().max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))?;
-    (rel.abs() > tol).then(|| (format!("the balance of {} (in − out)/throughput", plant.components[c]), rel))
+    (rel.abs() > tol).then(|| (format!("the balance of {} (in − out)/throughput", plant.components()[c]), rel))
 }
 
 /// Total holdups of block `bi` resting on their lower bound.
@@ -170,9 +170,9 @@ fn floors(plant: &Plant, x: &[f64], bi: usize) -> Vec<String> {
 fn saturated(plant: &Plant, x: &[f64], u: &[f64]) -> Vec<Warning> {
     let mut local = Vec::new();
     let mut out = Vec::new();
-    for b in plant.blocks.iter().filter(|b| b.kind == BlockKind::Controller) {
+    for b in plant.blocks().iter().filter(|b| b.kind == BlockKind::Controller) {
         plant.gather(b, x, u, &mut local);
-        let io = UnitIo { local: &local, layout: &b.layout, thermo: &plant.thermo, time: 0.0 };
+        let io = UnitIo { local: &local, layout: &b.layout, thermo: &plant.thermo(), time: 0.0 };
         if let Some(s) = b.unit.saturation(&io) {
             let message = format!(
                 "controller `{}` is saturated: its output rests on {} = {} with the measurement {} off setpoint; the steady state holds the output at its limit, not the measurement at its setpoint",

@@ -235,7 +235,7 @@ pub fn solve_sequential_observed(
     let plan = plan(plant, u, &x);
     for (name, _) in &settings.per_scc {
         let in_recycle = plan.recycles().any(|s| {
-            s.order.iter().any(|&v| plan.groups[plan.graph[v]].blocks.iter().any(|&b| plant.blocks[b].name == *name))
+            s.order.iter().any(|&v| plan.groups[plan.graph[v]].blocks.iter().any(|&b| plant.blocks()[b].name == *name))
         });
         if !in_recycle {
             return Err(SmError::NotInRecycle(name.clone()));
@@ -294,7 +294,7 @@ impl Run<'_> {
                 |(row, _)| self.plant.equation_name(layout.global_row(self.plant, row)),
             );
             return Err(SmError::Local(Box::new(LocalFailure {
-                file: self.plant.file.clone(),
+                file: self.plant.file().to_string(),
                 group: self.plan.groups[g].name(self.plant),
                 status: rep.status,
                 iterations: rep.iterations,
@@ -319,7 +319,7 @@ impl Run<'_> {
         let index = self.report.sccs.len() + 1;
         let tears = plan.tear_vars(scc);
         let blocks_of = |v: NodeIndex| {
-            plan.groups[plan.graph[v]].blocks.iter().map(|&b| plant.blocks[b].name.clone()).collect::<Vec<_>>()
+            plan.groups[plan.graph[v]].blocks.iter().map(|&b| plant.blocks()[b].name.clone()).collect::<Vec<_>>()
         };
         let chosen = st
             .per_scc
@@ -327,7 +327,7 @@ impl Run<'_> {
             .find(|(name, _)| scc.order.iter().any(|&v| blocks_of(v).contains(name)))
             .map_or(st.accelerator, |(_, a)| *a);
         let method = chosen.resolve(scc.tears.len());
-        let spec = |v: usize| &plant.vars[v].spec;
+        let spec = |v: usize| &plant.vars()[v].spec;
         let floor: Vec<f64> = tears.iter().map(|&v| 1e-3 * spec(v).nominal).collect();
         let scale: Vec<f64> = tears.iter().zip(&floor).map(|(&v, f)| x[v].abs().max(*f)).collect();
         let bounds = tears.iter().map(|&v| (spec(v).lower, spec(v).upper)).collect();
@@ -386,7 +386,7 @@ impl Run<'_> {
         }
         let rec = self.report.sccs.last().expect("just pushed");
         Err(SmError::NotConverged(Box::new(TearFailure {
-            file: plant.file.clone(),
+            file: plant.file().to_string(),
             index,
             members: rec.groups.join(", "),
             passes: rec.passes,

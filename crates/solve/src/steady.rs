@@ -20,9 +20,9 @@ impl<'a> PlantSystem<'a> {
     /// Wrap a plant at inputs `u`.
     pub fn new(plant: &'a Plant, u: &'a [f64]) -> PlantSystem<'a> {
         let mut mass = Vec::new();
-        for b in &plant.blocks {
+        for b in plant.blocks() {
             for k in 0..b.layout.n_own().min(b.n_eq) {
-                if plant.vars[b.own_offset + k].spec.kind == VarKind::Differential {
+                if plant.vars()[b.own_offset + k].spec.kind == VarKind::Differential {
                     mass.push((b.eq_offset + k, b.own_offset + k));
                 }
             }
@@ -43,10 +43,10 @@ impl System for PlantSystem<'_> {
         self.plant.jacobian(x, self.u, 0.0, r, jac, &mut ju);
     }
     fn nominal(&self, i: usize) -> f64 {
-        self.plant.vars[i].spec.nominal
+        self.plant.vars()[i].spec.nominal
     }
     fn bounds(&self, i: usize) -> (f64, f64) {
-        let s = &self.plant.vars[i].spec;
+        let s = &self.plant.vars()[i].spec;
         (s.lower, s.upper)
     }
     fn mass(&self) -> Vec<(usize, usize)> {
@@ -123,7 +123,7 @@ pub enum DofProbe {
 /// null-space probe that names the inventory or variable left free (an uncontrolled level, a flow
 /// fixed at both ends).
 pub fn dof_check(plant: &Plant, u: &[f64], x: &[f64], probe: DofProbe) -> Result<(), DofError> {
-    let file = plant.file.clone();
+    let file = plant.file().to_string();
     let (n_eqs, n_vars) = (plant.n_eqs(), plant.n_vars());
     if n_eqs != n_vars {
         let hint = if n_eqs > n_vars {
@@ -183,7 +183,7 @@ fn null_direction(plant: &Plant, u: &[f64], x: &[f64]) -> Option<Vec<usize>> {
     // Scale columns by their nominal values and rows by their largest entry.
     let mut a = Mat::<f64>::zeros(n, n);
     for &(i, j, v) in &jx {
-        a[(i, j)] += v * plant.vars[j].spec.nominal;
+        a[(i, j)] += v * plant.vars()[j].spec.nominal;
     }
     for i in 0..n {
         let s = (0..n).map(|j| a[(i, j)].abs()).fold(0.0, f64::max);
@@ -207,11 +207,11 @@ fn null_direction(plant: &Plant, u: &[f64], x: &[f64]) -> Option<Vec<usize>> {
 }
 
 fn explain_loose(plant: &Plant, vars: &[usize], why: &str) -> String {
-    let paths: Vec<&str> = vars.iter().take(8).map(|&j| plant.vars[j].path.as_str()).collect();
+    let paths: Vec<&str> = vars.iter().take(8).map(|&j| plant.vars()[j].path.as_str()).collect();
     let inventories: Vec<&str> = vars
         .iter()
-        .filter(|&&j| plant.vars[j].spec.kind == VarKind::Differential)
-        .map(|&j| plant.vars[j].path.as_str())
+        .filter(|&&j| plant.vars()[j].spec.kind == VarKind::Differential)
+        .map(|&j| plant.vars()[j].path.as_str())
         .collect();
     let mut s = format!("{why}: {}", paths.join(", "));
     if vars.len() > 8 {
@@ -329,9 +329,9 @@ pub fn steady_state_observed(
     }
     let (eq, worst) = report.worst.unwrap_or((0, f64::NAN));
     let equation = plant.equation_name(eq);
-    let variable = plant.equation_variable(eq).map(|j| plant.vars[j].path.clone()).unwrap_or_else(|| "-".into());
+    let variable = plant.equation_variable(eq).map(|j| plant.vars()[j].path.clone()).unwrap_or_else(|| "-".into());
     Err(SteadyError::NotConverged(Box::new(ConvergenceFailure {
-        file: plant.file.clone(),
+        file: plant.file().to_string(),
         status: report.status,
         iterations: report.iterations,
         residual: report.residual,

@@ -40,7 +40,7 @@ pub struct SolveGroup {
 impl SolveGroup {
     /// Name: the block names joined by `+`.
     pub fn name(&self, plant: &Plant) -> String {
-        self.blocks.iter().map(|&b| plant.blocks[b].name.as_str()).collect::<Vec<_>>().join("+")
+        self.blocks.iter().map(|&b| plant.blocks()[b].name.as_str()).collect::<Vec<_>>().join("+")
     }
 }
 
@@ -101,12 +101,12 @@ impl Partition {
 /// Blocks that read a variable of `b` (consumers) and blocks whose variables `b` reads (sources),
 /// through streams and signals.
 fn neighbours(plant: &Plant) -> (Vec<Vec<usize>>, Vec<Vec<usize>>) {
-    let n = plant.blocks.len();
+    let n = plant.blocks().len();
     let (mut out, mut inn) = (vec![Vec::new(); n], vec![Vec::new(); n]);
-    for (bi, b) in plant.blocks.iter().enumerate() {
+    for (bi, b) in plant.blocks().iter().enumerate() {
         for r in &b.reads {
             if let Read::Var(v) = *r {
-                let a = plant.vars[v].block;
+                let a = plant.vars()[v].block;
                 if a != bi && !out[a].contains(&bi) {
                     out[a].push(bi);
                     inn[bi].push(a);
@@ -144,16 +144,16 @@ fn shortest_path(out: &[Vec<usize>], from: usize, to: usize, skip: usize) -> Opt
 /// The solve groups of `plant` by the rules of the module documentation (before the structural
 /// check, which needs a point).
 pub fn solve_groups(plant: &Plant) -> Vec<SolveGroup> {
-    let n = plant.blocks.len();
-    let name = |b: usize| plant.blocks[b].name.as_str();
+    let n = plant.blocks().len();
+    let name = |b: usize| plant.blocks()[b].name.as_str();
     let mut part = Partition::new(n);
     let (out, inn) = neighbours(plant);
 
     // 1. Non-square units, grown until every group is square.
-    for (bi, b) in plant.blocks.iter().enumerate() {
+    for (bi, b) in plant.blocks().iter().enumerate() {
         let n_own = b.layout.n_own();
         if b.n_eq > n_own {
-            for s in plant.streams.iter().filter(|s| s.to.0 == bi) {
+            for s in plant.streams().iter().filter(|s| s.to.0 == bi) {
                 let why = format!("`{}` writes the equation for the outflow of `{}`", name(bi), name(s.from.0));
                 part.join(&[s.from.0, bi], why);
             }
@@ -161,7 +161,7 @@ pub fn solve_groups(plant: &Plant) -> Vec<SolveGroup> {
     }
     loop {
         let mut balance = vec![0isize; n];
-        for (bi, b) in plant.blocks.iter().enumerate() {
+        for (bi, b) in plant.blocks().iter().enumerate() {
             let r = part.find(bi);
             balance[r] += b.n_eq as isize - b.layout.n_own() as isize;
         }
@@ -180,10 +180,10 @@ pub fn solve_groups(plant: &Plant) -> Vec<SolveGroup> {
     }
 
     // 2. Integrating controllers with the loop they close.
-    let controllers: Vec<usize> = (0..n).filter(|&b| plant.blocks[b].kind == BlockKind::Controller).collect();
+    let controllers: Vec<usize> = (0..n).filter(|&b| plant.blocks()[b].kind == BlockKind::Controller).collect();
     for &c in &controllers {
-        let b = &plant.blocks[c];
-        let integrating = plant.vars[b.own_offset..b.own_offset + b.layout.n_own()]
+        let b = &plant.blocks()[c];
+        let integrating = plant.vars()[b.own_offset..b.own_offset + b.layout.n_own()]
             .iter()
             .any(|v| v.spec.kind == VarKind::Differential);
         if !integrating {
@@ -251,7 +251,7 @@ impl GroupLayout {
         let (mut col0, mut row0, mut unknowns) = (Vec::new(), Vec::new(), Vec::new());
         let mut rows = 0;
         for &b in blocks {
-            let blk = &plant.blocks[b];
+            let blk = &plant.blocks()[b];
             col0.push(unknowns.len());
             row0.push(rows);
             unknowns.extend(blk.own_offset..blk.own_offset + blk.layout.n_own());
@@ -261,18 +261,18 @@ impl GroupLayout {
     }
     /// Number of equations.
     pub fn n_rows(&self, plant: &Plant) -> usize {
-        self.blocks.iter().map(|&b| plant.blocks[b].n_eq).sum()
+        self.blocks.iter().map(|&b| plant.blocks()[b].n_eq).sum()
     }
     /// Local index of global variable `v`, if it is an unknown of the group.
     pub fn local(&self, plant: &Plant, v: usize) -> Option<usize> {
-        let b = plant.vars[v].block;
+        let b = plant.vars()[v].block;
         let k = self.blocks.iter().position(|&x| x == b)?;
-        Some(self.col0[k] + v - plant.blocks[b].own_offset)
+        Some(self.col0[k] + v - plant.blocks()[b].own_offset)
     }
     /// Global equation index and block of local row `row`.
     pub fn global_row(&self, plant: &Plant, row: usize) -> usize {
         let k = self.row0.iter().rposition(|&r| r <= row).unwrap_or(0);
-        plant.blocks[self.blocks[k]].eq_offset + row - self.row0[k]
+        plant.blocks()[self.blocks[k]].eq_offset + row - self.row0[k]
     }
 }
 
@@ -287,7 +287,7 @@ pub(crate) struct GroupSystem<'a> {
 impl GroupSystem<'_> {
     /// Block `k`'s local vector with the group's unknowns from `y`.
     fn gather(&self, k: usize, y: &[f64], local: &mut Vec<f64>) {
-        let b = &self.plant.blocks[self.layout.blocks[k]];
+        let b = &self.plant.blocks()[self.layout.blocks[k]];
         let c0 = self.layout.col0[k];
         local.clear();
         local.extend_from_slice(&y[c0..c0 + b.layout.n_own()]);
@@ -305,9 +305,9 @@ impl System for GroupSystem<'_> {
     fn residual(&self, y: &[f64], r: &mut [f64]) {
         let mut local = Vec::new();
         for (k, &bi) in self.layout.blocks.iter().enumerate() {
-            let b = &self.plant.blocks[bi];
+            let b = &self.plant.blocks()[bi];
             self.gather(k, y, &mut local);
-            let io = UnitIo { local: &local, layout: &b.layout, thermo: &self.plant.thermo, time: 0.0 };
+            let io = UnitIo { local: &local, layout: &b.layout, thermo: &self.plant.thermo(), time: 0.0 };
             let r0 = self.layout.row0[k];
             b.unit.residual(&io, &mut r[r0..r0 + b.n_eq]);
         }
@@ -316,12 +316,12 @@ impl System for GroupSystem<'_> {
         jac.clear();
         let (mut local, mut dense) = (Vec::new(), Vec::new());
         for (k, &bi) in self.layout.blocks.iter().enumerate() {
-            let b = &self.plant.blocks[bi];
+            let b = &self.plant.blocks()[bi];
             self.gather(k, y, &mut local);
             let n = local.len();
             dense.clear();
             dense.resize(b.n_eq * n, 0.0);
-            let io = UnitIo { local: &local, layout: &b.layout, thermo: &self.plant.thermo, time: 0.0 };
+            let io = UnitIo { local: &local, layout: &b.layout, thermo: &self.plant.thermo(), time: 0.0 };
             let (r0, c0, n_own) = (self.layout.row0[k], self.layout.col0[k], b.layout.n_own());
             b.unit.jacobian_colored(&io, &mut r[r0..r0 + b.n_eq], &mut dense, b.coloring.as_ref());
             let mut push = |row: usize, j: usize| {
@@ -344,18 +344,18 @@ impl System for GroupSystem<'_> {
         }
     }
     fn nominal(&self, i: usize) -> f64 {
-        self.plant.vars[self.layout.unknowns[i]].spec.nominal
+        self.plant.vars()[self.layout.unknowns[i]].spec.nominal
     }
     fn bounds(&self, i: usize) -> (f64, f64) {
-        let s = &self.plant.vars[self.layout.unknowns[i]].spec;
+        let s = &self.plant.vars()[self.layout.unknowns[i]].spec;
         (s.lower, s.upper)
     }
     fn mass(&self) -> Vec<(usize, usize)> {
         let mut m = Vec::new();
         for (k, &bi) in self.layout.blocks.iter().enumerate() {
-            let b = &self.plant.blocks[bi];
+            let b = &self.plant.blocks()[bi];
             for j in 0..b.layout.n_own().min(b.n_eq) {
-                if self.plant.vars[b.own_offset + j].spec.kind == VarKind::Differential {
+                if self.plant.vars()[b.own_offset + j].spec.kind == VarKind::Differential {
                     m.push((self.layout.row0[k] + j, self.layout.col0[k] + j));
                 }
             }

@@ -95,7 +95,7 @@ fn structurally_regular(plant: &Plant, blocks: &[usize], jx: &[(usize, usize, f6
     }
     let mut row_of = std::collections::HashMap::new();
     for (k, &b) in blocks.iter().enumerate() {
-        let blk = &plant.blocks[b];
+        let blk = &plant.blocks()[b];
         for i in 0..blk.n_eq {
             row_of.insert(blk.eq_offset + i, layout.row0[k] + i);
         }
