@@ -172,7 +172,7 @@ fn saturated(plant: &Plant, x: &[f64], u: &[f64]) -> Vec<Warning> {
     let mut out = Vec::new();
     for b in plant.blocks().iter().filter(|b| b.kind == BlockKind::Controller) {
         plant.gather(b, x, u, &mut local);
-        let io = UnitIo { local: &local, layout: &b.layout, thermo: &plant.thermo(), time: 0.0 };
+        let io = UnitIo { local: &local, layout: &b.layout, thermo: plant.thermo(), time: 0.0 };
         if let Some(s) = b.unit.saturation(&io) {
             let message = format!(
                 "controller `{}` is saturated: its output rests on {} = {} with the measurement {} off setpoint; the steady state holds the output at its limit, not the measurement at its setpoint",

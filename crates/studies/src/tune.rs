@@ -12,8 +12,11 @@
 //! The PI controller is `c(s) = K_c (1 + 1/(τ_I s))`. Results are in SI (times in seconds) until
 //! [`Tuning::in_time_unit`] converts them; gains are in the model's units (input per output).
 
+pub mod averaging;
 pub mod blt;
+pub mod fit;
 pub mod relay;
+pub mod rules;
 pub mod ultimate;
 
 use plantwide_analysis::tf::TfModel;

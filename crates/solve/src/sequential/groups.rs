@@ -307,7 +307,7 @@ impl System for GroupSystem<'_> {
         for (k, &bi) in self.layout.blocks.iter().enumerate() {
             let b = &self.plant.blocks()[bi];
             self.gather(k, y, &mut local);
-            let io = UnitIo { local: &local, layout: &b.layout, thermo: &self.plant.thermo(), time: 0.0 };
+            let io = UnitIo { local: &local, layout: &b.layout, thermo: self.plant.thermo(), time: 0.0 };
             let r0 = self.layout.row0[k];
             b.unit.residual(&io, &mut r[r0..r0 + b.n_eq]);
         }
@@ -321,7 +321,7 @@ impl System for GroupSystem<'_> {
             let n = local.len();
             dense.clear();
             dense.resize(b.n_eq * n, 0.0);
-            let io = UnitIo { local: &local, layout: &b.layout, thermo: &self.plant.thermo(), time: 0.0 };
+            let io = UnitIo { local: &local, layout: &b.layout, thermo: self.plant.thermo(), time: 0.0 };
             let (r0, c0, n_own) = (self.layout.row0[k], self.layout.col0[k], b.layout.n_own());
             b.unit.jacobian_colored(&io, &mut r[r0..r0 + b.n_eq], &mut dense, b.coloring.as_ref());
             let mut push = |row: usize, j: usize| {
