@@ -27,6 +27,7 @@ pub mod min_cond;
 pub mod perturb;
 pub mod plot;
 pub mod report;
+pub mod response;
 pub mod select;
 pub mod sensitivity;
 pub mod sensors;

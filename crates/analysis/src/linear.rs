@@ -17,7 +17,7 @@
 //! Units are SI throughout (s, mol, K, Pa, J); time derivatives are per second.
 
 use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
+use faer::sparse::linalg::solvers::Lu;
 use faer::sparse::{SparseColMat, Triplet};
 use faer::{Mat, c64};
 use plantwide_flowsheet::Plant;
@@ -25,6 +25,7 @@ use plantwide_solve::{PlantSystem, System};
 use rayon::prelude::*;
 
 use crate::error::AnalysisError;
+use crate::response::SparseResponse;
 
 /// The Jacobians of a plant at one point.
 #[derive(Debug, Clone)]
@@ -132,32 +133,14 @@ impl Linearization {
         outputs: &[usize],
         omegas: &[f64],
     ) -> Result<Vec<Mat<c64>>, AnalysisError> {
-        let build = |w: f64| -> Vec<Triplet<usize, usize, c64>> {
-            let mut t: Vec<Triplet<usize, usize, c64>> =
-                self.jx.iter().map(|&(i, j, v)| Triplet::new(i, j, c64::new(-v, 0.0))).collect();
-            t.extend(self.mass.iter().map(|&(i, j)| Triplet::new(i, j, c64::new(0.0, w))));
-            t
-        };
-        let first = SparseColMat::<usize, c64>::try_new_from_triplets(self.n, self.n, &build(0.0))
-            .map_err(|e| AnalysisError::Singular(format!("jωM − J: {e:?}")))?;
-        let symbolic = SymbolicLu::try_new(first.symbolic()).map_err(|_| singular("jωM − J"))?;
-        let b = self.input_columns(inputs);
-        omegas
-            .par_iter()
-            .map(|&w| {
-                let a = SparseColMat::<usize, c64>::try_new_from_triplets(self.n, self.n, &build(w))
-                    .map_err(|e| AnalysisError::Singular(format!("jωM − J: {e:?}")))?;
-                let lu = Lu::try_new_with_symbolic(symbolic.clone(), a.as_ref()).map_err(|_| singular("jωM − J"))?;
-                let mut x = Mat::from_fn(self.n, inputs.len(), |i, k| c64::new(b[(i, k)], 0.0));
-                lu.solve_in_place(x.as_mut());
-                let g = Mat::from_fn(outputs.len(), inputs.len(), |i, k| x[(outputs[i], k)]);
-                if g.col_iter().all(|c| c.iter().all(|v| v.re.is_finite() && v.im.is_finite())) {
-                    Ok(g)
-                } else {
-                    Err(singular(&format!("jωM − J at ω = {w} rad/s")))
-                }
-            })
-            .collect()
+        let response = self.response(inputs, outputs)?;
+        omegas.par_iter().map(|&w| response.at(w)).collect()
+    }
+
+    /// The frequency response from `inputs` (input indices) to `outputs` (variable indices), to be
+    /// evaluated one frequency at a time ([`SparseResponse::at`]).
+    pub fn response(&self, inputs: &[usize], outputs: &[usize]) -> Result<SparseResponse, AnalysisError> {
+        SparseResponse::new(self.n, &self.jx, &self.mass, self.input_columns(inputs), outputs)
     }
 
     /// State-space model for the chosen inputs (input indices) and outputs (variable indices), the

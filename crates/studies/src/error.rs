@@ -48,6 +48,14 @@ pub enum TuneError {
         /// Why, and what to change.
         why: String,
     },
+    /// The name is no PID controller of the plant.
+    #[error("no PID controller `{name}` in the flowsheet (its PID loops: {loops})")]
+    NotALoop {
+        /// The name asked for.
+        name: String,
+        /// The PID controllers it has.
+        loops: String,
+    },
     /// A numerical search failed.
     #[error("{0}")]
     Numerical(String),

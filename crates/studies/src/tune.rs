@@ -15,6 +15,7 @@
 pub mod averaging;
 pub mod blt;
 pub mod fit;
+pub mod loops;
 pub mod relay;
 pub mod rules;
 pub mod ultimate;
@@ -22,7 +23,7 @@ pub mod ultimate;
 use plantwide_analysis::tf::TfModel;
 use serde::Serialize;
 
-pub use blt::{BltSettings, blt, blt_detuning, max_log_modulus};
+pub use blt::{BltSettings, LoopSystem, blt, blt_detuning, blt_system, max_log_modulus};
 pub use relay::{RelayReport, RelaySettings, relay_test};
 pub use ultimate::{Ultimate, element_ultimate, ultimate};
 

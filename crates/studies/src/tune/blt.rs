@@ -124,6 +124,23 @@ pub fn blt_detuning(
     Ok((f, w, db))
 }
 
+/// A square system of loops to tune together: output i paired with input i, its frequency
+/// response, steady-state gain and the ultimate gain and period of each diagonal element.
+pub struct LoopSystem<'a> {
+    /// Name (for messages).
+    pub name: String,
+    /// Controlled outputs.
+    pub outputs: Vec<String>,
+    /// Manipulated inputs.
+    pub inputs: Vec<String>,
+    /// `G(jω)` at `ω` \[rad/s\] (n × n).
+    pub response: &'a dyn Fn(f64) -> Mat<c64>,
+    /// `G(0)`.
+    pub gain: Mat<f64>,
+    /// Ultimate gain and frequency of each diagonal element.
+    pub ultimates: Vec<Ultimate>,
+}
+
 /// Luyben's BLT tuning of the diagonal pairing (output i ↔ input i) of a square model.
 ///
 /// # Errors
@@ -131,27 +148,44 @@ pub fn blt_detuning(
 /// [`TuneError::NoPhaseCrossover`] naming a diagonal element without an ultimate gain,
 /// [`TuneError::Numerical`] from [`blt_detuning`].
 pub fn blt(model: &TfModel, settings: &BltSettings) -> Result<Tuning, TuneError> {
-    let n = model.outputs.len();
-    if n != model.inputs.len() {
-        return Err(TuneError::NotSquare { model: model.name.clone(), n_outputs: n, n_inputs: model.inputs.len() });
+    let ultimates: Vec<Ultimate> = diagonal_ultimates(model)?;
+    let g = |w: f64| model.response(w);
+    let system = LoopSystem {
+        name: model.name.clone(),
+        outputs: model.outputs.iter().map(|s| s.name.clone()).collect(),
+        inputs: model.inputs.iter().map(|s| s.name.clone()).collect(),
+        response: &g,
+        gain: model.gain(),
+        ultimates,
+    };
+    blt_system(&system, settings)
+}
+
+/// Luyben's BLT tuning of a [`LoopSystem`].
+///
+/// # Errors
+/// [`TuneError::NotSquare`], [`TuneError::SingularGain`], [`TuneError::Numerical`] as [`blt`].
+pub fn blt_system(system: &LoopSystem<'_>, settings: &BltSettings) -> Result<Tuning, TuneError> {
+    let n = system.outputs.len();
+    if n != system.inputs.len() || system.ultimates.len() != n {
+        return Err(TuneError::NotSquare { model: system.name.clone(), n_outputs: n, n_inputs: system.inputs.len() });
     }
-    let sv = model.gain().singular_values().map_err(|e| TuneError::Numerical(format!("SVD of G(0): {e:?}")))?;
+    let sv = system.gain.singular_values().map_err(|e| TuneError::Numerical(format!("SVD of G(0): {e:?}")))?;
     let (s_max, s_min) = (sv.iter().cloned().fold(0.0, f64::max), sv.iter().cloned().fold(f64::INFINITY, f64::min));
     let ratio = if s_max > 0.0 { s_min / s_max } else { 0.0 };
     if ratio.is_nan() || ratio < 1e-10 {
-        return Err(TuneError::SingularGain { model: model.name.clone(), ratio });
+        return Err(TuneError::SingularGain { model: system.name.clone(), ratio });
     }
-    let ultimates: Vec<Ultimate> = diagonal_ultimates(model)?;
+    let ultimates = &system.ultimates;
     let zn: Vec<(f64, f64)> = ultimates.iter().map(|u| PiRule::ZieglerNichols.settings(u)).collect();
     let w_min = ultimates.iter().map(|u| u.omega_u).fold(f64::INFINITY, f64::min);
     let w_max = ultimates.iter().map(|u| u.omega_u).fold(0.0, f64::max);
     let target = settings.target_db.unwrap_or(2.0 * n as f64);
-    let g = |w: f64| model.response(w);
-    let (f, w_peak, db) = blt_detuning(&g, &zn, (1e-4 * w_min, 10.0 * w_max), target, settings)?;
+    let (f, w_peak, db) = blt_detuning(system.response, &zn, (1e-4 * w_min, 10.0 * w_max), target, settings)?;
     let loops = (0..n)
         .map(|i| LoopTuning {
-            output: model.outputs[i].name.clone(),
-            input: model.inputs[i].name.clone(),
+            output: system.outputs[i].clone(),
+            input: system.inputs[i].clone(),
             ku: ultimates[i].ku,
             pu: ultimates[i].pu,
             kc: zn[i].0 / f,

@@ -29,7 +29,7 @@ const MAX_PHASE_STEP: f64 = std::f64::consts::PI / 16.0;
 
 /// The first phase crossover of `g` between `omega_lo` and `omega_hi` \[rad/s\], or `None`.
 ///
-/// The phase is unwrapped by marching up a log-spaced grid (ratio ≤ 1.02, shrunk so that no step
+/// The phase is unwrapped by marching up a log-spaced grid (ratio ≤ 1.1, shrunk so that no step
 /// turns the phase by more than π/16, so dead time cannot alias), starting from `arg(±g(jω_lo))`,
 /// the sign chosen so that the low-frequency phase lies in (−π/2, π/2]. The crossover is bracketed
 /// on that grid and solved to a relative width of 1e-12 in ω.
@@ -42,7 +42,7 @@ pub fn ultimate(g: impl Fn(f64) -> c64, omega_lo: f64, omega_hi: f64) -> Option<
     let h = |w: f64| g(w) * sign;
     let pi = std::f64::consts::PI;
     let (mut w, mut hw, mut phase) = (omega_lo, h(omega_lo), h(omega_lo).arg());
-    let mut ratio: f64 = 1.02;
+    let mut ratio: f64 = 1.1;
     while w < omega_hi {
         let w_next = (w * ratio).min(omega_hi);
         let h_next = h(w_next);
@@ -59,7 +59,7 @@ pub fn ultimate(g: impl Fn(f64) -> c64, omega_lo: f64, omega_hi: f64) -> Option<
             return Some(Ultimate { ku, omega_u: wu, pu: 2.0 * pi / wu });
         }
         (w, hw, phase) = (w_next, h_next, phase_next);
-        ratio = (1.0 + 2.0 * (ratio - 1.0)).min(1.02);
+        ratio = (1.0 + 2.0 * (ratio - 1.0)).min(1.1);
     }
     None
 }

@@ -1,0 +1,99 @@
+//! Tuning the loops of a flowsheet from its exact linearization, checked by independent routes.
+
+use faer::{Mat, c64};
+use plantwide_flowsheet::{Plant, load_with};
+use plantwide_studies::TuneError;
+use plantwide_studies::tune::loops::{LoopResponse, Measurement, loop_model, loop_ultimates, plant_blt, plant_loop};
+use plantwide_studies::tune::{BltSettings, max_log_modulus};
+
+/// The shipped two-column plant at its steady state, converged once for all tests of this file.
+fn two_column_plant() -> (Plant, Vec<f64>) {
+    static PLANT: std::sync::OnceLock<(Plant, Vec<f64>)> = std::sync::OnceLock::new();
+    PLANT
+        .get_or_init(|| {
+            let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../flowsheets/two_column_plant.json");
+            let plant = load_with(std::path::Path::new(path), &[]).unwrap();
+            let sol = plantwide_solve::converge(&plant, &Default::default()).unwrap();
+            (plant, sol.x)
+        })
+        .clone()
+}
+
+/// Eigenvalues of the loops' state-space model with loop `i` alone closed by the proportional
+/// feedback `u = −k z` through a first-order measurement lag `dz/dt = (y − z)/τ_m`: the states
+/// `[x; z]` with `dx/dt = A x − B_i k z`, `dz/dt = (C_i x − D_ii k z − z)/τ_m`.
+fn closed_loop_eigenvalues(ss: &plantwide_analysis::linear::StateSpace, i: usize, k: f64, lag: f64) -> Vec<c64> {
+    let n = ss.a.nrows();
+    let a = Mat::from_fn(n + 1, n + 1, |r, c| match (r < n, c < n) {
+        (true, true) => ss.a[(r, c)],
+        (true, false) => -ss.b[(r, i)] * k,
+        (false, true) => ss.c[(i, c)] / lag,
+        (false, false) => (-ss.d[(i, i)] * k - 1.0) / lag,
+    });
+    a.eigenvalues().unwrap()
+}
+
+const LOOPS: [&str; 2] = ["column1_top_T", "column1_bottom_T"];
+
+#[test]
+fn ultimate_gains_of_the_plant_put_closed_loop_poles_on_the_imaginary_axis() {
+    let (plant, x) = two_column_plant();
+    let loops: Vec<_> = LOOPS.iter().map(|n| plant_loop(&plant, n).unwrap()).collect();
+    let ss = loop_model(&plant, &x, &loops).unwrap().ss;
+    // Without measurement dynamics the bottom loop (bottoms flow → tray 11 through the sump level
+    // loop) rolls off like 1/ω² with its phase tending to −180° from above: no crossover.
+    let bare = LoopResponse::new(loop_model(&plant, &x, &loops).unwrap(), Measurement::default());
+    let err = loop_ultimates(&bare, &loops).unwrap_err();
+    assert!(matches!(&err, TuneError::NoPhaseCrossover { output, .. } if output == "column1.T[11]"), "{err}");
+    let lag = 30.0;
+    let seen = LoopResponse::new(loop_model(&plant, &x, &loops).unwrap(), Measurement { dead_time: 0.0, lag });
+    let ultimates = loop_ultimates(&seen, &loops).unwrap();
+    for (i, u) in ultimates.iter().enumerate() {
+        // The frequency search found K_u and ω_u from the sparse G(jω); an eigenvalue solve of the
+        // closed loop at K_u must find the pair ±jω_u (the definition of the ultimate point).
+        let ev = closed_loop_eigenvalues(&ss, i, u.ku, lag);
+        let scale = ev.iter().map(|l| l.norm()).fold(0.0, f64::max);
+        let near = ev.iter().min_by(|a, b| (a.im - u.omega_u).abs().total_cmp(&(b.im - u.omega_u).abs())).unwrap();
+        assert!(near.re.abs() < 1e-8 * scale && (near.im - u.omega_u).abs() < 1e-6 * u.omega_u, "{near} vs {u:?}");
+    }
+}
+
+#[test]
+fn plant_blt_reaches_luybens_target_log_modulus() {
+    let (plant, x) = two_column_plant();
+    let loops: Vec<_> = LOOPS.iter().map(|n| plant_loop(&plant, n).unwrap()).collect();
+    let minute = Measurement { dead_time: 60.0, lag: 0.0 };
+    let t = plant_blt(&plant, &x, &loops, minute, &BltSettings::default()).unwrap();
+    let f = t.detuning_factor.unwrap();
+    assert!(f >= 1.0, "{t:?}");
+    // Settings are ZN/F of each loop's own ultimate values.
+    for l in &t.loops {
+        assert!(
+            (l.kc - l.ku / 2.2 / f).abs() < 1e-12 * l.kc.abs() && (l.tau_i - l.pu / 1.2 * f).abs() < 1e-9 * l.tau_i
+        );
+    }
+    // An independent evaluation of the peak: the dense state-space solve `D + C (jωI − A)⁻¹ B`
+    // instead of the sparse LU of `jωM − J`, on a grid four times finer around the peak: 2n = 4 dB (or below, when F = 1 already keeps it there).
+    let ss = loop_model(&plant, &x, &loops).unwrap().ss;
+    let g = |w: f64| {
+        let g = ss.frequency_response(w);
+        Mat::from_fn(2, 2, |i, k| g[(i, k)] * minute.response(w))
+    };
+    let kc: Vec<f64> = t.loops.iter().map(|l| l.kc).collect();
+    let ti: Vec<f64> = t.loops.iter().map(|l| l.tau_i).collect();
+    let w = t.peak_omega.unwrap();
+    let (_, peak) = max_log_modulus(&g, &kc, &ti, (w / 10.0, w * 10.0), 200);
+    if f > 1.0 {
+        assert!((peak - 4.0).abs() < 1e-6, "peak {peak} dB, {t:?}");
+    } else {
+        assert!(peak <= 4.0 + 1e-9, "peak {peak} dB");
+    }
+}
+
+#[test]
+fn a_name_that_is_no_pid_loop_is_refused_with_the_loops_listed() {
+    let (plant, _) = two_column_plant();
+    let err = plant_loop(&plant, "column1_top").unwrap_err();
+    let TuneError::NotALoop { loops, .. } = &err else { panic!("{err}") };
+    assert!(loops.contains("column1_top_T") && loops.contains("reactor_level"), "{err}");
+}
