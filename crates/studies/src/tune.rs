@@ -13,6 +13,7 @@
 //! [`Tuning::in_time_unit`] converts them; gains are in the model's units (input per output).
 
 pub mod averaging;
+pub mod bench;
 pub mod blt;
 pub mod fit;
 pub mod loops;
