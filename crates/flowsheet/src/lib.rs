@@ -7,6 +7,7 @@
 
 pub mod assemble;
 pub mod components;
+pub mod edit;
 pub mod error;
 pub mod graph;
 pub mod guess;
