@@ -61,30 +61,37 @@ fn two_column_study_runs_and_reaches_its_conclusions() {
     let r: Value = serde_json::from_str(&text).expect("results are JSON");
     let report = std::fs::read_to_string(out.join("two_column_plant.md")).expect("the report");
     assert!(report.contains("## 8. Reactor safety") && report.contains("## Appendix: the commands"));
+    pin_base_and_structures(&r);
+    pin_production_and_sensitivity(&r);
+    pin_dynamics_and_safety(&r);
+    let _ = std::fs::remove_dir_all(&out);
+}
 
+/// §1–2 of the full study: the base case's conservation and design, the column structures' gains.
+fn pin_base_and_structures(r: &Value) {
     // Conservation of the base case: A atoms, B atoms, mass, reactor energy.
     for b in ["A + R", "B + R + 2S", "mass", "reactor energy"] {
         let e = r["base"]["balances"][b].as_f64().expect("balance");
         assert!(e < 1e-9, "{b}: relative imbalance {e:e}");
     }
     // The base case as designed (flowsheets/README.md).
-    close(&r, "base.product_kmol_h", 100.146, 1e-3);
-    close(&r, "base.recycle_kmol_h", 197.60, 1e-3);
-    close(&r, "base.reactor_T", 350.0, 1e-9);
-    close(&r, "base.residence_min", 19.81, 1e-3);
+    close(r, "base.product_kmol_h", 100.146, 1e-3);
+    close(r, "base.recycle_kmol_h", 197.60, 1e-3);
+    close(r, "base.reactor_T", 350.0, 1e-9);
+    close(r, "base.residence_min", 19.81, 1e-3);
 
     // Column structures: LV interactive on both columns, LB decoupled; the book's perturbation
     // gains re-converge for every structure and agree with the linearization.
-    close(&r, "column1.LV.rga11", 5.2216, 1e-3);
-    close(&r, "column1.LV.niederlinski", 0.19151, 1e-3);
-    close(&r, "column1.DV.rga11", 1.2401, 1e-3);
-    close(&r, "column1.LB.rga11", 1.1480, 1e-3);
-    close(&r, "column2.LV.rga11", 11.98, 1e-2);
-    close(&r, "column2.LB.rga11", 0.9762, 1e-3);
-    close(&r, "column2.DV.rga11", 0.02403, 1e-2);
+    close(r, "column1.LV.rga11", 5.2216, 1e-3);
+    close(r, "column1.LV.niederlinski", 0.19151, 1e-3);
+    close(r, "column1.DV.rga11", 1.2401, 1e-3);
+    close(r, "column1.LB.rga11", 1.1480, 1e-3);
+    close(r, "column2.LV.rga11", 11.98, 1e-2);
+    close(r, "column2.LB.rga11", 0.9762, 1e-3);
+    close(r, "column2.DV.rga11", 0.02403, 1e-2);
     for col in ["column1", "column2"] {
         for st in ["LV", "DV", "LB"] {
-            let d = num(&r, &format!("{col}.{st}.perturb_vs_linear"));
+            let d = num(r, &format!("{col}.{st}.perturb_vs_linear"));
             assert!(d < 1e-3, "{col} {st}: perturbation and linearization differ by {d:e}");
         }
     }
@@ -92,22 +99,25 @@ fn two_column_study_runs_and_reaches_its_conclusions() {
     // central differences there are 2 % off the linearization), so the gains at h and h/2 disagree
     // and the step is shrunk; every step requested ends in gains that agree with the linearization.
     for h in ["1e-4", "1e-5", "1e-6"] {
-        let d = num(&r, &format!("column2.LV_explicit_steps.{h}.perturb_vs_linear"));
+        let d = num(r, &format!("column2.LV_explicit_steps.{h}.perturb_vs_linear"));
         assert!(d < 1e-5, "--step {h}: perturbation and linearization differ by {d:e}");
     }
-    assert!(num(&r, "column2.LV_explicit_steps.1e-4.step") < 1e-4);
-    assert!(num(&r, "column2.LV_explicit_steps.1e-4.attempts") > 1.0);
+    assert!(num(r, "column2.LV_explicit_steps.1e-4.step") < 1e-4);
+    assert!(num(r, "column2.LV_explicit_steps.1e-4.attempts") > 1.0);
     assert!(r["column2"]["DB_error"].as_str().is_some_and(|e| e.contains("not determined")));
     assert_eq!(r["sensors_column1"], serde_json::json!([21, 11]));
+}
 
+/// §3–4 of the full study: what sets production, figure 6-6.
+fn pin_production_and_sensitivity(r: &Value) {
     // Production rate: the fresh-A flow sets it (all A leaves as R) and snowballs the recycle; the
     // reactor temperature does not move it.
-    close(&r, "production.P1.product", 0.99922, 1e-3);
-    close(&r, "production.P1.recycle_per_product", 4.615, 1e-3);
-    assert!(num(&r, "production.P2.product").abs() < 0.02);
+    close(r, "production.P1.product", 0.99922, 1e-3);
+    close(r, "production.P1.recycle_per_product", 4.615, 1e-3);
+    assert!(num(r, "production.P2.product").abs() < 0.02);
     // P3 (effluent flow fixed, fresh A on the reactor level) reaches P1's steady states.
-    close(&r, "production.P3.product", 0.17814, 1e-3);
-    close(&r, "production.P3.recycle_per_product", num(&r, "production.P1.recycle_per_product"), 1e-3);
+    close(r, "production.P3.product", 0.17814, 1e-3);
+    close(r, "production.P3.recycle_per_product", num(r, "production.P1.recycle_per_product"), 1e-3);
 
     // Figure 6-6: the bottoms impurity over ±10 % of each disturbance; the feed rate moves it most.
     let band = |d: &str| -> (f64, f64) {
@@ -120,27 +130,30 @@ fn two_column_study_runs_and_reaches_its_conclusions() {
         let (l, h) = band(d);
         assert!(h - l < hi - lo, "{d}: {l} … {h} wider than the feed-rate band");
     }
+}
 
+/// §5–8 of the full study: the surge tank, the reflux drum, reactor safety, the dynamic responses.
+fn pin_dynamics_and_safety(r: &Value) {
     // Surge tank: the measured attenuation of a 1 h flow cycle is the first-order filter's.
-    let att = num(&r, "surge.attenuation");
-    let closed = num(&r, "surge.first_order_closed_form");
+    let att = num(r, "surge.attenuation");
+    let closed = num(r, "surge.first_order_closed_form");
     assert!((att / closed - 1.0).abs() < 0.02, "attenuation {att} vs closed form {closed}");
-    close(&r, "surge.first_order_closed_form", 0.3033, 1e-3);
+    close(r, "surge.first_order_closed_form", 0.3033, 1e-3);
 
     // Reflux drum: a bigger drum lets less of a column upset into the reactor.
-    let through = |m: &str| num(&r, &format!("drum.{m}.recycle_max_dev_kmol_h"));
+    let through = |m: &str| num(r, &format!("drum.{m}.recycle_max_dev_kmol_h"));
     assert!(through("1min") > 2.0 * through("5min") && through("5min") > 2.0 * through("15min"));
 
     // Safety: open-loop unstable reactor; the trip holds it near the trip point; recycle upsets
     // start an excursion only with the temperature loop in manual.
-    assert!(num(&r, "safety.peak_no_action") > 390.0, "{}", r["safety"]);
-    assert!(num(&r, "safety.peak_trip") < 362.0, "{}", r["safety"]);
+    assert!(num(r, "safety.peak_no_action") > 390.0, "{}", r["safety"]);
+    assert!(num(r, "safety.peak_trip") < 362.0, "{}", r["safety"]);
     // Maximum cooling with the feeds kept stops the excursion but quenches the reactor, and the
     // unreacted A and B drive the recycle to the distillate valve's limit and column 1's reflux to ~0.
-    assert!(num(&r, "safety.peak_cooling_only") < 362.0, "{}", r["safety"]);
-    assert!(num(&r, "safety.min_cooling_only") < 320.0, "{}", r["safety"]);
-    close(&r, "safety.cooling_only_recycle_max", 400.0, 1e-6);
-    assert!(num(&r, "safety.cooling_only_reflux_end") < 10.0, "{}", r["safety"]);
+    assert!(num(r, "safety.peak_cooling_only") < 362.0, "{}", r["safety"]);
+    assert!(num(r, "safety.min_cooling_only") < 320.0, "{}", r["safety"]);
+    close(r, "safety.cooling_only_recycle_max", 400.0, 1e-6);
+    assert!(num(r, "safety.cooling_only_reflux_end") < 10.0, "{}", r["safety"]);
     let rec = &r["safety"]["recycle"];
     for k in ["recycle_flow_auto", "recycle_composition_auto"] {
         assert!(rec[k]["peak"].as_f64().expect("peak") < 351.0, "{k}: {}", rec[k]);
@@ -153,7 +166,6 @@ fn two_column_study_runs_and_reaches_its_conclusions() {
     let dy = &r["dynamics"];
     let rec_dev = |k: &str| dy[k]["recycle_max_dev_kmol_h"].as_f64().expect("recycle").abs();
     assert!(rec_dev("DV_production") > rec_dev("LB_production"));
-    let _ = std::fs::remove_dir_all(&out);
 }
 
 /// The base case converged once, shared by the checks below: the plant, its state and inputs.
