@@ -7,11 +7,12 @@ output, and lays the numbers out as a report. The commands are listed in the rep
 section so that any number can be reproduced by hand.
 
     python3 tools/two_column_study.py                       # docs/two_column_plant.md + figures
-    python3 tools/two_column_study.py --short --out DIR     # shorter horizons (the test's run)
+    python3 tools/two_column_study.py --short --out DIR     # shorter horizons (the full-study test's run)
 
 Outputs: `<out>/two_column_plant.md`, `<out>/two_column_plant/*.png|csv`, the variant
 flowsheets and scenarios under `<out>/two_column_plant/inputs/`, and
-`<out>/two_column_plant/results.json` (the numbers the test pins).
+`<out>/two_column_plant/results.json` (the numbers the test pins with PLANTWIDE_FULL_STUDY=1:
+`cargo test --test it two_column_study::`).
 """
 
 import argparse

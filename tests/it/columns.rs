@@ -1,8 +1,6 @@
 //! Distillation columns against published steady states.
 
-mod common;
-
-use common::{component_balance_error, converge, value};
+use crate::harness::{component_balance_error, converge, value};
 
 /// Skogestad column A (S&P 2005 §12.4): yD = 0.99 and xB = 0.01 at L = 2.70629, V = 3.20629
 /// kmol/min; the published model is the same model, so 1e-6 absolute.

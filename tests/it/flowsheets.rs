@@ -1,9 +1,9 @@
 //! Every shipped flowsheet validates, and the shipped JSON Schema is the one the types generate.
 
-use std::process::Command;
+use crate::harness;
 
 fn shipped() -> Vec<std::path::PathBuf> {
-    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/flowsheets");
+    let dir = harness::flowsheet("");
     let mut v: Vec<_> = std::fs::read_dir(dir)
         .unwrap()
         .map(|e| e.unwrap().path())
@@ -18,7 +18,7 @@ fn every_shipped_flowsheet_passes_check() {
     let files = shipped();
     assert!(files.len() >= 2);
     for f in files {
-        let out = Command::new(env!("CARGO_BIN_EXE_plantwide")).arg("check").arg(&f).output().unwrap();
+        let out = harness::command().arg("check").arg(&f).output().unwrap();
         assert!(out.status.success(), "{}: {}", f.display(), String::from_utf8_lossy(&out.stderr));
         assert!(String::from_utf8_lossy(&out.stdout).contains("degrees of freedom: 0"));
     }
@@ -26,10 +26,10 @@ fn every_shipped_flowsheet_passes_check() {
 
 #[test]
 fn shipped_schema_matches_the_types() {
-    let out = Command::new(env!("CARGO_BIN_EXE_plantwide")).arg("schema").output().unwrap();
+    let out = harness::plantwide(&["schema"]);
     assert!(out.status.success());
     let generated: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/flowsheets/plantwide.schema.json");
+    let path = harness::flowsheet("plantwide.schema.json");
     let shipped: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
     assert!(
         generated == shipped,

@@ -3,27 +3,27 @@
 //! "converged" plants). Each must now end with exit 1 naming the field, exit 2 naming the unit and
 //! equation, or a certified answer with a warning where that is the truth.
 
-use std::process::{Command, Output};
+use std::process::Output;
 use std::time::{Duration, Instant};
 
+use crate::harness;
 use plantwide::flowsheet::load_file;
 use plantwide::solve::{NewtonSettings, certify, steady_state};
 
-mod common;
-
-fn plantwide(args: &[&str]) -> (Output, Duration) {
+/// Run `plantwide ARGS` and time it.
+fn timed(args: &[&str]) -> (Output, Duration) {
     let t0 = Instant::now();
-    let out = Command::new(env!("CARGO_BIN_EXE_plantwide")).args(args).output().expect("the binary runs");
+    let out = harness::plantwide(args);
     (out, t0.elapsed())
 }
 
 fn case(name: &str) -> String {
-    format!("{}/tests/hostile/{name}", env!("CARGO_MANIFEST_DIR"))
+    harness::fixture(&format!("hostile/{name}"))
 }
 
 /// Run `args`, expect exit `code` within 10 s and every fragment in stderr.
 fn expect(args: &[&str], code: i32, fragments: &[&str]) {
-    let (out, took) = plantwide(args);
+    let (out, took) = timed(args);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(code), "{args:?}: stderr:\n{stderr}");
     assert!(took < Duration::from_secs(10), "{args:?} took {took:?}");
@@ -44,7 +44,7 @@ fn counts_that_would_exhaust_memory_are_refused_naming_the_field_and_the_limit()
         expect(&["check", &case(file)], 1, &["units.column.stages", n, "PLANTWIDE_MAX_STAGES"]);
     }
     expect(&["check", &case("flash_vl_mixer_inlets_1e9_abort.json")], 1, &["units.mix.inlets", "PLANTWIDE_MAX_INLETS"]);
-    let column_a = common::flowsheet("column_a.json");
+    let column_a = harness::flowsheet("column_a.json");
     expect(
         &["steady", &column_a, "--set", "column.stages=1000000"],
         1,
@@ -54,7 +54,7 @@ fn counts_that_would_exhaust_memory_are_refused_naming_the_field_and_the_limit()
 
 #[test]
 fn a_raised_stage_limit_still_bounds_the_jacobian_block() {
-    let out = Command::new(env!("CARGO_BIN_EXE_plantwide"))
+    let out = harness::command()
         .args(["check", &case("column_a_stages_5000.json")])
         .env("PLANTWIDE_MAX_STAGES", "5000")
         .output()
@@ -96,14 +96,14 @@ fn a_file_that_is_not_utf8_is_reported_with_the_byte_offset() {
 
 #[test]
 fn a_huge_unknown_component_name_is_answered_fast_and_not_echoed() {
-    let text = std::fs::read_to_string(common::flowsheet("surge_tank.json")).unwrap();
+    let text = std::fs::read_to_string(harness::flowsheet("surge_tank.json")).unwrap();
     let mut doc: serde_json::Value = serde_json::from_str(&text).unwrap();
     doc["components"] = serde_json::json!(["A".repeat(10_000_000)]);
     let dir = std::env::temp_dir().join(format!("plantwide-hostile-name-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("long_name.json");
     std::fs::write(&path, doc.to_string()).unwrap();
-    let (out, took) = plantwide(&["check", path.to_str().unwrap()]);
+    let (out, took) = timed(&["check", path.to_str().unwrap()]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1));
     assert!(took < Duration::from_secs(5), "{took:?}");
@@ -117,7 +117,7 @@ fn a_huge_unknown_component_name_is_answered_fast_and_not_echoed() {
 
 #[test]
 fn set_goes_through_the_loaders_validation() {
-    let f = common::flowsheet("column_a.json");
+    let f = harness::flowsheet("column_a.json");
     for (set, frag) in [
         ("feed_source.F=-1kmol/min", "must not be negative"),
         ("feed_source.z[light]=1.5", "outside the range 0 … 1"),
@@ -132,11 +132,11 @@ fn set_goes_through_the_loaders_validation() {
     // 1.3 Pa instead of 1.3 atm: in range for a pressure, but the saturated-liquid feed would boil
     // at 194 K, below benzene's triple point (Newton took 400 iterations to fail on it).
     expect(
-        &["steady", &common::flowsheet("btx_column.json"), "--set", "feed_source.P=1.3"],
+        &["steady", &harness::flowsheet("btx_column.json"), "--set", "feed_source.P=1.3"],
         1,
         &["units.feed_source.P", "193.7 K", "below 278.7 K", "benzene"],
     );
-    let f = common::flowsheet("flash_recycle.json");
+    let f = harness::flowsheet("flash_recycle.json");
     for (set, frag) in [
         ("fresh.T=1e-300", "outside the range 1 … 5000 K"),
         ("split.split[1]=1.5", "outside the range 0 … 1"),
@@ -167,11 +167,11 @@ fn an_infeasible_specification_is_not_reported_converged() {
 #[test]
 fn a_saturated_loop_off_setpoint_is_a_warning_in_text_and_json() {
     let file = case("column_a_xd_controller_saturated_silent.json");
-    let (out, _) = plantwide(&["steady", &file]);
+    let (out, _) = timed(&["steady", &file]);
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert_eq!(out.status.code(), Some(0));
     assert!(stdout.contains("warning: controller `xd` is saturated") && stdout.contains("op_max"), "{stdout}");
-    let (out, _) = plantwide(&["steady", &file, "--json"]);
+    let (out, _) = timed(&["steady", &file, "--json"]);
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
     let w = &v["warnings"][0];
     assert_eq!(w["path"], "xd.op");
@@ -181,14 +181,14 @@ fn a_saturated_loop_off_setpoint_is_a_warning_in_text_and_json() {
     let xd = v["values"]["distillate.x[light]"].as_f64().unwrap();
     assert!((w["offset"].as_f64().unwrap() - (xd - 0.9999)).abs() < 1e-9 && xd < 0.999);
     // A loop within its limits gives no warning.
-    let (out, _) = plantwide(&["steady", &common::flowsheet("column_a.json"), "--json"]);
+    let (out, _) = timed(&["steady", &harness::flowsheet("column_a.json"), "--json"]);
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
     assert_eq!(v["warnings"], serde_json::json!([]));
 }
 
 #[test]
 fn the_certificate_fails_on_a_state_that_violates_a_balance() {
-    let (plant, ss) = common::converge("column_a.json");
+    let (plant, ss) = harness::converge("column_a.json");
     assert!(certify(&plant, &ss.x, &ss.u).is_ok());
     let mut x = ss.x.clone();
     let d = plant.var("distillate.F").unwrap();
@@ -196,7 +196,7 @@ fn the_certificate_fails_on_a_state_that_violates_a_balance() {
     let e = certify(&plant, &x, &ss.u).expect_err("a 1e-6 excess distillate breaks the column's balance");
     assert_eq!(e.unit, "column");
     assert!(e.equation.contains("balance") && e.relative.abs() > 1e-8, "{e}");
-    let plant = load_file(std::path::Path::new(&common::flowsheet("example_4_1.json"))).unwrap();
+    let plant = load_file(std::path::Path::new(&harness::flowsheet("example_4_1.json"))).unwrap();
     let u = plant.input_values();
     let ss = steady_state(&plant, &u, None, &NewtonSettings::default()).unwrap();
     let mut x = ss.x.clone();
@@ -218,7 +218,7 @@ fn a_singular_guess_is_not_called_an_uncontrolled_inventory() {
         return;
     }
     let file = case("meoh_2col_design.json");
-    let out = Command::new(env!("CARGO_BIN_EXE_plantwide")).args(["steady", &file, "--json"]).output().unwrap();
+    let out = harness::command().args(["steady", &file, "--json"]).output().unwrap();
     assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
     assert_eq!(v["warnings"][0]["path"], "lp_xB.op");
@@ -229,7 +229,7 @@ fn a_singular_guess_is_not_called_an_uncontrolled_inventory() {
 /// refused like any other request above the row limit (it grew the heap past 2 GiB in the fuzzer).
 #[test]
 fn a_record_request_that_overflows_is_refused() {
-    let plant = load_file(std::path::Path::new(&common::flowsheet("surge_tank_pi.json"))).unwrap();
+    let plant = load_file(std::path::Path::new(&harness::flowsheet("surge_tank_pi.json"))).unwrap();
     let text = r#"{"format_version": 1, "duration": "1e12 s", "events": [],
         "record": {"interval": "1e-300 s", "paths": ["tank.level"]}}"#;
     let spec = plantwide::flowsheet::scenario::parse_scenario(text, "s.json").unwrap();
@@ -244,7 +244,7 @@ type Mutation = (&'static str, fn(&mut serde_json::Value), &'static [&'static st
 /// Values the fuzzer found silently accepted in a file, each refused naming its field.
 #[test]
 fn implausible_file_values_are_refused_naming_the_field() {
-    let text = std::fs::read_to_string(common::flowsheet("column_a.json")).unwrap();
+    let text = std::fs::read_to_string(harness::flowsheet("column_a.json")).unwrap();
     let base: serde_json::Value = serde_json::from_str(&text).unwrap();
     let dir = std::env::temp_dir().join(format!("plantwide-hostile-values-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();

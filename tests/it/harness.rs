@@ -1,14 +1,34 @@
-//! Shared helpers of the end-to-end tests: load a shipped flowsheet, converge it, read values by
-//! path, and check conservation around every unit.
-#![allow(dead_code)]
+//! The shared harness of the integration tests: the `plantwide` binary as a command, the paths of
+//! the shipped flowsheets and of the test fixtures, and the checks several test modules make (load
+//! and converge a shipped flowsheet, read values by path, conservation around every unit).
+
+use std::process::{Command, Output};
 
 use plantwide::flowsheet::{BlockKind, Plant, load_file};
 use plantwide::model::stream::{F, Z0};
 use plantwide::solve::{NewtonSettings, SteadyState, steady_state};
 
-/// Path of a shipped flowsheet.
+/// The repository root (the root package's manifest directory).
+pub const ROOT: &str = env!("CARGO_MANIFEST_DIR");
+
+/// The `plantwide` binary built for these tests, as a command to add arguments to.
+pub fn command() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_plantwide"))
+}
+
+/// Run `plantwide ARGS` to completion and return its exit status and output.
+pub fn plantwide(args: &[&str]) -> Output {
+    command().args(args).output().expect("the plantwide binary runs")
+}
+
+/// Path of a shipped flowsheet (`flowsheets/NAME`).
 pub fn flowsheet(name: &str) -> String {
-    format!("{}/flowsheets/{name}", env!("CARGO_MANIFEST_DIR"))
+    format!("{ROOT}/flowsheets/{name}")
+}
+
+/// Path of a test fixture (`tests/NAME`: `data/…`, `broken/…`, `hostile/…`).
+pub fn fixture(name: &str) -> String {
+    format!("{ROOT}/tests/{name}")
 }
 
 /// Load and converge a shipped flowsheet from a cold start.
@@ -27,13 +47,14 @@ pub fn value(plant: &Plant, x: &[f64], path: &str) -> f64 {
 /// Largest relative component-balance error `|Σ in F z − Σ out F z| / Σ in F z` over all process
 /// units except those listed in `generating` (reactors), and over the plant as a whole.
 pub fn component_balance_error(plant: &Plant, x: &[f64], generating: &[&str]) -> f64 {
-    let nc = plant.components.len();
+    let nc = plant.components().len();
+    let width = plant.stream_layout().len();
     let mut worst: f64 = 0.0;
     let flows = |s: &plantwide::flowsheet::StreamInfo| -> Vec<f64> {
-        let v = &x[s.offset..s.offset + plant.stream_layout.len()];
+        let v = &x[s.offset..s.offset + width];
         (0..nc).map(|j| v[F] * v[Z0 + j]).collect()
     };
-    for (bi, b) in plant.blocks.iter().enumerate() {
+    for (bi, b) in plant.blocks().iter().enumerate() {
         if b.kind != BlockKind::Unit
             || b.layout.n_inlets == 0
             || b.layout.n_outlets == 0
@@ -43,7 +64,7 @@ pub fn component_balance_error(plant: &Plant, x: &[f64], generating: &[&str]) ->
         }
         let mut inn = vec![0.0; nc];
         let mut out = vec![0.0; nc];
-        for s in &plant.streams {
+        for s in plant.streams() {
             if s.to.0 == bi {
                 inn.iter_mut().zip(flows(s)).for_each(|(a, b)| *a += b);
             }

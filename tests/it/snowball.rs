@@ -3,9 +3,7 @@
 //! closed form of the same model; structure 2 (reactor effluent fixed, level by fresh feed) keeps
 //! the column load constant when production moves.
 
-mod common;
-
-use std::process::Command;
+use crate::harness;
 
 const XD: f64 = 0.95;
 const XB: f64 = 0.0105;
@@ -14,8 +12,17 @@ const XB: f64 = 0.0105;
 fn sweep(file: &str, disturb: &str, outputs: &str, points: &str) -> Vec<(f64, Vec<f64>)> {
     let csv =
         std::env::temp_dir().join(format!("snowball-{}-{}.csv", std::process::id(), file.replace(['/', '.'], "_")));
-    let out = Command::new(env!("CARGO_BIN_EXE_plantwide"))
-        .args(["sensitivity", &common::flowsheet(file), "--disturb", disturb, "--outputs", outputs, "--points", points])
+    let out = harness::command()
+        .args([
+            "sensitivity",
+            &harness::flowsheet(file),
+            "--disturb",
+            disturb,
+            "--outputs",
+            outputs,
+            "--points",
+            points,
+        ])
         .arg("--csv")
         .arg(&csv)
         .output()

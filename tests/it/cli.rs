@@ -1,12 +1,6 @@
 //! The `plantwide` command line: output formats, overrides and exit codes.
 
-mod common;
-
-use std::process::Command;
-
-fn plantwide(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_plantwide")).args(args).output().unwrap()
-}
+use crate::harness::{self, plantwide};
 
 fn steady_json(args: &[&str]) -> serde_json::Value {
     let mut all = vec!["steady", "--json"];
@@ -18,7 +12,7 @@ fn steady_json(args: &[&str]) -> serde_json::Value {
 
 #[test]
 fn steady_json_has_the_documented_shape() {
-    let v = steady_json(&[&common::flowsheet("column_a.json")]);
+    let v = steady_json(&[&harness::flowsheet("column_a.json")]);
     assert_eq!(v["converged"], true);
     assert!(v["iterations"].as_u64().is_some());
     assert!(v["residual"].as_f64().is_some_and(|r| r < 1e-9));
@@ -42,7 +36,7 @@ fn steady_json_has_the_documented_shape() {
 #[test]
 fn set_overrides_an_input_through_its_stream_and_a_unit_field() {
     // `feed.F` names the stream; the input belongs to the feed unit that produces it.
-    let v = steady_json(&[&common::flowsheet("column_a.json"), "--set", "feed.F=1.01kmol/min"]);
+    let v = steady_json(&[&harness::flowsheet("column_a.json"), "--set", "feed.F=1.01kmol/min"]);
     let f = v["values"]["feed.F"].as_f64().unwrap();
     assert!((f - 1010.0 / 60.0).abs() < 1e-9, "feed.F = {f}");
     // The mass balance moves the extra feed to the products.
@@ -50,19 +44,19 @@ fn set_overrides_an_input_through_its_stream_and_a_unit_field() {
     let b = v["values"]["bottoms.F"].as_f64().unwrap();
     assert!((d + b - f).abs() < 1e-9 * f);
     // A unit parameter that is not an input: the tray holdup.
-    let v = steady_json(&[&common::flowsheet("column_a.json"), "--set", "column.tray_holdup=1kmol"]);
+    let v = steady_json(&[&harness::flowsheet("column_a.json"), "--set", "column.tray_holdup=1kmol"]);
     assert!((v["values"]["column.M[10]"].as_f64().unwrap() - 1000.0).abs() < 1e-6);
 }
 
 #[test]
 fn bad_overrides_are_user_errors() {
-    let out = plantwide(&["steady", &common::flowsheet("column_a.json"), "--set", "column.trays=3"]);
+    let out = plantwide(&["steady", &harness::flowsheet("column_a.json"), "--set", "column.trays=3"]);
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("`column` has no field `trays`"));
-    let out = plantwide(&["steady", &common::flowsheet("column_a.json"), "--set", "feed.F=3 K"]);
+    let out = plantwide(&["steady", &harness::flowsheet("column_a.json"), "--set", "feed.F=3 K"]);
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("is a temperature but a molar flow is expected"));
-    let out = plantwide(&["steady", &common::flowsheet("column_a.json"), "--set", "column.distillate=1kmol/min"]);
+    let out = plantwide(&["steady", &harness::flowsheet("column_a.json"), "--set", "column.distillate=1kmol/min"]);
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("driven by a controller"));
 }
@@ -71,7 +65,7 @@ fn bad_overrides_are_user_errors() {
 /// and the failure is numerical (exit 2) with the worst equation named.
 #[test]
 fn no_steady_state_is_a_numerical_failure_naming_the_worst_equation() {
-    let out = plantwide(&["steady", &common::flowsheet("flash_recycle.json"), "--set", "heater.duty=1.6MW"]);
+    let out = plantwide(&["steady", &harness::flowsheet("flash_recycle.json"), "--set", "heater.duty=1.6MW"]);
     assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
@@ -88,7 +82,7 @@ fn no_steady_state_is_a_numerical_failure_naming_the_worst_equation() {
 #[test]
 fn a_controller_at_its_limit_at_the_guess_is_not_called_undetermined() {
     let mut spec: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(common::flowsheet("surge_tank_pi.json")).unwrap()).unwrap();
+        serde_json::from_str(&std::fs::read_to_string(harness::flowsheet("surge_tank_pi.json")).unwrap()).unwrap();
     let lc = &mut spec["controllers"]["lc"];
     lc["op_max"] = "60 mol/s".into();
     lc["kc"] = "500 mol/s/m".into();

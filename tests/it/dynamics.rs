@@ -3,15 +3,13 @@
 //! the new steady state, time constant, conservation, step count), event timing, controller
 //! mode switches and failures, sampled controllers and analyzers, and snapshot → resume.
 
-mod common;
-
 use plantwide::flowsheet::overrides::{set_field, set_input};
 use plantwide::flowsheet::scenario::{parse_scenario, resolve};
 use plantwide::flowsheet::{FlowsheetSpec, Plant, assemble, parse_spec};
 use plantwide::solve::dynamic::{Progress, SimulationResult, Snapshot, Start, simulate};
 use plantwide::solve::{NewtonSettings, steady_state};
 
-use common::flowsheet;
+use crate::harness::{self, flowsheet};
 
 /// Load a shipped flowsheet with `--set`-style field overrides, converge it, run `scenario`.
 fn run(name: &str, fields: &[(&str, &str)], scenario: &str) -> (Plant, Vec<f64>, SimulationResult) {
@@ -77,7 +75,7 @@ fn check_tank(fields: &[(&str, &str)], tau_i: Option<f64>) {
     let (plant, x0, res) = run("surge_tank_pi.json", fields, TANK_STEP);
     let (kc, df, t_s) = (50.0, 10.0, 100.0);
     // Level per mole from the model's own liquid volume at the (constant) tank temperature.
-    let v = common::value(&plant, &x0, "tank.level") / common::value(&plant, &x0, "tank.M");
+    let v = harness::value(&plant, &x0, "tank.level") / harness::value(&plant, &x0, "tank.M");
     let (level, out) = (column(&res, "tank.level"), column(&res, "out.F"));
     // The pump's flow setpoint, an input driven by the level controller, is recorded as the
     // controller's output: the flow the tank delivers, not the flowsheet's initial value.
@@ -149,7 +147,7 @@ fn column_a_feed_step_settles_on_the_new_steady_state_with_a_200_min_time_consta
     let xb = column(&res, "bottoms.x[light]");
     let yd = column(&res, "distillate.x[light]");
     let (xb_ss, yd_ss) =
-        (common::value(&plant, &ss.x, "bottoms.x[light]"), common::value(&plant, &ss.x, "distillate.x[light]"));
+        (harness::value(&plant, &ss.x, "bottoms.x[light]"), harness::value(&plant, &ss.x, "distillate.x[light]"));
     let (xb_end, yd_end) = (*xb.last().unwrap(), *yd.last().unwrap());
     eprintln!("xB {xb_end:.9} vs {xb_ss:.9}, yD {yd_end:.9} vs {yd_ss:.9}; {:?}", res.stats);
     assert!((xb_end - xb_ss).abs() < 1e-6 && (yd_end - yd_ss).abs() < 1e-6);
@@ -177,7 +175,7 @@ fn column_a_conserves_component_inventories() {
     let x = &res.x;
     for c in ["light", "heavy"] {
         let holdup =
-            |x: &[f64]| (1..=41).map(|s| common::value(&plant, x, &format!("column.n[{s}][{c}]"))).sum::<f64>();
+            |x: &[f64]| (1..=41).map(|s| harness::value(&plant, x, &format!("column.n[{s}][{c}]"))).sum::<f64>();
         let total = |s: &str| *column(&res, &format!("{s}.total[{c}]")).last().unwrap();
         let net = total("feed") - total("distillate") - total("bottoms");
         let change = holdup(x) - holdup(&x0);
@@ -236,7 +234,7 @@ fn reactor_plants_conserve_mass_to_round_off() {
         assert!(c.worst() < 1e-12, "{fs}: {c:?}");
         // A is fed and reacts: its moles are not conserved.
         let a_fed = *column(&res, "feed.total[A]").last().unwrap();
-        let a_held = |x: &[f64]| common::value(&plant, x, "reactor.N[A]");
+        let a_held = |x: &[f64]| harness::value(&plant, x, "reactor.N[A]");
         assert!(a_fed > a_held(&res.x) - a_held(&x0) + 1.0, "{fs}: A reacted");
     }
 }
@@ -289,7 +287,7 @@ fn snapshot_and_resume_continue_the_uninterrupted_trajectory() {
 /// Level per mole `v` of the surge tank and its initial state.
 fn tank(fields: &[(&str, &str)]) -> (Plant, Vec<f64>, f64) {
     let (plant, x0) = converged("surge_tank_pi.json", fields);
-    let v = common::value(&plant, &x0, "tank.level") / common::value(&plant, &x0, "tank.M");
+    let v = harness::value(&plant, &x0, "tank.level") / harness::value(&plant, &x0, "tank.M");
     (plant, x0, v)
 }
 
@@ -498,13 +496,12 @@ fn pade_delay_delays_a_sinusoid_by_its_dead_time() {
 /// the scenario and a resume from it that reproduces the rest of the CSV.
 #[test]
 fn cli_run_writes_csv_summary_plot_and_resumes_from_its_snapshot() {
-    use std::process::Command;
     let dir = std::env::temp_dir().join(format!("plantwide_run_{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let fs = flowsheet("surge_tank_pi.json");
     let sc = flowsheet("scenarios/surge_tank_inflow_step.json");
     let run = |extra: &[&str], csv: &str| {
-        let out = Command::new(env!("CARGO_BIN_EXE_plantwide"))
+        let out = harness::command()
             .current_dir(&dir)
             .args(["run", &fs, "--scenario", &sc, "--csv", csv])
             .args(extra)
@@ -539,7 +536,6 @@ fn cli_run_writes_csv_summary_plot_and_resumes_from_its_snapshot() {
 
 #[test]
 fn cli_run_reports_scenario_errors_with_their_json_paths() {
-    use std::process::Command;
     let dir = std::env::temp_dir().join(format!("plantwide_run_err_{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let bad = dir.join("bad.json");
@@ -551,7 +547,7 @@ fn cli_run_reports_scenario_errors_with_their_json_paths() {
                    {"type": "ramp", "at": "3 min", "path": "lc.sp", "to": "5 kg", "duration": "1 min"}]}"#,
     )
     .unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_plantwide"))
+    let out = harness::command()
         .args(["run", &flowsheet("surge_tank_pi.json"), "--scenario"])
         .arg(&bad)
         .args(["--csv", "/dev/null"])
@@ -564,7 +560,7 @@ fn cli_run_reports_scenario_errors_with_their_json_paths() {
     assert!(err.contains("events[2].to: `5 kg` is a mass but a length is expected"), "{err}");
     std::fs::write(&bad, r#"{"format_version": 1, "duration": "10 min", "events": [{"type": "jump", "at": 0}]}"#)
         .unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_plantwide"))
+    let out = harness::command()
         .args(["run", &flowsheet("surge_tank_pi.json"), "--scenario"])
         .arg(&bad)
         .args(["--csv", "/dev/null"])

@@ -163,7 +163,7 @@ const SET_VALUES: &[&str] = &["-1", "0", "1e308", "1e-300", "NaN", "1.5", "-0.1"
 /// A `--set PATH=VALUE` assignment: a free input with a bad value in its own unit (or a wrong
 /// one), a unit field set to a mutated value, or a malformed path.
 pub fn assignment(rng: &mut Rng, plant: &Plant, spec: &Value, names: &Names) -> (String, String) {
-    let free: Vec<_> = plant.inputs.iter().filter(|i| i.driven_by.is_none()).collect();
+    let free: Vec<_> = plant.inputs().iter().filter(|i| i.driven_by.is_none()).collect();
     match rng.below(5) {
         0..=1 if !free.is_empty() => {
             let inp = rng.pick(&free);

@@ -2,9 +2,7 @@
 //! and the whole-plant Newton, on Luyben's snowball plant under both control structures and on a
 //! flash loop with a vapour and a liquid recycle.
 
-mod common;
-
-use common::{component_balance_error, flowsheet, value};
+use crate::harness::{component_balance_error, flowsheet, plantwide, value};
 use plantwide::flowsheet::tears::{ConnectionKind, decompose};
 use plantwide::flowsheet::{Plant, load_file, load_str};
 use plantwide::solve::sequential::{
@@ -42,12 +40,12 @@ fn tears(plant: &Plant) -> Vec<Vec<String>> {
 /// Largest relative difference between two solutions over the stream variables (a floor of 1e-3
 /// of each variable's nominal value for quantities near zero).
 fn stream_difference(plant: &Plant, a: &[f64], b: &[f64]) -> f64 {
-    let n = plant.stream_layout.len();
+    let n = plant.stream_layout().len();
     plant
         .streams
         .iter()
         .flat_map(|s| s.offset..s.offset + n)
-        .map(|i| (a[i] - b[i]).abs() / a[i].abs().max(1e-3 * plant.vars[i].spec.nominal))
+        .map(|i| (a[i] - b[i]).abs() / a[i].abs().max(1e-3 * plant.vars()[i].spec.nominal))
         .fold(0.0, f64::max)
 }
 
@@ -190,7 +188,7 @@ fn free_outflow_vessel_and_its_valve_are_one_solve_block() {
     let f = 2.0 * 10.0 / 3.6;
     let z = [0.4, 0.6];
     let t = value(&p, &sol.x, "s3.T");
-    let (mw, v) = (p.thermo.mw(&z), p.thermo.v_liq(t, &z));
+    let (mw, v) = (p.thermo().mw(&z), p.thermo().v_liq(t, &z));
     let rho = mw / v;
     let dp = rho * (f * mw / (2e-4 * 0.5 * rho)).powi(2);
     let level = (dp - (1.5e5 - 1.45e5)) / (rho * 9.80665);
@@ -221,7 +219,7 @@ fn snowball_block_graph_has_controller_loops_inside_the_material_loop() {
         .tears
         .iter()
         .filter_map(|&e| match g[e].kind {
-            ConnectionKind::Stream(s) => Some(p.streams[s].name.as_str()),
+            ConnectionKind::Stream(s) => Some(p.streams()[s].name.as_str()),
             ConnectionKind::Signal(_) => None,
         })
         .collect();
@@ -372,8 +370,8 @@ fn flash_loop_with_two_recycles_is_torn_once_and_all_methods_agree() {
     // Independent check of the drum: an isobaric PH flash of the heated stream (the thermodynamic
     // package's flash, not the drum model) gives the same vapour fraction and compositions.
     let f = value(&p, &eo, "heated.F");
-    let z: Vec<f64> = p.components.iter().map(|c| value(&p, &eo, &format!("heated.x[{c}]"))).collect();
-    let flash = p.thermo.flash_ph(101_325.0, value(&p, &eo, "heated.h"), &z).unwrap();
+    let z: Vec<f64> = p.components().iter().map(|c| value(&p, &eo, &format!("heated.x[{c}]"))).collect();
+    let flash = p.thermo().flash_ph(101_325.0, value(&p, &eo, "heated.h"), &z).unwrap();
     assert!(
         (flash.beta - value(&p, &eo, "vapour.F") / f).abs() < 1e-8,
         "{} vs {}",
@@ -382,7 +380,7 @@ fn flash_loop_with_two_recycles_is_torn_once_and_all_methods_agree() {
     );
     assert!((flash.t - value(&p, &eo, "vapour.T")).abs() < 1e-6);
     // Plant balance: fresh feed = top + bottom product, per component.
-    for c in &p.components {
+    for c in p.components() {
         let n = |s: &str| value(&p, &eo, &format!("{s}.F")) * value(&p, &eo, &format!("{s}.x[{c}]"));
         let (i, o) = (n("feed"), n("top_product") + n("bottom_product"));
         assert!((i - o).abs() < 1e-9 * i, "{c}: {i} vs {o}");
@@ -424,10 +422,6 @@ fn sequential_modular_failures_name_the_place() {
         ..SmSettings::default()
     };
     assert_eq!(solve_sequential(&p, &u, None, &pick).unwrap().report.sccs[0].accelerator, Accelerator::Broyden);
-}
-
-fn plantwide(args: &[&str]) -> std::process::Output {
-    std::process::Command::new(env!("CARGO_BIN_EXE_plantwide")).args(args).output().unwrap()
 }
 
 #[test]

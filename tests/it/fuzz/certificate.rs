@@ -14,16 +14,16 @@ const TOL: f64 = 1e-9;
 /// Check the steady state `x` of `plant`.
 pub fn steady(plant: &Plant, x: &[f64]) -> Result<(), String> {
     if let Some(i) = x.iter().position(|v| !v.is_finite()) {
-        return Err(format!("{} = {} is not finite", plant.vars[i].path, x[i]));
+        return Err(format!("{} = {} is not finite", plant.vars()[i].path, x[i]));
     }
-    let len = plant.stream_layout.len();
-    for s in &plant.streams {
+    let len = plant.stream_layout().len();
+    for s in plant.streams() {
         let sum: f64 = x[s.offset + Z0..s.offset + len].iter().sum();
         if (sum - 1.0).abs() > TOL {
             return Err(format!("stream {}: mole fractions sum to {sum:.12}", s.name));
         }
     }
-    for (bi, b) in plant.blocks.iter().enumerate() {
+    for (bi, b) in plant.blocks().iter().enumerate() {
         if b.kind == BlockKind::Unit && !matches!(b.unit.type_name(), "feed" | "product") {
             balance(plant, bi, x)?;
         }
@@ -33,13 +33,13 @@ pub fn steady(plant: &Plant, x: &[f64]) -> Result<(), String> {
 
 /// Component (or, for a reacting unit, mass) balance of block `bi` over its port streams.
 fn balance(plant: &Plant, bi: usize, x: &[f64]) -> Result<(), String> {
-    let b = &plant.blocks[bi];
+    let b = &plant.blocks()[bi];
     let reacting = b.unit.type_name() == "cstr";
-    let mw: Vec<f64> = plant.thermo.components.iter().map(|c| c.mw).collect();
-    let nc = plant.stream_layout.n_comp;
+    let mw: Vec<f64> = plant.thermo().components.iter().map(|c| c.mw).collect();
+    let nc = plant.stream_layout().n_comp;
     let mut net = vec![0.0; if reacting { 1 } else { nc }];
     let (mut inflow, mut outflow) = (0.0f64, 0.0f64);
-    for s in &plant.streams {
+    for s in plant.streams() {
         let sign = match (s.to.0 == bi, s.from.0 == bi) {
             (true, false) => 1.0,
             (false, true) => -1.0,
@@ -61,7 +61,7 @@ fn balance(plant: &Plant, bi: usize, x: &[f64]) -> Result<(), String> {
     }
     let (k, worst) = net.iter().enumerate().fold((0, 0.0f64), |a, (k, n)| if n.abs() > a.1 { (k, n.abs()) } else { a });
     if worst / scale > TOL {
-        let what = if reacting { "mass".to_string() } else { format!("component {}", plant.components[k]) };
+        let what = if reacting { "mass".to_string() } else { format!("component {}", plant.components()[k]) };
         return Err(format!(
             "unit {}: {what} balance off by {:.3e} of its throughput (in {inflow:.6e}, out {outflow:.6e})",
             b.name,
@@ -73,7 +73,7 @@ fn balance(plant: &Plant, bi: usize, x: &[f64]) -> Result<(), String> {
 
 /// No total holdup at its lower bound.
 fn holdups(plant: &Plant, x: &[f64]) -> Result<(), String> {
-    for (v, &xv) in plant.vars.iter().zip(x) {
+    for (v, &xv) in plant.vars().iter().zip(x) {
         let s = &v.spec;
         let holdup = s.name == "M" || s.name.starts_with("M[");
         if holdup

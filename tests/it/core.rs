@@ -1,8 +1,6 @@
 //! The equation-oriented core on small plants, against closed forms and independent methods.
 
-mod common;
-
-use common::{component_balance_error, converge, flowsheet, value};
+use crate::harness::{component_balance_error, converge, flowsheet, value};
 use plantwide::flowsheet::{Plant, assemble, load_file, parse_spec};
 use plantwide::solve::{NewtonSettings, steady_state};
 
@@ -31,10 +29,10 @@ fn flash_recycle_loop_converges_by_newton_alone_from_a_cold_start() {
     let v = value(&plant, x, "vapour.F");
     assert!(v > 0.1 * value(&plant, x, "feed.F") && value(&plant, x, "bottoms.F") > 0.1 * value(&plant, x, "feed.F"));
     let (t, p) = (value(&plant, x, "vapour.T"), value(&plant, x, "vapour.P"));
-    let xl: Vec<f64> = plant.components.iter().map(|c| value(&plant, x, &format!("liquid.x[{c}]"))).collect();
+    let xl: Vec<f64> = plant.components().iter().map(|c| value(&plant, x, &format!("liquid.x[{c}]"))).collect();
     let mut k = vec![0.0; 3];
-    plant.thermo.k_values(t, p, &xl, &mut k);
-    for (j, c) in plant.components.iter().enumerate() {
+    plant.thermo().k_values(t, p, &xl, &mut k);
+    for (j, c) in plant.components().iter().enumerate() {
         assert!((value(&plant, x, &format!("vapour.x[{c}]")) - k[j] * xl[j]).abs() < 1e-10);
     }
 }
@@ -71,7 +69,7 @@ fn guess_at(plant: &Plant, t: f64) -> Vec<f64> {
     let k = 0.01 * (-(8.0e4 / 8.314_462_618) * (1.0 / t - 1.0 / 350.0)).exp();
     let xa = f / (f + k * m);
     let comp = [xa, 1.0 - xa];
-    let h = plant.thermo.h_liq(t, &comp);
+    let h = plant.thermo().h_liq(t, &comp);
     let tj = (5.0 * 4184.0 * 300.0 + 2000.0 * t) / (5.0 * 4184.0 + 2000.0);
     let mut set = |p: &str, v: f64| {
         let i = plant.var(p).unwrap_or_else(|| panic!("{p}"));
@@ -152,12 +150,12 @@ fn plant_jacobians_match_central_differences() {
                 dense[i * n + j] += v;
             }
             let row_scale: Vec<f64> = (0..n)
-                .map(|i| (0..n).map(|j| (dense[i * n + j] * plant.vars[j].spec.nominal).abs()).fold(1e-300, f64::max))
+                .map(|i| (0..n).map(|j| (dense[i * n + j] * plant.vars()[j].spec.nominal).abs()).fold(1e-300, f64::max))
                 .collect();
             let (mut rp, mut rm) = (vec![0.0; n], vec![0.0; n]);
             let mut worst: f64 = 0.0;
             for j in 0..n {
-                let h = 1e-6 * x[j].abs().max(plant.vars[j].spec.nominal * 1e-3);
+                let h = 1e-6 * x[j].abs().max(plant.vars()[j].spec.nominal * 1e-3);
                 let (mut xp, mut xm) = (x.clone(), x.clone());
                 xp[j] += h;
                 xm[j] -= h;
@@ -165,7 +163,7 @@ fn plant_jacobians_match_central_differences() {
                 plant.residual(&xm, &u, 0.0, &mut rm);
                 for i in 0..n {
                     let fd = (rp[i] - rm[i]) / (2.0 * h);
-                    let err = (fd - dense[i * n + j]).abs() * plant.vars[j].spec.nominal / row_scale[i];
+                    let err = (fd - dense[i * n + j]).abs() * plant.vars()[j].spec.nominal / row_scale[i];
                     worst = worst.max(err);
                 }
             }

@@ -1,13 +1,6 @@
 //! `plantwide tune --tf`: JSON shape, time units, and bad input (exit 1 with the message).
 
-use std::process::Command;
-
-mod common;
-use common::flowsheet;
-
-fn plantwide(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_plantwide")).args(args).output().unwrap()
-}
+use crate::harness::{flowsheet, plantwide};
 
 #[test]
 fn blt_json_on_wood_berry_in_minutes() {

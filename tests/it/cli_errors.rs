@@ -1,7 +1,7 @@
 //! Every deliberately broken flowsheet under tests/broken/ must make `plantwide check` exit 1 with
 //! a message naming the file, the JSON path and what would fix it — and never panic.
 
-use std::process::Command;
+use crate::harness;
 
 /// (file, fragments the error message must contain).
 const CASES: &[(&str, &[&str])] = &[
@@ -41,16 +41,15 @@ const CASES: &[(&str, &[&str])] = &[
 
 #[test]
 fn broken_flowsheets_give_clear_errors_and_exit_1() {
-    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/broken");
+    let dir = harness::fixture("broken");
     let mut listed: Vec<&str> = CASES.iter().map(|(f, _)| *f).collect();
     listed.sort();
     let mut on_disk: Vec<String> =
-        std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().into_string().unwrap()).collect();
+        std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name().into_string().unwrap()).collect();
     on_disk.sort();
     assert_eq!(listed, on_disk, "every broken file needs a case, every case a file");
     for (file, fragments) in CASES {
-        let out =
-            Command::new(env!("CARGO_BIN_EXE_plantwide")).args(["check", &format!("{dir}/{file}")]).output().unwrap();
+        let out = harness::plantwide(&["check", &format!("{dir}/{file}")]);
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(1), "{file}: expected exit 1, stderr:\n{stderr}");
         assert!(!stderr.contains("panicked"), "{file} panicked:\n{stderr}");
@@ -63,7 +62,7 @@ fn broken_flowsheets_give_clear_errors_and_exit_1() {
 
 #[test]
 fn missing_file_is_a_user_error() {
-    let out = Command::new(env!("CARGO_BIN_EXE_plantwide")).args(["check", "no/such/file.json"]).output().unwrap();
+    let out = harness::plantwide(&["check", "no/such/file.json"]);
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("no/such/file.json: cannot read the file"));
 }
@@ -247,9 +246,9 @@ fn hostile_scenarios_give_clear_errors_with_their_fields() {
     for case in SCENARIO_CASES {
         let scenario = dir.join(format!("{}.json", case.name));
         std::fs::write(&scenario, case.scenario).unwrap();
-        let flowsheet = format!("{}/flowsheets/{}", env!("CARGO_MANIFEST_DIR"), case.flowsheet);
+        let flowsheet = harness::flowsheet(case.flowsheet);
         let started = std::time::Instant::now();
-        let out = Command::new(env!("CARGO_BIN_EXE_plantwide"))
+        let out = harness::command()
             .args(["run", &flowsheet, "--scenario"])
             .arg(&scenario)
             .arg("--csv")

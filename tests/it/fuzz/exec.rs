@@ -46,7 +46,7 @@ pub fn execute(m: &Mutant) -> Result<Outcome, Dishonest> {
             Err(o) => Ok(o),
         },
         Mode::Run => {
-            plant.inputs.iter_mut().zip(&u).for_each(|(info, v)| info.value = *v);
+            plant.set_input_values(&u);
             run(m, &mut plant, &u)
         }
     }

@@ -1,0 +1,25 @@
+//! The integration tests of plantwide, one binary: the shipped flowsheets end to end against
+//! published numbers and independent closed forms, the command line, hostile and fuzzed input.
+//!
+//! One module per subject; [`harness`] holds what they share (the binary as a command, fixture
+//! paths, converge-and-read helpers, conservation checks). Data live beside the modules:
+//! `tests/broken/`, `tests/hostile/`, `tests/data/`. Run one module with
+//! `cargo test --test it columns::` (a name filter); opt-in slow parts are switched on by
+//! environment variables (`PLANTWIDE_FULL_STUDY=1`, `PLANTWIDE_FUZZ_MUTANTS=…`).
+
+mod harness;
+
+mod analysis;
+mod cli;
+mod cli_errors;
+mod columns;
+mod columns_rigorous;
+mod core;
+mod dynamics;
+mod flowsheets;
+mod fuzz;
+mod hostile;
+mod recycle;
+mod snowball;
+mod tune;
+mod two_column_study;
