@@ -13,12 +13,12 @@ use plantwide::analysis::linear::Linearization;
 use plantwide::analysis::measures::{niederlinski, rga};
 use plantwide::analysis::select::{select_inputs, select_outputs};
 use plantwide::flowsheet::load_with;
-use plantwide::solve::sequential::{StrategySettings, steady_state_checked};
+use plantwide::solve::{StrategySettings, converge};
 
 fn main() -> anyhow::Result<()> {
     let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("flowsheets/column_a.json");
     let plant = load_with(&file, &[])?;
-    let sol = steady_state_checked(&plant, &plant.input_values(), &StrategySettings::default(), &mut |_| {})?;
+    let sol = converge(&plant, &StrategySettings::default())?;
     let names = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>();
     // `PATH@unit`: the gains are reported in these display units.
     let inputs = select_inputs(&plant, &names(&["column.reflux@kmol/min", "column.boilup@kmol/min"]))?;

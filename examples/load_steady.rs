@@ -8,7 +8,7 @@ use std::path::PathBuf;
 
 use plantwide::flowsheet::{Override, load_with};
 use plantwide::model::stream::{F, T, Z0};
-use plantwide::solve::sequential::{StrategySettings, steady_state_checked};
+use plantwide::solve::{StrategySettings, converge};
 
 fn main() -> anyhow::Result<()> {
     let mut args = std::env::args().skip(1);
@@ -20,9 +20,8 @@ fn main() -> anyhow::Result<()> {
         overrides.push(Override::new("feed_source.F", "1.01 kmol/min"));
     }
     let plant = load_with(&file, &overrides)?;
-    let u = plant.input_values();
     // Sequential-modular pass on the recycles (if any), then whole-plant Newton.
-    let sol = steady_state_checked(&plant, &u, &StrategySettings::default(), &mut |_| {})?;
+    let sol = converge(&plant, &StrategySettings::default())?;
     println!("steady state of `{}` with {overrides:?}", plant.name());
     print!("{:<14} {:>12} {:>9}", "stream", "F [kmol/h]", "T [K]");
     for c in plant.components() {

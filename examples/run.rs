@@ -11,12 +11,12 @@ use std::path::Path;
 use plantwide::flowsheet::load_with;
 use plantwide::flowsheet::scenario::{parse_scenario, resolve};
 use plantwide::solve::dynamic::{Start, simulate};
-use plantwide::solve::sequential::{StrategySettings, steady_state_checked};
+use plantwide::solve::{StrategySettings, converge};
 
 fn main() -> anyhow::Result<()> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let mut plant = load_with(&root.join("flowsheets/column_a.json"), &[])?;
-    let sol = steady_state_checked(&plant, &plant.input_values(), &StrategySettings::default(), &mut |_| {})?;
+    let sol = converge(&plant, &StrategySettings::default())?;
     let name = "flowsheets/scenarios/column_a_feed_step.json";
     let text = std::fs::read_to_string(root.join(name))?;
     let scenario = resolve(&parse_scenario(&text, name)?, &plant, name)?;
