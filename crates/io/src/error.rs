@@ -20,7 +20,9 @@ pub enum IoError {
         /// The plot file.
         file: String,
     },
-    /// A figure could not be drawn or its file not written (the message is plotters').
+    /// A figure could not be drawn or its file not written: plotters' error, as each figure has
+    /// always worded it (a trend plot by its message, a sensitivity plot as `plot: ` and its debug
+    /// form).
     #[error("{0}")]
     Draw(String),
 }
