@@ -12,7 +12,8 @@ use plantwide::analysis::perturb::{PerturbSettings, perturb_gains};
 use plantwide::analysis::report::{GainJson, GainReport, ReportOptions};
 use plantwide::analysis::select::{Signal, SignalLabel, parse_block, parse_pairing, select_inputs, select_outputs};
 use plantwide::analysis::sensors::select_temperature_sensors;
-use plantwide::analysis::tf::TfModel;
+use plantwide::analysis::tf::TfSignal;
+use plantwide::io::tf;
 use plantwide::units::{Dimension, parse_quantity_as};
 
 use super::CliError;
@@ -210,13 +211,13 @@ pub fn display_gain(si: &Mat<f64>, inputs: &[Signal], outputs: &[Signal]) -> Mat
 fn run_tf(a: &GainsArgs, file: &Path) -> Result<(), CliError> {
     let name = file.display().to_string();
     let text = plantwide::flowsheet::read_text(file).map_err(|e| CliError::user(e.to_string()))?;
-    let model = TfModel::parse(&text, &name).map_err(analysis_error)?;
+    let model = tf::parse(&text, &name).map_err(|e| CliError::user(e.to_string()))?;
     if a.method == Method::Perturb {
         return Err(CliError::user(
             "--method perturb needs a flowsheet; a transfer-function model's gains are its element gains",
         ));
     }
-    let label = |s: &plantwide::analysis::tf::TfSignal| SignalLabel { path: s.name.clone(), unit: s.unit.clone() };
+    let label = |s: &TfSignal| SignalLabel { path: s.name.clone(), unit: s.unit.clone() };
     let ins: Vec<String> = model.inputs.iter().map(|s| s.name.clone()).collect();
     let outs: Vec<String> = model.outputs.iter().map(|s| s.name.clone()).collect();
     let opts = options(a, &ins, &outs, None)?;

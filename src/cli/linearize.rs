@@ -1,13 +1,13 @@
 //! `plantwide linearize FILE --inputs P1,P2 --outputs Q1,Q2 --out model.json [--time-unit min]
 //! [--frequencies LOW:HIGH:N]`: the state-space model at the steady state, for MATLAB and
-//! python-control (see `plantwide_analysis::export` for how to load it).
+//! python-control (see `plantwide_io::export` for how to load it).
 
 use std::path::PathBuf;
 
-use plantwide::analysis::export::ModelExport;
 use plantwide::analysis::faer::{Mat, c64};
 use plantwide::analysis::linear::Linearization;
 use plantwide::analysis::select::{select_inputs, select_outputs};
+use plantwide::io::export::ModelExport;
 use plantwide::units::{Dimension, Unit};
 
 use super::CliError;
@@ -130,9 +130,9 @@ pub fn run(a: &LinearizeArgs) -> Result<(), CliError> {
     }
     if let Some(out) = &a.out {
         let doc = ModelExport {
-            name: &plant.name,
+            name: plant.name(),
             model: &model,
-            states: model.states.iter().map(|&i| plant.vars[i].path.clone()).collect(),
+            states: model.states.iter().map(|&i| plant.vars()[i].path.clone()).collect(),
             state_values: model.states.iter().map(|&i| ss.x[i]).collect(),
             inputs: &inputs,
             input_values: ii.iter().map(|&i| ss.u[i]).collect(),

@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use plantwide::flowsheet::scenario::{Limits, parse_scenario, resolve_with};
-use plantwide::plot::{Trend, write_trends};
+use plantwide::io::plot::{Trend, write_trends};
 use plantwide::solve::dynamic::{
     CONSERVATION_TOL, Conservation, Progress, SimError, SimulationResult, Snapshot, Start, simulate,
 };
@@ -141,7 +141,8 @@ fn write_trends_files(
                 values: res.rows.iter().map(|r| to_unit(r[k], &res.columns[k].unit)).collect(),
             })
             .collect();
-        write_trends(p, title, &format!("time [{time_unit}]"), &times, &trends).map_err(CliError::user)?;
+        write_trends(p, title, &format!("time [{time_unit}]"), &times, &trends)
+            .map_err(|e| CliError::user(e.to_string()))?;
     }
     Ok(())
 }

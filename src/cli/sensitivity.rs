@@ -4,10 +4,11 @@
 use std::path::PathBuf;
 
 use plantwide::analysis::AnalysisError;
-use plantwide::analysis::plot::draw_sensitivity;
 use plantwide::analysis::select::select_outputs;
-use plantwide::analysis::sensitivity::{Disturbance, SweepSettings, sweep, to_csv};
-use plotters::prelude::{BitMapBackend, IntoDrawingArea, SVGBackend};
+use plantwide::analysis::sensitivity::{Disturbance, SweepSettings, sweep};
+use plantwide::io::IoError;
+use plantwide::io::csv::sensitivity_csv;
+use plantwide::io::plot::write_sensitivity;
 
 use super::CliError;
 use super::gains::sig;
@@ -44,12 +45,12 @@ fn analysis_error(e: AnalysisError) -> CliError {
 }
 
 pub fn run(a: &SensitivityArgs) -> Result<(), CliError> {
-    let svg = match a.plot.as_ref().and_then(|p| p.extension()).and_then(|e| e.to_str()) {
-        None if a.plot.is_none() => false,
-        Some("svg") => true,
-        Some("png") => false,
-        _ => return Err(CliError::user("--plot: the file must end in .png or .svg")),
-    };
+    // Checked before any work (the plot is drawn last).
+    if let Some(p) = &a.plot
+        && !matches!(p.extension().and_then(|e| e.to_str()), Some("svg" | "png"))
+    {
+        return Err(CliError::user("--plot: the file must end in .png or .svg"));
+    }
     let (plant, u) = load_with_overrides(&a.file, &a.set)?;
     let disturbances = a
         .disturb
@@ -84,20 +85,16 @@ pub fn run(a: &SensitivityArgs) -> Result<(), CliError> {
         }
     }
     if let Some(path) = &a.csv {
-        std::fs::write(path, to_csv(&curves, &outputs))
+        std::fs::write(path, sensitivity_csv(&curves, &outputs))
             .map_err(|e| CliError::user(format!("{}: cannot write: {e}", path.display())))?;
         outln!("\nwrote {}", path.display());
     }
     if let Some(path) = &a.plot {
         let title = format!("{}: sensitivity", plant.name);
-        let height = 120 + 380 * outputs.len() as u32;
-        if svg {
-            let root = SVGBackend::new(path, (900, height)).into_drawing_area();
-            draw_sensitivity(&root, &title, &curves, &outputs).map_err(analysis_error)?;
-        } else {
-            let root = BitMapBackend::new(path, (900, height)).into_drawing_area();
-            draw_sensitivity(&root, &title, &curves, &outputs).map_err(analysis_error)?;
-        }
+        write_sensitivity(path, &title, &curves, &outputs).map_err(|e| match e {
+            IoError::Draw(_) => CliError::numerical(e.to_string()),
+            _ => CliError::user(e.to_string()),
+        })?;
         outln!("wrote {}", path.display());
     }
     let failures: Vec<&String> = curves.iter().flat_map(|c| &c.failures).collect();

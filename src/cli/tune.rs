@@ -5,6 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use plantwide::analysis::tf::TfModel;
+use plantwide::io::tf;
 use plantwide::studies::TuneError;
 use plantwide::studies::tune::{BltSettings, PiRule, TuneMethod, Tuning, blt, single_loop};
 
@@ -63,7 +64,7 @@ pub fn run(a: &TuneArgs) -> Result<(), CliError> {
 
 fn load(file: &Path) -> Result<TfModel, CliError> {
     let text = plantwide::flowsheet::read_text(file).map_err(|e| CliError::user(e.to_string()))?;
-    TfModel::parse(&text, &file.display().to_string()).map_err(|e| CliError::user(e.to_string()))
+    tf::parse(&text, &file.display().to_string()).map_err(|e| CliError::user(e.to_string()))
 }
 
 fn print_table(t: &Tuning, model: &TfModel, file: &Path, tu: &TimeUnit) {

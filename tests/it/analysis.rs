@@ -12,7 +12,7 @@ use plantwide::analysis::perturb::{PerturbSettings, perturb_gains};
 use plantwide::analysis::select::{Signal, select_inputs, select_outputs};
 use plantwide::analysis::sensitivity::{Disturbance, SweepSettings, sweep};
 use plantwide::analysis::sensors::select_temperature_sensors;
-use plantwide::analysis::tf::TfModel;
+use plantwide::io::tf;
 use plantwide::solve::{NewtonSettings, steady_state};
 
 fn strings(v: &[&str]) -> Vec<String> {
@@ -282,7 +282,7 @@ fn surge_tank_eigenvalues_and_gains_match_the_closed_form() {
 #[test]
 fn wood_berry_relative_gain_and_niederlinski_index() {
     let text = std::fs::read_to_string(flowsheet("transfer_functions/wood_berry.tf.json")).unwrap();
-    let model = TfModel::parse(&text, "wood_berry.tf.json").unwrap();
+    let model = tf::parse(&text, "wood_berry.tf.json").unwrap();
     let g = model.gain();
     let l = rga(g.as_ref()).unwrap();
     assert!((l[(0, 0)] - 2.01).abs() < 0.005, "λ11 = {}", l[(0, 0)]);

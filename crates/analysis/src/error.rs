@@ -1,5 +1,5 @@
 //! Errors of the analysis layer: bad requests (a path that names nothing, a unit of the wrong
-//! dimension, a malformed transfer-function file) and numerical failures (a singular Jacobian, a
+//! dimension, an inconsistent transfer-function model) and numerical failures (a singular Jacobian, a
 //! perturbed plant that does not re-converge).
 
 /// Why an analysis could not be done.
@@ -8,16 +8,6 @@ pub enum AnalysisError {
     /// A path, unit, range or option given by the user is wrong; the message says what would fix it.
     #[error("{0}")]
     Request(String),
-    /// A transfer-function file is unreadable or inconsistent.
-    #[error("{file}: {path}: {message}")]
-    TfFile {
-        /// File name.
-        file: String,
-        /// JSON path of the offending field (`elements[2].lags[0]`).
-        path: String,
-        /// What is wrong and what would fix it.
-        message: String,
-    },
     /// A matrix that must be invertible is (numerically) singular.
     #[error("{0}")]
     Singular(String),
@@ -28,9 +18,6 @@ pub enum AnalysisError {
     /// every step tried: never returned as if they were right.
     #[error("{0}")]
     PerturbationUnverified(Box<Unverified>),
-    /// A plot could not be drawn.
-    #[error("plot: {0}")]
-    Plot(String),
 }
 
 /// Why perturbation gains were refused: the pair, the check, the two estimates and what to try
@@ -67,7 +54,7 @@ pub struct Unverified {
 impl AnalysisError {
     /// True for problems of the request (exit code 1), false for numerical failures (exit code 2).
     pub fn is_user_error(&self) -> bool {
-        matches!(self, AnalysisError::Request(_) | AnalysisError::TfFile { .. })
+        matches!(self, AnalysisError::Request(_))
     }
 }
 

@@ -8,24 +8,22 @@
 //!   central differences extrapolated (Richardson) and verified, never returned unverified.
 //! - [`measures`], [`min_cond`]: RGA, RGA number, SVD, condition number and its minimized value,
 //!   Niederlinski index, block relative gain, scaling, Morari resiliency index.
-//! - [`tf`]: transfer-function matrix files (gain, lags, leads, dead time per element).
+//! - [`tf`]: transfer-function matrix models (gain, lags, leads, dead time per element) and
+//!   their `G(jω)`.
 //! - [`sensitivity`]: disturbance sweeps with the control structure active, by continuation.
 //! - [`sensors`]: tray-temperature sensor selection (SVD and slope criteria).
 //! - [`report`]: the gain report shared by flowsheets and transfer-function models.
-//! - [`export`]: the state-space model as JSON for MATLAB and python-control.
-//! - [`plot`]: sensitivity plots (plotters; the caller chooses the backend and the file).
 //!
-//! **Architecture Invariant:** nothing here reads or writes files or the terminal; the CLI does.
+//! **Architecture Invariant:** nothing here reads or writes files or the terminal, parses a file
+//! format or draws: file formats and plots are `plantwide_io`'s, files and the terminal the CLI's.
 
 #![warn(missing_docs)]
 
 pub mod error;
-pub mod export;
 pub mod linear;
 pub mod measures;
 pub mod min_cond;
 pub mod perturb;
-pub mod plot;
 pub mod report;
 pub mod response;
 pub mod select;

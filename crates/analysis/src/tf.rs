@@ -1,73 +1,26 @@
-//! Transfer-function matrix models (`*.tf.json`): the form plant tests and identification produce,
-//! analysed like a flowsheet's linearization.
+//! Transfer-function matrix models: the form plant tests and identification produce, analysed
+//! like a flowsheet's linearization.
 //!
 //! Each element from input (or disturbance) `j` to output `i` is
 //! `g_ij(s) = K · Π_k (τ_lead,k s + 1) / Π_k (τ_lag,k s + 1) · e^(−θ s)`, with the gain `K` in
-//! output units per input unit (the units the file declares for its signals), lags `τ_lag > 0`,
-//! leads `τ_lead ≠ 0` (negative: a right-half-plane zero, inverse response) and dead time `θ ≥ 0`.
-//! Times are quantities (`"16.7 min"`) or bare numbers in seconds. A missing element is zero.
-//!
-//! ```json
-//! {
-//!   "format_version": 1,
-//!   "name": "wood_berry",
-//!   "inputs":  [{"name": "R", "unit": "lb/min", "description": "reflux"}],
-//!   "outputs": [{"name": "xD", "unit": "mol%"}],
-//!   "disturbances": [{"name": "F", "unit": "lb/min"}],
-//!   "elements": [
-//!     {"output": "xD", "input": "R", "gain": 12.8, "lags": ["16.7 min"], "dead_time": "1 min"},
-//!     {"output": "xD", "input": "F", "gain": 3.8, "lags": ["14.9 min"], "dead_time": "8.1 min"}
-//!   ]
-//! }
-//! ```
+//! output units per input unit (the units declared for the signals), lags `τ_lag > 0`, leads
+//! `τ_lead ≠ 0` (negative: a right-half-plane zero, inverse response) and dead time `θ ≥ 0`, all
+//! times in seconds. A missing element is zero. The file format (`*.tf.json`) is read by
+//! `plantwide_io::tf`.
 
 use faer::{Mat, c64};
-use plantwide_units::{Dimension, QuantityValue};
-use serde::Deserialize;
 
-use crate::error::AnalysisError;
-
-/// A transfer-function file as written.
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct TfFile {
-    format_version: u32,
-    name: String,
-    #[serde(default)]
-    description: String,
-    inputs: Vec<TfSignal>,
-    outputs: Vec<TfSignal>,
-    #[serde(default)]
-    disturbances: Vec<TfSignal>,
-    elements: Vec<ElementSpec>,
-}
+use crate::error::{AnalysisError, request};
 
 /// An input, output or disturbance of a transfer-function model.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct TfSignal {
     /// Name used by the elements.
     pub name: String,
     /// Unit of the signal (a label: gains are in output units per input unit).
-    #[serde(default)]
     pub unit: String,
     /// What it is.
-    #[serde(default)]
     pub description: String,
-}
-
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct ElementSpec {
-    output: String,
-    input: String,
-    gain: f64,
-    #[serde(default)]
-    lags: Vec<QuantityValue>,
-    #[serde(default)]
-    leads: Vec<QuantityValue>,
-    #[serde(default)]
-    dead_time: Option<QuantityValue>,
 }
 
 /// One element `K Π(τ_lead s + 1) / Π(τ_lag s + 1) e^(−θ s)`; times in seconds.
@@ -110,109 +63,25 @@ pub struct TfModel {
     elements: Vec<Vec<Option<Element>>>,
 }
 
-fn tf_error(file: &str, path: impl Into<String>, message: impl Into<String>) -> AnalysisError {
-    AnalysisError::TfFile { file: file.to_string(), path: path.into(), message: message.into() }
-}
-
-fn times(file: &str, path: &str, values: &[QuantityValue]) -> Result<Vec<f64>, AnalysisError> {
-    values
-        .iter()
-        .enumerate()
-        .map(|(k, v)| v.to_si(Dimension::TIME).map_err(|e| tf_error(file, format!("{path}[{k}]"), e.to_string())))
-        .collect()
-}
-
 impl TfModel {
-    /// Parse and check a transfer-function file (`file` names it in messages).
-    pub fn parse(text: &str, file: &str) -> Result<TfModel, AnalysisError> {
-        let de = &mut serde_json::Deserializer::from_str(text);
-        let spec: TfFile = serde_path_to_error::deserialize(de).map_err(|e| {
-            let path = e.path().to_string();
-            tf_error(file, if path == "." { "(top level)".to_string() } else { path }, e.into_inner().to_string())
-        })?;
-        if spec.format_version != 1 {
-            return Err(tf_error(
-                file,
-                "format_version",
-                format!("version {} is not supported (this build reads version 1)", spec.format_version),
-            ));
+    /// A model from its signals and its elements, outputs × (inputs then disturbances) with
+    /// `None` for a zero element; refused when the element matrix does not have that shape.
+    pub fn new(
+        name: String,
+        description: String,
+        inputs: Vec<TfSignal>,
+        outputs: Vec<TfSignal>,
+        disturbances: Vec<TfSignal>,
+        elements: Vec<Vec<Option<Element>>>,
+    ) -> Result<TfModel, AnalysisError> {
+        let n_cols = inputs.len() + disturbances.len();
+        if elements.len() != outputs.len() || elements.iter().any(|row| row.len() != n_cols) {
+            return Err(request(format!(
+                "transfer-function model `{name}`: the elements must form a {} × {n_cols} matrix (outputs × inputs and disturbances)",
+                outputs.len()
+            )));
         }
-        let mut names: Vec<(&str, String)> = Vec::new();
-        for (list, key) in [(&spec.inputs, "inputs"), (&spec.outputs, "outputs"), (&spec.disturbances, "disturbances")]
-        {
-            for (k, s) in list.iter().enumerate() {
-                if let Some((_, other)) = names.iter().find(|(n, _)| *n == s.name) {
-                    return Err(tf_error(
-                        file,
-                        format!("{key}[{k}].name"),
-                        format!("`{}` is already used by {other}", s.name),
-                    ));
-                }
-                names.push((&s.name, format!("{key}[{k}]")));
-            }
-        }
-        if spec.inputs.is_empty() || spec.outputs.is_empty() {
-            return Err(tf_error(file, "inputs", "a model needs at least one input and one output"));
-        }
-        let n_cols = spec.inputs.len() + spec.disturbances.len();
-        let mut elements = vec![vec![None; n_cols]; spec.outputs.len()];
-        let col_names: Vec<&str> = spec.inputs.iter().chain(&spec.disturbances).map(|s| s.name.as_str()).collect();
-        for (k, e) in spec.elements.iter().enumerate() {
-            let at = |field: &str| format!("elements[{k}].{field}");
-            let i = spec.outputs.iter().position(|s| s.name == e.output).ok_or_else(|| {
-                let outs: Vec<&str> = spec.outputs.iter().map(|s| s.name.as_str()).collect();
-                tf_error(file, at("output"), format!("no output `{}` (outputs: {})", e.output, outs.join(", ")))
-            })?;
-            let j = col_names.iter().position(|n| *n == e.input).ok_or_else(|| {
-                tf_error(
-                    file,
-                    at("input"),
-                    format!("no input or disturbance `{}` (declared: {})", e.input, col_names.join(", ")),
-                )
-            })?;
-            if elements[i][j].is_some() {
-                return Err(tf_error(
-                    file,
-                    at("input"),
-                    format!("a second element from `{}` to `{}`", e.input, e.output),
-                ));
-            }
-            if !e.gain.is_finite() {
-                return Err(tf_error(file, at("gain"), "must be a finite number"));
-            }
-            let lags = times(file, &at("lags"), &e.lags)?;
-            if let Some(k2) = lags.iter().position(|t| !(t.is_finite() && *t > 0.0)) {
-                return Err(tf_error(
-                    file,
-                    format!("{}[{k2}]", at("lags")),
-                    "a lag time constant must be positive (an unstable pole is not supported)",
-                ));
-            }
-            let leads = times(file, &at("leads"), &e.leads)?;
-            if let Some(k2) = leads.iter().position(|t| !(t.is_finite() && *t != 0.0)) {
-                return Err(tf_error(
-                    file,
-                    format!("{}[{k2}]", at("leads")),
-                    "a lead time constant must be non-zero (negative for inverse response)",
-                ));
-            }
-            let dead_time = match &e.dead_time {
-                Some(v) => v.to_si(Dimension::TIME).map_err(|err| tf_error(file, at("dead_time"), err.to_string()))?,
-                None => 0.0,
-            };
-            if !(dead_time.is_finite() && dead_time >= 0.0) {
-                return Err(tf_error(file, at("dead_time"), "must be zero or positive"));
-            }
-            elements[i][j] = Some(Element { gain: e.gain, lags, leads, dead_time });
-        }
-        Ok(TfModel {
-            name: spec.name,
-            description: spec.description,
-            inputs: spec.inputs,
-            outputs: spec.outputs,
-            disturbances: spec.disturbances,
-            elements,
-        })
+        Ok(TfModel { name, description, inputs, outputs, disturbances, elements })
     }
 
     /// The element from column `j` (inputs, then disturbances) to output `i`.
@@ -250,49 +119,24 @@ impl TfModel {
 mod tests {
     use super::*;
 
-    const TWO_BY_TWO: &str = r#"{
-      "format_version": 1, "name": "t",
-      "inputs": [{"name": "u1"}, {"name": "u2"}],
-      "outputs": [{"name": "y1"}, {"name": "y2", "unit": "K"}],
-      "disturbances": [{"name": "d"}],
-      "elements": [
-        {"output": "y1", "input": "u1", "gain": 2.0, "lags": ["10 s", 5], "leads": ["-3 s"], "dead_time": "2 s"},
-        {"output": "y2", "input": "u2", "gain": -1.5},
-        {"output": "y2", "input": "d", "gain": 0.5, "lags": ["1 min"]}
-      ]
-    }"#;
-
-    #[test]
-    fn elements_evaluate_their_transfer_functions() {
-        let m = TfModel::parse(TWO_BY_TWO, "t.tf.json").unwrap();
-        let g = m.gain();
-        assert_eq!((g[(0, 0)], g[(0, 1)], g[(1, 0)], g[(1, 1)]), (2.0, 0.0, 0.0, -1.5));
-        assert_eq!(m.disturbance_gain()[(1, 0)], 0.5);
-        // g11(jω) = 2 (1 − 3jω) e^(−2jω) / ((1 + 10jω)(1 + 5jω)) at ω = 0.1 rad/s.
-        let w = 0.1;
-        let exact = c64::new(1.0, -3.0 * w) * c64::new(0.0, -2.0 * w).exp() * 2.0
-            / (c64::new(1.0, 10.0 * w) * c64::new(1.0, 5.0 * w));
-        assert!((m.response(w)[(0, 0)] - exact).norm() < 1e-15);
-        // |e^(−jωθ)| = 1 and the phase of the delay is −ωθ.
-        let delay_only = Element { gain: 1.0, lags: vec![], leads: vec![], dead_time: 7.0 };
-        assert!((delay_only.response(0.3).arg() - (-2.1)).abs() < 1e-14);
+    fn signal(name: &str) -> TfSignal {
+        TfSignal { name: name.into(), unit: String::new(), description: String::new() }
     }
 
     #[test]
-    fn mistakes_are_reported_with_their_json_path() {
-        let bad_input = TWO_BY_TWO.replace(r#""input": "u2""#, r#""input": "u3""#);
-        let e = TfModel::parse(&bad_input, "t.tf.json").unwrap_err().to_string();
-        assert!(e.starts_with("t.tf.json: elements[1].input: no input or disturbance `u3`"), "{e}");
-        let bad_lag = TWO_BY_TWO.replace(r#""lags": ["1 min"]"#, r#""lags": ["-1 min"]"#);
-        let e = TfModel::parse(&bad_lag, "t.tf.json").unwrap_err().to_string();
-        assert!(e.contains("elements[2].lags[0]: a lag time constant must be positive"), "{e}");
-        let bad_unit = TWO_BY_TWO.replace(r#""dead_time": "2 s""#, r#""dead_time": "2 K""#);
-        let e = TfModel::parse(&bad_unit, "t.tf.json").unwrap_err().to_string();
-        assert!(e.contains("elements[0].dead_time: `2 K` is a temperature"), "{e}");
-        let unknown = TWO_BY_TWO.replace(r#""gain": -1.5"#, r#""gain": -1.5, "gian": 1"#);
-        let e = TfModel::parse(&unknown, "t.tf.json").unwrap_err().to_string();
-        assert!(e.contains("elements[1]") && e.contains("unknown field `gian`"), "{e}");
-        let twice = TWO_BY_TWO.replace(r#"{"name": "d"}"#, r#"{"name": "u1"}"#);
-        assert!(TfModel::parse(&twice, "t").unwrap_err().to_string().contains("already used by inputs[0]"));
+    fn a_model_needs_an_outputs_by_columns_element_matrix() {
+        let g = Element { gain: 2.0, lags: vec![10.0], leads: vec![], dead_time: 0.0 };
+        let m = TfModel::new(
+            "m".into(),
+            String::new(),
+            vec![signal("u")],
+            vec![signal("y")],
+            vec![signal("d")],
+            vec![vec![Some(g), None]],
+        )
+        .unwrap();
+        assert_eq!((m.gain()[(0, 0)], m.disturbance_gain()[(0, 0)]), (2.0, 0.0));
+        let e = TfModel::new("m".into(), String::new(), vec![signal("u")], vec![signal("y")], vec![], vec![]);
+        assert!(e.unwrap_err().to_string().contains("must form a 1 × 1 matrix"));
     }
 }

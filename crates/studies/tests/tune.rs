@@ -2,6 +2,7 @@
 
 use faer::c64;
 use plantwide_analysis::tf::TfModel;
+use plantwide_io::tf;
 use plantwide_studies::TuneError;
 use plantwide_studies::tune::{BltSettings, PiRule, TuneMethod, blt, single_loop};
 
@@ -9,7 +10,7 @@ const MIN: f64 = 60.0;
 
 fn wood_berry() -> TfModel {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../flowsheets/transfer_functions/wood_berry.tf.json");
-    TfModel::parse(&std::fs::read_to_string(path).unwrap(), "wood_berry.tf.json").unwrap()
+    tf::parse(&std::fs::read_to_string(path).unwrap(), "wood_berry.tf.json").unwrap()
 }
 
 /// Ogunnaike, Lemaire, Morari & Ray (1983), AIChE J. 29, 632: the 3 × 3 ethanol-water pilot
@@ -89,7 +90,7 @@ fn lcm_3x3(m: &TfModel, kc: &[f64], ti: &[f64], w: f64) -> f64 {
 
 #[test]
 fn blt_on_a_3x3_column_reaches_6_db_with_zn_settings_over_f() {
-    let model = TfModel::parse(OGUNNAIKE_RAY, "ogunnaike_ray").unwrap();
+    let model = tf::parse(OGUNNAIKE_RAY, "ogunnaike_ray").unwrap();
     let t = blt(&model, &BltSettings::default()).unwrap();
     let zn = single_loop(&model, PiRule::ZieglerNichols).unwrap();
     let f = t.detuning_factor.unwrap();
@@ -120,7 +121,7 @@ fn bad_models_are_rejected_naming_the_problem() {
     let mut v2 = v.clone();
     v2["outputs"].as_array_mut().unwrap().pop();
     v2["elements"].as_array_mut().unwrap().retain(|e| e["output"] != "y3");
-    let m = TfModel::parse(&v2.to_string(), "two_by_three").unwrap();
+    let m = tf::parse(&v2.to_string(), "two_by_three").unwrap();
     let e = blt(&m, &BltSettings::default()).unwrap_err();
     assert!(matches!(e, TuneError::NotSquare { n_outputs: 2, n_inputs: 3, .. }), "{e}");
     assert!(e.to_string().contains("`ogunnaike_ray` is not square (2 outputs × 3 inputs)"), "{e}");
@@ -128,7 +129,7 @@ fn bad_models_are_rejected_naming_the_problem() {
 
     let mut v3 = v.clone();
     v3["elements"][4] = serde_json::json!({"output": "y2", "input": "u2", "gain": -2.36, "lags": ["5 min"]});
-    let m = TfModel::parse(&v3.to_string(), "first_order").unwrap();
+    let m = tf::parse(&v3.to_string(), "first_order").unwrap();
     let e = blt(&m, &BltSettings::default()).unwrap_err().to_string();
     assert!(e.starts_with("element y2 ← u2 has no phase crossover"), "{e}");
     assert!(e.contains("a lag of order 1 without dead time") && e.contains("add the element's dead time"), "{e}");
@@ -140,7 +141,7 @@ fn bad_models_are_rejected_naming_the_problem() {
         {"output": "y", "input": "b", "gain": 2, "lags": [10], "dead_time": 1},
         {"output": "z", "input": "a", "gain": 2, "lags": [10], "dead_time": 1},
         {"output": "z", "input": "b", "gain": 4, "lags": [10], "dead_time": 1}]}"#;
-    let e = blt(&TfModel::parse(singular, "twins").unwrap(), &BltSettings::default()).unwrap_err();
+    let e = blt(&tf::parse(singular, "twins").unwrap(), &BltSettings::default()).unwrap_err();
     assert!(matches!(e, TuneError::SingularGain { .. }) && e.to_string().contains("`twins` is singular"), "{e}");
 }
 

@@ -16,9 +16,9 @@
 use faer::{Mat, c64};
 use serde::Serialize;
 
-use crate::linear::StateSpace;
-use crate::measures::rows;
-use crate::select::Signal;
+use plantwide_analysis::linear::StateSpace;
+use plantwide_analysis::measures::rows;
+use plantwide_analysis::select::Signal;
 
 /// A state-space model with its labels, ready to serialize.
 #[derive(Debug, Clone)]

@@ -1,0 +1,23 @@
+//! File formats and figures of plantwide: what the faces (CLI, Python, server) read and write
+//! besides flowsheets and scenarios (those are `plantwide_flowsheet`'s).
+//!
+//! - [`tf`]: the transfer-function model file (`*.tf.json`) → [`TfModel`](plantwide_analysis::tf::TfModel).
+//! - [`export`]: the state-space model as JSON for MATLAB and python-control.
+//! - [`csv`]: sensitivity sweeps as CSV.
+//! - [`plot`]: trend plots of dynamic runs and sensitivity plots, PNG or SVG, with one embedded
+//!   font (DejaVu Sans) registered once, so no system font library is needed.
+//!
+//! **Architecture Invariant:** io sits above the numerical crates (units, analysis; later studies)
+//! and is never imported by them: they compute typed results, io turns those into text and
+//! pictures. Writing a figure is the only file access here; reading a file's text is the
+//! caller's.
+
+#![warn(missing_docs)]
+
+pub mod csv;
+pub mod error;
+pub mod export;
+pub mod plot;
+pub mod tf;
+
+pub use error::IoError;
