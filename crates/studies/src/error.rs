@@ -56,6 +56,33 @@ pub enum TuneError {
         /// The PID controllers it has.
         loops: String,
     },
+    /// Averaging-level tuning of a measurement that does not integrate.
+    #[error(
+        "`{controller}` measures {measurement}, which settles at a finite gain when its output moves: averaging \
+         tuning is for levels (integrating measurements); use --method simc or blt"
+    )]
+    NotIntegrating {
+        /// Controller.
+        controller: String,
+        /// Its measurement.
+        measurement: String,
+    },
+    /// The file's action is the opposite of what the process gain needs.
+    #[error(
+        "`{controller}` has action \"{file}\" in the file, but its process gain needs \"{needed}\" (the loop would \
+         run away); set its action to \"{needed}\""
+    )]
+    WrongAction {
+        /// Controller.
+        controller: String,
+        /// The file's action.
+        file: &'static str,
+        /// The action needed.
+        needed: &'static str,
+    },
+    /// Averaging-level settings cannot be computed.
+    #[error(transparent)]
+    Averaging(#[from] crate::tune::averaging::AveragingError),
     /// A numerical search failed.
     #[error("{0}")]
     Numerical(String),

@@ -16,6 +16,7 @@ pub mod averaging;
 pub mod bench;
 pub mod blt;
 pub mod fit;
+pub mod flowsheet;
 pub mod loops;
 pub mod relay;
 pub mod rules;

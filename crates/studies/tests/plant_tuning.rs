@@ -3,6 +3,8 @@
 use faer::{Mat, c64};
 use plantwide_flowsheet::{Plant, load_with};
 use plantwide_studies::TuneError;
+use plantwide_studies::tune::averaging::AveragingForm;
+use plantwide_studies::tune::flowsheet::{averaging_loop, integrating_gain};
 use plantwide_studies::tune::loops::{LoopResponse, Measurement, loop_model, loop_ultimates, plant_blt, plant_loop};
 use plantwide_studies::tune::{BltSettings, max_log_modulus};
 
@@ -96,4 +98,31 @@ fn a_name_that_is_no_pid_loop_is_refused_with_the_loops_listed() {
     let err = plant_loop(&plant, "column1_top").unwrap_err();
     let TuneError::NotALoop { loops, .. } = &err else { panic!("{err}") };
     assert!(loops.contains("column1_top_T") && loops.contains("reactor_level"), "{err}");
+}
+
+#[test]
+fn a_tanks_integrating_gain_is_its_molar_volume_over_its_area() {
+    // Flow-set outflow: dM/dt = F_in − F_out and level = M v_L / A, so d(level)/dt per unit outflow
+    // is −v_L/A, v_L = V/M at the steady state and A = π d²/4 with d = 1.5 m.
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../flowsheets/surge_tank.json");
+    let plant = load_with(std::path::Path::new(path), &[]).unwrap();
+    let x = plantwide_solve::converge(&plant, &Default::default()).unwrap().x;
+    let l = plant_loop(&plant, "level_control").unwrap();
+    let k = integrating_gain(&plant, &x, &l).unwrap();
+    let v_l = x[plant.var("tank.V").unwrap()] / x[plant.var("tank.M").unwrap()];
+    let area = std::f64::consts::PI * 1.5f64.powi(2) / 4.0;
+    assert!((k + v_l / area).abs() < 1e-6 * v_l / area, "{k} vs {}", -v_l / area);
+    // P-only averaging for a 10 kmol/h inflow step in a ±0.5 m band: |Kc| = 10 kmol/h / 0.5 m,
+    // direct action (more level, more outflow), filter time Δh/(|k| Δu).
+    let du = 10.0 / 3.6;
+    let t = averaging_loop(&plant, &x, &l, Some(du), Some(0.5), AveragingForm::P).unwrap();
+    let e = &t.loops[0];
+    assert!((e.kc + du / 0.5).abs() < 1e-12 * du && e.action == "direct" && e.file_action.is_none(), "{e:?}");
+    let tau = e.averaging.unwrap().time;
+    assert!((tau - 0.5 * area / (v_l * du)).abs() < 1e-5 * tau, "{tau}");
+    // A temperature is no level.
+    let two = two_column_plant().0;
+    let x2 = two_column_plant().1;
+    let err = integrating_gain(&two, &x2, &plant_loop(&two, "column1_top_T").unwrap()).unwrap_err();
+    assert!(matches!(err, TuneError::NotIntegrating { .. }), "{err}");
 }

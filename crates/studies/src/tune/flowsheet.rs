@@ -1,0 +1,236 @@
+//! Tuning the PID loops of a flowsheet, and writing the settings back into its file.
+//!
+//! Each result names the controller, its measurement (`output`) and output (`input`), the
+//! settings in SI (gains in the controller's output unit per measurement unit, times in s), and
+//! the action they require: a process gain `k > 0` needs reverse action (`e = sp − pv`), `k < 0`
+//! direct; the file's `kc` is the magnitude. [`edits`] turns a result into field edits of the
+//! flowsheet text, each in the unit the file wrote the field in, so a reviewer's diff shows only
+//! the new settings.
+
+use plantwide_flowsheet::Plant;
+use plantwide_flowsheet::edit::FieldEdit;
+use plantwide_model::ControllerSpec;
+use plantwide_model::controllers::Action;
+use plantwide_units::{QuantityValue, convert_from_si};
+use serde::Serialize;
+
+use super::averaging::{AveragingForm, AveragingSettings, averaging};
+use super::blt::BltSettings;
+use super::loops::{LoopResponse, Measurement, PlantLoop, in_manual, loop_model, plant_blt};
+use crate::TuneError;
+
+/// The tuning of one loop of a flowsheet.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FlowsheetLoop {
+    /// Controller.
+    pub controller: String,
+    /// Its measurement's path.
+    pub output: String,
+    /// Its output (`<ctrl>.op`).
+    pub input: String,
+    /// Ultimate gain (relay, ZN, TL, BLT).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ku: Option<f64>,
+    /// Ultimate period \[s or the time unit asked for\].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pu: Option<f64>,
+    /// Signed controller gain (the sign of the process gain), SI.
+    pub kc: f64,
+    /// Reset time (`None`: P only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tau_i: Option<f64>,
+    /// Derivative time.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tau_d: Option<f64>,
+    /// The action the sign of `kc` requires.
+    pub action: &'static str,
+    /// The action the file has, when it differs (the loop would run away).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub file_action: Option<&'static str>,
+    /// Averaging-level details.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub averaging: Option<AveragingSettings>,
+}
+
+/// The tuning of a set of loops of a flowsheet.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FlowsheetTuning {
+    /// Method (`blt`, `zn`, `tl`, `relay`, `simc`, `imc`, `averaging`).
+    pub method: &'static str,
+    /// BLT detuning factor.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub detuning_factor: Option<f64>,
+    /// One entry per loop, in the order asked for.
+    pub loops: Vec<FlowsheetLoop>,
+}
+
+impl FlowsheetTuning {
+    /// Times (`pu`, `tau_i`, `tau_d`, averaging times) in a unit of `seconds` s; gains unchanged
+    /// except an averaging `time`.
+    pub fn in_time_unit(mut self, seconds: f64) -> FlowsheetTuning {
+        for l in &mut self.loops {
+            l.pu = l.pu.map(|p| p / seconds);
+            l.tau_i = l.tau_i.map(|t| t / seconds);
+            l.tau_d = l.tau_d.map(|t| t / seconds);
+            if let Some(a) = &mut l.averaging {
+                a.time /= seconds;
+                a.tau_i = a.tau_i.map(|t| t / seconds);
+            }
+        }
+        self
+    }
+}
+
+fn action_name(a: Action) -> &'static str {
+    match a {
+        Action::Reverse => "reverse",
+        Action::Direct => "direct",
+    }
+}
+
+/// The entry of `l` with signed gain `kc` and reset/derivative times.
+fn entry(l: &PlantLoop, kc: f64, tau_i: Option<f64>, tau_d: Option<f64>) -> FlowsheetLoop {
+    let needed = if kc >= 0.0 { Action::Reverse } else { Action::Direct };
+    FlowsheetLoop {
+        controller: l.name.clone(),
+        output: l.pv_path.clone(),
+        input: format!("{}.op", l.name),
+        ku: None,
+        pu: None,
+        kc,
+        tau_i,
+        tau_d: tau_d.filter(|t| *t > 0.0),
+        action: action_name(needed),
+        file_action: (needed != l.action).then(|| action_name(l.action)),
+        averaging: None,
+    }
+}
+
+/// Luyben's BLT of `loops` at the steady state `x` ([`plant_blt`]).
+///
+/// # Errors
+/// As [`plant_blt`].
+pub fn blt_loops(
+    plant: &Plant,
+    x: &[f64],
+    loops: &[PlantLoop],
+    measurement: Measurement,
+) -> Result<FlowsheetTuning, TuneError> {
+    let t = plant_blt(plant, x, loops, measurement, &BltSettings::default())?;
+    let entries = loops
+        .iter()
+        .zip(&t.loops)
+        .map(|(l, s)| FlowsheetLoop { ku: Some(s.ku), pu: Some(s.pu), ..entry(l, s.kc, Some(s.tau_i), None) })
+        .collect();
+    Ok(FlowsheetTuning { method: "blt", detuning_factor: t.detuning_factor, loops: entries })
+}
+
+/// The integrating gain `k = lim_{s→0} s g(s)` of a level loop's element at `x` (level units per
+/// output unit per second), from the linear model with the loop in manual, evaluated at a
+/// frequency a million times below the slowest nonzero eigenvalue (`s g(s) = k (1 + O(s τ))`, so
+/// the relative error is about 1e-6).
+///
+/// # Errors
+/// [`TuneError::NotIntegrating`] when the element has a finite steady-state gain.
+pub fn integrating_gain(plant: &Plant, x: &[f64], l: &PlantLoop) -> Result<f64, TuneError> {
+    let model = loop_model(plant, x, std::slice::from_ref(l))?;
+    let ev = model.ss.eigenvalues().map_err(|e| TuneError::Numerical(e.to_string()))?;
+    let scale = ev.iter().map(|v| v.norm()).fold(0.0, f64::max);
+    let slow = ev.iter().map(|v| v.norm()).filter(|m| *m > 1e-10 * scale).fold(f64::INFINITY, f64::min);
+    let w = 1e-6 * slow;
+    let response = LoopResponse::new(model, Measurement::default());
+    let g = response.at(w)[(0, 0)];
+    let sg = g * faer::c64::new(0.0, w);
+    if sg.im.abs() > 1e-2 * sg.re.abs() || !sg.re.is_finite() {
+        return Err(TuneError::NotIntegrating { controller: l.name.clone(), measurement: l.pv_path.clone() });
+    }
+    Ok(sg.re)
+}
+
+/// Averaging-level settings of level loop `l`: a disturbance that the output must move by
+/// `flow_change` to balance (default: 10 % of the output's steady value) within a level band
+/// (default: a quarter of the measurement's steady value).
+///
+/// # Errors
+/// [`TuneError::NotIntegrating`] for a loop whose measurement does not integrate; bad bands.
+pub fn averaging_loop(
+    plant: &Plant,
+    x: &[f64],
+    l: &PlantLoop,
+    flow_change: Option<f64>,
+    band: Option<f64>,
+    form: AveragingForm,
+) -> Result<FlowsheetTuning, TuneError> {
+    let k = integrating_gain(plant, x, l)?;
+    let du = flow_change.unwrap_or(0.1 * x[l.op].abs());
+    let band = band.unwrap_or(0.25 * x[l.pv].abs());
+    let a = averaging(k, du, band, form).map_err(TuneError::from)?;
+    let mut e = entry(l, a.kc, a.tau_i, None);
+    e.averaging = Some(a);
+    Ok(FlowsheetTuning { method: "averaging", detuning_factor: None, loops: vec![e] })
+}
+
+/// The steady state `x` with every loop of `loops` in manual (for tests that move their outputs).
+pub fn manual_plant(plant: &Plant, x: &[f64], loops: &[PlantLoop]) -> Plant {
+    in_manual(plant, x, loops)
+}
+
+/// Field edits writing `tuning` into the flowsheet text of `plant`: `kc` as the magnitude, and
+/// `tau_i`/`tau_d` (removed settings are left as they are), each in the unit the file wrote it in
+/// (SI numbers when it wrote a number; `time_unit` for a time the file did not have).
+///
+/// # Errors
+/// [`TuneError::WrongAction`] when the file's action would make a tuned loop run away.
+pub fn edits(plant: &Plant, tuning: &FlowsheetTuning, time_unit: &str) -> Result<Vec<FieldEdit>, TuneError> {
+    let mut out = Vec::new();
+    for l in &tuning.loops {
+        if let Some(file) = l.file_action {
+            return Err(TuneError::WrongAction { controller: l.controller.clone(), file, needed: l.action });
+        }
+        let Some(ControllerSpec::Pid(cfg)) = plant.spec().controllers.get(&l.controller) else { continue };
+        let path = |f: &str| vec!["controllers".to_string(), l.controller.clone(), f.to_string()];
+        out.push(FieldEdit { path: path("kc"), value: quantity(l.kc.abs(), Some(&cfg.kc), None) });
+        if let Some(ti) = l.tau_i {
+            out.push(FieldEdit { path: path("tau_i"), value: quantity(ti, cfg.tau_i.as_ref(), Some(time_unit)) });
+        }
+        if let Some(td) = l.tau_d {
+            out.push(FieldEdit { path: path("tau_d"), value: quantity(td, cfg.tau_d.as_ref(), Some(time_unit)) });
+        }
+    }
+    Ok(out)
+}
+
+/// The JSON text of SI value `v` in the unit of `old` (a quantity string), else `fallback`, else
+/// the bare SI number; six significant digits.
+fn quantity(v: f64, old: Option<&QuantityValue>, fallback: Option<&str>) -> String {
+    let unit = match old {
+        Some(QuantityValue::Text(t)) => t.trim().split_once(char::is_whitespace).map(|(_, u)| u.trim().to_string()),
+        _ => None,
+    };
+    let unit = unit.or_else(|| fallback.filter(|u| *u != "s").map(str::to_string));
+    match unit.as_deref().and_then(|u| convert_from_si(v, u).ok().map(|x| (x, u))) {
+        Some((x, u)) => format!("\"{} {u}\"", significant(x)),
+        None => significant(v),
+    }
+}
+
+/// `v` to six significant digits, as JSON.
+fn significant(v: f64) -> String {
+    let s = format!("{v:.5e}");
+    s.parse::<f64>().map_or(s, |x| x.to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quantities_are_written_in_the_files_unit() {
+        let old = QuantityValue::Text("20 kmol/h/K".into());
+        // 1 kmol/h/K = 1000/3600 mol/(s K).
+        assert_eq!(quantity(2.5 * 1000.0 / 3600.0, Some(&old), None), "\"2.5 kmol/h/K\"");
+        assert_eq!(quantity(1234.5678, Some(&QuantityValue::Number(3.0)), None), "1234.57");
+        assert_eq!(quantity(600.0, None, Some("min")), "\"10 min\"");
+        assert_eq!(quantity(600.0, None, Some("s")), "600");
+    }
+}
