@@ -51,12 +51,12 @@ fn edit_one(text: &str, file: &str, e: &FieldEdit) -> Result<String, EditError> 
     let (last, parents) = e.path.split_last().ok_or_else(|| fail("empty path".into()))?;
     let mut span = (0, text.len());
     for key in parents {
-        let members = members(&text[span.0..span.1]).map_err(|why| fail(why))?;
+        let members = members(&text[span.0..span.1]).map_err(&fail)?;
         let raw = members.get(key.as_str()).ok_or_else(|| fail(format!("no member `{key}`")))?;
         span = offset_of(text, raw);
     }
     let object = &text[span.0..span.1];
-    let members = members(object).map_err(|why| fail(why))?;
+    let members = members(object).map_err(&fail)?;
     if let Some(raw) = members.get(last.as_str()) {
         let (a, b) = offset_of(text, raw);
         return Ok(format!("{}{}{}", &text[..a], e.value, &text[b..]));
