@@ -48,14 +48,37 @@ pub enum TuneError {
         /// Why, and what to change.
         why: String,
     },
-    /// A numerical search failed.
-    #[error("{0}")]
-    Numerical(String),
+    /// A relay test on an element with more leads than lags (an improper transfer function).
+    #[error("relay test: no limit cycle: the element has {leads} leads and {lags} lags (improper)")]
+    ImproperElement {
+        /// Number of leads.
+        leads: usize,
+        /// Number of lags.
+        lags: usize,
+    },
+    /// BLT: no detuning factor up to the largest allowed brings the biggest log modulus down to
+    /// its target.
+    #[error(
+        "BLT: the biggest log modulus stays above {target_db} dB up to F = {detuning}: the loops interact too \
+         strongly for one detuning factor (check the pairing)"
+    )]
+    DetuningLimit {
+        /// The target of the biggest log modulus [dB].
+        target_db: f64,
+        /// The largest detuning factor tried (at least `max_detuning`).
+        detuning: f64,
+    },
+    /// The singular values of `G(0)` could not be computed.
+    #[error("SVD of G(0): {detail}")]
+    Svd {
+        /// What the linear-algebra library reported.
+        detail: String,
+    },
 }
 
 impl TuneError {
     /// True for problems of the request (exit code 1), false for numerical failures (exit code 2).
     pub fn is_user_error(&self) -> bool {
-        !matches!(self, TuneError::Numerical(_))
+        !matches!(self, TuneError::DetuningLimit { .. } | TuneError::Svd { .. })
     }
 }
