@@ -151,8 +151,8 @@ pub enum PerturbError {
         input: String,
         /// Its move from the base case (SI).
         by: f64,
-        /// Why the point did not re-converge.
-        cause: PointError,
+        /// Why the point did not re-converge (boxed: it carries the solver's reason).
+        cause: Box<PointError>,
     },
     /// The re-converged outputs are less accurate than the step moves them by.
     #[error(
@@ -303,7 +303,7 @@ impl Problem<'_> {
                         file: plant.file().to_string(),
                         input: plant.inputs()[input].path.clone(),
                         by: d,
-                        cause,
+                        cause: Box::new(cause),
                     }
                 })
             })
