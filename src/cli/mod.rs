@@ -27,6 +27,8 @@ mod run;
 mod sensitivity;
 mod steady;
 mod tune;
+mod tune_bench;
+mod tune_plant;
 
 use std::path::PathBuf;
 

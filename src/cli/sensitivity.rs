@@ -97,7 +97,7 @@ pub fn run(a: &SensitivityArgs) -> Result<(), CliError> {
         })?;
         outln!("wrote {}", path.display());
     }
-    let failures: Vec<&String> = curves.iter().flat_map(|c| &c.failures).collect();
+    let failures: Vec<String> = curves.iter().flat_map(|c| &c.failures).map(|f| f.to_string()).collect();
     if !failures.is_empty() {
         let list: Vec<&str> = failures.iter().map(|s| s.as_str()).collect();
         return Err(CliError::numerical(format!("{}: the sweep stopped early: {}", plant.file, list.join("; "))));

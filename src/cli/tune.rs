@@ -1,6 +1,10 @@
 //! `plantwide tune --tf MODEL.tf.json --method blt|zn|tl [--time-unit min] [--json]`: PI settings
 //! of the diagonal loops of a transfer-function model from the ultimate gains and periods of its
 //! diagonal elements (Ziegler–Nichols, Tyreus–Luyben), or Luyben's BLT detuning of the ZN settings.
+//!
+//! `plantwide tune FILE --loop CTRL --method relay|zn|tl|simc|imc|averaging` and
+//! `plantwide tune FILE --loops C1,C2,… --method blt` tune the PID loops of a flowsheet
+//! ([`super::tune_plant`]).
 
 use std::path::{Path, PathBuf};
 
@@ -17,40 +21,129 @@ use super::linearize::TimeUnit;
 pub enum MethodArg {
     /// Luyben's biggest-log-modulus tuning: ZN settings detuned by one F, max L_cm = 2n dB.
     Blt,
-    /// Ziegler–Nichols PI of each loop alone: Kc = Ku/2.2, τI = Pu/1.2.
+    /// Ziegler–Nichols PI (from the ultimate gain; on a flowsheet, from a relay test): Kc = Ku/2.2, τI = Pu/1.2.
     Zn,
-    /// Tyreus–Luyben PI of each loop alone: Kc = Ku/3.2, τI = 2.2 Pu.
+    /// Tyreus–Luyben PI (from the ultimate gain; on a flowsheet, from a relay test): Kc = Ku/3.2, τI = 2.2 Pu.
     Tl,
+    /// Relay-feedback test on the dynamic model: Ku, Pu and Tyreus–Luyben settings.
+    Relay,
+    /// Step test, FOPTD/SOPTD/IPDT fit, Skogestad's SIMC settings.
+    Simc,
+    /// Step test, fit, internal-model-control settings.
+    Imc,
+    /// Averaging level control of a level loop (P only, or critically damped PI with --form pi).
+    Averaging,
 }
 
 /// Arguments of `plantwide tune`.
 #[derive(Debug, clap::Args)]
 pub struct TuneArgs {
+    /// Flowsheet whose PID loops to tune (with --loop or --loops).
+    #[arg(value_name = "FILE", required_unless_present = "tf", conflicts_with = "tf")]
+    pub(super) file: Option<PathBuf>,
     /// Transfer-function model (`*.tf.json`); output i is paired with input i.
     #[arg(long, value_name = "MODEL")]
-    tf: PathBuf,
+    pub(super) tf: Option<PathBuf>,
     /// Tuning method.
     #[arg(long, value_enum)]
-    method: MethodArg,
+    pub(super) method: MethodArg,
+    /// The PID controller to tune (relay, zn, tl, simc, imc, averaging).
+    #[arg(long = "loop", value_name = "CTRL")]
+    pub(super) loop_name: Option<String>,
+    /// The PID controllers to tune together (blt), comma separated.
+    #[arg(long, value_name = "C1,C2,…", value_delimiter = ',')]
+    pub(super) loops: Vec<String>,
+    /// Override an input or unit field before converging (repeatable).
+    #[arg(long = "set", value_name = "PATH=VALUE")]
+    pub(super) set: Vec<String>,
+    /// Write the flowsheet with the tuned settings (only those fields change) to this file.
+    #[arg(long, value_name = "OUT.json")]
+    pub(super) write: Option<PathBuf>,
+    /// Measurement dead time of every loop that the model leaves out (blt), e.g. "1 min".
+    #[arg(long, value_name = "TIME")]
+    pub(super) measurement_dead_time: Option<String>,
+    /// Measurement first-order lag of every loop (blt), e.g. "30 s".
+    #[arg(long, value_name = "TIME")]
+    pub(super) measurement_lag: Option<String>,
+    /// Relay amplitude in the controller's output unit (default: 5 % of the output's steady value).
+    #[arg(long, value_name = "VALUE")]
+    pub(super) relay_amplitude: Option<String>,
+    /// Relay hysteresis in the measurement's unit (default 0).
+    #[arg(long, value_name = "VALUE")]
+    pub(super) hysteresis: Option<String>,
+    /// Scan (sampling) interval of the relay and step tests (default: from the loop's linear model).
+    #[arg(long, value_name = "TIME")]
+    pub(super) scan: Option<String>,
+    /// Step of the output in a step test, in its unit (default: 5 % of its steady value).
+    #[arg(long, value_name = "VALUE")]
+    pub(super) step: Option<String>,
+    /// Model fitted to the step test (default foptd; integrating for a level).
+    #[arg(long, value_enum)]
+    pub(super) model: Option<ModelArg>,
+    /// Closed-loop time constant τc (SIMC) or filter time λ (IMC) (default: the fitted dead time).
+    #[arg(long, value_name = "TIME")]
+    pub(super) tau_c: Option<String>,
+    /// PID instead of PI (SIMC on a SOPTD fit, IMC).
+    #[arg(long)]
+    pub(super) pid: bool,
+    /// Averaging: the largest allowed level deviation (default: a quarter of the level).
+    #[arg(long, value_name = "LEVEL")]
+    pub(super) level_band: Option<String>,
+    /// Averaging: the output change that balances the design disturbance (default: 10 % of the output).
+    #[arg(long, value_name = "VALUE")]
+    pub(super) flow_change: Option<String>,
+    /// Averaging: P only (default) or critically damped PI.
+    #[arg(long, value_enum, default_value = "p")]
+    pub(super) form: FormArg,
     /// Time unit of the periods and reset times printed (s, min, h).
     #[arg(long, default_value = "s")]
-    time_unit: String,
+    pub(super) time_unit: String,
     /// Print JSON instead of a table.
     #[arg(long)]
-    json: bool,
+    pub(super) json: bool,
 }
 
-fn tune_error(e: TuneError) -> CliError {
+/// Model fitted to a step test.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum ModelArg {
+    /// First order plus dead time.
+    Foptd,
+    /// Second order plus dead time.
+    Soptd,
+    /// Integrating plus dead time.
+    Integrating,
+}
+
+/// Averaging-level form.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum FormArg {
+    /// Proportional only.
+    P,
+    /// Critically damped PI.
+    Pi,
+}
+
+pub(super) fn tune_error(e: TuneError) -> CliError {
     if e.is_user_error() { CliError::user(e.to_string()) } else { CliError::numerical(e.to_string()) }
 }
 
 pub fn run(a: &TuneArgs) -> Result<(), CliError> {
     let tu = TimeUnit::parse(&a.time_unit)?;
-    let model = load(&a.tf)?;
+    let (Some(tf_file), None) = (&a.tf, &a.file) else {
+        return super::tune_plant::run(a, &tu);
+    };
+    let model = load(tf_file)?;
     let tuning = match a.method {
         MethodArg::Blt => blt(&model, &BltSettings::default()),
         MethodArg::Zn => single_loop(&model, PiRule::ZieglerNichols),
         MethodArg::Tl => single_loop(&model, PiRule::TyreusLuyben),
+        m => {
+            return Err(CliError::user(format!(
+                "--method {}: a transfer-function model is tuned by blt, zn or tl; relay, simc, imc and averaging \
+                 test a flowsheet's loops (plantwide tune FILE --loop CTRL)",
+                format!("{m:?}").to_lowercase()
+            )));
+        }
     }
     .map_err(tune_error)?
     .in_time_unit(tu.seconds);
@@ -58,7 +151,7 @@ pub fn run(a: &TuneArgs) -> Result<(), CliError> {
         outln!("{}", serde_json::to_string_pretty(&tuning).map_err(|e| CliError::user(e.to_string()))?);
         return Ok(());
     }
-    print_table(&tuning, &model, &a.tf, &tu);
+    print_table(&tuning, &model, tf_file, &tu);
     Ok(())
 }
 

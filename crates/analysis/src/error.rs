@@ -1,9 +1,13 @@
 //! Errors of the analysis layer: bad requests (a path that names nothing, a unit of the wrong
 //! dimension, an inconsistent transfer-function model) and numerical failures (a singular Jacobian, a
-//! perturbed plant that does not re-converge).
+//! perturbed plant that does not re-converge). [`AnalysisError`] is the crate-level error
+//! (`plantwide_analysis::Error`); the perturbation's own errors ([`PerturbError`], [`Unverified`])
+//! join it by `From`.
 
-/// Why an analysis could not be done.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+use crate::perturb::PerturbError;
+
+/// Why an analysis could not be done (the crate-level error, `plantwide_analysis::Error`).
+#[derive(Debug, Clone, thiserror::Error)]
 pub enum AnalysisError {
     /// A path, unit, range or option given by the user is wrong; the message says what would fix it.
     #[error("{0}")]
@@ -11,9 +15,10 @@ pub enum AnalysisError {
     /// A matrix that must be invertible is (numerically) singular.
     #[error("{0}")]
     Singular(String),
-    /// A perturbed or swept plant did not re-converge.
-    #[error("{0}")]
-    NotConverged(String),
+    /// A perturbed plant did not re-converge, or too inaccurately for the effect of its step
+    /// (boxed: it carries the solver's reason).
+    #[error(transparent)]
+    NotConverged(Box<PerturbError>),
     /// Perturbation gains that failed their check (step halving, RGA, exact linearization) at
     /// every step tried: never returned as if they were right.
     #[error("{0}")]
@@ -49,6 +54,18 @@ pub struct Unverified {
     pub step: f64,
     /// A smaller relative step to try.
     pub suggestion: f64,
+}
+
+impl From<PerturbError> for AnalysisError {
+    fn from(e: PerturbError) -> Self {
+        AnalysisError::NotConverged(Box::new(e))
+    }
+}
+
+impl From<Unverified> for AnalysisError {
+    fn from(e: Unverified) -> Self {
+        AnalysisError::PerturbationUnverified(Box::new(e))
+    }
 }
 
 impl AnalysisError {

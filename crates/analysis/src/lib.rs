@@ -32,5 +32,8 @@ pub mod sensors;
 pub mod tf;
 
 pub use error::AnalysisError;
+/// The crate-level error: every public fallible function of this crate returns an
+/// [`AnalysisError`].
+pub use error::AnalysisError as Error;
 /// The linear algebra the API speaks (`Mat`, `c64`).
 pub use faer;

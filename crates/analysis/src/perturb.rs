@@ -41,8 +41,8 @@
 
 use faer::Mat;
 use plantwide_flowsheet::Plant;
-use plantwide_solve::sequential::{StrategySettings, steady_state_by};
-use plantwide_solve::sparse::SparseLu;
+use plantwide_solve::sequential::{SolveError, StrategySettings, steady_state_by};
+use plantwide_solve::sparse::{SparseError, SparseLu};
 use plantwide_solve::{NewtonSettings, NewtonStatus, PlantSystem, solve_steady};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -137,6 +137,66 @@ pub struct PerturbGains {
     pub check: PerturbCheck,
 }
 
+/// Why gains by perturbation could not be computed: a perturbed plant that did not re-converge,
+/// or re-converged too inaccurately for the effect of its step. Joined into
+/// [`AnalysisError::NotConverged`].
+#[derive(Debug, Clone, thiserror::Error)]
+pub enum PerturbError {
+    /// A perturbed plant did not re-converge (at any step tried, the last reason is reported).
+    #[error("{file}: the plant did not re-converge: `{input}` moved by {by:+.3e} (SI): {cause}; try a smaller --step")]
+    Reconverge {
+        /// Flowsheet file.
+        file: String,
+        /// Path of the moved input.
+        input: String,
+        /// Its move from the base case (SI).
+        by: f64,
+        /// Why the point did not re-converge (boxed: it carries the solver's reason).
+        cause: Box<PointError>,
+    },
+    /// The re-converged outputs are less accurate than the step moves them by.
+    #[error(
+        "{file}: moving `{input}` by ±{step:.3e} (SI) changes the outputs by at most {effect:.3e}, but the re-converged steady states are only accurate to {accuracy:.3e}; increase --step"
+    )]
+    Inaccurate {
+        /// Flowsheet file.
+        file: String,
+        /// Path of the moved input.
+        input: String,
+        /// The smaller move `h/2` (SI).
+        step: f64,
+        /// Largest output change `|y(u + h/2) − y(u − h/2)| / 2` (SI).
+        effect: f64,
+        /// Largest estimated convergence error left in an output (SI).
+        accuracy: f64,
+    },
+}
+
+/// Why one perturbed point gave no outputs.
+#[derive(Debug, Clone, thiserror::Error)]
+pub enum PointError {
+    /// Newton from the base point failed, and so did the steady-state strategy from scratch.
+    #[error(
+        "from the base point: {status:?} after {iterations} iterations (worst: {equation}, scaled residual {residual:.2e}); from scratch: {scratch}"
+    )]
+    NotConverged {
+        /// Newton's verdict from the base point.
+        status: NewtonStatus,
+        /// Its iterations.
+        iterations: usize,
+        /// The equation with the largest scaled residual.
+        equation: String,
+        /// That scaled residual.
+        residual: f64,
+        /// Why the cold start failed too.
+        scratch: SolveError,
+    },
+    /// The Jacobian at the re-converged point could not be factored for the polishing
+    /// corrections.
+    #[error(transparent)]
+    Polish(#[from] SparseError),
+}
+
 /// Outputs at one perturbed point and the estimated convergence error in each.
 struct Point {
     y: Vec<f64>,
@@ -160,22 +220,22 @@ fn reconverge(
     outputs: &[usize],
     settings: &NewtonSettings,
     error_goal: f64,
-) -> Result<Point, String> {
+) -> Result<Point, PointError> {
     let sys = PlantSystem::new(plant, u);
     let mut x = x0.to_vec();
     let report = solve_steady(&sys, &mut x, settings);
     let mut iterations = report.iterations;
     if report.status != NewtonStatus::Converged {
-        let (eq, res) = report.worst.unwrap_or((0, f64::NAN));
-        let from_base = format!(
-            "from the base point: {:?} after {} iterations (worst: {}, scaled residual {res:.2e})",
-            report.status,
-            report.iterations,
-            plant.equation_name(eq)
-        );
+        let (eq, residual) = report.worst.unwrap_or((0, f64::NAN));
         let strategy = StrategySettings { newton: settings.clone(), ..StrategySettings::default() };
         let solution =
-            steady_state_by(plant, u, &strategy, &mut |_| {}).map_err(|e| format!("{from_base}; from scratch: {e}"))?;
+            steady_state_by(plant, u, &strategy, &mut |_| {}).map_err(|scratch| PointError::NotConverged {
+                status: report.status,
+                iterations: report.iterations,
+                equation: plant.equation_name(eq),
+                residual,
+                scratch,
+            })?;
         x = solution.x;
         iterations += solution.newton.map_or(0, |n| n.iterations);
     }
@@ -186,7 +246,7 @@ fn reconverge(
     for _ in 0..4 {
         plant.jacobian(&x, u, 0.0, &mut r, &mut jx, &mut ju);
         let mut dx: Vec<f64> = r.iter().map(|v| -v).collect();
-        lu.solve(n, &jx, &mut dx).map_err(|e| e.to_string())?;
+        lu.solve(n, &jx, &mut dx)?;
         errors = outputs.iter().map(|&k| dx[k].abs()).collect();
         x.iter_mut().zip(&dx).for_each(|(a, b)| *a += b);
         if errors.iter().all(|e| *e <= error_goal) {
@@ -225,7 +285,7 @@ struct Problem<'a> {
 
 impl Problem<'_> {
     /// Re-converge with input `k` moved by `±h` and `±h/2`; `Err` names the failed move.
-    fn column(&self, k: usize, h: f64) -> Result<Column, String> {
+    fn column(&self, k: usize, h: f64) -> Result<Column, PerturbError> {
         let (plant, input) = (self.plant, self.inputs[k]);
         // Aim at the accuracy relative to the outputs' nominal sizes times the smaller relative
         // step; the error ratio is checked against the effect afterwards.
@@ -238,10 +298,16 @@ impl Problem<'_> {
             .map(|&d| {
                 let mut u = self.u0.to_vec();
                 u[input] += d;
-                reconverge(plant, &u, self.x0, self.outputs, &self.settings.newton, goal)
-                    .map_err(|e| format!("`{}` moved by {d:+.3e} (SI): {e}", plant.inputs[input].path))
+                reconverge(plant, &u, self.x0, self.outputs, &self.settings.newton, goal).map_err(|cause| {
+                    PerturbError::Reconverge {
+                        file: plant.file().to_string(),
+                        input: plant.inputs()[input].path.clone(),
+                        by: d,
+                        cause: Box::new(cause),
+                    }
+                })
             })
-            .collect::<Result<Vec<Point>, String>>()?;
+            .collect::<Result<Vec<Point>, PerturbError>>()?;
         let diff = |a: &Point, b: &Point, i: usize| a.y[i] - b.y[i];
         let n = self.outputs.len();
         Ok(Column {
@@ -428,17 +494,14 @@ pub fn perturb_gains(
     let mut iterations = 0;
     let mut last: Option<AnalysisError> = None;
     for attempt in 1..=settings.max_attempts.max(1) {
-        let columns: Vec<Result<Column, String>> =
+        let columns: Vec<Result<Column, PerturbError>> =
             (0..inputs.len()).into_par_iter().map(|k| p.column(k, rel[k] * p.scales[k])).collect();
         iterations += columns.iter().flatten().map(|c| c.iterations).sum::<usize>();
         // A move too large to re-converge: a tenth of the step for that input, and try again.
-        let failed: Vec<(usize, &String)> =
+        let failed: Vec<(usize, &PerturbError)> =
             columns.iter().enumerate().filter_map(|(k, c)| c.as_ref().err().map(|e| (k, e))).collect();
         if let Some((_, e)) = failed.first() {
-            last = Some(AnalysisError::NotConverged(format!(
-                "{}: the plant did not re-converge: {e}; try a smaller --step",
-                plant.file
-            )));
+            last = Some((*e).clone().into());
             failed.iter().for_each(|&(k, _)| rel[k] = (rel[k] / 10.0).max(MIN_STEP));
             continue;
         }
@@ -474,7 +537,8 @@ pub fn perturb_gains(
             break;
         }
     }
-    Err(last.unwrap_or_else(|| AnalysisError::NotConverged(format!("{}: no perturbation attempted", plant.file))))
+    // Every attempt that does not return leaves its reason in `last`.
+    Err(last.expect("at least one attempt is made"))
 }
 
 /// The largest ratio of convergence error to output change; `Err` when it exceeds `accuracy`.
@@ -484,14 +548,14 @@ fn noise_check(p: &Problem, columns: &[Column], rel: &[f64]) -> Result<f64, Anal
         // No output moves at all (not even by round-off): the gains are exactly zero.
         let ratio = if c.effect == 0.0 { 0.0 } else { c.error / c.effect };
         if ratio.is_nan() || ratio > p.settings.accuracy {
-            return Err(AnalysisError::NotConverged(format!(
-                "{}: moving `{}` by ±{:.3e} (SI) changes the outputs by at most {:.3e}, but the re-converged steady states are only accurate to {:.3e}; increase --step",
-                p.plant.file,
-                p.plant.inputs[p.inputs[k]].path,
-                rel[k] * p.scales[k] / 2.0,
-                c.effect,
-                c.error
-            )));
+            return Err(PerturbError::Inaccurate {
+                file: p.plant.file().to_string(),
+                input: p.plant.inputs()[p.inputs[k]].path.clone(),
+                step: rel[k] * p.scales[k] / 2.0,
+                effect: c.effect,
+                accuracy: c.error,
+            }
+            .into());
         }
         error_ratio = error_ratio.max(ratio);
     }
@@ -500,7 +564,7 @@ fn noise_check(p: &Problem, columns: &[Column], rel: &[f64]) -> Result<f64, Anal
 
 /// The typed error for a check that failed at the last step tried.
 fn unverified(p: &Problem, f: &Failure, step: f64, next: f64) -> AnalysisError {
-    AnalysisError::PerturbationUnverified(Box::new(Unverified {
+    Unverified {
         file: p.plant.file.clone(),
         quantity: f.quantity,
         output: p.plant.vars[p.outputs[f.output]].path.clone(),
@@ -512,7 +576,8 @@ fn unverified(p: &Problem, f: &Failure, step: f64, next: f64) -> AnalysisError {
         tolerance: f.tolerance,
         step,
         suggestion: next,
-    }))
+    }
+    .into()
 }
 
 #[cfg(test)]

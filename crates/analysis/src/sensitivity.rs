@@ -97,11 +97,38 @@ pub struct Curve {
     /// Outputs (SI) at each value.
     pub outputs: Vec<Option<Vec<f64>>>,
     /// Why the walk stopped early on a side, if it did.
-    pub failures: Vec<String>,
+    pub failures: Vec<SweepFailure>,
+}
+
+/// Why a sweep stopped early on one side: the point it could not reach, from where, and Newton's
+/// verdict at the last halving of the step.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("`{path}` = {value:.6e} (SI): not converged from {from:.6e}: {newton}")]
+pub struct SweepFailure {
+    /// Path of the disturbance.
+    pub path: String,
+    /// The value it could not reach (SI).
+    pub value: f64,
+    /// The last value reached (SI).
+    pub from: f64,
+    /// Why Newton failed there.
+    pub newton: NewtonFailure,
+}
+
+/// A Newton iteration that did not converge: its verdict and where the residual is worst.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{status:?} (worst: {equation}, scaled residual {residual:.2e})")]
+pub struct NewtonFailure {
+    /// Newton's verdict.
+    pub status: NewtonStatus,
+    /// The equation with the largest scaled residual.
+    pub equation: String,
+    /// That scaled residual.
+    pub residual: f64,
 }
 
 /// Outputs at each target of one walk (`None` past a failure) and why it stopped, if it did.
-type Walk = (Vec<Option<Vec<f64>>>, Option<String>);
+type Walk = (Vec<Option<Vec<f64>>>, Option<SweepFailure>);
 
 /// Walk from `(x0, base)` through `targets` (ordered away from the base), each from its neighbour.
 fn walk(
@@ -116,7 +143,7 @@ fn walk(
     let mut x = x0.to_vec();
     let mut at = d.base;
     let mut res = Vec::with_capacity(targets.len());
-    let solve = |x: &mut Vec<f64>, value: f64| -> Result<(), String> {
+    let solve = |x: &mut Vec<f64>, value: f64| -> Result<(), NewtonFailure> {
         let mut u = u0.to_vec();
         u[d.signal.index] = value;
         let mut trial = x.clone();
@@ -125,8 +152,8 @@ fn walk(
             *x = trial;
             Ok(())
         } else {
-            let (eq, r) = report.worst.unwrap_or((0, f64::NAN));
-            Err(format!("{:?} (worst: {}, scaled residual {r:.2e})", report.status, plant.equation_name(eq)))
+            let (eq, residual) = report.worst.unwrap_or((0, f64::NAN));
+            Err(NewtonFailure { status: report.status, equation: plant.equation_name(eq), residual })
         }
     };
     for (k, &target) in targets.iter().enumerate() {
@@ -137,9 +164,9 @@ fn walk(
             let next = if (target - at).abs() <= step.abs() { target } else { at + step };
             match solve(&mut x, next) {
                 Ok(()) => at = next,
-                Err(e) if halvings >= 6 => {
+                Err(newton) if halvings >= 6 => {
                     res.extend(std::iter::repeat_n(None, targets.len() - k));
-                    let why = format!("`{}` = {:.6e} (SI): not converged from {:.6e}: {e}", d.signal.path, next, at);
+                    let why = SweepFailure { path: d.signal.path.clone(), value: next, from: at, newton };
                     return (res, Some(why));
                 }
                 Err(_) => {

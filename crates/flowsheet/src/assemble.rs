@@ -468,7 +468,7 @@ fn check_inputs(blocks: &[Block], inputs: &[InputInfo], diags: &mut Vec<Diagnost
         let b = &blocks[info.block];
         let name = info.path.strip_prefix(&format!("{}.", b.name)).unwrap_or(&info.path);
         if let Err(why) = plantwide_model::limits::check_input(name, info.dim, info.value) {
-            diags.push(Diagnostic::new(format!("{}.{name}", section_path(b)), why));
+            diags.push(Diagnostic::new(format!("{}.{name}", section_path(b)), why.to_string()));
         }
     }
 }

@@ -87,7 +87,7 @@ pub fn check_input_value(plant: &Plant, i: usize, v: f64) -> Result<(), String> 
     let info = &plant.inputs[i];
     let block = &plant.blocks[info.block].name;
     let name = info.path.strip_prefix(&format!("{block}.")).unwrap_or(&info.path);
-    plantwide_model::limits::check_input(name, info.dim, v)
+    plantwide_model::limits::check_input(name, info.dim, v).map_err(|e| e.to_string())
 }
 
 /// Read the flowsheet at `path` and apply `overrides`: inputs (validated like the file's values)
@@ -132,7 +132,7 @@ pub fn check_unit_inputs(plant: &Plant, u: &[f64]) -> Result<(), (String, String
         let section = if b.kind == crate::BlockKind::Unit { "units" } else { "controllers" };
         b.unit
             .check_inputs(&plant.thermo, &values)
-            .map_err(|(name, why)| (format!("{section}.{}.{name}", b.name), why))?;
+            .map_err(|e| (format!("{section}.{}.{}", b.name, e.input()), e.to_string()))?;
     }
     Ok(())
 }

@@ -231,7 +231,7 @@ fn plain_map<T: DeserializeOwned>(
 }
 
 /// The type names of a registry and its deserializer of one tagged description.
-type Registry<T> = (&'static [&'static str], fn(&str, &Value) -> Result<T, (String, String)>);
+type Registry<T> = (&'static [&'static str], fn(&str, &Value) -> Result<T, plantwide_model::SpecError>);
 
 fn tagged_map<T>(
     value: Option<&Value>,
@@ -266,7 +266,7 @@ fn tagged_map<T>(
                         Ok(spec) => {
                             out.insert(name.clone(), spec);
                         }
-                        Err((inner, msg)) => {
+                        Err(plantwide_model::SpecError { path: inner, message: msg }) => {
                             let path = if inner.is_empty() { path } else { format!("{path}.{inner}") };
                             diags.push(Diagnostic::new(path, explain(&msg)));
                         }

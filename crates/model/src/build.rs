@@ -6,18 +6,13 @@ use plantwide_thermo::ThermoPackage;
 use plantwide_units::{Dimension, QuantityValue};
 
 /// A problem with one field of the flowsheet file.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{path}: {message}")]
 pub struct FieldError {
     /// JSON path of the field (`units.feed.F`).
     pub path: String,
     /// What is wrong and what would fix it.
     pub message: String,
-}
-
-impl std::fmt::Display for FieldError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "{}: {}", self.path, self.message)
-    }
 }
 
 /// Context for building one unit: the flowsheet's components and thermodynamics, the JSON path of

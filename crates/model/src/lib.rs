@@ -9,8 +9,11 @@
 //! **Architecture Invariant:** a unit sees only its local read vector ([`UnitIo`]); global indices,
 //! other units and solvers never leak in. This crate knows nothing about files or solvers.
 
+#![warn(missing_docs)]
+
 pub mod build;
 pub mod controllers;
+pub mod error;
 pub mod limits;
 pub mod registry;
 pub mod stream;
@@ -20,6 +23,7 @@ pub mod units;
 pub mod var;
 
 pub use build::{BuildCx, FieldError};
+pub use error::{Error, InputError, SpecError};
 pub use registry::{ControllerSpec, UnitSpec};
 pub use stream::{Stream, StreamLayout};
 pub use unit::{Coloring, InputSpec, LocalLayout, Saturation, SignalSpec, Unit, UnitIo, UnitModel};

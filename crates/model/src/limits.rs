@@ -275,17 +275,57 @@ pub fn input_range(name: &str, dim: Dimension) -> (f64, f64) {
     }
 }
 
-/// Check an input value against [`input_range`]: `Err` says what is wrong and the range.
-pub fn check_input(name: &str, dim: Dimension, value: f64) -> Result<(), String> {
+/// An input value outside its physical range ([`check_input`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum RangeError {
+    /// The value is NaN or infinite.
+    #[error("{value} is not a finite number")]
+    NotFinite {
+        /// The input's name within its unit (`F`, `z[light]`).
+        name: String,
+        /// The value (SI).
+        value: f64,
+    },
+    /// The value is finite but outside [`input_range`].
+    #[error(
+        "{}{}{} is outside the range {} … {}{} in which the models hold",
+        negative_hint(*.value, *.lo), number(*.value), unit_suffix(*.dim), number(*.lo), number(*.hi), unit_suffix(*.dim)
+    )]
+    Outside {
+        /// The input's name within its unit.
+        name: String,
+        /// Its dimension.
+        dim: Dimension,
+        /// The value (SI).
+        value: f64,
+        /// Lower end of the range (SI).
+        lo: f64,
+        /// Upper end of the range (SI).
+        hi: f64,
+    },
+}
+
+/// `"must not be negative: "` for a negative value of a quantity whose range starts at zero.
+fn negative_hint(value: f64, lo: f64) -> &'static str {
+    if lo == 0.0 && value < 0.0 { "must not be negative: " } else { "" }
+}
+
+/// ` <SI unit>` after a number, nothing for a dimensionless one.
+fn unit_suffix(dim: Dimension) -> String {
+    if dim.is_dimensionless() { String::new() } else { format!(" {dim}") }
+}
+
+/// Check an input value against [`input_range`].
+///
+/// # Errors
+/// [`RangeError`] naming the input, its value and the range.
+pub fn check_input(name: &str, dim: Dimension, value: f64) -> Result<(), RangeError> {
     let (lo, hi) = input_range(name, dim);
     if !value.is_finite() {
-        return Err(format!("{value} is not a finite number"));
+        return Err(RangeError::NotFinite { name: name.to_string(), value });
     }
     if value < lo || value > hi {
-        let unit = if dim.is_dimensionless() { String::new() } else { format!(" {dim}") };
-        let what = if lo == 0.0 && value < 0.0 { "must not be negative: " } else { "" };
-        let (v, lo, hi) = (number(value), number(lo), number(hi));
-        return Err(format!("{what}{v}{unit} is outside the range {lo} … {hi}{unit} in which the models hold"));
+        return Err(RangeError::Outside { name: name.to_string(), dim, value, lo, hi });
     }
     Ok(())
 }
@@ -308,7 +348,9 @@ mod tests {
 
     #[test]
     fn inputs_outside_their_physical_range_are_named() {
-        assert!(check_input("F", Dimension::MOLAR_FLOW, -1.0).unwrap_err().contains("must not be negative"));
+        assert!(
+            check_input("F", Dimension::MOLAR_FLOW, -1.0).unwrap_err().to_string().contains("must not be negative")
+        );
         assert!(check_input("T", Dimension::TEMPERATURE, 1e-300).is_err());
         assert!(check_input("sp", Dimension::TEMPERATURE, -1e308).is_err());
         assert!(check_input("z[light]", Dimension::DIMENSIONLESS, 1.5).is_err());
@@ -316,6 +358,18 @@ mod tests {
         assert!(check_input("duty", Dimension::POWER, f64::NAN).is_err());
         assert!(check_input("duty", Dimension::POWER, -1e6).is_ok());
         assert!(check_input("P", Dimension::PRESSURE, 101_325.0).is_ok());
+        // The typed errors print the messages the loader and `--set` always printed.
+        let e = check_input("F", Dimension::MOLAR_FLOW, -1.0).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "must not be negative: -1 mol/s is outside the range 0 … 1e6 mol/s in which the models hold"
+        );
+        let e = check_input("z[light]", Dimension::DIMENSIONLESS, 1.5).unwrap_err();
+        assert_eq!(e.to_string(), "1.5 is outside the range 0 … 1 in which the models hold");
+        assert_eq!(
+            check_input("T", Dimension::TEMPERATURE, f64::NAN).unwrap_err().to_string(),
+            "NaN is not a finite number"
+        );
     }
 
     #[test]

@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::controllers::{self, ControllerConfig, ControllerLinks};
 use crate::units;
-use crate::{BuildCx, FieldError, Unit};
+use crate::{BuildCx, FieldError, SpecError, Unit};
 
 /// What every unit description offers (nothing beyond `Debug` for now).
 pub trait UnitConfig: std::fmt::Debug {}
@@ -41,20 +41,23 @@ macro_rules! registry {
             }
 
             /// Deserialize the description of `"type": tag` from `value` (the `type` key is
-            /// ignored); on failure, the JSON path below `value` of the first problem and its
-            /// message (serde's internally tagged enums lose that path).
-            pub fn from_tagged(tag: &str, value: &serde_json::Value) -> Result<Self, (String, String)> {
+            /// ignored).
+            ///
+            /// # Errors
+            /// [`SpecError`]: the JSON path below `value` of the first problem and its message
+            /// (serde's internally tagged enums lose that path).
+            pub fn from_tagged(tag: &str, value: &serde_json::Value) -> Result<Self, SpecError> {
                 let mut body = value.clone();
                 if let Some(o) = body.as_object_mut() {
                     o.remove("type");
                 }
                 let path_error = |e: serde_path_to_error::Error<serde_json::Error>| {
                     let path = e.path().to_string();
-                    (if path == "." { String::new() } else { path }, e.into_inner().to_string())
+                    SpecError { path: if path == "." { String::new() } else { path }, message: e.into_inner().to_string() }
                 };
                 match tag {
                     $($tag => serde_path_to_error::deserialize::<_, $cfg>(&body).map($name::$variant).map_err(path_error),)*
-                    _ => Err(("type".into(), format!("unknown type `{tag}`"))),
+                    _ => Err(SpecError { path: "type".into(), message: format!("unknown type `{tag}`") }),
                 }
             }
 

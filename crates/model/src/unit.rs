@@ -18,7 +18,7 @@ use num_dual::Dual64;
 use plantwide_thermo::ThermoPackage;
 use plantwide_units::Dimension;
 
-use crate::{Scalar, Stream, StreamLayout, VarSpec};
+use crate::{InputError, Scalar, Stream, StreamLayout, VarSpec};
 
 /// A manipulable input declared by a unit.
 #[derive(Debug, Clone, PartialEq)]
@@ -194,9 +194,12 @@ pub trait UnitModel: Send + Sync + std::fmt::Debug {
         None
     }
     /// Check the unit's input values (SI, in [`UnitModel::inputs`] order) for what only the unit
-    /// knows, beyond each value's physical range: `Err((input name, why))`. Run on the file's values
-    /// and after `--set` (default: nothing to check).
-    fn check_inputs(&self, _thermo: &ThermoPackage, _inputs: &[f64]) -> Result<(), (String, String)> {
+    /// knows, beyond each value's physical range. Run on the file's values and after `--set`
+    /// (default: nothing to check).
+    ///
+    /// # Errors
+    /// [`InputError`] naming the input and why its value is refused.
+    fn check_inputs(&self, _thermo: &ThermoPackage, _inputs: &[f64]) -> Result<(), InputError> {
         Ok(())
     }
     /// This controller with its output limits removed, if it has any (default: none). A clamped
@@ -254,7 +257,7 @@ pub trait Unit: Send + Sync + std::fmt::Debug {
     /// See [`UnitModel::saturation`].
     fn saturation(&self, io: &UnitIo<'_, f64>) -> Option<Saturation>;
     /// See [`UnitModel::check_inputs`].
-    fn check_inputs(&self, thermo: &ThermoPackage, inputs: &[f64]) -> Result<(), (String, String)>;
+    fn check_inputs(&self, thermo: &ThermoPackage, inputs: &[f64]) -> Result<(), InputError>;
 }
 
 /// A controller output held at a limit with the measurement off its setpoint.
@@ -278,7 +281,7 @@ impl<U: UnitModel + 'static> Unit for U {
     fn saturation(&self, io: &UnitIo<'_, f64>) -> Option<Saturation> {
         UnitModel::saturation(self, io)
     }
-    fn check_inputs(&self, thermo: &ThermoPackage, inputs: &[f64]) -> Result<(), (String, String)> {
+    fn check_inputs(&self, thermo: &ThermoPackage, inputs: &[f64]) -> Result<(), InputError> {
         UnitModel::check_inputs(self, thermo, inputs)
     }
     fn inlet_ports(&self) -> Vec<String> {

@@ -83,14 +83,89 @@ pub enum TuneError {
     /// Averaging-level settings cannot be computed.
     #[error(transparent)]
     Averaging(#[from] crate::tune::averaging::AveragingError),
-    /// A numerical search failed.
-    #[error("{0}")]
-    Numerical(String),
+    /// A relay test on an element with more leads than lags (an improper transfer function).
+    #[error("relay test: no limit cycle: the element has {leads} leads and {lags} lags (improper)")]
+    ImproperElement {
+        /// Number of leads.
+        leads: usize,
+        /// Number of lags.
+        lags: usize,
+    },
+    /// BLT: no detuning factor up to the largest allowed brings the biggest log modulus down to
+    /// its target.
+    #[error(
+        "BLT: the biggest log modulus stays above {target_db} dB up to F = {detuning}: the loops interact too \
+         strongly for one detuning factor (check the pairing)"
+    )]
+    DetuningLimit {
+        /// The target of the biggest log modulus [dB].
+        target_db: f64,
+        /// The largest detuning factor tried (at least `max_detuning`).
+        detuning: f64,
+    },
+    /// The singular values of `G(0)` could not be computed.
+    #[error("SVD of G(0): {detail}")]
+    Svd {
+        /// What the linear-algebra library reported.
+        detail: String,
+    },
+    /// The plant's linear model could not be formed or analysed (eigenvalues, steady gain).
+    #[error("linear model of the loops: {0}")]
+    Linear(#[from] Box<plantwide_analysis::AnalysisError>),
+    /// The loop's element has no usable dynamics to size a test by.
+    #[error(
+        "`{controller}`: its element's mean residence time is {value} s (no dynamics between its output and its \
+         measurement?); give --scan"
+    )]
+    ResidenceTime {
+        /// Controller.
+        controller: String,
+        /// The value found.
+        value: f64,
+    },
+    /// The loop's linear model has no state.
+    #[error("`{controller}`: no dynamics between its output and its measurement (the linear model has no state)")]
+    NoDynamics {
+        /// Controller.
+        controller: String,
+    },
+    /// The plant could not be integrated during a test.
+    #[error(transparent)]
+    Simulation(Box<plantwide_solve::dynamic::SimError>),
+    /// A relay test found no usable cycle.
+    #[error("relay test of `{controller}`: {source}")]
+    Relay {
+        /// Controller.
+        controller: String,
+        /// Why.
+        source: Box<crate::tune::bench::RelayError<plantwide_solve::dynamic::SimError>>,
+    },
+    /// A test amplitude of zero (the output's steady value is zero).
+    #[error("`{controller}`: the test amplitude is {amplitude} (5 % of an output at zero); give --relay-amplitude or --step")]
+    RelayAmplitude {
+        /// Controller.
+        controller: String,
+        /// The amplitude.
+        amplitude: f64,
+    },
+    /// The step record determines no model.
+    #[error(transparent)]
+    Fit(#[from] crate::tune::fit::FitError),
+    /// A model-based rule cannot be applied.
+    #[error(transparent)]
+    Rule(#[from] crate::tune::rules::RuleError),
 }
 
 impl TuneError {
     /// True for problems of the request (exit code 1), false for numerical failures (exit code 2).
     pub fn is_user_error(&self) -> bool {
-        !matches!(self, TuneError::Numerical(_))
+        !matches!(
+            self,
+            TuneError::DetuningLimit { .. }
+                | TuneError::Svd { .. }
+                | TuneError::Linear(_)
+                | TuneError::Simulation(_)
+                | TuneError::ResidenceTime { .. }
+        )
     }
 }

@@ -11,3 +11,5 @@ mod numeric;
 pub mod tune;
 
 pub use error::TuneError;
+/// The crate-level error: every public fallible function of this crate returns a [`TuneError`].
+pub use error::TuneError as Error;

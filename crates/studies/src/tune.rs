@@ -18,6 +18,7 @@ pub mod blt;
 pub mod fit;
 pub mod flowsheet;
 pub mod loops;
+pub mod plant_tests;
 pub mod relay;
 pub mod rules;
 pub mod ultimate;

@@ -56,15 +56,47 @@ pub struct Component {
 #[serde(tag = "form", rename_all = "snake_case", deny_unknown_fields)]
 pub enum VapourPressure {
     /// DIPPR 101: `ln P = c[0] + c[1]/T + c[2] ln T + c[3] T^c[4]`, P in Pa.
-    Dippr101 { c: [f64; 5], tmin: f64, tmax: f64 },
+    Dippr101 {
+        /// Coefficients `c[0] … c[4]` (P in Pa, T in K).
+        c: [f64; 5],
+        /// Lowest temperature of the data [K].
+        tmin: f64,
+        /// Highest temperature of the data [K].
+        tmax: f64,
+    },
     /// Extended Antoine (Aspen PLXANT form): `ln P = c[0] + c[1]/(T + c[2]) + c[3] T + c[4] ln T + c[5] T^c[6]`, P in Pa.
-    ExtendedAntoine { c: [f64; 7], tmin: f64, tmax: f64 },
+    ExtendedAntoine {
+        /// Coefficients `c[0] … c[6]` (P in Pa, T in K).
+        c: [f64; 7],
+        /// Lowest temperature of the data [K].
+        tmin: f64,
+        /// Highest temperature of the data [K].
+        tmax: f64,
+    },
     /// Classic Antoine: `log10 P = a − b/(T + c)`, P in Pa, T in K.
-    Antoine { a: f64, b: f64, c: f64, tmin: f64, tmax: f64 },
+    Antoine {
+        /// Constant term (log10 of Pa).
+        a: f64,
+        /// Slope [K].
+        b: f64,
+        /// Temperature offset [K].
+        c: f64,
+        /// Lowest temperature of the data [K].
+        tmin: f64,
+        /// Highest temperature of the data [K].
+        tmax: f64,
+    },
     /// Clausius–Clapeyron with constant heat of vaporization, for hypothetical components:
     /// `P = p_ref · exp(−hvap/R · (1/T − 1/t_ref))`. Components sharing `hvap` and `t_ref` have a
     /// constant relative volatility equal to the ratio of their `p_ref`.
-    ClausiusClapeyron { p_ref: f64, t_ref: f64, hvap: f64 },
+    ClausiusClapeyron {
+        /// Vapour pressure at `t_ref` [Pa].
+        p_ref: f64,
+        /// Reference temperature [K].
+        t_ref: f64,
+        /// Heat of vaporization [J/mol].
+        hvap: f64,
+    },
 }
 
 impl VapourPressure {
@@ -86,11 +118,20 @@ impl VapourPressure {
 #[serde(tag = "form", rename_all = "snake_case", deny_unknown_fields)]
 pub enum CpIdealGas {
     /// DIPPR 107 (Aly–Lee): `cp = c[0] + c[1]·((c[2]/T)/sinh(c[2]/T))² + c[3]·((c[4]/T)/cosh(c[4]/T))²`, J/(mol·K).
-    Dippr107 { c: [f64; 5] },
+    Dippr107 {
+        /// Coefficients `c[0] … c[4]` (cp in J/(mol·K), `c[2]`, `c[4]` in K).
+        c: [f64; 5],
+    },
     /// Polynomial `cp = c[0] + c[1] T + c[2] T² + c[3] T³`, J/(mol·K).
-    Polynomial { c: [f64; 4] },
+    Polynomial {
+        /// Coefficients `c[0] … c[3]` (cp in J/(mol·K), T in K).
+        c: [f64; 4],
+    },
     /// Constant, J/(mol·K).
-    Constant { cp: f64 },
+    Constant {
+        /// Heat capacity [J/(mol·K)].
+        cp: f64,
+    },
 }
 
 /// Liquid heat capacity [J/(mol·K)].
@@ -98,9 +139,15 @@ pub enum CpIdealGas {
 #[serde(tag = "form", rename_all = "snake_case", deny_unknown_fields)]
 pub enum CpLiquid {
     /// DIPPR 100: `cp = c[0] + c[1] T + c[2] T² + c[3] T³ + c[4] T⁴`, J/(mol·K).
-    Dippr100 { c: [f64; 5] },
+    Dippr100 {
+        /// Coefficients `c[0] … c[4]` (cp in J/(mol·K), T in K).
+        c: [f64; 5],
+    },
     /// Constant, J/(mol·K).
-    Constant { cp: f64 },
+    Constant {
+        /// Heat capacity [J/(mol·K)].
+        cp: f64,
+    },
 }
 
 /// Heat of vaporization `ΔH_vap(T)` [J/mol].
@@ -108,11 +155,28 @@ pub enum CpLiquid {
 #[serde(tag = "form", rename_all = "snake_case", deny_unknown_fields)]
 pub enum HeatOfVaporization {
     /// Watson: `ΔH = h_ref · ((tc − T)/(tc − t_ref))^n`, usually `n = 0.38` and `t_ref = tb`; 0 above tc.
-    Watson { h_ref: f64, t_ref: f64, tc: f64, n: f64 },
+    Watson {
+        /// Heat of vaporization at `t_ref` [J/mol].
+        h_ref: f64,
+        /// Reference temperature [K], usually the normal boiling point.
+        t_ref: f64,
+        /// Critical temperature [K].
+        tc: f64,
+        /// Watson exponent [-], usually 0.38.
+        n: f64,
+    },
     /// DIPPR 106: `ΔH = c[0] (1 − Tr)^(c[1] + c[2] Tr + c[3] Tr² + c[4] Tr³)`, `Tr = T/tc`, J/mol.
-    Dippr106 { c: [f64; 5], tc: f64 },
+    Dippr106 {
+        /// Coefficients `c[0]` [J/mol] and `c[1] … c[4]` [-].
+        c: [f64; 5],
+        /// Critical temperature [K].
+        tc: f64,
+    },
     /// Constant, J/mol (hypothetical components).
-    Constant { h: f64 },
+    Constant {
+        /// Heat of vaporization [J/mol].
+        h: f64,
+    },
 }
 
 /// Liquid molar volume [m³/mol].
@@ -120,11 +184,24 @@ pub enum HeatOfVaporization {
 #[serde(tag = "form", rename_all = "snake_case", deny_unknown_fields)]
 pub enum LiquidVolume {
     /// DIPPR 105 density: `ρ = c[0] / c[1]^(1 + (1 − T/c[2])^c[3])` in mol/m³; volume = 1/ρ.
-    Dippr105 { c: [f64; 4] },
+    Dippr105 {
+        /// Coefficients: `c[0]` [mol/m³], `c[1]` [-], `c[2]` [K], `c[3]` [-].
+        c: [f64; 4],
+    },
     /// Rackett: `V = (R tc / pc) · zra^(1 + (1 − T/tc)^(2/7))`.
-    Rackett { tc: f64, pc: f64, zra: f64 },
+    Rackett {
+        /// Critical temperature [K].
+        tc: f64,
+        /// Critical pressure [Pa].
+        pc: f64,
+        /// Rackett compressibility factor [-].
+        zra: f64,
+    },
     /// Constant, m³/mol.
-    Constant { v: f64 },
+    Constant {
+        /// Molar volume [m³/mol].
+        v: f64,
+    },
 }
 
 impl Component {

@@ -11,6 +11,8 @@
 //!
 //! **Architecture Invariant:** this crate depends on no other plantwide crate.
 
+#![warn(missing_docs)]
+
 pub mod component;
 mod correlations;
 pub mod equilibrium;
@@ -26,6 +28,8 @@ mod solve1d;
 
 pub use component::{Component, CpIdealGas, CpLiquid, HeatOfVaporization, LiquidVolume, VapourPressure};
 pub use error::ThermoError;
+/// The crate-level error: every public fallible function of this crate returns a [`ThermoError`].
+pub use error::ThermoError as Error;
 pub use flash::{FlashResult, PhaseState, SaturationPoint};
 pub use library::{BinaryPair, Library};
 pub use package::ThermoPackage;

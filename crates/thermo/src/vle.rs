@@ -29,10 +29,22 @@ pub enum VleModel {
 pub enum ActivityModel {
     /// NRTL (Renon & Prausnitz 1968): `τ_ij = a_ij + b_ij/T`, `G_ij = exp(−α_ij τ_ij)`,
     /// `ln γ_i = Σ_j τ_ji G_ji x_j / Σ_k G_ki x_k + Σ_j x_j G_ij/Σ_k G_kj x_k · (τ_ij − Σ_m x_m τ_mj G_mj / Σ_k G_kj x_k)`.
-    Nrtl { a: Vec<Vec<f64>>, b: Vec<Vec<f64>>, alpha: Vec<Vec<f64>> },
+    Nrtl {
+        /// `a_ij` [-].
+        a: Vec<Vec<f64>>,
+        /// `b_ij` [K].
+        b: Vec<Vec<f64>>,
+        /// Non-randomness `α_ij` [-].
+        alpha: Vec<Vec<f64>>,
+    },
     /// Wilson (1964): `ln Λ_ij = a_ij + b_ij/T`,
     /// `ln γ_i = 1 − ln(Σ_j x_j Λ_ij) − Σ_k x_k Λ_ki / Σ_j x_j Λ_kj`.
-    Wilson { a: Vec<Vec<f64>>, b: Vec<Vec<f64>> },
+    Wilson {
+        /// `a_ij` [-].
+        a: Vec<Vec<f64>>,
+        /// `b_ij` [K].
+        b: Vec<Vec<f64>>,
+    },
 }
 
 impl ActivityModel {

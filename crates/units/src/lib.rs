@@ -59,6 +59,8 @@ mod value;
 
 pub use dimension::Dimension;
 pub use error::UnitError;
+/// The crate-level error: every public fallible function of this crate returns a [`UnitError`].
+pub use error::UnitError as Error;
 pub use named::{NamedDimension, named_dimensions};
 pub use quantity::{
     Quantity, convert_from_si, convert_to_si, parse_difference, parse_difference_as, parse_quantity, parse_quantity_as,

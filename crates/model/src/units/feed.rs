@@ -17,7 +17,7 @@ use plantwide_thermo::ThermoPackage;
 
 use super::Phase;
 use crate::stream::{F, H, P, T, Z0};
-use crate::{BuildCx, FieldError, InputSpec, Scalar, UnitIo, UnitModel};
+use crate::{BuildCx, FieldError, InputError, InputSpec, Scalar, UnitIo, UnitModel};
 
 /// Thermal condition of a feed.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
@@ -122,23 +122,26 @@ impl UnitModel for Feed {
     /// lowest temperature of a present component's correlation (its triple-point region) there is
     /// no liquid, and the bubble point would be an extrapolation (a feed at 1.3 Pa instead of
     /// 1.3 atm).
-    fn check_inputs(&self, thermo: &ThermoPackage, inputs: &[f64]) -> Result<(), (String, String)> {
+    fn check_inputs(&self, thermo: &ThermoPackage, inputs: &[f64]) -> Result<(), InputError> {
         if self.has_t_input() {
             return Ok(());
         }
         let p = inputs[1];
         let mut z: Vec<f64> = inputs[2..].to_vec();
         z.push(1.0 - z.iter().sum::<f64>());
-        let t = thermo.bubble_t(p, &z).map_err(|e| ("P".to_string(), format!("no bubble point at {p} Pa: {e}")))?.t;
+        let t = thermo
+            .bubble_t(p, &z)
+            .map_err(|source| InputError::NoBubblePoint { input: "P".into(), pressure: p, source })?
+            .t;
         for (c, _) in thermo.components.iter().zip(&z).filter(|(_, zi)| **zi > 0.0) {
             if let Some(t_min) = c.psat.t_min().filter(|&t_min| t < t_min) {
-                return Err((
-                    "P".into(),
-                    format!(
-                        "at {p} Pa this saturated liquid would boil at {t:.1} K, below {t_min:.1} K where the vapour-pressure data of {} begin (no liquid exists there): raise the pressure",
-                        c.name
-                    ),
-                ));
+                return Err(InputError::BelowVapourPressureData {
+                    input: "P".into(),
+                    pressure: p,
+                    bubble_t: t,
+                    t_min,
+                    component: c.name.clone(),
+                });
             }
         }
         Ok(())

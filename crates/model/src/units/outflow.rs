@@ -100,10 +100,24 @@ pub enum Outflow {
 /// A built outflow law (SI).
 #[derive(Debug, Clone, PartialEq)]
 pub enum OutflowLaw {
-    /// See [`Outflow::Valve`]; `cv` [m²], `p_out` [Pa].
-    Valve { cv: f64, characteristic: Characteristic, rangeability: f64, opening: f64, p_out: f64 },
-    /// See [`Outflow::Flow`]; `flow` [mol/s].
-    Flow { flow: f64 },
+    /// See [`Outflow::Valve`].
+    Valve {
+        /// SI valve coefficient [m²].
+        cv: f64,
+        /// Valve characteristic.
+        characteristic: Characteristic,
+        /// Rangeability `R` [-] of an equal-percentage valve.
+        rangeability: f64,
+        /// Opening [-], 0 … 1 (the initial value of input `opening`).
+        opening: f64,
+        /// Downstream pressure [Pa].
+        p_out: f64,
+    },
+    /// See [`Outflow::Flow`].
+    Flow {
+        /// Molar outflow [mol/s] (the initial value of input `outflow`).
+        flow: f64,
+    },
     /// See [`Outflow::Free`].
     Free,
 }

@@ -91,7 +91,7 @@ pub fn max_log_modulus(
 /// below the target. The peak is sought over `[omega_range.0 / F, omega_range.1]` \[rad/s\].
 ///
 /// # Errors
-/// [`TuneError::Numerical`] when even F = `max_detuning` leaves the peak above the target.
+/// [`TuneError::DetuningLimit`] when even F = `max_detuning` leaves the peak above the target.
 pub fn blt_detuning(
     g: &dyn Fn(f64) -> Mat<c64>,
     zn: &[(f64, f64)],
@@ -112,10 +112,7 @@ pub fn blt_detuning(
     let (mut f_lo, mut f_hi) = (1.0, 2.0);
     while peak(f_hi).1 > target_db {
         if f_hi >= settings.max_detuning {
-            return Err(TuneError::Numerical(format!(
-                "BLT: the biggest log modulus stays above {target_db} dB up to F = {f_hi}: the loops interact too \
-                 strongly for one detuning factor (check the pairing)"
-            )));
+            return Err(TuneError::DetuningLimit { target_db, detuning: f_hi });
         }
         (f_lo, f_hi) = (f_hi, 2.0 * f_hi);
     }
@@ -146,7 +143,7 @@ pub struct LoopSystem<'a> {
 /// # Errors
 /// [`TuneError::NotSquare`], [`TuneError::SingularGain`] (σ_min/σ_max of `G(0)` below 1e-10),
 /// [`TuneError::NoPhaseCrossover`] naming a diagonal element without an ultimate gain,
-/// [`TuneError::Numerical`] from [`blt_detuning`].
+/// [`TuneError::Svd`] when the SVD of `G(0)` fails, [`TuneError::DetuningLimit`] from [`blt_detuning`].
 pub fn blt(model: &TfModel, settings: &BltSettings) -> Result<Tuning, TuneError> {
     let ultimates: Vec<Ultimate> = diagonal_ultimates(model)?;
     let g = |w: f64| model.response(w);
@@ -164,13 +161,13 @@ pub fn blt(model: &TfModel, settings: &BltSettings) -> Result<Tuning, TuneError>
 /// Luyben's BLT tuning of a [`LoopSystem`].
 ///
 /// # Errors
-/// [`TuneError::NotSquare`], [`TuneError::SingularGain`], [`TuneError::Numerical`] as [`blt`].
+/// [`TuneError::NotSquare`], [`TuneError::SingularGain`], [`TuneError::Svd`], [`TuneError::DetuningLimit`] as [`blt`].
 pub fn blt_system(system: &LoopSystem<'_>, settings: &BltSettings) -> Result<Tuning, TuneError> {
     let n = system.outputs.len();
     if n != system.inputs.len() || system.ultimates.len() != n {
         return Err(TuneError::NotSquare { model: system.name.clone(), n_outputs: n, n_inputs: system.inputs.len() });
     }
-    let sv = system.gain.singular_values().map_err(|e| TuneError::Numerical(format!("SVD of G(0): {e:?}")))?;
+    let sv = system.gain.singular_values().map_err(|e| TuneError::Svd { detail: format!("{e:?}") })?;
     let (s_max, s_min) = (sv.iter().cloned().fold(0.0, f64::max), sv.iter().cloned().fold(f64::INFINITY, f64::min));
     let ratio = if s_max > 0.0 { s_min / s_max } else { 0.0 };
     if ratio.is_nan() || ratio < 1e-10 {

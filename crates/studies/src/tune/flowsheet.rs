@@ -14,9 +14,14 @@ use plantwide_model::controllers::Action;
 use plantwide_units::{QuantityValue, convert_from_si};
 use serde::Serialize;
 
+use super::PiRule;
 use super::averaging::{AveragingForm, AveragingSettings, averaging};
+use super::bench::RelayCycle;
+use super::fit::ModelFit;
+use super::rules::{ModelRule, model_rule};
+use super::ultimate::Ultimate;
 use super::blt::BltSettings;
-use super::loops::{LoopResponse, Measurement, PlantLoop, in_manual, loop_model, plant_blt};
+use super::loops::{LoopResponse, Measurement, PlantLoop, loop_model, plant_blt};
 use crate::TuneError;
 
 /// The tuning of one loop of a flowsheet.
@@ -50,6 +55,18 @@ pub struct FlowsheetLoop {
     /// Averaging-level details.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub averaging: Option<AveragingSettings>,
+    /// The relay cycle the settings come from.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub relay: Option<RelayCycle>,
+    /// The model fitted to the step test, and its fit.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fit: Option<ModelFit>,
+    /// Whether the step response settled within the test (an unsettled fit is extrapolated).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub settled: Option<bool>,
+    /// SIMC's τc or IMC's λ used \[s or the time unit asked for\].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tau_c: Option<f64>,
 }
 
 /// The tuning of a set of loops of a flowsheet.
@@ -72,6 +89,13 @@ impl FlowsheetTuning {
             l.pu = l.pu.map(|p| p / seconds);
             l.tau_i = l.tau_i.map(|t| t / seconds);
             l.tau_d = l.tau_d.map(|t| t / seconds);
+            l.tau_c = l.tau_c.map(|t| t / seconds);
+            if let Some(r) = &mut l.relay {
+                r.pu /= seconds;
+            }
+            if let Some(f) = &mut l.fit {
+                f.model = f.model.in_time_unit(seconds);
+            }
             if let Some(a) = &mut l.averaging {
                 a.time /= seconds;
                 a.tau_i = a.tau_i.map(|t| t / seconds);
@@ -103,6 +127,10 @@ fn entry(l: &PlantLoop, kc: f64, tau_i: Option<f64>, tau_d: Option<f64>) -> Flow
         action: action_name(needed),
         file_action: (needed != l.action).then(|| action_name(l.action)),
         averaging: None,
+        relay: None,
+        fit: None,
+        settled: None,
+        tau_c: None,
     }
 }
 
@@ -134,7 +162,7 @@ pub fn blt_loops(
 /// [`TuneError::NotIntegrating`] when the element has a finite steady-state gain.
 pub fn integrating_gain(plant: &Plant, x: &[f64], l: &PlantLoop) -> Result<f64, TuneError> {
     let model = loop_model(plant, x, std::slice::from_ref(l))?;
-    let ev = model.ss.eigenvalues().map_err(|e| TuneError::Numerical(e.to_string()))?;
+    let ev = model.ss.eigenvalues().map_err(|e| TuneError::Linear(Box::new(e)))?;
     let scale = ev.iter().map(|v| v.norm()).fold(0.0, f64::max);
     let slow = ev.iter().map(|v| v.norm()).filter(|m| *m > 1e-10 * scale).fold(f64::INFINITY, f64::min);
     let w = 1e-6 * slow;
@@ -170,9 +198,39 @@ pub fn averaging_loop(
     Ok(FlowsheetTuning { method: "averaging", detuning_factor: None, loops: vec![e] })
 }
 
-/// The steady state `x` with every loop of `loops` in manual (for tests that move their outputs).
-pub fn manual_plant(plant: &Plant, x: &[f64], loops: &[PlantLoop]) -> Plant {
-    in_manual(plant, x, loops)
+/// Ziegler–Nichols or Tyreus–Luyben PI settings of loop `l` from its relay `cycle`; `method`
+/// names the result (`relay`, `zn`, `tl`).
+pub fn from_relay(l: &PlantLoop, cycle: &RelayCycle, rule: PiRule, method: &'static str) -> FlowsheetTuning {
+    let ultimate = Ultimate { ku: cycle.ku, omega_u: 2.0 * std::f64::consts::PI / cycle.pu, pu: cycle.pu };
+    let (kc, tau_i) = rule.settings(&ultimate);
+    let e = FlowsheetLoop { ku: Some(cycle.ku), pu: Some(cycle.pu), relay: Some(cycle.clone()), ..entry(l, kc, Some(tau_i), None) };
+    FlowsheetTuning { method, detuning_factor: None, loops: vec![e] }
+}
+
+/// SIMC or IMC settings of loop `l` from the model fitted to its step test.
+///
+/// # Errors
+/// [`TuneError::Rule`] for a degenerate model.
+pub fn from_step(
+    l: &PlantLoop,
+    fit: ModelFit,
+    settled: bool,
+    rule: ModelRule,
+    tau_c: Option<f64>,
+    derivative: bool,
+) -> Result<FlowsheetTuning, TuneError> {
+    let p = model_rule(rule, &fit.model, tau_c, derivative)?;
+    let e = FlowsheetLoop {
+        fit: Some(fit),
+        settled: Some(settled),
+        tau_c: Some(p.tau_c),
+        ..entry(l, p.kc, Some(p.tau_i), p.tau_d)
+    };
+    let method = match rule {
+        ModelRule::Simc => "simc",
+        ModelRule::Imc => "imc",
+    };
+    Ok(FlowsheetTuning { method, detuning_factor: None, loops: vec![e] })
 }
 
 /// Field edits writing `tuning` into the flowsheet text of `plant`: `kc` as the magnitude, and

@@ -91,14 +91,13 @@ pub struct LoopModel {
 /// The [`LoopModel`] of `loops` at the steady state `x` of `plant`.
 ///
 /// # Errors
-/// [`TuneError::Numerical`] when the linearization cannot be reduced to a state-space model.
+/// [`TuneError::Linear`] when the linearization cannot be reduced to a state-space model.
 pub fn loop_model(plant: &Plant, x: &[f64], loops: &[PlantLoop]) -> Result<LoopModel, TuneError> {
     let manual = in_manual(plant, x, loops);
     let lin = Linearization::new(&manual, x, &manual.input_values());
     let inputs: Vec<usize> = loops.iter().map(|l| l.op_manual).collect();
     let outputs: Vec<usize> = loops.iter().map(|l| l.pv).collect();
-    let numerical =
-        |e: plantwide_analysis::AnalysisError| TuneError::Numerical(format!("linear model of the loops: {e}"));
+    let numerical = |e: plantwide_analysis::AnalysisError| TuneError::Linear(Box::new(e));
     let ss = lin.state_space(&inputs, &outputs).map_err(numerical)?;
     Ok(LoopModel { response: HessenbergResponse::new(&ss), ss })
 }
@@ -151,13 +150,13 @@ impl LoopResponse {
 
 /// The frequency range in which a state-space model's phase crossovers lie: three decades
 /// below its slowest and above its fastest eigenvalue \[rad/s\].
-fn frequency_range(ss: &StateSpace) -> Result<(f64, f64), TuneError> {
-    let ev = ss.eigenvalues().map_err(|e| TuneError::Numerical(e.to_string()))?;
+fn frequency_range(ss: &StateSpace, loops: &[PlantLoop]) -> Result<(f64, f64), TuneError> {
+    let ev = ss.eigenvalues().map_err(|e| TuneError::Linear(Box::new(e)))?;
     let mags: Vec<f64> = ev.iter().map(|l| l.norm()).filter(|m| *m > 0.0 && m.is_finite()).collect();
     let lo = mags.iter().cloned().fold(f64::INFINITY, f64::min);
     let hi = mags.iter().cloned().fold(0.0, f64::max);
     if mags.is_empty() {
-        return Err(TuneError::Numerical("the loops' linear model has no dynamics (no state)".into()));
+        return Err(TuneError::NoDynamics { controller: loops.iter().map(|l| l.name.as_str()).collect::<Vec<_>>().join(", ") });
     }
     Ok((1e-3 * lo, 1e3 * hi))
 }
@@ -168,7 +167,7 @@ fn frequency_range(ss: &StateSpace) -> Result<(f64, f64), TuneError> {
 /// # Errors
 /// [`TuneError::NoPhaseCrossover`] naming a loop whose element never reaches −180°.
 pub fn loop_ultimates(response: &LoopResponse, loops: &[PlantLoop]) -> Result<Vec<Ultimate>, TuneError> {
-    let (lo, mut hi) = frequency_range(&response.model.ss)?;
+    let (lo, mut hi) = frequency_range(&response.model.ss, loops)?;
     let m = response.measurement;
     if m.dead_time > 0.0 {
         hi = hi.min(1e3 / m.dead_time);
@@ -201,7 +200,7 @@ pub fn plant_blt(
     settings: &BltSettings,
 ) -> Result<Tuning, TuneError> {
     let model = loop_model(plant, x, loops)?;
-    let gain = model.ss.steady_gain().map_err(|e| TuneError::Numerical(e.to_string()))?;
+    let gain = model.ss.steady_gain().map_err(|e| TuneError::Linear(Box::new(e)))?;
     let response = LoopResponse::new(model, measurement);
     let ultimates = loop_ultimates(&response, loops)?;
     let g = |w: f64| -> Mat<c64> { response.at(w) };

@@ -59,9 +59,9 @@ pub struct RelayReport {
 }
 
 /// The element as a chain of sections `(τ_lag, r)`: `w = r v + (1 − r) x`, `τ_lag ẋ = v − x`.
-fn sections(e: &Element) -> Result<Vec<(f64, f64)>, String> {
+fn sections(e: &Element) -> Result<Vec<(f64, f64)>, TuneError> {
     if e.leads.len() > e.lags.len() {
-        return Err(format!("has {} leads and {} lags (improper)", e.leads.len(), e.lags.len()));
+        return Err(TuneError::ImproperElement { leads: e.leads.len(), lags: e.lags.len() });
     }
     Ok(e.lags.iter().enumerate().map(|(k, &t)| (t, e.leads.get(k).map_or(0.0, |l| l / t))).collect())
 }
@@ -95,10 +95,11 @@ fn rk4(sec: &[(f64, f64)], x: &[f64], v: f64, h: f64) -> Vec<f64> {
 ///
 /// # Errors
 /// [`TuneError::NoCycle`] when the loop does not settle into a cycle (no phase crossover: a lag
-/// of order ≤ 2 without dead time chatters at the step size), or the element is improper.
+/// of order ≤ 2 without dead time chatters at the step size), [`TuneError::ImproperElement`]
+/// when the element has more leads than lags.
 pub fn relay_test(e: &Element, settings: &RelaySettings) -> Result<RelayReport, TuneError> {
     let no_cycle = |why: String| TuneError::NoCycle { why };
-    let sec = sections(e).map_err(|w| no_cycle(format!("the element {w}")))?;
+    let sec = sections(e)?;
     let fastest =
         e.lags.iter().map(|t| t.abs()).chain([e.dead_time]).filter(|t| *t > 0.0).fold(f64::INFINITY, f64::min);
     if !fastest.is_finite() || e.gain == 0.0 {
