@@ -1,7 +1,7 @@
 //! From a parsed [`FlowsheetSpec`] to an assembled [`Plant`], checking everything that needs more
 //! than the file's structure: components, ports and connections, controller paths, quantities.
 //!
-//! Assembly runs in phases, each of which adds to one [`Assembler`] and records what it finds wrong;
+//! Assembly runs in phases, each of which adds to one `Assembler` and records what it finds wrong;
 //! a phase whose successors need its results whole stops the assembly when anything was found:
 //! 1. the components and the thermodynamic package;
 //! 2. names (lengths, characters, one name space for units and controllers, no stream named alike);
