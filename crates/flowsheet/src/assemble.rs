@@ -1,18 +1,36 @@
 //! From a parsed [`FlowsheetSpec`] to an assembled [`Plant`], checking everything that needs more
 //! than the file's structure: components, ports and connections, controller paths, quantities.
+//!
+//! Assembly runs in phases, each of which adds to one `Assembler` and records what it finds wrong;
+//! a phase whose successors need its results whole stops the assembly when anything was found:
+//! 1. the components and the thermodynamic package;
+//! 2. names (lengths, characters, one name space for units and controllers, no stream named alike);
+//! 3. unit models, built from their descriptions;
+//! 4. streams: each end resolved to a port, every port connected exactly once;
+//! 5. unit blocks, in file order: each owns its outlet streams' variables, then its internal ones;
+//! 6. controllers: measured variables and driven inputs resolved, then built (after the units, in
+//!    file order) with the dimensions found, and their outputs wired to the inputs they drive;
+//! 7. input aliases, input values within range, the size of the plant;
+//! 8. every block's reads (inlet streams, inputs or the controller outputs driving them, signals)
+//!    and equation offsets, then each unit's check of its input values.
+//!
+//! The variable order is therefore: per unit, its outlet streams then its internal variables; then
+//! per controller its internal variables. Blocks are units then controllers, in file order.
 
 use std::collections::HashMap;
 use std::path::Path;
 
 use plantwide_model::controllers::ControllerLinks;
-use plantwide_model::stream::StreamLayout;
-use plantwide_model::{BuildCx, Coloring, LocalLayout, Unit};
-
 use plantwide_model::limits::Limits;
+use plantwide_model::stream::StreamLayout;
+use plantwide_model::{BuildCx, Coloring, ControllerSpec, LocalLayout, Unit};
+use plantwide_thermo::ThermoPackage;
+use plantwide_units::Dimension;
 
 use crate::components::thermo_package;
 use crate::error::{Diagnostic, LoadError, did_you_mean};
 use crate::parse::parse_spec;
+use crate::path::VarPath;
 use crate::plant::{Block, BlockKind, InputInfo, Plant, Read, StreamInfo, VarInfo};
 use crate::spec::FlowsheetSpec;
 
@@ -28,6 +46,23 @@ pub fn load_str(text: &str, file: &str) -> Result<Plant, LoadError> {
     assemble(&spec, file)
 }
 
+/// Assemble a parsed flowsheet.
+pub fn assemble(spec: &FlowsheetSpec, file: &str) -> Result<Plant, LoadError> {
+    let mut a = Assembler::new(spec, file)?;
+    a.check_names()?;
+    let units = a.build_units()?;
+    let outlet_of = a.connect_streams(&units)?;
+    a.push_units(units, &outlet_of);
+    let pending = a.resolve_controllers()?;
+    a.push_controllers(&pending)?;
+    a.wire_outputs(&pending);
+    a.resolve_aliases();
+    a.check_plant();
+    a.reads_and_offsets()?;
+    a.finish()
+}
+
+/// `unit.port` → (`unit`, `port`); `unit` alone → (`unit`, `None`).
 fn split_port(s: &str) -> (&str, Option<&str>) {
     match s.split_once('.') {
         Some((u, p)) => (u, Some(p)),
@@ -35,196 +70,273 @@ fn split_port(s: &str) -> (&str, Option<&str>) {
     }
 }
 
-/// Assemble a parsed flowsheet.
-pub fn assemble(spec: &FlowsheetSpec, file: &str) -> Result<Plant, LoadError> {
-    let invalid = |diagnostics: Vec<Diagnostic>| LoadError::Invalid { file: file.to_string(), diagnostics };
-    let mut diags = Vec::new();
-    let Some((components, thermo, _)) = thermo_package(&spec.components, &spec.thermo, &mut diags) else {
-        return Err(invalid(diags));
-    };
-    let stream_layout = StreamLayout { n_comp: components.len() };
+/// The state of one assembly: what the phases have built so far and the problems found.
+struct Assembler<'s> {
+    spec: &'s FlowsheetSpec,
+    file: &'s str,
+    components: Vec<String>,
+    thermo: ThermoPackage,
+    stream_layout: StreamLayout,
+    diags: Vec<Diagnostic>,
+    blocks: Vec<Block>,
+    vars: Vec<VarInfo>,
+    inputs: Vec<InputInfo>,
+    streams: Vec<StreamInfo>,
+    aliases: HashMap<String, usize>,
+    var_index: HashMap<String, usize>,
+    input_index: HashMap<String, usize>,
+}
 
-    // Names: units and controllers share one name space; names must be usable in paths.
-    let name_len = plantwide_model::limits::Limits::get().name_len();
-    for name in spec.units.keys().chain(spec.controllers.keys()).chain(spec.streams.keys()) {
-        if let Some(msg) = name_len.check(name.chars().count(), "the length of this name") {
-            diags.push(Diagnostic::new(plantwide_model::limits::clip(name), msg));
+/// The unit models built from the file, with their names, in file order.
+type Units = Vec<(String, Box<dyn Unit>)>;
+
+/// A controller whose paths resolved: its measured paths and the input indices it drives.
+struct Pending<'s> {
+    name: &'s str,
+    config: &'s ControllerSpec,
+    measured: Vec<VarPath>,
+    driven: Vec<usize>,
+}
+
+impl<'s> Assembler<'s> {
+    /// Phase 1: the components and the thermodynamic package.
+    fn new(spec: &'s FlowsheetSpec, file: &'s str) -> Result<Assembler<'s>, LoadError> {
+        let mut diags = Vec::new();
+        let Some((components, thermo, _)) = thermo_package(&spec.components, &spec.thermo, &mut diags) else {
+            return Err(LoadError::Invalid { file: file.to_string(), diagnostics: diags });
+        };
+        let stream_layout = StreamLayout { n_comp: components.len() };
+        Ok(Assembler {
+            spec,
+            file,
+            components,
+            thermo,
+            stream_layout,
+            diags,
+            blocks: Vec::new(),
+            vars: Vec::new(),
+            inputs: Vec::new(),
+            streams: Vec::new(),
+            aliases: HashMap::new(),
+            var_index: HashMap::new(),
+            input_index: HashMap::new(),
+        })
+    }
+
+    /// Stop here if any problem was found.
+    fn stop_if_invalid(&mut self) -> Result<(), LoadError> {
+        if self.diags.is_empty() {
+            Ok(())
+        } else {
+            Err(LoadError::Invalid { file: self.file.to_string(), diagnostics: std::mem::take(&mut self.diags) })
         }
     }
-    if !diags.is_empty() {
-        return Err(invalid(diags));
-    }
-    for name in spec.units.keys().chain(spec.controllers.keys()) {
-        if name.is_empty() || name.contains(['.', '[', ']', '@', ',', '=', ' ']) {
-            diags.push(Diagnostic::new(name.clone(), "names may not be empty or contain '.', '[', ']', '@', ',', '=' or spaces (they appear in variable paths)"));
+
+    /// Phase 2: names within the length limit (else stop), usable in paths, one name space for
+    /// units and controllers, no stream named like either.
+    fn check_names(&mut self) -> Result<(), LoadError> {
+        let spec = self.spec;
+        let name_len = Limits::get().name_len();
+        for name in spec.units.keys().chain(spec.controllers.keys()).chain(spec.streams.keys()) {
+            if let Some(msg) = name_len.check(name.chars().count(), "the length of this name") {
+                self.diags.push(Diagnostic::new(plantwide_model::limits::clip(name), msg));
+            }
         }
-    }
-    for name in spec.controllers.keys().filter(|n| spec.units.contains_key(*n)) {
-        diags.push(Diagnostic::new(
-            format!("controllers.{name}"),
-            format!("`{name}` is also a unit name; units and controllers share one name space"),
-        ));
-    }
-    for name in spec.streams.keys().filter(|n| spec.units.contains_key(*n) || spec.controllers.contains_key(*n)) {
-        diags.push(Diagnostic::new(
-            format!("streams.{name}"),
-            format!("`{name}` is also a unit or controller name; stream paths would be ambiguous"),
-        ));
+        self.stop_if_invalid()?;
+        for name in spec.units.keys().chain(spec.controllers.keys()) {
+            if name.is_empty() || name.contains(['.', '[', ']', '@', ',', '=', ' ']) {
+                self.diags.push(Diagnostic::new(name.clone(), "names may not be empty or contain '.', '[', ']', '@', ',', '=' or spaces (they appear in variable paths)"));
+            }
+        }
+        for name in spec.controllers.keys().filter(|n| spec.units.contains_key(*n)) {
+            self.diags.push(Diagnostic::new(
+                format!("controllers.{name}"),
+                format!("`{name}` is also a unit name; units and controllers share one name space"),
+            ));
+        }
+        for name in spec.streams.keys().filter(|n| spec.units.contains_key(*n) || spec.controllers.contains_key(*n)) {
+            self.diags.push(Diagnostic::new(
+                format!("streams.{name}"),
+                format!("`{name}` is also a unit or controller name; stream paths would be ambiguous"),
+            ));
+        }
+        Ok(())
     }
 
-    // Units.
-    let mut units: Vec<(String, Box<dyn Unit>)> = Vec::new();
-    for (name, u) in &spec.units {
-        let cx = BuildCx::new(&components, &thermo, format!("units.{name}"));
-        match u.build(cx, ()) {
-            Ok(unit) => units.push((name.clone(), unit)),
-            Err(errs) => diags.extend(errs.into_iter().map(|e| Diagnostic::new(e.path, e.message))),
+    /// Phase 3: every unit model built from its description, in file order (stops on any problem
+    /// found so far).
+    fn build_units(&mut self) -> Result<Units, LoadError> {
+        let mut units = Vec::new();
+        for (name, u) in &self.spec.units {
+            let cx = BuildCx::new(&self.components, &self.thermo, format!("units.{name}"));
+            match u.build(cx, ()) {
+                Ok(unit) => units.push((name.clone(), unit)),
+                Err(errs) => self.diags.extend(errs.into_iter().map(|e| Diagnostic::new(e.path, e.message))),
+            }
         }
+        self.stop_if_invalid()?;
+        Ok(units)
     }
-    if !diags.is_empty() {
-        return Err(invalid(diags));
-    }
-    let unit_index: HashMap<&str, usize> = units.iter().enumerate().map(|(i, (n, _))| (n.as_str(), i)).collect();
 
-    // Streams: resolve ports, each port connected exactly once.
-    let mut outlet_of: HashMap<(usize, usize), String> = HashMap::new();
-    let mut inlet_of: HashMap<(usize, usize), String> = HashMap::new();
-    let mut links = Vec::new();
-    for (sname, s) in &spec.streams {
-        let mut resolve = |end: &str, text: &str, outlet: bool| -> Option<(usize, usize)> {
-            let path = format!("streams.{sname}.{end}");
-            let (uname, port) = split_port(text);
-            let Some(&ui) = unit_index.get(uname) else {
-                diags.push(Diagnostic::new(
-                    path,
-                    format!("no unit named `{uname}`{}", did_you_mean(uname, unit_index.keys().copied())),
+    /// Phase 4: each stream's ends resolved to ports, each port connected exactly once. Returns the
+    /// stream leaving each (unit, outlet port); stops on any problem.
+    fn connect_streams(
+        &mut self,
+        units: &[(String, Box<dyn Unit>)],
+    ) -> Result<HashMap<(usize, usize), String>, LoadError> {
+        let unit_index: HashMap<&str, usize> = units.iter().enumerate().map(|(i, (n, _))| (n.as_str(), i)).collect();
+        let mut outlet_of: HashMap<(usize, usize), String> = HashMap::new();
+        let mut inlet_of: HashMap<(usize, usize), String> = HashMap::new();
+        for (sname, s) in &self.spec.streams {
+            let from = self.resolve_port(units, &unit_index, &format!("streams.{sname}.from"), &s.from, true);
+            let to = self.resolve_port(units, &unit_index, &format!("streams.{sname}.to"), &s.to, false);
+            if let Some(prev) = from.and_then(|f| outlet_of.insert(f, sname.clone())) {
+                self.diags.push(Diagnostic::new(
+                    format!("streams.{sname}.from"),
+                    format!(
+                        "outlet `{}` is already the source of stream `{prev}`: a port takes one stream (use a splitter)",
+                        s.from
+                    ),
                 ));
-                return None;
-            };
-            let unit = &units[ui].1;
-            let ports = if outlet { unit.outlet_ports() } else { unit.inlet_ports() };
-            let dir = if outlet { "outlet" } else { "inlet" };
-            let port = match port {
-                Some(p) => p.to_string(),
-                None if ports.len() == 1 => ports[0].clone(),
-                None => {
-                    diags.push(Diagnostic::new(
-                        path,
-                        format!(
-                            "`{uname}` ({}) has {} {dir} ports: name one as `{uname}.<port>` ({})",
-                            unit.type_name(),
-                            ports.len(),
-                            ports.join(", ")
-                        ),
-                    ));
-                    return None;
-                }
-            };
-            match ports.iter().position(|p| *p == port) {
-                Some(k) => Some((ui, k)),
-                None => {
-                    let hint = if ports.is_empty() {
-                        format!("it has no {dir} ports")
-                    } else {
-                        format!("{dir} ports: {}", ports.join(", "))
-                    };
-                    diags.push(Diagnostic::new(
-                        path,
-                        format!(
-                            "`{uname}` ({}) has no {dir} port `{port}`{}; {hint}",
-                            unit.type_name(),
-                            did_you_mean(&port, ports.iter().map(String::as_str))
-                        ),
-                    ));
-                    None
+            }
+            if let Some(prev) = to.and_then(|t| inlet_of.insert(t, sname.clone())) {
+                self.diags.push(Diagnostic::new(
+                    format!("streams.{sname}.to"),
+                    format!(
+                        "inlet `{}` is already fed by stream `{prev}`: a port takes one stream (use a mixer)",
+                        s.to
+                    ),
+                ));
+            }
+            if let (Some(f), Some(t)) = (from, to) {
+                self.streams.push(StreamInfo { name: sname.clone(), from: f, to: t, offset: 0, tear: s.tear });
+            }
+        }
+        for (ui, (name, unit)) in units.iter().enumerate() {
+            for (k, p) in unit.outlet_ports().iter().enumerate() {
+                if !outlet_of.contains_key(&(ui, k)) {
+                    self.diags.push(Diagnostic::new(format!("units.{name}"), format!("outlet port `{name}.{p}` is not connected: add a stream from it (to a `product` unit if it leaves the plant)")));
                 }
             }
+            for (k, p) in unit.inlet_ports().iter().enumerate() {
+                if !inlet_of.contains_key(&(ui, k)) {
+                    self.diags.push(Diagnostic::new(
+                        format!("units.{name}"),
+                        format!("inlet port `{name}.{p}` is not connected: add a stream to it"),
+                    ));
+                }
+            }
+        }
+        self.stop_if_invalid()?;
+        Ok(outlet_of)
+    }
+
+    /// The (unit, port) that stream end `text` (`unit.port`, or `unit` with one port of that
+    /// direction) names, at JSON path `path`; `outlet` tells the direction.
+    fn resolve_port(
+        &mut self,
+        units: &[(String, Box<dyn Unit>)],
+        unit_index: &HashMap<&str, usize>,
+        path: &str,
+        text: &str,
+        outlet: bool,
+    ) -> Option<(usize, usize)> {
+        let (uname, port) = split_port(text);
+        let Some(&ui) = unit_index.get(uname) else {
+            self.diags.push(Diagnostic::new(
+                path,
+                format!("no unit named `{uname}`{}", did_you_mean(uname, unit_index.keys().copied())),
+            ));
+            return None;
         };
-        let from = resolve("from", &s.from, true);
-        let to = resolve("to", &s.to, false);
-        if let Some(prev) = from.and_then(|f| outlet_of.insert(f, sname.clone())) {
-            diags.push(Diagnostic::new(
-                format!("streams.{sname}.from"),
+        let unit = &units[ui].1;
+        let ports = if outlet { unit.outlet_ports() } else { unit.inlet_ports() };
+        let dir = if outlet { "outlet" } else { "inlet" };
+        let port = match port {
+            Some(p) => p.to_string(),
+            None if ports.len() == 1 => ports[0].clone(),
+            None => {
+                self.diags.push(Diagnostic::new(
+                    path,
+                    format!(
+                        "`{uname}` ({}) has {} {dir} ports: name one as `{uname}.<port>` ({})",
+                        unit.type_name(),
+                        ports.len(),
+                        ports.join(", ")
+                    ),
+                ));
+                return None;
+            }
+        };
+        let k = ports.iter().position(|p| *p == port);
+        if k.is_none() {
+            let hint = if ports.is_empty() {
+                format!("it has no {dir} ports")
+            } else {
+                format!("{dir} ports: {}", ports.join(", "))
+            };
+            self.diags.push(Diagnostic::new(
+                path,
                 format!(
-                    "outlet `{}` is already the source of stream `{prev}`: a port takes one stream (use a splitter)",
-                    s.from
+                    "`{uname}` ({}) has no {dir} port `{port}`{}; {hint}",
+                    unit.type_name(),
+                    did_you_mean(&port, ports.iter().map(String::as_str))
                 ),
             ));
         }
-        if let Some(prev) = to.and_then(|t| inlet_of.insert(t, sname.clone())) {
-            diags.push(Diagnostic::new(
-                format!("streams.{sname}.to"),
-                format!("inlet `{}` is already fed by stream `{prev}`: a port takes one stream (use a mixer)", s.to),
-            ));
-        }
-        if let (Some(f), Some(t)) = (from, to) {
-            links.push((sname.clone(), f, t, s.tear));
-        }
-    }
-    for (ui, (name, unit)) in units.iter().enumerate() {
-        for (k, p) in unit.outlet_ports().iter().enumerate() {
-            if !outlet_of.contains_key(&(ui, k)) {
-                diags.push(Diagnostic::new(format!("units.{name}"), format!("outlet port `{name}.{p}` is not connected: add a stream from it (to a `product` unit if it leaves the plant)")));
-            }
-        }
-        for (k, p) in unit.inlet_ports().iter().enumerate() {
-            if !inlet_of.contains_key(&(ui, k)) {
-                diags.push(Diagnostic::new(
-                    format!("units.{name}"),
-                    format!("inlet port `{name}.{p}` is not connected: add a stream to it"),
-                ));
-            }
-        }
-    }
-    if !diags.is_empty() {
-        return Err(invalid(diags));
+        k.map(|k| (ui, k))
     }
 
-    // Layout of the unit blocks.
-    let slen = stream_layout.len();
-    let mut vars = Vec::new();
-    let mut inputs = Vec::new();
-    let mut blocks = Vec::new();
-    let mut stream_offset: HashMap<(usize, usize), usize> = HashMap::new();
-    for (ui, (name, unit)) in units.into_iter().enumerate() {
-        let own_offset = vars.len();
-        let outlets = unit.outlet_ports();
-        for k in 0..outlets.len() {
-            stream_offset.insert((ui, k), vars.len());
-            let sname = &outlet_of[&(ui, k)];
-            for v in stream_layout.var_specs(&components, 1.0) {
-                vars.push(VarInfo { path: format!("{sname}.{}", v.name), spec: v, block: ui });
-            }
+    /// Phase 5: the unit blocks, in file order, each owning its outlet streams' variables (named
+    /// by the stream) before its internal ones; then each stream's offset, at its source's variables.
+    fn push_units(&mut self, units: Units, outlet_of: &HashMap<(usize, usize), String>) {
+        for (ui, (name, unit)) in units.into_iter().enumerate() {
+            let outlets: Vec<&str> = (0..unit.outlet_ports().len()).map(|k| outlet_of[&(ui, k)].as_str()).collect();
+            self.push_block(name, BlockKind::Unit, unit, &outlets);
         }
-        for v in unit.internal_vars() {
-            vars.push(VarInfo { path: format!("{name}.{}", v.name), spec: v, block: ui });
+        let slen = self.stream_layout.len();
+        for st in &mut self.streams {
+            st.offset = self.blocks[st.from.0].own_offset + st.from.1 * slen;
         }
-        let input_ids = unit
-            .inputs()
-            .into_iter()
-            .map(|i| {
-                inputs.push(InputInfo {
-                    path: format!("{name}.{}", i.name),
-                    dim: i.dim,
-                    value: i.value,
-                    driven_by: None,
-                    block: ui,
-                });
-                inputs.len() - 1
-            })
-            .collect();
+    }
+
+    /// Append block `name` (a unit or a controller) with its own variables: the variables of the
+    /// streams leaving it (`outlets`, named by stream), then its internal variables; and its
+    /// declared inputs. Every path is indexed as it is added.
+    fn push_block(&mut self, name: String, kind: BlockKind, unit: Box<dyn Unit>, outlets: &[&str]) {
+        let block = self.blocks.len();
+        let own_offset = self.vars.len();
+        let mut own = Vec::new();
+        for s in outlets {
+            own.extend(
+                self.stream_layout.var_specs(&self.components, 1.0).into_iter().map(|v| (VarPath::new(s, &v.name), v)),
+            );
+        }
+        own.extend(unit.internal_vars().into_iter().map(|v| (VarPath::new(&name, &v.name), v)));
+        for (path, spec) in own {
+            self.var_index.insert(path.to_string(), self.vars.len());
+            self.vars.push(VarInfo { path: path.into(), spec, block });
+        }
+        let mut input_ids = Vec::new();
+        for i in unit.inputs() {
+            let path = VarPath::new(&name, &i.name).to_string();
+            self.input_index.insert(path.clone(), self.inputs.len());
+            input_ids.push(self.inputs.len());
+            self.inputs.push(InputInfo { path, dim: i.dim, value: i.value, driven_by: None, block });
+        }
+        let is_unit = kind == BlockKind::Unit;
         let layout = LocalLayout {
-            stream: stream_layout,
+            stream: self.stream_layout,
             n_outlets: outlets.len(),
             n_internal: unit.internal_vars().len(),
-            n_inlets: unit.inlet_ports().len(),
+            n_inlets: if is_unit { unit.inlet_ports().len() } else { 0 },
             n_inputs: unit.inputs().len(),
-            n_signals: 0,
+            n_signals: if is_unit { 0 } else { unit.signals().len() },
         };
         let n_eq = (layout.n_own() as isize + unit.extra_equations()).max(0) as usize;
-        blocks.push(Block {
+        self.blocks.push(Block {
             name,
-            kind: BlockKind::Unit,
+            kind,
             unit: unit.into(),
             layout,
             own_offset,
@@ -236,221 +348,200 @@ pub fn assemble(spec: &FlowsheetSpec, file: &str) -> Result<Plant, LoadError> {
             coloring: None,
         });
     }
-    let streams: Vec<StreamInfo> = links
-        .iter()
-        .map(|(name, f, t, tear)| StreamInfo {
-            name: name.clone(),
-            from: *f,
-            to: *t,
-            offset: stream_offset[f],
-            tear: *tear,
-        })
-        .collect();
-    let mut var_index: HashMap<String, usize> = vars.iter().enumerate().map(|(i, v)| (v.path.clone(), i)).collect();
-    let mut input_index: HashMap<String, usize> = inputs.iter().enumerate().map(|(i, v)| (v.path.clone(), i)).collect();
 
-    // Controllers: resolve paths, then build with the resolved dimensions.
-    let mut driven_by_ctrl: HashMap<usize, String> = HashMap::new();
-    let mut pending = Vec::new();
-    for (cname, c) in &spec.controllers {
-        let paths = c.config().paths();
-        let mut measured = Vec::new();
-        let mut ok = true;
-        for (field, p) in &paths.measured {
-            // A measurement may name another controller's output, laid out below: accept `<ctrl>.op`.
-            let (head, _) = split_port(p);
-            if spec.controllers.contains_key(head) {
-                measured.push(p.clone());
-                continue;
-            }
-            match var_index.get(p).or_else(|| var_index.get(&p.replace(".z[", ".x["))) {
-                Some(_) => measured.push(p.clone()),
-                None => {
+    /// Phase 6a: every controller's measured variables and driven inputs resolved against the units
+    /// (a measurement may name another controller's output, laid out later: `<ctrl>.op`); an input
+    /// takes one controller. Stops on any problem.
+    fn resolve_controllers(&mut self) -> Result<Vec<Pending<'s>>, LoadError> {
+        let spec = self.spec;
+        let mut driven_by: HashMap<usize, &str> = HashMap::new();
+        let mut pending = Vec::new();
+        for (name, config) in &spec.controllers {
+            let paths = config.config().paths();
+            let mut ok = true;
+            let mut measured = Vec::new();
+            for (field, p) in &paths.measured {
+                let path = VarPath::parse(p);
+                if spec.controllers.contains_key(path.owner()) || path.find(&self.var_index).is_some() {
+                    measured.push(path);
+                } else {
                     ok = false;
-                    diags.push(Diagnostic::new(
-                        format!("controllers.{cname}.{field}"),
-                        format!("no variable `{p}`{}", did_you_mean(p, var_index.keys().map(String::as_str))),
+                    let hint = did_you_mean(p, self.var_index.keys().map(String::as_str));
+                    self.diags.push(Diagnostic::new(
+                        format!("controllers.{name}.{field}"),
+                        format!("no variable `{p}`{hint}"),
                     ));
                 }
             }
-        }
-        let mut driven = Vec::new();
-        for (field, p) in &paths.driven {
-            match input_index.get(p) {
-                Some(&i) => {
-                    if let Some(prev) = driven_by_ctrl.insert(i, cname.clone()) {
-                        ok = false;
-                        diags.push(Diagnostic::new(format!("controllers.{cname}.{field}"), format!("input `{p}` is already driven by controller `{prev}`: an input takes one controller (use a selector or split range)")));
+            let mut driven = Vec::new();
+            for (field, p) in &paths.driven {
+                let at = format!("controllers.{name}.{field}");
+                match self.input_index.get(p) {
+                    Some(&i) => {
+                        if let Some(prev) = driven_by.insert(i, name) {
+                            ok = false;
+                            self.diags.push(Diagnostic::new(at, format!("input `{p}` is already driven by controller `{prev}`: an input takes one controller (use a selector or split range)")));
+                        }
+                        driven.push(i);
                     }
-                    driven.push(i);
-                }
-                None => {
-                    ok = false;
-                    diags.push(Diagnostic::new(
-                        format!("controllers.{cname}.{field}"),
-                        format!("no manipulable input `{p}`{}; inputs are declared by units (e.g. `valve.opening`, `heater.duty`)", did_you_mean(p, input_index.keys().map(String::as_str))),
-                    ));
+                    None => {
+                        ok = false;
+                        let hint = did_you_mean(p, self.input_index.keys().map(String::as_str));
+                        self.diags.push(Diagnostic::new(at, format!("no manipulable input `{p}`{hint}; inputs are declared by units (e.g. `valve.opening`, `heater.duty`)")));
+                    }
                 }
             }
+            if ok {
+                pending.push(Pending { name, config, measured, driven });
+            }
         }
-        if ok {
-            pending.push((cname.clone(), c, measured, driven));
+        self.stop_if_invalid()?;
+        Ok(pending)
+    }
+
+    /// Phase 6b: the controller blocks, in file order, each built with the dimensions of what it
+    /// measures and drives. Stops on any problem.
+    fn push_controllers(&mut self, pending: &[Pending<'s>]) -> Result<(), LoadError> {
+        for c in pending {
+            let links = self.controller_links(pending, c);
+            let cx = BuildCx::new(&self.components, &self.thermo, format!("controllers.{}", c.name));
+            match c.config.build(cx, &links) {
+                Ok(unit) => self.push_block(c.name.to_string(), BlockKind::Controller, unit, &[]),
+                Err(errs) => self.diags.extend(errs.into_iter().map(|e| Diagnostic::new(e.path, e.message))),
+            }
         }
+        self.stop_if_invalid()
     }
-    if !diags.is_empty() {
-        return Err(invalid(diags));
-    }
-    for (cname, c, measured, driven) in &pending {
-        let pv_dim = measured.first().and_then(|p| var_index.get(p).map(|&i| vars[i].spec.dim)).or_else(|| {
-            measured.first().and_then(|p| {
-                let (head, _) = split_port(p);
-                pending.iter().find(|(n, ..)| n == head).and_then(|(_, _, _, d)| d.first().map(|&i| inputs[i].dim))
+
+    /// What controller `c` is built with: the dimension of its first measurement (a variable laid
+    /// out so far, or the first input driven by the controller whose output it reads; else
+    /// dimensionless), that of its first driven input (or the output dimension its kind gives),
+    /// that input's value as the output's bias, and a unit measurement scale (`pv_nominal` = 1).
+    fn controller_links(&self, pending: &[Pending<'s>], c: &Pending<'s>) -> ControllerLinks {
+        let pv_dim = c.measured.first().and_then(|p| {
+            p.find(&self.var_index).map(|i| self.vars[i].spec.dim).or_else(|| {
+                let master = pending.iter().find(|m| m.name == p.owner())?;
+                master.driven.first().map(|&i| self.inputs[i].dim)
             })
         });
-        let first = driven.first().copied();
-        let pv_dim = pv_dim.unwrap_or(plantwide_units::Dimension::DIMENSIONLESS);
+        let pv_dim = pv_dim.unwrap_or(Dimension::DIMENSIONLESS);
+        let first = c.driven.first().copied();
         let op_dim = match first {
-            Some(i) => inputs[i].dim,
-            None => c.config().op_dimension(pv_dim).unwrap_or(plantwide_units::Dimension::DIMENSIONLESS),
+            Some(i) => self.inputs[i].dim,
+            None => c.config.config().op_dimension(pv_dim).unwrap_or(Dimension::DIMENSIONLESS),
         };
-        let links =
-            ControllerLinks { pv_dim, op_dim, op_value: first.map_or(0.0, |i| inputs[i].value), pv_nominal: 1.0 };
-        let cx = BuildCx::new(&components, &thermo, format!("controllers.{cname}"));
-        match c.build(cx, &links) {
-            Ok(unit) => {
-                let own_offset = vars.len();
-                for v in unit.internal_vars() {
-                    vars.push(VarInfo { path: format!("{cname}.{}", v.name), spec: v, block: blocks.len() });
-                    var_index.insert(vars[vars.len() - 1].path.clone(), vars.len() - 1);
+        ControllerLinks { pv_dim, op_dim, op_value: first.map_or(0.0, |i| self.inputs[i].value), pv_nominal: 1.0 }
+    }
+
+    /// Phase 6c: controller outputs drive inputs: driven input k takes output k
+    /// ([`VarPath::controller_output`]: `<ctrl>.op`, `<ctrl>.op2`, …).
+    fn wire_outputs(&mut self, pending: &[Pending<'s>]) {
+        for c in pending {
+            for (k, &i) in c.driven.iter().enumerate() {
+                self.inputs[i].driven_by = self.var_index.get(VarPath::controller_output(c.name, k).as_str()).copied();
+            }
+        }
+    }
+
+    /// Phase 7a: input aliases, each naming a declared input.
+    fn resolve_aliases(&mut self) {
+        for (alias, p) in &self.spec.inputs {
+            match self.input_index.get(p) {
+                Some(&i) => {
+                    self.aliases.insert(alias.clone(), i);
                 }
-                let input_ids = unit
-                    .inputs()
-                    .into_iter()
-                    .map(|i| {
-                        inputs.push(InputInfo {
-                            path: format!("{cname}.{}", i.name),
-                            dim: i.dim,
-                            value: i.value,
-                            driven_by: None,
-                            block: blocks.len(),
-                        });
-                        input_index.insert(inputs[inputs.len() - 1].path.clone(), inputs.len() - 1);
-                        inputs.len() - 1
-                    })
-                    .collect();
-                let layout = LocalLayout {
-                    stream: stream_layout,
-                    n_outlets: 0,
-                    n_internal: unit.internal_vars().len(),
-                    n_inlets: 0,
-                    n_inputs: unit.inputs().len(),
-                    n_signals: unit.signals().len(),
-                };
-                let n_eq = (layout.n_own() as isize + unit.extra_equations()).max(0) as usize;
-                blocks.push(Block {
-                    name: cname.clone(),
-                    kind: BlockKind::Controller,
-                    unit: unit.into(),
-                    layout,
-                    own_offset,
-                    eq_offset: 0,
-                    n_eq,
-                    reads: Vec::new(),
-                    input_ids,
-                    pattern: None,
-                    coloring: None,
-                });
-            }
-            Err(errs) => diags.extend(errs.into_iter().map(|e| Diagnostic::new(e.path, e.message))),
-        }
-    }
-    if !diags.is_empty() {
-        return Err(invalid(diags));
-    }
-    // Controller outputs drive inputs: driven input k takes `<ctrl>.op` (k = 0) or `<ctrl>.op<k+1>`
-    // (split range: `op`, `op2`).
-    for (cname, _, _, driven) in &pending {
-        for (k, &i) in driven.iter().enumerate() {
-            let op = if k == 0 { format!("{cname}.op") } else { format!("{cname}.op{}", k + 1) };
-            inputs[i].driven_by = var_index.get(&op).copied();
-        }
-    }
-
-    // Aliases.
-    let mut aliases = HashMap::new();
-    for (alias, p) in &spec.inputs {
-        match input_index.get(p) {
-            Some(&i) => {
-                aliases.insert(alias.clone(), i);
-            }
-            None => diags.push(Diagnostic::new(
-                format!("inputs.{alias}"),
-                format!("no manipulable input `{p}`{}", did_you_mean(p, input_index.keys().map(String::as_str))),
-            )),
-        }
-    }
-
-    check_inputs(&blocks, &inputs, &mut diags);
-    if let Some(msg) = Limits::get().variables().check(vars.len(), "the number of variables of the plant") {
-        diags.push(Diagnostic::new("units", msg));
-    }
-
-    // Reads of every block, and equation offsets.
-    let mut eq_offset = 0;
-    for (bi, b) in blocks.iter_mut().enumerate() {
-        if let Some(msg) = block_size(b) {
-            diags.push(Diagnostic::new(section_path(b), msg));
-            continue;
-        }
-        let mut reads = Vec::new();
-        if b.kind == BlockKind::Unit {
-            for k in 0..b.layout.n_inlets {
-                let off = streams.iter().find(|s| s.to == (bi, k)).map(|s| s.offset).unwrap_or(0);
-                reads.extend((off..off + slen).map(Read::Var));
-            }
-        }
-        for &i in &b.input_ids {
-            reads.push(match inputs[i].driven_by {
-                Some(v) => Read::Var(v),
-                None => Read::Input(i),
-            });
-        }
-        for s in b.unit.signals() {
-            match var_index.get(&s.path).or_else(|| var_index.get(&s.path.replace(".z[", ".x["))) {
-                Some(&v) => reads.push(Read::Var(v)),
-                None => diags.push(Diagnostic::new(
-                    format!("controllers.{}.{}", b.name, s.role),
-                    format!("no variable `{}`", s.path),
+                None => self.diags.push(Diagnostic::new(
+                    format!("inputs.{alias}"),
+                    format!(
+                        "no manipulable input `{p}`{}",
+                        did_you_mean(p, self.input_index.keys().map(String::as_str))
+                    ),
                 )),
             }
         }
-        b.reads = reads;
-        b.pattern = b.unit.pattern(&b.layout);
-        b.coloring = b.pattern.as_ref().map(|p| Coloring::new(p, b.n_eq, b.layout.len()));
-        b.eq_offset = eq_offset;
-        eq_offset += b.n_eq;
     }
-    if !diags.is_empty() {
-        return Err(invalid(diags));
+
+    /// Phase 7b: every input value of the file within its physical range
+    /// ([`plantwide_model::limits::check_input`], the check `--set` and scenario events go through
+    /// too), and the number of variables within its limit.
+    fn check_plant(&mut self) {
+        for info in &self.inputs {
+            let b = &self.blocks[info.block];
+            let path = VarPath::parse(&info.path);
+            let name = path.field().unwrap_or(&info.path);
+            if let Err(why) = plantwide_model::limits::check_input(name, info.dim, info.value) {
+                self.diags.push(Diagnostic::new(format!("{}.{name}", section_path(b)), why.to_string()));
+            }
+        }
+        if let Some(msg) = Limits::get().variables().check(self.vars.len(), "the number of variables of the plant") {
+            self.diags.push(Diagnostic::new("units", msg));
+        }
     }
-    let plant = Plant {
-        file: file.to_string(),
-        name: spec.name.clone(),
-        components,
-        thermo,
-        stream_layout,
-        blocks,
-        vars,
-        inputs,
-        streams,
-        aliases,
-        var_index,
-        input_index,
-        spec: spec.clone(),
-    };
-    crate::overrides::check_unit_inputs(&plant, &plant.input_values())
-        .map_err(|(path, why)| invalid(vec![Diagnostic::new(path, why)]))?;
-    Ok(plant)
+
+    /// Phase 8: the reads of every block (its inlet streams, its inputs or the controller outputs
+    /// driving them, its signals), its sparsity pattern and colouring, and equation offsets in
+    /// block order. A block too large to evaluate is reported and skipped. Stops on any problem.
+    fn reads_and_offsets(&mut self) -> Result<(), LoadError> {
+        let slen = self.stream_layout.len();
+        let mut eq_offset = 0;
+        for (bi, b) in self.blocks.iter_mut().enumerate() {
+            if let Some(msg) = block_size(b) {
+                self.diags.push(Diagnostic::new(section_path(b), msg));
+                continue;
+            }
+            let mut reads = Vec::new();
+            if b.kind == BlockKind::Unit {
+                for k in 0..b.layout.n_inlets {
+                    let off = self.streams.iter().find(|s| s.to == (bi, k)).map(|s| s.offset).unwrap_or(0);
+                    reads.extend((off..off + slen).map(Read::Var));
+                }
+            }
+            for &i in &b.input_ids {
+                reads.push(match self.inputs[i].driven_by {
+                    Some(v) => Read::Var(v),
+                    None => Read::Input(i),
+                });
+            }
+            for s in b.unit.signals() {
+                match VarPath::parse(&s.path).find(&self.var_index) {
+                    Some(v) => reads.push(Read::Var(v)),
+                    None => self.diags.push(Diagnostic::new(
+                        format!("controllers.{}.{}", b.name, s.role),
+                        format!("no variable `{}`", s.path),
+                    )),
+                }
+            }
+            b.reads = reads;
+            b.pattern = b.unit.pattern(&b.layout);
+            b.coloring = b.pattern.as_ref().map(|p| Coloring::new(p, b.n_eq, b.layout.len()));
+            b.eq_offset = eq_offset;
+            eq_offset += b.n_eq;
+        }
+        self.stop_if_invalid()
+    }
+
+    /// The plant, after each unit's own check of its input values.
+    fn finish(self) -> Result<Plant, LoadError> {
+        let plant = Plant {
+            file: self.file.to_string(),
+            name: self.spec.name.clone(),
+            components: self.components,
+            thermo: self.thermo,
+            stream_layout: self.stream_layout,
+            blocks: self.blocks,
+            vars: self.vars,
+            inputs: self.inputs,
+            streams: self.streams,
+            aliases: self.aliases,
+            var_index: self.var_index,
+            input_index: self.input_index,
+            spec: self.spec.clone(),
+        };
+        crate::overrides::check_unit_inputs(&plant, &plant.input_values()).map_err(|(path, why)| {
+            LoadError::Invalid { file: plant.file().to_string(), diagnostics: vec![Diagnostic::new(path, why)] }
+        })?;
+        Ok(plant)
+    }
 }
 
 /// `units.<name>` or `controllers.<name>`: where block `b` is described in the file.
@@ -458,18 +549,6 @@ fn section_path(b: &Block) -> String {
     match b.kind {
         BlockKind::Unit => format!("units.{}", b.name),
         BlockKind::Controller => format!("controllers.{}", b.name),
-    }
-}
-
-/// Every input value of the file within its physical range ([`plantwide_model::limits::check_input`],
-/// the check `--set` and scenario events go through too).
-fn check_inputs(blocks: &[Block], inputs: &[InputInfo], diags: &mut Vec<Diagnostic>) {
-    for info in inputs {
-        let b = &blocks[info.block];
-        let name = info.path.strip_prefix(&format!("{}.", b.name)).unwrap_or(&info.path);
-        if let Err(why) = plantwide_model::limits::check_input(name, info.dim, info.value) {
-            diags.push(Diagnostic::new(format!("{}.{name}", section_path(b)), why.to_string()));
-        }
     }
 }
 

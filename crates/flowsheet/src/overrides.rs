@@ -5,6 +5,7 @@ use plantwide_units::parse_quantity_as;
 use serde_json::Value;
 
 use crate::error::did_you_mean;
+use crate::path::VarPath;
 use crate::plant::Plant;
 use crate::spec::FlowsheetSpec;
 
@@ -14,9 +15,9 @@ pub fn resolve_input(plant: &Plant, path: &str) -> Option<usize> {
     if let Some(i) = plant.input(path) {
         return Some(i);
     }
-    let (head, rest) = path.split_once('.')?;
-    let s = plant.streams.iter().find(|s| s.name == head)?;
-    plant.input(&format!("{}.{rest}", plant.blocks[s.from.0].name))
+    let path = VarPath::parse(path);
+    let s = plant.streams.iter().find(|s| s.name == path.owner())?;
+    plant.input(VarPath::new(&plant.blocks[s.from.0].name, path.field()?).as_str())
 }
 
 /// One `--set PATH=VALUE` assignment: an input (its value with units) or a field of a unit or
@@ -142,7 +143,10 @@ pub fn check_unit_inputs(plant: &Plant, u: &[f64]) -> Result<(), (String, String
 pub fn check_compositions(plant: &Plant, u: &[f64]) -> Result<(), OverrideError> {
     for (bi, b) in plant.blocks.iter().enumerate() {
         let z: Vec<usize> = (0..plant.inputs.len())
-            .filter(|&i| plant.inputs[i].block == bi && plant.inputs[i].path.starts_with(&format!("{}.z[", b.name)))
+            .filter(|&i| {
+                let path = VarPath::parse(&plant.inputs[i].path);
+                plant.inputs[i].block == bi && path.owner() == b.name && path.is_composition()
+            })
             .collect();
         let sum: f64 = z.iter().map(|&i| u[i]).sum();
         if sum > 1.0 + 1e-9 {
@@ -231,7 +235,9 @@ pub enum OverrideError {
 /// (`unit.field=value`): the value is stored as written (a quantity string or a JSON literal).
 pub fn set_field(spec: &mut FlowsheetSpec, path: &str, value: &str) -> Result<(), OverrideError> {
     let field_error = |why: String| OverrideError::Field { path: path.to_string(), why };
-    let (head, field) = path.split_once('.').ok_or_else(|| field_error("expected `unit.field`".into()))?;
+    let parsed_path = VarPath::parse(path);
+    let head = parsed_path.owner();
+    let field = parsed_path.field().ok_or_else(|| field_error("expected `unit.field`".into()))?;
     let mut doc = serde_json::to_value(&*spec).map_err(|e| field_error(e.to_string()))?;
     let section = if spec.units.contains_key(head) {
         "units"

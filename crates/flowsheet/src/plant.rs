@@ -189,7 +189,7 @@ impl Plant {
     }
     /// Global index of the variable at `path` (`stream.x[comp]` and `stream.z[comp]` both work).
     pub fn var(&self, path: &str) -> Option<usize> {
-        self.var_index.get(path).or_else(|| self.var_index.get(&path.replace(".z[", ".x["))).copied()
+        crate::path::VarPath::parse(path).find(&self.var_index)
     }
     /// Index of the input at `path` or named by an alias.
     pub fn input(&self, path: &str) -> Option<usize> {

@@ -26,6 +26,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{Diagnostic, LoadError, did_you_mean};
 use crate::overrides::resolve_input;
+use crate::path::VarPath;
 use crate::plant::{BlockKind, Plant, Read};
 
 pub use plantwide_model::limits::{Limits, LimitsError};
@@ -854,7 +855,7 @@ fn default_paths(plant: &Plant, events: &[Event]) -> Vec<(String, Option<String>
         paths.extend(
             plant.vars[b.own_offset..b.own_offset + b.layout.n_own()]
                 .iter()
-                .filter(|v| v.path.ends_with(".op"))
+                .filter(|v| VarPath::parse(&v.path).is_controller_output())
                 .map(|v| v.path.clone()),
         );
     }
@@ -926,7 +927,7 @@ fn event(cx: &mut Cx<'_>, base: &str, e: &EventSpec) -> Vec<Event> {
             let (auto_input, manual_input) =
                 (cx.plant.input(&format!("{controller}.auto")), cx.plant.input(&format!("{controller}.op_manual")));
             let (Some(auto_input), Some(manual_input), Some(op)) =
-                (auto_input, manual_input, cx.plant.var(&format!("{controller}.op")))
+                (auto_input, manual_input, cx.plant.var(VarPath::controller_output(controller, 0).as_str()))
             else {
                 let kind = cx.plant.blocks[b].unit.type_name();
                 cx.diags.push(Diagnostic::new(

@@ -3,7 +3,7 @@
 use thiserror::Error;
 
 /// Why a tuning request was refused.
-#[derive(Debug, Clone, PartialEq, Error)]
+#[derive(Debug, Clone, Error)]
 pub enum TuneError {
     /// BLT needs as many inputs as outputs (one loop per output).
     #[error(

@@ -14,7 +14,8 @@ use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 /// What the flowsheet resolved for a controller before building it: the dimensions of the measured
-/// variable and of the driven input, and the driven input's value in the flowsheet.
+/// variable and of the driven input, the driven input's value in the flowsheet, and the scale of the
+/// measurement.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ControllerLinks {
     /// Dimension of the measurement (`pv`).
@@ -23,7 +24,12 @@ pub struct ControllerLinks {
     pub op_dim: Dimension,
     /// The driven input's value in the flowsheet (SI): the default bias, for a bumpless start.
     pub op_value: f64,
-    /// Current value of the measurement at the initial guess (SI), used for scaling.
+    /// Scale of the measurement (SI): the nominal magnitude of the states that carry it (a PID's
+    /// integral `I` ~ `pv_nominal τ_I` and filter `x_f`, a lag's or delay's states with the bias),
+    /// hence of Newton's scaling and the integrator's absolute tolerance on them; and the least
+    /// scale against which a saturated PID's offset is judged. The flowsheet passes 1 (one SI
+    /// unit of the measurement) for every controller: a plant's numbers are pinned to that scale,
+    /// and the measurement's value is not known before the plant is assembled and guessed.
     pub pv_nominal: f64,
 }
 

@@ -181,6 +181,27 @@ pub struct RigorousColumn {
 }
 
 // Inputs, in declaration order; `condenser_duty` (if any) follows, then the side draws.
+/// What every stage's balances of one evaluation read: the flows and duties set by the inputs and
+/// the stage enthalpies.
+struct Shared<S> {
+    /// Reflux L [mol/s].
+    l_in: S,
+    /// Reboiler duty Q_R [W].
+    q_r: S,
+    /// Distillate D [mol/s].
+    d_in: S,
+    /// Bottoms B [mol/s].
+    b_in: S,
+    /// Condenser duty Q_C [W] (a variable).
+    qc: S,
+    /// Side-draw flows [mol/s], in draw order.
+    draw_flow: Vec<S>,
+    /// Liquid enthalpy of every stage [J/mol].
+    h_l: Vec<S>,
+    /// Vapour enthalpy of every stage [J/mol].
+    h_v: Vec<S>,
+}
+
 const IN_REFLUX: usize = 0;
 const IN_REBOILER_DUTY: usize = 1;
 const IN_DISTILLATE: usize = 2;
@@ -231,6 +252,82 @@ impl RigorousColumn {
             0 => self.n_stages - 1,
             1 => 0,
             _ => self.draws[k - 2].stage,
+        }
+    }
+
+    /// Stage `s`'s outflows and inflows: returns (liquid leaving, vapour leaving, energy balance),
+    /// with the components flowing in into `comp_in`. Liquid and vapour leave to the neighbours (or
+    /// the bottoms), as distillate and as side draws; the energy balance counts the enthalpy of the
+    /// vaporized stream and of every inflow relative to the stage liquid, less the condenser duty
+    /// on the top stage, plus the reboiler duty on the bottom one.
+    fn stage_flows<S: Scalar>(&self, io: &UnitIo<'_, S>, sh: &Shared<S>, s: usize, comp_in: &mut [S]) -> (S, S, S) {
+        let n = self.n_stages;
+        let ix = StageIdx { nc: self.nc() };
+        let st = |s: usize| io.vars(self.stage(s), self.per_stage());
+        let v = st(s);
+        let (l, vap) = (v[ix.l()], v[ix.v()]);
+        let (h_l, h_v) = (&sh.h_l, &sh.h_v);
+        comp_in.iter_mut().for_each(|c| *c = S::from(0.0));
+        let (mut liquid_out, mut vapour_out) = (l, vap);
+        if s + 1 == n && !self.partial {
+            liquid_out += sh.d_in;
+        }
+        for (d, fl) in self.draws.iter().zip(&sh.draw_flow).filter(|(d, _)| d.stage == s) {
+            if d.vapour {
+                vapour_out += *fl;
+            } else {
+                liquid_out += *fl;
+            }
+        }
+        let mut energy = -vapour_out * (h_v[s] - h_l[s]);
+        if s + 1 < n {
+            let up = st(s + 1);
+            comp_in.iter_mut().enumerate().for_each(|(j, c)| *c += up[ix.l()] * up[ix.x(j)]);
+            energy += up[ix.l()] * (h_l[s + 1] - h_l[s]);
+        }
+        if s > 0 {
+            let dn = st(s - 1);
+            comp_in.iter_mut().enumerate().for_each(|(j, c)| *c += dn[ix.v()] * dn[ix.y(j)]);
+            energy += dn[ix.v()] * (h_v[s - 1] - h_l[s]);
+        }
+        for (f, _) in self.feeds.iter().enumerate().filter(|(_, st)| **st == s) {
+            let feed = io.inlet(f);
+            comp_in.iter_mut().zip(feed.z()).for_each(|(c, z)| *c += feed.f() * *z);
+            energy += feed.f() * (feed.h() - h_l[s]);
+        }
+        if s + 1 == n {
+            energy -= sh.qc;
+        }
+        if s == 0 {
+            energy += sh.q_r;
+        }
+        (liquid_out, vapour_out, energy)
+    }
+
+    /// Outlet residuals: each outlet takes its flow (distillate `D`, bottoms `L_1`, a draw's input)
+    /// and the state of its stage, as liquid or vapour.
+    fn outlet_residuals<S: Scalar>(&self, io: &UnitIo<'_, S>, sh: &Shared<S>, r: &mut [S]) {
+        let ix = StageIdx { nc: self.nc() };
+        let slen = io.layout.stream.len();
+        let st = |s: usize| io.vars(self.stage(s), self.per_stage());
+        for k in 0..self.n_outlets() {
+            let s = self.outlet_stage(k);
+            let flow = match k {
+                0 => sh.d_in,
+                1 => st(0)[ix.l()],
+                _ => sh.draw_flow[k - 2],
+            };
+            let out = io.outlet(k);
+            let v = st(s);
+            let (h, z0) = if self.outlet_is_vapour(k) { (sh.h_v[s], ix.y(0)) } else { (sh.h_l[s], ix.x(0)) };
+            let rr = &mut r[k * slen..(k + 1) * slen];
+            rr[F] = out.f() - flow;
+            rr[T] = out.t() - v[ix.t()];
+            rr[P] = out.p() - self.pressure[s];
+            rr[H] = out.h() - h;
+            for j in 0..self.nc() {
+                rr[Z0 + j] = out.z()[j] - v[z0 + j];
+            }
         }
     }
 }
@@ -345,17 +442,20 @@ impl UnitModel for RigorousColumn {
     fn eval<S: Scalar>(&self, io: &UnitIo<'_, S>, r: &mut [S]) {
         let nc = self.nc();
         let n = self.n_stages;
-        let slen = io.layout.stream.len();
-        let internal0 = self.n_outlets() * slen;
+        let internal0 = self.n_outlets() * io.layout.stream.len();
         let ix = StageIdx { nc };
         let th = io.thermo;
         let st = |s: usize| io.vars(self.stage(s), self.per_stage());
-        let (l_in, q_r, d_in, b_in) =
-            (io.input(IN_REFLUX), self.q_r(io.input(IN_REBOILER_DUTY)), io.input(IN_DISTILLATE), io.input(IN_BOTTOMS));
-        let qc = io.var(self.qc());
-        let draw_flow: Vec<S> = (0..self.draws.len()).map(|k| io.input(self.draw_input(k))).collect();
-        let h_l: Vec<S> = (0..n).map(|s| th.h_liq(st(s)[ix.t()], &st(s)[ix.x(0)..ix.x(0) + nc])).collect();
-        let h_v: Vec<S> = (0..n).map(|s| th.h_vap(st(s)[ix.t()], &st(s)[ix.y(0)..ix.y(0) + nc])).collect();
+        let sh = Shared {
+            l_in: io.input(IN_REFLUX),
+            q_r: self.q_r(io.input(IN_REBOILER_DUTY)),
+            d_in: io.input(IN_DISTILLATE),
+            b_in: io.input(IN_BOTTOMS),
+            qc: io.var(self.qc()),
+            draw_flow: (0..self.draws.len()).map(|k| io.input(self.draw_input(k))).collect(),
+            h_l: (0..n).map(|s| th.h_liq(st(s)[ix.t()], &st(s)[ix.x(0)..ix.x(0) + nc])).collect(),
+            h_v: (0..n).map(|s| th.h_vap(st(s)[ix.t()], &st(s)[ix.y(0)..ix.y(0) + nc])).collect(),
+        };
         let mut k = vec![S::from(0.0); nc];
         let mut comp_in = vec![S::from(0.0); nc];
         let mut condenser_energy = S::from(0.0);
@@ -365,42 +465,9 @@ impl UnitModel for RigorousColumn {
             let (t, m, l, vap) = (v[ix.t()], v[ix.m()], v[ix.l()], v[ix.v()]);
             let x = &v[ix.x(0)..ix.x(0) + nc];
             let p = S::from(self.pressure[s]);
-            comp_in.iter_mut().for_each(|c| *c = S::from(0.0));
-            // Liquid and vapour leaving: to the neighbours (or bottoms), distillate, side draws.
-            let (mut liquid_out, mut vapour_out) = (l, vap);
-            if s + 1 == n && !self.partial {
-                liquid_out += d_in;
-            }
-            for (d, fl) in self.draws.iter().zip(&draw_flow).filter(|(d, _)| d.stage == s) {
-                if d.vapour {
-                    vapour_out += *fl;
-                } else {
-                    liquid_out += *fl;
-                }
-            }
-            let mut energy = -vapour_out * (h_v[s] - h_l[s]);
-            // Inflows: components, and enthalpy relative to the stage liquid.
-            if s + 1 < n {
-                let up = st(s + 1);
-                comp_in.iter_mut().enumerate().for_each(|(j, c)| *c += up[ix.l()] * up[ix.x(j)]);
-                energy += up[ix.l()] * (h_l[s + 1] - h_l[s]);
-            }
-            if s > 0 {
-                let dn = st(s - 1);
-                comp_in.iter_mut().enumerate().for_each(|(j, c)| *c += dn[ix.v()] * dn[ix.y(j)]);
-                energy += dn[ix.v()] * (h_v[s - 1] - h_l[s]);
-            }
-            for (f, _) in self.feeds.iter().enumerate().filter(|(_, st)| **st == s) {
-                let feed = io.inlet(f);
-                comp_in.iter_mut().zip(feed.z()).for_each(|(c, z)| *c += feed.f() * *z);
-                energy += feed.f() * (feed.h() - h_l[s]);
-            }
+            let (liquid_out, vapour_out, energy) = self.stage_flows(io, &sh, s, &mut comp_in);
             if s + 1 == n {
-                energy -= qc;
                 condenser_energy = energy;
-            }
-            if s == 0 {
-                energy += q_r;
             }
             for j in 0..nc {
                 r[o + ix.n(j)] = comp_in[j] - liquid_out * x[j] - vapour_out * v[ix.y(j)];
@@ -427,44 +494,26 @@ impl UnitModel for RigorousColumn {
             };
             r[o + ix.m()] = m - v[ix.n(0)..ix.n(0) + nc].iter().fold(S::from(0.0), |a, b| a + *b);
             r[o + ix.l()] = if s + 1 == n {
-                l - l_in
+                l - sh.l_in
             } else if s == 0 {
-                l - b_in
+                l - sh.b_in
             } else {
                 l - self.weir.flow(m, th.v_liq(t, x))
             };
             r[o + ix.v()] = match (s + 1 == n, self.partial) {
-                (true, true) => vap - d_in,
+                (true, true) => vap - sh.d_in,
                 (true, false) => vap,
                 _ => energy,
             };
         }
         r[internal0 + self.qc()] = match self.condenser {
             Condenser::BubblePoint => condenser_energy,
-            Condenser::Duty(_) => qc - io.input(IN_CONDENSER_DUTY),
+            Condenser::Duty(_) => sh.qc - io.input(IN_CONDENSER_DUTY),
             Condenser::Coolant { t_in, ua, cp, .. } => {
-                qc - coolant_duty(io.input(IN_CONDENSER_DUTY), st(n - 1)[ix.t()], t_in, ua, cp)
+                sh.qc - coolant_duty(io.input(IN_CONDENSER_DUTY), st(n - 1)[ix.t()], t_in, ua, cp)
             }
         };
-        for k in 0..self.n_outlets() {
-            let s = self.outlet_stage(k);
-            let flow = match k {
-                0 => d_in,
-                1 => st(0)[ix.l()],
-                _ => draw_flow[k - 2],
-            };
-            let out = io.outlet(k);
-            let v = st(s);
-            let (h, z0) = if self.outlet_is_vapour(k) { (h_v[s], ix.y(0)) } else { (h_l[s], ix.x(0)) };
-            let rr = &mut r[k * slen..(k + 1) * slen];
-            rr[F] = out.f() - flow;
-            rr[T] = out.t() - v[ix.t()];
-            rr[P] = out.p() - self.pressure[s];
-            rr[H] = out.h() - h;
-            for j in 0..nc {
-                rr[Z0 + j] = out.z()[j] - v[z0 + j];
-            }
-        }
+        self.outlet_residuals(io, &sh, r);
     }
     fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]) {
         profile::guess(self, io, own);

@@ -181,6 +181,58 @@ impl SimpleColumn {
     fn stage(&self, s: usize) -> usize {
         s * self.per_stage()
     }
+
+    /// Per stage: the feeds' component flows `Σ F z_j` and their vapour `Σ (1 − q) F`, with
+    /// `q = (h_V − h_F)/(h_V − h_L)` at the feed stage where it is not given.
+    fn feed_terms<S: Scalar>(&self, io: &UnitIo<'_, S>) -> (Vec<Vec<S>>, Vec<S>) {
+        let (nc, n, ix) = (self.nc(), self.n_stages, StageIdx { nc: self.nc() });
+        let st = |s: usize| io.vars(self.stage(s), self.per_stage());
+        let mut feed_comp = vec![vec![S::from(0.0); nc]; n];
+        let mut feed_vap = vec![S::from(0.0); n];
+        for (k, f) in self.feeds.iter().enumerate() {
+            let s = io.inlet(k);
+            for (acc, z) in feed_comp[f.stage].iter_mut().zip(s.z()) {
+                *acc += s.f() * *z;
+            }
+            let q = match f.q {
+                Some(q) => S::from(q),
+                None => {
+                    let v = st(f.stage);
+                    let hv = io.thermo.h_vap(v[ix.t()], &v[ix.y(0)..ix.y(0) + nc]);
+                    let hl = io.thermo.h_liq(v[ix.t()], &v[ix.x(0)..ix.x(0) + nc]);
+                    (hv - s.h()) / (hv - hl)
+                }
+            };
+            feed_vap[f.stage] += (S::from(1.0) - q) * s.f();
+        }
+        (feed_comp, feed_vap)
+    }
+
+    /// Outlet residuals: distillate from the condenser (flow `D`), bottoms from the reboiler (its
+    /// liquid `L_1`), each side draw from its stage; every outlet leaves as the stage's liquid.
+    fn outlet_residuals<S: Scalar>(&self, io: &UnitIo<'_, S>, d_in: S, draw_flow: &[S], r: &mut [S]) {
+        let (nc, n, ix) = (self.nc(), self.n_stages, StageIdx { nc: self.nc() });
+        let slen = io.layout.stream.len();
+        let p = S::from(self.pressure);
+        let st = |s: usize| io.vars(self.stage(s), self.per_stage());
+        let outlet = |k: usize, s: usize, flow: S, r: &mut [S]| {
+            let out = io.outlet(k);
+            let v = st(s);
+            let rr = &mut r[k * slen..(k + 1) * slen];
+            rr[F] = out.f() - flow;
+            rr[T] = out.t() - v[ix.t()];
+            rr[P] = out.p() - p;
+            rr[H] = out.h() - io.thermo.h_liq(v[ix.t()], &v[ix.x(0)..ix.x(0) + nc]);
+            for j in 0..nc {
+                rr[Z0 + j] = out.z()[j] - v[ix.x(j)];
+            }
+        };
+        outlet(0, n - 1, d_in, r);
+        outlet(1, 0, st(0)[ix.l()], r);
+        for (k, d) in self.draws.iter().enumerate() {
+            outlet(2 + k, d.stage, draw_flow[k], r);
+        }
+    }
 }
 
 impl UnitModel for SimpleColumn {
@@ -283,26 +335,7 @@ impl UnitModel for SimpleColumn {
         let (l_in, v_in, d_in, b_in) =
             (io.input(IN_REFLUX), io.input(IN_BOILUP), io.input(IN_DISTILLATE), io.input(IN_BOTTOMS));
         let mut kbuf = vec![S::from(0.0); nc];
-
-        // Feed contributions and (1 − q) vapour per stage.
-        let mut feed_comp = vec![vec![S::from(0.0); nc]; n];
-        let mut feed_vap = vec![S::from(0.0); n];
-        for (k, f) in self.feeds.iter().enumerate() {
-            let s = io.inlet(k);
-            for (acc, z) in feed_comp[f.stage].iter_mut().zip(s.z()) {
-                *acc += s.f() * *z;
-            }
-            let q = match f.q {
-                Some(q) => S::from(q),
-                None => {
-                    let v = st(f.stage);
-                    let hv = io.thermo.h_vap(v[ix.t()], &v[ix.y(0)..ix.y(0) + nc]);
-                    let hl = io.thermo.h_liq(v[ix.t()], &v[ix.x(0)..ix.x(0) + nc]);
-                    (hv - s.h()) / (hv - hl)
-                }
-            };
-            feed_vap[f.stage] += (S::from(1.0) - q) * s.f();
-        }
+        let (feed_comp, feed_vap) = self.feed_terms(io);
         let draw_flow: Vec<S> = (0..self.draws.len()).map(|k| io.input(4 + k)).collect();
 
         for s in 0..n {
@@ -360,25 +393,7 @@ impl UnitModel for SimpleColumn {
                 v[ix.v()] - st(s - 1)[ix.v()] - feed_vap[s]
             };
         }
-
-        // Outlet streams.
-        let outlet = |k: usize, s: usize, flow: S, r: &mut [S]| {
-            let out = io.outlet(k);
-            let v = st(s);
-            let rr = &mut r[k * slen..(k + 1) * slen];
-            rr[F] = out.f() - flow;
-            rr[T] = out.t() - v[ix.t()];
-            rr[P] = out.p() - p;
-            rr[H] = out.h() - io.thermo.h_liq(v[ix.t()], &v[ix.x(0)..ix.x(0) + nc]);
-            for j in 0..nc {
-                rr[Z0 + j] = out.z()[j] - v[ix.x(j)];
-            }
-        };
-        outlet(0, n - 1, d_in, r);
-        outlet(1, 0, st(0)[ix.l()], r);
-        for (k, d) in self.draws.iter().enumerate() {
-            outlet(2 + k, d.stage, draw_flow[k], r);
-        }
+        self.outlet_residuals(io, d_in, &draw_flow, r);
     }
     fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]) {
         let nc = self.nc();

@@ -108,94 +108,9 @@ impl RigorousColumn {
         let reflux = cx.non_negative("reflux", &c.reflux, flow);
         let distillate = cx.non_negative("distillate", &c.distillate, flow);
         let bottoms = cx.non_negative("bottoms", &c.bottoms, flow);
-        let (mut reboiler_duty, mut condenser, mut efficiency, mut dp) = (f64::NAN, Condenser::BubblePoint, 1.0, 0.0);
-        let (mut steam_latent_heat, mut partial) = (None, false);
-        let mut weir = Weir { length: f64::NAN, height: f64::NAN, area: f64::NAN };
-        if let Some(r) = &c.rigorous {
-            match (&r.reboiler_duty, &r.reboiler) {
-                (Some(q), None) => reboiler_duty = cx.non_negative("rigorous.reboiler_duty", q, Dimension::POWER),
-                (None, Some(s)) => {
-                    reboiler_duty = cx.non_negative("rigorous.reboiler.steam_flow", &s.steam_flow, Dimension::MASS_FLOW);
-                    steam_latent_heat = Some(cx.positive(
-                        "rigorous.reboiler.steam_latent_heat",
-                        &s.steam_latent_heat,
-                        Dimension::SPECIFIC_ENERGY,
-                    ));
-                }
-                (Some(_), Some(_)) => cx.error(
-                    "rigorous.reboiler",
-                    "give either `reboiler_duty` or the steam `reboiler`, not both: remove one",
-                ),
-                (None, None) => cx.error(
-                    "rigorous.reboiler_duty",
-                    r#"the rigorous model needs `reboiler_duty` (e.g. "1.2 MW") or a steam `reboiler` (e.g. {"steam_flow": "1800 kg/h", "steam_latent_heat": "2100 kJ/kg"})"#,
-                ),
-            }
-            if let Some(q) = &r.condenser_duty {
-                condenser = Condenser::Duty(cx.non_negative("rigorous.condenser_duty", q, Dimension::POWER));
-            }
-            if let Some(c) = &r.condenser {
-                if r.condenser_duty.is_some() {
-                    cx.error(
-                        "rigorous.condenser",
-                        "give either `condenser_duty` or the coolant `condenser`, not both: remove one",
-                    );
-                }
-                let cp =
-                    c.cp.as_ref()
-                        .map_or(4184.0, |v| cx.positive("rigorous.condenser.cp", v, Dimension::HEAT_CAPACITY_MASS));
-                condenser = Condenser::Coolant {
-                    flow: cx.positive("rigorous.condenser.coolant_flow", &c.coolant_flow, Dimension::MASS_FLOW),
-                    t_in: cx.positive("rigorous.condenser.coolant_T_in", &c.coolant_t_in, Dimension::TEMPERATURE),
-                    ua: cx.positive("rigorous.condenser.ua", &c.ua, Dimension::UA),
-                    cp,
-                };
-            }
-            partial = r.condenser_type == CondenserType::Partial;
-            if partial && (r.condenser_duty.is_some() || r.condenser.is_some()) {
-                cx.error(
-                    "rigorous.condenser_type",
-                    "a partial condenser keeps its drum at the bubble point, so its duty is computed: remove \
-                     `condenser_duty` / `condenser`, or make the condenser `total`",
-                );
-            }
-            if let Some(e) = r.murphree_efficiency {
-                if !(e.is_finite() && e > 0.0 && e <= 1.0) {
-                    cx.error(
-                        "rigorous.murphree_efficiency",
-                        format!("must lie in (0, 1] (1 = equilibrium trays); got {e}"),
-                    );
-                }
-                efficiency = e;
-            }
-            dp = r
-                .tray_pressure_drop
-                .as_ref()
-                .map_or(0.0, |v| cx.non_negative("rigorous.tray_pressure_drop", v, Dimension::PRESSURE));
-            weir = Weir {
-                length: cx.positive("rigorous.weir_length", &r.weir_length, Dimension::LENGTH),
-                height: cx.non_negative("rigorous.weir_height", &r.weir_height, Dimension::LENGTH),
-                area: cx.positive("rigorous.tray_area", &r.tray_area, Dimension::AREA),
-            };
-        }
-        if c.feeds.is_empty() {
-            cx.error("feeds", "give at least one feed, e.g. [{\"port\": \"feed\", \"stage\": 10}]");
-        }
-        let mut feeds = Vec::new();
-        let mut feed_ports: Vec<String> = Vec::new();
-        for (k, f) in c.feeds.iter().enumerate() {
-            if f.stage < 1 || f.stage > n {
-                cx.error(
-                    &format!("feeds[{k}].stage"),
-                    format!("must be between 1 (reboiler) and {n} (condenser); got {}", f.stage),
-                );
-            }
-            if feed_ports.contains(&f.port) {
-                cx.error(&format!("feeds[{k}].port"), format!("port `{}` is used twice", f.port));
-            }
-            feed_ports.push(f.port.clone());
-            feeds.push(f.stage.saturating_sub(1));
-        }
+        let RigorousData { reboiler_duty, steam_latent_heat, condenser, partial, efficiency, dp, weir } =
+            c.rigorous.as_ref().map_or_else(RigorousData::default, |r| rigorous_data(r, &mut cx));
+        let (feeds, feed_ports) = feed_stages(c, n, &mut cx);
         let (draws, draw_ports) = side_draws(c, n, &feed_ports, &mut cx);
         check_ranges(&mut cx, &weir, (p_top, dp), n);
         let pressure = (0..n).map(|s| p_top + (n - 1 - s) as f64 * dp).collect();
@@ -226,6 +141,122 @@ impl RigorousColumn {
         };
         cx.finish(column)
     }
+}
+
+/// The `rigorous` block's data in SI: heating, condenser, tray efficiency, pressure drop, weir.
+struct RigorousData {
+    reboiler_duty: f64,
+    steam_latent_heat: Option<f64>,
+    condenser: Condenser,
+    partial: bool,
+    efficiency: f64,
+    dp: f64,
+    weir: Weir,
+}
+
+impl Default for RigorousData {
+    /// Without a `rigorous` block (an error the caller reports): no duty, equilibrium trays.
+    fn default() -> RigorousData {
+        RigorousData {
+            reboiler_duty: f64::NAN,
+            steam_latent_heat: None,
+            condenser: Condenser::BubblePoint,
+            partial: false,
+            efficiency: 1.0,
+            dp: 0.0,
+            weir: Weir { length: f64::NAN, height: f64::NAN, area: f64::NAN },
+        }
+    }
+}
+
+/// Read and check the `rigorous` block `r`, recording its errors in `cx`.
+fn rigorous_data(r: &RigorousConfig, cx: &mut BuildCx<'_>) -> RigorousData {
+    let mut d = RigorousData::default();
+    match (&r.reboiler_duty, &r.reboiler) {
+            (Some(q), None) => d.reboiler_duty = cx.non_negative("rigorous.reboiler_duty", q, Dimension::POWER),
+            (None, Some(s)) => {
+                d.reboiler_duty = cx.non_negative("rigorous.reboiler.steam_flow", &s.steam_flow, Dimension::MASS_FLOW);
+                d.steam_latent_heat = Some(cx.positive(
+                    "rigorous.reboiler.steam_latent_heat",
+                    &s.steam_latent_heat,
+                    Dimension::SPECIFIC_ENERGY,
+                ));
+            }
+            (Some(_), Some(_)) => cx.error(
+                "rigorous.reboiler",
+                "give either `reboiler_duty` or the steam `reboiler`, not both: remove one",
+            ),
+            (None, None) => cx.error(
+                "rigorous.reboiler_duty",
+                r#"the rigorous model needs `reboiler_duty` (e.g. "1.2 MW") or a steam `reboiler` (e.g. {"steam_flow": "1800 kg/h", "steam_latent_heat": "2100 kJ/kg"})"#,
+            ),
+        }
+    if let Some(q) = &r.condenser_duty {
+        d.condenser = Condenser::Duty(cx.non_negative("rigorous.condenser_duty", q, Dimension::POWER));
+    }
+    if let Some(c) = &r.condenser {
+        if r.condenser_duty.is_some() {
+            cx.error(
+                "rigorous.condenser",
+                "give either `condenser_duty` or the coolant `condenser`, not both: remove one",
+            );
+        }
+        let cp =
+            c.cp.as_ref().map_or(4184.0, |v| cx.positive("rigorous.condenser.cp", v, Dimension::HEAT_CAPACITY_MASS));
+        d.condenser = Condenser::Coolant {
+            flow: cx.positive("rigorous.condenser.coolant_flow", &c.coolant_flow, Dimension::MASS_FLOW),
+            t_in: cx.positive("rigorous.condenser.coolant_T_in", &c.coolant_t_in, Dimension::TEMPERATURE),
+            ua: cx.positive("rigorous.condenser.ua", &c.ua, Dimension::UA),
+            cp,
+        };
+    }
+    d.partial = r.condenser_type == CondenserType::Partial;
+    if d.partial && (r.condenser_duty.is_some() || r.condenser.is_some()) {
+        cx.error(
+            "rigorous.condenser_type",
+            "a partial condenser keeps its drum at the bubble point, so its duty is computed: remove \
+                 `condenser_duty` / `condenser`, or make the condenser `total`",
+        );
+    }
+    if let Some(e) = r.murphree_efficiency {
+        if !(e.is_finite() && e > 0.0 && e <= 1.0) {
+            cx.error("rigorous.murphree_efficiency", format!("must lie in (0, 1] (1 = equilibrium trays); got {e}"));
+        }
+        d.efficiency = e;
+    }
+    d.dp = r
+        .tray_pressure_drop
+        .as_ref()
+        .map_or(0.0, |v| cx.non_negative("rigorous.tray_pressure_drop", v, Dimension::PRESSURE));
+    d.weir = Weir {
+        length: cx.positive("rigorous.weir_length", &r.weir_length, Dimension::LENGTH),
+        height: cx.non_negative("rigorous.weir_height", &r.weir_height, Dimension::LENGTH),
+        area: cx.positive("rigorous.tray_area", &r.tray_area, Dimension::AREA),
+    };
+    d
+}
+
+/// The feeds' stages (0-based) and port names, each stage within the column and each port used once.
+fn feed_stages(c: &ColumnConfig, n: usize, cx: &mut BuildCx<'_>) -> (Vec<usize>, Vec<String>) {
+    if c.feeds.is_empty() {
+        cx.error("feeds", "give at least one feed, e.g. [{\"port\": \"feed\", \"stage\": 10}]");
+    }
+    let mut feeds = Vec::new();
+    let mut feed_ports: Vec<String> = Vec::new();
+    for (k, f) in c.feeds.iter().enumerate() {
+        if f.stage < 1 || f.stage > n {
+            cx.error(
+                &format!("feeds[{k}].stage"),
+                format!("must be between 1 (reboiler) and {n} (condenser); got {}", f.stage),
+            );
+        }
+        if feed_ports.contains(&f.port) {
+            cx.error(&format!("feeds[{k}].port"), format!("port `{}` is used twice", f.port));
+        }
+        feed_ports.push(f.port.clone());
+        feeds.push(f.stage.saturating_sub(1));
+    }
+    (feeds, feed_ports)
 }
 
 /// Tray geometry and pressures within the range of real columns: weirs of a few cm (the Francis

@@ -1,0 +1,139 @@
+//! Relay and step tests of a flowsheet's loop on its nonlinear dynamic model, the other loops
+//! as the file has them: the loop goes to manual at its steady state and its `op_manual` is moved
+//! by the test ([`super::bench`]) through a [`Session`] of the plant.
+//!
+//! Defaults come from the loop's exact linear model at the steady state: the relay's scan is
+//! `P_u/200` of the linear ultimate period (so that the scan's delay, ~`Δ/2`, moves `P_u` by about
+//! 0.25 %), and a step test samples at `T/100` for up to `30 T`, `T` the element's mean residence
+//! time `−g'(0)/g(0)` (for an integrating element, that of `s g(s)`), both read from `g(jω)` at a
+//! frequency far below the element's dynamics.
+
+use faer::c64;
+use plantwide_flowsheet::Plant;
+use plantwide_solve::dynamic::{Session, SimError};
+
+use super::bench::{Bench, RelayCycle, SampledRelay, StepTest, relay, step};
+use super::fit::{ModelFit, ModelOrder, fit_step};
+use super::loops::{LoopResponse, Measurement, PlantLoop, in_manual, loop_model, loop_ultimates};
+use crate::TuneError;
+
+/// The plant with one loop in manual, run by a [`Session`].
+struct PlantBench<'a> {
+    session: Session,
+    l: &'a PlantLoop,
+}
+
+impl Bench for PlantBench<'_> {
+    type Error = SimError;
+    fn time(&self) -> f64 {
+        self.session.time()
+    }
+    fn measurement(&self) -> f64 {
+        self.session.state()[self.l.pv]
+    }
+    fn set_output(&mut self, u: f64) {
+        self.session.set_input(self.l.op_manual, u);
+    }
+    fn advance_to(&mut self, t: f64) -> Result<(), SimError> {
+        self.session.advance_to(t)
+    }
+}
+
+fn bench<'a>(plant: &Plant, x: &[f64], l: &'a PlantLoop) -> Result<PlantBench<'a>, TuneError> {
+    let manual = in_manual(plant, x, std::slice::from_ref(l));
+    let session = Session::new(&manual, x).map_err(|e| TuneError::Simulation(Box::new(e)))?;
+    Ok(PlantBench { session, l })
+}
+
+/// Options of a relay test; `None` takes the default.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct RelayOptions {
+    /// Relay amplitude (output units; default 5 % of the output's steady value).
+    pub amplitude: Option<f64>,
+    /// Hysteresis (measurement units; default 0).
+    pub hysteresis: Option<f64>,
+    /// Scan \[s\] (default `P_u/200` of the linear model).
+    pub scan: Option<f64>,
+}
+
+/// A relay test of loop `l` at the steady state `x`.
+///
+/// # Errors
+/// [`TuneError::NoPhaseCrossover`] when the linear model already shows that no cycle exists,
+/// [`TuneError::Relay`] when the test finds none or the plant cannot be integrated.
+pub fn relay_loop(plant: &Plant, x: &[f64], l: &PlantLoop, o: RelayOptions) -> Result<RelayCycle, TuneError> {
+    let model = loop_model(plant, x, std::slice::from_ref(l))?;
+    let gain_sign = model.ss.steady_gain().map(|g| g[(0, 0)].signum()).unwrap_or(1.0);
+    let response = LoopResponse::new(model, Measurement::default());
+    let linear = loop_ultimates(&response, std::slice::from_ref(l))?[0];
+    let u0 = x[l.op];
+    let settings = SampledRelay {
+        amplitude: o.amplitude.unwrap_or(0.05 * u0.abs()),
+        hysteresis: o.hysteresis.unwrap_or(0.0),
+        scan: o.scan.unwrap_or(linear.pu / 200.0),
+        sign: if linear.ku.is_finite() { linear.ku.signum() } else { gain_sign },
+        n_cycles: 3,
+        tolerance: 1e-2,
+        max_switches: 60,
+    };
+    if !(settings.amplitude > 0.0) {
+        return Err(TuneError::RelayAmplitude { controller: l.name.clone(), amplitude: settings.amplitude });
+    }
+    let mut b = bench(plant, x, l)?;
+    relay(&mut b, u0, &settings).map_err(|e| TuneError::Relay { controller: l.name.clone(), source: Box::new(e) })
+}
+
+/// Options of a step test; `None` takes the default.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct StepOptions {
+    /// Output step (output units; default 5 % of its steady value).
+    pub step: Option<f64>,
+    /// Sampling interval \[s\].
+    pub scan: Option<f64>,
+    /// Model to fit (default FOPTD, IPDT for an integrating element).
+    pub order: Option<ModelOrder>,
+}
+
+/// A step test of loop `l` at the steady state `x` and the model fitted to it, with whether the
+/// response settled.
+///
+/// # Errors
+/// [`TuneError::Simulation`] when the plant cannot be integrated, [`TuneError::Fit`] when the
+/// record determines no model.
+pub fn step_loop(plant: &Plant, x: &[f64], l: &PlantLoop, o: StepOptions) -> Result<(ModelFit, bool), TuneError> {
+    let (t_mean, integrating) = residence_time(plant, x, l)?;
+    let order = o.order.unwrap_or(if integrating { ModelOrder::Integrating } else { ModelOrder::Foptd });
+    let u0 = x[l.op];
+    let settings = StepTest {
+        step: o.step.unwrap_or(0.05 * u0.abs()),
+        scan: o.scan.unwrap_or(t_mean / 100.0),
+        max_duration: if integrating { 5.0 * t_mean } else { 30.0 * t_mean },
+        settle: 2e-3,
+    };
+    if !(settings.step != 0.0 && settings.step.is_finite()) {
+        return Err(TuneError::RelayAmplitude { controller: l.name.clone(), amplitude: settings.step });
+    }
+    let mut b = bench(plant, x, l)?;
+    let (record, settled) = step(&mut b, u0, &settings).map_err(|e| TuneError::Simulation(Box::new(e)))?;
+    let fit = fit_step(&record, order).map_err(TuneError::from)?;
+    Ok((fit, settled || integrating))
+}
+
+/// The element's mean residence time `T = −g'(0)/g(0)` \[s\] and whether it integrates: from
+/// `g(jω) ≈ g(0)(1 − jωT)` at ω a million times below the slowest nonzero eigenvalue (for an
+/// integrating element, `s g(s)` in place of `g`).
+fn residence_time(plant: &Plant, x: &[f64], l: &PlantLoop) -> Result<(f64, bool), TuneError> {
+    let model = loop_model(plant, x, std::slice::from_ref(l))?;
+    let ev = model.ss.eigenvalues().map_err(|e| TuneError::Linear(Box::new(e)))?;
+    let scale = ev.iter().map(|v| v.norm()).fold(0.0, f64::max);
+    let slow = ev.iter().map(|v| v.norm()).filter(|m| *m > 1e-10 * scale).fold(f64::INFINITY, f64::min);
+    let w = 1e-6 * slow;
+    let g = LoopResponse::new(model, Measurement::default()).at(w)[(0, 0)];
+    let integrating = g.im.abs() > g.re.abs();
+    let h = if integrating { g * c64::new(0.0, w) } else { g };
+    let t = -h.im / (w * h.re);
+    if !(t.is_finite() && t > 0.0) {
+        return Err(TuneError::ResidenceTime { controller: l.name.clone(), value: t });
+    }
+    Ok((t, integrating))
+}

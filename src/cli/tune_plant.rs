@@ -1,0 +1,123 @@
+//! `plantwide tune FILE --loop CTRL --method relay|zn|tl|simc|imc|averaging` and
+//! `plantwide tune FILE --loops C1,C2,… --method blt`: tune the PID loops of a flowsheet at its
+//! steady state and optionally write the settings into a copy of the file (`--write`).
+
+use std::path::Path;
+
+use plantwide::flowsheet::Plant;
+use plantwide::studies::tune::averaging::AveragingForm;
+use plantwide::studies::tune::flowsheet::{FlowsheetTuning, averaging_loop, blt_loops, edits};
+use plantwide::studies::tune::loops::{Measurement, PlantLoop, plant_loop};
+use plantwide::units::{Dimension, parse_quantity_as};
+
+use super::CliError;
+use super::linearize::TimeUnit;
+use super::steady::{converge, load_with_overrides};
+use super::tune::{FormArg, MethodArg, TuneArgs, tune_error};
+
+/// Tune the loops of `a.file`.
+pub fn run(a: &TuneArgs, tu: &TimeUnit) -> Result<(), CliError> {
+    let Some(file) = &a.file else { return Err(CliError::user("give a flowsheet FILE or --tf MODEL".into())) };
+    let (plant, u) = load_with_overrides(file, &a.set)?;
+    let names = loop_names(a)?;
+    let loops: Vec<PlantLoop> = names.iter().map(|n| plant_loop(&plant, n)).collect::<Result<_, _>>().map_err(tune_error)?;
+    let x = converge(&plant, &u)?.x;
+    let tuning = match a.method {
+        MethodArg::Blt => blt_loops(&plant, &x, &loops, measurement(a)?).map_err(tune_error)?,
+        MethodArg::Averaging => averaging(a, &plant, &x, &loops[0])?,
+        m => super::tune_bench::run(a, &plant, &x, &loops[0], m)?,
+    };
+    if let Some(out) = &a.write {
+        write(file, out, &plant, &tuning, tu)?;
+    }
+    let shown = tuning.clone().in_time_unit(tu.seconds);
+    if a.json {
+        outln!("{}", serde_json::to_string_pretty(&shown).map_err(|e| CliError::user(e.to_string()))?);
+    } else {
+        print_table(&shown, &plant, tu);
+    }
+    Ok(())
+}
+
+/// The loops asked for: `--loops` for BLT (at least one), `--loop` for the single-loop methods.
+fn loop_names(a: &TuneArgs) -> Result<Vec<String>, CliError> {
+    match (a.method, &a.loop_name, a.loops.is_empty()) {
+        (MethodArg::Blt, None, false) => Ok(a.loops.clone()),
+        (MethodArg::Blt, Some(l), true) => Ok(vec![l.clone()]),
+        (MethodArg::Blt, _, _) => Err(CliError::user("--method blt tunes the loops of --loops C1,C2,… together".into())),
+        (_, Some(l), true) => Ok(vec![l.clone()]),
+        _ => Err(CliError::user("this method tunes one loop: give --loop CTRL (--loops is for --method blt)".into())),
+    }
+}
+
+/// An optional quantity option in SI.
+pub(super) fn quantity(text: &Option<String>, flag: &str, dim: Dimension) -> Result<Option<f64>, CliError> {
+    text.as_ref()
+        .map(|t| parse_quantity_as(t, dim).map_err(|e| CliError::user(format!("--{flag} {t}: {e}"))))
+        .transpose()
+}
+
+fn measurement(a: &TuneArgs) -> Result<Measurement, CliError> {
+    let dead_time = quantity(&a.measurement_dead_time, "measurement-dead-time", Dimension::TIME)?.unwrap_or(0.0);
+    let lag = quantity(&a.measurement_lag, "measurement-lag", Dimension::TIME)?.unwrap_or(0.0);
+    if dead_time < 0.0 || lag < 0.0 {
+        return Err(CliError::user("--measurement-dead-time and --measurement-lag must not be negative".into()));
+    }
+    Ok(Measurement { dead_time, lag })
+}
+
+fn averaging(a: &TuneArgs, plant: &Plant, x: &[f64], l: &PlantLoop) -> Result<FlowsheetTuning, CliError> {
+    let dim = |v: usize| plant.vars()[v].spec.dim;
+    let du = quantity(&a.flow_change, "flow-change", dim(l.op))?;
+    let band = quantity(&a.level_band, "level-band", dim(l.pv))?;
+    let form = match a.form {
+        FormArg::P => AveragingForm::P,
+        FormArg::Pi => AveragingForm::Pi,
+    };
+    averaging_loop(plant, x, l, du, band, form).map_err(tune_error)
+}
+
+/// Write `file` with the tuned settings to `out`.
+fn write(file: &Path, out: &Path, plant: &Plant, t: &FlowsheetTuning, tu: &TimeUnit) -> Result<(), CliError> {
+    let text = plantwide::flowsheet::read_text(file).map_err(|e| CliError::user(e.to_string()))?;
+    let edits = edits(plant, t, &tu.name).map_err(tune_error)?;
+    let name = file.display().to_string();
+    let new = plantwide::flowsheet::edit::edit_fields(&text, &name, &edits).map_err(|e| CliError::user(e.to_string()))?;
+    std::fs::write(out, new).map_err(|e| CliError::user(format!("{}: cannot write: {e}", out.display())))
+}
+
+fn print_table(t: &FlowsheetTuning, plant: &Plant, tu: &TimeUnit) {
+    match t.detuning_factor {
+        Some(f) => outln!("tuning of `{}`: {} (Luyben 1986), detuning factor F = {f:.4}\n", plant.name(), t.method),
+        None => outln!("tuning of `{}`: {}\n", plant.name(), t.method),
+    }
+    let u = &tu.name;
+    outln!(
+        "{:<18} {:<18} {:>11} {:>11} {:>12} {:>11} {:>11}  action",
+        "controller",
+        "measurement",
+        "Ku",
+        format!("Pu [{u}]"),
+        "Kc (SI)",
+        format!("τI [{u}]"),
+        format!("τD [{u}]")
+    );
+    let opt = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.5}"));
+    for l in &t.loops {
+        let warn = l.file_action.map_or(String::new(), |f| format!("  (the file has {f}: the loop would run away)"));
+        outln!(
+            "{:<18} {:<18} {:>11} {:>11} {:>12.5e} {:>11} {:>11}  {}{warn}",
+            l.controller,
+            l.output,
+            opt(l.ku),
+            opt(l.pu),
+            l.kc.abs(),
+            opt(l.tau_i),
+            opt(l.tau_d),
+            l.action
+        );
+        if let Some(av) = &l.averaging {
+            outln!("  averaging {:?}: largest level deviation {} at {:.4} {u}", av.form, av.band, av.time);
+        }
+    }
+}
