@@ -8,6 +8,7 @@
 //!   central differences extrapolated (Richardson) and verified, never returned unverified.
 //! - [`measures`], [`min_cond`]: RGA, RGA number, SVD, condition number and its minimized value,
 //!   Niederlinski index, block relative gain, scaling, Morari resiliency index.
+//! - [`figures`]: figures of merit of a dynamic run (IAE, ISE, largest deviation, settling time).
 //! - [`tf`]: transfer-function matrix files (gain, lags, leads, dead time per element).
 //! - [`sensitivity`]: disturbance sweeps with the control structure active, by continuation.
 //! - [`sensors`]: tray-temperature sensor selection (SVD and slope criteria).
@@ -21,6 +22,7 @@
 
 pub mod error;
 pub mod export;
+pub mod figures;
 pub mod linear;
 pub mod measures;
 pub mod min_cond;

@@ -11,6 +11,7 @@ pub mod guess;
 pub mod overrides;
 pub mod parse;
 pub mod plant;
+pub mod query;
 pub mod scenario;
 pub mod spec;
 pub mod tears;
