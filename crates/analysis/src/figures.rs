@@ -69,3 +69,40 @@ fn path_summary(res: &SimulationResult, k: usize, t_first: f64) -> PathSummary {
         settling_time,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use plantwide_solve::dae::BdfStats;
+    use plantwide_solve::dynamic::{Column, Conservation};
+
+    /// A unit step recorded at t = 0, 1, 2 s: `y = [0, 1, 1]`, once against its initial value and
+    /// once against a setpoint of 1.
+    fn step(reference: Option<Vec<f64>>) -> SimulationResult {
+        SimulationResult {
+            columns: vec![Column { path: "y".into(), unit: "m".into(), si_unit: "m".into() }],
+            times: vec![0.0, 1.0, 2.0],
+            rows: vec![vec![0.0], vec![1.0], vec![1.0]],
+            references: vec![reference],
+            events: Vec::new(),
+            x: Vec::new(),
+            t: 2.0,
+            stats: BdfStats::default(),
+            conservation: Conservation::new(&[], None, [&[], &[]], &[], &[]),
+        }
+    }
+
+    #[test]
+    fn trapezoid_integrals_deviation_and_settling_of_a_step() {
+        // e = [0, 1, 1]: IAE = ISE = ½·(0 + 1) + ½·(1 + 1) = 1.5; settled (2 % band) from t = 1 s.
+        let s = &summary(&step(None))[0];
+        assert_eq!(s.reference, "initial");
+        assert!((s.iae - 1.5).abs() < 1e-15 && (s.ise - 1.5).abs() < 1e-15, "{s:?}");
+        assert!((s.max_deviation - 1.0).abs() < 1e-15 && s.settling_time == Some(1.0), "{s:?}");
+        // Against a setpoint of 1: e = [−1, 0, 0], IAE = ISE = ½, the largest deviation −1.
+        let s = &summary(&step(Some(vec![1.0; 3])))[0];
+        assert_eq!(s.reference, "setpoint");
+        assert!((s.iae - 0.5).abs() < 1e-15 && (s.ise - 0.5).abs() < 1e-15, "{s:?}");
+        assert!((s.max_deviation + 1.0).abs() < 1e-15, "{s:?}");
+    }
+}

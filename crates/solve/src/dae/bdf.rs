@@ -177,6 +177,14 @@ fn change_d(d: &mut [Vec<f64>], order: usize, factor: f64) {
 
 /// One corrector problem: at `t_new`, from the predictor `x_pred`, with `c = h/γ_q`, `ψ`, the
 /// error weights `scale` and the Newton tolerance `tol`.
+/// A converged corrector: the Newton iterations it took, the new state and the correction
+/// `d = x − x⁽⁰⁾`.
+struct Corrected {
+    iters: usize,
+    x: Vec<f64>,
+    d: Vec<f64>,
+}
+
 #[derive(Clone, Copy)]
 struct Corrector<'a> {
     t_new: f64,
@@ -395,7 +403,7 @@ impl Bdf {
             let scale = self.scale(sys, &x_pred);
             let c = h / self.gamma[order];
             let corrector = Corrector { t_new, x_pred: &x_pred, c, psi: &psi, scale: &scale, tol: newton_tol };
-            let Some((iters, x_new, d)) = self.correct(sys, &corrector, &mut lu_ok)? else {
+            let Some(Corrected { iters, x: x_new, d }) = self.correct(sys, &corrector, &mut lu_ok)? else {
                 self.st.stats.n_newton_failures += 1;
                 self.scale_step(h_abs, order, 0.5);
                 lu_ok = false;
@@ -434,13 +442,13 @@ impl Bdf {
 
     /// Solve the corrector, refactorizing `M − cJ` when `c` or the Jacobian changed
     /// (`lu_ok` false) and re-evaluating a stale Jacobian once after a Newton failure; returns
-    /// (iterations, x, d), or `None` if Newton failed with a current Jacobian.
+    /// the converged corrector, or `None` if Newton failed with a current Jacobian.
     fn correct(
         &mut self,
         sys: &dyn DaeSystem,
         corr: &Corrector<'_>,
         lu_ok: &mut bool,
-    ) -> Result<Option<(usize, Vec<f64>, Vec<f64>)>, DaeError> {
+    ) -> Result<Option<Corrected>, DaeError> {
         let n = corr.x_pred.len();
         loop {
             if !*lu_ok || self.st.lu_c != Some(corr.c) {
@@ -449,7 +457,7 @@ impl Bdf {
             }
             let (converged, iters, x, d) = self.newton(sys, corr);
             if converged {
-                return Ok(Some((iters, x, d)));
+                return Ok(Some(Corrected { iters, x, d }));
             }
             if self.st.current_jac {
                 return Ok(None);
