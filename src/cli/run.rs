@@ -52,7 +52,7 @@ fn read(path: &Path) -> Result<String, CliError> {
 pub fn run(args: &RunArgs) -> Result<(), CliError> {
     let flowsheet_text = read(&args.file)?;
     let (mut plant, u) = load_with_overrides(&args.file, &args.set)?;
-    plant.inputs.iter_mut().zip(&u).for_each(|(info, v)| info.value = *v);
+    plant.set_input_values(&u);
     let scen_name = args.scenario.display().to_string();
     let spec = parse_scenario(&read(&args.scenario)?, &scen_name).map_err(|e| CliError::user(e.to_string()))?;
     let limits = Limits::from_env().map_err(|e| CliError::user(e.to_string()))?;
@@ -78,7 +78,7 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
     let started = Instant::now();
     let mut write_error = None;
     let fp = fingerprint(&flowsheet_text, &args.set);
-    let result = simulate(&mut plant, &sc, start, &fp, &mut |p| match p {
+    let result = simulate(&plant, &sc, start, &fp, &mut |p| match p {
         Progress::Step { t, duration } => {
             let real = started.elapsed().as_secs_f64().max(1e-9);
             bar.set_position((1000.0 * t / duration) as u64);
@@ -92,10 +92,10 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
         }
     });
     bar.finish_and_clear();
-    let title = if sc.name.is_empty() { plant.name.clone() } else { format!("{}: {}", plant.name, sc.name) };
+    let title = if sc.name.is_empty() { plant.name().to_string() } else { format!("{}: {}", plant.name(), sc.name) };
     let res = match result {
         Ok(res) => res,
-        Err(e @ SimError::Snapshot { .. }) => return Err(CliError::user(e.to_string())),
+        Err(e @ (SimError::Snapshot { .. } | SimError::Wiring(_))) => return Err(CliError::user(e.to_string())),
         Err(SimError::Conservation { file, source, result }) => {
             // The whole run is there: write and summarize it, then fail on the balance.
             write_trends_files(args, &result, &title, &sc.time_unit, time_factor)?;
@@ -178,7 +178,7 @@ fn print_summary(
     time_factor: f64,
     time_unit: &str,
 ) -> Result<(), CliError> {
-    let summary = res.summary();
+    let summary = plantwide::analysis::figures::summary(res);
     let s = &res.stats;
     if json {
         let finals: serde_json::Map<String, serde_json::Value> =

@@ -2,12 +2,12 @@
 //! step test with a model fit (`simc`, `imc`) on the dynamic model.
 
 use plantwide::flowsheet::Plant;
+use plantwide::studies::tune::PiRule;
 use plantwide::studies::tune::fit::ModelOrder;
 use plantwide::studies::tune::flowsheet::{FlowsheetTuning, from_relay, from_step};
 use plantwide::studies::tune::loops::PlantLoop;
 use plantwide::studies::tune::plant_tests::{RelayOptions, StepOptions, relay_loop, step_loop};
 use plantwide::studies::tune::rules::ModelRule;
-use plantwide::studies::tune::PiRule;
 use plantwide::units::Dimension;
 
 use super::CliError;
@@ -15,7 +15,13 @@ use super::tune::{MethodArg, ModelArg, TuneArgs, tune_error};
 use super::tune_plant::quantity;
 
 /// Run the test `method` asks for on loop `l` at the steady state `x`.
-pub fn run(a: &TuneArgs, plant: &Plant, x: &[f64], l: &PlantLoop, method: MethodArg) -> Result<FlowsheetTuning, CliError> {
+pub fn run(
+    a: &TuneArgs,
+    plant: &Plant,
+    x: &[f64],
+    l: &PlantLoop,
+    method: MethodArg,
+) -> Result<FlowsheetTuning, CliError> {
     let (out_dim, pv_dim) = (plant.vars()[l.op].spec.dim, plant.vars()[l.pv].spec.dim);
     let scan = quantity(&a.scan, "scan", Dimension::TIME)?;
     match method {

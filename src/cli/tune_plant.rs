@@ -17,10 +17,11 @@ use super::tune::{FormArg, MethodArg, TuneArgs, tune_error};
 
 /// Tune the loops of `a.file`.
 pub fn run(a: &TuneArgs, tu: &TimeUnit) -> Result<(), CliError> {
-    let Some(file) = &a.file else { return Err(CliError::user("give a flowsheet FILE or --tf MODEL".into())) };
+    let Some(file) = &a.file else { return Err(CliError::user("give a flowsheet FILE or --tf MODEL")) };
     let (plant, u) = load_with_overrides(file, &a.set)?;
     let names = loop_names(a)?;
-    let loops: Vec<PlantLoop> = names.iter().map(|n| plant_loop(&plant, n)).collect::<Result<_, _>>().map_err(tune_error)?;
+    let loops: Vec<PlantLoop> =
+        names.iter().map(|n| plant_loop(&plant, n)).collect::<Result<_, _>>().map_err(tune_error)?;
     let x = converge(&plant, &u)?.x;
     let tuning = match a.method {
         MethodArg::Blt => blt_loops(&plant, &x, &loops, measurement(a)?).map_err(tune_error)?,
@@ -44,9 +45,9 @@ fn loop_names(a: &TuneArgs) -> Result<Vec<String>, CliError> {
     match (a.method, &a.loop_name, a.loops.is_empty()) {
         (MethodArg::Blt, None, false) => Ok(a.loops.clone()),
         (MethodArg::Blt, Some(l), true) => Ok(vec![l.clone()]),
-        (MethodArg::Blt, _, _) => Err(CliError::user("--method blt tunes the loops of --loops C1,C2,… together".into())),
+        (MethodArg::Blt, _, _) => Err(CliError::user("--method blt tunes the loops of --loops C1,C2,… together")),
         (_, Some(l), true) => Ok(vec![l.clone()]),
-        _ => Err(CliError::user("this method tunes one loop: give --loop CTRL (--loops is for --method blt)".into())),
+        _ => Err(CliError::user("this method tunes one loop: give --loop CTRL (--loops is for --method blt)")),
     }
 }
 
@@ -61,7 +62,7 @@ fn measurement(a: &TuneArgs) -> Result<Measurement, CliError> {
     let dead_time = quantity(&a.measurement_dead_time, "measurement-dead-time", Dimension::TIME)?.unwrap_or(0.0);
     let lag = quantity(&a.measurement_lag, "measurement-lag", Dimension::TIME)?.unwrap_or(0.0);
     if dead_time < 0.0 || lag < 0.0 {
-        return Err(CliError::user("--measurement-dead-time and --measurement-lag must not be negative".into()));
+        return Err(CliError::user("--measurement-dead-time and --measurement-lag must not be negative"));
     }
     Ok(Measurement { dead_time, lag })
 }
@@ -82,7 +83,8 @@ fn write(file: &Path, out: &Path, plant: &Plant, t: &FlowsheetTuning, tu: &TimeU
     let text = plantwide::flowsheet::read_text(file).map_err(|e| CliError::user(e.to_string()))?;
     let edits = edits(plant, t, &tu.name).map_err(tune_error)?;
     let name = file.display().to_string();
-    let new = plantwide::flowsheet::edit::edit_fields(&text, &name, &edits).map_err(|e| CliError::user(e.to_string()))?;
+    let new =
+        plantwide::flowsheet::edit::edit_fields(&text, &name, &edits).map_err(|e| CliError::user(e.to_string()))?;
     std::fs::write(out, new).map_err(|e| CliError::user(format!("{}: cannot write: {e}", out.display())))
 }
 

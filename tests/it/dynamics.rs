@@ -13,8 +13,8 @@ use crate::harness::{self, flowsheet};
 
 /// Load a shipped flowsheet with `--set`-style field overrides, converge it, run `scenario`.
 fn run(name: &str, fields: &[(&str, &str)], scenario: &str) -> (Plant, Vec<f64>, SimulationResult) {
-    let (mut plant, x0) = converged(name, fields);
-    let res = run_from(&mut plant, scenario, Start::Steady(&x0), &mut |_| {});
+    let (plant, x0) = converged(name, fields);
+    let res = run_from(&plant, scenario, Start::Steady(&x0), &mut |_| {});
     (plant, x0, res)
 }
 
@@ -31,7 +31,7 @@ fn converged(name: &str, fields: &[(&str, &str)]) -> (Plant, Vec<f64>) {
 }
 
 fn run_from(
-    plant: &mut Plant,
+    plant: &Plant,
     scenario: &str,
     start: Start<'_>,
     observer: &mut dyn FnMut(Progress<'_>),
@@ -248,9 +248,9 @@ fn snapshot_and_resume_continue_the_uninterrupted_trajectory() {
         r#""duration": "2000 min","#,
         r#""duration": "1200 min", "snapshots": [{"at": "700 min", "file": "snap.json"}],"#,
     );
-    let (mut plant, x0) = converged("column_a.json", &[]);
+    let (plant, x0) = converged("column_a.json", &[]);
     let mut saved = None;
-    let full = run_from(&mut plant, &scenario, Start::Steady(&x0), &mut |p| {
+    let full = run_from(&plant, &scenario, Start::Steady(&x0), &mut |p| {
         if let Progress::Snapshot { file, snapshot } = p {
             assert_eq!(file, "snap.json");
             saved = Some(serde_json::to_string(snapshot).unwrap());
@@ -258,8 +258,8 @@ fn snapshot_and_resume_continue_the_uninterrupted_trajectory() {
     });
     let snap: Snapshot = serde_json::from_str(&saved.expect("snapshot taken")).unwrap();
     assert!(snap.t >= 700.0 * 60.0 && snap.t < 800.0 * 60.0, "{}", snap.t);
-    let (mut plant2, _) = converged("column_a.json", &[]);
-    let resumed = run_from(&mut plant2, &scenario, Start::Snapshot(&snap), &mut |_| {});
+    let (plant2, _) = converged("column_a.json", &[]);
+    let resumed = run_from(&plant2, &scenario, Start::Snapshot(&snap), &mut |_| {});
     let mut compared = 0;
     let mut worst: f64 = 0.0;
     for (i, t) in resumed.times.iter().enumerate() {
@@ -272,10 +272,10 @@ fn snapshot_and_resume_continue_the_uninterrupted_trajectory() {
     eprintln!("resumed at {:.3} min: {compared} rows, largest relative difference {worst:.1e}", snap.t / 60.0);
     assert!(compared > 400 && worst <= 1e-10, "{compared} rows, {worst}");
     // Retuned: Kc of the reboiler level loop doubled for the rest of the run.
-    let (mut plant3, _) = converged("column_a.json", &[("reboiler_level.kc", "\"20 kmol/min/kmol\"")]);
+    let (plant3, _) = converged("column_a.json", &[("reboiler_level.kc", "\"20 kmol/min/kmol\"")]);
     let spec = parse_scenario(&scenario, "s.json").unwrap();
     let sc = resolve(&spec, &plant3, "s.json").unwrap();
-    let retuned = simulate(&mut plant3, &sc, Start::Snapshot(&snap), "retuned", &mut |_| {}).unwrap();
+    let retuned = simulate(&plant3, &sc, Start::Snapshot(&snap), "retuned", &mut |_| {}).unwrap();
     assert!(retuned.stats.n_restarts >= 1);
     let xb = column(&retuned, "bottoms.x[light]");
     let xb_full = column(&full, "bottoms.x[light]");
@@ -296,9 +296,9 @@ fn tank(fields: &[(&str, &str)]) -> (Plant, Vec<f64>, f64) {
 /// manual output with lag τ_I, so the return bumps by about τ_I·Kc·de/dt while the level ramps).
 #[test]
 fn manual_mode_holds_the_output_and_auto_returns_to_setpoint() {
-    let (mut plant, x0, v) = tank(&[]);
+    let (plant, x0, v) = tank(&[]);
     let res = run_from(
-        &mut plant,
+        &plant,
         r#"{"format_version": 1, "duration": "3000 s", "integrator": {"rtol": 1e-9},
         "events": [{"type": "mode", "at": "100 s", "controller": "lc", "mode": "manual"},
                    {"type": "step", "at": "200 s", "path": "F_in", "to": "60 mol/s"},
@@ -323,13 +323,13 @@ fn manual_mode_holds_the_output_and_auto_returns_to_setpoint() {
 fn stuck_valve_freezes_the_input_and_the_controller_winds_up() {
     // Continuous, and scanned every 5 s (the scan must not move a stuck input either).
     for sampling in ["{}", r#"{"lc": "5 s"}"#] {
-        let (mut plant, x0, v) = tank(&[]);
+        let (plant, x0, v) = tank(&[]);
         let scenario = r#"{"format_version": 1, "duration": "600 s", "integrator": {"rtol": 1e-9},
             "events": [{"type": "valve_stuck", "at": "100 s", "path": "tank.outflow"},
                        {"type": "step", "at": "200 s", "path": "F_in", "to": "60 mol/s"}],
             "sampling": SAMPLING,
             "record": {"interval": "10 s", "time_unit": "s", "paths": ["tank.level", "out.F", "lc.op"]}}"#;
-        let res = run_from(&mut plant, &scenario.replace("SAMPLING", sampling), Start::Steady(&x0), &mut |_| {});
+        let res = run_from(&plant, &scenario.replace("SAMPLING", sampling), Start::Steady(&x0), &mut |_| {});
         let (level, out, op) = (column(&res, "tank.level"), column(&res, "out.F"), column(&res, "lc.op"));
         let n = level.len() - 1;
         assert!(out.iter().all(|f| (f - 50.0).abs() < 1e-9), "outflow frozen ({sampling})");
@@ -341,9 +341,9 @@ fn stuck_valve_freezes_the_input_and_the_controller_winds_up() {
 /// Feed lost at 100 s with a P-only loop: the first-order closed form with dF = −50 mol/s.
 #[test]
 fn feed_lost_drains_the_tank_along_the_first_order_closed_form() {
-    let (mut plant, x0, v) = tank(&[("lc.tau_i", "null")]);
+    let (plant, x0, v) = tank(&[("lc.tau_i", "null")]);
     let res = run_from(
-        &mut plant,
+        &plant,
         r#"{"format_version": 1, "duration": "1000 s", "integrator": {"rtol": 1e-10, "atol": 1e-12},
         "events": [{"type": "feed_lost", "at": "100 s", "unit": "inflow"}],
         "record": {"interval": "10 s", "time_unit": "s", "paths": ["tank.level", "feed.F"]}}"#,
@@ -361,9 +361,9 @@ fn feed_lost_drains_the_tank_along_the_first_order_closed_form() {
 /// piecewise linear: h_{k+1} = h_k + v T (F_in − F0 − Kc (h_k − sp)) (exact recurrence).
 #[test]
 fn sampled_controller_holds_its_output_between_scans() {
-    let (mut plant, x0, v) = tank(&[("lc.tau_i", "null")]);
+    let (plant, x0, v) = tank(&[("lc.tau_i", "null")]);
     let res = run_from(
-        &mut plant,
+        &plant,
         r#"{"format_version": 1, "duration": "600 s", "integrator": {"rtol": 1e-10, "atol": 1e-12},
         "events": [{"type": "step", "at": "0 s", "path": "F_in", "to": "60 mol/s"}],
         "sampling": {"lc": "10 s"},
@@ -387,9 +387,9 @@ fn sampled_controller_holds_its_output_between_scans() {
 /// h(kT) from kT + 30 s on; the level is piecewise linear between releases (exact recurrence).
 #[test]
 fn analyzer_samples_and_delays_the_measurement() {
-    let (mut plant, x0, v) = tank(&[("lc.tau_i", "null")]);
+    let (plant, x0, v) = tank(&[("lc.tau_i", "null")]);
     let res = run_from(
-        &mut plant,
+        &plant,
         r#"{"format_version": 1, "duration": "400 s", "integrator": {"rtol": 1e-10, "atol": 1e-12},
         "events": [{"type": "step", "at": "0 s", "path": "F_in", "to": "60 mol/s"}],
         "analyzers": {"lc": {"sample_time": "20 s", "dead_time": "30 s"}},
@@ -421,6 +421,27 @@ fn analyzer_samples_and_delays_the_measurement() {
     assert!(worst < 1e-9, "{worst}");
 }
 
+/// A run rewires a copy of the plant, never the caller's: after a run with an analyzer, a sampled
+/// controller and a stuck valve the plant has the same inputs and reads, and a second run on it
+/// repeats the first exactly.
+#[test]
+fn a_run_leaves_the_callers_plant_as_it_was() {
+    let (plant, x0, _) = tank(&[("lc.tau_i", "null")]);
+    let reads: Vec<_> = plant.blocks().iter().map(|b| b.reads.clone()).collect();
+    let driven: Vec<_> = plant.inputs().iter().map(|i| (i.path.clone(), i.driven_by)).collect();
+    let scenario = r#"{"format_version": 1, "duration": "300 s",
+        "events": [{"type": "step", "at": "0 s", "path": "F_in", "to": "60 mol/s"},
+                   {"type": "valve_stuck", "at": "200 s", "path": "tank.outflow"}],
+        "analyzers": {"lc": {"sample_time": "20 s", "dead_time": "30 s"}},
+        "sampling": {"lc": "10 s"},
+        "record": {"interval": "10 s", "time_unit": "s", "paths": ["tank.level", "out.F"]}}"#;
+    let first = run_from(&plant, scenario, Start::Steady(&x0), &mut |_| {});
+    assert!(plant.blocks().iter().map(|b| &b.reads).eq(&reads), "reads rewired");
+    assert!(plant.inputs().iter().map(|i| (i.path.clone(), i.driven_by)).eq(driven), "inputs rewired");
+    let second = run_from(&plant, scenario, Start::Steady(&x0), &mut |_| {});
+    assert!(first.rows == second.rows && first.stats == second.stats, "the second run differs");
+}
+
 /// The surge tank with extra controllers (JSON object of name → description) added to the file.
 fn tank_with(controllers: serde_json::Value) -> (Plant, Vec<f64>) {
     let path = flowsheet("surge_tank_pi.json");
@@ -439,12 +460,12 @@ fn tank_with(controllers: serde_json::Value) -> (Plant, Vec<f64>) {
 /// `op = u − Δ e^{−t/τ}`; rate-limited at r, it ramps at r until `u − op = rτ`, then lags.
 #[test]
 fn lag_and_rate_limit_follow_their_closed_forms() {
-    let (mut plant, x0) = tank_with(serde_json::json!({
+    let (plant, x0) = tank_with(serde_json::json!({
         "lag": {"type": "lag", "pv": "feed.F", "tau": "20 s"},
         "slow": {"type": "lag", "pv": "feed.F", "tau": "20 s", "rate_limit": "0.1 mol/s/s"}
     }));
     let res = run_from(
-        &mut plant,
+        &plant,
         r#"{"format_version": 1, "duration": "300 s", "integrator": {"rtol": 1e-10, "atol": 1e-12},
         "events": [{"type": "step", "at": "0 s", "path": "F_in", "by": "10 mol/s"}],
         "record": {"interval": "1 s", "time_unit": "s", "paths": ["lag.op", "slow.op"]}}"#,
@@ -469,10 +490,10 @@ fn lag_and_rate_limit_follow_their_closed_forms() {
 /// phase error ~ (ωθ)⁹/(8! 9!), far below the integration tolerance; all-pass gain 1).
 #[test]
 fn pade_delay_delays_a_sinusoid_by_its_dead_time() {
-    let (mut plant, x0) =
+    let (plant, x0) =
         tank_with(serde_json::json!({"dly": {"type": "delay", "pv": "feed.F", "delay": "30 s", "order": 4}}));
     let res = run_from(
-        &mut plant,
+        &plant,
         r#"{"format_version": 1, "duration": "3000 s", "integrator": {"rtol": 1e-9, "atol": 1e-12},
         "events": [{"type": "sinusoid", "at": "0 s", "path": "F_in", "amplitude": "5 mol/s", "period": "600 s"}],
         "record": {"interval": "5 s", "time_unit": "s", "paths": ["dly.op"]}}"#,

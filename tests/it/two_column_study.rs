@@ -368,8 +368,7 @@ fn surge_tank_passes_a_cycle_as_a_first_order_lag() {
 /// streams brought in and took out (`record.totals`), while A + B → R and 2 B → S run.
 #[test]
 fn two_column_plant_conserves_atoms_through_an_upset() {
-    let mut plant =
-        load_file(Path::new(&harness::flowsheet("two_column_plant.json"))).unwrap_or_else(|e| panic!("{e}"));
+    let plant = load_file(Path::new(&harness::flowsheet("two_column_plant.json"))).unwrap_or_else(|e| panic!("{e}"));
     let u = plant.input_values();
     let x0 = steady_state_by(&plant, &u, &StrategySettings::default(), &mut |_| {}).unwrap_or_else(|e| panic!("{e}")).x;
     let scenario = r#"{"format_version": 1, "duration": "1 h",
@@ -377,7 +376,7 @@ fn two_column_plant_conserves_atoms_through_an_upset() {
                    {"type": "step", "at": "10 min", "path": "feed_cooler.T_out", "by": "5 K"}],
         "record": {"interval": "1 min", "paths": ["effluent.T"], "totals": ["feed_A", "feed_B", "product", "heavies"]}}"#;
     let sc = resolve(&parse_scenario(scenario, "upset.json").unwrap(), &plant, "upset.json").unwrap();
-    let res = simulate(&mut plant, &sc, Start::Steady(&x0), "test", &mut |_| {}).unwrap_or_else(|e| panic!("{e}"));
+    let res = simulate(&plant, &sc, Start::Steady(&x0), "test", &mut |_| {}).unwrap_or_else(|e| panic!("{e}"));
     let comps = ["A", "B", "R", "S"];
     // Moles of each component held in the plant.
     let held = |x: &[f64]| -> Vec<f64> {

@@ -8,6 +8,7 @@
 //!   central differences extrapolated (Richardson) and verified, never returned unverified.
 //! - [`measures`], [`min_cond`]: RGA, RGA number, SVD, condition number and its minimized value,
 //!   Niederlinski index, block relative gain, scaling, Morari resiliency index.
+//! - [`figures`]: figures of merit of a dynamic run (IAE, ISE, largest deviation, settling time).
 //! - [`tf`]: transfer-function matrix models (gain, lags, leads, dead time per element) and
 //!   their `G(jω)`.
 //! - [`sensitivity`]: disturbance sweeps with the control structure active, by continuation.
@@ -20,6 +21,7 @@
 #![warn(missing_docs)]
 
 pub mod error;
+pub mod figures;
 pub mod linear;
 pub mod measures;
 pub mod min_cond;

@@ -15,6 +15,7 @@ pub mod overrides;
 pub mod parse;
 pub mod path;
 pub mod plant;
+pub mod query;
 pub mod scenario;
 pub mod spec;
 pub mod tears;

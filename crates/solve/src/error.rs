@@ -35,7 +35,7 @@ impl Error {
     pub fn is_user_error(&self) -> bool {
         match self {
             Error::Steady(e) => e.is_user_error(),
-            Error::Simulation(e) => matches!(**e, SimError::Snapshot { .. }),
+            Error::Simulation(e) => matches!(**e, SimError::Snapshot { .. } | SimError::Wiring(_)),
             Error::Dae(_) | Error::Sparse(_) => false,
         }
     }

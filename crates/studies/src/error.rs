@@ -131,17 +131,19 @@ pub enum TuneError {
     },
     /// The plant could not be integrated during a test.
     #[error(transparent)]
-    Simulation(Box<plantwide_solve::dynamic::SimError>),
+    Simulation(Box<plantwide_solve::dynamic::SessionError>),
     /// A relay test found no usable cycle.
     #[error("relay test of `{controller}`: {source}")]
     Relay {
         /// Controller.
         controller: String,
         /// Why.
-        source: Box<crate::tune::bench::RelayError<plantwide_solve::dynamic::SimError>>,
+        source: Box<crate::tune::bench::RelayError<plantwide_solve::dynamic::SessionError>>,
     },
     /// A test amplitude of zero (the output's steady value is zero).
-    #[error("`{controller}`: the test amplitude is {amplitude} (5 % of an output at zero); give --relay-amplitude or --step")]
+    #[error(
+        "`{controller}`: the test amplitude is {amplitude} (5 % of an output at zero); give --relay-amplitude or --step"
+    )]
     RelayAmplitude {
         /// Controller.
         controller: String,

@@ -47,7 +47,7 @@ pub fn execute(m: &Mutant) -> Result<Outcome, Dishonest> {
         },
         Mode::Run => {
             plant.set_input_values(&u);
-            run(m, &mut plant, &u)
+            run(m, &plant, &u)
         }
     }
 }
@@ -70,7 +70,7 @@ fn steady(plant: &Plant, u: &[f64]) -> Result<Solution, Outcome> {
 }
 
 /// The scenario from the certified steady state, as `plantwide run` does.
-fn run(m: &Mutant, plant: &mut Plant, u: &[f64]) -> Result<Outcome, Dishonest> {
+fn run(m: &Mutant, plant: &Plant, u: &[f64]) -> Result<Outcome, Dishonest> {
     let (file, text) = m.scenario.as_ref().expect("a run mutant has a scenario");
     let sc = match parse_scenario(text, file).and_then(|s| resolve(&s, plant, file)) {
         Ok(sc) => sc,
@@ -83,7 +83,7 @@ fn run(m: &Mutant, plant: &mut Plant, u: &[f64]) -> Result<Outcome, Dishonest> {
     certificate::steady(plant, &sol.x).map_err(Dishonest)?;
     match simulate(plant, &sc, Start::Steady(&sol.x), "fuzz", &mut |_| {}) {
         Ok(res) => certificate::run(&res).map(|()| Outcome::Ok).map_err(|e| Dishonest(format!("run: {e}"))),
-        Err(e @ SimError::Snapshot { .. }) => Ok(Outcome::User(e.to_string())),
+        Err(e @ (SimError::Snapshot { .. } | SimError::Wiring(_))) => Ok(Outcome::User(e.to_string())),
         Err(e) => Ok(Outcome::Numerical(e.to_string())),
     }
 }

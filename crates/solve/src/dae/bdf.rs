@@ -175,6 +175,26 @@ fn change_d(d: &mut [Vec<f64>], order: usize, factor: f64) {
     }
 }
 
+/// One corrector problem: at `t_new`, from the predictor `x_pred`, with `c = h/γ_q`, `ψ`, the
+/// error weights `scale` and the Newton tolerance `tol`.
+/// A converged corrector: the Newton iterations it took, the new state and the correction
+/// `d = x − x⁽⁰⁾`.
+struct Corrected {
+    iters: usize,
+    x: Vec<f64>,
+    d: Vec<f64>,
+}
+
+#[derive(Clone, Copy)]
+struct Corrector<'a> {
+    t_new: f64,
+    x_pred: &'a [f64],
+    c: f64,
+    psi: &'a [f64],
+    scale: &'a [f64],
+    tol: f64,
+}
+
 impl Bdf {
     /// A BDF integrator with these settings; call [`DaeIntegrator::restart`] before stepping.
     pub fn new(settings: BdfSettings) -> Bdf {
@@ -269,24 +289,15 @@ impl Bdf {
         let mut trip: Vec<(usize, usize, f64)> =
             self.st.jac.iter().map(|&(i, j, v)| (i, j, if diff_row[i] { -c * v } else { -v })).collect();
         trip.extend(sys.mass().iter().map(|&(i, j)| (i, j, 1.0)));
-        self.lu.factor(n, &trip).map_err(|reason| DaeError::Singular { time: self.st.t, reason })?;
+        self.lu.factor(n, &trip).map_err(|source| DaeError::Singular { time: self.st.t, source })?;
         self.st.lu_c = Some(c);
         self.st.stats.n_lu += 1;
         Ok(())
     }
 
     /// Simplified Newton for the corrector; returns (converged, iterations, x, d).
-    #[allow(clippy::too_many_arguments)]
-    fn newton(
-        &mut self,
-        sys: &dyn DaeSystem,
-        t_new: f64,
-        x_pred: &[f64],
-        c: f64,
-        psi: &[f64],
-        scale: &[f64],
-        tol: f64,
-    ) -> (bool, usize, Vec<f64>, Vec<f64>) {
+    fn newton(&mut self, sys: &dyn DaeSystem, corr: &Corrector<'_>) -> (bool, usize, Vec<f64>, Vec<f64>) {
+        let Corrector { t_new, x_pred, c, psi, scale, tol } = *corr;
         let n = x_pred.len();
         let mut x = x_pred.to_vec();
         let mut d = vec![0.0; n];
@@ -333,6 +344,172 @@ impl Bdf {
             dy_norm_old = Some(dy_norm);
         }
         (false, iters, x, d)
+    }
+
+    /// The planned step size brought within `[min_step, max_step]` (the differences re-interpolated
+    /// if it changes).
+    fn bounded_step(&mut self, min_step: f64) -> f64 {
+        let max_step = self.settings.max_step;
+        let mut h_abs = self.st.h_abs;
+        if h_abs > max_step {
+            change_d(&mut self.st.d, self.st.order, max_step / h_abs);
+            h_abs = max_step;
+            self.st.n_equal_steps = 0;
+        } else if h_abs < min_step {
+            change_d(&mut self.st.d, self.st.order, min_step / h_abs);
+            h_abs = min_step;
+            self.st.n_equal_steps = 0;
+        }
+        h_abs
+    }
+
+    /// Multiply the step `h_abs` by `factor` and re-interpolate the differences of `order`.
+    fn scale_step(&mut self, h_abs: &mut f64, order: usize, factor: f64) {
+        *h_abs *= factor;
+        change_d(&mut self.st.d, order, factor);
+        self.st.n_equal_steps = 0;
+    }
+
+    /// Attempt steps from the current time, shrinking `h_abs` after a Newton failure or a failed
+    /// error test, until one is accepted; returns (its end time, the new state, the correction `d`,
+    /// the Newton iterations).
+    fn accepted_step(
+        &mut self,
+        sys: &dyn DaeSystem,
+        t_stop: f64,
+        min_step: f64,
+        h_abs: &mut f64,
+    ) -> Result<(f64, Vec<f64>, Vec<f64>, usize), DaeError> {
+        let t = self.st.t;
+        let order = self.st.order;
+        let rtol = self.settings.rtol;
+        let newton_tol = (10.0 * f64::EPSILON / rtol).max(0.03f64.min(rtol.sqrt()));
+        let mut lu_ok = self.st.lu_c.is_some() && self.lu.is_factored();
+        loop {
+            if *h_abs < min_step {
+                return Err(DaeError::StepSizeTooSmall { time: t, h: *h_abs });
+            }
+            let mut t_new = t + *h_abs;
+            if t_new >= t_stop {
+                t_new = t_stop;
+                let factor = (t_new - t) / *h_abs;
+                change_d(&mut self.st.d, order, factor);
+                self.st.n_equal_steps = 0;
+                lu_ok = false;
+                *h_abs = t_new - t;
+            }
+            let h = t_new - t;
+            let (x_pred, psi) = self.predict(order);
+            let scale = self.scale(sys, &x_pred);
+            let c = h / self.gamma[order];
+            let corrector = Corrector { t_new, x_pred: &x_pred, c, psi: &psi, scale: &scale, tol: newton_tol };
+            let Some(Corrected { iters, x: x_new, d }) = self.correct(sys, &corrector, &mut lu_ok)? else {
+                self.st.stats.n_newton_failures += 1;
+                self.scale_step(h_abs, order, 0.5);
+                lu_ok = false;
+                continue;
+            };
+            let safety = 0.9 * (2 * NEWTON_MAXITER + 1) as f64 / (2 * NEWTON_MAXITER + iters) as f64;
+            let scale = self.scale(sys, &x_new);
+            let err: Vec<f64> = d.iter().map(|v| self.error_const[order] * v).collect();
+            let error_norm = rms(&err, &scale, &self.controlled);
+            if error_norm > 1.0 {
+                self.st.stats.n_error_test_failures += 1;
+                let factor = MIN_FACTOR.max(safety * error_norm.powf(-1.0 / (order as f64 + 1.0)));
+                // Newton converged: the factors stay valid for the Jacobian, c changes below.
+                self.scale_step(h_abs, order, factor);
+                continue;
+            }
+            return Ok((t_new, x_new, d, iters));
+        }
+    }
+
+    /// The predictor `x⁽⁰⁾ = Σ_{k=0}^{q} D[k]` and `ψ = (1/γ_q) Σ_{k=1}^{q} γ_k D[k]`.
+    fn predict(&self, order: usize) -> (Vec<f64>, Vec<f64>) {
+        let n = self.st.d[0].len();
+        let alpha = self.gamma[order];
+        let mut x_pred = vec![0.0; n];
+        for row in &self.st.d[..=order] {
+            x_pred.iter_mut().zip(row).for_each(|(a, b)| *a += b);
+        }
+        let mut psi = vec![0.0; n];
+        for k in 1..=order {
+            let g = self.gamma[k] / alpha;
+            psi.iter_mut().zip(&self.st.d[k]).for_each(|(a, b)| *a += g * b);
+        }
+        (x_pred, psi)
+    }
+
+    /// Solve the corrector, refactorizing `M − cJ` when `c` or the Jacobian changed
+    /// (`lu_ok` false) and re-evaluating a stale Jacobian once after a Newton failure; returns
+    /// the converged corrector, or `None` if Newton failed with a current Jacobian.
+    fn correct(
+        &mut self,
+        sys: &dyn DaeSystem,
+        corr: &Corrector<'_>,
+        lu_ok: &mut bool,
+    ) -> Result<Option<Corrected>, DaeError> {
+        let n = corr.x_pred.len();
+        loop {
+            if !*lu_ok || self.st.lu_c != Some(corr.c) {
+                self.factor(n, sys, corr.c)?;
+                *lu_ok = true;
+            }
+            let (converged, iters, x, d) = self.newton(sys, corr);
+            if converged {
+                return Ok(Some(Corrected { iters, x, d }));
+            }
+            if self.st.current_jac {
+                return Ok(None);
+            }
+            let mut f = vec![0.0; n];
+            sys.jacobian(corr.t_new, corr.x_pred, &mut f, &mut self.st.jac);
+            self.st.stats.n_jacobian_evals += 1;
+            self.st.current_jac = true;
+            *lu_ok = false;
+        }
+    }
+
+    /// After an accepted step of `order` with correction `d`: `D[q+2] = d − D[q+1]`,
+    /// `D[q+1] = d`, `D[i] += D[i+1]` for `i = q … 0`.
+    fn update_differences(&mut self, order: usize, d: Vec<f64>) {
+        let dd = &mut self.st.d;
+        let next: Vec<f64> = d.iter().zip(&dd[order + 1]).map(|(a, b)| a - b).collect();
+        dd[order + 2] = next;
+        dd[order + 1] = d;
+        for i in (0..=order).rev() {
+            let (lo, hi) = dd.split_at_mut(i + 1);
+            lo[i].iter_mut().zip(&hi[0]).for_each(|(a, b)| *a += b);
+        }
+    }
+
+    /// After `q + 1` steps at one size: move to the order among `q − 1, q, q + 1` whose error
+    /// estimate promises the longest step, and grow or shrink the step accordingly (at most
+    /// [`MAX_FACTOR`], safety scaled by the `n_iter` Newton iterations of the last step).
+    fn adapt_order_and_step(&mut self, sys: &dyn DaeSystem, order: usize, n_iter: usize) {
+        let scale = self.scale(sys, &self.st.d[0]);
+        let norm_of = |k: usize, row: usize| {
+            let e: Vec<f64> = self.st.d[row].iter().map(|v| self.error_const[k] * v).collect();
+            rms(&e, &scale, &self.controlled)
+        };
+        let error_m = if order > 1 { norm_of(order - 1, order) } else { f64::INFINITY };
+        let error = norm_of(order, order + 1);
+        let error_p = if order < MAX_ORDER { norm_of(order + 1, order + 2) } else { f64::INFINITY };
+        let factors = [
+            error_m.powf(-1.0 / order as f64),
+            error.powf(-1.0 / (order as f64 + 1.0)),
+            error_p.powf(-1.0 / (order as f64 + 2.0)),
+        ];
+        let best = (0..3).fold(0, |b, k| if factors[k] > factors[b] { k } else { b });
+        let new_order = order + best - 1;
+        let safety = 0.9 * (2 * NEWTON_MAXITER + 1) as f64 / (2 * NEWTON_MAXITER + n_iter) as f64;
+        let factor = MAX_FACTOR.min(safety * factors[best]);
+        self.st.order = new_order;
+        self.st.h_abs *= factor;
+        change_d(&mut self.st.d, new_order, factor);
+        self.st.n_equal_steps = 0;
+        self.st.lu_c = None;
+        self.lu.invalidate();
     }
 }
 
@@ -382,136 +559,26 @@ impl DaeIntegrator for Bdf {
     }
 
     fn step(&mut self, sys: &dyn DaeSystem, t_stop: f64) -> Result<(), DaeError> {
-        let n = sys.n();
         if self.st.stats.n_steps >= self.settings.max_steps {
             return Err(DaeError::TooManySteps { time: self.st.t, max_steps: self.settings.max_steps });
         }
         let t = self.st.t;
         let min_step = 10.0 * (t.next_up() - t).abs();
-        let max_step = self.settings.max_step;
-        let mut h_abs = self.st.h_abs;
-        if h_abs > max_step {
-            change_d(&mut self.st.d, self.st.order, max_step / h_abs);
-            h_abs = max_step;
-            self.st.n_equal_steps = 0;
-        } else if h_abs < min_step {
-            change_d(&mut self.st.d, self.st.order, min_step / h_abs);
-            h_abs = min_step;
-            self.st.n_equal_steps = 0;
-        }
+        let mut h_abs = self.bounded_step(min_step);
         let order = self.st.order;
-        let rtol = self.settings.rtol;
-        let newton_tol = (10.0 * f64::EPSILON / rtol).max(0.03f64.min(rtol.sqrt()));
-        let alpha = self.gamma[order];
-        let mut lu_ok = self.st.lu_c.is_some() && self.lu.is_factored();
-        let (t_new, x_new, d, n_iter) = loop {
-            if h_abs < min_step {
-                return Err(DaeError::StepSizeTooSmall { time: t, h: h_abs });
-            }
-            let mut t_new = t + h_abs;
-            if t_new >= t_stop {
-                t_new = t_stop;
-                let factor = (t_new - t) / h_abs;
-                change_d(&mut self.st.d, order, factor);
-                self.st.n_equal_steps = 0;
-                lu_ok = false;
-                h_abs = t_new - t;
-            }
-            let h = t_new - t;
-            let mut x_pred = vec![0.0; n];
-            for row in &self.st.d[..=order] {
-                x_pred.iter_mut().zip(row).for_each(|(a, b)| *a += b);
-            }
-            let scale = self.scale(sys, &x_pred);
-            let mut psi = vec![0.0; n];
-            for k in 1..=order {
-                let g = self.gamma[k] / alpha;
-                psi.iter_mut().zip(&self.st.d[k]).for_each(|(a, b)| *a += g * b);
-            }
-            let c = h / alpha;
-            let outcome = loop {
-                if !lu_ok || self.st.lu_c != Some(c) {
-                    self.factor(n, sys, c)?;
-                    lu_ok = true;
-                }
-                let (converged, iters, x, d) = self.newton(sys, t_new, &x_pred, c, &psi, &scale, newton_tol);
-                if converged {
-                    break Some((iters, x, d));
-                }
-                if self.st.current_jac {
-                    break None;
-                }
-                let mut f = vec![0.0; n];
-                sys.jacobian(t_new, &x_pred, &mut f, &mut self.st.jac);
-                self.st.stats.n_jacobian_evals += 1;
-                self.st.current_jac = true;
-                lu_ok = false;
-            };
-            let Some((iters, x_new, d)) = outcome else {
-                self.st.stats.n_newton_failures += 1;
-                h_abs *= 0.5;
-                change_d(&mut self.st.d, order, 0.5);
-                self.st.n_equal_steps = 0;
-                lu_ok = false;
-                continue;
-            };
-            let safety = 0.9 * (2 * NEWTON_MAXITER + 1) as f64 / (2 * NEWTON_MAXITER + iters) as f64;
-            let scale = self.scale(sys, &x_new);
-            let err: Vec<f64> = d.iter().map(|v| self.error_const[order] * v).collect();
-            let error_norm = rms(&err, &scale, &self.controlled);
-            if error_norm > 1.0 {
-                self.st.stats.n_error_test_failures += 1;
-                let factor = MIN_FACTOR.max(safety * error_norm.powf(-1.0 / (order as f64 + 1.0)));
-                h_abs *= factor;
-                change_d(&mut self.st.d, order, factor);
-                self.st.n_equal_steps = 0;
-                // Newton converged: the factors stay valid for the Jacobian, c changes below.
-                continue;
-            }
-            break (t_new, x_new, d, iters);
-        };
+        let (t_new, x_new, d, n_iter) = self.accepted_step(sys, t_stop, min_step, &mut h_abs)?;
         self.st.stats.n_steps += 1;
         self.st.n_equal_steps += 1;
         self.st.t_prev = t;
         self.st.t = t_new;
         self.st.h_abs = h_abs;
         self.st.current_jac = false;
-        // Update the differences: D[q+2] = d − D[q+1], D[q+1] = d, D[i] += D[i+1] for i = q … 0.
-        let dd = &mut self.st.d;
-        let next: Vec<f64> = d.iter().zip(&dd[order + 1]).map(|(a, b)| a - b).collect();
-        dd[order + 2] = next;
-        dd[order + 1] = d;
-        for i in (0..=order).rev() {
-            let (lo, hi) = dd.split_at_mut(i + 1);
-            lo[i].iter_mut().zip(&hi[0]).for_each(|(a, b)| *a += b);
-        }
-        debug_assert!(x_new.iter().zip(&dd[0]).all(|(a, b)| (a - b).abs() <= 1e-9 * (1.0 + a.abs())));
+        self.update_differences(order, d);
+        debug_assert!(x_new.iter().zip(&self.st.d[0]).all(|(a, b)| (a - b).abs() <= 1e-9 * (1.0 + a.abs())));
         if self.st.n_equal_steps < order + 1 {
             return Ok(());
         }
-        let scale = self.scale(sys, &self.st.d[0]);
-        let norm_of = |k: usize, row: usize| {
-            let e: Vec<f64> = self.st.d[row].iter().map(|v| self.error_const[k] * v).collect();
-            rms(&e, &scale, &self.controlled)
-        };
-        let error_m = if order > 1 { norm_of(order - 1, order) } else { f64::INFINITY };
-        let error = norm_of(order, order + 1);
-        let error_p = if order < MAX_ORDER { norm_of(order + 1, order + 2) } else { f64::INFINITY };
-        let factors = [
-            error_m.powf(-1.0 / order as f64),
-            error.powf(-1.0 / (order as f64 + 1.0)),
-            error_p.powf(-1.0 / (order as f64 + 2.0)),
-        ];
-        let best = (0..3).fold(0, |b, k| if factors[k] > factors[b] { k } else { b });
-        let new_order = order + best - 1;
-        let safety = 0.9 * (2 * NEWTON_MAXITER + 1) as f64 / (2 * NEWTON_MAXITER + n_iter) as f64;
-        let factor = MAX_FACTOR.min(safety * factors[best]);
-        self.st.order = new_order;
-        self.st.h_abs *= factor;
-        change_d(&mut self.st.d, new_order, factor);
-        self.st.n_equal_steps = 0;
-        self.st.lu_c = None;
-        self.lu.invalidate();
+        self.adapt_order_and_step(sys, order, n_iter);
         Ok(())
     }
 

@@ -4,8 +4,48 @@
 
 use faer::col::ColMut;
 use faer::linalg::solvers::Solve;
+use faer::sparse::linalg::LuError;
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
-use faer::sparse::{SparseColMat, Triplet};
+use faer::sparse::{CreationError, FaerError, SparseColMat, Triplet};
+
+/// Why the iteration matrix could not be factorized.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+pub enum LinearError {
+    /// A triplet lies outside the `n × n` matrix.
+    #[error("entry ({row}, {col}) outside the {n} × {n} matrix")]
+    OutOfBounds {
+        /// Row of the entry.
+        row: usize,
+        /// Column of the entry.
+        col: usize,
+        /// Matrix dimension.
+        n: usize,
+    },
+    /// The pattern is structurally singular: no pivot at this elimination step.
+    #[error("structurally singular: no pivot at elimination step {index}")]
+    StructurallySingular {
+        /// Elimination step at which no pivot was found.
+        index: usize,
+    },
+    /// faer ran out of memory or of index range.
+    #[error("sparse LU: {0:?}")]
+    Faer(FaerError),
+}
+
+impl LinearError {
+    fn creation(n: usize, e: CreationError) -> LinearError {
+        match e {
+            CreationError::OutOfBounds { row, col } => LinearError::OutOfBounds { row, col, n },
+            CreationError::Generic(e) => LinearError::Faer(e),
+        }
+    }
+    fn lu(e: LuError) -> LinearError {
+        match e {
+            LuError::SymbolicSingular { index } => LinearError::StructurallySingular { index },
+            LuError::Generic(e) => LinearError::Faer(e),
+        }
+    }
+}
 
 /// A pattern (as triplet positions) and its symbolic LU.
 type Symbolic = (Vec<(usize, usize)>, SymbolicLu<usize>);
@@ -22,17 +62,18 @@ impl IterationMatrix {
     /// value is exactly zero are left out: the units declare generous structural patterns (column
     /// A: 15 708 structural entries, 1 675 nonzero values), and the LU of the values' own pattern
     /// is about 20 times cheaper; the symbolic analysis is redone only if that pattern changes.
-    pub(crate) fn factor(&mut self, n: usize, triplets: &[(usize, usize, f64)]) -> Result<(), String> {
+    pub(crate) fn factor(&mut self, n: usize, triplets: &[(usize, usize, f64)]) -> Result<(), LinearError> {
         let trip: Vec<Triplet<usize, usize, f64>> =
             triplets.iter().filter(|t| t.2 != 0.0).map(|&(i, j, v)| Triplet::new(i, j, v)).collect();
-        let a = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &trip).map_err(|e| format!("{e:?}"))?;
+        let a =
+            SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &trip).map_err(|e| LinearError::creation(n, e))?;
         let pattern: Vec<(usize, usize)> = trip.iter().map(|t| (t.row, t.col)).collect();
         let symbolic = match self.symbolic.take() {
             Some((p, s)) if p == pattern => s,
-            _ => SymbolicLu::try_new(a.symbolic()).map_err(|e| format!("{e:?}"))?,
+            _ => SymbolicLu::try_new(a.symbolic()).map_err(LinearError::Faer)?,
         };
         self.lu = None;
-        let lu = Lu::try_new_with_symbolic(symbolic.clone(), a.as_ref()).map_err(|e| format!("{e:?}"))?;
+        let lu = Lu::try_new_with_symbolic(symbolic.clone(), a.as_ref()).map_err(LinearError::lu)?;
         self.symbolic = Some((pattern, symbolic));
         self.lu = Some(lu);
         Ok(())

@@ -16,6 +16,7 @@ mod linear;
 
 pub use bdf::{Bdf, BdfSettings, BdfState, BdfStats};
 pub use init::consistent_algebraic;
+pub use linear::LinearError;
 
 /// A time-aware semi-explicit DAE `M dx/dt = f(t, x)` with a 0/1 mass matrix.
 pub trait DaeSystem: Sync {
@@ -72,12 +73,12 @@ pub enum DaeError {
         equation: usize,
     },
     /// The iteration matrix could not be factorized.
-    #[error("iteration matrix singular at t = {time} s: {reason}")]
+    #[error("iteration matrix singular at t = {time} s: {source}")]
     Singular {
         /// Time [s].
         time: f64,
         /// What the factorization said.
-        reason: String,
+        source: LinearError,
     },
     /// A restored state does not fit the system.
     #[error("integrator state does not fit the system: {0}")]

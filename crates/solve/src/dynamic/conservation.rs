@@ -142,9 +142,9 @@ impl Conservation {
 /// The boundary streams: `(stream, +1)` for the outlets of `feed` units, `(stream, −1)` for the
 /// inlets of `product` units.
 pub fn boundary_streams(plant: &Plant) -> Vec<(usize, f64)> {
-    let type_of = |b: usize| (plant.blocks[b].kind == BlockKind::Unit).then(|| plant.blocks[b].unit.type_name());
+    let type_of = |b: usize| (plant.blocks()[b].kind == BlockKind::Unit).then(|| plant.blocks()[b].unit.type_name());
     let mut v = Vec::new();
-    for (k, s) in plant.streams.iter().enumerate() {
+    for (k, s) in plant.streams().iter().enumerate() {
         if type_of(s.from.0) == Some("feed") {
             v.push((k, 1.0));
         }
@@ -157,11 +157,11 @@ pub fn boundary_streams(plant: &Plant) -> Vec<(usize, f64)> {
 
 /// Component amounts [mol] held by all units at the plant state `x` (inputs `u`, time `t`).
 pub fn plant_holdup(plant: &Plant, x: &[f64], u: &[f64], t: f64) -> Vec<f64> {
-    let mut held = vec![0.0; plant.components.len()];
+    let mut held = vec![0.0; plant.components().len()];
     let mut local = Vec::new();
-    for b in plant.blocks.iter().filter(|b| b.kind == BlockKind::Unit) {
+    for b in plant.blocks().iter().filter(|b| b.kind == BlockKind::Unit) {
         plant.gather(b, x, u, &mut local);
-        let io = UnitIo { local: &local, layout: &b.layout, thermo: &plant.thermo, time: t };
+        let io = UnitIo { local: &local, layout: &b.layout, thermo: plant.thermo(), time: t };
         if let Some(n) = b.unit.holdup(&io) {
             held.iter_mut().zip(&n).for_each(|(h, v)| *h += v);
         }
@@ -171,7 +171,7 @@ pub fn plant_holdup(plant: &Plant, x: &[f64], u: &[f64], t: f64) -> Vec<f64> {
 
 /// Whether the plant conserves mass rather than moles per component (a unit reacts).
 pub fn reacts(plant: &Plant) -> bool {
-    plant.blocks.iter().any(|b| b.kind == BlockKind::Unit && b.unit.reacts())
+    plant.blocks().iter().any(|b| b.kind == BlockKind::Unit && b.unit.reacts())
 }
 
 #[cfg(test)]

@@ -17,11 +17,11 @@ use serde::Serialize;
 use super::PiRule;
 use super::averaging::{AveragingForm, AveragingSettings, averaging};
 use super::bench::RelayCycle;
+use super::blt::BltSettings;
 use super::fit::ModelFit;
+use super::loops::{LoopResponse, Measurement, PlantLoop, loop_model, plant_blt};
 use super::rules::{ModelRule, model_rule};
 use super::ultimate::Ultimate;
-use super::blt::BltSettings;
-use super::loops::{LoopResponse, Measurement, PlantLoop, loop_model, plant_blt};
 use crate::TuneError;
 
 /// The tuning of one loop of a flowsheet.
@@ -203,7 +203,12 @@ pub fn averaging_loop(
 pub fn from_relay(l: &PlantLoop, cycle: &RelayCycle, rule: PiRule, method: &'static str) -> FlowsheetTuning {
     let ultimate = Ultimate { ku: cycle.ku, omega_u: 2.0 * std::f64::consts::PI / cycle.pu, pu: cycle.pu };
     let (kc, tau_i) = rule.settings(&ultimate);
-    let e = FlowsheetLoop { ku: Some(cycle.ku), pu: Some(cycle.pu), relay: Some(cycle.clone()), ..entry(l, kc, Some(tau_i), None) };
+    let e = FlowsheetLoop {
+        ku: Some(cycle.ku),
+        pu: Some(cycle.pu),
+        relay: Some(cycle.clone()),
+        ..entry(l, kc, Some(tau_i), None)
+    };
     FlowsheetTuning { method, detuning_factor: None, loops: vec![e] }
 }
 

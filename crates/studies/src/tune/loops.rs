@@ -156,7 +156,9 @@ fn frequency_range(ss: &StateSpace, loops: &[PlantLoop]) -> Result<(f64, f64), T
     let lo = mags.iter().cloned().fold(f64::INFINITY, f64::min);
     let hi = mags.iter().cloned().fold(0.0, f64::max);
     if mags.is_empty() {
-        return Err(TuneError::NoDynamics { controller: loops.iter().map(|l| l.name.as_str()).collect::<Vec<_>>().join(", ") });
+        return Err(TuneError::NoDynamics {
+            controller: loops.iter().map(|l| l.name.as_str()).collect::<Vec<_>>().join(", "),
+        });
     }
     Ok((1e-3 * lo, 1e3 * hi))
 }

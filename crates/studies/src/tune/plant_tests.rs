@@ -10,7 +10,7 @@
 
 use faer::c64;
 use plantwide_flowsheet::Plant;
-use plantwide_solve::dynamic::{Session, SimError};
+use plantwide_solve::dynamic::{Session, SessionError};
 
 use super::bench::{Bench, RelayCycle, SampledRelay, StepTest, relay, step};
 use super::fit::{ModelFit, ModelOrder, fit_step};
@@ -24,7 +24,7 @@ struct PlantBench<'a> {
 }
 
 impl Bench for PlantBench<'_> {
-    type Error = SimError;
+    type Error = SessionError;
     fn time(&self) -> f64 {
         self.session.time()
     }
@@ -34,7 +34,7 @@ impl Bench for PlantBench<'_> {
     fn set_output(&mut self, u: f64) {
         self.session.set_input(self.l.op_manual, u);
     }
-    fn advance_to(&mut self, t: f64) -> Result<(), SimError> {
+    fn advance_to(&mut self, t: f64) -> Result<(), SessionError> {
         self.session.advance_to(t)
     }
 }
@@ -76,7 +76,7 @@ pub fn relay_loop(plant: &Plant, x: &[f64], l: &PlantLoop, o: RelayOptions) -> R
         tolerance: 1e-2,
         max_switches: 60,
     };
-    if !(settings.amplitude > 0.0) {
+    if !(settings.amplitude.is_finite() && settings.amplitude > 0.0) {
         return Err(TuneError::RelayAmplitude { controller: l.name.clone(), amplitude: settings.amplitude });
     }
     let mut b = bench(plant, x, l)?;

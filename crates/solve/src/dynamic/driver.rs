@@ -1,0 +1,457 @@
+//! The event driver: integrates between the discrete times of a run (scenario events, controller
+//! scans, analyzer samples and releases, the end), applies what is due at each, restarts the
+//! integrator when an input changed, records rows and hands out snapshots.
+//!
+//! The driver owns a copy of the plant, rewired through the flowsheet's wiring methods: a sampled
+//! controller's driven inputs are held ([`Plant::manual`]) and set to its output at every scan, an
+//! analyzer's controller reads a held copy of its measurement ([`Plant::hold_measurement`]), and a
+//! stuck valve's input is held at its last value ([`Plant::hold_input`]).
+
+use plantwide_flowsheet::scenario::{Action, Scenario};
+use plantwide_flowsheet::{Plant, Read};
+
+use super::adapter::{DaeShape, PlantDae, Quadratures};
+use super::snapshot::{self, DriverState, SNAPSHOT_VERSION, Snapshot};
+use super::waveform::{Waveform, values_at};
+use super::{Column, Conservation, Progress, SimError, SimulationResult, Start, conservation};
+use crate::dae::{Bdf, BdfSettings, BdfState, DaeError, DaeIntegrator};
+
+/// One run in progress.
+pub(super) struct Driver<'p> {
+    /// The caller's plant, rewired for this run.
+    plant: Plant,
+    sc: &'p Scenario,
+    st: DriverState,
+    bdf: Bdf,
+    fingerprint: String,
+    /// Per sampled controller: (driven input, its controller output variable).
+    sampled: Vec<Vec<(usize, usize)>>,
+    /// Per analyzer: (held input, measured variable).
+    analyzers: Vec<(usize, usize)>,
+    times: Vec<f64>,
+    rows: Vec<Vec<f64>>,
+    /// Per recorded path: the setpoint input of the controller that measures it.
+    refs: Vec<Option<usize>>,
+    ref_rows: Vec<Vec<f64>>,
+    events: Vec<(f64, String)>,
+    /// Start from a snapshot of the same plant: the history to restore instead of restarting.
+    restore: Option<BdfState>,
+    x0: Vec<f64>,
+    t0: f64,
+    quad: Quadratures,
+    shape: DaeShape,
+}
+
+/// The state a run starts from, extended by the quadratures (0 at a steady start).
+fn initial_state(plant: &Plant, quad: &Quadratures, start: Start<'_>) -> Vec<f64> {
+    let n_state = quad.n_state(plant);
+    match start {
+        Start::Steady(x) => {
+            let mut v = x.to_vec();
+            v.resize(n_state, 0.0);
+            v
+        }
+        Start::Snapshot(s) => snapshot::mapped_state(plant, &quad.state_paths(plant), n_state, s),
+    }
+}
+
+/// Hold the measurement of every analyzer's controller at its value in `x`; returns per analyzer
+/// (held input, measured variable).
+fn hold_analyzers(plant: &mut Plant, sc: &Scenario, x: &[f64]) -> Result<Vec<(usize, usize)>, SimError> {
+    let mut analyzers = Vec::new();
+    for &(b, _, _) in &sc.analyzers {
+        // Without a measured variable there is nothing to hold: `hold_measurement` refuses.
+        let value = plant.measured_var(b).map_or(0.0, |v| x[v]);
+        analyzers.push(plant.hold_measurement(b, value)?);
+    }
+    Ok(analyzers)
+}
+
+/// Put every sampled controller's loop in manual at `x` (its driven inputs then follow its output
+/// only at scans); returns per sampled controller (held input, output variable).
+fn hold_sampled(plant: &mut Plant, sc: &Scenario, x: &[f64]) -> Vec<Vec<(usize, usize)>> {
+    sc.sampling.iter().map(|&(b, _)| plant.manual(b, x)).collect()
+}
+
+/// The BDF settings a scenario asks for.
+fn bdf_settings(sc: &Scenario) -> BdfSettings {
+    BdfSettings {
+        rtol: sc.rtol,
+        atol: sc.atol,
+        max_step: sc.max_step,
+        first_step: sc.first_step,
+        ..BdfSettings::default()
+    }
+}
+
+impl<'p> Driver<'p> {
+    /// A run of `sc` on a copy of `plant` from `start`; `fingerprint` identifies the plant
+    /// description in snapshots.
+    pub(super) fn new(
+        plant: &Plant,
+        sc: &'p Scenario,
+        start: Start<'_>,
+        fingerprint: &str,
+    ) -> Result<Driver<'p>, SimError> {
+        let mut plant = plant.clone();
+        let quad = Quadratures::new(&plant, &sc.totals);
+        let x0 = initial_state(&plant, &quad, start);
+        // Which controller measures each recorded path: read before the analyzers rewire it.
+        let refs = sc.record.iter().map(|r| reference_of(&plant, r.source)).collect();
+        let analyzers = hold_analyzers(&mut plant, sc, &x0)?;
+        let mut sampled = hold_sampled(&mut plant, sc, &x0);
+        let mut st = DriverState::start(&plant, sc);
+        let (mut restore, mut t0) = (None, 0.0);
+        if let Start::Snapshot(s) = start {
+            let paths = quad.state_paths(&plant);
+            let resumed = snapshot::resume(&mut plant, sc, s, fingerprint, &paths, st, &mut sampled)?;
+            (st, restore, t0) = (resumed.driver, resumed.integrator, s.t);
+        }
+        let shape = DaeShape::new(&plant, &quad.streams);
+        Ok(Driver {
+            shape,
+            plant,
+            sc,
+            st,
+            bdf: Bdf::new(bdf_settings(sc)),
+            fingerprint: fingerprint.to_string(),
+            sampled,
+            analyzers,
+            times: Vec::new(),
+            rows: Vec::new(),
+            refs,
+            ref_rows: Vec::new(),
+            events: Vec::new(),
+            restore,
+            x0,
+            t0,
+            quad,
+        })
+    }
+
+    fn t(&self) -> f64 {
+        self.bdf.t()
+    }
+
+    /// The earliest discrete time after `t`.
+    fn next_stop(&self, t: f64) -> f64 {
+        let mut next = self.sc.duration;
+        if let Some(e) = self.sc.events.get(self.st.next_event) {
+            next = next.min(e.t);
+        }
+        for (k, &(_, scan)) in self.sc.sampling.iter().enumerate() {
+            next = next.min(self.st.next_scan[k] as f64 * scan);
+        }
+        for (k, &(_, ts, _)) in self.sc.analyzers.iter().enumerate() {
+            next = next.min(self.st.next_sample[k] as f64 * ts);
+            for &(release, _) in &self.st.pending[k] {
+                next = next.min(release);
+            }
+        }
+        next.max(t)
+    }
+
+    fn push_row(&mut self, t: f64, x: &[f64]) {
+        let (row, refs) = row_at(&self.plant, self.sc, &self.refs, &self.st.waveforms, t, x);
+        self.times.push(t);
+        self.rows.push(row);
+        self.ref_rows.push(refs);
+    }
+
+    /// Apply everything due at `t` (the integrator's time, or the start before it is started);
+    /// true if the integrator must restart.
+    fn apply_due_at(&mut self, t: f64, x: &mut [f64]) -> bool {
+        let scenario_event = self.apply_events(t, x);
+        let scanned = self.apply_scans(t, x);
+        let sampled = self.apply_samples(t, x);
+        scanned || sampled || scenario_event
+    }
+
+    /// Apply the scenario events due at `t` (a row just before the first); true if any was.
+    fn apply_events(&mut self, t: f64, x: &[f64]) -> bool {
+        let mut scenario_event = false;
+        while let Some(e) = self.sc.events.get(self.st.next_event).filter(|e| e.t <= t) {
+            if !scenario_event && self.times.last() != Some(&t) {
+                self.push_row(t, x);
+            }
+            scenario_event = true;
+            let (action, origin) = (e.action.clone(), e.origin.clone());
+            self.apply(&action, t, x);
+            self.events.push((t, origin));
+            self.st.next_event += 1;
+        }
+        scenario_event
+    }
+
+    /// The scans of sampled controllers due at `t`: their held inputs take the output's value in
+    /// `x` (zero-order hold); true if one changed.
+    fn apply_scans(&mut self, t: f64, x: &[f64]) -> bool {
+        let mut changed = false;
+        for (k, &(_, scan)) in self.sc.sampling.iter().enumerate() {
+            if self.st.next_scan[k] as f64 * scan <= t {
+                for &(i, op) in &self.sampled[k] {
+                    changed |= self.st.waveforms[i] != Waveform::Constant(x[op]);
+                    self.st.waveforms[i] = Waveform::Constant(x[op]);
+                }
+                self.st.next_scan[k] = (t / scan).floor() as u64 + 1;
+            }
+        }
+        changed
+    }
+
+    /// The analyzer samples due at `t` (queued for release one dead time later) and the results
+    /// released by `t` (the held measurement takes the latest); true if a held value changed.
+    fn apply_samples(&mut self, t: f64, x: &[f64]) -> bool {
+        let mut changed = false;
+        for (k, &(_, ts, td)) in self.sc.analyzers.iter().enumerate() {
+            let (input, v) = self.analyzers[k];
+            if self.st.next_sample[k] as f64 * ts <= t {
+                self.st.pending[k].push((self.st.next_sample[k] as f64 * ts + td, x[v]));
+                self.st.next_sample[k] = (t / ts).floor() as u64 + 1;
+            }
+            let due: Vec<(f64, f64)> = self.st.pending[k].iter().copied().filter(|&(r, _)| r <= t).collect();
+            if let Some(&(_, value)) = due.last() {
+                changed |= self.st.waveforms[input] != Waveform::Constant(value);
+                self.st.waveforms[input] = Waveform::Constant(value);
+            }
+            self.st.pending[k].retain(|&(r, _)| r > t);
+        }
+        changed
+    }
+
+    /// Apply one scenario action at `t`, state `x`.
+    fn apply(&mut self, action: &Action, t: f64, x: &[f64]) {
+        let w = &mut self.st.waveforms;
+        match *action {
+            Action::Step { input, change } => w[input] = Waveform::Constant(change.apply(w[input].at(t))),
+            Action::Ramp { input, change, end } => {
+                let v0 = w[input].at(t);
+                w[input] = Waveform::Ramp { t0: t, v0, t1: end, v1: change.apply(v0) };
+            }
+            Action::Hold { input } => w[input] = Waveform::Constant(w[input].at(t)),
+            Action::Pulse { input, change } => {
+                let v0 = w[input].at(t);
+                self.st.saved[input] = Some(v0);
+                w[input] = Waveform::Constant(change.apply(v0));
+            }
+            Action::Sinusoid { input, amplitude, period } => {
+                let base = w[input].at(t);
+                self.st.saved[input] = Some(base);
+                w[input] = Waveform::Sine { t0: t, base, amplitude, period };
+            }
+            Action::Restore { input } => {
+                if let Some(v) = self.st.saved[input].take() {
+                    w[input] = Waveform::Constant(v);
+                }
+            }
+            Action::Mode { auto_input, manual_input, op, auto, output } => {
+                if !auto {
+                    w[manual_input] = Waveform::Constant(output.unwrap_or(x[op]));
+                }
+                w[auto_input] = Waveform::Constant(if auto { 1.0 } else { 0.0 });
+            }
+            Action::Stuck { input } => {
+                let value = w[input].at(t);
+                let frozen = self.plant.hold_input(input).map_or(value, |op| x[op]);
+                self.sampled.iter_mut().for_each(|s| s.retain(|&(i, _)| i != input));
+                self.st.waveforms[input] = Waveform::Constant(frozen);
+                self.st.stuck.push(self.plant.inputs()[input].path.clone());
+            }
+        }
+    }
+
+    /// (Re)start the integrator at `t` from `x` after applying what is due there; a row after the
+    /// scenario events applied, if any.
+    fn restart_after_due(&mut self, t: f64, x: &mut [f64]) -> Result<(), DaeError> {
+        let events = self.st.next_event;
+        if self.apply_due_at(t, x) {
+            let sys = PlantDae::new(&self.plant, &self.st.waveforms, &self.shape);
+            self.bdf.restart(&sys, t, x)?;
+            if self.st.next_event > events {
+                x.copy_from_slice(self.bdf.x());
+                self.push_row(t, x);
+            }
+        }
+        Ok(())
+    }
+
+    /// Start the integrator: restore a snapshot's history, or record the start, apply what is
+    /// due at it and make one consistent start. Returns the state.
+    fn start(&mut self) -> Result<Vec<f64>, DaeError> {
+        let mut x = self.x0.clone();
+        if let Some(state) = self.restore.take() {
+            let sys = PlantDae::new(&self.plant, &self.st.waveforms, &self.shape);
+            self.bdf.restore(&sys, state)?;
+            x.copy_from_slice(self.bdf.x());
+            return Ok(x);
+        }
+        let (t0, interval) = (self.t0, self.sc.interval);
+        if self.st.next_record as f64 * interval <= t0 {
+            self.push_row(t0, &x);
+            self.st.next_record = (t0 / interval).floor() as u64 + 1;
+        }
+        let events = self.st.next_event;
+        self.apply_due_at(t0, &mut x);
+        let sys = PlantDae::new(&self.plant, &self.st.waveforms, &self.shape);
+        self.bdf.restart(&sys, t0, &x)?;
+        if self.st.next_event > events {
+            x.copy_from_slice(self.bdf.x());
+            self.push_row(t0, &x);
+        }
+        Ok(x)
+    }
+
+    /// Run to the scenario's end, reporting steps and snapshots to `observer`.
+    pub(super) fn run(&mut self, observer: &mut dyn FnMut(Progress<'_>)) -> Result<(), DaeError> {
+        let mut x = self.start()?;
+        loop {
+            let t = self.t();
+            x.copy_from_slice(self.bdf.x());
+            self.restart_after_due(t, &mut x)?;
+            if t >= self.sc.duration {
+                return Ok(());
+            }
+            let t_stop = self.next_stop(t);
+            let mut xi = vec![0.0; x.len()];
+            while self.bdf.t() < t_stop {
+                let sys = PlantDae::new(&self.plant, &self.st.waveforms, &self.shape);
+                self.bdf.step(&sys, t_stop)?;
+                let now = self.bdf.t();
+                self.record_through(now, &mut xi);
+                self.offer_snapshots(now, observer);
+                observer(Progress::Step { t: now, duration: self.sc.duration });
+            }
+        }
+    }
+
+    /// Record every row due by `now` (and by the end), interpolated within the last step.
+    fn record_through(&mut self, now: f64, xi: &mut [f64]) {
+        let interval = self.sc.interval;
+        while (self.st.next_record as f64 * interval) <= now
+            && self.st.next_record as f64 * interval <= self.sc.duration
+        {
+            let tr = self.st.next_record as f64 * interval;
+            if tr == now {
+                xi.copy_from_slice(self.bdf.x());
+            } else {
+                self.bdf.interpolate(tr, xi);
+            }
+            let (row, refs) = row_at(&self.plant, self.sc, &self.refs, &self.st.waveforms, tr, xi);
+            self.times.push(tr);
+            self.rows.push(row);
+            self.ref_rows.push(refs);
+            self.st.next_record += 1;
+        }
+    }
+
+    /// Hand the snapshots due by `now` to `observer`.
+    fn offer_snapshots(&mut self, now: f64, observer: &mut dyn FnMut(Progress<'_>)) {
+        for k in 0..self.sc.snapshots.len() {
+            if !self.st.snapshots_done[k] && self.sc.snapshots[k].0 <= now {
+                self.st.snapshots_done[k] = true;
+                let snap = Snapshot {
+                    format_version: SNAPSHOT_VERSION,
+                    fingerprint: self.fingerprint.clone(),
+                    t: now,
+                    paths: self.quad.state_paths(&self.plant),
+                    inputs: self.plant.inputs().iter().map(|i| i.path.clone()).collect(),
+                    driver: self.st.clone(),
+                    integrator: self.bdf.state().clone(),
+                };
+                observer(Progress::Snapshot { file: &self.sc.snapshots[k].1, snapshot: &snap });
+            }
+        }
+    }
+
+    /// Material balances from `x0` to the integrator's state.
+    fn conservation(&self) -> Conservation {
+        let (plant, nc, np) = (&self.plant, self.plant.components().len(), self.plant.n_vars());
+        let (t, x1) = (self.bdf.t(), self.bdf.x());
+        let u = values_at(&self.st.waveforms, t);
+        let held = [
+            conservation::plant_holdup(plant, &self.x0[..np], &u, self.t0),
+            conservation::plant_holdup(plant, &x1[..np], &u, t),
+        ];
+        let (fed, removed) = self.quad.fed_and_removed(np, nc, &self.x0, x1);
+        let mw: Vec<f64> = plant.thermo().components.iter().map(|c| c.mw).collect();
+        let mw = conservation::reacts(plant).then_some(mw.as_slice());
+        Conservation::new(plant.components(), mw, [&held[0], &held[1]], &fed, &removed)
+    }
+
+    /// The recorded columns: the scenario's paths, then `<stream>.total[<component>]` [mol].
+    fn columns(&self) -> Vec<Column> {
+        let mut columns: Vec<Column> = self
+            .sc
+            .record
+            .iter()
+            .map(|r| Column { path: r.path.clone(), unit: r.unit.clone(), si_unit: r.dim.to_string() })
+            .collect();
+        for &s in &self.sc.totals {
+            for c in self.plant.components() {
+                columns.push(Column {
+                    path: format!("{}.total[{c}]", self.plant.streams()[s].name),
+                    unit: "mol".into(),
+                    si_unit: "mol".into(),
+                });
+            }
+        }
+        columns
+    }
+
+    /// The run so far as a result.
+    pub(super) fn finish(self) -> SimulationResult {
+        let conservation = self.conservation();
+        let columns = self.columns();
+        let n_tot = columns.len() - self.refs.len();
+        let references = self
+            .refs
+            .iter()
+            .enumerate()
+            .map(|(k, r)| r.map(|_| self.ref_rows.iter().map(|row| row[k]).collect()))
+            .chain(std::iter::repeat_n(None, n_tot))
+            .collect();
+        SimulationResult {
+            columns,
+            times: self.times,
+            rows: self.rows,
+            references,
+            events: self.events,
+            x: self.bdf.x().to_vec(),
+            t: self.bdf.t(),
+            stats: self.bdf.stats(),
+            conservation,
+        }
+    }
+}
+
+/// One recorded row at `t` from the state `x`, and the references. An input driven by a
+/// controller is recorded as the controller's output, the value the plant receives.
+fn row_at(
+    plant: &Plant,
+    sc: &Scenario,
+    refs: &[Option<usize>],
+    waves: &[Waveform],
+    t: f64,
+    x: &[f64],
+) -> (Vec<f64>, Vec<f64>) {
+    let mut row: Vec<f64> = sc
+        .record
+        .iter()
+        .map(|r| match r.source {
+            Read::Var(v) => x[v],
+            Read::Input(i) => plant.inputs()[i].driven_by.map_or_else(|| waves[i].at(t), |v| x[v]),
+        })
+        .collect();
+    let np = plant.n_vars();
+    row.extend_from_slice(&x[np..np + sc.totals.len() * plant.components().len()]);
+    (row, refs.iter().map(|r| r.map_or(f64::NAN, |i| waves[i].at(t))).collect())
+}
+
+/// The setpoint input of the controller that measures `source`, if any.
+fn reference_of(plant: &Plant, source: Read) -> Option<usize> {
+    let Read::Var(v) = source else { return None };
+    (0..plant.blocks().len()).find_map(|b| {
+        let measures = plant.measured_var(b) == Some(v);
+        measures.then(|| plant.input(&format!("{}.sp", plant.blocks()[b].name))).flatten()
+    })
+}

@@ -1,0 +1,146 @@
+//! The snapshot format: the plant state, the driver state and the full BDF history (difference
+//! array, order, step, Jacobian), so that resuming continues the uninterrupted trajectory exactly.
+//! Resuming a changed plant (another fingerprint, other variables or inputs) maps the state and
+//! the input waveforms by path and restarts the integrator at order 1.
+
+use serde::{Deserialize, Serialize};
+
+use plantwide_flowsheet::Plant;
+use plantwide_flowsheet::scenario::Scenario;
+
+use super::SimError;
+use super::waveform::Waveform;
+use crate::dae::BdfState;
+
+/// Version of the snapshot format.
+pub const SNAPSHOT_VERSION: u32 = 1;
+
+/// The driver's own state (part of a snapshot).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct DriverState {
+    /// Input waveforms, one per input (plant inputs, then the analyzers' held inputs).
+    pub waveforms: Vec<Waveform>,
+    /// Values to return to after a pulse or sinusoid.
+    pub saved: Vec<Option<f64>>,
+    /// Paths of inputs frozen by `valve_stuck` events.
+    pub stuck: Vec<String>,
+    /// Index of the next scenario event.
+    pub next_event: usize,
+    /// Next scan number of each sampled controller (time = k · scan).
+    pub next_scan: Vec<u64>,
+    /// Next sample number of each analyzer (time = k · sample time).
+    pub next_sample: Vec<u64>,
+    /// Pending analyzer results `(release time [s], value)`, per analyzer.
+    pub pending: Vec<Vec<(f64, f64)>>,
+    /// Next recording number (time = k · interval).
+    pub next_record: u64,
+    /// Snapshots already taken.
+    pub snapshots_done: Vec<bool>,
+}
+
+impl DriverState {
+    /// The state at the start of a run of `sc` on the (rewired) `plant`: every input constant at
+    /// its value, nothing due yet but the first scan, sample and recording.
+    pub(super) fn start(plant: &Plant, sc: &Scenario) -> DriverState {
+        DriverState {
+            waveforms: plant.inputs().iter().map(|i| Waveform::Constant(i.value)).collect(),
+            saved: vec![None; plant.inputs().len()],
+            stuck: Vec::new(),
+            next_event: 0,
+            next_scan: vec![1; sc.sampling.len()],
+            next_sample: vec![0; sc.analyzers.len()],
+            pending: vec![Vec::new(); sc.analyzers.len()],
+            next_record: 0,
+            snapshots_done: vec![false; sc.snapshots.len()],
+        }
+    }
+}
+
+/// Everything needed to continue a run (serialize it with serde).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Snapshot {
+    /// Format version.
+    pub format_version: u32,
+    /// Identifies the plant description the state belongs to (chosen by the caller, e.g. a hash
+    /// of the flowsheet text and overrides); a different one means "parameters changed".
+    pub fingerprint: String,
+    /// Time [s].
+    pub t: f64,
+    /// Paths of the state vector entries (plant variables, then totals).
+    pub paths: Vec<String>,
+    /// Paths of the inputs (plant inputs, then the analyzers' held inputs).
+    pub inputs: Vec<String>,
+    /// Driver state.
+    pub driver: DriverState,
+    /// Integrator state (its `d[0]` is the state vector).
+    pub integrator: BdfState,
+}
+
+/// What a run resumed from a snapshot starts with.
+pub(super) struct Resumed {
+    /// The driver state, its waveforms mapped to this plant's inputs.
+    pub(super) driver: DriverState,
+    /// The integrator history to restore, if the plant is the snapshot's own (otherwise the run
+    /// restarts at order 1).
+    pub(super) integrator: Option<BdfState>,
+}
+
+/// The state vector of length `n_state` for a run resumed from `s`: the plant's initial guess,
+/// overwritten by path with the snapshot's values (`paths` are this run's state paths; entries
+/// the snapshot lacks keep the guess, quadratures start at 0).
+pub(super) fn mapped_state(plant: &Plant, paths: &[String], n_state: usize, s: &Snapshot) -> Vec<f64> {
+    let mut v = plant.initial_guess();
+    v.resize(n_state, 0.0);
+    for (p, val) in s.paths.iter().zip(&s.integrator.d[0]) {
+        if let Some(k) = paths.iter().position(|q| q == p) {
+            v[k] = *val;
+        }
+    }
+    v
+}
+
+/// Resume from `s`: check that it fits `sc` and the plant, freeze the inputs its stuck valves
+/// froze (and drop them from the `sampled` controllers' held inputs), and map its driver state
+/// onto `fresh` (the state a new run would start with). `paths` are this run's state paths.
+pub(super) fn resume(
+    plant: &mut Plant,
+    sc: &Scenario,
+    s: &Snapshot,
+    fingerprint: &str,
+    paths: &[String],
+    fresh: DriverState,
+    sampled: &mut [Vec<(usize, usize)>],
+) -> Result<Resumed, SimError> {
+    let file = plant.file().to_string();
+    let bad = |reason: String| SimError::Snapshot { file: file.clone(), reason };
+    if s.format_version != SNAPSHOT_VERSION {
+        return Err(bad(format!("snapshot format_version {} (this build reads {SNAPSHOT_VERSION})", s.format_version)));
+    }
+    for p in &s.driver.stuck {
+        let i =
+            plant.inputs().iter().position(|i| i.path == *p).ok_or_else(|| bad(format!("no input `{p}` to freeze")))?;
+        plant.hold_input(i);
+        sampled.iter_mut().for_each(|s| s.retain(|&(j, _)| j != i));
+    }
+    let input_paths: Vec<String> = plant.inputs().iter().map(|i| i.path.clone()).collect();
+    let same = s.fingerprint == fingerprint && s.paths == paths && s.inputs == input_paths;
+    let mut driver = s.driver.clone();
+    if !same {
+        // Map the input waveforms by path; everything else keeps its meaning by index.
+        let mut waves = fresh.waveforms.clone();
+        let mut saved = vec![None; input_paths.len()];
+        for (k, p) in s.inputs.iter().enumerate() {
+            if let Some(j) = input_paths.iter().position(|q| q == p) {
+                waves[j] = s.driver.waveforms[k];
+                saved[j] = s.driver.saved[k];
+            }
+        }
+        driver.waveforms = waves;
+        driver.saved = saved;
+    }
+    if driver.next_scan.len() != fresh.next_scan.len() || driver.next_sample.len() != fresh.next_sample.len() {
+        return Err(bad("the scenario's sampled controllers or analyzers differ from the snapshot's".into()));
+    }
+    driver.snapshots_done.resize(sc.snapshots.len(), true);
+    Ok(Resumed { driver, integrator: same.then(|| s.integrator.clone()) })
+}
