@@ -9,19 +9,19 @@ use super::CliError;
 
 pub fn run(file: &Path) -> Result<(), CliError> {
     let plant = load_file(file).map_err(|e| CliError::user(e.to_string()))?;
-    outln!("flowsheet `{}` ({})", plant.name, file.display());
-    outln!("components ({}): {}", plant.components.len(), plant.components.join(", "));
-    let units: Vec<_> = plant.blocks.iter().filter(|b| b.kind == BlockKind::Unit).collect();
+    outln!("flowsheet `{}` ({})", plant.name(), file.display());
+    outln!("components ({}): {}", plant.components().len(), plant.components().join(", "));
+    let units: Vec<_> = plant.blocks().iter().filter(|b| b.kind == BlockKind::Unit).collect();
     outln!("units ({}):", units.len());
     for b in &units {
         outln!("  {:<16} {}", b.name, b.unit.type_name());
     }
-    outln!("streams ({}):", plant.streams.len());
-    for s in &plant.streams {
+    outln!("streams ({}):", plant.streams().len());
+    for s in plant.streams() {
         let (fb, fp) = s.from;
         let (tb, tp) = s.to;
-        let from = &plant.blocks[fb];
-        let to = &plant.blocks[tb];
+        let from = &plant.blocks()[fb];
+        let to = &plant.blocks()[tb];
         outln!(
             "  {:<16} {}.{} -> {}.{}",
             s.name,
@@ -31,16 +31,17 @@ pub fn run(file: &Path) -> Result<(), CliError> {
             to.unit.inlet_ports()[tp]
         );
     }
-    let ctrls: Vec<_> = plant.blocks.iter().filter(|b| b.kind == BlockKind::Controller).collect();
+    let ctrls: Vec<_> = plant.blocks().iter().filter(|b| b.kind == BlockKind::Controller).collect();
     outln!("controllers ({}):", ctrls.len());
     for b in &ctrls {
         let measured: Vec<String> = b.unit.signals().iter().map(|s| format!("{}={}", s.role, s.path)).collect();
         let driven: Vec<&str> = plant
-            .inputs
+            .inputs()
             .iter()
             .filter(|i| {
                 i.driven_by.is_some_and(|v| {
-                    plant.vars[v].block == plant.blocks.iter().position(|x| std::ptr::eq(x, *b)).unwrap_or(usize::MAX)
+                    plant.vars()[v].block
+                        == plant.blocks().iter().position(|x| std::ptr::eq(x, *b)).unwrap_or(usize::MAX)
                 })
             })
             .map(|i| i.path.as_str())
@@ -54,15 +55,15 @@ pub fn run(file: &Path) -> Result<(), CliError> {
         );
     }
     let n_diff = plant.differential().iter().filter(|d| **d).count();
-    let free: Vec<&str> = plant.inputs.iter().filter(|i| i.driven_by.is_none()).map(|i| i.path.as_str()).collect();
+    let free: Vec<&str> = plant.inputs().iter().filter(|i| i.driven_by.is_none()).map(|i| i.path.as_str()).collect();
     outln!(
         "variables: {} ({} differential, {} algebraic); equations: {}; inputs: {} ({} driven by controllers)",
         plant.n_vars(),
         n_diff,
         plant.n_vars() - n_diff,
         plant.n_eqs(),
-        plant.inputs.len(),
-        plant.inputs.len() - free.len()
+        plant.inputs().len(),
+        plant.inputs().len() - free.len()
     );
     outln!("free inputs (manipulated variables and disturbances): {}", free.join(", "));
     let recycles = plant.recycles();

@@ -148,8 +148,8 @@ pub fn run(a: &GainsArgs) -> Result<(), CliError> {
     let inputs = select_inputs(&plant, &a.inputs).map_err(analysis_error)?;
     let outputs = select_outputs(&plant, &a.outputs).map_err(analysis_error)?;
     let dims = (
-        inputs.iter().map(|s| (plant.inputs[s.index].dim, s.factor)).collect(),
-        outputs.iter().map(|s| (plant.vars[s.index].spec.dim, s.factor)).collect(),
+        inputs.iter().map(|s| (plant.inputs()[s.index].dim, s.factor)).collect(),
+        outputs.iter().map(|s| (plant.vars()[s.index].spec.dim, s.factor)).collect(),
     );
     let opts = options(a, &a.inputs, &a.outputs, Some(dims))?;
     let ss = converge(&plant, &u)?;
@@ -188,7 +188,7 @@ pub fn run(a: &GainsArgs) -> Result<(), CliError> {
         outln!("{}", serde_json::to_string_pretty(&json).map_err(|e| CliError::user(e.to_string()))?);
         return Ok(());
     }
-    outln!("steady-state gains of `{}` ({note})\n", plant.name);
+    outln!("steady-state gains of `{}` ({note})\n", plant.name());
     print_report(&report);
     if let Some(text) = &a.frequencies {
         let tu = TimeUnit::parse(&a.time_unit)?;
@@ -410,7 +410,7 @@ pub fn run_sensors(a: &SensorsArgs) -> Result<(), CliError> {
         outln!("{}", serde_json::to_string_pretty(&doc).map_err(|e| CliError::user(e.to_string()))?);
         return Ok(());
     }
-    outln!("temperature-sensor selection for `{}` in `{}` (gains in K per input unit)\n", a.column, plant.name);
+    outln!("temperature-sensor selection for `{}` in `{}` (gains in K per input unit)\n", a.column, plant.name());
     out!("{:>6} {:>10} {:>9}", "stage", "T [K]", "ΔT [K]");
     for i in &inputs {
         out!(" {:>22}", format!("dT/d{} [K/{}]", i.path.rsplit('.').next().unwrap_or(&i.path), i.unit));

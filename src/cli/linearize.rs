@@ -102,7 +102,7 @@ pub fn run(a: &LinearizeArgs) -> Result<(), CliError> {
         .collect();
     outln!(
         "linear model of `{}` at its steady state: {} states, {} inputs, {} outputs",
-        plant.name,
+        plant.name(),
         model.states.len(),
         inputs.len(),
         outputs.len()

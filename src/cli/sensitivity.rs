@@ -65,7 +65,7 @@ pub fn run(a: &SensitivityArgs) -> Result<(), CliError> {
     let curves = sweep(&plant, &ss.x, &ss.u, &disturbances, &idx, &settings).map_err(analysis_error)?;
     outln!(
         "sensitivity of `{}` (control structure as in the flowsheet, each point re-converged from its neighbour)",
-        plant.name
+        plant.name()
     );
     for c in &curves {
         let d = &c.disturbance;
@@ -90,7 +90,7 @@ pub fn run(a: &SensitivityArgs) -> Result<(), CliError> {
         outln!("\nwrote {}", path.display());
     }
     if let Some(path) = &a.plot {
-        let title = format!("{}: sensitivity", plant.name);
+        let title = format!("{}: sensitivity", plant.name());
         write_sensitivity(path, &title, &curves, &outputs).map_err(|e| match e {
             IoError::Draw(_) => CliError::numerical(e.to_string()),
             _ => CliError::user(e.to_string()),
@@ -100,7 +100,7 @@ pub fn run(a: &SensitivityArgs) -> Result<(), CliError> {
     let failures: Vec<String> = curves.iter().flat_map(|c| &c.failures).map(|f| f.to_string()).collect();
     if !failures.is_empty() {
         let list: Vec<&str> = failures.iter().map(|s| s.as_str()).collect();
-        return Err(CliError::numerical(format!("{}: the sweep stopped early: {}", plant.file, list.join("; "))));
+        return Err(CliError::numerical(format!("{}: the sweep stopped early: {}", plant.file(), list.join("; "))));
     }
     Ok(())
 }

@@ -74,10 +74,10 @@ pub fn run(file: &Path, json: bool, sets: &[String], method: MethodArg) -> Resul
     };
     if json {
         let mut values = serde_json::Map::new();
-        for (v, x) in plant.vars.iter().zip(&sol.x) {
+        for (v, x) in plant.vars().iter().zip(&sol.x) {
             values.insert(v.path.clone(), (*x).into());
         }
-        for (i, x) in plant.inputs.iter().zip(&sol.u) {
+        for (i, x) in plant.inputs().iter().zip(&sol.u) {
             if i.driven_by.is_none() {
                 values.insert(i.path.clone(), (*x).into());
             }
@@ -103,25 +103,25 @@ pub fn run(file: &Path, json: bool, sets: &[String], method: MethodArg) -> Resul
     match (&sol.newton, &sol.sm) {
         (None, Some(sm)) => outln!(
             "steady state of `{}`: converged by the sequential-modular method in {} passes, tear residual {residual:.2e}\n",
-            plant.name,
+            plant.name(),
             sm.passes()
         ),
         _ => outln!(
             "steady state of `{}`: converged in {iterations} iterations, scaled residual {residual:.2e}\n",
-            plant.name
+            plant.name()
         ),
     }
     for w in &sol.warnings {
         outln!("warning: {}\n", w.message);
     }
-    let comps = &plant.components;
+    let comps = plant.components();
     out!("{:<14} {:>12} {:>9} {:>10} {:>11}", "stream", "F kmol/h", "T K", "P kPa", "h kJ/mol");
     for c in comps {
         out!(" {:>10}", format!("x[{}]", truncate(c, 7)));
     }
     outln!();
-    for s in &plant.streams {
-        let v = &sol.x[s.offset..s.offset + plant.stream_layout.len()];
+    for s in plant.streams() {
+        let v = &sol.x[s.offset..s.offset + plant.stream_layout().len()];
         out!(
             "{:<14} {:>12.4} {:>9.3} {:>10.3} {:>11.4}",
             truncate(&s.name, 14),
@@ -136,13 +136,13 @@ pub fn run(file: &Path, json: bool, sets: &[String], method: MethodArg) -> Resul
         outln!();
     }
     outln!();
-    for (bi, b) in plant.blocks.iter().enumerate() {
+    for (bi, b) in plant.blocks().iter().enumerate() {
         let internal: Vec<String> = plant
-            .vars
+            .vars()
             .iter()
             .zip(&sol.x)
             .filter(|(v, _)| {
-                v.block == bi && !plant.streams.iter().any(|s| v.path.starts_with(&format!("{}.", s.name)))
+                v.block == bi && !plant.streams().iter().any(|s| v.path.starts_with(&format!("{}.", s.name)))
             })
             .map(|(v, x)| format!("{}={:.6}", v.path.trim_start_matches(&format!("{}.", b.name)), x))
             .collect();

@@ -42,7 +42,7 @@ fn tears(plant: &Plant) -> Vec<Vec<String>> {
 fn stream_difference(plant: &Plant, a: &[f64], b: &[f64]) -> f64 {
     let n = plant.stream_layout().len();
     plant
-        .streams
+        .streams()
         .iter()
         .flat_map(|s| s.offset..s.offset + n)
         .map(|i| (a[i] - b[i]).abs() / a[i].abs().max(1e-3 * plant.vars()[i].spec.nominal))

@@ -289,7 +289,7 @@ impl Problem<'_> {
         let (plant, input) = (self.plant, self.inputs[k]);
         // Aim at the accuracy relative to the outputs' nominal sizes times the smaller relative
         // step; the error ratio is checked against the effect afterwards.
-        let goal = self.outputs.iter().map(|&o| plant.vars[o].spec.nominal).fold(f64::INFINITY, f64::min)
+        let goal = self.outputs.iter().map(|&o| plant.vars()[o].spec.nominal).fold(f64::INFINITY, f64::min)
             * (h / 2.0 / self.scales[k])
             * self.settings.accuracy;
         let moves = [h, -h, h / 2.0, -h / 2.0];
@@ -326,7 +326,7 @@ impl Problem<'_> {
         self.outputs
             .iter()
             .map(|&o| {
-                let (spec, y) = (&self.plant.vars[o].spec, self.x0[o]);
+                let (spec, y) = (&self.plant.vars()[o].spec, self.x0[o]);
                 let room = match (spec.lower.is_finite(), spec.upper.is_finite()) {
                     (true, true) => (y - spec.lower).min(spec.upper - y),
                     (true, false) => y - spec.lower,
@@ -350,7 +350,7 @@ impl Problem<'_> {
                     let slope = g[(i, k)].abs() * self.scales[k];
                     if slope > 0.0 {
                         cap = cap.min(self.settings.linear_range * rooms[i] / slope);
-                        floor = floor.max(MIN_EFFECT * self.plant.vars[o].spec.nominal / slope);
+                        floor = floor.max(MIN_EFFECT * self.plant.vars()[o].spec.nominal / slope);
                     }
                 }
                 cap.max(floor.min(steps[k])).max(MIN_STEP)
@@ -565,10 +565,10 @@ fn noise_check(p: &Problem, columns: &[Column], rel: &[f64]) -> Result<f64, Anal
 /// The typed error for a check that failed at the last step tried.
 fn unverified(p: &Problem, f: &Failure, step: f64, next: f64) -> AnalysisError {
     Unverified {
-        file: p.plant.file.clone(),
+        file: p.plant.file().to_string(),
         quantity: f.quantity,
-        output: p.plant.vars[p.outputs[f.output]].path.clone(),
-        input: p.plant.inputs[p.inputs[f.input]].path.clone(),
+        output: p.plant.vars()[p.outputs[f.output]].path.clone(),
+        input: p.plant.inputs()[p.inputs[f.input]].path.clone(),
         check: f.check,
         first: f.first,
         second: f.second,

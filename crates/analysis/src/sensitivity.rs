@@ -42,7 +42,7 @@ impl Disturbance {
         let (lo, hi) = range
             .split_once(':')
             .ok_or_else(|| request(format!("--disturb `{text}`: the range needs LOW:HIGH, e.g. `-10%:+10%`")))?;
-        let dim = plant.inputs[signal.index].dim;
+        let dim = plant.inputs()[signal.index].dim;
         let end = |s: &str| -> Result<f64, AnalysisError> {
             let s = s.trim();
             if let Some(p) = s.strip_suffix('%') {

@@ -67,10 +67,10 @@ pub fn select_temperature_sensors(
     }
     if stages.len() < 2 {
         let columns: Vec<&str> =
-            plant.blocks.iter().filter(|b| b.unit.type_name() == "column").map(|b| b.name.as_str()).collect();
+            plant.blocks().iter().filter(|b| b.unit.type_name() == "column").map(|b| b.name.as_str()).collect();
         return Err(request(format!(
             "{}: `{column}` has no stage temperatures `{column}.T[1]`, `{column}.T[2]`, …; columns in this flowsheet: {}",
-            plant.file,
+            plant.file(),
             if columns.is_empty() { "none".to_string() } else { columns.join(", ") }
         )));
     }

@@ -104,25 +104,25 @@ pub struct StreamInfo {
 #[derive(Debug, Clone)]
 pub struct Plant {
     /// File the plant came from (for messages).
-    pub file: String,
+    pub(crate) file: String,
     /// Name of the plant.
-    pub name: String,
+    pub(crate) name: String,
     /// Component names.
-    pub components: Vec<String>,
+    pub(crate) components: Vec<String>,
     /// Thermodynamic package.
-    pub thermo: ThermoPackage,
+    pub(crate) thermo: ThermoPackage,
     /// Stream layout.
-    pub stream_layout: StreamLayout,
+    pub(crate) stream_layout: StreamLayout,
     /// Units and controllers.
-    pub blocks: Vec<Block>,
+    pub(crate) blocks: Vec<Block>,
     /// Global variables.
-    pub vars: Vec<VarInfo>,
+    pub(crate) vars: Vec<VarInfo>,
     /// Declared inputs.
-    pub inputs: Vec<InputInfo>,
+    pub(crate) inputs: Vec<InputInfo>,
     /// Streams.
-    pub streams: Vec<StreamInfo>,
+    pub(crate) streams: Vec<StreamInfo>,
     /// Named inputs (`alias → input index`).
-    pub aliases: HashMap<String, usize>,
+    pub(crate) aliases: HashMap<String, usize>,
     pub(crate) var_index: HashMap<String, usize>,
     pub(crate) input_index: HashMap<String, usize>,
     /// The description the plant was assembled from (after field overrides): structure variants

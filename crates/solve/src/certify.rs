@@ -156,7 +156,7 @@ fn imbalance(
 /// Total holdups of block `bi` resting on their lower bound.
 fn floors(plant: &Plant, x: &[f64], bi: usize) -> Vec<String> {
     plant
-        .vars
+        .vars()
         .iter()
         .zip(x)
         .filter(|&(v, &xv)| {
