@@ -6,7 +6,7 @@ use std::path::Path;
 
 use plantwide::flowsheet::Plant;
 use plantwide::studies::tune::averaging::AveragingForm;
-use plantwide::studies::tune::flowsheet::{FlowsheetTuning, averaging_loop, blt_loops, edits};
+use plantwide::studies::tune::flowsheet::{FlowsheetLoop, FlowsheetTuning, averaging_loop, blt_loops, edits, kc_text};
 use plantwide::studies::tune::loops::{Measurement, PlantLoop, plant_loop};
 use plantwide::units::{Dimension, parse_quantity_as};
 
@@ -95,12 +95,12 @@ fn print_table(t: &FlowsheetTuning, plant: &Plant, tu: &TimeUnit) {
     }
     let u = &tu.name;
     outln!(
-        "{:<18} {:<18} {:>11} {:>11} {:>12} {:>11} {:>11}  action",
+        "{:<18} {:<18} {:>11} {:>11} {:>22} {:>11} {:>11}  action",
         "controller",
         "measurement",
-        "Ku",
+        "Ku (SI)",
         format!("Pu [{u}]"),
-        "Kc (SI)",
+        "Kc",
         format!("τI [{u}]"),
         format!("τD [{u}]")
     );
@@ -108,18 +108,41 @@ fn print_table(t: &FlowsheetTuning, plant: &Plant, tu: &TimeUnit) {
     for l in &t.loops {
         let warn = l.file_action.map_or(String::new(), |f| format!("  (the file has {f}: the loop would run away)"));
         outln!(
-            "{:<18} {:<18} {:>11} {:>11} {:>12.5e} {:>11} {:>11}  {}{warn}",
+            "{:<18} {:<18} {:>11} {:>11} {:>22} {:>11} {:>11}  {}{warn}",
             l.controller,
             l.output,
             opt(l.ku),
             opt(l.pu),
-            l.kc.abs(),
+            kc_text(plant, &l.controller, l.kc),
             opt(l.tau_i),
             opt(l.tau_d),
             l.action
         );
-        if let Some(av) = &l.averaging {
-            outln!("  averaging {:?}: largest level deviation {} at {:.4} {u}", av.form, av.band, av.time);
-        }
+        print_details(l, u);
+    }
+}
+
+/// The test behind a loop's settings: the relay cycle, the fitted model, the averaging design.
+fn print_details(l: &FlowsheetLoop, u: &str) {
+    if let Some(r) = &l.relay {
+        outln!(
+            "  relay: {} cycles after {} switches, amplitude {:.5e}, period spread {:.2} %, amplitude spread {:.2} %, \
+             time above the steady value {:.1} % of the period",
+            r.cycles,
+            r.switches,
+            r.amplitude,
+            100.0 * r.period_spread,
+            100.0 * r.amplitude_spread,
+            100.0 * r.duty
+        );
+    }
+    if let Some(f) = &l.fit {
+        let model = serde_json::to_string(&f.model).unwrap_or_default();
+        let settled =
+            if l.settled == Some(false) { "; the response had not settled: the fit extrapolates" } else { "" };
+        outln!("  fit ({u}): {model}, R² = {:.4}, RMSE/max = {:.2e}{settled}", f.r2, f.nrmse);
+    }
+    if let Some(av) = &l.averaging {
+        outln!("  averaging {:?}: largest level deviation {} at {:.4} {u}", av.form, av.band, av.time);
     }
 }

@@ -54,3 +54,119 @@ fn bad_models_exit_1_naming_the_problem() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Run `plantwide` in `dir` and parse its JSON output (asserting success).
+fn json_in(dir: &std::path::Path, args: &[&str]) -> serde_json::Value {
+    let out = crate::harness::command().current_dir(dir).args(args).output().unwrap();
+    assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+#[test]
+fn averaging_level_written_into_the_file_peaks_at_its_band_in_a_run() {
+    // surge_tank_pi: 0.1 m² tank, flow-set outflow, level 1 m. Design: the inflow steps by 10 mol/s,
+    // the level may move 0.2 m; critically damped PI: |Kc| = 2 Δu/(e Δh), τI = 2 e Δh/(|k| Δu),
+    // k = −v_L/A (the tank's integrating gain).
+    let dir = std::env::temp_dir().join(format!("plantwide-tune-avg-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let fs = flowsheet("surge_tank_pi.json");
+    let tuned = dir.join("tuned.json");
+    let args = [
+        "tune",
+        &fs,
+        "--loop",
+        "lc",
+        "--method",
+        "averaging",
+        "--form",
+        "pi",
+        "--flow-change",
+        "10 mol/s",
+        "--level-band",
+        "0.2 m",
+        "--write",
+        tuned.to_str().unwrap(),
+        "--json",
+    ];
+    let v = json_in(&dir, &args);
+    let l = &v["loops"][0];
+    let e = std::f64::consts::E;
+    assert!((l["kc"].as_f64().unwrap() + 2.0 * 10.0 / (e * 0.2)).abs() < 1e-9, "{l}");
+    assert_eq!(l["action"], "direct");
+    // Only kc and tau_i changed in the file.
+    let before: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&fs).unwrap()).unwrap();
+    let after: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&tuned).unwrap()).unwrap();
+    let mut expected = before.clone();
+    expected["controllers"]["lc"]["kc"] = after["controllers"]["lc"]["kc"].clone();
+    expected["controllers"]["lc"]["tau_i"] = after["controllers"]["lc"]["tau_i"].clone();
+    assert_eq!(after, expected);
+    assert_ne!(after["controllers"]["lc"]["kc"], before["controllers"]["lc"]["kc"]);
+    // The nonlinear run of the written file: the design step, its largest level deviation is the band
+    // (the tank's level is linear in its holdup) at t = 1/ω_n after the step, and it comes back.
+    let t_peak = l["averaging"]["time"].as_f64().unwrap();
+    let scenario = dir.join("step.json");
+    let sc = format!(
+        r#"{{"format_version": 1, "name": "design step", "duration": "{} s", "integrator": {{"rtol": 1e-8}},
+            "events": [{{"type": "step", "at": "10 s", "path": "F_in", "to": "60 mol/s"}}],
+            "record": {{"interval": "{} s", "paths": ["tank.level"]}}}}"#,
+        10.0 + 12.0 * t_peak,
+        t_peak / 200.0
+    );
+    std::fs::write(&scenario, sc).unwrap();
+    let csv = dir.join("step.csv");
+    let run = json_in(
+        &dir,
+        &[
+            "run",
+            tuned.to_str().unwrap(),
+            "--scenario",
+            scenario.to_str().unwrap(),
+            "--csv",
+            csv.to_str().unwrap(),
+            "--json",
+        ],
+    );
+    let level = run["paths"].as_array().unwrap().iter().find(|p| p["path"] == "tank.level").unwrap();
+    let dev = level["max_deviation"].as_f64().unwrap();
+    // Sampled every t_peak/200 near a flat maximum: the record misses the peak by ~1e-5 of it.
+    assert!((dev - 0.2).abs() < 1e-4 * 0.2, "largest deviation {dev} m, designed 0.2 m");
+    assert!((run["final_values"]["tank.level"].as_f64().unwrap() - 1.0).abs() < 0.01 * 0.2, "{run}");
+}
+
+#[test]
+fn relay_on_a_plant_loop_agrees_with_its_linear_ultimate_within_the_describing_function() {
+    // The relay test on the nonlinear two-column plant, and BLT of the same loop alone from the exact
+    // linearization (n = 1, F = 1 when ZN already stays below 2 dB, so Ku and Pu are the linear ones):
+    // the relay's describing function underestimates Ku by a few percent and gives Pu within a few.
+    let dir = std::env::temp_dir();
+    let fs = flowsheet("two_column_plant.json");
+    let relay = json_in(&dir, &["tune", &fs, "--loop", "column1_top_T", "--method", "tl", "--json"]);
+    let linear = json_in(&dir, &["tune", &fs, "--loops", "column1_top_T", "--method", "blt", "--json"]);
+    let (r, l) = (&relay["loops"][0], &linear["loops"][0]);
+    let ku = r["ku"].as_f64().unwrap() / l["ku"].as_f64().unwrap();
+    let pu = r["pu"].as_f64().unwrap() / l["pu"].as_f64().unwrap();
+    assert!(ku > 0.85 && ku < 1.0, "relay/linear Ku = {ku}");
+    assert!((pu - 1.0).abs() < 0.05, "relay/linear Pu = {pu}");
+    assert!(r["relay"]["period_spread"].as_f64().unwrap() < 0.01 && r["relay"]["cycles"] == 3, "{r}");
+    // Tyreus–Luyben from the relay's own Ku, Pu.
+    assert!((r["kc"].as_f64().unwrap() - r["ku"].as_f64().unwrap() / 3.2).abs() < 1e-12);
+    assert!((r["tau_i"].as_f64().unwrap() - 2.2 * r["pu"].as_f64().unwrap()).abs() < 1e-9);
+    assert_eq!(r["action"], "direct");
+}
+
+#[test]
+fn flowsheet_tuning_refuses_what_it_cannot_do() {
+    let fs = flowsheet("two_column_plant.json");
+    let cases: [(&[&str], &str); 4] = [
+        (&["--loop", "column1_top", "--method", "tl"], "no PID controller `column1_top`"),
+        (&["--loops", "column1_top_T,column1_bottom_T", "--method", "blt"], "no phase crossover"),
+        (&["--loop", "column1_top_T", "--method", "averaging"], "averaging tuning is for levels"),
+        (&["--loop", "column1_top_T", "--method", "simc"], "give --tau-c"),
+    ];
+    for (extra, msg) in cases {
+        let out = plantwide(&[&["tune", fs.as_str()], extra].concat());
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{extra:?}: {err}");
+        assert!(err.contains(msg), "{extra:?}: {err}");
+    }
+}

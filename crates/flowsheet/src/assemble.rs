@@ -537,8 +537,9 @@ impl<'s> Assembler<'s> {
             input_index: self.input_index,
             spec: self.spec.clone(),
         };
-        crate::overrides::check_unit_inputs(&plant, &plant.input_values()).map_err(|(path, why)| {
-            LoadError::Invalid { file: plant.file().to_string(), diagnostics: vec![Diagnostic::new(path, why)] }
+        crate::overrides::check_unit_inputs(&plant, &plant.input_values()).map_err(|e| LoadError::Invalid {
+            file: plant.file().to_string(),
+            diagnostics: vec![Diagnostic::new(e.path, e.source.to_string())],
         })?;
         Ok(plant)
     }

@@ -23,14 +23,14 @@ pub enum EditError {
     },
 }
 
-/// One field to set: its path of object keys (`["controllers", "tc1", "kc"]`) and the JSON text
-/// of its new value (`"\"2.5 kmol/h/K\""`).
+/// One field to set or remove: its path of object keys (`["controllers", "tc1", "kc"]`) and the
+/// JSON text of its new value (`"\"2.5 kmol/h/K\""`), or `None` to remove the member.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FieldEdit {
     /// Object keys from the top.
     pub path: Vec<String>,
-    /// The new value as JSON text.
-    pub value: String,
+    /// The new value as JSON text; `None` removes the member (nothing happens if it is absent).
+    pub value: Option<String>,
 }
 
 /// `text` with each edit applied: a field present is replaced in place; an absent field is added
@@ -57,9 +57,15 @@ fn edit_one(text: &str, file: &str, e: &FieldEdit) -> Result<String, EditError> 
     }
     let object = &text[span.0..span.1];
     let members = members(object).map_err(&fail)?;
+    let Some(value) = &e.value else {
+        return Ok(match members.get(last.as_str()) {
+            Some(raw) => remove_member(text, span.0, offset_of(text, raw)),
+            None => text.to_string(),
+        });
+    };
     if let Some(raw) = members.get(last.as_str()) {
         let (a, b) = offset_of(text, raw);
-        return Ok(format!("{}{}{}", &text[..a], e.value, &text[b..]));
+        return Ok(format!("{}{value}{}", &text[..a], &text[b..]));
     }
     let close = span.0 + object.rfind('}').ok_or_else(|| fail("not an object".into()))?;
     let indent = member_indent(object);
@@ -67,7 +73,27 @@ fn edit_one(text: &str, file: &str, e: &FieldEdit) -> Result<String, EditError> 
     let comma = if members.is_empty() { "" } else { "," };
     let closing_indent = &text[text[..close].rfind('\n').map_or(close, |n| n + 1)..close];
     let closing_indent = if closing_indent.trim().is_empty() { closing_indent } else { "" };
-    Ok(format!("{}{comma}\n{indent}\"{last}\": {}\n{closing_indent}{}", &text[..body_end], e.value, &text[close..]))
+    Ok(format!("{}{comma}\n{indent}\"{last}\": {value}\n{closing_indent}{}", &text[..body_end], &text[close..]))
+}
+
+/// `text` without the member whose value spans `value` inside the object starting at `object`:
+/// from its key (and the whitespace before it) through its value, with the comma that separated
+/// it from the member before it — or, for the first member, from the one after it.
+fn remove_member(text: &str, object: usize, (a, b): (usize, usize)) -> String {
+    let before = &text[object..a];
+    let colon = object + before.rfind(':').unwrap_or(0);
+    let key = object + text[object..colon].rfind('"').and_then(|q| text[object..object + q].rfind('"')).unwrap_or(0);
+    let prev = text[object..key].trim_end();
+    if let Some(stripped) = prev.strip_suffix(',') {
+        let cut = object + stripped.len();
+        return format!("{}{}", &text[..cut], &text[b..]);
+    }
+    // The first member: drop it, its trailing comma and the whitespace up to the next key.
+    let rest = text[b..].trim_start();
+    let rest = rest.strip_prefix(',').map_or(&text[b..], |r| r.trim_start());
+    let start = object + prev.len();
+    let gap = &text[start..key];
+    format!("{}{gap}{rest}", &text[..start])
 }
 
 /// The members of the JSON object `text`, each value's raw text borrowed from it.
@@ -108,7 +134,25 @@ mod tests {
 "#;
 
     fn edit(path: &[&str], value: &str) -> FieldEdit {
-        FieldEdit { path: path.iter().map(|s| s.to_string()).collect(), value: value.to_string() }
+        FieldEdit { path: path.iter().map(|s| s.to_string()).collect(), value: Some(value.to_string()) }
+    }
+
+    fn removal(path: &[&str]) -> FieldEdit {
+        FieldEdit { path: path.iter().map(|s| s.to_string()).collect(), value: None }
+    }
+
+    #[test]
+    fn removed_members_take_their_comma_with_them() {
+        let out = edit_fields(FILE, "f.json", &[removal(&["controllers", "tc", "tau_i"])]).unwrap();
+        assert_eq!(out, FILE.replace(",   \"tau_i\": 600", ""));
+        let out = edit_fields(FILE, "f.json", &[removal(&["controllers", "lc", "type"])]).unwrap();
+        assert_eq!(out, FILE.replace("\"type\": \"pid\",\n      \"kc\": 10", "\"kc\": 10"), "{out}");
+        let out = edit_fields(FILE, "f.json", &[removal(&["controllers", "lc", "kc"])]).unwrap();
+        assert_eq!(out, FILE.replace(",\n      \"kc\": 10", ""), "{out}");
+        assert_eq!(edit_fields(FILE, "f.json", &[removal(&["controllers", "lc", "tau_d"])]).unwrap(), FILE);
+        for o in [&out] {
+            serde_json::from_str::<serde_json::Value>(o).unwrap();
+        }
     }
 
     #[test]

@@ -76,7 +76,7 @@ pub fn set_input(plant: &Plant, u: &mut [f64], path: &str, value: &str) -> Resul
     check_input_value(plant, i, v).map_err(|why| OverrideError::Value {
         path: path.to_string(),
         value: Some(value.to_string()),
-        why,
+        why: why.to_string(),
     })?;
     u[i] = v;
     Ok(true)
@@ -84,11 +84,11 @@ pub fn set_input(plant: &Plant, u: &mut [f64], path: &str, value: &str) -> Resul
 
 /// Check value `v` (SI) of input `i` against its physical range: the one check that file values,
 /// `--set` overrides and scenario events all pass ([`plantwide_model::limits::check_input`]).
-pub fn check_input_value(plant: &Plant, i: usize, v: f64) -> Result<(), String> {
+pub fn check_input_value(plant: &Plant, i: usize, v: f64) -> Result<(), plantwide_model::limits::RangeError> {
     let info = &plant.inputs[i];
     let block = &plant.blocks[info.block].name;
     let name = info.path.strip_prefix(&format!("{block}.")).unwrap_or(&info.path);
-    plantwide_model::limits::check_input(name, info.dim, v).map_err(|e| e.to_string())
+    plantwide_model::limits::check_input(name, info.dim, v)
 }
 
 /// Read the flowsheet at `path` and apply `overrides`: inputs (validated like the file's values)
@@ -119,21 +119,31 @@ pub(crate) fn apply_inputs(plant: &mut Plant, overrides: &[Override]) -> Result<
     }
     check_compositions(plant, &u)?;
     if !overrides.is_empty() {
-        check_unit_inputs(plant, &u).map_err(|(path, why)| OverrideError::UnitInput { path, why })?;
+        check_unit_inputs(plant, &u)
+            .map_err(|e| OverrideError::UnitInput { path: e.path, why: e.source.to_string() })?;
     }
     plant.set_input_values(&u);
     Ok(())
 }
 
-/// Each unit's own check of its input values ([`plantwide_model::UnitModel::check_inputs`]) at `u`:
-/// `Err((JSON path of the input, why))`.
-pub fn check_unit_inputs(plant: &Plant, u: &[f64]) -> Result<(), (String, String)> {
+/// A unit's own check of an input value failed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{path}: {source}")]
+pub struct UnitInputError {
+    /// JSON path of the input (`units.feed.P`).
+    pub path: String,
+    /// Why.
+    pub source: plantwide_model::InputError,
+}
+
+/// Each unit's own check of its input values ([`plantwide_model::UnitModel::check_inputs`]) at `u`.
+pub fn check_unit_inputs(plant: &Plant, u: &[f64]) -> Result<(), UnitInputError> {
     for b in &plant.blocks {
         let values: Vec<f64> = b.input_ids.iter().map(|&i| u[i]).collect();
         let section = if b.kind == crate::BlockKind::Unit { "units" } else { "controllers" };
         b.unit
             .check_inputs(&plant.thermo, &values)
-            .map_err(|e| (format!("{section}.{}.{}", b.name, e.input()), e.to_string()))?;
+            .map_err(|e| UnitInputError { path: format!("{section}.{}.{}", b.name, e.input()), source: e })?;
     }
     Ok(())
 }

@@ -238,9 +238,19 @@ pub fn from_step(
     Ok(FlowsheetTuning { method, detuning_factor: None, loops: vec![e] })
 }
 
+/// The controller gain `|kc|` as the file of `plant` would write it (in the unit of its `kc`).
+pub fn kc_text(plant: &Plant, controller: &str, kc: f64) -> String {
+    let old = match plant.spec().controllers.get(controller) {
+        Some(ControllerSpec::Pid(cfg)) => Some(cfg.kc.clone()),
+        _ => None,
+    };
+    quantity(kc.abs(), old.as_ref(), None).trim_matches('"').to_string()
+}
+
 /// Field edits writing `tuning` into the flowsheet text of `plant`: `kc` as the magnitude, and
-/// `tau_i`/`tau_d` (removed settings are left as they are), each in the unit the file wrote it in
-/// (SI numbers when it wrote a number; `time_unit` for a time the file did not have).
+/// `tau_i`/`tau_d` set, or removed when the tuning has none (a P-only averaging level replaces a
+/// PI), each in the unit the file wrote it in (SI numbers when it wrote a number; `time_unit` for a
+/// time the file did not have).
 ///
 /// # Errors
 /// [`TuneError::WrongAction`] when the file's action would make a tuned loop run away.
@@ -252,20 +262,17 @@ pub fn edits(plant: &Plant, tuning: &FlowsheetTuning, time_unit: &str) -> Result
         }
         let Some(ControllerSpec::Pid(cfg)) = plant.spec().controllers.get(&l.controller) else { continue };
         let path = |f: &str| vec!["controllers".to_string(), l.controller.clone(), f.to_string()];
-        out.push(FieldEdit { path: path("kc"), value: quantity(l.kc.abs(), Some(&cfg.kc), None) });
-        if let Some(ti) = l.tau_i {
-            out.push(FieldEdit { path: path("tau_i"), value: quantity(ti, cfg.tau_i.as_ref(), Some(time_unit)) });
-        }
-        if let Some(td) = l.tau_d {
-            out.push(FieldEdit { path: path("tau_d"), value: quantity(td, cfg.tau_d.as_ref(), Some(time_unit)) });
-        }
+        out.push(FieldEdit { path: path("kc"), value: Some(quantity(l.kc.abs(), Some(&cfg.kc), None)) });
+        let time = |v: Option<f64>, old: Option<&QuantityValue>| v.map(|v| quantity(v, old, Some(time_unit)));
+        out.push(FieldEdit { path: path("tau_i"), value: time(l.tau_i, cfg.tau_i.as_ref()) });
+        out.push(FieldEdit { path: path("tau_d"), value: time(l.tau_d, cfg.tau_d.as_ref()) });
     }
     Ok(out)
 }
 
 /// The JSON text of SI value `v` in the unit of `old` (a quantity string), else `fallback`, else
 /// the bare SI number; six significant digits.
-fn quantity(v: f64, old: Option<&QuantityValue>, fallback: Option<&str>) -> String {
+pub fn quantity(v: f64, old: Option<&QuantityValue>, fallback: Option<&str>) -> String {
     let unit = match old {
         Some(QuantityValue::Text(t)) => t.trim().split_once(char::is_whitespace).map(|(_, u)| u.trim().to_string()),
         _ => None,

@@ -52,7 +52,7 @@ pub struct PidSettings {
 /// Why a rule cannot be applied.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum RuleError {
-    /// The model has no dead time and no `τ_c` was given.
+    /// The model has no dead time (below a thousandth of its lag) and no `τ_c` was given.
     #[error(
         "the fitted model has no dead time, so the default closed-loop time constant τc = θ is zero; give \
          --tau-c (a time about the dead time of the loop's measurement and valve, or a fraction of τ)"
@@ -93,7 +93,7 @@ pub fn model_rule(
     let theta = model.dead_time();
     let tc = match tau_c {
         Some(t) => t,
-        None if theta > 0.0 => theta,
+        None if theta > 1e-3 * lag(&model) => theta,
         None => return Err(RuleError::NoDeadTime),
     };
     if !(tc.is_finite() && tc > 0.0) {
@@ -104,6 +104,16 @@ pub fn model_rule(
         ModelRule::Imc => imc(&model, tc, derivative),
     };
     Ok(PidSettings { kc, tau_i, tau_d, tau_c: tc })
+}
+
+/// The model's dominant lag \[s\] (0 for an integrator): a fitted dead time below a thousandth of
+/// it is no dead time to tune for.
+fn lag(model: &ProcessModel) -> f64 {
+    match *model {
+        ProcessModel::Foptd { tau, .. } => tau,
+        ProcessModel::Soptd { tau1, .. } => tau1,
+        ProcessModel::Integrating { .. } => 0.0,
+    }
 }
 
 /// Skogestad's half rule on a SOPTD model (half of `τ₂` to `τ₁`, half to the dead time); other
@@ -272,6 +282,9 @@ mod tests {
     fn degenerate_models_are_refused() {
         let no_delay = ProcessModel::Foptd { k: 1.0, tau: 5.0, theta: 0.0 };
         assert_eq!(model_rule(ModelRule::Simc, &no_delay, None, false), Err(RuleError::NoDeadTime));
+        // A fitted dead time of rounding size is none either (it would make τc = θ absurd).
+        let fitted = ProcessModel::Foptd { k: 1.0, tau: 700.0, theta: 2e-12 };
+        assert_eq!(model_rule(ModelRule::Simc, &fitted, None, false), Err(RuleError::NoDeadTime));
         assert!(model_rule(ModelRule::Simc, &no_delay, Some(1.0), false).is_ok());
         let dead = ProcessModel::Foptd { k: 0.0, tau: 5.0, theta: 1.0 };
         assert!(matches!(model_rule(ModelRule::Imc, &dead, None, false), Err(RuleError::Degenerate { .. })));
