@@ -133,7 +133,7 @@ pub struct UnitInputError {
     /// JSON path of the input (`units.feed.P`).
     pub path: String,
     /// Why.
-    pub source: plantwide_model::InputError,
+    pub source: Box<plantwide_model::InputError>,
 }
 
 /// Each unit's own check of its input values ([`plantwide_model::UnitModel::check_inputs`]) at `u`.
@@ -143,7 +143,7 @@ pub fn check_unit_inputs(plant: &Plant, u: &[f64]) -> Result<(), UnitInputError>
         let section = if b.kind == crate::BlockKind::Unit { "units" } else { "controllers" };
         b.unit
             .check_inputs(&plant.thermo, &values)
-            .map_err(|e| UnitInputError { path: format!("{section}.{}.{}", b.name, e.input()), source: e })?;
+            .map_err(|e| UnitInputError { path: format!("{section}.{}.{}", b.name, e.input()), source: Box::new(e) })?;
     }
     Ok(())
 }
