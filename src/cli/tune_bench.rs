@@ -30,6 +30,7 @@ pub fn run(
                 amplitude: quantity(&a.relay_amplitude, "relay-amplitude", out_dim)?,
                 hysteresis: quantity(&a.hysteresis, "hysteresis", pv_dim)?,
                 scan,
+                measurement: super::tune_plant::measurement(a)?,
             };
             let cycle = relay_loop(plant, x, l, o).map_err(tune_error)?;
             let (name, rule) = match method {

@@ -58,7 +58,7 @@ pub(super) fn quantity(text: &Option<String>, flag: &str, dim: Dimension) -> Res
         .transpose()
 }
 
-fn measurement(a: &TuneArgs) -> Result<Measurement, CliError> {
+pub(super) fn measurement(a: &TuneArgs) -> Result<Measurement, CliError> {
     let dead_time = quantity(&a.measurement_dead_time, "measurement-dead-time", Dimension::TIME)?.unwrap_or(0.0);
     let lag = quantity(&a.measurement_lag, "measurement-lag", Dimension::TIME)?.unwrap_or(0.0);
     if dead_time < 0.0 || lag < 0.0 {

@@ -152,6 +152,19 @@ fn relay_on_a_plant_loop_agrees_with_its_linear_ultimate_within_the_describing_f
     assert!((r["kc"].as_f64().unwrap() - r["ku"].as_f64().unwrap() / 3.2).abs() < 1e-12);
     assert!((r["tau_i"].as_f64().unwrap() - 2.2 * r["pu"].as_f64().unwrap()).abs() < 1e-9);
     assert_eq!(r["action"], "direct");
+    // The bottom loop has no crossover of its own (1/ω² roll-off); with the transmitter's 1-min dead
+    // time the relay sees (a delay of whole scans) and the linear model's e^(−θs), both find one.
+    let dt = ["--measurement-dead-time", "1 min"];
+    let relay =
+        json_in(&dir, &[&["tune", &fs, "--loop", "column1_bottom_T", "--method", "tl"][..], &dt, &["--json"]].concat());
+    let linear = json_in(
+        &dir,
+        &[&["tune", &fs, "--loops", "column1_bottom_T", "--method", "blt"][..], &dt, &["--json"]].concat(),
+    );
+    let (r, l) = (&relay["loops"][0], &linear["loops"][0]);
+    let ku = r["ku"].as_f64().unwrap() / l["ku"].as_f64().unwrap();
+    let pu = r["pu"].as_f64().unwrap() / l["pu"].as_f64().unwrap();
+    assert!(ku > 0.85 && ku < 1.0 && (pu - 1.0).abs() < 0.05, "with dead time: relay/linear Ku = {ku}, Pu = {pu}");
 }
 
 #[test]

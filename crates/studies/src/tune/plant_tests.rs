@@ -17,10 +17,18 @@ use super::fit::{ModelFit, ModelOrder, fit_step};
 use super::loops::{LoopResponse, Measurement, PlantLoop, in_manual, loop_model, loop_ultimates};
 use crate::TuneError;
 
-/// The plant with one loop in manual, run by a [`Session`].
+/// The plant with one loop in manual, run by a [`Session`], its measurement seen through the
+/// transmitter the model leaves out: a dead time of whole scans (`round(θ_m/Δ)` samples old) and a
+/// first-order lag updated exactly for a sample held over each step (`z += (1 − e^(−Δt/τ_m))(y − z)`).
 struct PlantBench<'a> {
     session: Session,
     l: &'a PlantLoop,
+    measurement: Measurement,
+    scan: f64,
+    /// Raw samples, oldest first, the dead time's worth of them.
+    delayed: std::collections::VecDeque<f64>,
+    /// The lag's output.
+    seen: f64,
 }
 
 impl Bench for PlantBench<'_> {
@@ -29,20 +37,41 @@ impl Bench for PlantBench<'_> {
         self.session.time()
     }
     fn measurement(&self) -> f64 {
-        self.session.state()[self.l.pv]
+        self.seen
     }
     fn set_output(&mut self, u: f64) {
         self.session.set_input(self.l.op_manual, u);
     }
     fn advance_to(&mut self, t: f64) -> Result<(), SessionError> {
-        self.session.advance_to(t)
+        let dt = t - self.session.time();
+        self.session.advance_to(t)?;
+        self.delayed.push_back(self.session.state()[self.l.pv]);
+        let steps = (self.measurement.dead_time / self.scan).round() as usize;
+        while self.delayed.len() > steps + 1 {
+            self.delayed.pop_front();
+        }
+        let y = self.delayed.front().copied().unwrap_or(self.seen);
+        self.seen = if self.measurement.lag > 0.0 {
+            self.seen + (1.0 - (-dt / self.measurement.lag).exp()) * (y - self.seen)
+        } else {
+            y
+        };
+        Ok(())
     }
 }
 
-fn bench<'a>(plant: &Plant, x: &[f64], l: &'a PlantLoop) -> Result<PlantBench<'a>, TuneError> {
+fn bench<'a>(
+    plant: &Plant,
+    x: &[f64],
+    l: &'a PlantLoop,
+    measurement: Measurement,
+    scan: f64,
+) -> Result<PlantBench<'a>, TuneError> {
     let manual = in_manual(plant, x, std::slice::from_ref(l));
     let session = Session::new(&manual, x).map_err(|e| TuneError::Simulation(Box::new(e)))?;
-    Ok(PlantBench { session, l })
+    let y0 = x[l.pv];
+    let steps = (measurement.dead_time / scan).round() as usize;
+    Ok(PlantBench { session, l, measurement, scan, delayed: std::iter::repeat_n(y0, steps + 1).collect(), seen: y0 })
 }
 
 /// Options of a relay test; `None` takes the default.
@@ -54,6 +83,8 @@ pub struct RelayOptions {
     pub hysteresis: Option<f64>,
     /// Scan \[s\] (default `P_u/200` of the linear model).
     pub scan: Option<f64>,
+    /// The measurement's dead time and lag that the model leaves out.
+    pub measurement: Measurement,
 }
 
 /// A relay test of loop `l` at the steady state `x`.
@@ -64,7 +95,7 @@ pub struct RelayOptions {
 pub fn relay_loop(plant: &Plant, x: &[f64], l: &PlantLoop, o: RelayOptions) -> Result<RelayCycle, TuneError> {
     let model = loop_model(plant, x, std::slice::from_ref(l))?;
     let gain_sign = model.ss.steady_gain().map(|g| g[(0, 0)].signum()).unwrap_or(1.0);
-    let response = LoopResponse::new(model, Measurement::default());
+    let response = LoopResponse::new(model, o.measurement);
     let linear = loop_ultimates(&response, std::slice::from_ref(l))?[0];
     let u0 = x[l.op];
     let settings = SampledRelay {
@@ -79,7 +110,7 @@ pub fn relay_loop(plant: &Plant, x: &[f64], l: &PlantLoop, o: RelayOptions) -> R
     if !(settings.amplitude.is_finite() && settings.amplitude > 0.0) {
         return Err(TuneError::RelayAmplitude { controller: l.name.clone(), amplitude: settings.amplitude });
     }
-    let mut b = bench(plant, x, l)?;
+    let mut b = bench(plant, x, l, o.measurement, settings.scan)?;
     relay(&mut b, u0, &settings).map_err(|e| TuneError::Relay { controller: l.name.clone(), source: Box::new(e) })
 }
 
@@ -113,7 +144,7 @@ pub fn step_loop(plant: &Plant, x: &[f64], l: &PlantLoop, o: StepOptions) -> Res
     if !(settings.step != 0.0 && settings.step.is_finite()) {
         return Err(TuneError::RelayAmplitude { controller: l.name.clone(), amplitude: settings.step });
     }
-    let mut b = bench(plant, x, l)?;
+    let mut b = bench(plant, x, l, Measurement::default(), settings.scan)?;
     let (record, settled) = step(&mut b, u0, &settings).map_err(|e| TuneError::Simulation(Box::new(e)))?;
     let fit = fit_step(&record, order).map_err(TuneError::from)?;
     Ok((fit, settled || integrating))
