@@ -170,11 +170,15 @@ fn relay_on_a_plant_loop_agrees_with_its_linear_ultimate_within_the_describing_f
 #[test]
 fn flowsheet_tuning_refuses_what_it_cannot_do() {
     let fs = flowsheet("two_column_plant.json");
-    let cases: [(&[&str], &str); 4] = [
+    let cases: [(&[&str], &str); 5] = [
         (&["--loop", "column1_top", "--method", "tl"], "no PID controller `column1_top`"),
         (&["--loops", "column1_top_T,column1_bottom_T", "--method", "blt"], "no phase crossover"),
         (&["--loop", "column1_top_T", "--method", "averaging"], "averaging tuning is for levels"),
         (&["--loop", "column1_top_T", "--method", "simc"], "give --tau-c"),
+        (
+            &["--loop", "column1_top_T", "--method", "tl", "--relay-amplitude", "1000 kmol/h"],
+            "moves column1.reflux to -",
+        ),
     ];
     for (extra, msg) in cases {
         let out = plantwide(&[&["tune", fs.as_str()], extra].concat());

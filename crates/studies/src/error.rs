@@ -150,6 +150,18 @@ pub enum TuneError {
         /// The amplitude.
         amplitude: f64,
     },
+    /// A test would drive its input out of range (a valve past fully open).
+    #[error("`{controller}`: the test moves {input} to {value}: {why}; give a smaller --relay-amplitude or --step")]
+    Saturates {
+        /// Controller.
+        controller: String,
+        /// The input it drives.
+        input: String,
+        /// The value the test would give it.
+        value: f64,
+        /// Why that value is out of range.
+        why: String,
+    },
     /// The step record determines no model.
     #[error(transparent)]
     Fit(#[from] crate::tune::fit::FitError),

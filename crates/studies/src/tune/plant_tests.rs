@@ -110,6 +110,8 @@ pub fn relay_loop(plant: &Plant, x: &[f64], l: &PlantLoop, o: RelayOptions) -> R
     if !(settings.amplitude.is_finite() && settings.amplitude > 0.0) {
         return Err(TuneError::RelayAmplitude { controller: l.name.clone(), amplitude: settings.amplitude });
     }
+    within_range(plant, l, u0 + settings.amplitude)?;
+    within_range(plant, l, u0 - settings.amplitude)?;
     let mut b = bench(plant, x, l, o.measurement, settings.scan)?;
     relay(&mut b, u0, &settings).map_err(|e| TuneError::Relay { controller: l.name.clone(), source: Box::new(e) })
 }
@@ -144,10 +146,28 @@ pub fn step_loop(plant: &Plant, x: &[f64], l: &PlantLoop, o: StepOptions) -> Res
     if !(settings.step != 0.0 && settings.step.is_finite()) {
         return Err(TuneError::RelayAmplitude { controller: l.name.clone(), amplitude: settings.step });
     }
+    within_range(plant, l, u0 + settings.step)?;
     let mut b = bench(plant, x, l, Measurement::default(), settings.scan)?;
     let (record, settled) = step(&mut b, u0, &settings).map_err(|e| TuneError::Simulation(Box::new(e)))?;
     let fit = fit_step(&record, order).map_err(TuneError::from)?;
     Ok((fit, settled || integrating))
+}
+
+/// A test output `u` must be a value the driven input can take (a valve opening within [0, 1], a
+/// flow not negative): a test that saturates its valve measures the limit, not the plant.
+fn within_range(plant: &Plant, l: &PlantLoop, u: f64) -> Result<(), TuneError> {
+    let Some(b) = plant.block_index(&l.name) else { return Ok(()) };
+    for i in plant.inputs_driven_by(b) {
+        if let Err(why) = plantwide_flowsheet::overrides::check_input_value(plant, i, u) {
+            return Err(TuneError::Saturates {
+                controller: l.name.clone(),
+                input: plant.inputs()[i].path.clone(),
+                value: u,
+                why: why.to_string(),
+            });
+        }
+    }
+    Ok(())
 }
 
 /// The element's mean residence time `T = −g'(0)/g(0)` \[s\] and whether it integrates: from
