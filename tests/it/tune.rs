@@ -187,3 +187,27 @@ fn flowsheet_tuning_refuses_what_it_cannot_do() {
         assert!(err.contains(msg), "{extra:?}: {err}");
     }
 }
+
+#[test]
+fn a_step_test_of_a_tank_level_fits_its_integrating_gain() {
+    // The nonlinear tank under a 5 % outflow step in manual: an IPDT fit must find k = −v_L/A
+    // (v_L = V/M of the steady state, A = π (1.5 m)²/4) and no dead time; SIMC then needs τc.
+    let dir = std::env::temp_dir();
+    let fs = flowsheet("surge_tank.json");
+    let steady = json_in(&dir, &["steady", &fs, "--json"]);
+    let v_l = steady["values"]["tank.V"].as_f64().unwrap() / steady["values"]["tank.M"].as_f64().unwrap();
+    let k_exact = -v_l / (std::f64::consts::PI * 1.5f64.powi(2) / 4.0);
+    let args =
+        ["tune", &fs, "--loop", "level_control", "--method", "simc", "--scan", "10 s", "--tau-c", "10 min", "--json"];
+    let v = json_in(&dir, &args);
+    let l = &v["loops"][0];
+    assert_eq!(l["fit"]["model"]["type"], "integrating");
+    let k = l["fit"]["model"]["k"].as_f64().unwrap();
+    assert!((k / k_exact - 1.0).abs() < 1e-6, "{k} vs {k_exact}");
+    assert!(l["fit"]["model"]["theta"].as_f64().unwrap() < 1e-6);
+    // SIMC for an integrator: Kc = 1/(k (τc + θ)), τI = 4 (τc + θ).
+    assert!(
+        (l["kc"].as_f64().unwrap() * k * 600.0 - 1.0).abs() < 1e-5
+            && (l["tau_i"].as_f64().unwrap() - 2400.0).abs() < 1e-3
+    );
+}

@@ -112,16 +112,14 @@ pub enum TuneError {
     /// The plant's linear model could not be formed or analysed (eigenvalues, steady gain).
     #[error("linear model of the loops: {0}")]
     Linear(#[from] Box<plantwide_analysis::AnalysisError>),
-    /// The loop's element has no usable dynamics to size a test by.
+    /// The loop's element has no time constant to size a test by (a pure integrator).
     #[error(
-        "`{controller}`: its element's mean residence time is {value} s (no dynamics between its output and its \
-         measurement?); give --scan"
+        "`{controller}`: its element has no lag or dead time of its own (a pure integrator?) to size the test by; \
+         give --scan (the test then runs 500 scans)"
     )]
     ResidenceTime {
         /// Controller.
         controller: String,
-        /// The value found.
-        value: f64,
     },
     /// The loop's linear model has no state.
     #[error("`{controller}`: no dynamics between its output and its measurement (the linear model has no state)")]

@@ -137,12 +137,13 @@ pub fn step_loop(plant: &Plant, x: &[f64], l: &PlantLoop, o: StepOptions) -> Res
     let (t_mean, integrating) = residence_time(plant, x, l)?;
     let order = o.order.unwrap_or(if integrating { ModelOrder::Integrating } else { ModelOrder::Foptd });
     let u0 = x[l.op];
-    let settings = StepTest {
-        step: o.step.unwrap_or(0.05 * u0.abs()),
-        scan: o.scan.unwrap_or(t_mean / 100.0),
-        max_duration: if integrating { 5.0 * t_mean } else { 30.0 * t_mean },
-        settle: 2e-3,
+    // A pure integrator has no time of its own: the test then runs 500 scans of the scan given.
+    let (scan, max_duration) = match (o.scan, t_mean) {
+        (scan, Some(t)) => (scan.unwrap_or(t / 100.0), if integrating { 5.0 * t } else { 30.0 * t }),
+        (Some(scan), None) => (scan, 500.0 * scan),
+        (None, None) => return Err(TuneError::ResidenceTime { controller: l.name.clone() }),
     };
+    let settings = StepTest { step: o.step.unwrap_or(0.05 * u0.abs()), scan, max_duration, settle: 2e-3 };
     if !(settings.step != 0.0 && settings.step.is_finite()) {
         return Err(TuneError::RelayAmplitude { controller: l.name.clone(), amplitude: settings.step });
     }
@@ -172,8 +173,8 @@ fn within_range(plant: &Plant, l: &PlantLoop, u: f64) -> Result<(), TuneError> {
 
 /// The element's mean residence time `T = −g'(0)/g(0)` \[s\] and whether it integrates: from
 /// `g(jω) ≈ g(0)(1 − jωT)` at ω a million times below the slowest nonzero eigenvalue (for an
-/// integrating element, `s g(s)` in place of `g`).
-fn residence_time(plant: &Plant, x: &[f64], l: &PlantLoop) -> Result<(f64, bool), TuneError> {
+/// integrating element, `s g(s)` in place of `g`); `None` when it has none (a pure integrator).
+fn residence_time(plant: &Plant, x: &[f64], l: &PlantLoop) -> Result<(Option<f64>, bool), TuneError> {
     let model = loop_model(plant, x, std::slice::from_ref(l))?;
     let ev = model.ss.eigenvalues().map_err(|e| TuneError::Linear(Box::new(e)))?;
     let scale = ev.iter().map(|v| v.norm()).fold(0.0, f64::max);
@@ -183,8 +184,6 @@ fn residence_time(plant: &Plant, x: &[f64], l: &PlantLoop) -> Result<(f64, bool)
     let integrating = g.im.abs() > g.re.abs();
     let h = if integrating { g * c64::new(0.0, w) } else { g };
     let t = -h.im / (w * h.re);
-    if !(t.is_finite() && t > 0.0) {
-        return Err(TuneError::ResidenceTime { controller: l.name.clone(), value: t });
-    }
-    Ok((t, integrating))
+    // Below a millionth of the slowest time scale it is rounding, not a lag.
+    Ok(((t.is_finite() && t > 1e-6 / slow).then_some(t), integrating))
 }
