@@ -5,8 +5,8 @@ use plantwide::flowsheet::Plant;
 use plantwide::flowsheet::scenario::{parse_scenario, resolve};
 use plantwide::flowsheet::{Override, load_str_with};
 use plantwide::solve::dynamic::{SimError, Start, simulate};
-use plantwide::solve::sequential::{Solution, StrategySettings, steady_state_by};
 use plantwide::solve::{DofProbe, dof_check};
+use plantwide::solve::{Solution, StrategySettings, converge};
 
 use super::certificate;
 use super::corpus::{Mode, Mutant};
@@ -61,11 +61,10 @@ fn load(m: &Mutant) -> Result<(Plant, Vec<f64>), String> {
     Ok((plant, u))
 }
 
-/// The DOF check and the default strategy, as `plantwide steady` runs them.
+/// The steady state as `plantwide steady` finds it ([`converge`]: DOF probe, strategy, certificate).
 fn steady(plant: &Plant, u: &[f64]) -> Result<Solution, Outcome> {
-    let x0 = plant.initial_guess_at(u);
-    dof_check(plant, u, &x0, DofProbe::Numerical).map_err(|e| Outcome::User(e.to_string()))?;
-    steady_state_by(plant, u, &StrategySettings::default(), &mut |_| {})
+    debug_assert_eq!(plant.input_values(), u);
+    converge(plant, &StrategySettings::default())
         .map_err(|e| if e.is_user_error() { Outcome::User(e.to_string()) } else { Outcome::Numerical(e.to_string()) })
 }
 
