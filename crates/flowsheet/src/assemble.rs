@@ -536,7 +536,10 @@ impl<'s> Assembler<'s> {
             var_index: self.var_index,
             input_index: self.input_index,
             spec: self.spec.clone(),
+            assembled_inputs: Vec::new(),
         };
+        let mut plant = plant;
+        plant.assembled_inputs = plant.input_values();
         crate::overrides::check_unit_inputs(&plant, &plant.input_values()).map_err(|e| LoadError::Invalid {
             file: plant.file().to_string(),
             diagnostics: vec![Diagnostic::new(e.path, e.source.to_string())],

@@ -128,6 +128,8 @@ pub struct Plant {
     /// The description the plant was assembled from (after field overrides): structure variants
     /// are edits of it, assembled again ([`Plant::variant`]).
     pub(crate) spec: FlowsheetSpec,
+    /// The input values as assembled from `spec`: a variant keeps only the values changed since.
+    pub(crate) assembled_inputs: Vec<f64>,
 }
 
 impl Plant {

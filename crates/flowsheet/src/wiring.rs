@@ -128,8 +128,9 @@ impl Plant {
 
     /// A structure variant: this plant's description with `overrides` applied (fields of units and
     /// controllers: another measurement or manipulated input of a controller, another pairing, a
-    /// unit's parameters; and input values), assembled again. Input values of this plant carry
-    /// over by path where the variant keeps the input.
+    /// unit's parameters; and input values), assembled again. Input values this plant changed since
+    /// it was assembled carry over by path where the variant keeps the input; the others take the
+    /// variant's own (so a field edit that changes an input's default, `mode` → `auto`, holds).
     pub fn variant(&self, overrides: &[Override]) -> Result<Plant, OverrideError> {
         let mut spec = self.spec.clone();
         let mut inputs = Vec::new();
@@ -141,13 +142,51 @@ impl Plant {
             }
         }
         let mut plant = crate::assemble(&spec, &self.file)?;
-        for (k, info) in plant.inputs.iter_mut().enumerate() {
-            if let Some(j) = self.input_index.get(&info.path) {
-                info.value = self.inputs[*j].value;
+        for info in plant.inputs.iter_mut() {
+            let Some(&j) = self.input_index.get(&info.path) else { continue };
+            if self.assembled_inputs.get(j) != Some(&self.inputs[j].value) {
+                info.value = self.inputs[j].value;
             }
-            debug_assert_eq!(plant.input_index.get(&info.path), Some(&k));
         }
         crate::overrides::apply_inputs(&mut plant, &inputs)?;
         Ok(plant)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::overrides::{Override, load_str_with};
+
+    const TANK: &str = r#"{
+      "format_version": 1, "name": "t", "components": ["water"], "thermo": {"vle": "ideal"},
+      "units": {
+        "inflow": {"type": "feed", "F": "50 mol/s", "T": "300 K", "P": "2 bar", "z": {"water": 1.0}},
+        "tank": {"type": "tank", "area": "0.1 m2", "height": "2 m", "outflow": {"type": "flow", "flow": "50 mol/s"}},
+        "out": {"type": "product"}
+      },
+      "streams": {"a": {"from": "inflow", "to": "tank"}, "b": {"from": "tank", "to": "out"}},
+      "controllers": {"lc": {"type": "pid", "pv": "tank.level", "output": "tank.outflow", "sp": "1 m",
+                             "kc": "50 mol/s/m", "tau_i": "200 s", "action": "direct", "mode": "auto"}}
+    }"#;
+
+    #[test]
+    fn a_variant_keeps_changed_inputs_and_takes_the_edits_defaults() {
+        let plant = load_str_with(TANK, "t.json", &[]).unwrap();
+        let auto = plant.input("lc.auto").unwrap();
+        let feed = plant.input("inflow.F").unwrap();
+        assert_eq!(plant.inputs()[auto].value, 1.0);
+        // A field edit that changes an input's default: the variant is in manual.
+        let manual = plant.variant(&[Override::new("lc.mode", "manual")]).unwrap();
+        assert_eq!(manual.inputs()[manual.input("lc.auto").unwrap()].value, 0.0);
+        // An input this plant changed carries over; an input override applies on top.
+        let mut changed = plant.clone();
+        changed.set_input_value(feed, 55.0);
+        let v = changed.variant(&[Override::new("lc.mode", "manual")]).unwrap();
+        assert_eq!(v.inputs()[v.input("inflow.F").unwrap()].value, 55.0);
+        let v = changed.variant(&[Override::new("inflow.F", "60 mol/s")]).unwrap();
+        assert_eq!(v.inputs()[v.input("inflow.F").unwrap()].value, 60.0);
+        // Through load_with the same: the edit's default holds.
+        let p = load_str_with(TANK, "t.json", &[Override::new("lc.mode", "manual")]).unwrap();
+        assert_eq!(p.inputs()[p.input("lc.auto").unwrap()].value, 0.0);
     }
 }
