@@ -14,7 +14,6 @@
 //! true steady state but not the one asked for: it is returned as a [`Warning`].
 
 use plantwide_flowsheet::{BlockKind, Plant};
-use plantwide_model::stream::{F, Z0};
 use plantwide_model::{UnitIo, limits::number};
 use serde::Serialize;
 
@@ -87,22 +86,21 @@ pub fn certify_to(plant: &Plant, x: &[f64], u: &[f64], tol: f64) -> Result<Vec<W
     if let Some(j) = x.iter().position(|v| !v.is_finite()) {
         return Err(fail(&plant.vars()[j].path, "its value, not finite,".into(), f64::INFINITY, Vec::new()));
     }
-    let nc = plant.components().len();
-    for s in plant.streams() {
-        let sum: f64 = x[s.offset + Z0..s.offset + Z0 + nc].iter().sum();
+    for (si, s) in plant.streams().iter().enumerate() {
+        let sum: f64 = x[plant.stream_composition_vars(si)].iter().sum();
         if (sum - 1.0).abs() > tol {
             let at_bound = floors(plant, x, s.from.0);
             return Err(fail(&s.name, "the sum of its mole fractions − 1".into(), sum - 1.0, at_bound));
         }
     }
     let reacting = plant.blocks().iter().any(|b| b.unit.reacts());
-    let scale = plant.streams().iter().map(|s| x[s.offset + F]).fold(0.0, f64::max).max(1e-12);
+    let scale = (0..plant.streams().len()).map(|s| x[plant.stream_flow_var(s)]).fold(0.0, f64::max).max(1e-12);
     for (bi, b) in plant.blocks().iter().enumerate() {
         if b.kind != BlockKind::Unit || matches!(b.unit.type_name(), "feed" | "product") {
             continue;
         }
-        let ins = plant.streams().iter().filter(|s| s.to.0 == bi).map(|s| s.offset);
-        let outs = plant.streams().iter().filter(|s| s.from.0 == bi).map(|s| s.offset);
+        let ins = (0..plant.streams().len()).filter(|&s| plant.streams()[s].to.0 == bi);
+        let outs = (0..plant.streams().len()).filter(|&s| plant.streams()[s].from.0 == bi);
         if let Some((equation, rel)) = imbalance(plant, x, (ins, outs), b.unit.reacts(), 1e-6 * scale, tol) {
             return Err(fail(&b.name, equation, rel, floors(plant, x, bi)));
         }
@@ -111,8 +109,8 @@ pub fn certify_to(plant: &Plant, x: &[f64], u: &[f64], tol: f64) -> Result<Vec<W
         }
     }
     let kind = |bi: usize| plant.blocks()[bi].unit.type_name();
-    let feeds = plant.streams().iter().filter(|s| kind(s.from.0) == "feed").map(|s| s.offset);
-    let products = plant.streams().iter().filter(|s| kind(s.to.0) == "product").map(|s| s.offset);
+    let feeds = (0..plant.streams().len()).filter(|&s| kind(plant.streams()[s].from.0) == "feed");
+    let products = (0..plant.streams().len()).filter(|&s| kind(plant.streams()[s].to.0) == "product");
     if let Some((equation, rel)) = imbalance(plant, x, (feeds, products), reacting, 1e-6 * scale, tol) {
         return Err(fail("plant", format!("{equation} (feeds against products)"), rel, Vec::new()));
     }
@@ -120,7 +118,7 @@ pub fn certify_to(plant: &Plant, x: &[f64], u: &[f64], tol: f64) -> Result<Vec<W
 }
 
 /// The worst relative imbalance of the component (or, with `mass`, the mass) balance between the
-/// streams at offsets `ins` and `outs`, if it exceeds `tol`; relative to the larger of the
+/// streams `ins` and `outs` (stream indices), if it exceeds `tol`; relative to the larger of the
 /// throughput and `floor` [mol/s].
 fn imbalance(
     plant: &Plant,
@@ -134,11 +132,11 @@ fn imbalance(
     let mw: Vec<f64> = plant.thermo().components.iter().map(|c| c.mw).collect();
     let mut net = vec![0.0; nc];
     let mut through = 0.0;
-    let mut add = |o: usize, sign: f64| {
-        let f = x[o + F];
+    let mut add = |s: usize, sign: f64| {
+        let (f, z) = (x[plant.stream_flow_var(s)], plant.stream_composition_vars(s).start);
         through += 0.5 * f;
         for (c, n) in net.iter_mut().enumerate() {
-            *n += sign * f * x[o + Z0 + c] * if mass { mw[c] } else { 1.0 };
+            *n += sign * f * x[z + c] * if mass { mw[c] } else { 1.0 };
         }
     };
     ins.for_each(|o| add(o, 1.0));
