@@ -118,3 +118,24 @@ fn edit_distance(a: &str, b: &str) -> usize {
 pub fn did_you_mean<'a>(word: &str, candidates: impl IntoIterator<Item = &'a str>) -> String {
     suggest(word, candidates).map(|s| format!(" (did you mean `{s}`?)")).unwrap_or_default()
 }
+
+/// Any failure of the flowsheet crate (the crate-level error): loading, overrides and variants,
+/// rewiring, editing a file's text.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum Error {
+    /// The file or a description could not be loaded.
+    #[error(transparent)]
+    Load(#[from] LoadError),
+    /// An override or a variant could not be applied.
+    #[error(transparent)]
+    Override(#[from] crate::overrides::OverrideError),
+    /// A unit's own check of its input values failed.
+    #[error(transparent)]
+    UnitInput(#[from] crate::overrides::UnitInputError),
+    /// The plant could not be rewired as asked.
+    #[error(transparent)]
+    Wiring(#[from] crate::wiring::WiringError),
+    /// A field of a file's text could not be edited.
+    #[error(transparent)]
+    Edit(#[from] crate::edit::EditError),
+}

@@ -22,7 +22,7 @@ pub mod tears;
 pub mod wiring;
 
 pub use assemble::{assemble, load_file, load_str};
-pub use error::{Diagnostic, LoadError};
+pub use error::{Diagnostic, Error, LoadError};
 pub use overrides::{Override, OverrideError, load_str_with, load_with};
 pub use parse::{parse_spec, read_text};
 pub use path::VarPath;

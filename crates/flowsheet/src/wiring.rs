@@ -157,7 +157,7 @@ impl Plant {
 mod tests {
     use crate::overrides::{Override, load_str_with};
 
-    const TANK: &str = r#"{
+    pub(super) const TANK: &str = r#"{
       "format_version": 1, "name": "t", "components": ["water"], "thermo": {"vle": "ideal"},
       "units": {
         "inflow": {"type": "feed", "F": "50 mol/s", "T": "300 K", "P": "2 bar", "z": {"water": 1.0}},
@@ -188,5 +188,27 @@ mod tests {
         // Through load_with the same: the edit's default holds.
         let p = load_str_with(TANK, "t.json", &[Override::new("lc.mode", "manual")]).unwrap();
         assert_eq!(p.inputs()[p.input("lc.auto").unwrap()].value, 0.0);
+    }
+}
+
+#[cfg(test)]
+mod variant_tests {
+    use crate::overrides::{Override, load_str_with};
+
+    #[test]
+    fn a_variant_moves_a_controllers_output_to_another_input() {
+        // The same tank with its level held by the inflow instead of the outflow (reverse action):
+        // the inventory configuration of the vessel changed, everything else as it was.
+        let text = super::tests::TANK;
+        let plant = load_str_with(text, "t.json", &[]).unwrap();
+        let moved = [Override::new("lc.output", "inflow.F"), Override::new("lc.action", "reverse")];
+        let v = plant.variant(&moved).unwrap();
+        let driven = |p: &crate::Plant, path: &str| p.inputs()[p.input(path).unwrap()].driven_by;
+        assert!(driven(&plant, "tank.outflow").is_some() && driven(&plant, "inflow.F").is_none());
+        assert!(driven(&v, "inflow.F").is_some() && driven(&v, "tank.outflow").is_none());
+        assert_eq!(v.n_vars(), plant.n_vars());
+        // A move to a path that is no input is refused by the assembly, naming it.
+        let err = plant.variant(&[Override::new("lc.output", "tank.nothing")]).unwrap_err();
+        assert!(err.to_string().contains("tank.nothing"), "{err}");
     }
 }
