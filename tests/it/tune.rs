@@ -170,7 +170,7 @@ fn relay_on_a_plant_loop_agrees_with_its_linear_ultimate_within_the_describing_f
 #[test]
 fn flowsheet_tuning_refuses_what_it_cannot_do() {
     let fs = flowsheet("two_column_plant.json");
-    let cases: [(&[&str], &str); 5] = [
+    let cases: [(&[&str], &str); 10] = [
         (&["--loop", "column1_top", "--method", "tl"], "no PID controller `column1_top`"),
         (&["--loops", "column1_top_T,column1_bottom_T", "--method", "blt"], "no phase crossover"),
         (&["--loop", "column1_top_T", "--method", "averaging"], "averaging tuning is for levels"),
@@ -179,6 +179,12 @@ fn flowsheet_tuning_refuses_what_it_cannot_do() {
             &["--loop", "column1_top_T", "--method", "tl", "--relay-amplitude", "1000 kmol/h"],
             "moves column1.reflux to -",
         ),
+        (&["--loops", "column1_top_T", "--method", "tl"], "give --loop CTRL"),
+        (&["--loop", "column1_top_T", "--method", "blt", "--measurement-dead-time=-1 min"], "must not be negative"),
+        (&["--loop", "reactor_level", "--method", "averaging", "--level-band", "2 kg"], "--level-band 2 kg"),
+        (&["--loop", "column1_top_T", "--method", "tl", "--scan", "fast"], "--scan fast"),
+        // A malformed command line is a user error too (clap's own exit code, 2, would read as numerical).
+        (&["--loop", "column1_top_T", "--method", "nope"], "invalid value 'nope'"),
     ];
     for (extra, msg) in cases {
         let out = plantwide(&[&["tune", fs.as_str()], extra].concat());
