@@ -217,3 +217,56 @@ fn a_step_test_of_a_tank_level_fits_its_integrating_gain() {
             && (l["tau_i"].as_f64().unwrap() - 2400.0).abs() < 1e-3
     );
 }
+
+/// A surge tank whose level controller sets the flow controller of its outflow valve.
+const CASCADE: &str = r#"{
+  "format_version": 1, "name": "tank_cascade", "components": ["water"], "thermo": {"vle": "ideal"},
+  "units": {
+    "inflow": {"type": "feed", "F": "100 kmol/h", "T": "25 degC", "P": "2 bar", "z": {"water": 1.0}},
+    "tank": {"type": "tank", "diameter": "1.5 m", "height": "4 m", "P": "1.5 bar",
+             "outflow": {"type": "valve", "cv": "1e-4 m2", "opening": 0.5, "p_out": "1.2 bar"}},
+    "downstream": {"type": "product"}
+  },
+  "streams": {"in": {"from": "inflow", "to": "tank"}, "out": {"from": "tank", "to": "downstream"}},
+  "controllers": {
+    "lc": {"type": "pid", "pv": "tank.level", "sp": "2 m", "kc": "50 kmol/h/m", "tau_i": "20 min",
+           "action": "direct", "bias": "100 kmol/h"},
+    "fc": {"type": "pid", "pv": "out.F", "output": "tank.opening", "sp": {"from": "lc.op"}, "kc": "0.01 h/kmol",
+           "tau_i": "0.2 min", "op_min": 0, "op_max": 1, "bias": 0.7}
+  }
+}"#;
+
+#[test]
+fn a_cascade_master_is_tested_with_its_slave_in_auto() {
+    // The master in manual moves the slave's setpoint; the slave in auto makes the outflow follow,
+    // so the master sees the flow-set tank: a pure integrator of gain −v_L/A per unit of its output.
+    // Averaging P for the default 10 % flow change over a 0.5 m band: τF = Δh/(|k| Δu).
+    let dir = std::env::temp_dir().join(format!("plantwide-tune-cascade-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let fs = dir.join("cascade.json");
+    std::fs::write(&fs, CASCADE).unwrap();
+    let fs = fs.to_str().unwrap();
+    let steady = json_in(&dir, &["steady", fs, "--json"]);
+    let val = |p: &str| steady["values"][p].as_f64().unwrap();
+    let k = val("tank.V") / val("tank.M") / (std::f64::consts::PI * 1.5f64.powi(2) / 4.0);
+    let du = 0.1 * val("lc.op");
+    let v = json_in(&dir, &["tune", fs, "--loop", "lc", "--method", "averaging", "--level-band", "0.5 m", "--json"]);
+    let l = &v["loops"][0];
+    assert!((l["kc"].as_f64().unwrap() + du / 0.5).abs() < 1e-9 * du, "{l}");
+    let tau = l["averaging"]["time"].as_f64().unwrap();
+    let k_linear = 0.5 / (tau * du);
+    // The slave's PI tracks the ramp that the level imposes on the valve's flow with a constant error,
+    // so the cascade integrates a few 1e-4 slower than the flow-set tank's −v_L/A.
+    assert!((k_linear / k - 1.0).abs() < 1e-3, "k {k_linear} vs −v_L/A {k}");
+    // A second route to the same gain: the nonlinear step test of the master and its IPDT fit.
+    let args = ["tune", fs, "--loop", "lc", "--method", "simc", "--scan", "10 s", "--tau-c", "10 min", "--json"];
+    let step = json_in(&dir, &args);
+    let k_step = -step["loops"][0]["fit"]["model"]["k"].as_f64().unwrap();
+    assert!((k_step / k_linear - 1.0).abs() < 1e-4, "step test k {k_step} vs linear {k_linear}");
+    // The slave's own relay test: opening → flow has no steady-state gain once the level is free
+    // (the level settles where the valve passes the inflow), so the flow never crosses back.
+    let out = plantwide(&["tune", fs, "--loop", "fc", "--method", "tl", "--measurement-lag", "2 s"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.code() == Some(1) || out.status.code() == Some(2), "{err}");
+    assert!(err.contains("relay test of `fc`"), "{err}");
+}

@@ -47,6 +47,8 @@ pub struct SampledRelay {
     pub tolerance: f64,
     /// Relay switches before giving up (default 60).
     pub max_switches: usize,
+    /// Scans without a switch before giving up (a measurement that does not come back).
+    pub max_quiet_scans: usize,
 }
 
 /// A sustained relay cycle.
@@ -90,6 +92,18 @@ pub enum RelayError<E: std::error::Error> {
         /// The scan \[s\].
         scan: f64,
     },
+    /// The measurement stopped crossing its steady value: no switch for many scans.
+    #[error(
+        "no relay switch for {scans} scans (to t = {t:.4e} s): the measurement does not come back across its \
+         steady value — the loop integrates, saturates at the relay's amplitude, or its scan is far too long; \
+         try a smaller amplitude or give --scan"
+    )]
+    NoSwitch {
+        /// Scans since the last switch.
+        scans: usize,
+        /// Time reached \[s\].
+        t: f64,
+    },
     /// The cycles did not settle.
     #[error(
         "no sustained cycle after {switches} relay switches (period spread {spread:.2} %): the loop may be \
@@ -114,9 +128,14 @@ pub fn relay<B: Bench>(bench: &mut B, u0: f64, s: &SampledRelay) -> Result<Relay
     let (mut switches, mut extremes): (Vec<f64>, Vec<(f64, f64)>) = (Vec::new(), Vec::new());
     let (mut lo, mut hi, mut above) = (f64::MAX, f64::MIN, 0.0);
     let mut above_per_half: Vec<f64> = Vec::new();
+    let mut since_switch = 0;
     while switches.len() < s.max_switches {
         let t = bench.time() + s.scan;
         bench.advance_to(t).map_err(RelayError::Bench)?;
+        since_switch += 1;
+        if since_switch > s.max_quiet_scans {
+            return Err(RelayError::NoSwitch { scans: since_switch - 1, t });
+        }
         let e = bench.measurement() - y0;
         (lo, hi) = (lo.min(e), hi.max(e));
         if e > 0.0 {
@@ -127,6 +146,7 @@ pub fn relay<B: Bench>(bench: &mut B, u0: f64, s: &SampledRelay) -> Result<Relay
             continue;
         }
         high = !high;
+        since_switch = 0;
         bench.set_output(u0 + if high { s.sign } else { -s.sign } * s.amplitude);
         switches.push(t);
         extremes.push((lo, hi));
@@ -313,6 +333,7 @@ mod tests {
             n_cycles: 3,
             tolerance: 1e-4,
             max_switches: 40,
+            max_quiet_scans: 100_000,
         };
         let c = relay(&mut foptd(k, tau, theta), 0.0, &settings).unwrap();
         let r = (-theta / tau).exp();
@@ -334,6 +355,24 @@ mod tests {
     }
 
     #[test]
+    fn a_measurement_that_never_comes_back_stops_the_test() {
+        // The relay pushes the wrong way (sign −1 on a positive gain): the output runs away and
+        // never crosses back, so the test must stop instead of integrating forever.
+        let settings = SampledRelay {
+            amplitude: 1.0,
+            hysteresis: 0.0,
+            scan: 0.1,
+            sign: -1.0,
+            n_cycles: 3,
+            tolerance: 1e-3,
+            max_switches: 40,
+            max_quiet_scans: 2000,
+        };
+        let err = relay(&mut foptd(1.0, 5.0, 1.0), 0.0, &settings).unwrap_err();
+        assert!(matches!(err, RelayError::NoSwitch { scans: 2000, .. }), "{err}");
+    }
+
+    #[test]
     fn a_lag_without_dead_time_chatters() {
         let settings = SampledRelay {
             amplitude: 1.0,
@@ -343,6 +382,7 @@ mod tests {
             n_cycles: 3,
             tolerance: 1e-3,
             max_switches: 40,
+            max_quiet_scans: 2000,
         };
         let err = relay(&mut foptd(1.0, 5.0, 0.0), 0.0, &settings).unwrap_err();
         assert!(matches!(err, RelayError::Chatter { .. }), "{err}");

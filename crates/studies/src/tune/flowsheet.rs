@@ -154,9 +154,9 @@ pub fn blt_loops(
 }
 
 /// The integrating gain `k = lim_{s→0} s g(s)` of a level loop's element at `x` (level units per
-/// output unit per second), from the linear model with the loop in manual, evaluated at a
-/// frequency a million times below the slowest nonzero eigenvalue (`s g(s) = k (1 + O(s τ))`, so
-/// the relative error is about 1e-6).
+/// output unit per second), from the linear model with the loop in manual: the real part of
+/// `s g(s) = k (1 − sT + O(s²))` at ω a thousand times below the slowest nonzero eigenvalue, whose
+/// error is `O((ωT)²)` ~ 1e-6 (far lower frequencies lose digits to the integrator's pole).
 ///
 /// # Errors
 /// [`TuneError::NotIntegrating`] when the element has a finite steady-state gain.
@@ -165,7 +165,7 @@ pub fn integrating_gain(plant: &Plant, x: &[f64], l: &PlantLoop) -> Result<f64, 
     let ev = model.ss.eigenvalues().map_err(|e| TuneError::Linear(Box::new(e)))?;
     let scale = ev.iter().map(|v| v.norm()).fold(0.0, f64::max);
     let slow = ev.iter().map(|v| v.norm()).filter(|m| *m > 1e-10 * scale).fold(f64::INFINITY, f64::min);
-    let w = 1e-6 * slow;
+    let w = 1e-3 * slow;
     let response = LoopResponse::new(model, Measurement::default());
     let g = response.at(w)[(0, 0)];
     let sg = g * faer::c64::new(0.0, w);

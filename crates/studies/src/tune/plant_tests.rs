@@ -106,6 +106,8 @@ pub fn relay_loop(plant: &Plant, x: &[f64], l: &PlantLoop, o: RelayOptions) -> R
         n_cycles: 3,
         tolerance: 1e-2,
         max_switches: 60,
+        // Twenty times the ~100 scans of the half cycle the default scan (P_u/200) expects.
+        max_quiet_scans: if o.scan.is_some() { 100_000 } else { 2000 },
     };
     if !(settings.amplitude.is_finite() && settings.amplitude > 0.0) {
         return Err(TuneError::RelayAmplitude { controller: l.name.clone(), amplitude: settings.amplitude });
@@ -139,7 +141,10 @@ pub fn step_loop(plant: &Plant, x: &[f64], l: &PlantLoop, o: StepOptions) -> Res
     let u0 = x[l.op];
     // A pure integrator has no time of its own: the test then runs 500 scans of the scan given.
     let (scan, max_duration) = match (o.scan, t_mean) {
-        (scan, Some(t)) => (scan.unwrap_or(t / 100.0), if integrating { 5.0 * t } else { 30.0 * t }),
+        (scan, Some(t)) => {
+            let scan = scan.unwrap_or(t / 100.0);
+            (scan, if integrating { (5.0 * t).max(500.0 * scan) } else { (30.0 * t).max(100.0 * scan) })
+        }
         (Some(scan), None) => (scan, 500.0 * scan),
         (None, None) => return Err(TuneError::ResidenceTime { controller: l.name.clone() }),
     };
@@ -172,14 +177,14 @@ fn within_range(plant: &Plant, l: &PlantLoop, u: f64) -> Result<(), TuneError> {
 }
 
 /// The element's mean residence time `T = −g'(0)/g(0)` \[s\] and whether it integrates: from
-/// `g(jω) ≈ g(0)(1 − jωT)` at ω a million times below the slowest nonzero eigenvalue (for an
+/// `g(jω) ≈ g(0)(1 − jωT)` at ω a thousand times below the slowest nonzero eigenvalue (for an
 /// integrating element, `s g(s)` in place of `g`); `None` when it has none (a pure integrator).
 fn residence_time(plant: &Plant, x: &[f64], l: &PlantLoop) -> Result<(Option<f64>, bool), TuneError> {
     let model = loop_model(plant, x, std::slice::from_ref(l))?;
     let ev = model.ss.eigenvalues().map_err(|e| TuneError::Linear(Box::new(e)))?;
     let scale = ev.iter().map(|v| v.norm()).fold(0.0, f64::max);
     let slow = ev.iter().map(|v| v.norm()).filter(|m| *m > 1e-10 * scale).fold(f64::INFINITY, f64::min);
-    let w = 1e-6 * slow;
+    let w = 1e-3 * slow;
     let g = LoopResponse::new(model, Measurement::default()).at(w)[(0, 0)];
     let integrating = g.im.abs() > g.re.abs();
     let h = if integrating { g * c64::new(0.0, w) } else { g };
