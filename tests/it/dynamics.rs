@@ -560,37 +560,26 @@ fn cli_run_reports_scenario_errors_with_their_json_paths() {
     let dir = std::env::temp_dir().join(format!("plantwide_run_err_{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let bad = dir.join("bad.json");
-    std::fs::write(
-        &bad,
-        r#"{"format_version": 1, "duration": "10 min",
+    // Run the PI surge tank through the scenario `text`: (exit code, stderr).
+    let run = |text: &str| {
+        std::fs::write(&bad, text).unwrap();
+        let out = harness::command()
+            .args(["run", &flowsheet("surge_tank_pi.json"), "--scenario"])
+            .arg(&bad)
+            .args(["--csv", "/dev/null"])
+            .output()
+            .unwrap();
+        (out.status.code(), String::from_utf8_lossy(&out.stderr).into_owned())
+    };
+    let (code, err) = run(r#"{"format_version": 1, "duration": "10 min",
         "events": [{"type": "step", "at": "1 min", "path": "F_inn", "to": "60 mol/s"},
                    {"type": "step", "at": "2 min", "path": "tank.outflow", "to": "60 mol/s"},
-                   {"type": "ramp", "at": "3 min", "path": "lc.sp", "to": "5 kg", "duration": "1 min"}]}"#,
-    )
-    .unwrap();
-    let out = harness::command()
-        .args(["run", &flowsheet("surge_tank_pi.json"), "--scenario"])
-        .arg(&bad)
-        .args(["--csv", "/dev/null"])
-        .output()
-        .unwrap();
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{err}");
+                   {"type": "ramp", "at": "3 min", "path": "lc.sp", "to": "5 kg", "duration": "1 min"}]}"#);
+    assert_eq!(code, Some(1), "{err}");
     assert!(err.contains("events[0].path: no input `F_inn` (did you mean `F_in`?)"), "{err}");
     assert!(err.contains("events[1].path: input `tank.outflow` is driven by controller `lc`"), "{err}");
     assert!(err.contains("events[2].to: `5 kg` is a mass but a length is expected"), "{err}");
-    std::fs::write(&bad, r#"{"format_version": 1, "duration": "10 min", "events": [{"type": "jump", "at": 0}]}"#)
-        .unwrap();
-    let out = harness::command()
-        .args(["run", &flowsheet("surge_tank_pi.json"), "--scenario"])
-        .arg(&bad)
-        .args(["--csv", "/dev/null"])
-        .output()
-        .unwrap();
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        out.status.code() == Some(1) && err.contains("events[0]") && err.contains("unknown variant `jump`"),
-        "{err}"
-    );
+    let (code, err) = run(r#"{"format_version": 1, "duration": "10 min", "events": [{"type": "jump", "at": 0}]}"#);
+    assert!(code == Some(1) && err.contains("events[0]") && err.contains("unknown variant `jump`"), "{err}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
