@@ -47,10 +47,11 @@ pub struct TuneArgs {
     /// Tuning method.
     #[arg(long, value_enum)]
     pub(super) method: MethodArg,
-    /// The PID controller to tune (relay, zn, tl, simc, imc, averaging).
+    /// The PID controller to tune.
     #[arg(long = "loop", value_name = "CTRL")]
     pub(super) loop_name: Option<String>,
-    /// The PID controllers to tune together (blt), comma separated.
+    /// The PID controllers to tune, comma separated: together (blt) or one after another, cascade
+    /// slaves before their masters, each tested with those before it tuned (the other methods).
     #[arg(long, value_name = "C1,C2,…", value_delimiter = ',')]
     pub(super) loops: Vec<String>,
     /// Override an input or unit field before converging (repeatable).

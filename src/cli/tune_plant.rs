@@ -7,7 +7,7 @@ use std::path::Path;
 use plantwide::flowsheet::Plant;
 use plantwide::studies::tune::averaging::AveragingForm;
 use plantwide::studies::tune::flowsheet::{FlowsheetLoop, FlowsheetTuning, averaging_loop, blt_loops, edits, kc_text};
-use plantwide::studies::tune::loops::{Measurement, PlantLoop, plant_loop};
+use plantwide::studies::tune::loops::{Measurement, PlantLoop, inner_first, plant_loop};
 use plantwide::units::{Dimension, parse_quantity_as};
 
 use super::CliError;
@@ -22,11 +22,9 @@ pub fn run(a: &TuneArgs, tu: &TimeUnit) -> Result<(), CliError> {
     let names = loop_names(a)?;
     let loops: Vec<PlantLoop> =
         names.iter().map(|n| plant_loop(&plant, n)).collect::<Result<_, _>>().map_err(tune_error)?;
-    let x = converge(&plant, &u)?.x;
     let tuning = match a.method {
-        MethodArg::Blt => blt_loops(&plant, &x, &loops, measurement(a)?).map_err(tune_error)?,
-        MethodArg::Averaging => averaging(a, &plant, &x, &loops[0])?,
-        m => super::tune_bench::run(a, &plant, &x, &loops[0], m)?,
+        MethodArg::Blt => blt_loops(&plant, &converge(&plant, &u)?.x, &loops, measurement(a)?).map_err(tune_error)?,
+        _ => in_sequence(a, file, &plant, &loops, tu)?,
     };
     if let Some(out) = &a.write {
         write(file, out, &plant, &tuning, tu)?;
@@ -40,15 +38,53 @@ pub fn run(a: &TuneArgs, tu: &TimeUnit) -> Result<(), CliError> {
     Ok(())
 }
 
-/// The loops asked for: `--loops` for BLT (at least one), `--loop` for the single-loop methods.
+/// The loops asked for: `--loop CTRL` or `--loops C1,C2,…` (BLT tunes them together, the other
+/// methods one after another).
 fn loop_names(a: &TuneArgs) -> Result<Vec<String>, CliError> {
-    match (a.method, &a.loop_name, a.loops.is_empty()) {
-        (MethodArg::Blt, None, false) => Ok(a.loops.clone()),
-        (MethodArg::Blt, Some(l), true) => Ok(vec![l.clone()]),
-        (MethodArg::Blt, _, _) => Err(CliError::user("--method blt tunes the loops of --loops C1,C2,… together")),
-        (_, Some(l), true) => Ok(vec![l.clone()]),
-        _ => Err(CliError::user("this method tunes one loop: give --loop CTRL (--loops is for --method blt)")),
+    match (&a.loop_name, a.loops.is_empty()) {
+        (None, false) => Ok(a.loops.clone()),
+        (Some(l), true) => Ok(vec![l.clone()]),
+        (Some(_), false) => Err(CliError::user("give either --loop CTRL or --loops C1,C2,…, not both")),
+        (None, true) => Err(CliError::user("give the loop to tune: --loop CTRL (or --loops C1,C2,…)")),
     }
+}
+
+/// A single-loop method on each of `loops` in turn, cascade slaves before their masters
+/// ([`inner_first`]): each loop's test runs on the plant with the loops tuned before it at their
+/// new settings (the file's text edited as `--write` would, loaded and converged again — a P-only
+/// loop given reset action moves the steady state).
+fn in_sequence(
+    a: &TuneArgs,
+    file: &Path,
+    plant: &Plant,
+    loops: &[PlantLoop],
+    tu: &TimeUnit,
+) -> Result<FlowsheetTuning, CliError> {
+    let text = plantwide::flowsheet::read_text(file).map_err(|e| CliError::user(e.to_string()))?;
+    let user = |e: plantwide::flowsheet::OverrideError| CliError::user(e.to_string());
+    let overrides = a.set.iter().map(|s| s.parse()).collect::<Result<Vec<_>, _>>().map_err(user)?;
+    let name = file.display().to_string();
+    let mut tuned: Option<FlowsheetTuning> = None;
+    let mut current = plant.clone();
+    for l in inner_first(plant, loops) {
+        if let Some(t) = &tuned {
+            let edited =
+                plantwide::flowsheet::edit::edit_fields(&text, &name, &edits(plant, t, &tu.name).map_err(tune_error)?)
+                    .map_err(|e| CliError::user(e.to_string()))?;
+            current = plantwide::flowsheet::load_str_with(&edited, &name, &overrides).map_err(user)?;
+        }
+        let x = converge(&current, &current.input_values())?.x;
+        let l = plant_loop(&current, &l.name).map_err(tune_error)?;
+        let one = match a.method {
+            MethodArg::Averaging => averaging(a, &current, &x, &l)?,
+            m => super::tune_bench::run(a, &current, &x, &l, m)?,
+        };
+        match &mut tuned {
+            Some(t) => t.loops.extend(one.loops),
+            None => tuned = Some(one),
+        }
+    }
+    tuned.ok_or_else(|| CliError::user("give the loop to tune: --loop CTRL (or --loops C1,C2,…)"))
 }
 
 /// An optional quantity option in SI.

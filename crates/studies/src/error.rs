@@ -160,6 +160,32 @@ pub enum TuneError {
         /// Why that value is out of range.
         why: String,
     },
+    /// The loop's output has no lasting effect on its measurement (a washout: the response returns
+    /// to where it started), so no model with a steady-state gain or an integrator describes it.
+    #[error(
+        "`{controller}`: its output has no steady-state effect on its measurement (the response returns to where it \
+         started: something else — another loop, an inventory left free — cancels it); tune the loops that hold \
+         the plant around it first, or tune this one on a faster test (--method relay)"
+    )]
+    NoSteadyGain {
+        /// Controller.
+        controller: String,
+    },
+    /// The fitted model does not describe the step response: settings from it would be arbitrary.
+    #[error(
+        "`{controller}`: the {model} model explains R² = {r2:.3} of the step response (at least {min_r2} needed); \
+         choose another --model, a smaller --step, or a relay test"
+    )]
+    PoorFit {
+        /// Controller.
+        controller: String,
+        /// The model fitted.
+        model: &'static str,
+        /// Its coefficient of determination.
+        r2: f64,
+        /// The least accepted.
+        min_r2: f64,
+    },
     /// The step record determines no model.
     #[error(transparent)]
     Fit(#[from] crate::tune::fit::FitError),

@@ -40,6 +40,17 @@ pub enum ModelOrder {
     Integrating,
 }
 
+impl ModelOrder {
+    /// The model's name in messages.
+    pub fn name(self) -> &'static str {
+        match self {
+            ModelOrder::Foptd => "first-order-plus-dead-time",
+            ModelOrder::Soptd => "second-order-plus-dead-time",
+            ModelOrder::Integrating => "integrating-plus-dead-time",
+        }
+    }
+}
+
 /// A fitted low-order model; gains in output units per input unit, times in seconds.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 #[serde(tag = "type", rename_all = "snake_case")]

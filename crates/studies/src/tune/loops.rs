@@ -12,7 +12,7 @@ use plantwide_analysis::linear::{Linearization, StateSpace};
 use plantwide_analysis::response::HessenbergResponse;
 use plantwide_flowsheet::Plant;
 use plantwide_model::ControllerSpec;
-use plantwide_model::controllers::Action;
+use plantwide_model::controllers::{Action, Setpoint};
 
 use super::Tuning;
 use super::blt::{BltSettings, LoopSystem, blt_system};
@@ -55,6 +55,32 @@ pub fn plant_loop(plant: &Plant, name: &str) -> Result<PlantLoop, TuneError> {
         return Err(not_a_loop());
     };
     Ok(PlantLoop { name: name.to_string(), pv_path: cfg.pv.clone(), pv, op, op_manual, auto, action: cfg.action })
+}
+
+/// `loops` in the order a cascade is tuned: a slave (a loop whose setpoint is another listed loop's
+/// output, `"sp": {"from": "<master>.op"}`) before its master, at any depth; otherwise as listed.
+/// Each master is then tested with its slaves in auto at their new settings.
+pub fn inner_first(plant: &Plant, loops: &[PlantLoop]) -> Vec<PlantLoop> {
+    let master_of = |l: &PlantLoop| match plant.spec().controllers.get(&l.name) {
+        Some(ControllerSpec::Pid(cfg)) => match &cfg.sp {
+            Setpoint::Remote { from } => from.strip_suffix(".op").map(str::to_string),
+            Setpoint::Value(_) => None,
+        },
+        _ => None,
+    };
+    // Depth of a loop below the listed masters above it: slaves deeper than their masters.
+    let depth = |l: &PlantLoop| {
+        let mut d = 0;
+        let mut at = master_of(l);
+        while let Some(m) = at.filter(|m| d < loops.len() && loops.iter().any(|o| &o.name == m)) {
+            d += 1;
+            at = loops.iter().find(|o| o.name == m).and_then(master_of);
+        }
+        d
+    };
+    let mut ordered: Vec<(usize, PlantLoop)> = loops.iter().map(|l| (depth(l), l.clone())).collect();
+    ordered.sort_by_key(|(d, _)| std::cmp::Reverse(*d));
+    ordered.into_iter().map(|(_, l)| l).collect()
 }
 
 /// Names of the PID controllers of `plant`, in file order.

@@ -118,6 +118,10 @@ pub fn relay_loop(plant: &Plant, x: &[f64], l: &PlantLoop, o: RelayOptions) -> R
     relay(&mut b, u0, &settings).map_err(|e| TuneError::Relay { controller: l.name.clone(), source: Box::new(e) })
 }
 
+/// The least fraction of a step response's variance a fitted model must explain for settings to
+/// be drawn from it (a FOPTD fit of a well-damped high-order response explains over 0.99).
+pub const MIN_R2: f64 = 0.9;
+
 /// Options of a step test; `None` takes the default.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct StepOptions {
@@ -156,6 +160,9 @@ pub fn step_loop(plant: &Plant, x: &[f64], l: &PlantLoop, o: StepOptions) -> Res
     let mut b = bench(plant, x, l, Measurement::default(), settings.scan)?;
     let (record, settled) = step(&mut b, u0, &settings).map_err(|e| TuneError::Simulation(Box::new(e)))?;
     let fit = fit_step(&record, order).map_err(TuneError::from)?;
+    if fit.r2.is_nan() || fit.r2 < MIN_R2 {
+        return Err(TuneError::PoorFit { controller: l.name.clone(), model: order.name(), r2: fit.r2, min_r2: MIN_R2 });
+    }
     Ok((fit, settled || integrating))
 }
 
@@ -179,16 +186,29 @@ fn within_range(plant: &Plant, l: &PlantLoop, u: f64) -> Result<(), TuneError> {
 /// The element's mean residence time `T = −g'(0)/g(0)` \[s\] and whether it integrates: from
 /// `g(jω) ≈ g(0)(1 − jωT)` at ω a thousand times below the slowest nonzero eigenvalue (for an
 /// integrating element, `s g(s)` in place of `g`); `None` when it has none (a pure integrator).
+/// For a stable element whose `T` comes out negative or nil, the slowest time constant.
 fn residence_time(plant: &Plant, x: &[f64], l: &PlantLoop) -> Result<(Option<f64>, bool), TuneError> {
     let model = loop_model(plant, x, std::slice::from_ref(l))?;
     let ev = model.ss.eigenvalues().map_err(|e| TuneError::Linear(Box::new(e)))?;
     let scale = ev.iter().map(|v| v.norm()).fold(0.0, f64::max);
     let slow = ev.iter().map(|v| v.norm()).filter(|m| *m > 1e-10 * scale).fold(f64::INFINITY, f64::min);
     let w = 1e-3 * slow;
-    let g = LoopResponse::new(model, Measurement::default()).at(w)[(0, 0)];
+    let response = LoopResponse::new(model, Measurement::default());
+    let g = response.at(w)[(0, 0)];
     let integrating = g.im.abs() > g.re.abs();
+    // A quadrature response that shrinks with the frequency is a washout (g(0) = 0), not an integrator.
+    if integrating && response.at(0.1 * w)[(0, 0)].norm() < g.norm() {
+        return Err(TuneError::NoSteadyGain { controller: l.name.clone() });
+    }
     let h = if integrating { g * c64::new(0.0, w) } else { g };
     let t = -h.im / (w * h.re);
-    // Below a millionth of the slowest time scale it is rounding, not a lag.
-    Ok(((t.is_finite() && t > 1e-6 / slow).then_some(t), integrating))
+    // Below a millionth of the slowest time scale it is rounding, not a lag. An element whose fast
+    // response exceeds its steady one (a loop closed around it cancels most of its gain) has T < 0:
+    // its slowest time constant sizes the test instead.
+    let t = match (t.is_finite() && t > 1e-6 / slow, integrating) {
+        (true, _) => Some(t),
+        (false, true) => None,
+        (false, false) => Some(1.0 / slow),
+    };
+    Ok((t, integrating))
 }

@@ -106,13 +106,14 @@ pub fn model_rule(
     Ok(PidSettings { kc, tau_i, tau_d, tau_c: tc })
 }
 
-/// The model's dominant lag \[s\] (0 for an integrator): a fitted dead time below a thousandth of
-/// it is no dead time to tune for.
+/// The model's dominant lag \[s\]: a fitted dead time below a thousandth of it is no dead time to
+/// tune for. An integrator has no lag of its own; there a dead time under a millisecond is the
+/// fit's rounding (1 ms = 1e-3 × 1 s).
 fn lag(model: &ProcessModel) -> f64 {
     match *model {
         ProcessModel::Foptd { tau, .. } => tau,
         ProcessModel::Soptd { tau1, .. } => tau1,
-        ProcessModel::Integrating { .. } => 0.0,
+        ProcessModel::Integrating { .. } => 1.0,
     }
 }
 
