@@ -118,11 +118,17 @@ pub fn run(a: &LinearizeArgs) -> Result<(), CliError> {
     if unstable.is_empty() {
         let g = display_gain(&model.steady_gain().map_err(map)?, &inputs, &outputs);
         let gd = display_gain(&direct, &inputs, &outputs);
-        let diff = (0..g.nrows())
-            .flat_map(|i| (0..g.ncols()).map(move |j| (i, j)))
-            .map(|(i, j)| (g[(i, j)] - gd[(i, j)]).abs() / gd[(i, j)].abs().max(f64::MIN_POSITIVE))
-            .fold(0.0, f64::max);
-        outln!("steady-state gain D − C A⁻¹ B (agrees with −C J⁻¹ B to {diff:.1e} relative):");
+        // Relative to the largest gain: an output held by integral action has a gain of rounding size,
+        // which no relative difference of its own describes.
+        let cells = || (0..g.nrows()).flat_map(|i| (0..g.ncols()).map(move |j| (i, j)));
+        let largest = cells().map(|(i, j)| gd[(i, j)].abs()).fold(0.0, f64::max);
+        let diff = cells().map(|(i, j)| (g[(i, j)] - gd[(i, j)]).abs()).fold(0.0, f64::max);
+        let check = if largest > 0.0 {
+            format!("agrees with −C J⁻¹ B to {:.1e} of its largest entry", diff / largest)
+        } else {
+            format!("−C J⁻¹ B is exactly 0, so the outputs are held at steady state; these are {diff:.1e} off it")
+        };
+        outln!("steady-state gain D − C A⁻¹ B ({check}):");
         for (i, o) in outputs.iter().enumerate() {
             let cells: Vec<String> = (0..g.ncols()).map(|j| format!("{:>14}", sig(g[(i, j)]))).collect();
             outln!("  {:<28} {}", format!("{} [{}]", o.path, o.unit), cells.join(" "));

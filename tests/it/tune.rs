@@ -340,3 +340,57 @@ fn column_a_composition_loops_tuned_by_blt_settle_the_shipped_feed_upset_faster_
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn two_column_quality_loops_tuned_by_blt_ride_out_the_shipped_production_step() {
+    // Both columns' pairs tuned by BLT (each pair together, 1 min of measurement dead time), then the
+    // shipped +10 kmol/h production step. The reactor's loops keep the file's hand tuning.
+    let dir = std::env::temp_dir().join(format!("plantwide-tune-2col-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (one, two) = (dir.join("blt1.json"), dir.join("blt.json"));
+    let blt = ["--method", "blt", "--measurement-dead-time", "1 min", "--json"];
+    let fs = flowsheet("two_column_plant.json");
+    for (from, loops, to) in [
+        (fs.as_str(), "column1_top_T,column1_bottom_T", &one),
+        (one.to_str().unwrap(), "column2_top_S,column2_bottom_T", &two),
+    ] {
+        let t = json_in(&dir, &[&["tune", from, "--loops", loops, "--write", to.to_str().unwrap()], &blt[..]].concat());
+        assert!(t["detuning_factor"].as_f64().unwrap() > 1.0, "{t}");
+    }
+    // The tuned plant is stable at its steady state: every mode decays, the slowest (~2.1 h, the
+    // hand-tuned reactor B loop with the recycle) included.
+    let model = dir.join("lin.json");
+    let lin = ["linearize", two.to_str().unwrap(), "--inputs", "fresh_A.F", "--outputs", "column1.T[21]", "--out"];
+    let out = crate::harness::command().current_dir(&dir).args(lin).arg(&model).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let lin: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&model).unwrap()).unwrap();
+    let re = lin["eigenvalues"].as_array().unwrap().iter().map(|e| e["re"].as_f64().unwrap());
+    let slowest = re.fold(f64::MIN, f64::max);
+    assert!(slowest < 0.0 && -1.0 / slowest < 3.0 * 3600.0, "slowest mode {slowest} 1/s");
+    let scenario = flowsheet("scenarios/two_column_production_step.json");
+    let csv = dir.join("run.csv");
+    let run = json_in(
+        &dir,
+        &["run", two.to_str().unwrap(), "--scenario", &scenario, "--csv", csv.to_str().unwrap(), "--json"],
+    );
+    let tuned = ["column1.T[21]", "column1.T[11]", "column2.T[6]", "product.x[S]"];
+    let on_setpoint: Vec<_> = run["paths"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|p| p["reference"] == "setpoint" && tuned.contains(&p["path"].as_str().unwrap()))
+        .collect();
+    assert_eq!(on_setpoint.len(), 4, "{run}");
+    for p in on_setpoint {
+        let (initial, last, dev) =
+            (p["initial"].as_f64().unwrap(), p["last"].as_f64().unwrap(), p["max_deviation"].as_f64().unwrap());
+        // Nine hours after the step, what the slow modes leave: e^(−9/2.1) ≈ 1.4 % of the excursion for the
+        // slowest alone; 5 % bounds it with the next ones (measured 2.5 % on column1.T[21]).
+        assert!(
+            (last - initial).abs() < 0.05 * dev.abs(),
+            "{}: {initial} → {last}, largest deviation {dev}",
+            p["path"]
+        );
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
