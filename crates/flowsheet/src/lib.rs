@@ -28,4 +28,4 @@ pub use parse::{parse_spec, read_text};
 pub use path::VarPath;
 pub use plant::{Block, BlockKind, InputInfo, Parallelism, Plant, Read, StreamInfo, VarInfo};
 pub use spec::FlowsheetSpec;
-pub use wiring::WiringError;
+pub use wiring::{StructureEdit, WiringError};

@@ -219,6 +219,14 @@ pub enum OverrideError {
         /// What is wrong (the fields it has, the deserialization error).
         why: String,
     },
+    /// A controller cannot be added or removed as asked ([`crate::Plant::restructure`]).
+    #[error("controller `{controller}`: {why}")]
+    Structure {
+        /// The controller.
+        controller: String,
+        /// What is wrong.
+        why: String,
+    },
     /// A unit's mole fractions sum above 1.
     #[error(
         "{unit}: mole fractions sum to {sum} > 1, leaving a negative fraction for the last component; set them so that they sum to at most 1 ({parts})"

@@ -132,13 +132,32 @@ impl Plant {
     /// it was assembled carry over by path where the variant keeps the input; the others take the
     /// variant's own (so a field edit that changes an input's default, `mode` → `auto`, holds).
     pub fn variant(&self, overrides: &[Override]) -> Result<Plant, OverrideError> {
+        let edits: Vec<StructureEdit> = overrides.iter().cloned().map(StructureEdit::Set).collect();
+        self.restructure(&edits)
+    }
+
+    /// A structure variant with controllers added or removed as well as fields set: `edits` applied
+    /// in order to this plant's description (so a field of a controller added earlier in `edits`
+    /// can be set), assembled again, input values carried over as in [`Plant::variant`].
+    pub fn restructure(&self, edits: &[StructureEdit]) -> Result<Plant, OverrideError> {
         let mut spec = self.spec.clone();
         let mut inputs = Vec::new();
-        for o in overrides {
-            if crate::overrides::resolve_input(self, &o.path).is_some() {
-                inputs.push(o.clone());
-            } else {
-                crate::overrides::set_field(&mut spec, &o.path, &o.value)?;
+        for e in edits {
+            match e {
+                StructureEdit::Set(o) if crate::overrides::resolve_input(self, &o.path).is_some() => {
+                    inputs.push(o.clone());
+                }
+                StructureEdit::Set(o) => crate::overrides::set_field(&mut spec, &o.path, &o.value)?,
+                StructureEdit::AddController { name, spec: c } => add_controller(&mut spec, name, c)?,
+                StructureEdit::RemoveController(name) => {
+                    if spec.controllers.shift_remove(name).is_none() {
+                        let hint = crate::error::did_you_mean(name, spec.controllers.keys().map(String::as_str));
+                        return Err(OverrideError::Structure {
+                            controller: name.clone(),
+                            why: format!("there is no such controller to remove{hint}"),
+                        });
+                    }
+                }
             }
         }
         let mut plant = crate::assemble(&spec, &self.file)?;
@@ -151,6 +170,33 @@ impl Plant {
         crate::overrides::apply_inputs(&mut plant, &inputs)?;
         Ok(plant)
     }
+}
+
+/// One change of a plant's description for [`Plant::restructure`].
+#[derive(Debug, Clone, PartialEq)]
+pub enum StructureEdit {
+    /// Set a field of a unit or controller, or an input's value (as [`Plant::variant`] does).
+    Set(Override),
+    /// Add a controller, described as in the file's `controllers` section (e.g. a ratio station
+    /// `{"type": "ratio", "wild": "distillate.F", "output": "column.reflux", "ratio": 5.4}`).
+    AddController {
+        /// Its name (not yet a controller's).
+        name: String,
+        /// Its description.
+        spec: serde_json::Value,
+    },
+    /// Remove a controller: the inputs it drove read their own values again.
+    RemoveController(String),
+}
+
+fn add_controller(spec: &mut crate::FlowsheetSpec, name: &str, c: &serde_json::Value) -> Result<(), OverrideError> {
+    let fail = |why: String| OverrideError::Structure { controller: name.to_string(), why };
+    if spec.controllers.contains_key(name) || spec.units.contains_key(name) {
+        return Err(fail("the name is taken by a unit or controller of the flowsheet".into()));
+    }
+    let parsed = serde_json::from_value(c.clone()).map_err(|e| fail(format!("not a controller description: {e}")))?;
+    spec.controllers.insert(name.to_string(), parsed);
+    Ok(())
 }
 
 #[cfg(test)]
@@ -210,5 +256,43 @@ mod variant_tests {
         // A move to a path that is no input is refused by the assembly, naming it.
         let err = plant.variant(&[Override::new("lc.output", "tank.nothing")]).unwrap_err();
         assert!(err.to_string().contains("tank.nothing"), "{err}");
+    }
+}
+
+#[cfg(test)]
+mod restructure_tests {
+    use crate::StructureEdit;
+    use crate::overrides::{Override, load_str_with};
+
+    #[test]
+    fn controllers_are_added_and_removed_and_a_new_ones_field_set() {
+        let plant = load_str_with(super::tests::TANK, "t.json", &[]).unwrap();
+        let driven = |p: &crate::Plant, path: &str| p.inputs()[p.input(path).unwrap()].driven_by;
+        // The level loop removed: the outflow reads its own value again.
+        let open = plant.restructure(&[StructureEdit::RemoveController("lc".into())]).unwrap();
+        assert!(open.controller("lc").is_err() && driven(&open, "tank.outflow").is_none());
+        // A ratio station on the outflow, then its ratio set: the outflow follows the inflow.
+        let ratio = serde_json::json!({"type": "ratio", "wild": "a.F", "output": "tank.outflow", "ratio": 1.0});
+        let edits = [
+            StructureEdit::RemoveController("lc".into()),
+            StructureEdit::AddController { name: "rs".into(), spec: ratio.clone() },
+            StructureEdit::Set(Override::new("rs.ratio", "0.9")),
+        ];
+        let v = plant.restructure(&edits).unwrap();
+        assert!(driven(&v, "tank.outflow").is_some());
+        assert_eq!(v.inputs()[v.input("rs.ratio").unwrap()].value, 0.9);
+        // Bad edits are named: a taken name, a description that is no controller, an unknown one.
+        let bad = [
+            (StructureEdit::AddController { name: "tank".into(), spec: ratio }, "controller `tank`: the name is taken"),
+            (
+                StructureEdit::AddController { name: "x".into(), spec: serde_json::json!({"type": "pdi"}) },
+                "not a controller",
+            ),
+            (StructureEdit::RemoveController("lcc".into()), "no such controller to remove"),
+        ];
+        for (e, msg) in bad {
+            let err = plant.restructure(&[e]).unwrap_err().to_string();
+            assert!(err.contains(msg), "{err}");
+        }
     }
 }
