@@ -24,6 +24,7 @@ mod components;
 mod gains;
 mod linearize;
 mod run;
+mod screen;
 mod sensitivity;
 mod steady;
 mod tune;
@@ -109,6 +110,9 @@ enum Command {
     /// PI tuning of the diagonal loops of a transfer-function model: ultimate gains and periods,
     /// Ziegler–Nichols, Tyreus–Luyben, or Luyben's BLT detuning for interaction.
     Tune(tune::TuneArgs),
+    /// Control-structure screening: a column's inventory configurations (LV, DV, LB, DB, (L/D)V,
+    /// L(V/B), (L/D)(V/B)) with their steady-state gains, RGA, Niederlinski index, condition numbers.
+    Screen(screen::ScreenArgs),
 }
 
 /// A failed command: message and exit code.
@@ -145,6 +149,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Sensitivity(a) => sensitivity::run(&a),
         Command::Sensors(a) => gains::run_sensors(&a),
         Command::Tune(a) => tune::run(&a),
+        Command::Screen(a) => screen::run(&a),
         Command::Schema => {
             let schema = schemars::schema_for!(plantwide::flowsheet::FlowsheetSpec);
             let text = serde_json::to_string_pretty(&schema).map_err(|e| CliError::user(e.to_string()))?;

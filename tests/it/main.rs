@@ -20,6 +20,7 @@ mod flowsheets;
 mod fuzz;
 mod hostile;
 mod recycle;
+mod screen;
 mod snowball;
 mod tune;
 mod two_column_study;

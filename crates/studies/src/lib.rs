@@ -8,6 +8,7 @@
 
 pub mod error;
 mod numeric;
+pub mod screen;
 pub mod tune;
 
 pub use error::TuneError;

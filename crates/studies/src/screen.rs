@@ -1,0 +1,106 @@
+//! Control-structure screening: a plant's candidate structures built as [`Plant`] variants through
+//! the flowsheet library, each judged by the steady-state interaction measures of its loops.
+//!
+//! Today: [`column`], the standard inventory configurations of one distillation column (LV, DV, LB,
+//! DB, (L/D)V, L(V/B), (L/D)(V/B)), with the exact steady-state gains of its two qualities to the
+//! two inputs each leaves free, RGA, Niederlinski index, condition numbers and a verdict.
+//!
+//! [`Plant`]: plantwide_flowsheet::Plant
+
+pub mod column;
+
+pub use column::{ColumnScreen, ColumnStructure, screen_column};
+
+/// Why a screening could not be done.
+#[derive(Debug, Clone, thiserror::Error)]
+pub enum ScreenError {
+    /// The unit named is no column (it lacks the reflux, reboiler, distillate and bottoms inputs).
+    #[error("no column `{name}` in the flowsheet{hint} (its columns: {columns})")]
+    NotAColumn {
+        /// The name asked for.
+        name: String,
+        /// A suggestion, or empty.
+        hint: String,
+        /// The flowsheet's columns.
+        columns: String,
+    },
+    /// A column end's inventory has no level loop on one of the column's flows to move.
+    #[error(
+        "column `{column}`: no P or PI controller holds its {end} level (a PID with pv `{pv}` driving one of \
+         {handles}); add the level loop the configurations rewire"
+    )]
+    NoLevelLoop {
+        /// The column.
+        column: String,
+        /// `condenser` or `reboiler`.
+        end: &'static str,
+        /// The measurement looked for.
+        pv: String,
+        /// The column's flows.
+        handles: String,
+    },
+    /// An output path names no variable.
+    #[error(
+        "--outputs: no variable `{path}`{hint}; give the two qualities as variable paths, e.g. distillate.x[light]"
+    )]
+    NoOutput {
+        /// The path.
+        path: String,
+        /// A suggestion, or empty.
+        hint: String,
+    },
+    /// Not two outputs.
+    #[error("--outputs: a column configuration controls two qualities (top, bottom); got {0}")]
+    OutputCount(usize),
+    /// A configuration could not be built.
+    #[error("configuration {structure}: {source}")]
+    Wiring {
+        /// The configuration.
+        structure: String,
+        /// Why.
+        source: Box<plantwide_flowsheet::OverrideError>,
+    },
+    /// The plant, or a configuration of it, has no steady state.
+    #[error("configuration {structure}: {source}")]
+    Steady {
+        /// The configuration (`file` for the plant as written).
+        structure: String,
+        /// The solver's reason, naming the unit, equation and worst residual.
+        source: Box<plantwide_solve::Error>,
+    },
+    /// A configuration's steady state is not the plant's (its qualities moved): its gains would
+    /// describe another operating point.
+    #[error(
+        "configuration {structure}: its steady state has {output} = {value:.9e}, not the file's {base:.9e}; the \
+         rewired level loops moved the operating point"
+    )]
+    Moved {
+        /// The configuration.
+        structure: String,
+        /// The quality that moved.
+        output: String,
+        /// Its value in the configuration.
+        value: f64,
+        /// Its value in the plant as written.
+        base: f64,
+    },
+    /// A linear-algebra step failed.
+    #[error("configuration {structure}: {source}")]
+    Analysis {
+        /// The configuration.
+        structure: String,
+        /// Why.
+        source: Box<plantwide_analysis::AnalysisError>,
+    },
+}
+
+impl ScreenError {
+    /// True for problems of the request (exit code 1), false for numerical failures (exit code 2).
+    pub fn is_user_error(&self) -> bool {
+        match self {
+            ScreenError::Steady { source, .. } => source.is_user_error(),
+            ScreenError::Moved { .. } | ScreenError::Analysis { .. } => false,
+            _ => true,
+        }
+    }
+}

@@ -1,0 +1,471 @@
+//! The inventory configurations of a distillation column (Skogestad & Morari 1987; Skogestad,
+//! Lundström & Jacobsen 1990; Luyben (ed.) 1992 ch. 5): which two of the column's four flows — reflux
+//! L, boilup V (or the reboiler duty or steam that sets it), distillate D, bottoms B — hold the
+//! condenser and reboiler levels, and so which two, or which ratios, are left to control the top
+//! and bottom qualities.
+//!
+//! | name | condenser level by | reboiler level by | quality inputs |
+//! |---|---|---|---|
+//! | LV | D | B | L, V |
+//! | DV | L | B | D, V |
+//! | LB | D | V | L, B |
+//! | DB | L | V | D, B |
+//! | (L/D)V | D, with L = R·D | B | R = L/D, V |
+//! | L(V/B) | D | B, with V = S·B | L, S = V/B |
+//! | (L/D)(V/B) | D, with L = R·D | B, with V = S·B | R, S |
+//!
+//! Each is built from the flowsheet as written through [`Plant::restructure`]: the column's quality
+//! loops (any other controller driving one of the four flows) opened, its level controllers moved
+//! to their configuration's flows (gain rescaled by the ratio of the two flows' values when their
+//! dimensions differ, bias and limits dropped so the loop is bumpless at the operating point), ratio
+//! stations added for L/D and V/B; every free flow held at its value in the plant's steady state.
+//! The configuration is then converged from that steady state, checked to reproduce the plant's
+//! qualities (holdups do not set a steady state's compositions; a moved quality is an error), and
+//! linearized: the gains of the two qualities to its two free inputs are exact (`−C J⁻¹ B`, SI units:
+//! mole fraction per mol/s, per mol/mol of a ratio, per W of a duty).
+//!
+//! DB is singular at steady state: with both products fixed, `D + B = F` leaves the total
+//! inventory undetermined (the Jacobian is singular), so its gains do not exist; it is reported as
+//! singular and not ranked (it can still be controlled dynamically — Skogestad et al. 1990).
+
+use faer::Mat;
+use plantwide_analysis::linear::Linearization;
+use plantwide_analysis::measures::{SINGULAR_RATIO, condition_number, niederlinski, rga, rows, svd};
+use plantwide_analysis::min_cond::minimized_condition_number;
+use plantwide_flowsheet::{Override, Plant, StructureEdit};
+use plantwide_model::ControllerSpec;
+use plantwide_solve::{NewtonSettings, StrategySettings, steady_state};
+use plantwide_units::QuantityValue;
+use serde::Serialize;
+
+use super::ScreenError;
+
+/// The flow left for the top quality: reflux, distillate, or the reflux ratio L/D.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Top {
+    L,
+    D,
+    Ratio,
+}
+
+/// The flow left for the bottom quality: boilup (or duty), bottoms, or the boilup ratio V/B.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Bottom {
+    V,
+    B,
+    Ratio,
+}
+
+/// The seven configurations, in the order they are reported.
+const CONFIGURATIONS: [(&str, Top, Bottom); 7] = [
+    ("LV", Top::L, Bottom::V),
+    ("DV", Top::D, Bottom::V),
+    ("LB", Top::L, Bottom::B),
+    ("DB", Top::D, Bottom::B),
+    ("(L/D)V", Top::Ratio, Bottom::V),
+    ("L(V/B)", Top::L, Bottom::Ratio),
+    ("(L/D)(V/B)", Top::Ratio, Bottom::Ratio),
+];
+
+/// One configuration's steady-state interaction measures. `gain[i][j]` is quality i (top, bottom)
+/// to input j of `inputs`; `rga[0][0]` pairs the top quality with the first input.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ColumnStructure {
+    /// `LV`, `DV`, `LB`, `DB`, `(L/D)V`, `L(V/B)` or `(L/D)(V/B)`.
+    pub name: String,
+    /// Input paths left for the qualities (top first): a column flow or a ratio station's `ratio`.
+    pub inputs: Vec<String>,
+    /// Steady-state gains (SI), `None` when singular.
+    pub gain: Option<Vec<Vec<f64>>>,
+    /// Relative gain array.
+    pub rga: Option<Vec<Vec<f64>>>,
+    /// Niederlinski index of the diagonal pairing.
+    pub niederlinski: Option<f64>,
+    /// `σ_max/σ_min` of the gains in SI units.
+    pub condition_number: Option<f64>,
+    /// The condition number minimized over input and output scalings.
+    pub minimized_condition_number: Option<f64>,
+    /// Singular at steady state.
+    pub singular: bool,
+    /// Place in the ranking (1 best), `None` when singular.
+    pub rank: Option<usize>,
+    /// What the numbers say, in words.
+    pub verdict: String,
+}
+
+/// The configurations of one column.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ColumnScreen {
+    /// The column.
+    pub column: String,
+    /// The top and bottom qualities.
+    pub outputs: Vec<String>,
+    /// Values of L, V (or its duty or steam), D and B at the steady state (SI).
+    pub flows: Flows,
+    /// The configurations, in the table's order.
+    pub structures: Vec<ColumnStructure>,
+}
+
+/// The column's four flows at the steady state (SI: mol/s; W or kg/s for a duty or steam boilup).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Flows {
+    /// Reflux.
+    pub reflux: f64,
+    /// Boilup, reboiler duty or steam flow.
+    pub boilup: f64,
+    /// Distillate.
+    pub distillate: f64,
+    /// Bottoms.
+    pub bottoms: f64,
+}
+
+/// The column as the configurations see it: its four flow inputs, its level loops, its products'
+/// flow variables and the quality loops to open.
+struct Handles {
+    column: String,
+    /// Input paths: reflux, boilup (or duty or steam), distillate, bottoms.
+    paths: [String; 4],
+    condenser_level: String,
+    reboiler_level: String,
+    distillate_flow: String,
+    bottoms_flow: String,
+    quality_loops: Vec<String>,
+}
+
+/// Screen the inventory configurations of `column` for the qualities `outputs` (top, bottom) at
+/// the steady state of `plant` as written.
+///
+/// # Errors
+/// [`ScreenError`] naming the column, output or configuration that failed.
+pub fn screen_column(plant: &Plant, column: &str, outputs: &[String]) -> Result<ColumnScreen, ScreenError> {
+    if outputs.len() != 2 {
+        return Err(ScreenError::OutputCount(outputs.len()));
+    }
+    let h = handles(plant, column)?;
+    let out: Vec<usize> = outputs.iter().map(|p| output_var(plant, p)).collect::<Result<_, _>>()?;
+    let steady = |e| ScreenError::Steady { structure: "file".into(), source: Box::new(e) };
+    let base = plantwide_solve::converge(plant, &StrategySettings::default()).map_err(|e| steady(e.into()))?;
+    let flows = h.paths.each_ref().map(|p| input_value(plant, &base.x, p));
+    let mut structures = Vec::new();
+    for (name, top, bottom) in CONFIGURATIONS {
+        structures.push(configuration(plant, &h, &base.x, &flows, &out, (name, top, bottom))?);
+    }
+    rank(&mut structures);
+    let [reflux, boilup, distillate, bottoms] = flows;
+    Ok(ColumnScreen {
+        column: column.to_string(),
+        outputs: outputs.to_vec(),
+        flows: Flows { reflux, boilup, distillate, bottoms },
+        structures,
+    })
+}
+
+/// The column's flows, level loops and quality loops.
+fn handles(plant: &Plant, column: &str) -> Result<Handles, ScreenError> {
+    let boil = ["boilup", "reboiler_duty", "steam_flow"];
+    let find = |c: &str| boil.iter().map(|b| format!("{c}.{b}")).find(|p| plant.input(p).is_some());
+    let is_column =
+        |c: &str| ["reflux", "distillate", "bottoms"].iter().all(|f| plant.input(&format!("{c}.{f}")).is_some());
+    let boilup = find(column).filter(|_| is_column(column));
+    let Some(boilup) = boilup else {
+        let columns: Vec<&str> =
+            plant.spec().units.keys().map(String::as_str).filter(|c| is_column(c) && find(c).is_some()).collect();
+        let hint = plantwide_flowsheet::error::did_you_mean(column, columns.iter().copied());
+        return Err(ScreenError::NotAColumn { name: column.into(), hint, columns: columns.join(", ") });
+    };
+    let paths = [format!("{column}.reflux"), boilup, format!("{column}.distillate"), format!("{column}.bottoms")];
+    let pids: Vec<(&String, &plantwide_model::controllers::pid::PidConfig)> = plant
+        .spec()
+        .controllers
+        .iter()
+        .filter_map(|(n, c)| if let ControllerSpec::Pid(p) = c { Some((n, p)) } else { None })
+        .collect();
+    let drives =
+        |p: &plantwide_model::controllers::pid::PidConfig| p.output.as_ref().is_some_and(|o| paths.contains(o));
+    let level = |end: &'static str, is_pv: &dyn Fn(&str) -> bool, pv: String| {
+        pids.iter()
+            .find(|(_, p)| drives(p) && is_pv(&p.pv))
+            .map(|(n, _)| (*n).clone())
+            .ok_or_else(|| ScreenError::NoLevelLoop { column: column.into(), end, pv, handles: paths.join(", ") })
+    };
+    let bottom_pv = format!("{column}.M[1]");
+    let reboiler_level = level("reboiler", &|pv| pv == bottom_pv, bottom_pv.clone())?;
+    let top = format!("{column}.M[");
+    let condenser_level = level("condenser", &|pv| pv.starts_with(&top) && pv != bottom_pv, format!("{top}N]"))?;
+    let quality_loops = plant
+        .spec()
+        .controllers
+        .iter()
+        .filter(|(n, c)| **n != condenser_level && **n != reboiler_level && drives_any(c, &paths))
+        .map(|(n, _)| n.clone())
+        .collect();
+    let product = |port: &str| stream_from(plant, &format!("{column}.{port}"));
+    Ok(Handles {
+        column: column.to_string(),
+        distillate_flow: product("distillate"),
+        bottoms_flow: product("bottoms"),
+        paths,
+        condenser_level,
+        reboiler_level,
+        quality_loops,
+    })
+}
+
+/// True when controller `c` drives one of `paths`.
+fn drives_any(c: &ControllerSpec, paths: &[String]) -> bool {
+    serde_json::to_value(c)
+        .ok()
+        .and_then(|v| v.get("output").and_then(|o| o.as_str().map(str::to_string)))
+        .is_some_and(|o| paths.contains(&o))
+}
+
+/// Path of the molar flow of the stream leaving `port` (`unit.port`), or of the port's own input
+/// when no stream leaves it.
+fn stream_from(plant: &Plant, port: &str) -> String {
+    plant
+        .spec()
+        .streams
+        .iter()
+        .find(|(_, s)| s.from == port)
+        .map_or_else(|| port.to_string(), |(name, _)| format!("{name}.F"))
+}
+
+fn output_var(plant: &Plant, path: &str) -> Result<usize, ScreenError> {
+    plant.var(path).ok_or_else(|| ScreenError::NoOutput {
+        path: path.into(),
+        hint: plantwide_flowsheet::error::did_you_mean(path, plant.vars().iter().map(|v| v.path.as_str())),
+    })
+}
+
+/// The value input `path` takes at state `x`: its controller's output when one drives it.
+fn input_value(plant: &Plant, x: &[f64], path: &str) -> f64 {
+    let Some(i) = plant.input(path) else { return f64::NAN };
+    let info = &plant.inputs()[i];
+    info.driven_by.map_or(info.value, |op| x[op])
+}
+
+/// Build configuration `(name, top, bottom)`, find its steady state from the plant's and measure
+/// its gains.
+fn configuration(
+    plant: &Plant,
+    h: &Handles,
+    x: &[f64],
+    flows: &[f64; 4],
+    out: &[usize],
+    (name, top, bottom): (&str, Top, Bottom),
+) -> Result<ColumnStructure, ScreenError> {
+    let (edits, inputs) = edits(plant, h, flows, top, bottom);
+    let wiring = |e| ScreenError::Wiring { structure: name.into(), source: Box::new(e) };
+    let v = plant.restructure(&edits).map_err(wiring)?;
+    let u = v.input_values();
+    let guess = guess(plant, x, &v, h, flows);
+    let ids: Vec<usize> = inputs.iter().filter_map(|p| v.input(p)).collect();
+    let outs: Vec<usize> = out.iter().filter_map(|&o| v.var(&plant.vars()[o].path)).collect();
+    let steady = match steady_state(&v, &u, Some(&guess), &NewtonSettings::default()) {
+        Ok(s) => s,
+        // No isolated steady state: singular when the Jacobian at the plant's point is; a failure else.
+        Err(e) => return singular_or_failure((&v, &guess, &u), name, inputs, (&ids, &outs), e),
+    };
+    for (&o, &ob) in outs.iter().zip(out) {
+        let (value, base) = (steady.x[o], x[ob]);
+        if (value - base).abs() > 1e-8 * base.abs().max(1e-8) {
+            return Err(ScreenError::Moved { structure: name.into(), output: v.vars()[o].path.clone(), value, base });
+        }
+    }
+    let g = Linearization::new(&v, &steady.x, &u).steady_gain(&ids, &outs);
+    measures(name, inputs, g.ok())
+}
+
+/// A configuration Newton could not converge: singular if its Jacobian at the plant's own steady
+/// state (which the configuration shares) is, a numerical failure otherwise.
+fn singular_or_failure(
+    (v, x, u): (&Plant, &[f64], &[f64]),
+    name: &str,
+    inputs: Vec<String>,
+    (ids, outs): (&[usize], &[usize]),
+    e: plantwide_solve::SteadyError,
+) -> Result<ColumnStructure, ScreenError> {
+    match Linearization::new(v, x, u).steady_gain(ids, outs) {
+        Err(_) => measures(name, inputs, None),
+        Ok(g) if is_singular(&g) => measures(name, inputs, None),
+        Ok(_) => Err(ScreenError::Steady {
+            structure: name.into(),
+            source: Box::new(plantwide_solve::Error::from(plantwide_solve::SolveError::from(e))),
+        }),
+    }
+}
+
+/// The edits that build a configuration, and its two quality inputs.
+fn edits(plant: &Plant, h: &Handles, flows: &[f64; 4], top: Top, bottom: Bottom) -> (Vec<StructureEdit>, Vec<String>) {
+    let mut e: Vec<StructureEdit> =
+        h.quality_loops.iter().map(|q| StructureEdit::RemoveController(q.clone())).collect();
+    let [l, v, d, b] = [0, 1, 2, 3].map(|k| h.paths[k].clone());
+    let (top_level, top_input) = match top {
+        Top::L => (d.clone(), l.clone()),
+        Top::D => (l.clone(), d.clone()),
+        Top::Ratio => (d.clone(), format!("{}_reflux_ratio.ratio", h.column)),
+    };
+    let (bottom_level, bottom_input) = match bottom {
+        Bottom::V => (b.clone(), v.clone()),
+        Bottom::B => (v.clone(), b.clone()),
+        Bottom::Ratio => (b.clone(), format!("{}_boilup_ratio.ratio", h.column)),
+    };
+    e.extend(move_level(plant, &h.condenser_level, &top_level, flows, &h.paths));
+    e.extend(move_level(plant, &h.reboiler_level, &bottom_level, flows, &h.paths));
+    if top == Top::Ratio {
+        e.push(ratio_station(&format!("{}_reflux_ratio", h.column), &h.distillate_flow, &l, flows[0] / flows[2]));
+    }
+    if bottom == Bottom::Ratio {
+        e.push(ratio_station(&format!("{}_boilup_ratio", h.column), &h.bottoms_flow, &v, flows[1] / flows[3]));
+    }
+    // The flows no controller drives now hold their steady-state values.
+    let mut driven = vec![top_level, bottom_level];
+    driven.extend((top == Top::Ratio).then_some(l));
+    driven.extend((bottom == Bottom::Ratio).then_some(v));
+    for (k, p) in h.paths.iter().enumerate().filter(|(_, p)| !driven.contains(p)) {
+        e.push(StructureEdit::Set(Override::new(p.clone(), format!("{:e}", flows[k]))));
+    }
+    (e, vec![top_input, bottom_input])
+}
+
+/// Level controller `name` moved to drive `to`: the same description with its output changed, its
+/// gain rescaled by the flows' ratio when the new flow has another dimension, bias and limits
+/// dropped (the bias defaults to the new flow's value: bumpless at the operating point).
+fn move_level(plant: &Plant, name: &str, to: &str, flows: &[f64; 4], paths: &[String; 4]) -> Vec<StructureEdit> {
+    let Some(ControllerSpec::Pid(cfg)) = plant.spec().controllers.get(name) else { return Vec::new() };
+    if cfg.output.as_deref() == Some(to) {
+        return Vec::new();
+    }
+    let mut c = cfg.clone();
+    let from = cfg.output.clone().unwrap_or_default();
+    let dim = |p: &str| plant.input(p).map(|i| plant.inputs()[i].dim);
+    if dim(&from) != dim(to) {
+        let value = |p: &str| paths.iter().position(|q| q == p).map_or(1.0, |k| flows[k]);
+        let kc = match &c.kc {
+            QuantityValue::Number(n) => *n,
+            QuantityValue::Text(t) => plantwide_units::parse_quantity(t).map_or(f64::NAN, |q| q.value_si),
+        };
+        c.kc = QuantityValue::Number(kc * value(to) / value(&from));
+    }
+    c.output = Some(to.to_string());
+    (c.bias, c.op_min, c.op_max) = (None, None, None);
+    let spec = serde_json::to_value(ControllerSpec::Pid(c)).unwrap_or_default();
+    vec![StructureEdit::RemoveController(name.into()), StructureEdit::AddController { name: name.into(), spec }]
+}
+
+/// A ratio station `name` driving `output` at `ratio` times the flow `wild`.
+fn ratio_station(name: &str, wild: &str, output: &str, ratio: f64) -> StructureEdit {
+    let spec = serde_json::json!({"type": "ratio", "wild": wild, "output": output, "ratio": ratio});
+    StructureEdit::AddController { name: name.into(), spec }
+}
+
+/// The configuration's starting point: the plant's steady state by variable path; a ratio
+/// station's output at the flow it drives.
+fn guess(plant: &Plant, x: &[f64], v: &Plant, h: &Handles, flows: &[f64; 4]) -> Vec<f64> {
+    let mut g = v.initial_guess_at(&v.input_values());
+    for (k, info) in v.vars().iter().enumerate() {
+        if let Some(j) = plant.var(&info.path) {
+            g[k] = x[j];
+        }
+    }
+    for (station, flow) in [("reflux_ratio", flows[0]), ("boilup_ratio", flows[1])] {
+        if let Some(k) = v.var(&format!("{}_{station}.op", h.column)) {
+            g[k] = flow;
+        }
+    }
+    g
+}
+
+/// Singular when the gains, rows and then columns scaled to a largest entry of 1 (so the units of
+/// the qualities and flows do not count), have `σ_min/σ_max` below `√SINGULAR_RATIO` (≈ 3e-7: the
+/// relative error of gains computed through a nearly singular Jacobian).
+fn is_singular(g: &Mat<f64>) -> bool {
+    if !g.is_all_finite() {
+        return true;
+    }
+    let mut e = g.clone();
+    for i in 0..e.nrows() {
+        let m = (0..e.ncols()).map(|j| e[(i, j)].abs()).fold(0.0, f64::max);
+        (0..e.ncols()).for_each(|j| e[(i, j)] /= m);
+    }
+    for j in 0..e.ncols() {
+        let m = (0..e.nrows()).map(|i| e[(i, j)].abs()).fold(0.0, f64::max);
+        (0..e.nrows()).for_each(|i| e[(i, j)] /= m);
+    }
+    !e.is_all_finite()
+        || svd(e.as_ref()).is_ok_and(|s| condition_number(&s.singular_values) > 1.0 / SINGULAR_RATIO.sqrt())
+}
+
+/// The measures of gains `g` (`None`: singular).
+fn measures(name: &str, inputs: Vec<String>, g: Option<Mat<f64>>) -> Result<ColumnStructure, ScreenError> {
+    let analysis = |e| ScreenError::Analysis { structure: name.into(), source: Box::new(e) };
+    let Some(g) = g.filter(|g| !is_singular(g)) else {
+        return Ok(ColumnStructure {
+            name: name.into(),
+            inputs,
+            gain: None,
+            rga: None,
+            niederlinski: None,
+            condition_number: None,
+            minimized_condition_number: None,
+            singular: true,
+            rank: None,
+            verdict: "singular at steady state: the two inputs cannot set both qualities (for DB, D + B = F ties \
+                      the products); not ranked"
+                .into(),
+        });
+    };
+    let l = rga(g.as_ref()).map_err(analysis)?;
+    let ni = niederlinski(g.as_ref(), &[0, 1]).map_err(analysis)?;
+    let cond = condition_number(&svd(g.as_ref()).map_err(analysis)?.singular_values);
+    let min_cond = minimized_condition_number(g.as_ref()).map_err(analysis)?;
+    Ok(ColumnStructure {
+        name: name.into(),
+        verdict: verdict(l[(0, 0)], &inputs),
+        inputs,
+        gain: Some(rows(g.as_ref())),
+        rga: Some(rows(l.as_ref())),
+        niederlinski: Some(ni),
+        condition_number: Some(cond),
+        minimized_condition_number: Some(min_cond),
+        singular: false,
+        rank: None,
+    })
+}
+
+/// The verdict on the diagonal pairing (top quality with the first input) from `λ11`: Skogestad &
+/// Morari (1987), large relative gains mean strong interaction and sensitivity to input
+/// uncertainty; a negative one fails integral controllability (the loop, or the plant with the
+/// other loop open, goes unstable).
+fn verdict(l11: f64, inputs: &[String]) -> String {
+    let other = "the top quality with the second input";
+    match l11 {
+        l if l < 0.0 => format!("λ11 = {l:.3} < 0: the diagonal pairing is not integral controllable; pair {other}"),
+        l if l < 0.5 => {
+            format!("λ11 = {l:.3}: the diagonal pairing is the weak one; pair {other} (λ = {:.3})", 1.0 - l)
+        }
+        l if l <= 2.0 => format!("λ11 = {l:.3}: little interaction; pair the top quality with {}", inputs[0]),
+        l if l <= 10.0 => format!("λ11 = {l:.3}: moderate interaction; detune the loops together (BLT)"),
+        l => format!(
+            "λ11 = {l:.3}: strong interaction; the loops fight and the large relative gains make the column \
+             sensitive to input uncertainty (Skogestad & Morari 1987)"
+        ),
+    }
+}
+
+/// Rank the regular configurations: integral-controllable pairings (λ11 > 0) first, closest to
+/// λ11 = 1 (by |ln λ11|), then by minimized condition number; the others after them.
+fn rank(structures: &mut [ColumnStructure]) {
+    let score = |s: &ColumnStructure| {
+        let l11 = s.rga.as_ref().map_or(f64::NAN, |r| r[0][0]);
+        let l = if l11 > 0.0 { l11.ln().abs() } else { f64::INFINITY };
+        (l, s.minimized_condition_number.unwrap_or(f64::INFINITY))
+    };
+    let mut order: Vec<usize> = (0..structures.len()).filter(|&k| !structures[k].singular).collect();
+    order.sort_by(|&a, &b| {
+        score(&structures[a]).partial_cmp(&score(&structures[b])).unwrap_or(std::cmp::Ordering::Equal)
+    });
+    for (place, k) in order.into_iter().enumerate() {
+        structures[k].rank = Some(place + 1);
+    }
+}
