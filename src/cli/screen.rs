@@ -1,9 +1,13 @@
 //! `plantwide screen FILE --column COL --outputs TOP,BOTTOM [--json] [--report DIR]`: the inventory
-//! configurations of a column, built through the library and judged by their steady-state gains.
+//! configurations of a column, built through the library and judged by their steady-state gains;
+//! `plantwide screen FILE --cvs … --mvs … [--disturbances …] [--throughput …]`: the pairings of CVs
+//! to MVs, filtered at steady state and the best tested dynamically.
 
 use std::path::{Path, PathBuf};
 
-use plantwide::studies::screen::{ColumnScreen, ScreenError, screen_column};
+use plantwide::studies::screen::pairings::{Disturbance, DynamicSettings, PairingRequest, PairingScreen};
+use plantwide::studies::screen::{ColumnScreen, ScreenError, screen_column, screen_pairings};
+use plantwide::units::Dimension;
 
 use super::CliError;
 use super::steady::load_with_overrides;
@@ -15,11 +19,32 @@ pub struct ScreenArgs {
     #[arg(value_name = "FILE")]
     file: PathBuf,
     /// The column whose inventory configurations to screen (LV, DV, LB, DB, (L/D)V, L(V/B), (L/D)(V/B)).
-    #[arg(long, value_name = "COL")]
-    column: String,
+    #[arg(long, value_name = "COL", required_unless_present = "cvs", conflicts_with = "cvs")]
+    column: Option<String>,
     /// The two qualities, top then bottom (variable paths), e.g. distillate.x[light],bottoms.x[light].
-    #[arg(long, value_name = "TOP,BOTTOM", value_delimiter = ',', required = true)]
+    #[arg(long, value_name = "TOP,BOTTOM", value_delimiter = ',', requires = "column")]
     outputs: Vec<String>,
+    /// Controlled variables to pair (variable paths), comma separated.
+    #[arg(long, value_name = "CV1,CV2,…", value_delimiter = ',', requires = "mvs")]
+    cvs: Vec<String>,
+    /// Manipulated variables (input paths), comma separated.
+    #[arg(long, value_name = "MV1,MV2,…", value_delimiter = ',')]
+    mvs: Vec<String>,
+    /// Throughput-manipulator candidates (each one of the MVs, held while the others are paired).
+    #[arg(long, value_name = "MV,…", value_delimiter = ',')]
+    throughput: Vec<String>,
+    /// Disturbances of the dynamic test: input paths, each stepped by +10 % or by PATH=±x%.
+    #[arg(long, value_name = "PATH[=±x%],…", value_delimiter = ',')]
+    disturbances: Vec<String>,
+    /// How many steady-state survivors to test dynamically.
+    #[arg(long, default_value_t = 4)]
+    candidates: usize,
+    /// Measurement dead time of every loop in the dynamic test's tuning.
+    #[arg(long, value_name = "TIME", default_value = "1 min")]
+    measurement_dead_time: String,
+    /// Length of each dynamic run (default: 20 × the longest reset time of the tuned loops).
+    #[arg(long, value_name = "TIME")]
+    duration: Option<String>,
     /// Override an input or unit field before converging (repeatable).
     #[arg(long = "set", value_name = "PATH=VALUE")]
     set: Vec<String>,
@@ -37,8 +62,12 @@ fn screen_error(e: ScreenError) -> CliError {
 
 /// Run `plantwide screen`.
 pub fn run(a: &ScreenArgs) -> Result<(), CliError> {
+    // The candidates run in parallel (rayon); faer's kernels then run sequentially inside each, so
+    // that no reduction's order, and no digit of the results, depends on the number of threads.
+    plantwide::analysis::faer::set_global_parallelism(plantwide::analysis::faer::Par::Seq);
     let (plant, _) = load_with_overrides(&a.file, &a.set)?;
-    let screen = screen_column(&plant, &a.column, &a.outputs).map_err(screen_error)?;
+    let Some(column) = &a.column else { return pairings(a, &plant) };
+    let screen = screen_column(&plant, column, &a.outputs).map_err(screen_error)?;
     let json = serde_json::to_string_pretty(&screen).map_err(|e| CliError::user(e.to_string()))?;
     if let Some(dir) = &a.report {
         write_report(dir, &a.file, &screen, &json)?;
@@ -86,4 +115,82 @@ fn write_report(dir: &Path, file: &Path, s: &ColumnScreen, json: &str) -> Result
     std::fs::write(dir.join("screen.json"), json).map_err(fail)?;
     let md = format!("# Column configurations: `{}`\n\n{}", s.column, table(s, file));
     std::fs::write(dir.join("screen.md"), md).map_err(fail)
+}
+
+fn time(text: &str, flag: &str) -> Result<f64, CliError> {
+    plantwide::units::parse_quantity_as(text, Dimension::TIME)
+        .map_err(|e| CliError::user(format!("--{flag} {text}: {e}")))
+}
+
+/// `PATH` (+10 %) or `PATH=±x%`.
+fn disturbance(text: &str) -> Result<Disturbance, CliError> {
+    let Some((path, step)) = text.split_once('=') else {
+        return Ok(Disturbance { path: text.trim().to_string(), fraction: 0.1 });
+    };
+    let pct =
+        step.trim().strip_suffix('%').and_then(|v| v.trim().parse::<f64>().ok()).filter(|v| v.is_finite() && *v != 0.0);
+    let Some(pct) = pct else {
+        return Err(CliError::user(format!("--disturbances {text}: expected PATH or PATH=±x% (e.g. fresh_A.F=+10%)")));
+    };
+    Ok(Disturbance { path: path.trim().to_string(), fraction: pct / 100.0 })
+}
+
+fn pairings(a: &ScreenArgs, plant: &plantwide::flowsheet::Plant) -> Result<(), CliError> {
+    let dead_time = time(&a.measurement_dead_time, "measurement-dead-time")?;
+    let duration = a.duration.as_deref().map(|d| time(d, "duration")).transpose()?;
+    let request = PairingRequest {
+        cvs: a.cvs.clone(),
+        mvs: a.mvs.clone(),
+        throughput: a.throughput.clone(),
+        disturbances: a.disturbances.iter().map(|d| disturbance(d)).collect::<Result<_, _>>()?,
+        dynamic: DynamicSettings {
+            candidates: a.candidates,
+            duration,
+            measurement: plantwide::studies::tune::loops::Measurement { dead_time, lag: 0.0 },
+        },
+    };
+    let screen = screen_pairings(plant, &request).map_err(screen_error)?;
+    let json = serde_json::to_string_pretty(&screen).map_err(|e| CliError::user(e.to_string()))?;
+    if let Some(dir) = &a.report {
+        let fail = |e: std::io::Error| CliError::user(format!("--report {}: {e}", dir.display()));
+        std::fs::create_dir_all(dir).map_err(fail)?;
+        std::fs::write(dir.join("screen.json"), &json).map_err(fail)?;
+        std::fs::write(dir.join("screen.md"), format!("# Pairings\n\n{}", pairing_table(&screen))).map_err(fail)?;
+    }
+    if a.json {
+        outln!("{json}");
+    } else {
+        outln!("{}", pairing_table(&screen));
+    }
+    Ok(())
+}
+
+/// The candidate structures as a markdown table, ranked first.
+fn pairing_table(s: &PairingScreen) -> String {
+    let mut t = format!(
+        "{} complete pairings examined, {} partial ones cut for a non-positive relative gain; loops opened: {}\n\n",
+        s.enumerated,
+        s.pruned,
+        if s.opened.is_empty() { "none".to_string() } else { s.opened.join(", ") }
+    );
+    t.push_str("| rank | throughput | pairs (relative gain) | NI | DIC | RGA number | dynamic score | note |\n");
+    t.push_str("|---|---|---|---|---|---|---|---|\n");
+    for c in &s.structures {
+        let pairs: Vec<String> =
+            c.pairs.iter().map(|p| format!("{} ← {} ({:.3})", p.cv, p.mv, p.relative_gain)).collect();
+        let dynamic = c.dynamic.as_ref();
+        let score = dynamic
+            .map_or("–".to_string(), |d| if d.failure.is_some() { "failed".into() } else { format!("{:.3}", d.score) });
+        let note = c.rejected.clone().or_else(|| dynamic.and_then(|d| d.failure.clone())).unwrap_or_default();
+        t.push_str(&format!(
+            "| {} | {} | {} | {:.4} | {} | {:.3} | {score} | {note} |\n",
+            c.rank.map_or("–".to_string(), |r| r.to_string()),
+            c.throughput.as_deref().unwrap_or("–"),
+            pairs.join("; "),
+            c.niederlinski,
+            if c.dic { "yes" } else { "no" },
+            c.rga_number
+        ));
+    }
+    t
 }

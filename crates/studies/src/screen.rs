@@ -8,8 +8,10 @@
 //! [`Plant`]: plantwide_flowsheet::Plant
 
 pub mod column;
+pub mod pairings;
 
 pub use column::{ColumnScreen, ColumnStructure, screen_column};
+pub use pairings::{PairingRequest, PairingScreen, screen_pairings};
 
 /// Why a screening could not be done.
 #[derive(Debug, Clone, thiserror::Error)]
@@ -52,6 +54,51 @@ pub enum ScreenError {
     /// Not two outputs.
     #[error("--outputs: a column configuration controls two qualities (top, bottom); got {0}")]
     OutputCount(usize),
+    /// A CV names no variable.
+    #[error("--cvs: no variable `{path}`{hint}")]
+    NoCv {
+        /// The path.
+        path: String,
+        /// A suggestion, or empty.
+        hint: String,
+    },
+    /// An MV names no input.
+    #[error("--mvs: `{path}` is no input of the plant{hint}")]
+    NoMv {
+        /// The path.
+        path: String,
+        /// A suggestion, or empty.
+        hint: String,
+    },
+    /// A throughput candidate that is not an MV.
+    #[error(
+        "--throughput {path}: a throughput candidate must be one of the --mvs (it is held while the others are paired)"
+    )]
+    ThroughputNotMv {
+        /// The path.
+        path: String,
+    },
+    /// Not as many free MVs as CVs.
+    #[error(
+        "{cvs} CVs and {mvs} MVs{}: pairing needs as many MVs as CVs (one more with --throughput), 1 to 8 of them",
+        if *throughput { " with a throughput manipulator" } else { "" }
+    )]
+    NotSquare {
+        /// CVs given.
+        cvs: usize,
+        /// MVs given.
+        mvs: usize,
+        /// Whether a throughput manipulator is held.
+        throughput: bool,
+    },
+    /// A disturbance that is no free input of the open plant.
+    #[error(
+        "--disturbances {path}: not an input of the plant that no controller drives; give a feed flow, composition or temperature"
+    )]
+    Disturbance {
+        /// The path.
+        path: String,
+    },
     /// A configuration could not be built.
     #[error("configuration {structure}: {source}")]
     Wiring {

@@ -212,11 +212,8 @@ fn handles(plant: &Plant, column: &str) -> Result<Handles, ScreenError> {
 }
 
 /// True when controller `c` drives one of `paths`.
-fn drives_any(c: &ControllerSpec, paths: &[String]) -> bool {
-    serde_json::to_value(c)
-        .ok()
-        .and_then(|v| v.get("output").and_then(|o| o.as_str().map(str::to_string)))
-        .is_some_and(|o| paths.contains(&o))
+pub(super) fn drives_any(c: &ControllerSpec, paths: &[String]) -> bool {
+    c.config().paths().driven.iter().any(|(_, p)| paths.contains(p))
 }
 
 /// Path of the molar flow of the stream leaving `port` (`unit.port`), or of the port's own input
@@ -238,7 +235,7 @@ fn output_var(plant: &Plant, path: &str) -> Result<usize, ScreenError> {
 }
 
 /// The value input `path` takes at state `x`: its controller's output when one drives it.
-fn input_value(plant: &Plant, x: &[f64], path: &str) -> f64 {
+pub(super) fn input_value(plant: &Plant, x: &[f64], path: &str) -> f64 {
     let Some(i) = plant.input(path) else { return f64::NAN };
     let info = &plant.inputs()[i];
     info.driven_by.map_or(info.value, |op| x[op])
@@ -362,12 +359,7 @@ fn ratio_station(name: &str, wild: &str, output: &str, ratio: f64) -> StructureE
 /// The configuration's starting point: the plant's steady state by variable path; a ratio
 /// station's output at the flow it drives.
 fn guess(plant: &Plant, x: &[f64], v: &Plant, h: &Handles, flows: &[f64; 4]) -> Vec<f64> {
-    let mut g = v.initial_guess_at(&v.input_values());
-    for (k, info) in v.vars().iter().enumerate() {
-        if let Some(j) = plant.var(&info.path) {
-            g[k] = x[j];
-        }
-    }
+    let mut g = mapped_guess(plant, x, v);
     for (station, flow) in [("reflux_ratio", flows[0]), ("boilup_ratio", flows[1])] {
         if let Some(k) = v.var(&format!("{}_{station}.op", h.column)) {
             g[k] = flow;
@@ -376,10 +368,21 @@ fn guess(plant: &Plant, x: &[f64], v: &Plant, h: &Handles, flows: &[f64; 4]) -> 
     g
 }
 
+/// A starting point for variant `v` of `plant`: `x` by variable path, `v`'s own guess elsewhere.
+pub(super) fn mapped_guess(plant: &Plant, x: &[f64], v: &Plant) -> Vec<f64> {
+    let mut g = v.initial_guess_at(&v.input_values());
+    for (k, info) in v.vars().iter().enumerate() {
+        if let Some(j) = plant.var(&info.path) {
+            g[k] = x[j];
+        }
+    }
+    g
+}
+
 /// Singular when the gains, rows and then columns scaled to a largest entry of 1 (so the units of
 /// the qualities and flows do not count), have `σ_min/σ_max` below `√SINGULAR_RATIO` (≈ 3e-7: the
 /// relative error of gains computed through a nearly singular Jacobian).
-fn is_singular(g: &Mat<f64>) -> bool {
+pub(super) fn is_singular(g: &Mat<f64>) -> bool {
     if !g.is_all_finite() {
         return true;
     }

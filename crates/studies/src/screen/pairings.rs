@@ -1,0 +1,393 @@
+//! Plantwide pairings: which of the manipulated variables (MVs) controls which controlled variable
+//! (CV), and which MV is left as the throughput manipulator.
+//!
+//! 1. The loops are opened: every controller that measures a CV or drives an MV is removed, the MVs
+//!    held at their values in the plant's steady state (an inventory that then nothing holds is an
+//!    error naming it). The open plant is converged from the plant's steady state and checked to keep
+//!    its CVs, and its exact steady-state gains `G` (CVs × MVs, SI) computed once.
+//! 2. For each throughput choice (an MV held as the throughput manipulator, or none), the square
+//!    `G_s` of the remaining MVs and its RGA `Λ`: the pairings are enumerated by branch and bound,
+//!    a partial pairing cut as soon as a pair's relative gain is not positive (below
+//!    [`MIN_RELATIVE_GAIN`]: a necessary condition
+//!    of integral controllability, Grosdidier, Morari & Holt 1985). At each complete pairing: the
+//!    Niederlinski index (NI > 0 necessary for integral stability, Niederlinski 1971), the necessary
+//!    conditions of decentralized integral controllability (DIC: NI > 0 of every principal
+//!    submatrix of the paired gains, Skogestad & Morari 1992) and the RGA number `Σ|Λ − P|`.
+//! 3. The best survivors by RGA number go to a dynamic test ([`dynamic`]): PI loops added, tuned
+//!    together by BLT on the exact linearization, then each disturbance stepped on the nonlinear
+//!    plant; ranked by their IAE relative to the best candidate's, per CV and disturbance.
+
+pub mod dynamic;
+
+use faer::Mat;
+use plantwide_analysis::linear::Linearization;
+use plantwide_analysis::measures::{niederlinski, rga};
+use plantwide_flowsheet::{Override, Plant, StructureEdit};
+use plantwide_solve::{NewtonSettings, StrategySettings, steady_state};
+use serde::Serialize;
+
+pub use dynamic::{CvFigures, DisturbanceRun, DynamicResult, DynamicSettings};
+
+use super::ScreenError;
+use super::column::is_singular;
+
+/// A disturbance of the dynamic test: input `path` stepped by `fraction` of its steady value.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Disturbance {
+    /// Input path.
+    pub path: String,
+    /// Step as a fraction of the steady value (0.1 for +10 %).
+    pub fraction: f64,
+}
+
+/// What to screen.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PairingRequest {
+    /// Controlled variables (variable paths).
+    pub cvs: Vec<String>,
+    /// Manipulated variables (input paths).
+    pub mvs: Vec<String>,
+    /// Throughput-manipulator candidates, each one of `mvs` (empty: as many MVs as CVs).
+    pub throughput: Vec<String>,
+    /// Disturbances of the dynamic test (empty: no dynamic test).
+    pub disturbances: Vec<Disturbance>,
+    /// The dynamic test's settings.
+    pub dynamic: DynamicSettings,
+}
+
+/// One CV–MV pair and its relative gain.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Pair {
+    /// Controlled variable.
+    pub cv: String,
+    /// Manipulated variable.
+    pub mv: String,
+    /// Its relative gain.
+    pub relative_gain: f64,
+}
+
+/// A candidate structure: a throughput manipulator and a pairing.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PairingStructure {
+    /// The MV held as throughput manipulator, if any.
+    pub throughput: Option<String>,
+    /// The pairs, in CV order.
+    pub pairs: Vec<Pair>,
+    /// Niederlinski index.
+    pub niederlinski: f64,
+    /// `Σ|Λ − P|` over all elements (0 for a decoupled plant).
+    pub rga_number: f64,
+    /// NI > 0 of every principal submatrix of the paired gains (necessary for DIC).
+    pub dic: bool,
+    /// Passed the steady-state filters.
+    pub passed: bool,
+    /// Why it failed them.
+    pub rejected: Option<String>,
+    /// The dynamic test, for the candidates that had one.
+    pub dynamic: Option<DynamicResult>,
+    /// Place in the ranking (1 best) among those that passed.
+    pub rank: Option<usize>,
+}
+
+/// The result of a pairing screen.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PairingScreen {
+    /// Controlled variables.
+    pub cvs: Vec<String>,
+    /// Manipulated variables.
+    pub mvs: Vec<String>,
+    /// Controllers removed to open the loops.
+    pub opened: Vec<String>,
+    /// Steady-state gains of the open plant, CVs × MVs (SI).
+    pub gain: Vec<Vec<f64>>,
+    /// Complete pairings examined (leaves of the branch and bound).
+    pub enumerated: usize,
+    /// Partial pairings cut for a non-positive relative gain.
+    pub pruned: usize,
+    /// The structures that reached a leaf, best first.
+    pub structures: Vec<PairingStructure>,
+}
+
+/// The open plant: the loops on the CVs and MVs removed, its steady state and gains.
+pub struct OpenPlant {
+    /// The plant.
+    pub plant: Plant,
+    /// Its steady state.
+    pub x: Vec<f64>,
+    /// The MVs' steady values.
+    pub mv_values: Vec<f64>,
+    /// The CVs' steady values.
+    pub cv_values: Vec<f64>,
+    /// Gains CVs × MVs.
+    pub gain: Mat<f64>,
+    /// The controllers removed.
+    pub opened: Vec<String>,
+}
+
+/// Screen the pairings of `request` on `plant`.
+///
+/// # Errors
+/// [`ScreenError`] naming the CV, MV or throughput choice that is wrong, or the inventory that
+/// opening the loops leaves uncontrolled.
+pub fn screen_pairings(plant: &Plant, request: &PairingRequest) -> Result<PairingScreen, ScreenError> {
+    check_request(plant, request)?;
+    let open = open_plant(plant, &request.cvs, &request.mvs)?;
+    let choices: Vec<Option<&String>> =
+        if request.throughput.is_empty() { vec![None] } else { request.throughput.iter().map(Some).collect() };
+    let (mut structures, mut enumerated, mut pruned) = (Vec::new(), 0, 0);
+    for tpm in choices {
+        let cols: Vec<usize> = (0..request.mvs.len()).filter(|&j| Some(&request.mvs[j]) != tpm).collect();
+        let g = Mat::from_fn(request.cvs.len(), cols.len(), |i, k| open.gain[(i, cols[k])]);
+        let mut found = Vec::new();
+        if !is_singular(&g) {
+            let lambda = rga(g.as_ref()).map_err(|e| analysis(e, tpm))?;
+            branch(&lambda, &mut Vec::new(), &mut found, &mut pruned);
+        }
+        enumerated += found.len();
+        for p in found {
+            structures.push(judge(request, &g, &cols, &p, tpm).map_err(|e| analysis(e, tpm))?);
+        }
+    }
+    structures.sort_by(|a, b| {
+        (!a.passed, a.rga_number).partial_cmp(&(!b.passed, b.rga_number)).unwrap_or(std::cmp::Ordering::Equal)
+    });
+    if !request.disturbances.is_empty() {
+        dynamic::test(&open, request, &mut structures)?;
+    }
+    rank(&mut structures);
+    Ok(PairingScreen {
+        cvs: request.cvs.clone(),
+        mvs: request.mvs.clone(),
+        opened: open.opened.clone(),
+        gain: plantwide_analysis::measures::rows(open.gain.as_ref()),
+        enumerated,
+        pruned,
+        structures,
+    })
+}
+
+fn analysis(e: plantwide_analysis::AnalysisError, tpm: Option<&String>) -> ScreenError {
+    let structure = tpm.map_or("pairings".to_string(), |t| format!("throughput {t}"));
+    ScreenError::Analysis { structure, source: Box::new(e) }
+}
+
+/// CVs are variables, MVs inputs, throughput candidates MVs, and the count square.
+fn check_request(plant: &Plant, r: &PairingRequest) -> Result<(), ScreenError> {
+    let hint = |p: &str, names: Vec<&str>| plantwide_flowsheet::error::did_you_mean(p, names);
+    if let Some(cv) = r.cvs.iter().find(|c| plant.var(c).is_none()) {
+        let hint = hint(cv, plant.vars().iter().map(|v| v.path.as_str()).collect());
+        return Err(ScreenError::NoCv { path: cv.clone(), hint });
+    }
+    if let Some(mv) = r.mvs.iter().find(|m| plant.input(m).is_none()) {
+        let hint = hint(mv, plant.inputs().iter().map(|v| v.path.as_str()).collect());
+        return Err(ScreenError::NoMv { path: mv.clone(), hint });
+    }
+    if let Some(t) = r.throughput.iter().find(|t| !r.mvs.contains(t)) {
+        return Err(ScreenError::ThroughputNotMv { path: t.clone() });
+    }
+    let free = r.mvs.len().saturating_sub(usize::from(!r.throughput.is_empty()));
+    if r.cvs.is_empty() || free != r.cvs.len() || r.cvs.len() > 8 {
+        return Err(ScreenError::NotSquare {
+            cvs: r.cvs.len(),
+            mvs: r.mvs.len(),
+            throughput: !r.throughput.is_empty(),
+        });
+    }
+    Ok(())
+}
+
+/// Open the loops on `cvs` and `mvs`, converge from the plant's steady state and linearize.
+pub fn open_plant(plant: &Plant, cvs: &[String], mvs: &[String]) -> Result<OpenPlant, ScreenError> {
+    let steady = |structure: &str, e: plantwide_solve::Error| ScreenError::Steady {
+        structure: structure.into(),
+        source: Box::new(e),
+    };
+    let base = plantwide_solve::converge(plant, &StrategySettings::default()).map_err(|e| steady("file", e.into()))?;
+    let opened: Vec<String> = plant
+        .spec()
+        .controllers
+        .iter()
+        .filter(|(_, c)| {
+            let p = c.config().paths();
+            p.driven.iter().any(|(_, d)| mvs.contains(d))
+                || p.measured.iter().any(|(f, m)| f == "pv" && cvs.contains(m))
+        })
+        .map(|(n, _)| n.clone())
+        .collect();
+    let mv_values: Vec<f64> = mvs.iter().map(|m| super::column::input_value(plant, &base.x, m)).collect();
+    let mut edits: Vec<StructureEdit> = opened.iter().map(|n| StructureEdit::RemoveController(n.clone())).collect();
+    edits.extend(
+        mvs.iter().zip(&mv_values).map(|(m, v)| StructureEdit::Set(Override::new(m.clone(), format!("{v:e}")))),
+    );
+    let label = format!("with the loops on the CVs and MVs opened ({})", opened.join(", "));
+    let wiring = |e| ScreenError::Wiring { structure: label.clone(), source: Box::new(e) };
+    let v = plant.restructure(&edits).map_err(wiring)?;
+    let u = v.input_values();
+    let guess = super::column::mapped_guess(plant, &base.x, &v);
+    let s = steady_state(&v, &u, Some(&guess), &NewtonSettings::default())
+        .map_err(|e| steady(&label, plantwide_solve::SolveError::from(e).into()))?;
+    let cv_ids: Vec<usize> = cvs.iter().filter_map(|c| v.var(c)).collect();
+    let cv_values: Vec<f64> = cvs.iter().filter_map(|c| plant.var(c)).map(|i| base.x[i]).collect();
+    for ((&i, &b), c) in cv_ids.iter().zip(&cv_values).zip(cvs) {
+        if (s.x[i] - b).abs() > 1e-8 * b.abs().max(1e-8) {
+            return Err(ScreenError::Moved { structure: label, output: c.clone(), value: s.x[i], base: b });
+        }
+    }
+    let mv_ids: Vec<usize> = mvs.iter().filter_map(|m| v.input(m)).collect();
+    let gain = Linearization::new(&v, &s.x, &u)
+        .steady_gain(&mv_ids, &cv_ids)
+        .map_err(|e| ScreenError::Analysis { structure: label.clone(), source: Box::new(e) })?;
+    Ok(OpenPlant { plant: v, x: s.x, mv_values, cv_values, gain, opened })
+}
+
+/// The smallest relative gain a pair may have: below it (a loop whose gain is rounding next to the
+/// interactions, e.g. a downstream column's input on an upstream quality) the pair cannot be closed.
+pub const MIN_RELATIVE_GAIN: f64 = 1e-6;
+
+/// Branch and bound over the pairings of `lambda`'s rows to its columns: row `k = p.len()` next,
+/// every unused column with a positive relative gain a branch; a complete pairing is a leaf.
+fn branch(lambda: &Mat<f64>, p: &mut Vec<usize>, leaves: &mut Vec<Vec<usize>>, pruned: &mut usize) {
+    let k = p.len();
+    if k == lambda.nrows() {
+        leaves.push(p.clone());
+        return;
+    }
+    for j in 0..lambda.ncols() {
+        if p.contains(&j) {
+            continue;
+        }
+        if lambda[(k, j)].is_nan() || lambda[(k, j)] <= MIN_RELATIVE_GAIN {
+            *pruned += 1;
+            continue;
+        }
+        p.push(j);
+        branch(lambda, p, leaves, pruned);
+        p.pop();
+    }
+}
+
+/// The steady-state measures and filters of pairing `p` (row i with column `p[i]` of `g`).
+fn judge(
+    r: &PairingRequest,
+    g: &Mat<f64>,
+    cols: &[usize],
+    p: &[usize],
+    tpm: Option<&String>,
+) -> Result<PairingStructure, plantwide_analysis::AnalysisError> {
+    let lambda = rga(g.as_ref())?;
+    let ni = niederlinski(g.as_ref(), p)?;
+    let n = p.len();
+    let rga_number: f64 = (0..n)
+        .flat_map(|i| (0..n).map(move |j| (i, j)))
+        .map(|(i, j)| (lambda[(i, j)] - if p[i] == j { 1.0 } else { 0.0 }).abs())
+        .sum();
+    let dic = dic_necessary(g, p)?;
+    let rejected = if ni <= 0.0 {
+        Some(format!("NI = {ni:.4} ≤ 0: the loops closed together with integral action are unstable"))
+    } else if !dic {
+        Some("a principal subsystem has NI ≤ 0: not decentralized integral controllable (loops taken out of service destabilize the rest)".into())
+    } else {
+        None
+    };
+    let pairs = (0..n)
+        .map(|i| Pair { cv: r.cvs[i].clone(), mv: r.mvs[cols[p[i]]].clone(), relative_gain: lambda[(i, p[i])] })
+        .collect();
+    Ok(PairingStructure {
+        throughput: tpm.cloned(),
+        pairs,
+        niederlinski: ni,
+        rga_number,
+        dic,
+        passed: rejected.is_none(),
+        rejected,
+        dynamic: None,
+        rank: None,
+    })
+}
+
+/// NI > 0 of every principal submatrix of the paired gains `G_p` (columns reordered so the pairs
+/// sit on the diagonal): necessary for decentralized integral controllability.
+fn dic_necessary(g: &Mat<f64>, p: &[usize]) -> Result<bool, plantwide_analysis::AnalysisError> {
+    let n = p.len();
+    let paired = Mat::from_fn(n, n, |i, k| g[(i, p[k])]);
+    for mask in 1u32..(1 << n) {
+        let idx: Vec<usize> = (0..n).filter(|&i| mask & (1 << i) != 0).collect();
+        if idx.len() < 2 {
+            continue;
+        }
+        let sub = Mat::from_fn(idx.len(), idx.len(), |a, b| paired[(idx[a], idx[b])]);
+        let diag: Vec<usize> = (0..idx.len()).collect();
+        if niederlinski(sub.as_ref(), &diag)? <= 0.0 {
+            return Ok(false);
+        }
+    }
+    Ok(true)
+}
+
+/// Rank: dynamically tested candidates by their score, then the other survivors by RGA number.
+fn rank(structures: &mut [PairingStructure]) {
+    let key = |s: &PairingStructure| {
+        let score = s.dynamic.as_ref().map_or(f64::INFINITY, |d| d.score);
+        (score, s.rga_number)
+    };
+    let mut order: Vec<usize> = (0..structures.len()).filter(|&k| structures[k].passed).collect();
+    order.sort_by(|&a, &b| key(&structures[a]).partial_cmp(&key(&structures[b])).unwrap_or(std::cmp::Ordering::Equal));
+    for (place, k) in order.into_iter().enumerate() {
+        structures[k].rank = Some(place + 1);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every permutation of 0..n (Heap's algorithm would do; n ≤ 5 here).
+    fn permutations(n: usize) -> Vec<Vec<usize>> {
+        if n == 0 {
+            return vec![Vec::new()];
+        }
+        let mut out = Vec::new();
+        for p in permutations(n - 1) {
+            for k in 0..n {
+                let mut q = p.clone();
+                q.insert(k, n - 1);
+                out.push(q);
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn branch_and_bound_finds_exactly_the_pairings_with_positive_relative_gains() {
+        // A deterministic pseudo-random 5 × 5 (linear congruential), its RGA, and brute force.
+        let mut seed = 12345u64;
+        let mut next = || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            ((seed >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+        };
+        let g = Mat::from_fn(5, 5, |_, _| next());
+        let lambda = rga(g.as_ref()).unwrap();
+        let (mut leaves, mut pruned) = (Vec::new(), 0);
+        branch(&lambda, &mut Vec::new(), &mut leaves, &mut pruned);
+        let mut brute: Vec<Vec<usize>> =
+            permutations(5).into_iter().filter(|p| (0..5).all(|i| lambda[(i, p[i])] > MIN_RELATIVE_GAIN)).collect();
+        brute.sort();
+        leaves.sort();
+        assert_eq!(leaves, brute);
+        assert!(pruned > 0 && leaves.len() < 120, "{} leaves, {pruned} cut", leaves.len());
+    }
+
+    #[test]
+    fn dic_fails_when_a_principal_subsystem_has_a_negative_niederlinski_index() {
+        // G = [[1, 2, 1], [1, 1, 0], [−2, 0, 1]]: det = 1·1 − 2·1 + 1·(0 + 2) = 1 and the diagonal's
+        // product 1, so NI = 1 > 0; but the loops 1–2 alone, [[1, 2], [1, 1]], have NI = −1: take loop 3
+        // out of service and the other two go unstable. Not DIC; the NI filter alone would pass it.
+        let h = Mat::from_fn(3, 3, |i, j| [[1.0, 2.0, 1.0], [1.0, 1.0, 0.0], [-2.0, 0.0, 1.0]][i][j]);
+        let ni = niederlinski(h.as_ref(), &[0, 1, 2]).unwrap();
+        assert!((ni - 1.0).abs() < 1e-12, "{ni}");
+        assert!(!dic_necessary(&h, &[0, 1, 2]).unwrap());
+        // A diagonally dominant plant passes.
+        let d = Mat::from_fn(3, 3, |i, j| if i == j { 2.0 } else { 0.3 });
+        assert!(dic_necessary(&d, &[0, 1, 2]).unwrap());
+    }
+}

@@ -1,0 +1,271 @@
+//! The dynamic test of candidate pairings: each candidate's PI loops added to the open plant, tuned
+//! together by Luyben's BLT on the exact linearization (with the measurement delay given), then
+//! every disturbance stepped on the nonlinear plant from its steady state, every run of the same
+//! length (given, or 20 reset times of the best-ranked candidate's slowest loop). Figures per CV: IAE,
+//! largest deviation, settling time (2 % band); per run, the MVs that reached a limit (each loop's
+//! output is bounded to [0, 2 u₀], or [2 u₀, 0] for a negative steady value u₀). The score of a
+//! candidate is the mean over disturbances and CVs of its IAE over the best candidate's, so 1 is
+//! best everywhere; a failed run scores infinity. Candidates run in parallel (rayon); each is a pure
+//! function of the plant and the request, so the results do not depend on the thread count.
+
+use plantwide_analysis::figures::summary;
+use plantwide_flowsheet::{Plant, StructureEdit};
+use plantwide_solve::dynamic::{Start, simulate};
+use plantwide_solve::{NewtonSettings, steady_state};
+use rayon::prelude::*;
+use serde::Serialize;
+
+use super::{OpenPlant, PairingRequest, PairingStructure};
+use crate::screen::ScreenError;
+use crate::tune::flowsheet::blt_loops;
+use crate::tune::loops::{Measurement, plant_loop};
+
+/// Settings of the dynamic test.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DynamicSettings {
+    /// How many of the best steady-state survivors to test.
+    pub candidates: usize,
+    /// Length of each run \[s\] (default: 20 times the longest reset time of the tuned loops).
+    pub duration: Option<f64>,
+    /// Measurement delay and lag of every loop, for the tuning.
+    pub measurement: Measurement,
+}
+
+impl Default for DynamicSettings {
+    fn default() -> Self {
+        DynamicSettings { candidates: 4, duration: None, measurement: Measurement::default() }
+    }
+}
+
+/// A loop of a tested candidate, as tuned.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TunedLoop {
+    /// Controlled variable.
+    pub cv: String,
+    /// Manipulated variable.
+    pub mv: String,
+    /// Gain magnitude (SI).
+    pub kc: f64,
+    /// Reset time \[s\].
+    pub tau_i: f64,
+    /// `direct` or `reverse`.
+    pub action: String,
+}
+
+/// Figures of one CV in one run.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CvFigures {
+    /// Controlled variable.
+    pub cv: String,
+    /// Integral of the absolute error (SI unit × s).
+    pub iae: f64,
+    /// Largest deviation from the setpoint.
+    pub max_deviation: f64,
+    /// Time from the step until it stays within 2 % of its excursion \[s\].
+    pub settling_time: Option<f64>,
+}
+
+/// One disturbance run.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct DisturbanceRun {
+    /// `path +x %`.
+    pub disturbance: String,
+    /// Figures per CV.
+    pub cvs: Vec<CvFigures>,
+    /// MVs whose loop output reached a limit.
+    pub saturated: Vec<String>,
+}
+
+/// A candidate's dynamic test.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct DynamicResult {
+    /// BLT's detuning factor.
+    pub detuning_factor: Option<f64>,
+    /// The tuned loops.
+    pub loops: Vec<TunedLoop>,
+    /// One run per disturbance.
+    pub runs: Vec<DisturbanceRun>,
+    /// Mean IAE relative to the best candidate's (1 best; infinite when a run failed).
+    pub score: f64,
+    /// Why the test failed (tuning or a run), if it did.
+    pub failure: Option<String>,
+}
+
+/// Test the first `r.dynamic.candidates` structures that passed, in parallel, and score them.
+pub(super) fn test(
+    open: &OpenPlant,
+    r: &PairingRequest,
+    structures: &mut [PairingStructure],
+) -> Result<(), ScreenError> {
+    for d in &r.disturbances {
+        match open.plant.input(&d.path) {
+            Some(i) if open.plant.inputs()[i].driven_by.is_none() => {}
+            _ => return Err(ScreenError::Disturbance { path: d.path.clone() }),
+        }
+    }
+    let picked: Vec<usize> =
+        (0..structures.len()).filter(|&k| structures[k].passed).take(r.dynamic.candidates).collect();
+    let tunings: Vec<TunedCandidate> = picked.par_iter().map(|&k| tuned_plant(open, r, &structures[k])).collect();
+    // One length for every run, so that IAEs compare: given, or 20 reset times of the best-ranked
+    // candidate that could be tuned.
+    let longest = tunings.iter().flatten().map(|(_, _, t)| t.tau_i_max).next().unwrap_or(0.0);
+    let duration = r.dynamic.duration.unwrap_or(20.0 * longest);
+    let results: Vec<DynamicResult> =
+        picked.par_iter().zip(tunings).map(|(&k, tuned)| candidate(tuned, r, &structures[k], duration)).collect();
+    let best: Vec<Vec<f64>> = (0..r.disturbances.len())
+        .map(|d| {
+            let ok = || results.iter().filter(|t| t.failure.is_none());
+            (0..r.cvs.len()).map(|c| ok().map(|t| t.runs[d].cvs[c].iae).fold(f64::INFINITY, f64::min)).collect()
+        })
+        .collect();
+    let best = |d: usize, c: usize| best[d][c];
+    for (k, mut t) in picked.into_iter().zip(results) {
+        if t.failure.is_none() {
+            let n = (r.disturbances.len() * r.cvs.len()).max(1) as f64;
+            let sum: f64 = (0..r.disturbances.len())
+                .flat_map(|d| (0..r.cvs.len()).map(move |c| (d, c)))
+                .map(|(d, c)| t.runs[d].cvs[c].iae / best(d, c).max(f64::MIN_POSITIVE))
+                .sum();
+            t.score = sum / n;
+        }
+        structures[k].dynamic = Some(t);
+    }
+    Ok(())
+}
+
+/// Run one tuned candidate; a failure is recorded, not returned (the other candidates go on).
+fn candidate(tuned: TunedCandidate, r: &PairingRequest, s: &PairingStructure, duration: f64) -> DynamicResult {
+    let failed = |why: String| DynamicResult {
+        detuning_factor: None,
+        loops: Vec::new(),
+        runs: Vec::new(),
+        score: f64::INFINITY,
+        failure: Some(why),
+    };
+    let (plant, x, tuned) = match tuned {
+        Ok(t) => t,
+        Err(why) => return failed(why),
+    };
+    let mut runs = Vec::new();
+    for d in &r.disturbances {
+        match run(&plant, &x, r, s, d, duration) {
+            Ok(run) => runs.push(run),
+            Err(why) => return DynamicResult { detuning_factor: tuned.detuning, loops: tuned.loops, ..failed(why) },
+        }
+    }
+    DynamicResult { detuning_factor: tuned.detuning, loops: tuned.loops, runs, score: f64::NAN, failure: None }
+}
+
+/// A candidate's plant with its tuned loops, its steady state and tuning, or why it has none.
+type TunedCandidate = Result<(Plant, Vec<f64>, Tuned), String>;
+
+/// The tuning of a candidate.
+struct Tuned {
+    detuning: Option<f64>,
+    loops: Vec<TunedLoop>,
+    /// Its longest reset time \[s\].
+    tau_i_max: f64,
+}
+
+/// The controller description of pair `i` with gain `kc` and reset `tau_i` (SI).
+fn loop_spec(open: &OpenPlant, s: &PairingStructure, i: usize, kc: f64, tau_i: f64, action: &str) -> serde_json::Value {
+    let p = &s.pairs[i];
+    // The open plant holds every MV at its steady value.
+    let u0 = open.plant.input(&p.mv).map_or(0.0, |m| open.plant.inputs()[m].value);
+    let (lo, hi) = (f64::min(0.0, 2.0 * u0), f64::max(0.0, 2.0 * u0));
+    let c = open.plant.var(&p.cv).map_or(f64::NAN, |v| open.x[v]);
+    serde_json::json!({"type": "pid", "pv": p.cv, "output": p.mv, "sp": c, "kc": kc, "tau_i": tau_i,
+                       "action": action, "op_min": lo, "op_max": hi})
+}
+
+/// The open plant with the candidate's loops, tuned by BLT, and its steady state.
+fn tuned_plant(open: &OpenPlant, r: &PairingRequest, s: &PairingStructure) -> TunedCandidate {
+    let n = s.pairs.len();
+    let cols: Vec<usize> = s.pairs.iter().map(|p| r.mvs.iter().position(|m| *m == p.mv).unwrap_or(0)).collect();
+    let action = |i: usize| if open.gain[(i, cols[i])] < 0.0 { "direct" } else { "reverse" };
+    let build = |kc: &[f64], ti: &[f64], actions: &[&str]| {
+        let edits: Vec<StructureEdit> = (0..n)
+            .map(|i| StructureEdit::AddController {
+                name: format!("pair{}", i + 1),
+                spec: loop_spec(open, s, i, kc[i], ti[i], actions[i]),
+            })
+            .collect();
+        let v = open.plant.restructure(&edits).map_err(|e| e.to_string())?;
+        let guess = crate::screen::column::mapped_guess(&open.plant, &open.x, &v);
+        let st =
+            steady_state(&v, &v.input_values(), Some(&guess), &NewtonSettings::default()).map_err(|e| e.to_string())?;
+        Ok::<_, String>((v, st.x))
+    };
+    let actions: Vec<&str> = (0..n).map(action).collect();
+    let (trial, x) = build(&vec![1.0; n], &vec![1e3; n], &actions)?;
+    let loops: Vec<_> = (0..n)
+        .map(|i| plant_loop(&trial, &format!("pair{}", i + 1)))
+        .collect::<Result<_, _>>()
+        .map_err(|e| e.to_string())?;
+    let t = blt_loops(&trial, &x, &loops, r.dynamic.measurement).map_err(|e| e.to_string())?;
+    let kc: Vec<f64> = t.loops.iter().map(|l| l.kc.abs()).collect();
+    let ti: Vec<f64> = t.loops.iter().map(|l| l.tau_i.unwrap_or(f64::INFINITY)).collect();
+    let actions: Vec<&str> = t.loops.iter().map(|l| l.action).collect();
+    let (plant, x) = build(&kc, &ti, &actions)?;
+    let tuned = (0..n)
+        .map(|i| TunedLoop {
+            cv: s.pairs[i].cv.clone(),
+            mv: s.pairs[i].mv.clone(),
+            kc: kc[i],
+            tau_i: ti[i],
+            action: actions[i].into(),
+        })
+        .collect();
+    Ok((
+        plant,
+        x,
+        Tuned { detuning: t.detuning_factor, loops: tuned, tau_i_max: ti.iter().copied().fold(0.0, f64::max) },
+    ))
+}
+
+/// One disturbance step on the tuned plant.
+fn run(
+    plant: &Plant,
+    x: &[f64],
+    r: &PairingRequest,
+    s: &PairingStructure,
+    d: &super::Disturbance,
+    duration: f64,
+) -> Result<DisturbanceRun, String> {
+    let u0 = plant.input(&d.path).map_or(f64::NAN, |i| plant.inputs()[i].value);
+    let ops: Vec<String> = (0..s.pairs.len()).map(|i| format!("pair{}.op", i + 1)).collect();
+    let record: Vec<&String> = r.cvs.iter().chain(&ops).collect();
+    let text = serde_json::json!({
+        "format_version": 1, "name": format!("{} step", d.path), "duration": format!("{duration} s"),
+        "integrator": {"rtol": 1e-6},
+        "events": [{"type": "step", "at": format!("{} s", 0.02 * duration), "path": d.path, "by": d.fraction * u0}],
+        "record": {"interval": format!("{} s", duration / 500.0), "paths": record}
+    })
+    .to_string();
+    let spec = plantwide_flowsheet::scenario::parse_scenario(&text, "screen").map_err(|e| e.to_string())?;
+    let scenario = plantwide_flowsheet::scenario::resolve(&spec, plant, "screen").map_err(|e| e.to_string())?;
+    let res = simulate(plant, &scenario, Start::Steady(x), "screen", &mut |_| {}).map_err(|e| e.to_string())?;
+    let figures = summary(&res);
+    let cvs = r
+        .cvs
+        .iter()
+        .map(|cv| {
+            let f = figures.iter().find(|f| &f.path == cv);
+            CvFigures {
+                cv: cv.clone(),
+                iae: f.map_or(f64::NAN, |f| f.iae),
+                max_deviation: f.map_or(f64::NAN, |f| f.max_deviation),
+                settling_time: f.and_then(|f| f.settling_time),
+            }
+        })
+        .collect();
+    let saturated = (0..s.pairs.len())
+        .filter(|&i| {
+            let k = r.cvs.len() + i;
+            let limits = [0.0, 2.0 * res.rows.first().map_or(0.0, |row| row[k])];
+            res.rows.iter().any(|row| limits.iter().any(|l| (row[k] - l).abs() <= 1e-9 * l.abs().max(1e-12)))
+        })
+        .map(|i| s.pairs[i].mv.clone())
+        .collect();
+    Ok(DisturbanceRun { disturbance: format!("{} {:+} %", d.path, 100.0 * d.fraction), cvs, saturated })
+}
