@@ -5,7 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-use plantwide::studies::screen::pairings::{Disturbance, DynamicSettings, PairingRequest, PairingScreen};
+use plantwide::studies::screen::pairings::{Disturbance, DynamicSettings, PairingRequest, PairingScreen, Watch};
 use plantwide::studies::screen::{ColumnScreen, ScreenError, screen_column, screen_pairings};
 use plantwide::units::Dimension;
 
@@ -36,6 +36,10 @@ pub struct ScreenArgs {
     /// Disturbances of the dynamic test: input paths, each stepped by +10 % or by PATH=±x%.
     #[arg(long, value_name = "PATH[=±x%],…", value_delimiter = ',')]
     disturbances: Vec<String>,
+    /// Uncontrolled variables that must stay in a band over ± each disturbance with the CVs held
+    /// (sensitivity test), e.g. "column1.x[1][B]=0:0.02" or "reactor.T=340 K:360 K".
+    #[arg(long, value_name = "PATH=LOW:HIGH")]
+    watch: Vec<String>,
     /// How many steady-state survivors to test dynamically.
     #[arg(long, default_value_t = 4)]
     candidates: usize,
@@ -135,6 +139,25 @@ fn disturbance(text: &str) -> Result<Disturbance, CliError> {
     Ok(Disturbance { path: path.trim().to_string(), fraction: pct / 100.0 })
 }
 
+/// `PATH=LOW:HIGH`, the ends in the variable's unit (SI when bare).
+fn watch(plant: &plantwide::flowsheet::Plant, text: &str) -> Result<Watch, CliError> {
+    let bad = || CliError::user(format!("--watch {text}: expected PATH=LOW:HIGH, e.g. column1.x[1][B]=0:0.02"));
+    let (path, band) = text.split_once('=').ok_or_else(bad)?;
+    let (lo, hi) = band.split_once(':').ok_or_else(bad)?;
+    let Some(v) = plant.var(path.trim()) else {
+        return Err(CliError::user(format!("--watch {text}: no variable `{}`", path.trim())));
+    };
+    let dim = plant.vars()[v].spec.dim;
+    let end = |s: &str| {
+        plantwide::units::parse_quantity_as(s.trim(), dim).map_err(|e| CliError::user(format!("--watch {text}: {e}")))
+    };
+    let (low, high) = (end(lo)?, end(hi)?);
+    if low.is_nan() || high.is_nan() || low >= high {
+        return Err(CliError::user(format!("--watch {text}: the band must go from low to high")));
+    }
+    Ok(Watch { path: path.trim().to_string(), low, high })
+}
+
 fn pairings(a: &ScreenArgs, plant: &plantwide::flowsheet::Plant) -> Result<(), CliError> {
     let dead_time = time(&a.measurement_dead_time, "measurement-dead-time")?;
     let duration = a.duration.as_deref().map(|d| time(d, "duration")).transpose()?;
@@ -143,6 +166,7 @@ fn pairings(a: &ScreenArgs, plant: &plantwide::flowsheet::Plant) -> Result<(), C
         mvs: a.mvs.clone(),
         throughput: a.throughput.clone(),
         disturbances: a.disturbances.iter().map(|d| disturbance(d)).collect::<Result<_, _>>()?,
+        watch: a.watch.iter().map(|w| watch(plant, w)).collect::<Result<_, _>>()?,
         dynamic: DynamicSettings {
             candidates: a.candidates,
             duration,
@@ -173,6 +197,28 @@ fn pairing_table(s: &PairingScreen) -> String {
         s.pruned,
         if s.opened.is_empty() { "none".to_string() } else { s.opened.join(", ") }
     );
+    let watched: Vec<String> = s
+        .structures
+        .first()
+        .map(|c| {
+            c.sensitivity
+                .iter()
+                .map(|w| {
+                    format!(
+                        "{} over {}: {:.6e} … {:.6e} ({})",
+                        w.path,
+                        w.disturbance,
+                        w.min,
+                        w.max,
+                        if w.within { "in band" } else { "OUT of band" }
+                    )
+                })
+                .collect()
+        })
+        .unwrap_or_default();
+    if !watched.is_empty() {
+        t.push_str(&format!("sensitivity (CVs held, first throughput choice): {}\n\n", watched.join("; ")));
+    }
     t.push_str("| rank | throughput | pairs (relative gain) | NI | DIC | RGA number | dynamic score | note |\n");
     t.push_str("|---|---|---|---|---|---|---|---|\n");
     for c in &s.structures {

@@ -237,3 +237,47 @@ fn bad_pairing_requests_exit_1_naming_what_is_wrong() {
         assert!(err.contains(msg) && !err.contains("panicked"), "{extra:?}: {err}");
     }
 }
+
+#[test]
+fn the_sensitivity_test_agrees_with_the_sensitivity_sweep_and_rejects_a_tight_band() {
+    // With the CVs held, column 1's bottoms B over fresh A ±10 %: the screen's own loops against the
+    // file's loops swept by `plantwide sensitivity` (the same CVs held by other controllers).
+    let dir = std::env::temp_dir().join(format!("plantwide-screen-sens-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let csv = dir.join("s.csv");
+    let fs = flowsheet("two_column_plant.json");
+    let args = [
+        "sensitivity",
+        &fs,
+        "--disturb",
+        "fresh_A.F=-10%:+10%",
+        "--outputs",
+        "bottoms1.x[B]",
+        "--points",
+        "9",
+        "--csv",
+    ];
+    let out = crate::harness::command().args(args).arg(&csv).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let xb: Vec<f64> = text.lines().skip(1).map(|l| l.rsplit(',').next().unwrap().parse().unwrap()).collect();
+    let (lo, hi) = (xb.iter().copied().fold(f64::INFINITY, f64::min), xb.iter().copied().fold(0.0, f64::max));
+    let v =
+        pairings(&["--disturbances", "fresh_A.F=+10%", "--watch", "bottoms1.x[B]=0:0.0025", "--candidates", "0"], "2");
+    let best = v["structures"].as_array().unwrap().iter().find(|c| c["rank"] == 1).unwrap();
+    let w = &best["sensitivity"][0];
+    assert!(w["within"].as_bool().unwrap(), "{w}");
+    for (got, want) in [(w["min"].as_f64().unwrap(), lo), (w["max"].as_f64().unwrap(), hi)] {
+        assert!((got - want).abs() < 1e-6 * want, "{got} vs {want}");
+    }
+    // A band the plant cannot keep: every pairing of this throughput choice rejected, none ranked.
+    let v =
+        pairings(&["--disturbances", "fresh_A.F=+10%", "--watch", "bottoms1.x[B]=0:0.002", "--candidates", "0"], "2");
+    for c in v["structures"].as_array().unwrap() {
+        assert!(
+            c["rank"].is_null() && c["rejected"].as_str().unwrap().starts_with("sensitivity: bottoms1.x[B]"),
+            "{c}"
+        );
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -62,6 +62,14 @@ pub enum ScreenError {
         /// A suggestion, or empty.
         hint: String,
     },
+    /// A watched variable names no variable.
+    #[error("--watch: no variable `{path}`{hint}")]
+    NoWatch {
+        /// The path.
+        path: String,
+        /// A suggestion, or empty.
+        hint: String,
+    },
     /// An MV names no input.
     #[error("--mvs: `{path}` is no input of the plant{hint}")]
     NoMv {
@@ -98,6 +106,14 @@ pub enum ScreenError {
     Disturbance {
         /// The path.
         path: String,
+    },
+    /// The sensitivity test could not be run for a throughput choice.
+    #[error("sensitivity test (throughput {throughput}): {why}")]
+    Sensitivity {
+        /// The throughput manipulator (empty for none).
+        throughput: String,
+        /// Why.
+        why: String,
     },
     /// A configuration could not be built.
     #[error("configuration {structure}: {source}")]
@@ -146,7 +162,7 @@ impl ScreenError {
     pub fn is_user_error(&self) -> bool {
         match self {
             ScreenError::Steady { source, .. } => source.is_user_error(),
-            ScreenError::Moved { .. } | ScreenError::Analysis { .. } => false,
+            ScreenError::Moved { .. } | ScreenError::Analysis { .. } | ScreenError::Sensitivity { .. } => false,
             _ => true,
         }
     }

@@ -13,11 +13,14 @@
 //!    Niederlinski index (NI > 0 necessary for integral stability, Niederlinski 1971), the necessary
 //!    conditions of decentralized integral controllability (DIC: NI > 0 of every principal
 //!    submatrix of the paired gains, Skogestad & Morari 1992) and the RGA number `Σ|Λ − P|`.
-//! 3. The best survivors by RGA number go to a dynamic test ([`dynamic`]): PI loops added, tuned
+//! 3. With watched variables, the sensitivity-plot test ([`sensitivity`]): each must stay in its
+//!    band over ± each disturbance with the CVs held.
+//! 4. The best survivors by RGA number go to a dynamic test ([`dynamic`]): PI loops added, tuned
 //!    together by BLT on the exact linearization, then each disturbance stepped on the nonlinear
 //!    plant; ranked by their IAE relative to the best candidate's, per CV and disturbance.
 
 pub mod dynamic;
+pub mod sensitivity;
 
 use faer::Mat;
 use plantwide_analysis::linear::Linearization;
@@ -27,6 +30,7 @@ use plantwide_solve::{NewtonSettings, StrategySettings, steady_state};
 use serde::Serialize;
 
 pub use dynamic::{CvFigures, DisturbanceRun, DynamicResult, DynamicSettings};
+pub use sensitivity::{Watch, WatchResult};
 
 use super::ScreenError;
 use super::column::is_singular;
@@ -49,8 +53,10 @@ pub struct PairingRequest {
     pub mvs: Vec<String>,
     /// Throughput-manipulator candidates, each one of `mvs` (empty: as many MVs as CVs).
     pub throughput: Vec<String>,
-    /// Disturbances of the dynamic test (empty: no dynamic test).
+    /// Disturbances of the sensitivity and dynamic tests (empty: neither).
     pub disturbances: Vec<Disturbance>,
+    /// Uncontrolled variables that must stay in a band over ± each disturbance (sensitivity test).
+    pub watch: Vec<Watch>,
     /// The dynamic test's settings.
     pub dynamic: DynamicSettings,
 }
@@ -83,6 +89,8 @@ pub struct PairingStructure {
     pub passed: bool,
     /// Why it failed them.
     pub rejected: Option<String>,
+    /// The watched variables over the disturbance sweeps (the sensitivity test).
+    pub sensitivity: Vec<WatchResult>,
     /// The dynamic test, for the candidates that had one.
     pub dynamic: Option<DynamicResult>,
     /// Place in the ranking (1 best) among those that passed.
@@ -151,6 +159,12 @@ pub fn screen_pairings(plant: &Plant, request: &PairingRequest) -> Result<Pairin
     structures.sort_by(|a, b| {
         (!a.passed, a.rga_number).partial_cmp(&(!b.passed, b.rga_number)).unwrap_or(std::cmp::Ordering::Equal)
     });
+    if !request.disturbances.is_empty() && !request.watch.is_empty() {
+        sensitivity::test(&open, request, &mut structures)?;
+        structures.sort_by(|a, b| {
+            (!a.passed, a.rga_number).partial_cmp(&(!b.passed, b.rga_number)).unwrap_or(std::cmp::Ordering::Equal)
+        });
+    }
     if !request.disturbances.is_empty() {
         dynamic::test(&open, request, &mut structures)?;
     }
@@ -181,6 +195,10 @@ fn check_request(plant: &Plant, r: &PairingRequest) -> Result<(), ScreenError> {
     if let Some(mv) = r.mvs.iter().find(|m| plant.input(m).is_none()) {
         let hint = hint(mv, plant.inputs().iter().map(|v| v.path.as_str()).collect());
         return Err(ScreenError::NoMv { path: mv.clone(), hint });
+    }
+    if let Some(w) = r.watch.iter().find(|w| plant.var(&w.path).is_none()) {
+        let hint = hint(&w.path, plant.vars().iter().map(|v| v.path.as_str()).collect());
+        return Err(ScreenError::NoWatch { path: w.path.clone(), hint });
     }
     if let Some(t) = r.throughput.iter().find(|t| !r.mvs.contains(t)) {
         return Err(ScreenError::ThroughputNotMv { path: t.clone() });
@@ -300,6 +318,7 @@ fn judge(
         dic,
         passed: rejected.is_none(),
         rejected,
+        sensitivity: Vec::new(),
         dynamic: None,
         rank: None,
     })

@@ -179,25 +179,44 @@ fn loop_spec(open: &OpenPlant, s: &PairingStructure, i: usize, kc: f64, tau_i: f
 }
 
 /// The open plant with the candidate's loops, tuned by BLT, and its steady state.
+/// The open plant with the candidate's loops closed (gains `kc`, resets `ti`, `actions`) and its
+/// steady state: the CVs on their setpoints, which at steady state no tuning changes.
+pub(super) fn closed_plant(
+    open: &OpenPlant,
+    s: &PairingStructure,
+    kc: &[f64],
+    ti: &[f64],
+    actions: &[&str],
+) -> Result<(Plant, Vec<f64>), String> {
+    let edits: Vec<StructureEdit> = (0..s.pairs.len())
+        .map(|i| StructureEdit::AddController {
+            name: format!("pair{}", i + 1),
+            spec: loop_spec(open, s, i, kc[i], ti[i], actions[i]),
+        })
+        .collect();
+    let v = open.plant.restructure(&edits).map_err(|e| e.to_string())?;
+    let guess = crate::screen::column::mapped_guess(&open.plant, &open.x, &v);
+    let st =
+        steady_state(&v, &v.input_values(), Some(&guess), &NewtonSettings::default()).map_err(|e| e.to_string())?;
+    Ok((v, st.x))
+}
+
+/// The actions that make each of the candidate's loops a negative feedback.
+pub(super) fn actions(open: &OpenPlant, r: &PairingRequest, s: &PairingStructure) -> Vec<&'static str> {
+    s.pairs
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let j = r.mvs.iter().position(|m| *m == p.mv).unwrap_or(0);
+            if open.gain[(i, j)] < 0.0 { "direct" } else { "reverse" }
+        })
+        .collect()
+}
+
 fn tuned_plant(open: &OpenPlant, r: &PairingRequest, s: &PairingStructure) -> TunedCandidate {
     let n = s.pairs.len();
-    let cols: Vec<usize> = s.pairs.iter().map(|p| r.mvs.iter().position(|m| *m == p.mv).unwrap_or(0)).collect();
-    let action = |i: usize| if open.gain[(i, cols[i])] < 0.0 { "direct" } else { "reverse" };
-    let build = |kc: &[f64], ti: &[f64], actions: &[&str]| {
-        let edits: Vec<StructureEdit> = (0..n)
-            .map(|i| StructureEdit::AddController {
-                name: format!("pair{}", i + 1),
-                spec: loop_spec(open, s, i, kc[i], ti[i], actions[i]),
-            })
-            .collect();
-        let v = open.plant.restructure(&edits).map_err(|e| e.to_string())?;
-        let guess = crate::screen::column::mapped_guess(&open.plant, &open.x, &v);
-        let st =
-            steady_state(&v, &v.input_values(), Some(&guess), &NewtonSettings::default()).map_err(|e| e.to_string())?;
-        Ok::<_, String>((v, st.x))
-    };
-    let actions: Vec<&str> = (0..n).map(action).collect();
-    let (trial, x) = build(&vec![1.0; n], &vec![1e3; n], &actions)?;
+    let build = |kc: &[f64], ti: &[f64], actions: &[&str]| closed_plant(open, s, kc, ti, actions);
+    let (trial, x) = build(&vec![1.0; n], &vec![1e3; n], &actions(open, r, s))?;
     let loops: Vec<_> = (0..n)
         .map(|i| plant_loop(&trial, &format!("pair{}", i + 1)))
         .collect::<Result<_, _>>()
