@@ -5,6 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
+use plantwide::io::plot::{LabelledMatrix, Overlay, write_matrices, write_overlays};
 use plantwide::studies::screen::pairings::{Disturbance, DynamicSettings, PairingRequest, PairingScreen, Watch};
 use plantwide::studies::screen::{ColumnScreen, ScreenError, screen_column, screen_pairings};
 use plantwide::units::Dimension;
@@ -117,8 +118,59 @@ fn write_report(dir: &Path, file: &Path, s: &ColumnScreen, json: &str) -> Result
     let fail = |e: std::io::Error| CliError::user(format!("--report {}: {e}", dir.display()));
     std::fs::create_dir_all(dir).map_err(fail)?;
     std::fs::write(dir.join("screen.json"), json).map_err(fail)?;
-    let md = format!("# Column configurations: `{}`\n\n{}", s.column, table(s, file));
+    let matrices: Vec<LabelledMatrix> = s
+        .structures
+        .iter()
+        .map(|c| LabelledMatrix {
+            label: format!("{} ({})", c.name, c.rank.map_or("not ranked".to_string(), |r| format!("rank {r}"))),
+            values: c.rga.clone(),
+        })
+        .collect();
+    let title = format!("relative gains of column `{}`: {} (row 1), {} (row 2)", s.column, s.outputs[0], s.outputs[1]);
+    for ext in ["png", "svg"] {
+        write_matrices(&dir.join(format!("rga.{ext}")), &title, &matrices)
+            .map_err(|e| CliError::user(e.to_string()))?;
+    }
+    let md = format!("# Column configurations: `{}`\n\n{}\n![relative gains](rga.png)\n", s.column, table(s, file));
     std::fs::write(dir.join("screen.md"), md).map_err(fail)
+}
+
+/// One figure per disturbance: each CV's response under the (up to three) best tested candidates.
+fn write_responses(dir: &Path, s: &PairingScreen) -> Result<Vec<String>, CliError> {
+    let mut best: Vec<_> = s
+        .structures
+        .iter()
+        .filter(|c| c.rank.is_some() && c.dynamic.as_ref().is_some_and(|d| d.failure.is_none()))
+        .collect();
+    best.sort_by_key(|c| c.rank);
+    best.truncate(3);
+    let Some(first) = best.first().and_then(|c| c.dynamic.as_ref()) else { return Ok(Vec::new()) };
+    let mut names = Vec::new();
+    for (d, run) in first.runs.iter().enumerate() {
+        let panels: Vec<Overlay> = s
+            .cvs
+            .iter()
+            .enumerate()
+            .map(|(k, cv)| Overlay {
+                label: format!("{cv} (SI)"),
+                curves: best
+                    .iter()
+                    .filter_map(|c| {
+                        c.dynamic
+                            .as_ref()
+                            .map(|t| (format!("rank {}", c.rank.unwrap_or(0)), t.runs[d].series[k].clone()))
+                    })
+                    .collect(),
+            })
+            .collect();
+        let times: Vec<f64> = run.times.iter().map(|t| t / 3600.0).collect();
+        let name = format!("responses_{}.png", d + 1);
+        let title = format!("{}: the best structures' responses", run.disturbance);
+        write_overlays(&dir.join(&name), &title, "time [h]", &times, &panels)
+            .map_err(|e| CliError::user(e.to_string()))?;
+        names.push(name);
+    }
+    Ok(names)
 }
 
 fn time(text: &str, flag: &str) -> Result<f64, CliError> {
@@ -179,7 +231,9 @@ fn pairings(a: &ScreenArgs, plant: &plantwide::flowsheet::Plant) -> Result<(), C
         let fail = |e: std::io::Error| CliError::user(format!("--report {}: {e}", dir.display()));
         std::fs::create_dir_all(dir).map_err(fail)?;
         std::fs::write(dir.join("screen.json"), &json).map_err(fail)?;
-        std::fs::write(dir.join("screen.md"), format!("# Pairings\n\n{}", pairing_table(&screen))).map_err(fail)?;
+        let figures: String = write_responses(dir, &screen)?.iter().map(|n| format!("\n![responses]({n})\n")).collect();
+        std::fs::write(dir.join("screen.md"), format!("# Pairings\n\n{}{figures}", pairing_table(&screen)))
+            .map_err(fail)?;
     }
     if a.json {
         outln!("{json}");

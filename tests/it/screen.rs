@@ -97,6 +97,20 @@ fn column_a_configurations_agree_with_the_transforms_of_its_lv_gains() {
     let l11 = lv["rga"][0][0].as_f64().unwrap();
     assert!((l11 - 35.1).abs() < 0.05 * 35.1, "{l11}");
     assert!(lv["verdict"].as_str().unwrap().contains("strong interaction"), "{lv}");
+    // The report: the same JSON, a markdown table and the RGA heat map with the values drawn.
+    let dir = std::env::temp_dir().join(format!("plantwide-screen-report-{}", std::process::id()));
+    let fs = flowsheet("column_a.json");
+    let q = "distillate.x[light],bottoms.x[light]";
+    let out = plantwide(&["screen", &fs, "--column", "column", "--outputs", q, "--report", dir.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let json: Value = serde_json::from_str(&std::fs::read_to_string(dir.join("screen.json")).unwrap()).unwrap();
+    assert_eq!(json, v);
+    let md = std::fs::read_to_string(dir.join("screen.md")).unwrap();
+    assert!(md.contains("| LV |") && md.contains("![relative gains](rga.png)"), "{md}");
+    let svg = std::fs::read_to_string(dir.join("rga.svg")).unwrap();
+    assert!(svg.contains(&format!("{l11:.3}")) && svg.contains("singular"));
+    assert!(std::fs::metadata(dir.join("rga.png")).unwrap().len() > 1000);
+    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]

@@ -1,8 +1,10 @@
 //! Figures as PNG or SVG files (chosen by the file extension), drawn with plotters: trend plots
-//! of a dynamic run ([`write_trends`]) and sensitivity plots ([`write_sensitivity`]). Text is
+//! of a dynamic run ([`write_trends`], several runs overlaid with [`write_overlays`]), sensitivity
+//! plots ([`write_sensitivity`]) and heat maps of small matrices ([`write_matrices`]). Text is
 //! drawn with the embedded DejaVu Sans font under the family `sans-serif`, so no system font
 //! library is needed.
 
+mod matrices;
 mod sensitivity;
 mod trends;
 
@@ -13,8 +15,9 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::{FontStyle, register_font};
 
+pub use matrices::{LabelledMatrix, write_matrices};
 pub use sensitivity::write_sensitivity;
-pub use trends::{Trend, write_trends};
+pub use trends::{Overlay, Trend, write_overlays, write_trends};
 
 use crate::error::IoError;
 

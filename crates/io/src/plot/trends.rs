@@ -1,4 +1,5 @@
-//! Trend plots of a dynamic run: one panel per recorded path against time, stacked.
+//! Trend plots of a dynamic run: one panel per recorded path against time, stacked; or several
+//! runs overlaid in each panel, with a legend (the responses of candidate control structures).
 
 use std::path::Path;
 
@@ -17,6 +18,15 @@ pub struct Trend {
     pub values: Vec<f64>,
 }
 
+/// One panel of overlaid curves: its axis label and `(name, values)` per curve.
+#[derive(Debug, Clone)]
+pub struct Overlay {
+    /// Axis label, e.g. `column1.T[21] [K]`.
+    pub label: String,
+    /// Named curves, one value per time.
+    pub curves: Vec<(String, Vec<f64>)>,
+}
+
 /// Write the trends to `file` (`.png` or `.svg`): `times` along x, labelled `time_label`; one
 /// panel of 1000 × 240 pixels per trend.
 pub fn write_trends(
@@ -26,17 +36,34 @@ pub fn write_trends(
     times: &[f64],
     trends: &[Trend],
 ) -> Result<(), IoError> {
-    let height = 70 + 240 * trends.len().max(1) as u32;
-    write_figure(file, (1000, height), &Trends { title, time_label, times, trends })
+    let panels: Vec<Overlay> = trends
+        .iter()
+        .map(|t| Overlay { label: t.label.clone(), curves: vec![(String::new(), t.values.clone())] })
+        .collect();
+    write_overlays(file, title, time_label, times, &panels)
 }
 
-/// The stacked trend panels under one title.
+/// Write overlaid curves to `file`: one panel per [`Overlay`], a legend where the curves are named.
+pub fn write_overlays(
+    file: &Path,
+    title: &str,
+    time_label: &str,
+    times: &[f64],
+    panels: &[Overlay],
+) -> Result<(), IoError> {
+    let height = 70 + 240 * panels.len().max(1) as u32;
+    write_figure(file, (1000, height), &Trends { title, time_label, times, trends: panels })
+}
+
+/// The stacked panels under one title.
 struct Trends<'a> {
     title: &'a str,
     time_label: &'a str,
     times: &'a [f64],
-    trends: &'a [Trend],
+    trends: &'a [Overlay],
 }
+
+const COLOURS: [RGBColor; 4] = [BLUE, RED, RGBColor(0, 140, 0), RGBColor(200, 120, 0)];
 
 impl Figure for Trends<'_> {
     fn draw<DB: DrawingBackend>(&self, root: DrawingArea<DB, Shift>) -> Result<(), IoError> {
@@ -48,7 +75,7 @@ impl Figure for Trends<'_> {
         let (t0, t1) = (times.first().copied().unwrap_or(0.0), times.last().copied().unwrap_or(1.0));
         let t1 = if t1 > t0 { t1 } else { t0 + 1.0 };
         for (panel, trend) in panels.iter().zip(trends) {
-            let finite = trend.values.iter().copied().filter(|v| v.is_finite());
+            let finite = trend.curves.iter().flat_map(|(_, v)| v.iter().copied()).filter(|v| v.is_finite());
             let (lo, hi) = finite.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
             let (lo, hi) = if !lo.is_finite() {
                 (0.0, 1.0)
@@ -76,8 +103,22 @@ impl Figure for Trends<'_> {
                 .y_label_formatter(&|v| format!("{v:.decimals$}"))
                 .draw()
                 .map_err(err)?;
-            let points = times.iter().copied().zip(trend.values.iter().copied()).filter(|(_, v)| v.is_finite());
-            chart.draw_series(LineSeries::new(points, BLUE.stroke_width(2))).map_err(err)?;
+            for (k, (name, values)) in trend.curves.iter().enumerate() {
+                let points = times.iter().copied().zip(values.iter().copied()).filter(|(_, v)| v.is_finite());
+                let c = COLOURS[k % COLOURS.len()];
+                let series = chart.draw_series(LineSeries::new(points, c.stroke_width(2))).map_err(err)?;
+                if !name.is_empty() {
+                    series.label(name.as_str()).legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c));
+                }
+            }
+            if trend.curves.iter().any(|(n, _)| !n.is_empty()) {
+                chart
+                    .configure_series_labels()
+                    .background_style(WHITE.mix(0.8))
+                    .border_style(BLACK)
+                    .draw()
+                    .map_err(err)?;
+            }
         }
         root.present().map_err(err)
     }

@@ -74,6 +74,12 @@ pub struct DisturbanceRun {
     pub cvs: Vec<CvFigures>,
     /// MVs whose loop output reached a limit.
     pub saturated: Vec<String>,
+    /// Recorded times \[s\] (for plots; not serialized).
+    #[serde(skip)]
+    pub times: Vec<f64>,
+    /// Each CV's record at `times` (for plots; not serialized).
+    #[serde(skip)]
+    pub series: Vec<Vec<f64>>,
 }
 
 /// A candidate's dynamic test.
@@ -286,5 +292,12 @@ fn run(
         })
         .map(|i| s.pairs[i].mv.clone())
         .collect();
-    Ok(DisturbanceRun { disturbance: format!("{} {:+} %", d.path, 100.0 * d.fraction), cvs, saturated })
+    let series = (0..r.cvs.len()).map(|k| res.rows.iter().map(|row| row[k]).collect()).collect();
+    Ok(DisturbanceRun {
+        disturbance: format!("{} {:+} %", d.path, 100.0 * d.fraction),
+        cvs,
+        saturated,
+        times: res.times.clone(),
+        series,
+    })
 }
