@@ -343,13 +343,16 @@ fn dic_necessary(g: &Mat<f64>, p: &[usize]) -> Result<bool, plantwide_analysis::
     Ok(true)
 }
 
-/// Rank: dynamically tested candidates by their score, then the other survivors by RGA number.
+/// Rank: dynamically tested candidates by their score, then the other survivors by RGA number; a
+/// candidate whose dynamic test failed (it could not be tuned, or a run stopped) is not ranked.
 fn rank(structures: &mut [PairingStructure]) {
     let key = |s: &PairingStructure| {
         let score = s.dynamic.as_ref().map_or(f64::INFINITY, |d| d.score);
         (score, s.rga_number)
     };
-    let mut order: Vec<usize> = (0..structures.len()).filter(|&k| structures[k].passed).collect();
+    let failed = |s: &PairingStructure| s.dynamic.as_ref().is_some_and(|d| d.failure.is_some());
+    let mut order: Vec<usize> =
+        (0..structures.len()).filter(|&k| structures[k].passed && !failed(&structures[k])).collect();
     order.sort_by(|&a, &b| key(&structures[a]).partial_cmp(&key(&structures[b])).unwrap_or(std::cmp::Ordering::Equal));
     for (place, k) in order.into_iter().enumerate() {
         structures[k].rank = Some(place + 1);
