@@ -1,6 +1,28 @@
-//! Errors of the studies.
+//! Errors of the studies: [`TuneError`] of tuning, [`crate::screen::ScreenError`] of screening,
+//! joined in the crate-level [`enum@Error`].
 
 use thiserror::Error;
+
+/// Any failure of a study (the crate-level error): each variant one study's typed error.
+#[derive(Debug, Clone, Error)]
+pub enum Error {
+    /// Tuning.
+    #[error(transparent)]
+    Tune(#[from] TuneError),
+    /// Screening.
+    #[error(transparent)]
+    Screen(#[from] crate::screen::ScreenError),
+}
+
+impl Error {
+    /// True for problems of the request (exit code 1), false for numerical failures (exit code 2).
+    pub fn is_user_error(&self) -> bool {
+        match self {
+            Error::Tune(e) => e.is_user_error(),
+            Error::Screen(e) => e.is_user_error(),
+        }
+    }
+}
 
 /// Why a tuning request was refused.
 #[derive(Debug, Clone, Error)]
@@ -98,7 +120,7 @@ pub enum TuneError {
          strongly for one detuning factor (check the pairing)"
     )]
     DetuningLimit {
-        /// The target of the biggest log modulus [dB].
+        /// The target of the biggest log modulus \[dB\].
         target_db: f64,
         /// The largest detuning factor tried (at least `max_detuning`).
         detuning: f64,

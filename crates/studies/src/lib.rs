@@ -1,9 +1,11 @@
 //! plantwide-studies: studies run on a model of the plant, returning typed results that serialize
 //! to the JSON the CLI prints.
 //!
-//! Today: [`tune`], controller tuning from a transfer-function model (ultimate gain and
-//! frequency, Ziegler–Nichols and Tyreus–Luyben PI settings, Luyben's BLT detuning of n diagonal
-//! PI loops).
+//! Today: [`tune`], controller tuning from a transfer-function model or a flowsheet's loops
+//! (ultimate gain and frequency, relay and step tests, Ziegler–Nichols, Tyreus–Luyben, SIMC, IMC,
+//! averaging level, Luyben's BLT detuning of n diagonal PI loops); [`screen`], control-structure
+//! screening (a column's inventory configurations; plantwide pairings with steady-state filters
+//! and a dynamic test).
 #![warn(missing_docs)]
 
 pub mod error;
@@ -11,6 +13,5 @@ mod numeric;
 pub mod screen;
 pub mod tune;
 
-pub use error::TuneError;
-/// The crate-level error: every public fallible function of this crate returns a [`TuneError`].
-pub use error::TuneError as Error;
+pub use error::{Error, TuneError};
+pub use screen::ScreenError;

@@ -1,7 +1,7 @@
 //! Control-structure screening: a plant's candidate structures built as [`Plant`] variants through
 //! the flowsheet library, each judged by the steady-state interaction measures of its loops.
 //!
-//! Today: [`column`], the standard inventory configurations of one distillation column (LV, DV, LB,
+//! Today: [`mod@column`], the standard inventory configurations of one distillation column (LV, DV, LB,
 //! DB, (L/D)V, L(V/B), (L/D)(V/B)), with the exact steady-state gains of its two qualities to the
 //! two inputs each leaves free, RGA, Niederlinski index, condition numbers and a verdict.
 //!

@@ -1,12 +1,12 @@
 //! Controller tuning from a transfer-function model (issue 16, first part).
 //!
-//! - [`ultimate`]: ultimate gain `K_u` and period `P_u` of a SISO element from `g(jω)`.
+//! - [`mod@ultimate`]: ultimate gain `K_u` and period `P_u` of a SISO element from `g(jω)`.
 //! - [`PiRule`]: Ziegler–Nichols PI, `K_c = K_u/2.2`, `τ_I = P_u/1.2` (Ziegler & Nichols 1942), and
 //!   Tyreus–Luyben PI, `K_c = K_u/3.2`, `τ_I = 2.2 P_u` (Tyreus & Luyben 1992, Ind. Eng. Chem. Res.
 //!   31, 2625).
 //! - [`relay`]: relay-feedback (ATV) test on a linear element, `K_u ≈ 4h/(πa)` (Åström &
 //!   Hägglund 1984).
-//! - [`blt`]: Luyben's biggest-log-modulus tuning of n diagonal PI loops (Luyben 1986, Ind. Eng.
+//! - [`mod@blt`]: Luyben's biggest-log-modulus tuning of n diagonal PI loops (Luyben 1986, Ind. Eng.
 //!   Chem. Process Des. Dev. 25, 654).
 //!
 //! The PI controller is `c(s) = K_c (1 + 1/(τ_I s))`. Results are in SI (times in seconds) until
