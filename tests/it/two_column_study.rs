@@ -106,6 +106,12 @@ fn pin_base_and_structures(r: &Value) {
     assert!(num(r, "column2.LV_explicit_steps.1e-4.attempts") > 1.0);
     assert!(r["column2"]["DB_error"].as_str().is_some_and(|e| e.contains("not determined")));
     assert_eq!(r["sensors_column1"], serde_json::json!([21, 11]));
+    // §2b, by `plantwide screen`: column 2's LB ranked first of its seven configurations, and the plantwide
+    // pairing with the throughput choices reaching §2–3's choice: fresh A, LB on both columns.
+    assert_eq!(r["screen"]["column2"]["LB"]["rank"], 1);
+    assert_eq!(r["screen"]["pairings"]["best_throughput"], "fresh_A.F");
+    let best = serde_json::json!(["column1.reflux", "column1.bottoms", "column2.reflux", "column2.bottoms"]);
+    assert_eq!(r["screen"]["pairings"]["best_mvs"], best);
 }
 
 /// §3–4 of the full study: what sets production, figure 6-6.
