@@ -5,7 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-use plantwide::io::plot::{LabelledMatrix, Overlay, write_matrices, write_overlays};
+use plantwide::io::plot::{LabelledMatrix, Overlay, write_bars, write_matrices, write_overlays};
 use plantwide::studies::screen::pairings::{Disturbance, DynamicSettings, PairingRequest, PairingScreen, Watch};
 use plantwide::studies::screen::{ColumnScreen, ScreenError, screen_column, screen_pairings};
 use plantwide::units::Dimension;
@@ -131,8 +131,44 @@ fn write_report(dir: &Path, file: &Path, s: &ColumnScreen, json: &str) -> Result
         write_matrices(&dir.join(format!("rga.{ext}")), &title, &matrices)
             .map_err(|e| CliError::user(e.to_string()))?;
     }
-    let md = format!("# Column configurations: `{}`\n\n{}\n![relative gains](rga.png)\n", s.column, table(s, file));
+    let mut ranked: Vec<_> = s.structures.iter().collect();
+    ranked.sort_by_key(|c| (c.rank.is_none(), c.rank));
+    let bars: Vec<(String, f64)> = ranked
+        .iter()
+        .map(|c| (c.name.clone(), c.rga.as_ref().filter(|_| c.rank.is_some()).map_or(f64::NAN, |r| r[0][0].ln().abs())))
+        .collect();
+    let title = format!("ranking of column `{}`'s configurations (0 = decoupled; – singular)", s.column);
+    write_bars(&dir.join("ranking.png"), &title, "|ln λ11|", &bars).map_err(|e| CliError::user(e.to_string()))?;
+    let md = format!(
+        "# Column configurations: `{}`\n\n{}\n![relative gains](rga.png)\n\n![ranking](ranking.png)\n",
+        s.column,
+        table(s, file)
+    );
     std::fs::write(dir.join("screen.md"), md).map_err(fail)
+}
+
+/// The ranked pairings' dynamic scores as bars (`false` when none was tested).
+fn write_ranking(dir: &Path, s: &PairingScreen) -> Result<bool, CliError> {
+    let mut ranked: Vec<_> = s.structures.iter().filter(|c| c.rank.is_some() && c.dynamic.is_some()).collect();
+    if ranked.is_empty() {
+        return Ok(false);
+    }
+    ranked.sort_by_key(|c| c.rank);
+    let bars: Vec<(String, f64)> = ranked
+        .iter()
+        .map(|c| {
+            let mvs: Vec<&str> = c.pairs.iter().map(|p| p.mv.as_str()).collect();
+            let tpm = c.throughput.as_deref().map_or(String::new(), |t| format!("TPM {t}: "));
+            (
+                format!("{} {tpm}{}", c.rank.unwrap_or(0), mvs.join(", ")),
+                c.dynamic.as_ref().map_or(f64::NAN, |d| d.score),
+            )
+        })
+        .collect();
+    let file = dir.join("ranking.png");
+    write_bars(&file, "dynamic score (1 = best on every CV and disturbance)", "score", &bars)
+        .map_err(|e| CliError::user(e.to_string()))?;
+    Ok(true)
 }
 
 /// One figure per disturbance: each CV's response under the (up to three) best tested candidates.
@@ -231,7 +267,11 @@ fn pairings(a: &ScreenArgs, plant: &plantwide::flowsheet::Plant) -> Result<(), C
         let fail = |e: std::io::Error| CliError::user(format!("--report {}: {e}", dir.display()));
         std::fs::create_dir_all(dir).map_err(fail)?;
         std::fs::write(dir.join("screen.json"), &json).map_err(fail)?;
-        let figures: String = write_responses(dir, &screen)?.iter().map(|n| format!("\n![responses]({n})\n")).collect();
+        let mut figures: String =
+            write_responses(dir, &screen)?.iter().map(|n| format!("\n![responses]({n})\n")).collect();
+        if write_ranking(dir, &screen)? {
+            figures.push_str("\n![ranking](ranking.png)\n");
+        }
         std::fs::write(dir.join("screen.md"), format!("# Pairings\n\n{}{figures}", pairing_table(&screen)))
             .map_err(fail)?;
     }

@@ -110,6 +110,7 @@ fn column_a_configurations_agree_with_the_transforms_of_its_lv_gains() {
     let svg = std::fs::read_to_string(dir.join("rga.svg")).unwrap();
     assert!(svg.contains(&format!("{l11:.3}")) && svg.contains("singular"));
     assert!(std::fs::metadata(dir.join("rga.png")).unwrap().len() > 1000);
+    assert!(md.contains("![ranking](ranking.png)") && std::fs::metadata(dir.join("ranking.png")).unwrap().len() > 1000);
     std::fs::remove_dir_all(&dir).ok();
 }
 

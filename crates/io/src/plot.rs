@@ -1,9 +1,11 @@
 //! Figures as PNG or SVG files (chosen by the file extension), drawn with plotters: trend plots
 //! of a dynamic run ([`write_trends`], several runs overlaid with [`write_overlays`]), sensitivity
-//! plots ([`write_sensitivity`]) and heat maps of small matrices ([`write_matrices`]). Text is
+//! plots ([`write_sensitivity`]), heat maps of small matrices ([`write_matrices`]) and rankings as bar
+//! charts ([`write_bars`]). Text is
 //! drawn with the embedded DejaVu Sans font under the family `sans-serif`, so no system font
 //! library is needed.
 
+mod bars;
 mod matrices;
 mod sensitivity;
 mod trends;
@@ -15,6 +17,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::{FontStyle, register_font};
 
+pub use bars::write_bars;
 pub use matrices::{LabelledMatrix, write_matrices};
 pub use sensitivity::write_sensitivity;
 pub use trends::{Overlay, Trend, write_overlays, write_trends};
