@@ -291,6 +291,12 @@ fn pairing_table(s: &PairingScreen) -> String {
         s.pruned,
         if s.opened.is_empty() { "none".to_string() } else { s.opened.join(", ") }
     );
+    for tpm in &s.singular {
+        let choice = tpm.as_deref().map_or("the MVs".to_string(), |t| format!("the MVs with {t} held"));
+        t.push_str(&format!(
+            "singular: {choice} cannot set the CVs independently at steady state; no pairing listed\n\n"
+        ));
+    }
     let watched: Vec<String> = s
         .structures
         .first()

@@ -88,6 +88,36 @@ fn check_configurations(v: &Value) {
 }
 
 #[test]
+fn a_singular_choice_of_mvs_is_reported_not_paired() {
+    // Column A's product flows against L and V: D = V − L and B = F + L − V at steady state, so the
+    // gains are [[−1, 1], [1, −1]]: singular, no pairing of them listed.
+    let fs = flowsheet("column_a.json");
+    let q = "distillate.x[light],bottoms.x[light]";
+    let out = plantwide(&[
+        "screen",
+        &fs,
+        "--cvs",
+        "distillate.F,bottoms.F",
+        "--mvs",
+        "column.reflux,column.boilup",
+        "--json",
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["singular"], serde_json::json!([null]), "{v}");
+    assert!(v["enumerated"] == 0 && v["structures"].as_array().unwrap().is_empty(), "{v}");
+    let g = &v["gain"];
+    for (i, j, want) in [(0, 0, -1.0), (0, 1, 1.0), (1, 0, 1.0), (1, 1, -1.0)] {
+        assert!((g[i][j].as_f64().unwrap() - want).abs() < 1e-9, "{g}");
+    }
+    // D and B are driven by the level loops: opening those leaves both inventories free, which is named.
+    let out = plantwide(&["screen", &fs, "--cvs", q, "--mvs", "column.distillate,column.bottoms"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("is uncontrolled at steady state"), "{err}");
+}
+
+#[test]
 fn column_a_configurations_agree_with_the_transforms_of_its_lv_gains() {
     let v = screen(&flowsheet("column_a.json"));
     check_configurations(&v);
@@ -227,8 +257,12 @@ fn two_column_pairings_rank_lb_on_both_columns_first_and_the_dynamic_test_agrees
 #[test]
 fn bad_pairing_requests_exit_1_naming_what_is_wrong() {
     let fs = flowsheet("two_column_plant.json");
-    let cases: [(&[&str], &str); 6] = [
+    let cases: [(&[&str], &str); 7] = [
         (&["--cvs", "column1.T[99]", "--mvs", "column1.reflux"], "--cvs: no variable `column1.T[99]`"),
+        (
+            &["--cvs", "column1.T[21]", "--mvs", "column1.reflux", "--watch", "bottoms1.x[B]=0:1"],
+            "--watch needs --disturbances",
+        ),
         (&["--cvs", "column1.T[21]", "--mvs", "column1.reflx"], "--mvs: `column1.reflx` is no input of the plant"),
         (&["--cvs", "column1.T[21]", "--mvs", "column1.reflux,column1.bottoms"], "1 CVs and 2 MVs"),
         (

@@ -70,6 +70,9 @@ pub enum ScreenError {
         /// A suggestion, or empty.
         hint: String,
     },
+    /// Watched variables without disturbances to sweep.
+    #[error("--watch needs --disturbances: the band is tested over ± each disturbance")]
+    WatchWithoutDisturbances,
     /// An MV names no input.
     #[error("--mvs: `{path}` is no input of the plant{hint}")]
     NoMv {

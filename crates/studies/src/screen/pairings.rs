@@ -112,6 +112,9 @@ pub struct PairingScreen {
     pub enumerated: usize,
     /// Partial pairings cut for a non-positive relative gain.
     pub pruned: usize,
+    /// Throughput choices (`null` for none) whose square gain matrix is singular: no pairing of
+    /// them can hold the CVs independently, so none is listed.
+    pub singular: Vec<Option<String>>,
     /// The structures that reached a leaf, best first.
     pub structures: Vec<PairingStructure>,
 }
@@ -142,12 +145,14 @@ pub fn screen_pairings(plant: &Plant, request: &PairingRequest) -> Result<Pairin
     let open = open_plant(plant, &request.cvs, &request.mvs)?;
     let choices: Vec<Option<&String>> =
         if request.throughput.is_empty() { vec![None] } else { request.throughput.iter().map(Some).collect() };
-    let (mut structures, mut enumerated, mut pruned) = (Vec::new(), 0, 0);
+    let (mut structures, mut enumerated, mut pruned, mut singular) = (Vec::new(), 0, 0, Vec::new());
     for tpm in choices {
         let cols: Vec<usize> = (0..request.mvs.len()).filter(|&j| Some(&request.mvs[j]) != tpm).collect();
         let g = Mat::from_fn(request.cvs.len(), cols.len(), |i, k| open.gain[(i, cols[k])]);
         let mut found = Vec::new();
-        if !is_singular(&g) {
+        if is_singular(&g) {
+            singular.push(tpm.cloned());
+        } else {
             let lambda = rga(g.as_ref()).map_err(|e| analysis(e, tpm))?;
             branch(&lambda, &mut Vec::new(), &mut found, &mut pruned);
         }
@@ -176,6 +181,7 @@ pub fn screen_pairings(plant: &Plant, request: &PairingRequest) -> Result<Pairin
         gain: plantwide_analysis::measures::rows(open.gain.as_ref()),
         enumerated,
         pruned,
+        singular,
         structures,
     })
 }
@@ -199,6 +205,9 @@ fn check_request(plant: &Plant, r: &PairingRequest) -> Result<(), ScreenError> {
     if let Some(w) = r.watch.iter().find(|w| plant.var(&w.path).is_none()) {
         let hint = hint(&w.path, plant.vars().iter().map(|v| v.path.as_str()).collect());
         return Err(ScreenError::NoWatch { path: w.path.clone(), hint });
+    }
+    if !r.watch.is_empty() && r.disturbances.is_empty() {
+        return Err(ScreenError::WatchWithoutDisturbances);
     }
     if let Some(t) = r.throughput.iter().find(|t| !r.mvs.contains(t)) {
         return Err(ScreenError::ThroughputNotMv { path: t.clone() });
@@ -252,9 +261,17 @@ pub fn open_plant(plant: &Plant, cvs: &[String], mvs: &[String]) -> Result<OpenP
         }
     }
     let mv_ids: Vec<usize> = mvs.iter().filter_map(|m| v.input(m)).collect();
-    let gain = Linearization::new(&v, &s.x, &u)
-        .steady_gain(&mv_ids, &cv_ids)
-        .map_err(|e| ScreenError::Analysis { structure: label.clone(), source: Box::new(e) })?;
+    let gain = match Linearization::new(&v, &s.x, &u).steady_gain(&mv_ids, &cv_ids) {
+        Ok(g) => g,
+        // A singular Jacobian at a point that satisfies the equations: name what is left free.
+        Err(e) => match plantwide_solve::dof_check(&v, &u, &s.x, plantwide_solve::DofProbe::Numerical) {
+            Err(dof) => {
+                let e = plantwide_solve::SolveError::from(plantwide_solve::SteadyError::from(dof));
+                return Err(steady(&label, e.into()));
+            }
+            Ok(()) => return Err(ScreenError::Analysis { structure: label, source: Box::new(e) }),
+        },
+    };
     Ok(OpenPlant { plant: v, x: s.x, mv_values, cv_values, gain, opened })
 }
 
