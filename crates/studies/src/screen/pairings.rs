@@ -29,7 +29,7 @@ use plantwide_flowsheet::{Override, Plant, StructureEdit};
 use plantwide_solve::{NewtonSettings, StrategySettings, steady_state};
 use serde::Serialize;
 
-pub use dynamic::{CvFigures, DisturbanceRun, DynamicResult, DynamicSettings};
+pub use dynamic::{CandidateFailure, CvFigures, DisturbanceRun, DynamicResult, DynamicSettings};
 pub use sensitivity::{Watch, WatchResult};
 
 use super::ScreenError;

@@ -20,6 +20,26 @@ use crate::screen::ScreenError;
 use crate::tune::flowsheet::blt_loops;
 use crate::tune::loops::{Measurement, plant_loop};
 
+/// Why a candidate's dynamic test failed (recorded as its `failure`, the other candidates go on).
+#[derive(Debug, Clone, thiserror::Error)]
+pub enum CandidateFailure {
+    /// Its loops could not be added to the open plant.
+    #[error(transparent)]
+    Wiring(#[from] plantwide_flowsheet::OverrideError),
+    /// The plant with its loops has no steady state.
+    #[error(transparent)]
+    Steady(#[from] plantwide_solve::SteadyError),
+    /// Its loops could not be tuned.
+    #[error(transparent)]
+    Tune(#[from] crate::TuneError),
+    /// The disturbance run could not be set up.
+    #[error(transparent)]
+    Scenario(#[from] plantwide_flowsheet::LoadError),
+    /// The disturbance run stopped.
+    #[error(transparent)]
+    Simulation(#[from] Box<plantwide_solve::dynamic::SimError>),
+}
+
 /// Settings of the dynamic test.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DynamicSettings {
@@ -150,20 +170,26 @@ fn candidate(tuned: TunedCandidate, r: &PairingRequest, s: &PairingStructure, du
     };
     let (plant, x, tuned) = match tuned {
         Ok(t) => t,
-        Err(why) => return failed(why),
+        Err(why) => return failed(why.to_string()),
     };
     let mut runs = Vec::new();
     for d in &r.disturbances {
         match run(&plant, &x, r, s, d, duration) {
             Ok(run) => runs.push(run),
-            Err(why) => return DynamicResult { detuning_factor: tuned.detuning, loops: tuned.loops, ..failed(why) },
+            Err(why) => {
+                return DynamicResult {
+                    detuning_factor: tuned.detuning,
+                    loops: tuned.loops,
+                    ..failed(why.to_string())
+                };
+            }
         }
     }
     DynamicResult { detuning_factor: tuned.detuning, loops: tuned.loops, runs, score: f64::NAN, failure: None }
 }
 
 /// A candidate's plant with its tuned loops, its steady state and tuning, or why it has none.
-type TunedCandidate = Result<(Plant, Vec<f64>, Tuned), String>;
+type TunedCandidate = Result<(Plant, Vec<f64>, Tuned), CandidateFailure>;
 
 /// The tuning of a candidate.
 struct Tuned {
@@ -193,17 +219,16 @@ pub(super) fn closed_plant(
     kc: &[f64],
     ti: &[f64],
     actions: &[&str],
-) -> Result<(Plant, Vec<f64>), String> {
+) -> Result<(Plant, Vec<f64>), CandidateFailure> {
     let edits: Vec<StructureEdit> = (0..s.pairs.len())
         .map(|i| StructureEdit::AddController {
             name: format!("pair{}", i + 1),
             spec: loop_spec(open, s, i, kc[i], ti[i], actions[i]),
         })
         .collect();
-    let v = open.plant.restructure(&edits).map_err(|e| e.to_string())?;
+    let v = open.plant.restructure(&edits)?;
     let guess = crate::screen::column::mapped_guess(&open.plant, &open.x, &v);
-    let st =
-        steady_state(&v, &v.input_values(), Some(&guess), &NewtonSettings::default()).map_err(|e| e.to_string())?;
+    let st = steady_state(&v, &v.input_values(), Some(&guess), &NewtonSettings::default())?;
     Ok((v, st.x))
 }
 
@@ -223,11 +248,8 @@ fn tuned_plant(open: &OpenPlant, r: &PairingRequest, s: &PairingStructure) -> Tu
     let n = s.pairs.len();
     let build = |kc: &[f64], ti: &[f64], actions: &[&str]| closed_plant(open, s, kc, ti, actions);
     let (trial, x) = build(&vec![1.0; n], &vec![1e3; n], &actions(open, r, s))?;
-    let loops: Vec<_> = (0..n)
-        .map(|i| plant_loop(&trial, &format!("pair{}", i + 1)))
-        .collect::<Result<_, _>>()
-        .map_err(|e| e.to_string())?;
-    let t = blt_loops(&trial, &x, &loops, r.dynamic.measurement).map_err(|e| e.to_string())?;
+    let loops: Vec<_> = (0..n).map(|i| plant_loop(&trial, &format!("pair{}", i + 1))).collect::<Result<_, _>>()?;
+    let t = blt_loops(&trial, &x, &loops, r.dynamic.measurement)?;
     let kc: Vec<f64> = t.loops.iter().map(|l| l.kc.abs()).collect();
     let ti: Vec<f64> = t.loops.iter().map(|l| l.tau_i.unwrap_or(f64::INFINITY)).collect();
     let actions: Vec<&str> = t.loops.iter().map(|l| l.action).collect();
@@ -256,7 +278,7 @@ fn run(
     s: &PairingStructure,
     d: &super::Disturbance,
     duration: f64,
-) -> Result<DisturbanceRun, String> {
+) -> Result<DisturbanceRun, CandidateFailure> {
     let u0 = plant.input(&d.path).map_or(f64::NAN, |i| plant.inputs()[i].value);
     let ops: Vec<String> = (0..s.pairs.len()).map(|i| format!("pair{}.op", i + 1)).collect();
     let record: Vec<&String> = r.cvs.iter().chain(&ops).collect();
@@ -267,9 +289,9 @@ fn run(
         "record": {"interval": format!("{} s", duration / 500.0), "paths": record}
     })
     .to_string();
-    let spec = plantwide_flowsheet::scenario::parse_scenario(&text, "screen").map_err(|e| e.to_string())?;
-    let scenario = plantwide_flowsheet::scenario::resolve(&spec, plant, "screen").map_err(|e| e.to_string())?;
-    let res = simulate(plant, &scenario, Start::Steady(x), "screen", &mut |_| {}).map_err(|e| e.to_string())?;
+    let spec = plantwide_flowsheet::scenario::parse_scenario(&text, "screen")?;
+    let scenario = plantwide_flowsheet::scenario::resolve(&spec, plant, "screen")?;
+    let res = simulate(plant, &scenario, Start::Steady(x), "screen", &mut |_| {}).map_err(Box::new)?;
     let figures = summary(&res);
     let cvs = r
         .cvs

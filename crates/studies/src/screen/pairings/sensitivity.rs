@@ -76,7 +76,8 @@ pub(super) fn test(
 fn choice(open: &OpenPlant, r: &PairingRequest, s: &PairingStructure) -> Result<Vec<WatchResult>, ScreenError> {
     let fail = |why: String| ScreenError::Sensitivity { throughput: s.throughput.clone().unwrap_or_default(), why };
     let n = s.pairs.len();
-    let (plant, x) = closed_plant(open, s, &vec![1.0; n], &vec![1e3; n], &actions(open, r, s)).map_err(fail)?;
+    let (plant, x) =
+        closed_plant(open, s, &vec![1.0; n], &vec![1e3; n], &actions(open, r, s)).map_err(|e| fail(e.to_string()))?;
     let u = plant.input_values();
     let outputs: Vec<usize> = r.watch.iter().filter_map(|w| plant.var(&w.path)).collect();
     let mut out = Vec::new();
