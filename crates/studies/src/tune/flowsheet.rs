@@ -19,7 +19,7 @@ use super::averaging::{AveragingForm, AveragingSettings, averaging};
 use super::bench::RelayCycle;
 use super::blt::BltSettings;
 use super::fit::ModelFit;
-use super::loops::{LoopResponse, Measurement, PlantLoop, loop_model, plant_blt};
+use super::loops::{Measurement, PlantLoop, low_frequency_probe, plant_blt};
 use super::rules::{ModelRule, model_rule};
 use super::ultimate::Ultimate;
 use crate::TuneError;
@@ -161,12 +161,7 @@ pub fn blt_loops(
 /// # Errors
 /// [`TuneError::NotIntegrating`] when the element has a finite steady-state gain.
 pub fn integrating_gain(plant: &Plant, x: &[f64], l: &PlantLoop) -> Result<f64, TuneError> {
-    let model = loop_model(plant, x, std::slice::from_ref(l))?;
-    let ev = model.ss.eigenvalues().map_err(|e| TuneError::Linear(Box::new(e)))?;
-    let scale = ev.iter().map(|v| v.norm()).fold(0.0, f64::max);
-    let slow = ev.iter().map(|v| v.norm()).filter(|m| *m > 1e-10 * scale).fold(f64::INFINITY, f64::min);
-    let w = 1e-3 * slow;
-    let response = LoopResponse::new(model, Measurement::default());
+    let (response, w, _) = low_frequency_probe(plant, x, l)?;
     let g = response.at(w)[(0, 0)];
     let sg = g * faer::c64::new(0.0, w);
     if sg.im.abs() > 1e-2 * sg.re.abs() || !sg.re.is_finite() {

@@ -83,6 +83,19 @@ pub fn inner_first(plant: &Plant, loops: &[PlantLoop]) -> Vec<PlantLoop> {
     ordered.into_iter().map(|(_, l)| l).collect()
 }
 
+/// The exact response of loop `l`'s element (no measurement dynamics) and the probe frequency
+/// `ω = 1e-3 · |λ|_min` \[rad/s\], a thousand times below its slowest nonzero eigenvalue (those
+/// under 1e-10 of the fastest count as the zeros of integrators): where `g(jω)` shows the element's
+/// steady-state behaviour to `O((ω T)²)` without losing digits to an integrator's pole. Also
+/// returns `|λ|_min` \[1/s\].
+pub fn low_frequency_probe(plant: &Plant, x: &[f64], l: &PlantLoop) -> Result<(LoopResponse, f64, f64), TuneError> {
+    let model = loop_model(plant, x, std::slice::from_ref(l))?;
+    let ev = model.ss.eigenvalues().map_err(|e| TuneError::Linear(Box::new(e)))?;
+    let scale = ev.iter().map(|v| v.norm()).fold(0.0, f64::max);
+    let slow = ev.iter().map(|v| v.norm()).filter(|m| *m > 1e-10 * scale).fold(f64::INFINITY, f64::min);
+    Ok((LoopResponse::new(model, Measurement::default()), 1e-3 * slow, slow))
+}
+
 /// Names of the PID controllers of `plant`, in file order.
 pub fn pid_names(plant: &Plant) -> Vec<String> {
     plant

@@ -14,7 +14,7 @@ use plantwide_solve::dynamic::{Session, SessionError};
 
 use super::bench::{Bench, RelayCycle, SampledRelay, StepTest, relay, step};
 use super::fit::{ModelFit, ModelOrder, fit_step};
-use super::loops::{LoopResponse, Measurement, PlantLoop, in_manual, loop_model, loop_ultimates};
+use super::loops::{LoopResponse, Measurement, PlantLoop, in_manual, loop_model, loop_ultimates, low_frequency_probe};
 use crate::TuneError;
 
 /// The plant with one loop in manual, run by a [`Session`], its measurement seen through the
@@ -188,12 +188,7 @@ fn within_range(plant: &Plant, l: &PlantLoop, u: f64) -> Result<(), TuneError> {
 /// integrating element, `s g(s)` in place of `g`); `None` when it has none (a pure integrator).
 /// For a stable element whose `T` comes out negative or nil, the slowest time constant.
 fn residence_time(plant: &Plant, x: &[f64], l: &PlantLoop) -> Result<(Option<f64>, bool), TuneError> {
-    let model = loop_model(plant, x, std::slice::from_ref(l))?;
-    let ev = model.ss.eigenvalues().map_err(|e| TuneError::Linear(Box::new(e)))?;
-    let scale = ev.iter().map(|v| v.norm()).fold(0.0, f64::max);
-    let slow = ev.iter().map(|v| v.norm()).filter(|m| *m > 1e-10 * scale).fold(f64::INFINITY, f64::min);
-    let w = 1e-3 * slow;
-    let response = LoopResponse::new(model, Measurement::default());
+    let (response, w, slow) = low_frequency_probe(plant, x, l)?;
     let g = response.at(w)[(0, 0)];
     let integrating = g.im.abs() > g.re.abs();
     // A quadrature response that shrinks with the frequency is a washout (g(0) = 0), not an integrator.
