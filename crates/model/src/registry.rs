@@ -98,4 +98,5 @@ registry!(
     "summer" => Summer(controllers::summer::SummerConfig, controllers::summer::Summer),
     "split_range" => SplitRange(controllers::split_range::SplitRangeConfig, controllers::split_range::SplitRange),
     "selector" => Selector(controllers::selector::SelectorConfig, controllers::selector::Selector),
+    "averaging_level" => AveragingLevel(controllers::averaging_level::AveragingLevelConfig, controllers::averaging_level::AveragingLevel),
 ]);

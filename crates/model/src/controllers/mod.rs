@@ -1,6 +1,7 @@
 //! Controllers are units: a PI controller's integral is a differential variable, so at steady state
 //! its residual forces the error to zero and a "design spec" is just a controller in the flowsheet.
 
+pub mod averaging_level;
 pub mod delay;
 pub mod lag;
 pub mod pid;
