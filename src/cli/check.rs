@@ -97,5 +97,34 @@ pub fn run(file: &Path) -> Result<(), CliError> {
         if numerical { ", numerically nonsingular at the initial guess" } else { "" }
     );
     plantwide::solve::sequential::plan(&plant, &u, &x).describe(&plant).iter().for_each(|l| outln!("{l}"));
+    residence(&plant, &u, &x);
     Ok(())
+}
+
+/// Residence times of the drums, sumps and vessels against the ~5 min rule, at the steady state
+/// (or, when the plant does not converge, at the initial guess, said so).
+fn residence(plant: &plantwide::flowsheet::Plant, u: &[f64], guess: &[f64]) {
+    use plantwide::studies::size::residence::{RULE_OF_THUMB, residence_times};
+    let (x, basis) = match super::steady::converge(plant, u) {
+        Ok(s) => (s.x, "at the steady state"),
+        Err(_) => (guess.to_vec(), "at the initial guess (the plant did not converge)"),
+    };
+    let times = residence_times(plant, &x);
+    if times.is_empty() {
+        return;
+    }
+    outln!(
+        "liquid residence times {basis} (holdup / total flow leaving; rule of thumb ~{:.0} min):",
+        RULE_OF_THUMB / 60.0
+    );
+    for r in times {
+        outln!(
+            "  {:<16} {:>9.2} min  (holdup {:.4e} mol, leaving {:.4e} mol/s){}",
+            r.vessel,
+            r.time / 60.0,
+            r.holdup,
+            r.throughput,
+            if r.short { "  — short: little surge capacity (Practical Distillation Control ch. 1)" } else { "" }
+        );
+    }
 }

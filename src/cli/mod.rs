@@ -26,6 +26,7 @@ mod linearize;
 mod run;
 mod screen;
 mod sensitivity;
+mod size;
 mod steady;
 mod tune;
 mod tune_bench;
@@ -113,6 +114,10 @@ enum Command {
     /// Control-structure screening: a column's inventory configurations (LV, DV, LB, DB, (L/D)V,
     /// L(V/B), (L/D)(V/B)) with their steady-state gains, RGA, Niederlinski index, condition numbers.
     Screen(screen::ScreenArgs),
+    /// Surge sizing: the cross-section and level controller (P, critically damped PI, optimal
+    /// averaging) that hold a vessel's level band and its outflow's rate limit, each verified by a
+    /// nonlinear run; or a ranking of where surge capacity needs the least volume.
+    Size(size::SizeArgs),
 }
 
 /// A failed command: message and exit code.
@@ -150,6 +155,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Sensors(a) => gains::run_sensors(&a),
         Command::Tune(a) => tune::run(&a),
         Command::Screen(a) => screen::run(&a),
+        Command::Size(a) => size::run(&a),
         Command::Schema => {
             let schema = schemars::schema_for!(plantwide::flowsheet::FlowsheetSpec);
             let text = serde_json::to_string_pretty(&schema).map_err(|e| CliError::user(e.to_string()))?;

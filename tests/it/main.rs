@@ -21,6 +21,7 @@ mod fuzz;
 mod hostile;
 mod recycle;
 mod screen;
+mod size;
 mod snowball;
 mod tune;
 mod two_column_study;

@@ -149,6 +149,9 @@ impl Plant {
                 }
                 StructureEdit::Set(o) => crate::overrides::set_field(&mut spec, &o.path, &o.value)?,
                 StructureEdit::AddController { name, spec: c } => add_controller(&mut spec, name, c)?,
+                StructureEdit::InsertOnStream { stream, unit, spec: u, outlet } => {
+                    insert_on_stream(&mut spec, stream, unit, u, outlet)?;
+                }
                 StructureEdit::RemoveController(name) => {
                     if spec.controllers.shift_remove(name).is_none() {
                         let hint = crate::error::did_you_mean(name, spec.controllers.keys().map(String::as_str));
@@ -187,6 +190,44 @@ pub enum StructureEdit {
     },
     /// Remove a controller: the inputs it drove read their own values again.
     RemoveController(String),
+    /// Put a new unit with one inlet and one outlet (a surge tank) on a stream: `stream` now ends
+    /// at `unit`, and a new stream `outlet` runs from `unit` to where `stream` went.
+    InsertOnStream {
+        /// The stream cut.
+        stream: String,
+        /// The new unit's name (not yet a unit's or controller's).
+        unit: String,
+        /// Its description, as in the file's `units` section.
+        spec: serde_json::Value,
+        /// The new stream's name (not yet a stream's).
+        outlet: String,
+    },
+}
+
+fn insert_on_stream(
+    spec: &mut crate::FlowsheetSpec,
+    stream: &str,
+    unit: &str,
+    u: &serde_json::Value,
+    outlet: &str,
+) -> Result<(), OverrideError> {
+    let fail = |why: String| OverrideError::Structure { controller: unit.to_string(), why };
+    if spec.units.contains_key(unit) || spec.controllers.contains_key(unit) {
+        return Err(fail("the name is taken by a unit or controller of the flowsheet".into()));
+    }
+    if spec.streams.contains_key(outlet) {
+        return Err(fail(format!("the outlet stream's name `{outlet}` is taken")));
+    }
+    let parsed = serde_json::from_value(u.clone()).map_err(|e| fail(format!("not a unit description: {e}")))?;
+    let Some(cut) = spec.streams.get_mut(stream) else {
+        let hint = crate::error::did_you_mean(stream, spec.streams.keys().map(String::as_str));
+        return Err(fail(format!("there is no stream `{stream}` to put it on{hint}")));
+    };
+    let to = std::mem::replace(&mut cut.to, unit.to_string());
+    let tear = std::mem::take(&mut cut.tear);
+    spec.units.insert(unit.to_string(), parsed);
+    spec.streams.insert(outlet.to_string(), crate::spec::StreamSpec { from: unit.to_string(), to, tear });
+    Ok(())
 }
 
 fn add_controller(spec: &mut crate::FlowsheetSpec, name: &str, c: &serde_json::Value) -> Result<(), OverrideError> {
@@ -294,5 +335,34 @@ mod restructure_tests {
             let err = plant.restructure(&[e]).unwrap_err().to_string();
             assert!(err.contains(msg), "{err}");
         }
+    }
+
+    #[test]
+    fn a_tank_put_on_a_stream_receives_it_and_feeds_its_old_destination() {
+        use crate::StructureEdit;
+        let plant = load_str_with(super::tests::TANK, "t.json", &[]).unwrap();
+        let tank = serde_json::json!({"type": "tank", "area": "1 m2", "height": "2 m",
+                                      "outflow": {"type": "flow", "flow": "50 mol/s"}});
+        let level = serde_json::json!({"type": "pid", "pv": "surge.level", "output": "surge.outflow", "sp": "1 m",
+                                       "kc": "50 mol/s/m", "action": "direct"});
+        let edits = [
+            StructureEdit::InsertOnStream { stream: "b".into(), unit: "surge".into(), spec: tank, outlet: "b2".into() },
+            StructureEdit::AddController { name: "surge_level".into(), spec: level },
+        ];
+        let v = plant.restructure(&edits).unwrap();
+        assert_eq!(v.spec().streams["b"].to, "surge");
+        assert_eq!((v.spec().streams["b2"].from.as_str(), v.spec().streams["b2"].to.as_str()), ("surge", "out"));
+        assert!(v.var("surge.level").is_some() && v.n_vars() > plant.n_vars());
+        // A stream that does not exist, or a name already taken, is refused by name.
+        let again = |stream: &str, unit: &str| StructureEdit::InsertOnStream {
+            stream: stream.into(),
+            unit: unit.into(),
+            spec: serde_json::json!({"type": "product"}),
+            outlet: "c".into(),
+        };
+        let err = plant.restructure(&[again("bb", "surge")]).unwrap_err().to_string();
+        assert!(err.contains("no stream `bb`"), "{err}");
+        let err = plant.restructure(&[again("b", "tank")]).unwrap_err().to_string();
+        assert!(err.contains("taken"), "{err}");
     }
 }

@@ -1,4 +1,5 @@
 //! Errors of the studies: [`TuneError`] of tuning, [`crate::screen::ScreenError`] of screening,
+//! [`crate::size::SizeError`] of surge sizing,
 //! joined in the crate-level [`enum@Error`].
 
 use thiserror::Error;
@@ -12,6 +13,9 @@ pub enum Error {
     /// Screening.
     #[error(transparent)]
     Screen(#[from] crate::screen::ScreenError),
+    /// Surge sizing.
+    #[error(transparent)]
+    Size(#[from] crate::size::SizeError),
 }
 
 impl Error {
@@ -20,6 +24,7 @@ impl Error {
         match self {
             Error::Tune(e) => e.is_user_error(),
             Error::Screen(e) => e.is_user_error(),
+            Error::Size(e) => e.is_user_error(),
         }
     }
 }

@@ -11,7 +11,9 @@
 pub mod error;
 mod numeric;
 pub mod screen;
+pub mod size;
 pub mod tune;
 
 pub use error::{Error, TuneError};
 pub use screen::ScreenError;
+pub use size::SizeError;

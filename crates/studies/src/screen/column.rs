@@ -369,7 +369,7 @@ fn guess(plant: &Plant, x: &[f64], v: &Plant, h: &Handles, flows: &[f64; 4]) -> 
 }
 
 /// A starting point for variant `v` of `plant`: `x` by variable path, `v`'s own guess elsewhere.
-pub(super) fn mapped_guess(plant: &Plant, x: &[f64], v: &Plant) -> Vec<f64> {
+pub(crate) fn mapped_guess(plant: &Plant, x: &[f64], v: &Plant) -> Vec<f64> {
     let mut g = v.initial_guess_at(&v.input_values());
     for (k, info) in v.vars().iter().enumerate() {
         if let Some(j) = plant.var(&info.path) {

@@ -1,0 +1,340 @@
+//! Surge sizing (issue 18): how big a vessel must be, and with which level controller, so that a
+//! disturbance reaching it leaves its level within a band and changes its outflow no faster than
+//! a limit; and where in a plant surge capacity does that with the least volume.
+//!
+//! For a vessel with a PID level loop on a flow, and a disturbance (an input stepped by `Δ`):
+//! 1. the flow change `Δu` the outflow must make is the difference of two checked steady states
+//!    (before and after the disturbance, every loop as the file has it), and the liquid's molar
+//!    volume `v_L` is read at the steady state;
+//! 2. the three designs of [`closed_form`] give the cross-section `A = c v_L Δu²/(r Δh)` and the
+//!    controller settings (P, critically damped PI from [`crate::tune::averaging`], and the optimal
+//!    averaging law of `plantwide_model::controllers::averaging_level` with its `max_rate` at `r`);
+//! 3. each design is written into the plant (the vessel's `area` or `diameter`, the level
+//!    controller replaced under its own name) and verified by a nonlinear dynamic run of the whole
+//!    plant: the largest level deviation and the largest rate of the outflow after the step.
+//!
+//! The closed forms take the disturbance as a step of `Δu` reaching the vessel; upstream dynamics
+//! that smooth it make the verified figures smaller than the design's (the design is then
+//! conservative), interaction through recycles can make them larger: the verification says which.
+//!
+//! Vessels: a `tank`, `cstr` or `flash` (level in m, cross-section from `area` or `diameter`), a
+//! column's reflux drum `COL.drum` or base `COL.sump` (holdup in mol: the column model has no
+//! geometry, so the area is that of a vertical drum holding the band volume over the level band,
+//! and the level controller's band is `A Δh/v_L` mol), or a stream `S` — a new surge tank put on it.
+
+pub mod candidates;
+pub mod closed_form;
+pub mod residence;
+mod verify;
+mod vessel;
+
+use plantwide_flowsheet::Plant;
+use plantwide_solve::dynamic::SessionError;
+use plantwide_solve::{NewtonSettings, SteadyError, steady_state};
+use serde::Serialize;
+
+pub use candidates::{CandidateRanking, RankedCandidate, rank_candidates};
+pub use closed_form::LevelDesign;
+use vessel::Vessel;
+
+/// Relative tolerance of the verification: sampling, the integrator's tolerance and the optimal
+/// law's rate-estimate filter (`t*/10⁴`) leave the verified peaks within it of the closed form.
+pub const VERIFY_TOLERANCE: f64 = 1e-3;
+
+/// A step disturbance: input `path` moved by `change` (SI) at the start of the run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Disturbance {
+    /// Input path (or alias).
+    pub path: String,
+    /// The step (SI, signed).
+    pub change: f64,
+}
+
+/// What to size for.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SizeRequest {
+    /// The disturbance.
+    pub disturbance: Disturbance,
+    /// The largest allowed level deviation from the setpoint, either way \[m\].
+    pub level_band: f64,
+    /// The largest allowed rate of change of the outflow (its SI unit per second).
+    pub max_outflow_rate: f64,
+    /// Length of each verification run \[s\] (default: 12 filter times for P, 14 times `1/ω_n`
+    /// for PI, 25 ramp times for the optimal law, and at least 5 of the plant's slowest time
+    /// constants).
+    pub duration: Option<f64>,
+}
+
+/// The peaks of one verification run.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Verified {
+    /// Largest `|level − setpoint|` \[m\].
+    pub max_level_deviation: f64,
+    /// Largest `|d outflow/dt|` (SI).
+    pub max_outflow_rate: f64,
+    /// Both within [`VERIFY_TOLERANCE`] of the band and the rate limit.
+    pub meets: bool,
+    /// Length of the run \[s\].
+    pub duration: f64,
+    /// Why the run did not settle, or stopped (the peaks are then those up to there).
+    pub failure: Option<String>,
+    /// The run's record (for plots; not serialized).
+    #[serde(skip)]
+    pub trace: Trace,
+}
+
+/// A verification run's record.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Trace {
+    /// Times from the step \[s\].
+    pub times: Vec<f64>,
+    /// Level deviation \[m\] (for a column's holdup: of the equivalent vertical drum).
+    pub deviation: Vec<f64>,
+    /// Outflow (SI).
+    pub outflow: Vec<f64>,
+}
+
+/// One design and its verification. Gains are in the level measurement's SI units (outflow per m,
+/// or per mol for a column's holdup), times in s.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Design {
+    /// `p`, `pi` or `optimal`.
+    pub controller: LevelDesign,
+    /// Cross-section \[m²\].
+    pub area: f64,
+    /// The closed form's cross-section \[m²\] (equal to `area` unless the run asked for more).
+    pub closed_form_area: f64,
+    /// How many times the design was corrected after its run exceeded a limit.
+    pub refinements: usize,
+    /// The flow change the controller is designed for (SI; the steady one unless refined).
+    pub design_flow_change: f64,
+    /// Optimal law refined: the band it was told to plan for \[m\] (inside the band asked).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub planned_band: Option<f64>,
+    /// `area × level band` \[m³\]: the volume the level sweeps between setpoint and band edge.
+    pub band_volume: f64,
+    /// Controller gain magnitude (P and PI).
+    pub kc: Option<f64>,
+    /// Reset time \[s\] (PI).
+    pub tau_i: Option<f64>,
+    /// Optimal law: capacity (outflow × s per unit of measurement).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub capacity: Option<f64>,
+    /// Optimal law: the ramp's duration `Δu/r` \[s\].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ramp_time: Option<f64>,
+    /// Optimal law: the return time written (4 ramp times) \[s\].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub return_time: Option<f64>,
+    /// Column drum or base: the normal holdup run (mol), at least twice the band's.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub normal_holdup: Option<f64>,
+    /// The nonlinear run.
+    pub verified: Verified,
+}
+
+/// The sizing of one vessel; serializes to the issue's `{"designs": [...]}` with the context.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct VesselSizing {
+    /// The vessel as asked.
+    pub vessel: String,
+    /// `vessel`, `column_drum`, `column_sump` or `new_surge_tank`.
+    pub kind: &'static str,
+    /// Its level controller.
+    pub level_controller: String,
+    /// The flow it moves (input path).
+    pub outflow: String,
+    /// `path +Δ` of the disturbance (SI).
+    pub disturbance: String,
+    /// The steady change of the outflow the disturbance needs (SI).
+    pub flow_change: f64,
+    /// Molar volume of the vessel's liquid \[m³/mol\].
+    pub liquid_molar_volume: f64,
+    /// Level band asked \[m\].
+    pub level_band: f64,
+    /// Rate limit asked (SI).
+    pub max_outflow_rate: f64,
+    /// The vessel as the file has it, run through the same disturbance (a new tank: the stream
+    /// without it).
+    pub current: Current,
+    /// The three designs.
+    pub designs: Vec<Design>,
+}
+
+/// The file's own vessel and controller through the disturbance.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Current {
+    /// Its cross-section \[m²\] (none for a column's holdup or a stream).
+    pub area: Option<f64>,
+    /// Largest deviation of the measurement (its SI unit: m, or mol for a column's holdup; none
+    /// for a stream).
+    pub max_deviation: Option<f64>,
+    /// Largest rate of the outflow (SI).
+    pub max_outflow_rate: f64,
+    /// Within the band (where the measurement is a level) and the rate limit.
+    pub meets: bool,
+    /// Why the run stopped, if it did.
+    pub failure: Option<String>,
+    /// The run's record (for plots; not serialized).
+    #[serde(skip)]
+    pub trace: Trace,
+}
+
+/// Why a sizing was refused or failed.
+#[derive(Debug, Clone, thiserror::Error)]
+pub enum SizeError {
+    /// No vessel of that name.
+    #[error("`{name}` is no vessel of the flowsheet: {why}; vessels with a level: {known}")]
+    Vessel {
+        /// As asked.
+        name: String,
+        /// Why.
+        why: String,
+        /// What could be sized.
+        known: String,
+    },
+    /// The vessel's level is not held by a PID on a flow.
+    #[error("vessel `{vessel}`: {why}")]
+    LevelLoop {
+        /// The vessel.
+        vessel: String,
+        /// Why.
+        why: String,
+    },
+    /// The band does not fit the vessel or is not positive.
+    #[error("--level-band {band} m for `{vessel}`: {why}")]
+    Band {
+        /// The vessel.
+        vessel: String,
+        /// The band \[m\].
+        band: f64,
+        /// Why.
+        why: String,
+    },
+    /// The rate limit is not positive.
+    #[error("--max-outflow-rate {value}: must be a positive rate of change of the outflow (e.g. \"5 kmol/h/min\")")]
+    Rate {
+        /// As given (SI).
+        value: f64,
+    },
+    /// The disturbance is no free input or is zero.
+    #[error("--disturbance {path}: {why}")]
+    Disturbance {
+        /// Its path.
+        path: String,
+        /// Why.
+        why: String,
+    },
+    /// The disturbance does not move the vessel's outflow.
+    #[error(
+        "the disturbance {path} does not move the outflow `{outflow}` of `{vessel}` at steady state (change {change:.3e}): \
+         there is no surge to size there"
+    )]
+    Unreached {
+        /// The vessel.
+        vessel: String,
+        /// Its outflow.
+        outflow: String,
+        /// The disturbance.
+        path: String,
+        /// The change found (SI).
+        change: f64,
+    },
+    /// A design could not be written into the plant.
+    #[error("writing the {what} into the flowsheet: {source}")]
+    Structure {
+        /// What.
+        what: String,
+        /// The flowsheet's reason.
+        source: plantwide_flowsheet::OverrideError,
+    },
+    /// No steady state.
+    #[error("{what}: {source}")]
+    Steady {
+        /// Which plant.
+        what: String,
+        /// The solver's reason.
+        source: Box<SteadyError>,
+    },
+    /// A verification run stopped.
+    #[error("{what}: {source}")]
+    Simulation {
+        /// Which run.
+        what: String,
+        /// The integrator's reason.
+        source: Box<SessionError>,
+    },
+}
+
+impl SizeError {
+    /// True for problems of the request (exit code 1), false for numerical failures (exit code 2).
+    pub fn is_user_error(&self) -> bool {
+        !matches!(self, SizeError::Steady { .. } | SizeError::Simulation { .. })
+    }
+}
+
+/// Size vessel `name` of `plant` (at its steady state `x`) for `r`.
+///
+/// # Errors
+/// [`SizeError`]: a bad request (vessel, band, rate, disturbance), a disturbance that does not
+/// reach the vessel, or a plant that cannot be solved or run.
+pub fn size_vessel(plant: &Plant, x: &[f64], name: &str, r: &SizeRequest) -> Result<VesselSizing, SizeError> {
+    check_request(plant, r)?;
+    let v = Vessel::resolve(plant, x, name, r)?;
+    let flow_change = v.flow_change(r)?;
+    let designs =
+        LevelDesign::ALL.iter().map(|&d| verify::design(&v, d, flow_change.abs(), r)).collect::<Result<Vec<_>, _>>()?;
+    let duration = designs.iter().map(|d| d.verified.duration).fold(0.0, f64::max);
+    let current = verify::current(&v, r, duration)?;
+    Ok(VesselSizing {
+        vessel: name.to_string(),
+        kind: v.kind_name(),
+        level_controller: v.controller.clone(),
+        outflow: v.outflow.clone(),
+        disturbance: format!("{} {:+}", r.disturbance.path, r.disturbance.change),
+        flow_change,
+        liquid_molar_volume: v.v_l,
+        level_band: r.level_band,
+        max_outflow_rate: r.max_outflow_rate,
+        current,
+        designs,
+    })
+}
+
+/// The checks that need no vessel: band, rate, disturbance.
+fn check_request(plant: &Plant, r: &SizeRequest) -> Result<(), SizeError> {
+    if r.max_outflow_rate.is_nan() || r.max_outflow_rate <= 0.0 || r.max_outflow_rate.is_infinite() {
+        return Err(SizeError::Rate { value: r.max_outflow_rate });
+    }
+    if r.level_band.is_nan() || r.level_band <= 0.0 || r.level_band.is_infinite() {
+        return Err(SizeError::Band {
+            vessel: String::new(),
+            band: r.level_band,
+            why: "must be a positive length (the largest deviation either way, e.g. \"0.3 m\")".into(),
+        });
+    }
+    let d = &r.disturbance;
+    let bad = |why: &str| Err(SizeError::Disturbance { path: d.path.clone(), why: why.to_string() });
+    match plantwide_flowsheet::overrides::resolve_input(plant, &d.path) {
+        None => bad("no input of the flowsheet has this path (a feed's `F`, a unit's parameter, an alias)"),
+        Some(i) if plant.inputs()[i].driven_by.is_some() => {
+            bad("this input is moved by a controller; disturb a free input (a feed, a setpoint)")
+        }
+        Some(_) if d.change.is_nan() || d.change == 0.0 || d.change.is_infinite() => {
+            bad("the step must be a nonzero finite change, e.g. +10% or \"+20 kmol/h\"")
+        }
+        Some(_) => Ok(()),
+    }
+}
+
+/// The steady state of `v` from the guess `x` of `base` (variables matched by path).
+fn steady_from(base: &Plant, x: &[f64], v: &Plant, what: &str) -> Result<Vec<f64>, SizeError> {
+    steady_at(v, &crate::screen::column::mapped_guess(base, x, v), what)
+}
+
+/// The steady state of `v` from `guess`.
+fn steady_at(v: &Plant, guess: &[f64], what: &str) -> Result<Vec<f64>, SizeError> {
+    steady_state(v, &v.input_values(), Some(guess), &NewtonSettings::default())
+        .map(|s| s.x)
+        .map_err(|e| SizeError::Steady { what: what.to_string(), source: Box::new(e) })
+}

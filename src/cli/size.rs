@@ -1,0 +1,255 @@
+//! `plantwide size FILE --vessel V --disturbance PATH=±Δ --level-band Δh --max-outflow-rate r
+//! [--json] [--plot OUT]`: the cross-section and level controller (P, critically damped PI,
+//! optimal averaging) that keep a vessel's level within `±Δh` and its outflow's rate under `r`,
+//! each verified by a nonlinear run; `--candidates V1,V2,…` ranks where surge capacity does it
+//! with the least volume.
+
+use std::path::{Path, PathBuf};
+
+use plantwide::flowsheet::Plant;
+use plantwide::io::plot::{Overlay, write_bars, write_overlays};
+use plantwide::studies::size::{
+    CandidateRanking, Disturbance, SizeError, SizeRequest, VesselSizing, rank_candidates, size_vessel,
+};
+use plantwide::units::{Dimension, parse_quantity_as};
+
+use super::CliError;
+use super::steady::{converge, load_with_overrides};
+
+/// Arguments of `plantwide size`.
+#[derive(Debug, clap::Args)]
+pub struct SizeArgs {
+    /// Flowsheet file (JSON).
+    #[arg(value_name = "FILE")]
+    file: PathBuf,
+    /// The vessel: a tank, CSTR or flash; a column's `COL.drum` or `COL.sump`; or a stream, for a
+    /// new surge tank on it.
+    #[arg(long, value_name = "V", required_unless_present = "candidates", conflicts_with = "candidates")]
+    vessel: Option<String>,
+    /// Rank these vessels (same forms as --vessel) by the surge volume they need.
+    #[arg(long, value_name = "V1,V2,…", value_delimiter = ',')]
+    candidates: Vec<String>,
+    /// The disturbance, a step of an input: PATH=±x% (of its value) or PATH=±VALUE with units.
+    #[arg(long, value_name = "PATH=±Δ")]
+    disturbance: String,
+    /// The largest allowed deviation of the level from its setpoint, either way (a length).
+    #[arg(long, value_name = "Δh", allow_hyphen_values = true)]
+    level_band: String,
+    /// The largest allowed rate of change of the vessel's outflow (e.g. "5 kmol/h/min").
+    #[arg(long, value_name = "r", allow_hyphen_values = true)]
+    max_outflow_rate: String,
+    /// Length of each verification run (default: long enough for the design and the plant to settle).
+    #[arg(long, value_name = "TIME")]
+    duration: Option<String>,
+    /// Override an input or unit field before converging (repeatable).
+    #[arg(long = "set", value_name = "PATH=VALUE")]
+    set: Vec<String>,
+    /// Print JSON (SI units) instead of a table.
+    #[arg(long)]
+    json: bool,
+    /// Write a plot here (.png or .svg): the designs' level and outflow, or the candidates' volumes.
+    #[arg(long, value_name = "OUT")]
+    plot: Option<PathBuf>,
+}
+
+fn size_error(e: SizeError) -> CliError {
+    if e.is_user_error() { CliError::user(e.to_string()) } else { CliError::numerical(e.to_string()) }
+}
+
+/// Run `plantwide size`.
+pub fn run(a: &SizeArgs) -> Result<(), CliError> {
+    plantwide::analysis::faer::set_global_parallelism(plantwide::analysis::faer::Par::Seq);
+    let (plant, u) = load_with_overrides(&a.file, &a.set)?;
+    let request = request(a, &plant)?;
+    let x = converge(&plant, &u)?.x;
+    if let Some(v) = &a.vessel {
+        let s = size_vessel(&plant, &x, v, &request).map_err(size_error)?;
+        if let Some(out) = &a.plot {
+            plot_designs(out, &s)?;
+        }
+        let json = serde_json::to_string_pretty(&s).map_err(|e| CliError::user(e.to_string()))?;
+        if a.json {
+            outln!("{json}")
+        } else {
+            outln!("{}", table(&s))
+        }
+        return Ok(());
+    }
+    let ranking = rank_candidates(&plant, &x, &a.candidates, &request).map_err(size_error)?;
+    if let Some(out) = &a.plot {
+        plot_candidates(out, &ranking)?;
+    }
+    let json = serde_json::to_string_pretty(&ranking).map_err(|e| CliError::user(e.to_string()))?;
+    if a.json {
+        outln!("{json}")
+    } else {
+        outln!("{}", ranking_table(&ranking))
+    }
+    Ok(())
+}
+
+/// The request in SI, each argument named when it does not parse.
+fn request(a: &SizeArgs, plant: &Plant) -> Result<SizeRequest, CliError> {
+    let quantity = |flag: &str, text: &str, dim: Dimension| {
+        parse_quantity_as(text, dim).map_err(|e| CliError::user(format!("{flag} {text}: {e}")))
+    };
+    let level_band = quantity("--level-band", &a.level_band, Dimension::LENGTH)?;
+    let max_outflow_rate =
+        quantity("--max-outflow-rate", &a.max_outflow_rate, Dimension::MOLAR_FLOW / Dimension::TIME)?;
+    let duration = a.duration.as_deref().map(|d| quantity("--duration", d, Dimension::TIME)).transpose()?;
+    if duration.is_some_and(|d| d.is_nan() || d <= 0.0) {
+        return Err(CliError::user("--duration: must be a positive time"));
+    }
+    Ok(SizeRequest { disturbance: disturbance(&a.disturbance, plant)?, level_band, max_outflow_rate, duration })
+}
+
+/// `PATH=±x%` or `PATH=±VALUE` with the input's units.
+fn disturbance(text: &str, plant: &Plant) -> Result<Disturbance, CliError> {
+    let bad = |why: String| CliError::user(format!("--disturbance {text}: {why}"));
+    let (path, value) = text
+        .split_once('=')
+        .map(|(p, v)| (p.trim(), v.trim()))
+        .ok_or_else(|| bad("expected PATH=±Δ, e.g. fresh_A.F=+10% or feed.F=+5kmol/h".into()))?;
+    let i = plantwide::flowsheet::overrides::resolve_input(plant, path)
+        .ok_or_else(|| bad(format!("`{path}` is no input of the flowsheet")))?;
+    let info = &plant.inputs()[i];
+    let change = match value.strip_suffix('%') {
+        Some(p) => {
+            p.trim().parse::<f64>().map_err(|e| bad(format!("`{p}` is not a number: {e}")))? / 100.0 * info.value
+        }
+        None => parse_quantity_as(value, info.dim).map_err(|e| bad(e.to_string()))?,
+    };
+    Ok(Disturbance { path: path.to_string(), change })
+}
+
+fn opt(v: Option<f64>, scale: f64) -> String {
+    v.map_or("–".into(), |v| format!("{:.4}", v * scale))
+}
+
+/// The designs as a markdown table.
+fn table(s: &VesselSizing) -> String {
+    let mut t = format!(
+        "surge sizing of `{}` ({}; level controller `{}` on `{}`) for {}: outflow change {:.4e} mol/s, \
+         level band ±{} m, rate limit {:.4e} mol/s², liquid {:.4e} m³/mol\n\n",
+        s.vessel,
+        s.kind,
+        s.level_controller,
+        s.outflow,
+        s.disturbance,
+        s.flow_change,
+        s.level_band,
+        s.max_outflow_rate,
+        s.liquid_molar_volume
+    );
+    t.push_str("| controller | area [m²] | band volume [m³] | kc [SI] | τI [min] | max level deviation [m] | max outflow rate [mol/s²] | meets |\n");
+    t.push_str("|---|---|---|---|---|---|---|---|\n");
+    for d in &s.designs {
+        t.push_str(&format!(
+            "| {} | {:.4} | {:.4} | {} | {} | {:.6} | {:.4e} | {} |\n",
+            d.controller.name(),
+            d.area,
+            d.band_volume,
+            opt(d.kc, 1.0),
+            opt(d.tau_i, 1.0 / 60.0),
+            d.verified.max_level_deviation,
+            d.verified.max_outflow_rate,
+            if d.verified.meets { "yes" } else { "NO" }
+        ));
+    }
+    let c = &s.current;
+    t.push_str(&format!(
+        "\nas the file has it{}: max deviation {}, max outflow rate {:.4e} mol/s² — {}\n",
+        c.area.map_or(String::new(), |a| format!(" (area {a:.4} m²)")),
+        opt(c.max_deviation, 1.0),
+        c.max_outflow_rate,
+        if c.meets { "meets the limits" } else { "exceeds them" }
+    ));
+    t
+}
+
+/// The candidates, best first.
+fn ranking_table(r: &CandidateRanking) -> String {
+    let mut t = String::from(
+        "| rank | candidate | kind | outflow change [mol/s] | now: max rate [mol/s²] | needs surge | optimal band volume [m³] | P band volume [m³] |\n|---|---|---|---|---|---|---|---|\n",
+    );
+    for c in &r.candidates {
+        let Some(s) = &c.sizing else {
+            t.push_str(&format!(
+                "| – | {} | – | – | – | – | – | {} |\n",
+                c.candidate.as_deref().unwrap_or("?"),
+                c.failure.as_deref().unwrap_or("")
+            ));
+            continue;
+        };
+        let vol = |k: usize| s.designs.get(k).map_or(f64::NAN, |d| d.band_volume);
+        t.push_str(&format!(
+            "| {} | {} | {} | {:.4e} | {:.4e} | {} | {:.4} | {:.4} |\n",
+            c.rank.unwrap_or(0),
+            s.vessel,
+            s.kind,
+            s.flow_change,
+            s.current.max_outflow_rate,
+            if c.needs_surge == Some(true) { "yes" } else { "no" },
+            vol(2),
+            vol(0)
+        ));
+    }
+    t
+}
+
+/// Level deviation and outflow of the designs and the file's vessel, on one time grid (each
+/// record held at its last value after it ends).
+fn plot_designs(out: &Path, s: &VesselSizing) -> Result<(), CliError> {
+    let end = s.designs.iter().map(|d| d.verified.duration).fold(0.0, f64::max);
+    let grid: Vec<f64> = (0..=1000).map(|k| end * k as f64 / 1000.0).collect();
+    let at = |times: &[f64], ys: &[f64]| -> Vec<f64> { grid.iter().map(|&t| interpolate(times, ys, t)).collect() };
+    let mut level = Vec::new();
+    let mut flow = Vec::new();
+    for d in &s.designs {
+        let tr = &d.verified.trace;
+        let name = format!("{} (A = {:.3} m²)", d.controller.name(), d.area);
+        level.push((name.clone(), at(&tr.times, &tr.deviation)));
+        flow.push((name, at(&tr.times, &tr.outflow)));
+    }
+    let tr = &s.current.trace;
+    flow.push(("as in the file".to_string(), at(&tr.times, &tr.outflow)));
+    let panels = [
+        Overlay { label: "level deviation [m]".into(), curves: level },
+        Overlay { label: format!("{} [mol/s]", s.outflow), curves: flow },
+    ];
+    let hours: Vec<f64> = grid.iter().map(|t| t / 3600.0).collect();
+    let title = format!("surge designs of `{}` for {} (band ±{} m)", s.vessel, s.disturbance, s.level_band);
+    write_overlays(out, &title, "time after the step [h]", &hours, &panels).map_err(|e| CliError::user(e.to_string()))
+}
+
+fn interpolate(times: &[f64], ys: &[f64], t: f64) -> f64 {
+    let k = times.partition_point(|&s| s < t);
+    match (k, times.get(k)) {
+        (0, _) => ys.first().copied().unwrap_or(f64::NAN),
+        (_, None) => ys.last().copied().unwrap_or(f64::NAN),
+        (k, Some(&t1)) => {
+            let (t0, y0, y1) = (times[k - 1], ys[k - 1], ys[k]);
+            if t1 > t0 { y0 + (y1 - y0) * (t - t0) / (t1 - t0) } else { y1 }
+        }
+    }
+}
+
+/// The candidates' optimal band volumes as bars.
+fn plot_candidates(out: &Path, r: &CandidateRanking) -> Result<(), CliError> {
+    let bars: Vec<(String, f64)> = r
+        .candidates
+        .iter()
+        .map(|c| match &c.sizing {
+            Some(s) => {
+                let need = if c.needs_surge == Some(true) { "needs surge" } else { "meets the limit now" };
+                (
+                    format!("{} {} ({need})", c.rank.unwrap_or(0), s.vessel),
+                    s.designs.get(2).map_or(f64::NAN, |d| d.band_volume),
+                )
+            }
+            None => (format!("– {}", c.candidate.as_deref().unwrap_or("?")), f64::NAN),
+        })
+        .collect();
+    write_bars(out, "band volume the optimal averaging controller needs", "m³", &bars)
+        .map_err(|e| CliError::user(e.to_string()))
+}

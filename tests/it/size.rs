@@ -1,0 +1,173 @@
+//! `plantwide size`: the three surge designs of the surge tank against their closed forms (derived
+//! in `plantwide_studies::size::closed_form`), their nonlinear verification, the optimal design
+//! run by `plantwide run`, the residence-time check, and bad input.
+
+use serde_json::Value;
+
+use crate::harness::{converge, flowsheet, plantwide, value};
+
+const E: f64 = std::f64::consts::E;
+
+/// `size --json` of the 0.1 m² surge tank for a 10 mol/s inflow step, ±0.2 m, 0.05 mol/s².
+fn tank_sizing() -> Value {
+    let file = flowsheet("surge_tank_pi.json");
+    let args = ["size", &file, "--vessel", "tank", "--disturbance", "F_in=+10 mol/s", "--level-band", "0.2 m"];
+    let out = plantwide(&[&args[..], &["--max-outflow-rate", "3 mol/s/min", "--json"]].concat());
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+fn num(v: &Value, key: &str) -> f64 {
+    v[key].as_f64().unwrap_or_else(|| panic!("no number `{key}` in {v}"))
+}
+
+fn rel(a: f64, b: f64) -> f64 {
+    (a - b).abs() / b.abs()
+}
+
+#[test]
+fn the_three_tank_designs_reproduce_their_closed_forms_and_hold_the_limits() {
+    let s = tank_sizing();
+    // The liquid's molar volume from the converged tank (V/M), the flow change from conservation:
+    // at steady state the pumped outflow equals the inflow, so it moves by the step.
+    let (plant, ss) = converge("surge_tank_pi.json");
+    let v_l = value(&plant, &ss.x, "tank.V") / value(&plant, &ss.x, "tank.M");
+    let (du, band, r) = (10.0, 0.2, 3.0 / 60.0);
+    assert!(rel(num(&s, "flow_change"), du) < 1e-9, "{}", s["flow_change"]);
+    assert!(rel(num(&s, "liquid_molar_volume"), v_l) < 1e-12);
+    let designs = s["designs"].as_array().unwrap();
+    let by = |c: &str| designs.iter().find(|d| d["controller"] == c).unwrap_or_else(|| panic!("no design {c}"));
+    // A = c v_L Δu²/(r Δh): c = 1 (P), 2/e (PI), 1/2 (optimal).
+    let area = |c: f64| c * v_l * du * du / (r * band);
+    let (p, pi, opt) = (by("p"), by("pi"), by("optimal"));
+    for (d, c) in [(p, 1.0), (pi, 2.0 / E), (opt, 0.5)] {
+        assert!(rel(num(d, "area"), area(c)) < 1e-6, "{d}");
+        assert!(rel(num(d, "band_volume"), area(c) * band) < 1e-6, "{d}");
+        assert_eq!(d["refinements"], 0, "the closed form holds on a linear tank: {d}");
+    }
+    // P: |Kc| = Δu/Δh; PI: |Kc| = 2Δu/(eΔh), τ_I = 2eΔh A/(v_L Δu); optimal: C = A/v_L, t* = Δu/r.
+    assert!(rel(num(p, "kc"), du / band) < 1e-6 && p["tau_i"].is_null());
+    assert!(rel(num(pi, "kc"), 2.0 * du / (E * band)) < 1e-6);
+    assert!(rel(num(pi, "tau_i"), 2.0 * E * band * area(2.0 / E) / (v_l * du)) < 1e-6);
+    assert!(rel(num(opt, "capacity"), area(0.5) / v_l) < 1e-6 && rel(num(opt, "ramp_time"), du / r) < 1e-9);
+    // Each design, run on the nonlinear tank, reaches the band and the rate limit (the three meet
+    // them exactly in the linear closed loop) and holds both.
+    for d in [p, pi, opt] {
+        let v = &d["verified"];
+        assert_eq!(v["meets"], true, "{d}");
+        assert!(rel(num(v, "max_level_deviation"), band) < 1e-3, "{v}");
+        assert!(rel(num(v, "max_outflow_rate"), r) < 1e-3, "{v}");
+    }
+    // The file's own PI (Kc = 50 mol/s/m on 0.1 m²) starts the outflow at Kc v_L Δu/A.
+    let c = &s["current"];
+    assert!(rel(num(c, "max_outflow_rate"), 50.0 * v_l * du / 0.1) < 1e-3, "{c}");
+    assert_eq!(c["meets"], false);
+}
+
+/// The optimal design written into the flowsheet as an `averaging_level` controller and run by
+/// `plantwide run`: the level stops at the band as the outflow, ramping at the limit, meets the
+/// inflow; the outflow never changes faster than the limit.
+#[test]
+fn the_optimal_design_runs_in_run() {
+    let s = tank_sizing();
+    let opt = s["designs"].as_array().unwrap().iter().find(|d| d["controller"] == "optimal").unwrap().clone();
+    let (band, r) = (0.2, 0.05);
+    let dir = std::env::temp_dir().join(format!("plantwide_size_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut sheet: Value =
+        serde_json::from_str(&std::fs::read_to_string(flowsheet("surge_tank_pi.json")).unwrap()).unwrap();
+    sheet["units"]["tank"]["area"] = opt["area"].clone();
+    let ramp = num(&opt, "ramp_time");
+    sheet["controllers"]["lc"] = serde_json::json!({
+        "type": "averaging_level", "law": "optimal", "pv": "tank.level", "output": "tank.outflow", "sp": "1 m",
+        "level_band": band, "capacity": opt["capacity"], "return_time": 4.0 * ramp, "max_rate": r,
+        "filter": 1e-4 * ramp, "action": "direct", "op_min": "0 mol/s"});
+    let file = dir.join("optimal.json");
+    std::fs::write(&file, sheet.to_string()).unwrap();
+    let scenario = dir.join("step.json");
+    let sc = serde_json::json!({"format_version": 1, "name": "step", "duration": format!("{} s", 50.0 * ramp),
+        "integrator": {"rtol": 1e-8},
+        "events": [{"type": "step", "at": "0 s", "path": "F_in", "to": "60 mol/s"}],
+        "record": {"interval": format!("{} s", ramp / 1000.0), "time_unit": "s", "paths": ["tank.level", "out.F"]}});
+    std::fs::write(&scenario, sc.to_string()).unwrap();
+    let csv = dir.join("run.csv");
+    let out = plantwide(&[
+        "run",
+        file.to_str().unwrap(),
+        "--scenario",
+        scenario.to_str().unwrap(),
+        "--csv",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let rows: Vec<Vec<f64>> =
+        text.lines().skip(1).map(|l| l.split(',').map(|c| c.trim().parse().unwrap()).collect()).collect();
+    let peak = rows.iter().map(|row| (row[1] - 1.0).abs()).fold(0.0, f64::max);
+    let rate = rows.windows(2).map(|w| (w[1][2] - w[0][2]).abs() / (w[1][0] - w[0][0])).fold(0.0, f64::max);
+    assert!(rel(peak, band) < 1e-3 && peak < band * (1.0 + 1e-3), "peak {peak}");
+    // The law's rate is capped at r; the record is the integrator's dense output between its steps,
+    // whose difference quotients over 0.1 s carry its interpolation error (~1e-5 here).
+    assert!(rate <= r * (1.0 + 1e-4) && rate > r * (1.0 - 1e-3), "rate {rate}");
+    // After the ramp the level returns to its setpoint and the outflow holds the new inflow.
+    let last = rows.last().unwrap();
+    assert!((last[1] - 1.0).abs() < 1e-3 * band && (last[2] - 60.0).abs() < 1e-3, "{last:?}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn check_reports_residence_times_against_the_five_minute_rule() {
+    let out = plantwide(&["check", &flowsheet("two_column_plant.json")]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8_lossy(&out.stdout);
+    // Column 1's drum: 40 kmol over reflux + distillate = (272.3 + 197.6) kmol/h → 5.107 min.
+    let line = text.lines().find(|l| l.trim_start().starts_with("column1.drum")).unwrap_or_else(|| panic!("{text}"));
+    let minutes: f64 = line.split_whitespace().nth(1).unwrap().parse().unwrap();
+    assert!((minutes - 40.0 / (272.3 + 197.6) * 60.0).abs() < 0.01, "{line}");
+    assert!(!line.contains("short"), "{line}");
+    let short = text.lines().find(|l| l.trim_start().starts_with("column2.drum")).unwrap();
+    assert!(short.contains("short"), "{short}");
+    // The 0.1 m² tank: 0.1 m³ of water (5.5 kmol) through 50 mol/s is 1.8 min.
+    let out = plantwide(&["check", &flowsheet("surge_tank_pi.json")]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.lines().any(|l| l.trim_start().starts_with("tank") && l.contains("1.84 min") && l.contains("short")),
+        "{text}"
+    );
+}
+
+/// `size` refuses each bad request with exit 1 and the fix.
+#[test]
+fn bad_requests_are_refused_by_name() {
+    let file = flowsheet("surge_tank_pi.json");
+    // The request with one argument changed: `--vessel`, `--disturbance`, `--level-band`, rate.
+    let request = |v: &str, d: &str, b: &str, r: &str| {
+        let args = ["size", &file, "--vessel", v, "--disturbance", d, "--level-band", b, "--max-outflow-rate", r];
+        let out = plantwide(&args);
+        (out.status.code(), String::from_utf8_lossy(&out.stderr).to_string())
+    };
+    let (d, b, r) = ("F_in=+10%", "0.2 m", "3 mol/s/min");
+    let cases = [
+        (request("tank", d, "1.5 m", r), "below the vessel's bottom (setpoint 1 m)"),
+        (request("tank", d, "-0.1 m", r), "positive length"),
+        (request("tank", d, b, "-1 mol/s/min"), "positive rate"),
+        (request("tank", d, b, "3 mol/s"), "--max-outflow-rate 3 mol/s"),
+        (request("tank", "F_in=+0%", b, r), "nonzero"),
+        (request("tank", "nothing.F=+10%", b, r), "no input"),
+        (request("tank", "tank.P=+10%", b, r), "does not move the outflow"),
+        (request("tonk", d, b, r), "vessels with a level: tank"),
+        (request("inflow", d, b, r), "holds no level"),
+    ];
+    for ((code, err), expected) in cases {
+        assert_eq!(code, Some(1), "{expected}: {err}");
+        assert!(err.contains(expected), "expected `{expected}` in: {err}");
+    }
+    // A band that reaches over the top: the setpoint moved to 1.5 m in the 2 m tank.
+    let args = ["size", &file, "--set", "lc.sp=1.5 m", "--vessel", "tank", "--disturbance", d, "--level-band", "0.6 m"];
+    let out = plantwide(&[&args[..], &["--max-outflow-rate", r]].concat());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        out.status.code() == Some(1) && err.contains("above the vessel's top (setpoint 1.5 m, height 2 m)"),
+        "{err}"
+    );
+}
