@@ -591,6 +591,99 @@ def surge_tank(s, md):
         "suffice.", "", "![with tank](two_column_plant/surge_with.png)", ""]
 
 
+SIZE_SPEC = ["--disturbance", "fresh_A.F=+10%", "--level-band", "0.3 m", "--max-outflow-rate", "0.2 kmol/h/min"]
+SIZE_CANDIDATES = "column1.drum,column1.sump,bottoms1"
+KMOLH_MIN = 3.6 * 60  # mol/s² -> kmol/h per min
+
+
+def surge_sizing(s, md):
+    """Sections 6-7's questions for a production step, answered by `plantwide size`."""
+    r = s.pw("size", BASE, "--candidates", SIZE_CANDIDATES, *SIZE_SPEC, "--json",
+             "--plot", s.fig("surge_candidates.png"), parse_json=True)
+    s.pw("size", BASE, "--vessel", "column1.drum", *SIZE_SPEC, "--plot", s.fig("drum_designs.png"))
+    md += ["## 6b. Where is surge capacity needed for a production step? (`plantwide size`)", "",
+           "`plantwide size --candidates` sizes each place for the same specification and ranks them by the band "
+           "volume the optimal averaging controller needs there. The specification: production stepped by +10 % "
+           "(fresh A 100 → 110 kmol/h), level within ±0.3 m of its setpoint, the flow leaving the vessel changing "
+           "by at most 0.2 kmol/h per minute. The candidates: column 1's reflux drum (its distillate is the "
+           "recycle to the reactor), its base (held by the boilup under LB), and a new surge tank on `bottoms1` "
+           "between the columns. Each design (P, critically damped PI, optimal) is sized by its closed form and "
+           "verified by a nonlinear run of the whole plant; a design the run shows short is corrected and run "
+           "again.", ""]
+    rows, res = [], {}
+    for c in r["candidates"]:
+        z = c.get("vessel") or c.get("candidate")
+        if "designs" not in c:
+            rows.append([z, "–", "–", "–", "–", "–", "–", "–"])
+            res[z] = {"failure": c.get("failure")}
+            continue
+        d = {x["controller"]: x for x in c["designs"]}
+        res[z] = {"kind": c["kind"], "flow_change_kmol_h": c["flow_change"] * KMOLH,
+                  "current_rate_kmol_h_min": c["current"]["max_outflow_rate"] * KMOLH_MIN,
+                  "needs_surge": c["needs_surge"], "liquid_molar_volume": c["liquid_molar_volume"],
+                  "designs": {k: {"area": x["area"], "closed_form_area": x["closed_form_area"],
+                                  "band_volume": x["band_volume"], "refinements": x["refinements"],
+                                  "normal_holdup_kmol": (x.get("normal_holdup") or 0) / 1000,
+                                  "meets": x["verified"]["meets"], "failure": x["verified"]["failure"],
+                                  "max_level_deviation": x["verified"]["max_level_deviation"],
+                                  "max_rate_kmol_h_min": x["verified"]["max_outflow_rate"] * KMOLH_MIN}
+                              for k, x in d.items()}}
+        verdict = lambda k: (fmt(d[k]["band_volume"]) + (" ✓" if d[k]["verified"]["meets"] else " ✗"))
+        rows.append([f"{c['rank']}. {z}", c["kind"], fmt(res[z]["flow_change_kmol_h"]),
+                     fmt(res[z]["current_rate_kmol_h_min"]), "yes" if c["needs_surge"] else "no",
+                     verdict("optimal"), verdict("pi"), verdict("p")])
+    s.results["sizing"] = res
+    md += [table(["candidate", "kind", "Δ outflow [kmol/h]", "now: max rate [kmol/h/min]", "needs surge",
+                  "optimal [m³]", "PI [m³]", "P [m³]"], rows), "",
+           "Band volumes; ✓ the nonlinear run holds both limits, ✗ it does not (or stopped).", ""]
+    md += sizing_conclusions(res)
+    md += ["![candidates](two_column_plant/surge_candidates.png)", "",
+           "![drum designs](two_column_plant/drum_designs.png)", ""]
+
+
+def sizing_conclusions(res):
+    """The answers, read from the sizing's numbers."""
+    out = []
+    b = res.get("bottoms1", {})
+    if "designs" in b:
+        need = "needs" if b["needs_surge"] else "does not need"
+        out.append(f"**Between the columns.** Without a tank column 2's feed changes by at most "
+                   f"{fmt(b['current_rate_kmol_h_min'])} kmol/h/min after the step (its flow moves by "
+                   f"{fmt(b['flow_change_kmol_h'])} kmol/h, smoothed by column 1's own holdups and loops): the plant "
+                   f"{need} a surge tank there for this specification. A tank that guaranteed it for a sharper upset "
+                   f"would hold {fmt(b['designs']['optimal']['band_volume'])} m³ of band with the optimal controller, "
+                   f"{fmt(b['designs']['p']['band_volume'])} m³ with P-only. (§6: against a 1-h cycle of column 1's "
+                   "feed temperature a tank does attenuate the flow swing.)")
+        out.append("")
+    d = res.get("column1.drum", {})
+    if "designs" in d:
+        need = "too small" if d["needs_surge"] else "big enough"
+        p = d["designs"]["p"]
+        out.append(f"**Column 1's reflux drum.** With its file controller (P-only, 10 1/h on 40 kmol) the recycle to the "
+                   f"reactor changes by up to {fmt(d['current_rate_kmol_h_min'])} kmol/h/min: the drum is {need} "
+                   f"to keep the step out of the reactor at 0.2 kmol/h/min. The distillate must move by "
+                   f"{fmt(d['flow_change_kmol_h'])} kmol/h; P-only needs a normal holdup of {fmt(p['normal_holdup_kmol'])} "
+                   f"kmol (band {fmt(p['band_volume'])} m³), the optimal controller "
+                   f"{fmt(d['designs']['optimal']['normal_holdup_kmol'])} kmol, against 40 kmol now: "
+                   f"{fmt(p['normal_holdup_kmol'] / 40)} and "
+                   f"{fmt(d['designs']['optimal']['normal_holdup_kmol'] / 40)} times the drum. Holding the recycle "
+                   "that smooth is a large vessel; §7 shows the reactor's loops absorb what today's drum passes.")
+        out.append("")
+    sump = res.get("column1.sump", {})
+    if "designs" in sump:
+        failed = {k: x["failure"] for k, x in sump["designs"].items() if not x["meets"]}
+        limits = "; ".join(f"{k}: {f.split('at a limit then: ', 1)[-1].rstrip(')')}" for k, f in failed.items()
+                           if f and "at a limit then" in f)
+        out.append(f"**Column 1's base.** Under LB the base level is held by the boilup, which must move by "
+                   f"{fmt(sump['flow_change_kmol_h'])} kmol/h — at 0.2 kmol/h/min a "
+                   f"{fmt(sump['flow_change_kmol_h'] / 0.2 / 60)}-hour ramp. {len(failed)} of 3 designs fail their "
+                   f"run, the integrator stopping with loops at their limits ({limits}): slowing the boilup starves "
+                   "column 1, whose bottoms-temperature loop closes the bottoms flow, and column 2 loses its feed. "
+                   "The base is no place for surge in this structure; its level loop must stay tight.")
+        out.append("")
+    return out
+
+
 def reflux_drum(s, md):
     md += ["## 7. Is column 1's reflux drum big enough?", "",
            "The distillate is the recycle; the drum's averaging level loop (P-only, tuned so that half the drum "
@@ -748,6 +841,7 @@ def main():
     sensitivity_66(s, md)
     dynamics(s, md)
     surge_tank(s, md)
+    surge_sizing(s, md)
     reflux_drum(s, md)
     safety(s, md)
     commands(s, md)

@@ -242,6 +242,8 @@ fn plot_candidates(out: &Path, r: &CandidateRanking) -> Result<(), CliError> {
         .map(|c| match &c.sizing {
             Some(s) => {
                 let need = if c.needs_surge == Some(true) { "needs surge" } else { "meets the limit now" };
+                let fails = s.designs.get(2).is_some_and(|d| !d.verified.meets);
+                let need = if fails { format!("{need}; the design fails its run") } else { need.to_string() };
                 (
                     format!("{} {} ({need})", c.rank.unwrap_or(0), s.vessel),
                     s.designs.get(2).map_or(f64::NAN, |d| d.band_volume),

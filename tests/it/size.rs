@@ -171,3 +171,64 @@ fn bad_requests_are_refused_by_name() {
         "{err}"
     );
 }
+
+/// The two-column plant's question "is a surge tank needed between the columns?" for a production
+/// step (+10 % fresh A), a ±0.3 m band and 0.2 kmol/h/min on column 2's feed: `size --vessel
+/// bottoms1` puts a tank there, sizes it, and runs the plant without it (`docs/two_column_plant.md`
+/// §6b). About 80 s unoptimized.
+#[test]
+fn between_the_columns_a_production_step_needs_no_surge_tank() {
+    let file = flowsheet("two_column_plant.json");
+    let spec = ["--disturbance", "fresh_A.F=+10%", "--level-band", "0.3 m", "--max-outflow-rate", "0.2 kmol/h/min"];
+    let out = plantwide(&[&["size", &file, "--vessel", "bottoms1", "--json"][..], &spec[..]].concat());
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let s: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(s["kind"], "new_surge_tank");
+    // The flow change from conservation at the two steady states: bottoms1 = column 2's distillate
+    // plus bottoms.
+    let products = |set: &[&str]| {
+        let out = plantwide(&[&["steady", &file, "--json"][..], set].concat());
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+        num(&v["values"], "product.F") + num(&v["values"], "heavies.F")
+    };
+    let du = products(&["--set", "fresh_A.F=110 kmol/h"]) - products(&[]);
+    assert!(rel(num(&s, "flow_change"), du) < 1e-6, "{} vs {du}", s["flow_change"]);
+    let (band, r, v_l) = (0.3, 0.2 / 3.6 / 60.0, num(&s, "liquid_molar_volume"));
+    for (d, c) in s["designs"].as_array().unwrap().iter().zip([1.0, 2.0 / E, 0.5]) {
+        assert!(rel(num(d, "closed_form_area"), c * v_l * du * du / (r * band)) < 1e-6, "{d}");
+        let v = &d["verified"];
+        assert_eq!(v["meets"], true, "{d}");
+        assert!(num(v, "max_level_deviation") <= band * 1.001 && num(v, "max_outflow_rate") <= r * 1.001, "{v}");
+    }
+    // Without the tank column 2's feed already changes slower than the limit: no tank is needed.
+    let c = &s["current"];
+    assert!(c["meets"] == true && num(c, "max_outflow_rate") < r, "{c}");
+}
+
+/// `--candidates`: each sized for the same request and ranked by the optimal design's band
+/// volume; the bar plot is written; a name that is no vessel or stream is refused.
+#[test]
+fn candidates_are_ranked_by_the_band_volume_they_need() {
+    let file = flowsheet("surge_tank_pi.json");
+    let plot = std::env::temp_dir().join(format!("plantwide_candidates_{}.png", std::process::id()));
+    let spec = ["--disturbance", "F_in=+10 mol/s", "--level-band", "0.2 m", "--max-outflow-rate", "3 mol/s/min"];
+    let args = ["size", &file, "--candidates", "tank,out", "--json", "--plot", plot.to_str().unwrap()];
+    let out = plantwide(&[&args[..], &spec[..]].concat());
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let r: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let c = r["candidates"].as_array().unwrap();
+    let volume = |k: usize| num(&c[k]["designs"][2], "band_volume");
+    assert_eq!((c[0]["rank"].as_u64(), c[1]["rank"].as_u64()), (Some(1), Some(2)));
+    assert!(volume(0) <= volume(1));
+    // The tank on `out` sees the same step (the outflow follows the inflow) in the same water: the
+    // same closed form. Both exceed the limit today: the file's PI starts the outflow at
+    // Kc v_L Δu / A = 0.0906 mol/s² > 0.05.
+    assert!(rel(volume(0), volume(1)) < 1e-6);
+    assert!(c.iter().all(|x| x["needs_surge"] == true), "{r}");
+    assert!(std::fs::metadata(&plot).is_ok_and(|m| m.len() > 1000));
+    std::fs::remove_file(&plot).ok();
+    let bad = plantwide(&[&["size", &file, "--candidates", "tank,nowhere"][..], &spec[..]].concat());
+    assert_eq!(bad.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("`nowhere` is no vessel"));
+}

@@ -64,7 +64,30 @@ fn two_column_study_runs_and_reaches_its_conclusions() {
     pin_base_and_structures(&r);
     pin_production_and_sensitivity(&r);
     pin_dynamics_and_safety(&r);
+    pin_sizing(&r);
     let _ = std::fs::remove_dir_all(&out);
+}
+
+/// §6b of the full study: `size --candidates` for a production step. No tank is needed between the
+/// columns (the bare stream already meets the rate limit); the reflux drum does not meet it with
+/// its file controller, and its three designs, verified on the plant, do; the base under LB cannot
+/// be a surge volume (every design's run stops). The drum's closed-form areas stand in the ratio
+/// 1 : 2/e : 1/2 (P, PI, optimal).
+fn pin_sizing(r: &Value) {
+    let s = &r["sizing"];
+    assert_eq!(s["bottoms1"]["needs_surge"], false, "{}", s["bottoms1"]);
+    assert_eq!(s["column1.drum"]["needs_surge"], true, "{}", s["column1.drum"]);
+    for d in ["p", "pi", "optimal"] {
+        assert_eq!(s["column1.drum"]["designs"][d]["meets"], true, "{d}: {}", s["column1.drum"]);
+        assert_eq!(s["bottoms1"]["designs"][d]["meets"], true, "{d}: {}", s["bottoms1"]);
+        assert_eq!(s["column1.sump"]["designs"][d]["meets"], false, "{d}: {}", s["column1.sump"]);
+    }
+    let drum = &s["column1.drum"]["designs"];
+    let a = |d: &str| drum[d]["closed_form_area"].as_f64().unwrap();
+    assert!((a("pi") / a("p") - 2.0 / std::f64::consts::E).abs() < 1e-9 && (a("optimal") / a("p") - 0.5).abs() < 1e-9);
+    // The recycle moves by more than column 2's feed (the snowball): the drum needs more band.
+    let flow = |c: &str| s[c]["flow_change_kmol_h"].as_f64().unwrap();
+    assert!(flow("column1.drum") > 3.0 * flow("bottoms1"), "{s}");
 }
 
 /// §1–2 of the full study: the base case's conservation and design, the column structures' gains.

@@ -291,7 +291,7 @@ pub fn size_vessel(plant: &Plant, x: &[f64], name: &str, r: &SizeRequest) -> Res
         kind: v.kind_name(),
         level_controller: v.controller.clone(),
         outflow: v.outflow.clone(),
-        disturbance: format!("{} {:+}", r.disturbance.path, r.disturbance.change),
+        disturbance: format!("{} {:+.6e} (SI)", r.disturbance.path, r.disturbance.change),
         flow_change,
         liquid_molar_volume: v.v_l,
         level_band: r.level_band,

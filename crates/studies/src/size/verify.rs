@@ -243,7 +243,9 @@ impl Run<'_> {
             dt = (1.1 * dt).min(dt_max);
             t = (t + dt).min(t_max);
             if let Err(e) = s.advance_to(t) {
-                return Ok((tr, Ending::Failed(e.to_string())));
+                let limits = at_limits(self.plant, s.state());
+                let why = if limits.is_empty() { e.to_string() } else { format!("{e} (at a limit then: {limits})") };
+                return Ok((tr, Ending::Failed(why)));
             }
             let (y, op) = (s.state()[self.pv] - y0, s.state()[self.op]);
             let still = (y - tr.deviation[tr.deviation.len() - 1]).abs() <= 1e-4 * band_y;
@@ -256,6 +258,24 @@ impl Run<'_> {
             }
         }
     }
+}
+
+/// The PID controllers whose output sits on one of its limits at state `x`, as `name at op_min
+/// (value SI)`: what a run that stopped had run out of.
+fn at_limits(plant: &Plant, x: &[f64]) -> String {
+    use plantwide_model::ControllerSpec;
+    let mut out = Vec::new();
+    for (name, c) in &plant.spec().controllers {
+        let (ControllerSpec::Pid(cfg), Some(op)) = (c, plant.var(&format!("{name}.op"))) else { continue };
+        let dim = plant.vars()[op].spec.dim;
+        for (which, limit) in [("op_min", &cfg.op_min), ("op_max", &cfg.op_max)] {
+            let Some(l) = limit.as_ref().and_then(|l| l.to_si(dim).ok()) else { continue };
+            if (x[op] - l).abs() <= 1e-9 * l.abs().max(1e-12) {
+                out.push(format!("`{name}` at {which} ({l:.6e})"));
+            }
+        }
+    }
+    out.join(", ")
 }
 
 /// The largest `|deviation|` and the largest `|Δoutflow/Δt|` of a record.
