@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use plantwide::flowsheet::Plant;
 use plantwide::io::plot::{Overlay, write_bars, write_overlays};
 use plantwide::studies::size::{
-    CandidateRanking, Disturbance, SizeError, SizeRequest, VesselSizing, rank_candidates, size_vessel,
+    CandidateRanking, Disturbance, Shape, SizeError, SizeRequest, VesselSizing, rank_candidates, size_vessel,
 };
 use plantwide::units::{Dimension, parse_quantity_as};
 
@@ -32,6 +32,12 @@ pub struct SizeArgs {
     /// The disturbance, a step of an input: PATH=±x% (of its value) or PATH=±VALUE with units.
     #[arg(long, value_name = "PATH=±Δ")]
     disturbance: String,
+    /// The disturbance as a ramp to the same change over this time, instead of a step.
+    #[arg(long, value_name = "TIME", conflicts_with = "sine")]
+    ramp: Option<String>,
+    /// The disturbance as a sinusoid of amplitude Δ and this period, instead of a step.
+    #[arg(long, value_name = "PERIOD")]
+    sine: Option<String>,
     /// The largest allowed deviation of the level from its setpoint, either way (a length).
     #[arg(long, value_name = "Δh", allow_hyphen_values = true)]
     level_band: String,
@@ -100,11 +106,18 @@ fn request(a: &SizeArgs, plant: &Plant) -> Result<SizeRequest, CliError> {
     if duration.is_some_and(|d| d.is_nan() || d <= 0.0) {
         return Err(CliError::user("--duration: must be a positive time"));
     }
-    Ok(SizeRequest { disturbance: disturbance(&a.disturbance, plant)?, level_band, max_outflow_rate, duration })
+    let time = |flag: &str, t: &Option<String>| t.as_deref().map(|t| quantity(flag, t, Dimension::TIME)).transpose();
+    let shape = match (time("--ramp", &a.ramp)?, time("--sine", &a.sine)?) {
+        (Some(duration), _) => Shape::Ramp { duration },
+        (None, Some(period)) => Shape::Sine { period },
+        (None, None) => Shape::Step,
+    };
+    let disturbance = disturbance(&a.disturbance, plant, shape)?;
+    Ok(SizeRequest { disturbance, level_band, max_outflow_rate, duration })
 }
 
 /// `PATH=±x%` or `PATH=±VALUE` with the input's units.
-fn disturbance(text: &str, plant: &Plant) -> Result<Disturbance, CliError> {
+fn disturbance(text: &str, plant: &Plant, shape: Shape) -> Result<Disturbance, CliError> {
     let bad = |why: String| CliError::user(format!("--disturbance {text}: {why}"));
     let (path, value) = text
         .split_once('=')
@@ -119,7 +132,7 @@ fn disturbance(text: &str, plant: &Plant) -> Result<Disturbance, CliError> {
         }
         None => parse_quantity_as(value, info.dim).map_err(|e| bad(e.to_string()))?,
     };
-    Ok(Disturbance { path: path.to_string(), change })
+    Ok(Disturbance { path: path.to_string(), change, shape })
 }
 
 fn opt(v: Option<f64>, scale: f64) -> String {
@@ -156,6 +169,9 @@ fn table(s: &VesselSizing) -> String {
             if d.verified.meets { "yes" } else { "NO" }
         ));
     }
+    for d in s.designs.iter().filter(|d| d.verified.failure.is_some()) {
+        t.push_str(&format!("\n{}: {}\n", d.controller.name(), d.verified.failure.as_deref().unwrap_or("")));
+    }
     let c = &s.current;
     t.push_str(&format!(
         "\nas the file has it{}: max deviation {}, max outflow rate {:.4e} mol/s² — {}\n",
@@ -164,6 +180,9 @@ fn table(s: &VesselSizing) -> String {
         c.max_outflow_rate,
         if c.meets { "meets the limits" } else { "exceeds them" }
     ));
+    if let Some(why) = &c.failure {
+        t.push_str(&format!("its run stopped: {why}\n"));
+    }
     t
 }
 

@@ -232,3 +232,45 @@ fn candidates_are_ranked_by_the_band_volume_they_need() {
     assert_eq!(bad.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&bad.stderr).contains("`nowhere` is no vessel"));
 }
+
+/// A ramp or a sinusoid instead of the step: the P design (the step's closed form) verified under
+/// the shape against the first-order closed loop's own closed forms. With `τ = A/(v_L K_c)` the
+/// filter time and `a = Δu`: a ramp over `T` moves the outflow fastest at its end,
+/// `(a/T)(1 − e^(−T/τ))`; a sinusoid from rest gives the level
+/// `h(t) = (a/K_c)/(1 + ω²τ²) · (sin ωt − ωτ cos ωt + ωτ e^(−t/τ))` and the outflow `K_c h`.
+#[test]
+fn ramps_and_sinusoids_verify_against_the_first_order_closed_loop() {
+    let file = flowsheet("surge_tank_pi.json");
+    let spec = ["--disturbance", "F_in=+10 mol/s", "--level-band", "0.2 m", "--max-outflow-rate", "3 mol/s/min"];
+    let size = |shape: &str| {
+        let out = plantwide(&[&["size", &file, "--vessel", "tank", "--json", shape][..], &spec[..]].concat());
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let s: Value = serde_json::from_slice(&out.stdout).unwrap();
+        s["designs"][0].clone()
+    };
+    let (a, kc) = (10.0, 10.0 / 0.2);
+    let p = size("--ramp=10 min");
+    assert_eq!((p["controller"].as_str(), p["refinements"].as_u64()), (Some("p"), Some(0)));
+    let v_l = {
+        let (plant, ss) = converge("surge_tank_pi.json");
+        value(&plant, &ss.x, "tank.V") / value(&plant, &ss.x, "tank.M")
+    };
+    let tau = num(&p, "area") / (v_l * kc);
+    let ramp = 600.0;
+    let expected = a / ramp * (1.0 - (-ramp / tau).exp());
+    assert!(rel(num(&p["verified"], "max_outflow_rate"), expected) < 1e-3, "{} vs {expected}", p["verified"]);
+    assert!(rel(num(&p["verified"], "max_level_deviation"), 0.2) < 1e-3, "the level still ends at the band");
+    let p = size("--sine=10 min");
+    let w = 2.0 * std::f64::consts::PI / 600.0;
+    let duration = num(&p["verified"], "duration");
+    let (mut h_max, mut rate_max) = (0.0f64, 0.0f64);
+    let g = a / kc / (1.0 + (w * tau).powi(2));
+    for k in 0..=200_000 {
+        let t = duration * k as f64 / 200_000.0;
+        let h = g * ((w * t).sin() - w * tau * (w * t).cos() + w * tau * (-t / tau).exp());
+        let dh = g * (w * (w * t).cos() + w * w * tau * (w * t).sin() - w * (-t / tau).exp());
+        (h_max, rate_max) = (h_max.max(h.abs()), rate_max.max((kc * dh).abs()));
+    }
+    assert!(rel(num(&p["verified"], "max_level_deviation"), h_max) < 1e-3, "{} vs {h_max}", p["verified"]);
+    assert!(rel(num(&p["verified"], "max_outflow_rate"), rate_max) < 1e-3, "{} vs {rate_max}", p["verified"]);
+}

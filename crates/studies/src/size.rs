@@ -41,13 +41,56 @@ use vessel::Vessel;
 /// law's rate-estimate filter (`t*/10⁴`) leave the verified peaks within it of the closed form.
 pub const VERIFY_TOLERANCE: f64 = 1e-3;
 
-/// A step disturbance: input `path` moved by `change` (SI) at the start of the run.
+/// A disturbance: input `path` moved by `change` (SI) from the start of the run, in `shape`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Disturbance {
     /// Input path (or alias).
     pub path: String,
-    /// The step (SI, signed).
+    /// The step, the ramp's total change or the sinusoid's amplitude (SI, signed).
     pub change: f64,
+    /// Its time course.
+    pub shape: Shape,
+}
+
+/// The time course of a disturbance. The designs are the closed forms of a step of the same size
+/// (a ramp is gentler: the step's design holds it with margin; a sinusoid near the loop's natural
+/// frequency can swing a PI-held level up to `e/2` times a step's peak, which the verification shows
+/// and the refinement corrects); every design is verified under the shape given.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Shape {
+    /// A step at `t = 0`.
+    Step,
+    /// A ramp from `t = 0` over `duration` \[s\].
+    Ramp {
+        /// \[s\]
+        duration: f64,
+    },
+    /// `change · sin(2π t/period)` from `t = 0`, for 10 periods or the design's settling time.
+    Sine {
+        /// \[s\]
+        period: f64,
+    },
+}
+
+impl Shape {
+    /// The waveform of input value `u0` moved by `change`.
+    fn wave(self, u0: f64, change: f64) -> plantwide_solve::dynamic::Waveform {
+        use plantwide_solve::dynamic::Waveform;
+        match self {
+            Shape::Step => Waveform::Constant(u0 + change),
+            Shape::Ramp { duration } => Waveform::Ramp { t0: 0.0, v0: u0, t1: duration, v1: u0 + change },
+            Shape::Sine { period } => Waveform::Sine { t0: 0.0, base: u0, amplitude: change, period },
+        }
+    }
+
+    /// `step`, `ramp over 600 s`, `sinusoid of period 3600 s`.
+    fn describe(self) -> String {
+        match self {
+            Shape::Step => "step".into(),
+            Shape::Ramp { duration } => format!("ramp over {duration} s"),
+            Shape::Sine { period } => format!("sinusoid of period {period} s"),
+        }
+    }
 }
 
 /// What to size for.
@@ -291,7 +334,12 @@ pub fn size_vessel(plant: &Plant, x: &[f64], name: &str, r: &SizeRequest) -> Res
         kind: v.kind_name(),
         level_controller: v.controller.clone(),
         outflow: v.outflow.clone(),
-        disturbance: format!("{} {:+.6e} (SI)", r.disturbance.path, r.disturbance.change),
+        disturbance: format!(
+            "{} {:+.6e} (SI), {}",
+            r.disturbance.path,
+            r.disturbance.change,
+            r.disturbance.shape.describe()
+        ),
         flow_change,
         liquid_molar_volume: v.v_l,
         level_band: r.level_band,
@@ -323,7 +371,12 @@ fn check_request(plant: &Plant, r: &SizeRequest) -> Result<(), SizeError> {
         Some(_) if d.change.is_nan() || d.change == 0.0 || d.change.is_infinite() => {
             bad("the step must be a nonzero finite change, e.g. +10% or \"+20 kmol/h\"")
         }
-        Some(_) => Ok(()),
+        Some(_) => match d.shape {
+            Shape::Ramp { duration: t } | Shape::Sine { period: t } if t.is_nan() || t <= 0.0 || t.is_infinite() => {
+                bad("the ramp's duration or the sinusoid's period must be a positive time")
+            }
+            _ => Ok(()),
+        },
     }
 }
 

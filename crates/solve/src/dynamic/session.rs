@@ -84,6 +84,15 @@ impl Session {
         }
     }
 
+    /// Drive input `i` by `wave` (times on the session's clock) from now on: a ramp or a sinusoid
+    /// that the integrator follows between steps, where [`Session::set_input`] holds a value.
+    pub fn set_waveform(&mut self, i: usize, wave: Waveform) {
+        if self.waves[i] != wave {
+            self.waves[i] = wave;
+            self.restart = true;
+        }
+    }
+
     /// Integrate to time `t` \[s\] (ending exactly on it).
     ///
     /// # Errors
