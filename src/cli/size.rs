@@ -9,7 +9,8 @@ use std::path::{Path, PathBuf};
 use plantwide::flowsheet::Plant;
 use plantwide::io::plot::{Overlay, write_bars, write_overlays};
 use plantwide::studies::size::{
-    CandidateRanking, Disturbance, Shape, SizeError, SizeRequest, VesselSizing, rank_candidates, size_vessel,
+    Attenuation, CandidateRanking, Disturbance, Shape, SizeError, SizeRequest, VesselSizing, rank_candidates,
+    size_vessel,
 };
 use plantwide::units::{Dimension, parse_quantity_as};
 
@@ -42,8 +43,15 @@ pub struct SizeArgs {
     #[arg(long, value_name = "Δh", allow_hyphen_values = true)]
     level_band: String,
     /// The largest allowed rate of change of the vessel's outflow (e.g. "5 kmol/h/min").
-    #[arg(long, value_name = "r", allow_hyphen_values = true)]
-    max_outflow_rate: String,
+    #[arg(long, value_name = "r", allow_hyphen_values = true, required_unless_present = "attenuation")]
+    max_outflow_rate: Option<String>,
+    /// Instead of a rate limit: the outflow of the disturbance, a sinusoid of amplitude Δ at
+    /// --period, may swing at most this fraction of the inflow's (in (0, 1)).
+    #[arg(long, value_name = "RATIO", requires = "period", conflicts_with_all = ["max_outflow_rate", "ramp", "sine"], allow_hyphen_values = true)]
+    attenuation: Option<f64>,
+    /// The period of --attenuation.
+    #[arg(long, value_name = "PERIOD", requires = "attenuation")]
+    period: Option<String>,
     /// Length of each verification run (default: long enough for the design and the plant to settle).
     #[arg(long, value_name = "TIME")]
     duration: Option<String>,
@@ -100,8 +108,14 @@ fn request(a: &SizeArgs, plant: &Plant) -> Result<SizeRequest, CliError> {
         parse_quantity_as(text, dim).map_err(|e| CliError::user(format!("{flag} {text}: {e}")))
     };
     let level_band = quantity("--level-band", &a.level_band, Dimension::LENGTH)?;
-    let max_outflow_rate =
-        quantity("--max-outflow-rate", &a.max_outflow_rate, Dimension::MOLAR_FLOW / Dimension::TIME)?;
+    let max_outflow_rate = match &a.max_outflow_rate {
+        Some(r) => quantity("--max-outflow-rate", r, Dimension::MOLAR_FLOW / Dimension::TIME)?,
+        None => f64::NAN,
+    };
+    let attenuation = match (a.attenuation, &a.period) {
+        (Some(ratio), Some(p)) => Some(Attenuation { ratio, period: quantity("--period", p, Dimension::TIME)? }),
+        _ => None,
+    };
     let duration = a.duration.as_deref().map(|d| quantity("--duration", d, Dimension::TIME)).transpose()?;
     if duration.is_some_and(|d| d.is_nan() || d <= 0.0) {
         return Err(CliError::user("--duration: must be a positive time"));
@@ -113,7 +127,7 @@ fn request(a: &SizeArgs, plant: &Plant) -> Result<SizeRequest, CliError> {
         (None, None) => Shape::Step,
     };
     let disturbance = disturbance(&a.disturbance, plant, shape)?;
-    Ok(SizeRequest { disturbance, level_band, max_outflow_rate, duration })
+    Ok(SizeRequest { disturbance, level_band, max_outflow_rate, attenuation, duration })
 }
 
 /// `PATH=±x%` or `PATH=±VALUE` with the input's units.
@@ -168,6 +182,17 @@ fn table(s: &VesselSizing) -> String {
             d.verified.max_outflow_rate,
             if d.verified.meets { "yes" } else { "NO" }
         ));
+    }
+    if let Some(a) = &s.attenuation {
+        t.push_str(&format!("\nperiodic swing at {} s (asked: outflow ≤ {} of the inflow):\n", a.period, a.ratio));
+        for d in &s.designs {
+            t.push_str(&format!(
+                "  {:<8} attenuation {}, level amplitude {} m\n",
+                d.controller.name(),
+                opt(d.verified.attenuation, 1.0),
+                opt(d.verified.level_amplitude, 1.0)
+            ));
+        }
     }
     for d in s.designs.iter().filter(|d| d.verified.failure.is_some()) {
         t.push_str(&format!("\n{}: {}\n", d.controller.name(), d.verified.failure.as_deref().unwrap_or("")));

@@ -102,10 +102,24 @@ pub struct SizeRequest {
     pub level_band: f64,
     /// The largest allowed rate of change of the outflow (its SI unit per second).
     pub max_outflow_rate: f64,
+    /// The alternative criterion: instead of the rate limit, the outflow of a sinusoidal
+    /// disturbance (the disturbance's `change` its amplitude) swings at most `ratio` times the
+    /// inflow at `period`, in the periodic steady state (P and PI by their attenuation closed forms;
+    /// the optimal law by its rate closed form for the steepest slope such a swing has, `ratio·Δu·ω`).
+    pub attenuation: Option<Attenuation>,
     /// Length of each verification run \[s\] (default: 12 filter times for P, 14 times `1/ω_n`
     /// for PI, 25 ramp times for the optimal law, and at least 5 of the plant's slowest time
     /// constants).
     pub duration: Option<f64>,
+}
+
+/// An attenuation criterion: outflow amplitude over inflow amplitude at a period.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Attenuation {
+    /// The largest allowed ratio, in (0, 1).
+    pub ratio: f64,
+    /// The period \[s\].
+    pub period: f64,
 }
 
 /// The peaks of one verification run.
@@ -121,6 +135,13 @@ pub struct Verified {
     pub duration: f64,
     /// Why the run did not settle, or stopped (the peaks are then those up to there).
     pub failure: Option<String>,
+    /// A sinusoid: the level's and the outflow's half peak-to-peak swing over its last two periods,
+    /// the outflow's over the inflow amplitude `|Δu|` (the periodic steady state).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub level_amplitude: Option<f64>,
+    /// See `level_amplitude`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub attenuation: Option<f64>,
     /// The run's record (for plots; not serialized).
     #[serde(skip)]
     pub trace: Trace,
@@ -195,8 +216,12 @@ pub struct VesselSizing {
     pub liquid_molar_volume: f64,
     /// Level band asked \[m\].
     pub level_band: f64,
-    /// Rate limit asked (SI).
+    /// Rate limit asked (SI; under an attenuation criterion the steepest slope of the allowed
+    /// outflow swing, `ratio·|Δu|·ω`).
     pub max_outflow_rate: f64,
+    /// The attenuation criterion, if asked.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub attenuation: Option<Attenuation>,
     /// The vessel as the file has it, run through the same disturbance (a new tank: the stream
     /// without it).
     pub current: Current,
@@ -218,6 +243,9 @@ pub struct Current {
     pub meets: bool,
     /// Why the run stopped, if it did.
     pub failure: Option<String>,
+    /// A sinusoid: the outflow's swing over the inflow's in the last two periods.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub attenuation: Option<f64>,
     /// The run's record (for plots; not serialized).
     #[serde(skip)]
     pub trace: Trace,
@@ -259,6 +287,12 @@ pub enum SizeError {
     Rate {
         /// As given (SI).
         value: f64,
+    },
+    /// The attenuation criterion is not a ratio in (0, 1) at a positive period.
+    #[error("--attenuation: {why}")]
+    Attenuation {
+        /// Why.
+        why: String,
     },
     /// The disturbance is no free input or is zero.
     #[error("--disturbance {path}: {why}")]
@@ -325,10 +359,19 @@ pub fn size_vessel(plant: &Plant, x: &[f64], name: &str, r: &SizeRequest) -> Res
     check_request(plant, r)?;
     let v = Vessel::resolve(plant, x, name, r)?;
     let flow_change = v.flow_change(r)?;
+    let effective = r.attenuation.map(|a| {
+        let omega = std::f64::consts::TAU / a.period;
+        SizeRequest {
+            disturbance: Disturbance { shape: Shape::Sine { period: a.period }, ..r.disturbance.clone() },
+            max_outflow_rate: a.ratio * flow_change.abs() * omega,
+            ..r.clone()
+        }
+    });
+    let r = effective.as_ref().unwrap_or(r);
     let designs =
         LevelDesign::ALL.iter().map(|&d| verify::design(&v, d, flow_change.abs(), r)).collect::<Result<Vec<_>, _>>()?;
     let duration = designs.iter().map(|d| d.verified.duration).fold(0.0, f64::max);
-    let current = verify::current(&v, r, duration)?;
+    let current = verify::current(&v, r, duration, flow_change)?;
     Ok(VesselSizing {
         vessel: name.to_string(),
         kind: v.kind_name(),
@@ -344,6 +387,7 @@ pub fn size_vessel(plant: &Plant, x: &[f64], name: &str, r: &SizeRequest) -> Res
         liquid_molar_volume: v.v_l,
         level_band: r.level_band,
         max_outflow_rate: r.max_outflow_rate,
+        attenuation: r.attenuation,
         current,
         designs,
     })
@@ -351,8 +395,18 @@ pub fn size_vessel(plant: &Plant, x: &[f64], name: &str, r: &SizeRequest) -> Res
 
 /// The checks that need no vessel: band, rate, disturbance.
 fn check_request(plant: &Plant, r: &SizeRequest) -> Result<(), SizeError> {
-    if r.max_outflow_rate.is_nan() || r.max_outflow_rate <= 0.0 || r.max_outflow_rate.is_infinite() {
-        return Err(SizeError::Rate { value: r.max_outflow_rate });
+    match r.attenuation {
+        Some(a) if a.ratio.is_nan() || a.ratio <= 0.0 || a.ratio >= 1.0 => {
+            return Err(SizeError::Attenuation { why: format!("the ratio {} must lie between 0 and 1", a.ratio) });
+        }
+        Some(a) if a.period.is_nan() || a.period <= 0.0 || a.period.is_infinite() => {
+            return Err(SizeError::Attenuation { why: format!("the period {} s must be a positive time", a.period) });
+        }
+        Some(_) => {}
+        None if r.max_outflow_rate.is_nan() || r.max_outflow_rate <= 0.0 || r.max_outflow_rate.is_infinite() => {
+            return Err(SizeError::Rate { value: r.max_outflow_rate });
+        }
+        None => {}
     }
     if r.level_band.is_nan() || r.level_band <= 0.0 || r.level_band.is_infinite() {
         return Err(SizeError::Band {

@@ -62,6 +62,31 @@ impl LevelDesign {
         self.coefficient() * dq * dq / (area * band)
     }
 
+    /// The attenuation closed forms, for a sinusoidal inflow of amplitude `dq` \[m³/s\] at `omega`
+    /// \[rad/s\] whose outflow may swing at most `a·dq` (`0 < a < 1`) with the level within `band`
+    /// \[m\], in the periodic steady state: `(area, T)`, `T` the filter time `τ_F` (P) or `1/ω_n`
+    /// (PI); `None` for the optimal law, which is no linear filter.
+    /// - P: `|1/(1 + jωτ)| = a` gives `ωτ = √(1/a² − 1)`; the level `q/(A s + K_c)`, `K_c = A/τ`,
+    ///   swings `dq/(A √(ω² + 1/τ²))`, so `A = dq √(1 − a²)/(ω Δh)`.
+    /// - PI: `|T(jω)|² = (u⁴ + 4u²)/(u² + 1)²`, `u = ω_n/ω`, rises from 0 to 1.25 at `u = 1`: for
+    ///   `a < 1` the root of `(1 − a²) w² + (4 − 2a²) w − a² = 0`, `w = u²`; the level
+    ///   `s q/(A (s + ω_n)²)` swings `ω dq/(A (ω² + ω_n²))`, so `A = ω dq/(Δh (ω² + ω_n²))`.
+    pub fn for_attenuation(self, dq: f64, a: f64, omega: f64, band: f64) -> Option<(f64, f64)> {
+        match self {
+            LevelDesign::P => {
+                let tau = (1.0 / (a * a) - 1.0).sqrt() / omega;
+                Some((dq * (1.0 - a * a).sqrt() / (omega * band), tau))
+            }
+            LevelDesign::Pi => {
+                let (q2, q1, q0) = (1.0 - a * a, 4.0 - 2.0 * a * a, -a * a);
+                let w = (-q1 + (q1 * q1 - 4.0 * q2 * q0).sqrt()) / (2.0 * q2);
+                let wn = omega * w.sqrt();
+                Some((omega * dq / (band * (omega * omega + wn * wn)), 1.0 / wn))
+            }
+            LevelDesign::Optimal => None,
+        }
+    }
+
     /// Name in reports and JSON.
     pub fn name(self) -> &'static str {
         match self {
@@ -115,6 +140,26 @@ mod tests {
             assert!(rate <= rq * (1.0 + 1e-9) && rate > rq * (1.0 - 1e-4), "{design:?}: {rate} vs {rq}");
             assert!((design.rate(dq, area, band) / rq - 1.0).abs() < 1e-12);
         }
+    }
+
+    #[test]
+    fn attenuation_designs_give_the_asked_amplitude_ratio_and_level_swing() {
+        let (dq, a, omega, band) = (0.01, 0.3, 2.0 * std::f64::consts::PI / 3600.0, 0.3);
+        // P: the filter 1/(1 + jωτ); the level q/(A jω + K_c).
+        let (area, tau) = LevelDesign::P.for_attenuation(dq, a, omega, band).unwrap();
+        let g = 1.0 / (1.0 + (omega * tau).powi(2)).sqrt();
+        let kc = area / tau;
+        let level = dq / ((area * omega).powi(2) + kc * kc).sqrt();
+        assert!((g - a).abs() < 1e-12 && (level / band - 1.0).abs() < 1e-12, "{g} {level}");
+        // PI: T = (2ω_n s + ω_n²)/(s + ω_n)², the level s q/(A (s + ω_n)²), by complex arithmetic.
+        let (area, t) = LevelDesign::Pi.for_attenuation(dq, a, omega, band).unwrap();
+        let wn = 1.0 / t;
+        let (re, im) = (wn * wn - omega * omega, 2.0 * wn * omega); // (jω + ω_n)²
+        let den = (re * re + im * im).sqrt();
+        let t_mag = (wn.powi(4) + 4.0 * wn * wn * omega * omega).sqrt() / den;
+        let level = omega * dq / (area * den);
+        assert!((t_mag - a).abs() < 1e-12 && (level / band - 1.0).abs() < 1e-12, "{t_mag} {level}");
+        assert!(LevelDesign::Optimal.for_attenuation(dq, a, omega, band).is_none());
     }
 
     #[test]

@@ -38,18 +38,18 @@ pub const MAX_REFINEMENTS: usize = 8;
 /// short of the edge); when that does not at least halve the excess (in log), the area grows by it
 /// too.
 pub(super) fn design(v: &Vessel, d: LevelDesign, du: f64, r: &SizeRequest) -> Result<Design, SizeError> {
-    let closed = d.area(v.v_l * du.abs(), v.v_l * r.max_outflow_rate, r.level_band);
+    let closed = closed_form(v, d, du.abs(), r).0;
     let (mut s, mut f, mut plan, mut previous) = (1.0, 1.0, 1.0, f64::INFINITY);
     for k in 0..=MAX_REFINEMENTS {
-        let area = f * d.area(v.v_l * s * du.abs(), v.v_l * r.max_outflow_rate, r.level_band);
-        let mut trial = attempt(v, d, du, Scales { flow: s, plan }, area, r)?;
+        let (area, time) = closed_form(v, d, s * du.abs(), r);
+        let mut trial = attempt(v, d, du, Scales { flow: s, plan, time }, f * area, r)?;
         trial.closed_form_area = closed;
         trial.refinements = k;
         let t = &trial.verified;
         if t.meets || t.failure.is_some() || k == MAX_REFINEMENTS {
             return Ok(trial);
         }
-        let level = (t.max_level_deviation / r.level_band).max(1.0) * 1.002;
+        let level = (t.level_amplitude.unwrap_or(t.max_level_deviation) / r.level_band).max(1.0) * 1.002;
         if d == LevelDesign::Optimal {
             // First the plan (the law overshooting its own target); when that did not at least
             // halve the excess in log, the capacity too (an inflow the capped rate cannot follow).
@@ -59,18 +59,36 @@ pub(super) fn design(v: &Vessel, d: LevelDesign, du: f64, r: &SizeRequest) -> Re
             (plan, previous) = (plan * level, level);
             continue;
         }
-        let rate = (t.max_outflow_rate / r.max_outflow_rate / level).max(1.0) * 1.002;
+        let swing = match (r.attenuation, t.attenuation) {
+            (Some(a), Some(got)) => got / a.ratio,
+            _ => t.max_outflow_rate / r.max_outflow_rate,
+        };
+        let rate = (swing / level).max(1.0) * 1.002;
         (s, f) = (s * level, f * rate);
     }
     unreachable!("the loop returns at its last pass")
 }
 
+/// The closed-form cross-section of design `d` for the flow change `du` (a magnitude): by the
+/// attenuation closed forms when the request has that criterion and the design has one (then with
+/// the design's time, `τ_F` or `1/ω_n`), else by the rate closed form.
+fn closed_form(v: &Vessel, d: LevelDesign, du: f64, r: &SizeRequest) -> (f64, Option<f64>) {
+    let by_attenuation = r
+        .attenuation
+        .and_then(|a| d.for_attenuation(v.v_l * du, a.ratio, std::f64::consts::TAU / a.period, r.level_band));
+    match by_attenuation {
+        Some((area, time)) => (area, Some(time)),
+        None => (d.area(v.v_l * du, v.v_l * r.max_outflow_rate, r.level_band), None),
+    }
+}
+
 /// The corrections of a design: its flow change and (optimal law) its planned band, each a factor
-/// on the closed form's.
+/// on the closed form's; and the design time of an attenuation closed form.
 #[derive(Debug, Clone, Copy)]
 struct Scales {
     flow: f64,
     plan: f64,
+    time: Option<f64>,
 }
 
 /// Design `d` for the flow change `s.flow·|du|` in a vessel of cross-section `area`, verified.
@@ -78,7 +96,15 @@ fn attempt(v: &Vessel, d: LevelDesign, du: f64, s: Scales, area: f64, r: &SizeRe
     let (band_y, k_y) = v.measurement_scale(area, r.level_band);
     let normal = matches!(v.kind, Kind::Holdup { .. }).then(|| v.sp.max(2.0 * band_y));
     let sp = serde_json::json!(normal.unwrap_or(v.sp));
-    let law = law(v, d, s.flow * du.abs(), band_y / s.plan, k_y, r.max_outflow_rate, sp)?;
+    let du_design = s.flow * du.abs();
+    // An attenuation design fixes the filter time instead of the band: the band the averaging rule
+    // takes to give it (P: τ_F = Δ/(|k| Δu); PI: 1/ω_n = e Δ/(|k| Δu)).
+    let law_band = match (s.time, d) {
+        (Some(t), LevelDesign::P) => t * k_y * du_design,
+        (Some(t), _) => t * k_y * du_design / std::f64::consts::E,
+        (None, _) => band_y / s.plan,
+    };
+    let law = law(v, d, du_design, law_band, k_y, r.max_outflow_rate, sp)?;
     let mut edits: Vec<StructureEdit> = v.size_edit(area).into_iter().collect();
     edits.push(StructureEdit::RemoveController(v.controller.clone()));
     edits.push(StructureEdit::AddController { name: v.controller.clone(), spec: law.spec });
@@ -103,16 +129,7 @@ fn attempt(v: &Vessel, d: LevelDesign, du: f64, s: Scales, area: f64, r: &SizeRe
         Kind::Holdup { .. } => v.v_l / area,
     };
     let trace = Trace { deviation: trace.deviation.iter().map(|y| y * to_m).collect(), ..trace };
-    let (dev, rate) = peaks(&trace);
-    let failure = match ending {
-        Ending::Settled => None,
-        Ending::Unsettled => Some(format!("not settled after {:.0} s", trace.times.last().copied().unwrap_or(0.0))),
-        Ending::Failed(why) => Some(why),
-    };
-    let meets = failure.is_none()
-        && dev <= r.level_band * (1.0 + VERIFY_TOLERANCE)
-        && rate <= r.max_outflow_rate * (1.0 + VERIFY_TOLERANCE);
-    let duration = trace.times.last().copied().unwrap_or(0.0);
+    let verified = judge(trace, ending, r, du);
     Ok(Design {
         controller: d,
         area,
@@ -127,8 +144,55 @@ fn attempt(v: &Vessel, d: LevelDesign, du: f64, s: Scales, area: f64, r: &SizeRe
         ramp_time: law.ramp,
         return_time: law.ramp.map(|t| 4.0 * t),
         normal_holdup: normal,
-        verified: Verified { max_level_deviation: dev, max_outflow_rate: rate, meets, duration, failure, trace },
+        verified,
     })
+}
+
+/// The verdict on a run's record (level in m): the peaks, a sinusoid's periodic swings, and whether
+/// it holds the request's limits — the band and the rate, or under an attenuation criterion the
+/// band and the ratio in the periodic steady state.
+fn judge(trace: Trace, ending: Ending, r: &SizeRequest, du: f64) -> Verified {
+    let (dev, rate) = peaks(&trace);
+    let failure = match ending {
+        Ending::Settled => None,
+        Ending::Unsettled => Some(format!("not settled after {:.0} s", trace.times.last().copied().unwrap_or(0.0))),
+        Ending::Failed(why) => Some(why),
+    };
+    let (level_amplitude, attenuation) = match r.disturbance.shape {
+        Shape::Sine { period } => {
+            let (level, flow) = swings(&trace, 2.0 * period);
+            (Some(level), Some(flow / du.abs()))
+        }
+        _ => (None, None),
+    };
+    let within = |v: f64, limit: f64| v <= limit * (1.0 + VERIFY_TOLERANCE);
+    let holds = match (r.attenuation, level_amplitude, attenuation) {
+        (Some(a), Some(level), Some(att)) => within(level, r.level_band) && within(att, a.ratio),
+        _ => within(dev, r.level_band) && within(rate, r.max_outflow_rate),
+    };
+    let duration = trace.times.last().copied().unwrap_or(0.0);
+    let meets = failure.is_none() && holds;
+    Verified {
+        max_level_deviation: dev,
+        max_outflow_rate: rate,
+        meets,
+        duration,
+        failure,
+        level_amplitude,
+        attenuation,
+        trace,
+    }
+}
+
+/// Half the peak-to-peak swing of the level and of the outflow over the record's last `window` s.
+fn swings(tr: &Trace, window: f64) -> (f64, f64) {
+    let end = tr.times.last().copied().unwrap_or(0.0);
+    let from = tr.times.partition_point(|&t| t < end - window);
+    let half = |v: &[f64]| {
+        let (lo, hi) = v.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &x| (lo.min(x), hi.max(x)));
+        0.5 * (hi - lo)
+    };
+    (half(&tr.deviation[from..]), half(&tr.outflow[from..]))
 }
 
 /// The guess of a column stage's holdup (`COL.M[k]` and its `COL.n[k][c]`) scaled by `factor`:
@@ -315,8 +379,8 @@ fn peaks(tr: &Trace) -> (f64, f64) {
 }
 
 /// The file's own vessel and level controller (for a new tank: the stream without it) through the
-/// disturbance, over `duration`.
-pub(super) fn current(v: &Vessel, r: &SizeRequest, duration: f64) -> Result<Current, SizeError> {
+/// disturbance, over `duration` (`du` the steady flow change, the inflow amplitude of a sinusoid).
+pub(super) fn current(v: &Vessel, r: &SizeRequest, duration: f64, du: f64) -> Result<Current, SizeError> {
     let (plant, x) = (&v.original.0, &v.original.1);
     let (pv, op, area) = match &v.kind {
         Kind::Area { new_on: Some(stream), .. } => {
@@ -337,6 +401,14 @@ pub(super) fn current(v: &Vessel, r: &SizeRequest, duration: f64) -> Result<Curr
     let new_tank = matches!(v.kind, Kind::Area { new_on: Some(_), .. });
     let max_deviation = (!new_tank).then_some(dev);
     let level_ok = !matches!(v.kind, Kind::Area { new_on: None, .. }) || dev <= r.level_band * (1.0 + VERIFY_TOLERANCE);
-    let meets = failure.is_none() && level_ok && rate <= r.max_outflow_rate * (1.0 + VERIFY_TOLERANCE);
-    Ok(Current { area, max_deviation, max_outflow_rate: rate, meets, failure, trace })
+    let attenuation = match (r.attenuation, r.disturbance.shape) {
+        (Some(_), Shape::Sine { period }) => Some(swings(&trace, 2.0 * period).1 / du.abs()),
+        _ => None,
+    };
+    let swing_ok = match (r.attenuation, attenuation) {
+        (Some(a), Some(att)) => att <= a.ratio * (1.0 + VERIFY_TOLERANCE),
+        _ => rate <= r.max_outflow_rate * (1.0 + VERIFY_TOLERANCE),
+    };
+    let meets = failure.is_none() && level_ok && swing_ok;
+    Ok(Current { area, max_deviation, max_outflow_rate: rate, meets, failure, attenuation, trace })
 }
