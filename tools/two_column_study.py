@@ -672,11 +672,11 @@ def sizing_conclusions(res):
     sump = res.get("column1.sump", {})
     if "designs" in sump:
         failed = {k: x["failure"] for k, x in sump["designs"].items() if not x["meets"]}
-        limits = "; ".join(f"{k}: {f.split('at a limit then: ', 1)[-1].rstrip(')')}" for k, f in failed.items()
+        limits = "; ".join(f"{k}: {f.split('at a limit then: ', 1)[-1].removesuffix(')')}" for k, f in failed.items()
                            if f and "at a limit then" in f)
         out.append(f"**Column 1's base.** Under LB the base level is held by the boilup, which must move by "
-                   f"{fmt(sump['flow_change_kmol_h'])} kmol/h — at 0.2 kmol/h/min a "
-                   f"{fmt(sump['flow_change_kmol_h'] / 0.2 / 60)}-hour ramp. {len(failed)} of 3 designs fail their "
+                   f"{fmt(sump['flow_change_kmol_h'])} kmol/h — at 0.2 kmol/h/min a ramp of "
+                   f"{fmt(sump['flow_change_kmol_h'] / 0.2 / 60)} h. {len(failed)} of 3 designs fail their "
                    f"run, the integrator stopping with loops at their limits ({limits}): slowing the boilup starves "
                    "column 1, whose bottoms-temperature loop closes the bottoms flow, and column 2 loses its feed. "
                    "The base is no place for surge in this structure; its level loop must stay tight.")

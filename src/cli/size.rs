@@ -31,8 +31,12 @@ pub struct SizeArgs {
     #[arg(long, value_name = "V1,V2,…", value_delimiter = ',')]
     candidates: Vec<String>,
     /// The disturbance, a step of an input: PATH=±x% (of its value) or PATH=±VALUE with units.
-    #[arg(long, value_name = "PATH=±Δ")]
-    disturbance: String,
+    #[arg(long, value_name = "PATH=±Δ", required_unless_present = "scenario")]
+    disturbance: Option<String>,
+    /// The disturbance as the one step, ramp or sinusoid of a scenario file (started at once from
+    /// the steady state), instead of --disturbance.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["disturbance", "ramp", "sine", "attenuation"])]
+    scenario: Option<PathBuf>,
     /// The disturbance as a ramp to the same change over this time, instead of a step.
     #[arg(long, value_name = "TIME", conflicts_with = "sine")]
     ramp: Option<String>,
@@ -126,8 +130,23 @@ fn request(a: &SizeArgs, plant: &Plant) -> Result<SizeRequest, CliError> {
         (None, Some(period)) => Shape::Sine { period },
         (None, None) => Shape::Step,
     };
-    let disturbance = disturbance(&a.disturbance, plant, shape)?;
+    let disturbance = match (&a.disturbance, &a.scenario) {
+        (Some(d), _) => disturbance(d, plant, shape)?,
+        (None, Some(file)) => from_scenario(file, plant)?,
+        (None, None) => return Err(CliError::user("give --disturbance PATH=±Δ or --scenario FILE")),
+    };
     Ok(SizeRequest { disturbance, level_band, max_outflow_rate, attenuation, duration })
+}
+
+/// The disturbance of scenario file `file`.
+fn from_scenario(file: &Path, plant: &Plant) -> Result<Disturbance, CliError> {
+    let name = file.display().to_string();
+    let text = std::fs::read_to_string(file).map_err(|e| CliError::user(format!("--scenario {name}: {e}")))?;
+    let spec =
+        plantwide::flowsheet::scenario::parse_scenario(&text, &name).map_err(|e| CliError::user(e.to_string()))?;
+    let scenario =
+        plantwide::flowsheet::scenario::resolve(&spec, plant, &name).map_err(|e| CliError::user(e.to_string()))?;
+    Disturbance::from_scenario(&scenario, plant).map_err(|e| CliError::user(format!("{name}: {e}")))
 }
 
 /// `PATH=±x%` or `PATH=±VALUE` with the input's units.
@@ -184,7 +203,11 @@ fn table(s: &VesselSizing) -> String {
         ));
     }
     if let Some(a) = &s.attenuation {
-        t.push_str(&format!("\nperiodic swing at {} s (asked: outflow ≤ {} of the inflow):\n", a.period, a.ratio));
+        t.push_str(&format!(
+            "\nperiodic swing at {} s (asked: outflow ≤ {} of the inflow; `meets` is judged on it, the peaks above \
+             include the start from rest):\n",
+            a.period, a.ratio
+        ));
         for d in &s.designs {
             t.push_str(&format!(
                 "  {:<8} attenuation {}, level amplitude {} m\n",

@@ -296,3 +296,24 @@ fn attenuation_designs_swing_as_asked_in_the_periodic_steady_state() {
     assert_eq!(bad.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&bad.stderr).contains("between 0 and 1"));
 }
+
+/// `--scenario FILE`: the shipped inflow step (50 → 60 mol/s) is the same disturbance as
+/// `--disturbance F_in=+10mol/s`, so the same designs; a scenario with a pulse is refused.
+#[test]
+fn a_scenarios_step_sizes_as_the_same_disturbance() {
+    let s = tank_sizing();
+    let file = flowsheet("surge_tank_pi.json");
+    let scenario = flowsheet("scenarios/surge_tank_inflow_step.json");
+    let args = ["size", &file, "--vessel", "tank", "--scenario", &scenario, "--level-band", "0.2 m"];
+    let out = plantwide(&[&args[..], &["--max-outflow-rate", "3 mol/s/min", "--json"]].concat());
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let t: Value = serde_json::from_slice(&out.stdout).unwrap();
+    for k in 0..3 {
+        assert!(rel(num(&t["designs"][k], "area"), num(&s["designs"][k], "area")) < 1e-12, "{}", t["designs"][k]);
+    }
+    let upsets = flowsheet("scenarios/surge_tank_upsets.json");
+    let args = ["size", &file, "--vessel", "tank", "--scenario", &upsets, "--level-band", "0.2 m"];
+    let out = plantwide(&[&args[..], &["--max-outflow-rate", "3 mol/s/min"]].concat());
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("a pulse"), "{}", String::from_utf8_lossy(&out.stderr));
+}

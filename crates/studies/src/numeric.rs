@@ -141,6 +141,17 @@ pub(crate) fn nelder_mead(
     (x, fx, evals)
 }
 
+/// One classical Runge–Kutta (RK4) step of `dx/dt = f(x)` from `x` over `dt` (the tests' reference
+/// integrator of small closed loops).
+#[cfg(test)]
+pub(crate) fn rk4<const N: usize>(f: impl Fn([f64; N]) -> [f64; N], x: [f64; N], dt: f64) -> [f64; N] {
+    let k1 = f(x);
+    let k2 = f(std::array::from_fn(|i| x[i] + 0.5 * dt * k1[i]));
+    let k3 = f(std::array::from_fn(|i| x[i] + 0.5 * dt * k2[i]));
+    let k4 = f(std::array::from_fn(|i| x[i] + dt * k3[i]));
+    std::array::from_fn(|i| x[i] + dt / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

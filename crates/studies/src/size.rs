@@ -52,6 +52,44 @@ pub struct Disturbance {
     pub shape: Shape,
 }
 
+impl Disturbance {
+    /// The disturbance of a scenario: its one step, ramp or sinusoid of an input (the end of a ramp
+    /// or a sinusoid implied; the event's time and the scenario's length are not used — the
+    /// verification starts the disturbance from the steady state).
+    ///
+    /// # Errors
+    /// [`SizeError::Disturbance`] for a scenario with no such event, with more than one, or with a
+    /// pulse.
+    pub fn from_scenario(
+        scenario: &plantwide_flowsheet::scenario::Scenario,
+        plant: &Plant,
+    ) -> Result<Disturbance, SizeError> {
+        use plantwide_flowsheet::scenario::Action;
+        let refuse = |why: String| SizeError::Disturbance { path: format!("(scenario `{}`)", scenario.name), why };
+        let mut found = Vec::new();
+        for e in &scenario.events {
+            let (input, change, shape) = match e.action {
+                Action::Step { input, change } => (input, change, Shape::Step),
+                Action::Ramp { input, change, end } => (input, change, Shape::Ramp { duration: end - e.t }),
+                Action::Sinusoid { input, amplitude, period } => {
+                    (input, plantwide_flowsheet::scenario::Change::By(amplitude), Shape::Sine { period })
+                }
+                Action::Pulse { .. } => {
+                    return Err(refuse(format!("{}: a pulse; sizing takes a step, a ramp or a sinusoid", e.origin)));
+                }
+                _ => continue,
+            };
+            let info = &plant.inputs()[input];
+            found.push(Disturbance { path: info.path.clone(), change: change.apply(info.value) - info.value, shape });
+        }
+        match found.len() {
+            1 => Ok(found.remove(0)),
+            0 => Err(refuse("the scenario has no step, ramp or sinusoid of an input".into())),
+            n => Err(refuse(format!("the scenario has {n} disturbance events; sizing takes one"))),
+        }
+    }
+}
+
 /// The time course of a disturbance. The designs are the closed forms of a step of the same size
 /// (a ramp is gentler: the step's design holds it with margin; a sinusoid near the loop's natural
 /// frequency can swing a PI-held level up to `e/2` times a step's peak, which the verification shows

@@ -109,13 +109,7 @@ mod tests {
         let (mut x, mut peak, mut rate) = ([0.0f64; 2], 0.0f64, 0.0f64);
         let mut q = 0.0;
         for _ in 0..(t_end / dt).round() as usize {
-            let k1 = f(x);
-            let k2 = f([x[0] + 0.5 * dt * k1[0], x[1] + 0.5 * dt * k1[1]]);
-            let k3 = f([x[0] + 0.5 * dt * k2[0], x[1] + 0.5 * dt * k2[1]]);
-            let k4 = f([x[0] + dt * k3[0], x[1] + dt * k3[1]]);
-            for i in 0..2 {
-                x[i] += dt / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
-            }
+            x = crate::numeric::rk4(f, x, dt);
             let q_new = kc * (x[0] + x[1] / ti);
             rate = rate.max((q_new - q).abs() / dt);
             q = q_new;

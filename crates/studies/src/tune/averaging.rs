@@ -101,13 +101,7 @@ mod tests {
         let (mut x, mut peak, mut t_peak) = ([0.0, 0.0], 0.0f64, 0.0);
         let steps = (t_end / dt).round() as usize;
         for step in 1..=steps {
-            let k1 = f(x);
-            let k2 = f([x[0] + 0.5 * dt * k1[0], x[1] + 0.5 * dt * k1[1]]);
-            let k3 = f([x[0] + 0.5 * dt * k2[0], x[1] + 0.5 * dt * k2[1]]);
-            let k4 = f([x[0] + dt * k3[0], x[1] + dt * k3[1]]);
-            for i in 0..2 {
-                x[i] += dt / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
-            }
+            x = crate::numeric::rk4(f, x, dt);
             if x[0].abs() > peak {
                 (peak, t_peak) = (x[0].abs(), step as f64 * dt);
             }
