@@ -64,8 +64,8 @@ fn the_three_tank_designs_reproduce_their_closed_forms_and_hold_the_limits() {
     assert_eq!(c["meets"], false);
 }
 
-/// The optimal design as shipped (`flowsheets/surge_tank_averaging.json`: the area and the
-/// `averaging_level` law `size` designs, checked here against its output) run by `plantwide run`:
+/// The optimal design written as a flowsheet (`tests/data/surge_tank_averaging.json`: the area and
+/// the `averaging_level` law `size` designs, checked here against its output) run by `plantwide run`:
 /// the level stops at the band as the outflow, ramping at the limit, meets the inflow; the outflow
 /// never changes faster than the limit; then the level returns to its setpoint.
 #[test]
@@ -73,7 +73,7 @@ fn the_optimal_design_runs_in_run() {
     let s = tank_sizing();
     let opt = s["designs"].as_array().unwrap().iter().find(|d| d["controller"] == "optimal").unwrap().clone();
     let (band, r) = (0.2, 0.05);
-    let file = flowsheet("surge_tank_averaging.json");
+    let file = crate::harness::fixture("data/surge_tank_averaging.json");
     let sheet: Value = serde_json::from_str(&std::fs::read_to_string(&file).unwrap()).unwrap();
     let area: f64 = sheet["units"]["tank"]["area"].as_str().unwrap().trim_end_matches(" m2").parse().unwrap();
     assert!(rel(area, num(&opt, "area")) < 1e-6, "{area} vs {}", opt["area"]);
@@ -316,4 +316,23 @@ fn a_scenarios_step_sizes_as_the_same_disturbance() {
     let out = plantwide(&[&args[..], &["--max-outflow-rate", "3 mol/s/min"]].concat());
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("a pulse"), "{}", String::from_utf8_lossy(&out.stderr));
+}
+
+/// The error-squared law (P only) in the surge tank: `op = bias + K_c e|e|/Δ`, so after the inflow
+/// moves by 10 mol/s the level settles `√(Δ · 10/K_c)` above its setpoint, which `steady` finds.
+#[test]
+fn the_error_squared_law_settles_where_its_gain_balances_the_flow() {
+    let mut sheet: Value =
+        serde_json::from_str(&std::fs::read_to_string(flowsheet("surge_tank_pi.json")).unwrap()).unwrap();
+    sheet["controllers"]["lc"] = serde_json::json!({"type": "averaging_level", "law": "error_squared",
+        "pv": "tank.level", "output": "tank.outflow", "sp": "1 m", "level_band": "0.5 m", "kc": "40 mol/s/m",
+        "action": "direct", "bias": "50 mol/s"});
+    let file = std::env::temp_dir().join(format!("plantwide_error_squared_{}.json", std::process::id()));
+    std::fs::write(&file, sheet.to_string()).unwrap();
+    let out = plantwide(&["steady", file.to_str().unwrap(), "--json", "--set", "F_in=60 mol/s"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let expected = 1.0 + (0.5f64 * 10.0 / 40.0).sqrt();
+    assert!((num(&v["values"], "tank.level") - expected).abs() < 1e-9, "{} vs {expected}", v["values"]["tank.level"]);
+    std::fs::remove_file(&file).ok();
 }
