@@ -336,3 +336,19 @@ fn the_error_squared_law_settles_where_its_gain_balances_the_flow() {
     assert!((num(&v["values"], "tank.level") - expected).abs() < 1e-9, "{} vs {expected}", v["values"]["tank.level"]);
     std::fs::remove_file(&file).ok();
 }
+
+/// Hostile shapes end in bounded time and memory: a ramp of 1e-300 s (a step in all but name) is
+/// sampled no finer than the run's length allows (at most 2e5 samples) and sizes as the step.
+#[test]
+fn a_vanishing_ramp_is_sized_as_the_step_in_bounded_time() {
+    let s = tank_sizing();
+    let file = flowsheet("surge_tank_pi.json");
+    let args = ["size", &file, "--vessel", "tank", "--disturbance", "F_in=+10 mol/s", "--level-band", "0.2 m"];
+    let out = plantwide(&[&args[..], &["--max-outflow-rate", "3 mol/s/min", "--ramp=1e-300 s", "--json"]].concat());
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let t: Value = serde_json::from_slice(&out.stdout).unwrap();
+    for k in 0..3 {
+        assert!(rel(num(&t["designs"][k], "area"), num(&s["designs"][k], "area")) < 1e-12);
+        assert_eq!(t["designs"][k]["verified"]["meets"], true, "{}", t["designs"][k]);
+    }
+}

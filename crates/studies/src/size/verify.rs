@@ -22,6 +22,10 @@ use super::{
 };
 use crate::tune::averaging::{AveragingForm, averaging};
 
+/// Most samples of one verification run (the sampling coarsens beyond it, so that no request makes a
+/// run record without bound).
+const MAX_SAMPLES: f64 = 2e5;
+
 /// Most corrections of a closed-form design that the plant's run showed short.
 pub const MAX_REFINEMENTS: usize = 8;
 
@@ -325,8 +329,10 @@ impl Run<'_> {
             Shape::Ramp { duration: ramp } => (self.t_char / 200.0).min(ramp / 200.0),
             Shape::Step => self.t_char / 200.0,
         };
-        let (mut t, mut dt) = (0.0, 1e-5 * self.t_char.min(dt_max * 200.0));
         let t_max = if exact { duration } else { 8.0 * duration };
+        // At most MAX_SAMPLES samples, whatever the duration, ramp or period asked.
+        let dt_max = dt_max.max(t_max / MAX_SAMPLES);
+        let (mut t, mut dt) = (0.0, 1e-5 * self.t_char.min(dt_max * 200.0));
         loop {
             dt = (1.1 * dt).min(dt_max);
             t = (t + dt).min(t_max);
