@@ -1,10 +1,31 @@
-//! Sparse LU on faer, with the symbolic analysis done once per pattern.
+//! The one sparse LU of the solvers (Newton, pseudo-transient, BDF, perturbation analysis), on
+//! faer's sparse LU with partial pivoting.
+//!
+//! **Pattern.** The plant's Jacobian comes as triplets whose positions are the units' declared
+//! structural patterns, the same at every point. Declared patterns are generous (column A:
+//! 15 708 structural entries, 1 675 nonzero values at any point), and the factorization cost grows
+//! with the pattern it is given, so the matrix factorized is the *live* pattern: the structural
+//! entries that have ever held a nonzero value. An entry that turns nonzero later (a controller
+//! leaving its limit, a tray that fills) joins it and the symbolic analysis is redone; an entry
+//! that returns to zero stays, as an explicit zero. The live pattern is therefore exact wherever the
+//! Jacobian has been evaluated, and never loses a value.
+//!
+//! **Work per factorization.** The triplet → compressed-column map, the column ordering (COLAMD)
+//! and the symbolic factorization are computed once per live pattern; a refactorization sums the
+//! triplet values into the held matrix in place and runs faer's numeric LU into held storage and
+//! a held workspace. Solves run in place, with `A` or `Aᵀ`. Everything runs on the calling thread
+//! (the solvers parallelize over independent solves instead).
 
-use faer::Col;
-use faer::linalg::solvers::Solve;
+use std::mem::MaybeUninit;
+
+use faer::Par;
+use faer::col::ColMut;
+use faer::dyn_stack::{MemStack, StackReq};
+use faer::linalg::lu::partial_pivoting::factor::PartialPivLuParams;
 use faer::sparse::linalg::LuError;
-use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
-use faer::sparse::{CreationError, SparseColMat, Triplet};
+use faer::sparse::linalg::lu::{LuRef, LuSymbolicParams, NumericLu, SymbolicLu, factorize_symbolic_lu};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+use faer::{Conj, Spec};
 
 /// Why a sparse factorization failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -24,7 +45,7 @@ pub enum SparseError {
     Resources {
         /// Order of the matrix.
         n: usize,
-        /// Number of triplets.
+        /// Number of stored entries.
         nnz: usize,
     },
     /// No pivot at elimination step `index`: the matrix is structurally or numerically singular.
@@ -41,55 +62,335 @@ pub enum SparseError {
         /// Order of the matrix.
         n: usize,
     },
+    /// A solve was asked for before any factorization succeeded.
+    #[error("sparse LU: no factorization is held")]
+    NotFactored,
 }
 
-impl SparseError {
-    fn creation(e: CreationError, n: usize, nnz: usize) -> SparseError {
-        match e {
-            CreationError::OutOfBounds { row, col } => SparseError::OutOfBounds { row, col, n },
-            CreationError::Generic(_) => SparseError::Resources { n, nnz },
+/// The structural pattern of the triplets and where each one goes.
+#[derive(Debug, Default)]
+struct Structure {
+    /// Triplet positions, in the caller's order (the key: another order is another structure),
+    /// then the pinned positions.
+    positions: Vec<(usize, usize)>,
+    /// How many of `positions` are triplets (the rest are pinned).
+    n_triplets: usize,
+    /// For each triplet, its slot in the structural compressed-column arrays (duplicates share).
+    slot: Vec<usize>,
+    /// Row index of each structural slot, and for each slot whether it has ever been nonzero.
+    row: Vec<usize>,
+    col_ptr: Vec<usize>,
+    live: Vec<bool>,
+    /// Values summed per structural slot (scratch of every refill).
+    sum: Vec<f64>,
+}
+
+impl Structure {
+    fn new(n: usize, triplets: &[(usize, usize, f64)], pinned: &[(usize, usize)]) -> Result<Structure, SparseError> {
+        let positions: Vec<(usize, usize)> =
+            triplets.iter().map(|&(i, j, _)| (i, j)).chain(pinned.iter().copied()).collect();
+        if let Some(&(row, col)) = positions.iter().find(|t| t.0 >= n || t.1 >= n) {
+            return Err(SparseError::OutOfBounds { row, col, n });
         }
+        let mut order: Vec<usize> = (0..positions.len()).collect();
+        order.sort_unstable_by_key(|&k| (positions[k].1, positions[k].0));
+        let (mut row, mut col_ptr, mut slot) = (Vec::new(), vec![0; n + 1], vec![0; positions.len()]);
+        let mut last = None;
+        for k in order {
+            let (i, j) = positions[k];
+            if last != Some((i, j)) {
+                row.push(i);
+                col_ptr[j + 1] += 1;
+                last = Some((i, j));
+            }
+            slot[k] = row.len() - 1;
+        }
+        for j in 0..n {
+            col_ptr[j + 1] += col_ptr[j];
+        }
+        let m = row.len();
+        let mut live = vec![false; m];
+        slot[triplets.len()..].iter().for_each(|&k| live[k] = true);
+        Ok(Structure { positions, n_triplets: triplets.len(), slot, row, col_ptr, live, sum: vec![0.0; m] })
     }
 
-    fn lu(e: LuError, n: usize, nnz: usize) -> SparseError {
-        match e {
-            LuError::SymbolicSingular { index } => SparseError::Singular { index, n },
-            LuError::Generic(_) => SparseError::Resources { n, nnz },
+    fn matches(&self, triplets: &[(usize, usize, f64)], pinned: &[(usize, usize)]) -> bool {
+        let (t, p) = self.positions.split_at(self.n_triplets);
+        t.len() == triplets.len() && p == pinned && t.iter().zip(triplets).all(|(p, t)| p.0 == t.0 && p.1 == t.1)
+    }
+
+    /// Sum the triplet values per slot; true if a slot outside the live pattern became nonzero
+    /// (it is added to the pattern).
+    fn accumulate(&mut self, triplets: &[(usize, usize, f64)]) -> bool {
+        self.sum.iter_mut().for_each(|s| *s = 0.0);
+        for (t, &s) in triplets.iter().zip(&self.slot) {
+            self.sum[s] += t.2;
         }
+        let mut grew = false;
+        for (live, &v) in self.live.iter_mut().zip(&self.sum) {
+            if !*live && v != 0.0 {
+                *live = true;
+                grew = true;
+            }
+        }
+        grew
     }
 }
 
-/// A pattern (as triplet positions) and its symbolic LU.
-type Symbolic = (Vec<(usize, usize)>, SymbolicLu<usize>);
+/// The live pattern as a compressed-column matrix, its symbolic LU and the map from structural
+/// slots to stored entries.
+#[derive(Debug)]
+struct Live {
+    col_ptr: Vec<usize>,
+    row: Vec<usize>,
+    /// Column of each stored entry.
+    col: Vec<usize>,
+    /// Structural slot of each stored entry.
+    from: Vec<usize>,
+    /// The loaded (summed) values, and the values factorized (mapped from them).
+    base: Vec<f64>,
+    values: Vec<f64>,
+    symbolic: SymbolicLu<usize>,
+}
 
-/// A sparse LU solver that reuses the symbolic factorization while the pattern is unchanged.
+impl Live {
+    fn new(n: usize, s: &Structure) -> Result<Live, SparseError> {
+        let (mut col_ptr, mut row, mut col, mut from) = (vec![0; n + 1], Vec::new(), Vec::new(), Vec::new());
+        for j in 0..n {
+            for k in s.col_ptr[j]..s.col_ptr[j + 1] {
+                if s.live[k] {
+                    row.push(s.row[k]);
+                    col.push(j);
+                    from.push(k);
+                }
+            }
+            col_ptr[j + 1] = row.len();
+        }
+        let nnz = row.len();
+        let pattern = SymbolicSparseColMatRef::new_checked(n, n, &col_ptr, None, &row);
+        let symbolic = factorize_symbolic_lu(pattern, LuSymbolicParams::default())
+            .map_err(|_| SparseError::Resources { n, nnz })?;
+        Ok(Live { col_ptr, row, col, from, base: vec![0.0; nnz], values: vec![0.0; nnz], symbolic })
+    }
+}
+
+/// A sparse LU that keeps its pattern, symbolic analysis, factors and workspace between
+/// factorizations (see the module documentation).
 #[derive(Debug, Default)]
 pub struct SparseLu {
-    symbolic: Option<Symbolic>,
+    n: usize,
+    structure: Structure,
+    live: Option<Live>,
+    numeric: NumericLu<usize, f64>,
+    factored: bool,
+    work: Vec<MaybeUninit<u8>>,
+    /// Symbolic analyses and numeric factorizations done, for benchmarks.
+    counts: (usize, usize),
+}
+
+fn params() -> Spec<PartialPivLuParams, f64> {
+    Default::default()
 }
 
 impl SparseLu {
-    /// Factorize the `n × n` matrix given by `triplets` and solve `A x = b` in place.
-    pub fn solve(&mut self, n: usize, triplets: &[(usize, usize, f64)], b: &mut [f64]) -> Result<(), SparseError> {
-        let trip: Vec<Triplet<usize, usize, f64>> = triplets.iter().map(|&(i, j, v)| Triplet::new(i, j, v)).collect();
-        let a = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &trip)
-            .map_err(|e| SparseError::creation(e, n, trip.len()))?;
-        let pattern: Vec<(usize, usize)> = triplets.iter().map(|&(i, j, _)| (i, j)).collect();
-        let reuse = matches!(&self.symbolic, Some((p, _)) if *p == pattern);
-        if !reuse {
-            let sym = SymbolicLu::try_new(a.symbolic()).map_err(|e| SparseError::creation(e.into(), n, trip.len()))?;
-            self.symbolic = Some((pattern, sym));
+    /// Factorize the `n × n` matrix given by `triplets` (duplicates summed).
+    pub fn factor(&mut self, n: usize, triplets: &[(usize, usize, f64)]) -> Result<(), SparseError> {
+        self.load(n, triplets)?;
+        self.factor_mapped(|_, _, v| v)
+    }
+
+    /// Load the matrix given by `triplets` (duplicates summed) without factorizing it; the live
+    /// pattern grows if a new entry is nonzero.
+    pub fn load(&mut self, n: usize, triplets: &[(usize, usize, f64)]) -> Result<(), SparseError> {
+        self.load_pinned(n, triplets, &[])
+    }
+
+    /// [`SparseLu::load`] with the positions `pinned` in the live pattern whatever their loaded
+    /// value (zero unless a triplet is there too): entries that [`SparseLu::factor_mapped`] fills,
+    /// such as the mass-matrix diagonal of `M − cJ`, which a loaded `J_ii = −1` must not cancel.
+    pub fn load_pinned(
+        &mut self,
+        n: usize,
+        triplets: &[(usize, usize, f64)],
+        pinned: &[(usize, usize)],
+    ) -> Result<(), SparseError> {
+        self.factored = false;
+        if self.n != n || self.live.is_none() || !self.structure.matches(triplets, pinned) {
+            self.structure = Structure::new(n, triplets, pinned)?;
+            self.live = None;
+            self.n = n;
         }
-        let Some((_, sym)) = &self.symbolic else { unreachable!("symbolic factorization set above") };
-        let lu = Lu::try_new_with_symbolic(sym.clone(), a.as_ref()).map_err(|e| SparseError::lu(e, n, trip.len()))?;
-        let rhs = Col::<f64>::from_fn(n, |i| b[i]);
-        let x = lu.solve(&rhs);
-        for (i, bi) in b.iter_mut().enumerate() {
-            *bi = x[i];
+        if self.structure.accumulate(triplets) || self.live.is_none() {
+            self.live = Some(Live::new(n, &self.structure)?);
+            self.counts.0 += 1;
         }
-        if b.iter().any(|v| !v.is_finite()) {
-            return Err(SparseError::NonFinite { n });
+        let Some(live) = &mut self.live else { unreachable!("live pattern built above") };
+        for (v, &k) in live.base.iter_mut().zip(&live.from) {
+            *v = self.structure.sum[k];
         }
         Ok(())
+    }
+
+    /// Factorize the loaded matrix with each entry `(row, col, value)` replaced by
+    /// `map(row, col, value)` (the map must keep zero entries' positions meaningful: entries are
+    /// those of the live pattern). Cheap to repeat: the BDF iteration matrix `M − cJ` for a new `c`.
+    pub fn factor_mapped(&mut self, map: impl Fn(usize, usize, f64) -> f64) -> Result<(), SparseError> {
+        self.factored = false;
+        let n = self.n;
+        let Some(live) = &mut self.live else { return Err(SparseError::NotFactored) };
+        for k in 0..live.values.len() {
+            live.values[k] = map(live.row[k], live.col[k], live.base[k]);
+        }
+        let nnz = live.values.len();
+        let req = live
+            .symbolic
+            .factorize_numeric_lu_scratch::<f64>(Par::Seq, params())
+            .or(live.symbolic.solve_in_place_scratch::<f64>(1, Par::Seq));
+        let stack = workspace(&mut self.work, req).ok_or(SparseError::Resources { n, nnz })?;
+        let symbolic = SymbolicSparseColMatRef::new_checked(n, n, &live.col_ptr, None, &live.row);
+        let a = SparseColMatRef::new(symbolic, &live.values);
+        live.symbolic.factorize_numeric_lu(&mut self.numeric, a, Par::Seq, stack, params()).map_err(|e| match e {
+            LuError::SymbolicSingular { index } => SparseError::Singular { index, n },
+            LuError::Generic(_) => SparseError::Resources { n, nnz },
+        })?;
+        self.counts.1 += 1;
+        self.factored = true;
+        Ok(())
+    }
+
+    /// Solve `A x = b` in place with the held factors.
+    pub fn solve_in_place(&mut self, b: &mut [f64]) -> Result<(), SparseError> {
+        self.solve_with(b, false)
+    }
+
+    /// Solve `Aᵀ x = b` in place with the held factors.
+    pub fn solve_transpose_in_place(&mut self, b: &mut [f64]) -> Result<(), SparseError> {
+        self.solve_with(b, true)
+    }
+
+    fn solve_with(&mut self, b: &mut [f64], transpose: bool) -> Result<(), SparseError> {
+        let (Some(live), true) = (&self.live, self.factored) else { return Err(SparseError::NotFactored) };
+        let n = self.n;
+        let req = live.symbolic.solve_in_place_scratch::<f64>(1, Par::Seq);
+        let stack = workspace(&mut self.work, req).ok_or(SparseError::Resources { n, nnz: live.values.len() })?;
+        let lu = LuRef::new_unchecked(&live.symbolic, &self.numeric);
+        let rhs = ColMut::from_slice_mut(b).as_mat_mut();
+        if transpose {
+            lu.solve_transpose_in_place_with_conj(Conj::No, rhs, Par::Seq, stack);
+        } else {
+            lu.solve_in_place_with_conj(Conj::No, rhs, Par::Seq, stack);
+        }
+        if b.iter().all(|v| v.is_finite()) { Ok(()) } else { Err(SparseError::NonFinite { n }) }
+    }
+
+    /// Factorize and solve `A x = b` in place.
+    pub fn solve(&mut self, n: usize, triplets: &[(usize, usize, f64)], b: &mut [f64]) -> Result<(), SparseError> {
+        self.factor(n, triplets)?;
+        self.solve_in_place(b)
+    }
+
+    /// Whether factors are held.
+    pub fn is_factored(&self) -> bool {
+        self.factored
+    }
+
+    /// Drop the numeric factors (the pattern and its symbolic analysis are kept).
+    pub fn invalidate(&mut self) {
+        self.factored = false;
+    }
+
+    /// Entries of the live pattern (the matrix factorized).
+    pub fn live_nnz(&self) -> usize {
+        self.live.as_ref().map_or(0, |l| l.values.len())
+    }
+
+    /// The column eliminated at step `index` of the last analysis (the fill-reducing order), to
+    /// name the column of a [`SparseError::Singular`].
+    pub fn pivot_column(&self, index: usize) -> Option<usize> {
+        let live = self.live.as_ref()?;
+        live.symbolic.col_perm().arrays().0.get(index).copied()
+    }
+
+    /// Symbolic analyses and numeric factorizations done so far.
+    pub fn counts(&self) -> (usize, usize) {
+        self.counts
+    }
+}
+
+/// A memory stack over `buf`, grown to hold `req`; `None` if it cannot be allocated.
+fn workspace(buf: &mut Vec<MaybeUninit<u8>>, req: StackReq) -> Option<&mut MemStack> {
+    let bytes = req.unaligned_bytes_required();
+    if buf.len() < bytes {
+        buf.try_reserve_exact(bytes - buf.len()).ok()?;
+        buf.resize(bytes, MaybeUninit::uninit());
+    }
+    Some(MemStack::new(buf))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `[[2, 1, 0], [1, 3, 1], [0, 1, 4]]` with a structural zero at (0, 2) and a duplicate at (1, 1).
+    fn triplets(a02: f64) -> Vec<(usize, usize, f64)> {
+        vec![
+            (0, 0, 2.0),
+            (0, 1, 1.0),
+            (1, 0, 1.0),
+            (1, 1, 1.0),
+            (1, 1, 2.0),
+            (1, 2, 1.0),
+            (2, 1, 1.0),
+            (2, 2, 4.0),
+            (0, 2, a02),
+        ]
+    }
+
+    fn residual(t: &[(usize, usize, f64)], x: &[f64], b: &[f64]) -> f64 {
+        let mut r = b.to_vec();
+        t.iter().for_each(|&(i, j, v)| r[i] -= v * x[j]);
+        r.iter().fold(0.0, |m, v| m.max(v.abs()))
+    }
+
+    #[test]
+    fn solves_and_transposes_and_grows_its_live_pattern() {
+        let mut lu = SparseLu::default();
+        let b = [1.0, 2.0, 3.0];
+        let t = triplets(0.0);
+        let mut x = b;
+        lu.solve(3, &t, &mut x).unwrap();
+        assert!(residual(&t, &x, &b) < 1e-14);
+        assert_eq!(lu.live_nnz(), 7, "the structural zero is left out, the duplicate summed");
+        let mut y = b;
+        lu.solve_transpose_in_place(&mut y).unwrap();
+        let tt: Vec<_> = t.iter().map(|&(i, j, v)| (j, i, v)).collect();
+        assert!(residual(&tt, &y, &b) < 1e-14);
+        // The structural zero turns nonzero: it joins the pattern, a new analysis is made.
+        let t = triplets(0.5);
+        let mut x = b;
+        lu.solve(3, &t, &mut x).unwrap();
+        assert!(residual(&t, &x, &b) < 1e-14);
+        assert_eq!((lu.live_nnz(), lu.counts()), (8, (2, 2)));
+        // Back to zero: kept as an explicit zero, no new analysis.
+        let t = triplets(0.0);
+        let mut x = b;
+        lu.solve(3, &t, &mut x).unwrap();
+        assert!(residual(&t, &x, &b) < 1e-14);
+        assert_eq!((lu.live_nnz(), lu.counts()), (8, (2, 3)));
+    }
+
+    #[test]
+    fn singular_and_out_of_bounds_are_errors() {
+        let mut lu = SparseLu::default();
+        let mut x = [1.0, 1.0];
+        let e = lu.solve(2, &[(0, 0, 1.0), (1, 0, 1.0)], &mut x).unwrap_err();
+        assert!(matches!(e, SparseError::Singular { .. } | SparseError::NonFinite { .. }), "{e:?}");
+        let e = lu.solve(2, &[(0, 0, 1.0), (2, 1, 1.0)], &mut x).unwrap_err();
+        assert_eq!(e, SparseError::OutOfBounds { row: 2, col: 1, n: 2 });
+        let mut fresh = SparseLu::default();
+        assert_eq!(fresh.solve_in_place(&mut x), Err(SparseError::NotFactored));
+        let mut x = [1.0, 1.0];
+        let e = lu.solve(2, &[(0, 0, 1.0), (0, 1, 1.0), (1, 0, 1.0), (1, 1, 1.0)], &mut x).unwrap_err();
+        assert!(matches!(e, SparseError::NonFinite { .. } | SparseError::Singular { .. }), "{e:?}");
     }
 }

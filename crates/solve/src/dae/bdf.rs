@@ -35,8 +35,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::linear::IterationMatrix;
 use super::{DaeError, DaeIntegrator, DaeSystem, consistent_algebraic, rms};
+use crate::sparse::SparseLu;
 
 /// Highest order.
 const MAX_ORDER: usize = 5;
@@ -46,6 +46,9 @@ const NEWTON_MAXITER: usize = 4;
 const MIN_FACTOR: f64 = 0.2;
 /// Largest step growth.
 const MAX_FACTOR: f64 = 10.0;
+/// The iteration matrix `M − cJ` is refactorized when `c` has moved by more than this fraction
+/// since the factorization (CVODE's `DGMAX`), after a Newton failure, or for a new Jacobian.
+const REFACTOR_RATIO: f64 = 0.3;
 
 /// Settings of the BDF integrator.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -121,12 +124,16 @@ pub struct BdfState {
 pub struct Bdf {
     settings: BdfSettings,
     st: BdfState,
-    lu: IterationMatrix,
+    lu: SparseLu,
     gamma: [f64; MAX_ORDER + 2],
     error_const: [f64; MAX_ORDER + 2],
     /// Variables in the error test, and in the Newton convergence test.
     controlled: Vec<bool>,
     all: Vec<bool>,
+    /// For each equation, the variable whose derivative it is (`usize::MAX`: algebraic).
+    diff_var: Vec<usize>,
+    /// Whether `st.jac` is the matrix loaded into the LU (a new Jacobian must be loaded again).
+    jac_loaded: bool,
 }
 
 /// `R(ρ)` of the module documentation, `(order+1)²` row-major.
@@ -221,11 +228,13 @@ impl Bdf {
         Bdf {
             settings,
             st,
-            lu: IterationMatrix::default(),
+            lu: SparseLu::default(),
             gamma,
             error_const,
             controlled: Vec::new(),
             all: Vec::new(),
+            diff_var: Vec::new(),
+            jac_loaded: false,
         }
     }
 
@@ -273,6 +282,9 @@ impl Bdf {
         let n = sys.n();
         self.controlled = (0..n).map(|i| sys.error_controlled(i)).collect();
         self.all = (0..n).map(|i| !sys.quadrature(i)).collect();
+        self.diff_var = vec![usize::MAX; n];
+        sys.mass().iter().for_each(|&(i, j)| self.diff_var[i] = j);
+        self.jac_loaded = false;
     }
 
     fn scale(&self, sys: &dyn DaeSystem, x: &[f64]) -> Vec<f64> {
@@ -282,29 +294,41 @@ impl Bdf {
             .collect()
     }
 
-    /// Factorize `M − cJ` (algebraic rows: `−J`).
+    /// Factorize `M − cJ` (algebraic rows: `−J`). The Jacobian is loaded into the LU once per
+    /// evaluation (the mass entries pinned in its pattern); a new `c` only maps and refactorizes
+    /// the held values.
     fn factor(&mut self, n: usize, sys: &dyn DaeSystem, c: f64) -> Result<(), DaeError> {
-        let mut diff_row = vec![false; n];
-        sys.mass().iter().for_each(|&(i, _)| diff_row[i] = true);
-        let mut trip: Vec<(usize, usize, f64)> =
-            self.st.jac.iter().map(|&(i, j, v)| (i, j, if diff_row[i] { -c * v } else { -v })).collect();
-        trip.extend(sys.mass().iter().map(|&(i, j)| (i, j, 1.0)));
-        self.lu.factor(n, &trip).map_err(|source| DaeError::Singular { time: self.st.t, source })?;
+        let time = self.st.t;
+        if !self.jac_loaded {
+            self.lu.load_pinned(n, &self.st.jac, sys.mass()).map_err(|source| DaeError::Singular { time, source })?;
+            self.jac_loaded = true;
+        }
+        let diff_var = &self.diff_var;
+        let entry = |i: usize, j: usize, v: f64| match diff_var[i] {
+            usize::MAX => -v,
+            m if m == j => 1.0 - c * v,
+            _ => -c * v,
+        };
+        self.lu.factor_mapped(entry).map_err(|source| DaeError::Singular { time, source })?;
         self.st.lu_c = Some(c);
         self.st.stats.n_lu += 1;
         Ok(())
     }
 
-    /// Simplified Newton for the corrector; returns (converged, iterations, x, d).
+    /// Simplified Newton for the corrector; returns (converged, iterations, x, d). The held
+    /// factors may be of `M − c_lu J` with `c_lu ≠ c` (within [`REFACTOR_RATIO`]): the
+    /// differential rows' residual is then taken at `c_lu` and the correction scaled by
+    /// `2/(1 + c_lu/c)`, as SUNDIALS IDA does with its `cj` ratio (Hindmarsh et al. 2005, §3.1 of
+    /// the IDA documentation), so that stiff and non-stiff directions err equally.
     fn newton(&mut self, sys: &dyn DaeSystem, corr: &Corrector<'_>) -> (bool, usize, Vec<f64>, Vec<f64>) {
         let Corrector { t_new, x_pred, c, psi, scale, tol } = *corr;
         let n = x_pred.len();
+        let c_lu = self.st.lu_c.unwrap_or(c);
+        let (ratio, damping) = (c_lu / c, 2.0 / (1.0 + c_lu / c));
         let mut x = x_pred.to_vec();
         let mut d = vec![0.0; n];
         let mut f = vec![0.0; n];
         let mut rhs = vec![0.0; n];
-        let mut diff_row = vec![usize::MAX; n];
-        sys.mass().iter().for_each(|&(i, j)| diff_row[i] = j);
         let mut dy_norm_old: Option<f64> = None;
         let mut iters = 0;
         for k in 0..NEWTON_MAXITER {
@@ -316,13 +340,16 @@ impl Bdf {
                 return (false, iters, x, d);
             }
             for i in 0..n {
-                rhs[i] = match diff_row[i] {
+                rhs[i] = match self.diff_var[i] {
                     usize::MAX => f[i],
-                    j => c * f[i] - psi[j] - d[j],
+                    j => ratio * (c * f[i] - psi[j] - d[j]),
                 };
             }
-            if !self.lu.solve_in_place(&mut rhs) {
+            if self.lu.solve_in_place(&mut rhs).is_err() {
                 return (false, iters, x, d);
+            }
+            if ratio != 1.0 {
+                rhs.iter_mut().for_each(|v| *v *= damping);
             }
             let dy_norm = rms(&rhs, scale, &self.all);
             let rate = dy_norm_old.map(|old| dy_norm / old);
@@ -395,7 +422,6 @@ impl Bdf {
                 let factor = (t_new - t) / *h_abs;
                 change_d(&mut self.st.d, order, factor);
                 self.st.n_equal_steps = 0;
-                lu_ok = false;
                 *h_abs = t_new - t;
             }
             let h = t_new - t;
@@ -451,7 +477,8 @@ impl Bdf {
     ) -> Result<Option<Corrected>, DaeError> {
         let n = corr.x_pred.len();
         loop {
-            if !*lu_ok || self.st.lu_c != Some(corr.c) {
+            let stale = self.st.lu_c.is_none_or(|c_lu| (corr.c / c_lu - 1.0).abs() > REFACTOR_RATIO);
+            if !*lu_ok || stale {
                 self.factor(n, sys, corr.c)?;
                 *lu_ok = true;
             }
@@ -466,6 +493,7 @@ impl Bdf {
             sys.jacobian(corr.t_new, corr.x_pred, &mut f, &mut self.st.jac);
             self.st.stats.n_jacobian_evals += 1;
             self.st.current_jac = true;
+            self.jac_loaded = false;
             *lu_ok = false;
         }
     }
@@ -508,8 +536,6 @@ impl Bdf {
         self.st.h_abs *= factor;
         change_d(&mut self.st.d, new_order, factor);
         self.st.n_equal_steps = 0;
-        self.st.lu_c = None;
-        self.lu.invalidate();
     }
 }
 
@@ -523,6 +549,7 @@ impl DaeIntegrator for Bdf {
         self.st.stats.n_jacobian_evals += n_jac;
         let mut f = vec![0.0; n];
         sys.jacobian(t, &x, &mut f, &mut self.st.jac);
+        self.jac_loaded = false;
         self.st.stats.n_jacobian_evals += 1;
         self.st.stats.n_residual_evals += 1;
         let mut xdot = vec![0.0; n];

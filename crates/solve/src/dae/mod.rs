@@ -12,11 +12,9 @@
 
 pub mod bdf;
 mod init;
-mod linear;
 
 pub use bdf::{Bdf, BdfSettings, BdfState, BdfStats};
 pub use init::consistent_algebraic;
-pub use linear::LinearError;
 
 /// A time-aware semi-explicit DAE `M dx/dt = f(t, x)` with a 0/1 mass matrix.
 pub trait DaeSystem: Sync {
@@ -78,7 +76,7 @@ pub enum DaeError {
         /// Time [s].
         time: f64,
         /// What the factorization said.
-        source: LinearError,
+        source: crate::sparse::SparseError,
     },
     /// A restored state does not fit the system.
     #[error("integrator state does not fit the system: {0}")]

@@ -78,6 +78,8 @@ impl Quadratures {
 #[derive(Debug, Clone)]
 pub(super) struct DaeShape {
     mass: Vec<(usize, usize)>,
+    /// Whether each plant variable is differential (carries a mass entry).
+    differential: Vec<bool>,
     /// Per integrated stream: its flow variable and its composition variables.
     flows: Vec<(usize, Range<usize>)>,
     n_plant: usize,
@@ -92,8 +94,10 @@ impl DaeShape {
         let mut mass = PlantSystem::new(plant, &[]).mass();
         let flows: Vec<(usize, Range<usize>)> =
             streams.iter().map(|&s| (plant.stream_flow_var(s), plant.stream_composition_vars(s))).collect();
+        let mut differential = vec![false; n_plant];
+        mass.iter().for_each(|&(_, j)| differential[j] = true);
         mass.extend((n_plant..n_plant + flows.len() * nc).map(|k| (k, k)));
-        DaeShape { mass, flows, n_plant, nc }
+        DaeShape { mass, differential, flows, n_plant, nc }
     }
 }
 
@@ -152,7 +156,7 @@ impl DaeSystem for PlantDae<'_> {
         }
     }
     fn error_controlled(&self, i: usize) -> bool {
-        i < self.shape.n_plant && self.shape.mass.iter().any(|&(_, j)| j == i)
+        self.shape.differential.get(i).copied().unwrap_or(false)
     }
     fn quadrature(&self, i: usize) -> bool {
         i >= self.shape.n_plant
