@@ -79,7 +79,7 @@ pub fn run(file: &Path) -> Result<(), CliError> {
     // The numerical probe judges one point: a singular Jacobian at the cold-start guess (a dry tray,
     // a closed valve) proves nothing until the plant also fails to converge from there.
     let numerical = match dof_check(&plant, &u, &x, DofProbe::Numerical) {
-        Ok(()) => plant.n_vars() <= plantwide::solve::steady::DENSE_PROBE_LIMIT,
+        Ok(()) => true,
         Err(e @ plantwide::solve::DofError::Count { .. }) => return Err(CliError::user(e.to_string())),
         Err(e) => match super::steady::converge(&plant, &u) {
             Ok(_) => {

@@ -151,6 +151,12 @@ fn imbalance(
     (rel.abs() > tol).then(|| (format!("the balance of {} (in − out)/throughput", plant.components()[c]), rel))
 }
 
+/// Total holdups of the whole plant resting on their lower bound at `x` (a failed solve's last
+/// iterate: a drum run dry says what the specification asks for).
+pub fn floors_anywhere(plant: &Plant, x: &[f64]) -> Vec<String> {
+    (0..plant.blocks().len()).flat_map(|bi| floors(plant, x, bi)).collect()
+}
+
 /// Total holdups of block `bi` resting on their lower bound.
 fn floors(plant: &Plant, x: &[f64], bi: usize) -> Vec<String> {
     plant

@@ -12,6 +12,7 @@ pub mod dae;
 pub mod dynamic;
 pub mod error;
 pub mod newton;
+pub mod rank;
 pub mod sequential;
 pub mod sparse;
 pub mod steady;

@@ -1,10 +1,10 @@
 //! Whole-plant steady state: the degrees-of-freedom check, then Newton on `f(x, u) = 0`.
 
-use faer::Mat;
 use plantwide_flowsheet::Plant;
 use plantwide_model::VarKind;
 
 use crate::certify::{CertificateFailure, Warning, certify};
+use crate::rank::{self, Rank};
 use crate::{NewtonReport, NewtonSettings, NewtonStatus, System, maximum_matching, solve_steady_observed};
 
 /// The plant at fixed inputs `u`, seen as a nonlinear system.
@@ -82,6 +82,17 @@ pub enum DofError {
     },
 }
 
+fn floor_note(at_floor: &[String]) -> String {
+    if at_floor.is_empty() {
+        return String::new();
+    }
+    format!(
+        "; at the last iterate {} {} lower bound: the specification may ask for more than the plant can deliver (a product flow above its feed, a holdup setpoint below zero) — check the flows and setpoints of that unit",
+        at_floor.join(", "),
+        if at_floor.len() == 1 { "rests on its" } else { "rest on their" }
+    )
+}
+
 fn newton_note(newton: &Option<String>) -> String {
     newton.as_ref().map_or(String::new(), |n| {
         format!(
@@ -106,21 +117,18 @@ pub fn history_summary(report: &NewtonReport) -> String {
     format!("history (iteration: scaled residual) {}", items.join(", "))
 }
 
-/// Largest plant for which the numerical null-space probe (a dense SVD) is run.
-pub const DENSE_PROBE_LIMIT: usize = 1500;
-
 /// How thorough the degrees-of-freedom check is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum DofProbe {
     /// Equation count and structural rank only (cheap: O(nnz · n) at worst).
     Structural,
-    /// Also the dense numerical null-space probe (an SVD; plants up to [`DENSE_PROBE_LIMIT`]).
+    /// Also the numerical null-space probe (sparse estimates of the extreme singular values and
+    /// the null direction, O(nnz) per iteration).
     Numerical,
 }
 
 /// Degrees-of-freedom check at the point `x`: equation count, structural rank (maximum matching)
-/// and, with [`DofProbe::Numerical`] for plants up to [`DENSE_PROBE_LIMIT`] variables, a numerical
-/// null-space probe that names the inventory or variable left free (an uncontrolled level, a flow
+/// and, with [`DofProbe::Numerical`], a numerical null-space probe that names the inventory or variable left free (an uncontrolled level, a flow
 /// fixed at both ends).
 pub fn dof_check(plant: &Plant, u: &[f64], x: &[f64], probe: DofProbe) -> Result<(), DofError> {
     let file = plant.file().to_string();
@@ -147,7 +155,7 @@ pub fn dof_check(plant: &Plant, u: &[f64], x: &[f64], probe: DofProbe) -> Result
             newton: None,
         });
     }
-    if probe == DofProbe::Numerical && n_vars <= DENSE_PROBE_LIMIT && n_vars > 0 {
+    if probe == DofProbe::Numerical && n_vars > 0 {
         // A plant that is ill-posed is singular at every consistent point; a guess can be singular
         // by accident (a component absent from a loop's measurement at a linear profile). Only a
         // null direction found at the guess and again after a few pseudo-transient steps (which
@@ -174,36 +182,44 @@ pub fn dof_check(plant: &Plant, u: &[f64], x: &[f64], probe: DofProbe) -> Result
 }
 
 /// The variables spanning a numerical null direction of the scaled Jacobian at `x`, largest first,
-/// or `None` if the smallest singular value is not negligible.
+/// or `None` if the smallest singular value is not negligible (≤ 10⁻¹² of the largest): the sparse
+/// estimate of [`crate::rank`], whose inverse-iteration vector is the direction.
 fn null_direction(plant: &Plant, u: &[f64], x: &[f64]) -> Option<Vec<usize>> {
     let n = plant.n_vars();
     let mut r = vec![0.0; n];
     let (mut jx, mut ju) = (Vec::new(), Vec::new());
     plant.jacobian_without_limits(x, u, &mut r, &mut jx, &mut ju);
-    // Scale columns by their nominal values and rows by their largest entry.
-    let mut a = Mat::<f64>::zeros(n, n);
-    for &(i, j, v) in &jx {
-        a[(i, j)] += v * plant.vars()[j].spec.nominal;
+    let a = scaled(plant, jx);
+    let direction = |v: &[f64]| {
+        let null: Vec<f64> = v.iter().map(|a| a.abs()).collect();
+        let top = null.iter().cloned().fold(0.0, f64::max);
+        let mut idx: Vec<usize> = (0..n).filter(|&j| null[j] > 0.05 * top).collect();
+        idx.sort_by(|&a, &b| null[b].total_cmp(&null[a]));
+        idx
+    };
+    match rank::estimate(n, &a) {
+        Rank::Estimated { sigma_max, sigma_min, .. } if sigma_min > 1e-12 * sigma_max => None,
+        Rank::Estimated { v, .. } | Rank::Singular { v } => Some(direction(&v)),
+        Rank::Pivotless(col) => Some(col.into_iter().collect()),
     }
-    for i in 0..n {
-        let s = (0..n).map(|j| a[(i, j)].abs()).fold(0.0, f64::max);
-        if s > 0.0 {
-            for j in 0..n {
-                a[(i, j)] /= s;
-            }
+}
+
+/// The Jacobian triplets with duplicates summed, columns scaled by their variables' nominal values
+/// and rows by their largest entry.
+fn scaled(plant: &Plant, mut jx: Vec<(usize, usize, f64)>) -> Vec<(usize, usize, f64)> {
+    jx.sort_unstable_by_key(|t| (t.0, t.1));
+    let mut a: Vec<(usize, usize, f64)> = Vec::with_capacity(jx.len());
+    for (i, j, v) in jx {
+        let v = v * plant.vars()[j].spec.nominal;
+        match a.last_mut() {
+            Some(last) if (last.0, last.1) == (i, j) => last.2 += v,
+            _ => a.push((i, j, v)),
         }
     }
-    let svd = a.svd().ok()?;
-    let s = svd.S().column_vector();
-    if s[n - 1] > 1e-12 * s[0] {
-        return None;
-    }
-    let v = svd.V();
-    let null: Vec<f64> = (0..n).map(|j| v[(j, n - 1)].abs()).collect();
-    let top = null.iter().cloned().fold(0.0, f64::max);
-    let mut idx: Vec<usize> = (0..n).filter(|&j| null[j] > 0.05 * top).collect();
-    idx.sort_by(|&a, &b| null[b].total_cmp(&null[a]));
-    Some(idx)
+    let mut row_max = vec![0.0f64; plant.n_vars()];
+    a.iter().for_each(|&(i, _, v)| row_max[i] = row_max[i].max(v.abs()));
+    a.iter_mut().filter(|t| row_max[t.0] > 0.0).for_each(|t| t.2 /= row_max[t.0]);
+    a
 }
 
 fn explain_loose(plant: &Plant, vars: &[usize], why: &str) -> String {
@@ -213,7 +229,11 @@ fn explain_loose(plant: &Plant, vars: &[usize], why: &str) -> String {
         .filter(|&&j| plant.vars()[j].spec.kind == VarKind::Differential)
         .map(|&j| plant.vars()[j].path.as_str())
         .collect();
-    let mut s = format!("{why}: {}", paths.join(", "));
+    let mut s = if paths.is_empty() {
+        format!("{why}: the sparse LU finds no pivot, even with a diagonal shift, and cannot name them")
+    } else {
+        format!("{why}: {}", paths.join(", "))
+    };
     if vars.len() > 8 {
         s.push_str(&format!(" and {} more", vars.len() - 8));
     }
@@ -261,7 +281,7 @@ pub enum SteadyError {
 /// A steady-state solve that did not converge: where and how it failed.
 #[derive(Debug, Clone, thiserror::Error)]
 #[error(
-    "{file}: steady state not found ({status:?} after {iterations} iterations, scaled residual {residual:.3e}); worst equation: {equation} (variable {variable}, scaled residual {worst:.3e}); {}", history_summary(.report)
+    "{file}: steady state not found ({status:?} after {iterations} iterations, scaled residual {residual:.3e}); worst equation: {equation} (variable {variable}, scaled residual {worst:.3e}){}; {}", floor_note(.at_floor), history_summary(.report)
 )]
 pub struct ConvergenceFailure {
     /// Flowsheet file.
@@ -278,6 +298,8 @@ pub struct ConvergenceFailure {
     pub variable: String,
     /// Its scaled residual.
     pub worst: f64,
+    /// Total holdups resting on their lower bound at the last iterate.
+    pub at_floor: Vec<String>,
     /// The full report with the iteration history.
     pub report: NewtonReport,
     /// The last iterate.
@@ -338,6 +360,7 @@ pub fn steady_state_observed(
         equation,
         variable,
         worst,
+        at_floor: crate::certify::floors_anywhere(plant, &x),
         report,
         x,
     })))
