@@ -248,6 +248,7 @@ pub(crate) struct GroupLayout {
 
 impl GroupLayout {
     pub fn new(plant: &Plant, blocks: &[usize]) -> GroupLayout {
+        debug_assert!(blocks.windows(2).all(|w| w[0] < w[1]), "a group's blocks are ascending");
         let (mut col0, mut row0, mut unknowns) = (Vec::new(), Vec::new(), Vec::new());
         let mut rows = 0;
         for &b in blocks {
@@ -266,7 +267,7 @@ impl GroupLayout {
     /// Local index of global variable `v`, if it is an unknown of the group.
     pub fn local(&self, plant: &Plant, v: usize) -> Option<usize> {
         let b = plant.vars()[v].block;
-        let k = self.blocks.iter().position(|&x| x == b)?;
+        let k = self.blocks.binary_search(&b).ok()?;
         Some(self.col0[k] + v - plant.blocks()[b].own_offset)
     }
     /// Global equation index and block of local row `row`.

@@ -53,7 +53,7 @@ pub fn plan(plant: &Plant, u: &[f64], x: &[f64]) -> SequentialPlan {
         let members: Vec<Vec<usize>> = groups.iter().map(|g| g.blocks.clone()).collect();
         let graph = plant.group_graph(&members);
         let sccs = decompose(&graph);
-        let singular = groups.iter().position(|g| !structurally_regular(plant, &g.blocks, &jx));
+        let singular = first_singular(plant, &groups, &jx);
         let Some(bad) = singular else { return SequentialPlan { groups, graph, sccs } };
         let node = graph.node_indices().find(|&v| graph[v] == bad).expect("every group is a node");
         let scc = sccs.iter().find(|s| s.order.contains(&node)).expect("every node is in an SCC");
@@ -86,21 +86,36 @@ pub fn plan(plant: &Plant, u: &[f64], x: &[f64]) -> SequentialPlan {
     }
 }
 
-/// True if the group's equations can be matched one-to-one with its own variables.
-fn structurally_regular(plant: &Plant, blocks: &[usize], jx: &[(usize, usize, f64)]) -> bool {
-    let layout = GroupLayout::new(plant, blocks);
-    let n = layout.unknowns.len();
-    if layout.n_rows(plant) != n {
-        return false;
+/// The first group whose equations cannot be matched one-to-one with its own variables. One pass
+/// over the Jacobian's entries buckets those that lie inside a group (equation and variable both
+/// its own), then each group is matched alone: linear in the plant's size, whatever the number of
+/// groups.
+fn first_singular(plant: &Plant, groups: &[SolveGroup], jx: &[(usize, usize, f64)]) -> Option<usize> {
+    let blocks = plant.blocks();
+    // For each block: its group, and the first local row and column of the block in that group.
+    let mut at = vec![(usize::MAX, 0, 0); blocks.len()];
+    let mut sizes = Vec::with_capacity(groups.len());
+    for (gi, g) in groups.iter().enumerate() {
+        let layout = GroupLayout::new(plant, &g.blocks);
+        for (k, &b) in g.blocks.iter().enumerate() {
+            at[b] = (gi, layout.row0[k], layout.col0[k]);
+        }
+        sizes.push((layout.n_rows(plant), layout.unknowns.len()));
     }
-    let mut row_of = std::collections::HashMap::new();
-    for (k, &b) in blocks.iter().enumerate() {
-        let blk = &plant.blocks()[b];
-        for i in 0..blk.n_eq {
-            row_of.insert(blk.eq_offset + i, layout.row0[k] + i);
+    let mut eq_block = vec![0; plant.n_eqs()];
+    for (bi, b) in blocks.iter().enumerate() {
+        eq_block[b.eq_offset..b.eq_offset + b.n_eq].fill(bi);
+    }
+    let mut entries: Vec<Vec<(usize, usize)>> = vec![Vec::new(); groups.len()];
+    for &(i, j, _) in jx {
+        let (bi, bj) = (eq_block[i], plant.vars()[j].block);
+        let ((gi, row0, _), (gj, _, col0)) = (at[bi], at[bj]);
+        if gi == gj && gi != usize::MAX {
+            entries[gi].push((row0 + i - blocks[bi].eq_offset, col0 + j - blocks[bj].own_offset));
         }
     }
-    let entries: Vec<(usize, usize)> =
-        jx.iter().filter_map(|&(i, j, _)| Some((*row_of.get(&i)?, layout.local(plant, j)?))).collect();
-    maximum_matching(n, n, &entries).size() == n
+    (0..groups.len()).find(|&g| {
+        let (rows, n) = sizes[g];
+        rows != n || maximum_matching(n, n, &entries[g]).size() != n
+    })
 }
