@@ -1,0 +1,317 @@
+#!/usr/bin/env python3
+"""Column A feed step: plantwide's BDF against SciPy, SUNDIALS CVODE and CasADi, in one run.
+
+What it measures: the wall time (median of repeated runs, after one untimed warm-up run) of integrating
+the same model and scenario as tools/bench_bdf_scipy.py, whose model definition (constants, state
+layout n[i, c] in mol, RHS, sparsity pattern, steady state by fsolve) is imported from there unchanged:
+Skogestad's column A in closed loop (LV, P-only level loops D = 0.5 + 10 (M_41 - 0.5),
+B = 0.5 + 10 (M_1 - 0.5) [kmol/min, kmol]), feed step F 1 -> 1.01 kmol/min at t = 0, 2000 min,
+rtol 1e-6, atol 1e-8 x nominal (0.5 kmol per component holdup, so 5e-6 mol for every state), SI units
+(mol, s). Every Python peer starts from the same steady state at F = 1 (the array returned by fsolve);
+plantwide starts from its own converged steady state. The script checks that the final xB, yD agree.
+
+Peers:
+  scipy_bdf           scipy.integrate.solve_ivp(method="BDF"), Python (numpy) RHS, Jacobian by grouped
+                      finite differences on the exact sparsity pattern (jac_sparsity), sparse LU (SuperLU).
+  cvode_python        SUNDIALS CVODE (scikit-sundae), BDF, Python (numpy) RHS, band linear solver
+                      (lband = uband = 3, the bandwidth of the block-tridiagonal Jacobian), Jacobian by
+                      CVODE's internal band difference quotients (7 RHS calls per Jacobian).
+  cvode_python_dense  the same with the dense linear solver and dense difference quotients (82 RHS calls
+                      per Jacobian).
+                      For both, rhs_s = (RHS calls, counted by a wrapper, incl. difference quotients) x
+                      (time per RHS call, measured separately on the initial state), i.e. the share of
+                      the wall time spent in the Python RHS itself (callback overhead from C not included).
+  casadi_cvodes       CasADi's "cvodes" plugin on the RHS written with casadi.SX symbols: the RHS and its
+  casadi_idas         exact Jacobian (CasADi's AD, its default) are evaluated by CasADi's SX virtual
+                      machine in C++ (no Python per call; no code generation or JIT); CasADi's default
+                      linear solver (csparse, sparse direct) and Newton scheme ("direct"); same rtol and
+                      scalar abstol. "idas" is the same ODE handed to IDAS in implicit form. The integrator
+                      is built once outside the timing loop; only the call I(x0=..., p=...) is timed.
+  plantwide           `cargo bench --bench dynamics` run once from the repository root (median of 15 runs
+                      inside the bench; exact Jacobians by dual numbers); --no-plantwide skips it,
+                      --plantwide-json '<json line>' passes its last line in instead.
+
+The figures are medians on this machine (2 cores, shared with whatever else is running): compare ratios
+from one run, not absolute times across runs.
+
+Usage (virtual environment outside the repository):
+  python3 -m venv /work/venv-bench && /work/venv-bench/bin/pip install numpy scipy casadi scikit-sundae
+  /work/venv-bench/bin/python tools/bench_dynamics_peers.py [--no-plantwide | --plantwide-json '<json>']
+                                                           [--repeats N]
+--repeats N (default 21) is the number of timed runs of SciPy and CVODE; CasADi gets 3 N (it is fast).
+numpy and scipy are required; a peer whose package (scikit-sundae, casadi) is missing is skipped with a
+note in the JSON. Prints one line per peer, then one JSON line.
+"""
+
+import argparse
+import json
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+sys.dont_write_bytecode = True  # importing bench_bdf_scipy must leave no __pycache__ in the repository
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+try:
+    import numpy as np
+    import scipy
+    from scipy.integrate import solve_ivp
+
+    import bench_bdf_scipy as model
+except ImportError as e:
+    sys.exit(f"bench_dynamics_peers.py: missing required package '{e.name}' (numpy and scipy are required); "
+             "install with /work/venv-bench/bin/pip install numpy scipy casadi scikit-sundae")
+
+N = model.N
+FEED_STEP = 1.01 * model.KMOL_MIN  # mol/s
+T_END = 2000.0 * 60.0  # s
+RTOL = 1e-6
+ATOL = 1e-8 * model.M0  # mol
+PEERS = ("plantwide", "scipy_bdf", "cvode_python", "cvode_python_dense", "casadi_cvodes", "casadi_idas")
+XB_REF, YD_REF = 0.0171621032, 0.9924946428  # plantwide's final values from the bench
+
+
+def ends(n):
+    """(xB, yD): light-component fractions of the reboiler (stage 0) and the condenser (stage N-1)."""
+    n = np.asarray(n, dtype=float).reshape(N, 2)
+    x = n[:, 0] / n.sum(axis=1)
+    return float(x[0]), float(x[N - 1])
+
+
+def timed(run, repeats):
+    """One untimed warm-up run, then `repeats` timed runs; (median wall [s], fastest [s], last result)."""
+    run()
+    walls = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        out = run()
+        walls.append(time.perf_counter() - start)
+    return statistics.median(walls), min(walls), out
+
+
+def run_scipy(n0, repeats):
+    pattern = model.sparsity()
+
+    def run():
+        sol = solve_ivp(model.rhs, (0.0, T_END), n0, method="BDF", rtol=RTOL, atol=ATOL, args=(FEED_STEP,),
+                        jac_sparsity=pattern)
+        assert sol.success, sol.message
+        return sol
+
+    wall, fastest, sol = timed(run, repeats)
+    xb, yd = ends(sol.y[:, -1])
+    return {"wall_s": wall, "min_s": fastest, "steps": len(sol.t) - 1, "rhs_evals": int(sol.nfev),
+            "jacobian_evals": int(sol.njev), "lu": int(sol.nlu), "xB": xb, "yD": yd, "repeats": repeats,
+            "config": "solve_ivp BDF, Python RHS, FD Jacobian on jac_sparsity, SuperLU"}
+
+
+def run_cvode(n0, repeats, linsolver):
+    from sksundae.cvode import CVODE
+
+    calls = [0]
+
+    def f(_t, y, yp):
+        calls[0] += 1
+        yp[:] = model.rhs(_t, y, FEED_STEP)
+
+    band = {"lband": 3, "uband": 3} if linsolver == "band" else {}
+    solver = CVODE(f, method="BDF", rtol=RTOL, atol=ATOL, linsolver=linsolver, max_num_steps=100000, **band)
+    tspan = np.array([0.0, T_END])
+
+    def run():
+        calls[0] = 0
+        sol = solver.solve(tspan, n0)
+        assert sol.success, sol.message
+        return sol, calls[0]
+
+    wall, fastest, (sol, ncalls) = timed(run, repeats)
+    # time per Python RHS call, measured on its own
+    yp = np.empty(2 * N)
+    reps = 2000
+    start = time.perf_counter()
+    for _ in range(reps):
+        f(0.0, n0, yp)
+    per_call = (time.perf_counter() - start) / reps
+    xb, yd = ends(sol.y[-1])
+    return {"wall_s": wall, "min_s": fastest, "rhs_s": ncalls * per_call, "rhs_fraction": ncalls * per_call / wall,
+            "rhs_call_s": per_call, "steps": len(sol.t) - 1, "rhs_calls": ncalls, "rhs_evals_nfe": int(sol.nfev),
+            "jacobian_evals": int(sol.njev), "xB": xb, "yD": yd, "repeats": repeats,
+            "config": f"CVODE BDF, Python RHS, {linsolver} linear solver, internal {linsolver} DQ Jacobian"}
+
+
+def rhs_sx(ca, n, feed):
+    """model.rhs written with CasADi symbols, term by term (checked against model.rhs below)."""
+    m = [n[2 * i] + n[2 * i + 1] for i in range(N)]
+    x = [n[2 * i] / m[i] for i in range(N)]
+    y = [model.ALPHA * x[i] / (1.0 + (model.ALPHA - 1.0) * x[i]) for i in range(N)]
+    d = 0.5 * model.KMOL_MIN + model.KC * (m[N - 1] - model.M0)
+    b = 0.5 * model.KMOL_MIN + model.KC * (m[0] - model.M0)
+    liq = [model.L0[i] + (m[i] - model.M0) / model.TAU_L for i in range(N)]
+    liq[N - 1] = model.L_NOM
+    liq[0] = b
+    vap = [model.V_NOM] * N
+    vap[N - 1] = 0.0
+    xs = [(x[i], 1.0 - x[i]) for i in range(N)]
+    ys = [(y[i], 1.0 - y[i]) for i in range(N)]
+    out = []
+    for i in range(N):
+        for c in range(2):
+            r = -liq[i] * xs[i][c] - vap[i] * ys[i][c]
+            if i < N - 1:
+                r = r + liq[i + 1] * xs[i + 1][c]
+            if i > 0:
+                r = r + vap[i - 1] * ys[i - 1][c]
+            if i == model.FEED:
+                r = r + feed * 0.5
+            if i == N - 1:
+                r = r - d * xs[i][c]
+            out.append(r)
+    return ca.vertcat(*out)
+
+
+def casadi_model(n0):
+    import casadi as ca
+
+    n = ca.SX.sym("n", 2 * N)
+    feed = ca.SX.sym("F")
+    ode = rhs_sx(ca, n, feed)
+    f = ca.Function("f", [n, feed], [ode])
+    # the SX RHS must be the numpy RHS: at the initial state and at perturbed states
+    rng = np.random.default_rng(1)
+    diff = 0.0
+    for state in [n0] + [n0 * (1.0 + 0.05 * rng.standard_normal(2 * N)) for _ in range(3)]:
+        ref = model.rhs(0.0, state, FEED_STEP)
+        got = np.array(f(state, FEED_STEP)).ravel()
+        diff = max(diff, float(np.max(np.abs(got - ref)) / np.max(np.abs(ref))))
+    return ca, {"x": n, "p": feed, "ode": ode}, f, diff
+
+
+def run_casadi(ca, dae, n0, repeats, plugin):
+    opts = {"abstol": ATOL, "reltol": RTOL, "max_num_steps": 100000}
+    integ = ca.integrator("F", plugin, dae, 0.0, T_END, opts)
+
+    def run():
+        return integ(x0=n0, p=FEED_STEP)
+
+    wall, fastest, res = timed(run, repeats)
+    st = integ.stats()
+    xb, yd = ends(np.array(res["xf"]).ravel())
+    return {"wall_s": wall, "min_s": fastest, "steps": int(st["nsteps"]), "rhs_evals": int(st["nfevals"]),
+            "jacobian_evals": int(st["n_call_jacF"]), "lu": int(st["nlinsetups"]), "newton_iters": int(st["nniters"]),
+            "error_test_failures": int(st["netfails"]), "xB": xb, "yD": yd, "repeats": repeats,
+            "config": f"CasADi {ca.__version__} {plugin}, SX RHS, AD Jacobian, csparse"}
+
+
+def run_plantwide(root):
+    out = subprocess.run(["cargo", "bench", "--bench", "dynamics"], cwd=root, capture_output=True, text=True)
+    lines = [line for line in out.stdout.splitlines() if line.startswith('{"wall_s":')]
+    if out.returncode != 0 or not lines:
+        tail = "\n".join(out.stderr.splitlines()[-10:])
+        raise RuntimeError(f"cargo bench --bench dynamics failed (exit {out.returncode}):\n{tail}")
+    return json.loads(lines[-1])
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--no-plantwide", action="store_true", help="skip `cargo bench --bench dynamics`")
+    ap.add_argument("--plantwide-json", metavar="JSON", help="the bench's last line, instead of running it")
+    ap.add_argument("--repeats", type=int, default=21, help="timed runs for SciPy and CVODE (CasADi: 3x)")
+    args = ap.parse_args()
+    root = Path(__file__).resolve().parent.parent
+    result = {"model": "column_a_feed_step_2000min", "rtol": RTOL, "atol": 1e-8}
+
+    # plantwide first, so that its build (if any) is over before the Python peers are timed
+    if args.plantwide_json:
+        pw = json.loads(args.plantwide_json)
+    elif args.no_plantwide:
+        pw = {"skipped": "--no-plantwide"}
+    else:
+        try:
+            pw = run_plantwide(root)
+        except RuntimeError as e:
+            pw = {"error": str(e).splitlines()[0]}
+            print(e, file=sys.stderr)
+    result["plantwide"] = pw
+    if "wall_s" in pw:
+        print(f"plantwide BDF (median of 15, in the bench): {pw['wall_s'] * 1e3:.2f} ms, {pw['steps']} steps, "
+              f"{pw['residual_evals']} residual evaluations, {pw['jacobian_evals']} exact Jacobians, {pw['lu']} LU; "
+              f"xB = {pw['xB']:.10f}, yD = {pw['yD']:.10f}")
+    else:
+        print(f"plantwide: {pw}")
+
+    n0 = model.steady_state()
+    xb0, yd0 = ends(n0)
+    res0 = float(np.max(np.abs(model.rhs(0.0, n0, model.F_NOM))))
+    print(f"Python peers: numpy {np.__version__}, SciPy {scipy.__version__}; initial steady state at F = 1 "
+          f"kmol/min (fsolve): xB = {xb0:.10f}, yD = {yd0:.10f}, max |dn/dt| = {res0:.1e} mol/s")
+    result["initial"] = {"xB": xb0, "yD": yd0, "max_abs_rhs_mol_s": res0, "xB_minus_0.01": xb0 - 0.01,
+                         "yD_minus_0.99": yd0 - 0.99,
+                         "note": "one array for all Python peers; plantwide converges its own (yD 0.99, xB 0.01)"}
+
+    s = run_scipy(n0, args.repeats)
+    result["scipy_bdf"] = s
+    print(f"SciPy BDF (median of {args.repeats}): {s['wall_s'] * 1e3:.2f} ms, {s['steps']} steps, {s['rhs_evals']} RHS "
+          f"evaluations (incl. FD Jacobians), {s['jacobian_evals']} Jacobians, {s['lu']} LU; "
+          f"xB = {s['xB']:.10f}, yD = {s['yD']:.10f}")
+
+    try:
+        import sksundae
+        for key, ls in (("cvode_python", "band"), ("cvode_python_dense", "dense")):
+            c = run_cvode(n0, args.repeats, ls)
+            result[key] = c
+            print(f"CVODE (scikit-sundae {sksundae.__version__}, {ls}, median of {args.repeats}): "
+                  f"{c['wall_s'] * 1e3:.2f} ms, {c['steps']} steps, {c['rhs_calls']} Python RHS calls "
+                  f"({c['rhs_evals_nfe']} + DQ Jacobians), {c['jacobian_evals']} Jacobians; Python RHS "
+                  f"{c['rhs_calls']} x {c['rhs_call_s'] * 1e6:.1f} us = {c['rhs_s'] * 1e3:.2f} ms "
+                  f"({100 * c['rhs_fraction']:.0f} %); xB = {c['xB']:.10f}, yD = {c['yD']:.10f}")
+    except ImportError:
+        result["cvode_python"] = {"skipped": "scikit-sundae not installed"}
+        print("CVODE: skipped (scikit-sundae not installed)")
+
+    try:
+        ca, dae, _, sx_diff = casadi_model(n0)
+        result["casadi_rhs_vs_numpy_max_rel_diff"] = sx_diff
+        print(f"CasADi {ca.__version__}: SX RHS against numpy RHS, max relative difference {sx_diff:.1e}")
+        for key, plugin in (("casadi_cvodes", "cvodes"), ("casadi_idas", "idas")):
+            c = run_casadi(ca, dae, n0, 3 * args.repeats, plugin)
+            result[key] = c
+            print(f"CasADi {plugin} (median of {3 * args.repeats}): {c['wall_s'] * 1e3:.2f} ms, {c['steps']} steps, "
+                  f"{c['rhs_evals']} RHS evaluations, {c['jacobian_evals']} AD Jacobians, {c['lu']} LU setups, "
+                  f"{c['error_test_failures']} error-test failures; xB = {c['xB']:.10f}, yD = {c['yD']:.10f}")
+    except ImportError:
+        result["casadi_cvodes"] = result["casadi_idas"] = {"skipped": "casadi not installed"}
+        print("CasADi: skipped (casadi not installed)")
+
+    peers = [k for k in PEERS if "xB" in result.get(k, {})]
+    ref_name = "plantwide" if "plantwide" in peers else "reference (plantwide's earlier bench)"
+    ref = result["plantwide"] if "plantwide" in peers else {"xB": XB_REF, "yD": YD_REF}
+    agreement = {"against": ref_name}
+    for k in peers:
+        if k != "plantwide":
+            agreement[k] = {"xB_rel": abs(result[k]["xB"] / ref["xB"] - 1.0),
+                            "yD_rel": abs(result[k]["yD"] / ref["yD"] - 1.0)}
+    agreement["max_rel"] = max([max(v["xB_rel"], v["yD_rel"]) for k, v in agreement.items() if isinstance(v, dict)],
+                               default=0.0)
+    result["agreement"] = agreement
+    print(f"final values against {ref_name}: largest relative difference {agreement['max_rel']:.1e} "
+          f"({'within' if agreement['max_rel'] < 1e-6 else 'OUTSIDE'} 1e-6); "
+          + ", ".join(f"{k} xB {v['xB_rel']:.1e} yD {v['yD_rel']:.1e}" for k, v in agreement.items()
+                      if isinstance(v, dict)))
+
+    ratios = {}
+    if "wall_s" in pw:
+        for k in ("scipy_bdf", "cvode_python", "cvode_python_dense"):
+            if "wall_s" in result.get(k, {}):
+                ratios[f"{k}/plantwide"] = result[k]["wall_s"] / pw["wall_s"]
+        for k in ("casadi_cvodes", "casadi_idas"):
+            if "wall_s" in result.get(k, {}):
+                ratios[f"plantwide/{k}"] = pw["wall_s"] / result[k]["wall_s"]
+    result["ratios"] = ratios
+    if ratios:
+        print("wall-time ratios: " + ", ".join(f"{k} {v:.2f}" for k, v in ratios.items()))
+    print(json.dumps(result))
+
+
+if __name__ == "__main__":
+    main()
