@@ -70,6 +70,13 @@ struct System<'a> {
     differential: Vec<bool>,
     /// Column colouring of the column's Jacobian pattern, computed once.
     coloring: Option<Coloring>,
+    /// Per core row: the core positions and local columns its Jacobian row can hold (a regular
+    /// row; the level-law rows hold their two), from the unit's pattern.
+    row_cols: Vec<Vec<(usize, usize)>>,
+    /// The dense core matrix, allocated once for every Newton call of one polish: a fresh m²
+    /// matrix per call (m ≈ 330 for 32 stages, 0.9 MB) comes from mmap and page faults, which
+    /// made a failing cold start with a thousand pseudo-time steps several times slower.
+    core: std::cell::RefCell<Vec<f64>>,
 }
 
 const SUMP_LAW: usize = usize::MAX - 1;
@@ -101,6 +108,17 @@ impl<'a> System<'a> {
             nominal[at] = flow_nom;
             bounds[at] = (0.0, f64::INFINITY);
         }
+        let core_cols: Vec<usize> = [b_at].into_iter().chain(internal0..n_own).chain([d_at]).collect();
+        let core_rows: Vec<usize> = [SUMP_LAW].into_iter().chain(internal0..n_own).chain([DRUM_LAW]).collect();
+        let pattern = UnitModel::pattern(col, lay);
+        let row_cols = core_structure(
+            &core_rows,
+            &core_cols,
+            pattern.as_deref(),
+            len,
+            internal0,
+            [(b_at, m_sump), (d_at, m_drum)],
+        );
         System {
             col,
             io,
@@ -114,13 +132,71 @@ impl<'a> System<'a> {
             b0,
             k_d: (reflux + d0).max(1e-3) / col.m_condenser,
             k_b: (reflux + b0).max(1e-3) / col.m_reboiler,
-            core_cols: [b_at].into_iter().chain(internal0..n_own).chain([d_at]).collect(),
-            core_rows: [SUMP_LAW].into_iter().chain(internal0..n_own).chain([DRUM_LAW]).collect(),
+            core_cols,
+            core_rows,
             nominal,
             bounds,
             differential,
-            coloring: UnitModel::pattern(col, lay).map(|p| Coloring::new(&p, n_own, len)),
+            coloring: pattern.map(|p| Coloring::new(&p, n_own, len)),
+            core: std::cell::RefCell::new(vec![0.0; row_cols.len() * row_cols.len()]),
+            row_cols,
         }
+    }
+    /// The core matrix and right-hand side at the Jacobian `jac` and residuals `r` (implicit
+    /// Euler of step `dt` on the differential rows), after clearing the region `dirty` (the band
+    /// of the last solve) of `a`.
+    fn fill_core(
+        &self,
+        a: &mut [f64],
+        rhs: &mut [f64],
+        dirty: (usize, usize),
+        jac: &[f64],
+        r: &[f64],
+        dt: Option<f64>,
+    ) {
+        let (m, len, n_own) = (self.core_rows.len(), self.len, self.n_own);
+        let internal0 = self.col.n_outlets() * self.io.layout.stream.len();
+        let (below, above) = dirty;
+        for i in 0..m {
+            a[i * m + i.saturating_sub(below)..=i * m + (i + above + below).min(m - 1)].fill(0.0);
+        }
+        for (i, &row) in self.core_rows.iter().enumerate() {
+            let extra = match row {
+                SUMP_LAW => n_own,
+                DRUM_LAW => n_own + 1,
+                _ => {
+                    for &(k, c) in &self.row_cols[i] {
+                        a[i * m + k] = jac[row * len + c];
+                    }
+                    if let (Some(dt), true) = (dt, self.differential[row]) {
+                        a[i * m + (row - internal0 + 1)] -= 1.0 / dt;
+                    }
+                    rhs[i] = -r[row];
+                    continue;
+                }
+            };
+            let gain = if row == SUMP_LAW { self.k_b } else { self.k_d };
+            let (k_at, k_held) = (self.row_cols[i][0].0, self.row_cols[i][1].0);
+            a[i * m + k_at] = 1.0;
+            a[i * m + k_held] = -gain;
+            rhs[i] = -r[extra];
+        }
+    }
+    /// The band `(below, above)` of the core matrix at the Jacobian `jac`: its nonzero values,
+    /// the implicit-Euler diagonal and the level laws. The declared pattern would give a full
+    /// band (the distillate and bottoms, first and last core unknowns, are declared in every row).
+    fn value_band(&self, jac: &[f64]) -> (usize, usize) {
+        let (mut below, mut above) = (0, 0);
+        for (i, (&row, entries)) in self.core_rows.iter().zip(&self.row_cols).enumerate() {
+            let law = row == SUMP_LAW || row == DRUM_LAW;
+            for &(k, c) in entries {
+                if law || jac[row * self.len + c] != 0.0 {
+                    below = below.max(i.saturating_sub(k));
+                    above = above.max(k.saturating_sub(i));
+                }
+            }
+        }
+        (below, above)
     }
     fn io<'b>(&'b self, local: &'b [f64]) -> UnitIo<'b, f64> {
         UnitIo { local, layout: self.io.layout, thermo: self.io.thermo, time: 0.0 }
@@ -151,6 +227,11 @@ impl<'a> System<'a> {
             }
         };
         let merit = |r: &[f64], w: &[f64]| r.iter().zip(w).map(|(a, b)| (a * b).powi(2)).sum::<f64>();
+        let mut a = self.core.borrow_mut();
+        let mut rhs = vec![0.0; m];
+        // The band of the held Jacobian's nonzero values, and the region the last solve may have
+        // written (elimination with row exchanges reaches `above + below` right of the diagonal).
+        let (mut band, mut dirty) = ((0, 0), (m, m));
         for it in 0..max_iter {
             if it == 0 || dt.is_none() {
                 jac.iter_mut().for_each(|v| *v = 0.0);
@@ -161,6 +242,7 @@ impl<'a> System<'a> {
                 }
                 w[n_own] = 1.0 / self.nominal[self.b_at];
                 w[n_own + 1] = 1.0 / self.nominal[self.d_at];
+                band = self.value_band(&jac);
             }
             stepped(local, &mut r);
             let norm = r.iter().zip(&w).map(|(a, b)| (a * b).abs()).fold(0.0, f64::max);
@@ -170,29 +252,9 @@ impl<'a> System<'a> {
             if norm <= tol {
                 return Some(it);
             }
-            let mut a = vec![0.0; m * m];
-            let mut rhs = vec![0.0; m];
-            for (i, &row) in self.core_rows.iter().enumerate() {
-                let (extra, at, held, gain) = match row {
-                    SUMP_LAW => (n_own, self.b_at, self.m_sump, self.k_b),
-                    DRUM_LAW => (n_own + 1, self.d_at, self.m_drum, self.k_d),
-                    _ => {
-                        for (k, &c) in self.core_cols.iter().enumerate() {
-                            a[i * m + k] = jac[row * len + c];
-                        }
-                        if let (Some(dt), true) = (dt, self.differential[row]) {
-                            a[i * m + (row - internal0 + 1)] -= 1.0 / dt;
-                        }
-                        rhs[i] = -r[row];
-                        continue;
-                    }
-                };
-                let col_of = |c: usize| self.core_cols.iter().position(|&k| k == c);
-                a[i * m + col_of(at)?] = 1.0;
-                a[i * m + col_of(held)?] = -gain;
-                rhs[i] = -r[extra];
-            }
-            if !banded_solve(&mut a, &mut rhs, m) {
+            self.fill_core(&mut a, &mut rhs, dirty, &jac, &r, dt);
+            dirty = band;
+            if !banded_solve(&mut a, &mut rhs, m, band) {
                 return None;
             }
             // Outlet streams: unit coefficient on their own variable, none on another outlet's.
@@ -297,19 +359,47 @@ pub(super) fn polish(col: &RigorousColumn, io: &UnitIo<'_, f64>, own: &mut [f64]
     true
 }
 
+/// The core matrix's structure (see [`System`]): for each core row, the `(core position, local
+/// column)` pairs of its structural Jacobian entries (the pattern, or every core column for a
+/// dense unit), and the level-law rows' `(position of the flow, position of the holdup)`.
+fn core_structure(
+    core_rows: &[usize],
+    core_cols: &[usize],
+    pattern: Option<&[(usize, usize)]>,
+    len: usize,
+    internal0: usize,
+    laws: [(usize, usize); 2],
+) -> Vec<Vec<(usize, usize)>> {
+    let mut pos = vec![usize::MAX; len];
+    core_cols.iter().enumerate().for_each(|(k, &c)| pos[c] = k);
+    let mut by_row: Vec<Vec<usize>> = vec![Vec::new(); core_rows.len() + internal0];
+    let n_rows = by_row.len();
+    match pattern {
+        Some(p) => p.iter().filter(|&&(r, _)| r < n_rows).for_each(|&(r, c)| by_row[r].push(c)),
+        None => by_row.iter_mut().for_each(|v| v.extend(0..len)),
+    }
+    core_rows
+        .iter()
+        .map(|&row| match row {
+            SUMP_LAW | DRUM_LAW => {
+                let (at, held) = laws[usize::from(row == DRUM_LAW)];
+                vec![(pos[at], at), (pos[held], held)]
+            }
+            _ => {
+                let mut v: Vec<(usize, usize)> =
+                    by_row[row].iter().filter(|&&c| pos[c] != usize::MAX).map(|&c| (pos[c], c)).collect();
+                v.sort_unstable();
+                v.dedup();
+                v
+            }
+        })
+        .collect()
+}
+
 /// Solve `A x = b` in place (`A` row-major `n × n`, nonzeros near the diagonal) by Gaussian
 /// elimination with partial pivoting, each step confined to the band of the remaining matrix;
 /// false if `A` is singular.
-fn banded_solve(a: &mut [f64], b: &mut [f64], n: usize) -> bool {
-    let (mut kl, mut ku) = (0, 0);
-    for i in 0..n {
-        for j in 0..n {
-            if a[i * n + j] != 0.0 {
-                kl = kl.max(i.saturating_sub(j));
-                ku = ku.max(j.saturating_sub(i));
-            }
-        }
-    }
+fn banded_solve(a: &mut [f64], b: &mut [f64], n: usize, (kl, ku): (usize, usize)) -> bool {
     for c in 0..n {
         let last_row = (c + kl).min(n - 1);
         let last_col = (c + ku + kl).min(n - 1);
