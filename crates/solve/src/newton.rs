@@ -200,9 +200,21 @@ pub fn solve_steady_observed<S: System>(
     settings: &NewtonSettings,
     observer: &mut dyn FnMut(&IterationRecord),
 ) -> NewtonReport {
+    solve_steady_reusing(sys, x, settings, observer, &mut SparseLu::default())
+}
+
+/// [`solve_steady_observed`] with the caller's LU, whose pattern analysis carries over from an
+/// earlier solve of the same system (the sequential pass solves each group once per pass).
+pub fn solve_steady_reusing<S: System>(
+    sys: &S,
+    x: &mut [f64],
+    settings: &NewtonSettings,
+    observer: &mut dyn FnMut(&IterationRecord),
+    lu: &mut SparseLu,
+) -> NewtonReport {
     let n = sys.n();
     let mut wk =
-        Work { sys, n, lu: SparseLu::default(), jac: Vec::new(), r: vec![0.0; n], w: vec![1.0; n], n_res: 0, n_jac: 0 };
+        Work { sys, n, lu: std::mem::take(lu), jac: Vec::new(), r: vec![0.0; n], w: vec![1.0; n], n_res: 0, n_jac: 0 };
     let mut history = Observed { records: Vec::new(), observer };
     let mut status = newton_phase(&mut wk, x, settings, &mut history);
     if status != NewtonStatus::Converged && settings.pseudo_transient {
@@ -215,6 +227,7 @@ pub fn solve_steady_observed<S: System>(
     let history = history.records;
     wk.linearize(x);
     let (residual, worst) = wk.scaled_norm(&wk.r.clone());
+    *lu = std::mem::take(&mut wk.lu);
     NewtonReport {
         status,
         iterations: history.len(),

@@ -54,7 +54,9 @@ pub use strategy::{
     Method, Progress, Solution, SolveError, StrategySettings, converge, converge_observed, steady_state_by,
 };
 
-use crate::{DofError, DofProbe, NewtonSettings, NewtonStatus, dof_check, solve_steady};
+use crate::newton::solve_steady_reusing;
+use crate::sparse::SparseLu;
+use crate::{DofError, DofProbe, NewtonSettings, NewtonStatus, dof_check};
 use accel::{TearIteration, WegsteinBounds};
 use groups::{GroupLayout, GroupSystem};
 
@@ -250,6 +252,7 @@ pub fn solve_sequential_observed(
         layouts: &layouts,
         torn: vec![false; plant.n_vars()],
         phi: vec![0.0; plant.n_vars()],
+        lus: (0..layouts.len()).map(|_| SparseLu::default()).collect(),
         report: SmReport::default(),
     };
     run.report.n_groups = plan.groups.len();
@@ -276,6 +279,8 @@ struct Run<'a> {
     torn: Vec<bool>,
     /// New values `φ` of the torn variables.
     phi: Vec<f64>,
+    /// One LU per group, kept from pass to pass.
+    lus: Vec<SparseLu>,
     report: SmReport,
 }
 
@@ -284,8 +289,8 @@ impl Run<'_> {
     fn solve_group(&mut self, g: usize, x: &mut [f64]) -> Result<(), SmError> {
         let layout = &self.layouts[g];
         let mut y: Vec<f64> = layout.unknowns.iter().map(|&v| x[v]).collect();
-        let rep =
-            solve_steady(&GroupSystem { plant: self.plant, u: self.u, base: x, layout }, &mut y, &self.settings.local);
+        let sys = GroupSystem { plant: self.plant, u: self.u, base: x, layout };
+        let rep = solve_steady_reusing(&sys, &mut y, &self.settings.local, &mut |_| {}, &mut self.lus[g]);
         self.report.local_iterations += rep.iterations;
         self.report.local_solves += 1;
         if rep.status != NewtonStatus::Converged {

@@ -92,8 +92,21 @@ impl Structure {
         if let Some(&(row, col)) = positions.iter().find(|t| t.0 >= n || t.1 >= n) {
             return Err(SparseError::OutOfBounds { row, col, n });
         }
-        let mut order: Vec<usize> = (0..positions.len()).collect();
-        order.sort_unstable_by_key(|&k| (positions[k].1, positions[k].0));
+        // Counting sort by column, then by row within each column: O(nnz + n) and stable.
+        let mut start = vec![0usize; n + 1];
+        positions.iter().for_each(|&(_, j)| start[j + 1] += 1);
+        for j in 0..n {
+            start[j + 1] += start[j];
+        }
+        let mut order = vec![0usize; positions.len()];
+        let mut next = start.clone();
+        for (k, &(_, j)) in positions.iter().enumerate() {
+            order[next[j]] = k;
+            next[j] += 1;
+        }
+        for j in 0..n {
+            order[start[j]..start[j + 1]].sort_unstable_by_key(|&k| positions[k].0);
+        }
         let (mut row, mut col_ptr, mut slot) = (Vec::new(), vec![0; n + 1], vec![0; positions.len()]);
         let mut last = None;
         for k in order {
