@@ -136,15 +136,15 @@ pub fn run(file: &Path, json: bool, sets: &[String], method: MethodArg) -> Resul
         outln!();
     }
     outln!();
-    for (bi, b) in plant.blocks().iter().enumerate() {
-        let internal: Vec<String> = plant
-            .vars()
-            .iter()
-            .zip(&sol.x)
-            .filter(|(v, _)| {
-                v.block == bi && !plant.streams().iter().any(|s| v.path.starts_with(&format!("{}.", s.name)))
-            })
-            .map(|(v, x)| format!("{}={:.6}", v.path.trim_start_matches(&format!("{}.", b.name)), x))
+    let slen = plant.stream_layout().len();
+    let mut in_stream = vec![false; plant.n_vars()];
+    plant.streams().iter().for_each(|s| in_stream[s.offset..s.offset + slen].fill(true));
+    for b in plant.blocks() {
+        let own = b.own_offset..b.own_offset + b.layout.n_own();
+        let prefix = format!("{}.", b.name);
+        let internal: Vec<String> = own
+            .filter(|&j| !in_stream[j])
+            .map(|j| format!("{}={:.6}", plant.vars()[j].path.trim_start_matches(&prefix), sol.x[j]))
             .collect();
         let kind = if b.kind == BlockKind::Controller { "controller" } else { "unit" };
         if internal.len() > 12 {
