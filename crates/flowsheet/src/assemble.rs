@@ -512,7 +512,12 @@ impl<'s> Assembler<'s> {
                 }
             }
             b.reads = reads;
-            b.pattern = b.unit.pattern(&b.layout);
+            // One triplet is emitted per declared entry: a repeated entry would be summed twice.
+            b.pattern = b.unit.pattern(&b.layout).map(|mut p| {
+                p.sort_unstable();
+                p.dedup();
+                p
+            });
             b.coloring = b.pattern.as_ref().map(|p| Coloring::new(p, b.n_eq, b.layout.len()));
             b.eq_offset = eq_offset;
             eq_offset += b.n_eq;
