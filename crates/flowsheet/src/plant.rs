@@ -255,9 +255,11 @@ impl Plant {
         jx: &mut Vec<(usize, usize, f64)>,
         ju: &mut Vec<(usize, usize, f64)>,
     ) {
-        let work: usize = self.blocks.iter().map(|b| b.n_eq * (b.layout.len() + 1)).sum();
-        let par =
-            if self.blocks.len() > 1 && work > PARALLEL_WORK { Parallelism::Rayon } else { Parallelism::Sequential };
+        // Parallel when the blocks other than the largest carry enough work: a plant that is one
+        // column and its small neighbours gains nothing from threads but their wake-up.
+        let work: Vec<usize> = self.blocks.iter().map(|b| b.n_eq * (b.layout.len() + 1)).collect();
+        let rest = work.iter().sum::<usize>() - work.iter().max().copied().unwrap_or(0);
+        let par = if rest > PARALLEL_WORK { Parallelism::Rayon } else { Parallelism::Sequential };
         self.jacobian_with(par, x, u, t, r, jx, ju);
     }
 
