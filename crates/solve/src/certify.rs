@@ -40,7 +40,8 @@ pub struct CertificateFailure {
     pub at_bound: Vec<String>,
 }
 
-fn hint(at_bound: &[String]) -> String {
+/// `; X rests on its lower bound: …` with what would fix it (empty if nothing is on its floor).
+pub(crate) fn hint(at_bound: &[String]) -> String {
     if at_bound.is_empty() {
         return String::new();
     }

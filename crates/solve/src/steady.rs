@@ -82,15 +82,9 @@ pub enum DofError {
     },
 }
 
+/// The holdups on their floor at a failed solve's last iterate, said as the certificate says them.
 fn floor_note(at_floor: &[String]) -> String {
-    if at_floor.is_empty() {
-        return String::new();
-    }
-    format!(
-        "; at the last iterate {} {} lower bound: the specification may ask for more than the plant can deliver (a product flow above its feed, a holdup setpoint below zero) — check the flows and setpoints of that unit",
-        at_floor.join(", "),
-        if at_floor.len() == 1 { "rests on its" } else { "rest on their" }
-    )
+    crate::certify::hint(at_floor).replacen("; ", "; at the last iterate ", 1)
 }
 
 fn newton_note(newton: &Option<String>) -> String {
