@@ -17,10 +17,9 @@
 //! Units are SI throughout (s, mol, K, Pa, J); time derivatives are per second.
 
 use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::Lu;
-use faer::sparse::{SparseColMat, Triplet};
 use faer::{Mat, c64};
 use plantwide_flowsheet::Plant;
+use plantwide_solve::sparse::SparseLu;
 use plantwide_solve::{PlantSystem, System};
 use rayon::prelude::*;
 
@@ -57,15 +56,16 @@ fn singular(what: &str) -> AnalysisError {
     ))
 }
 
-/// Factorize the square sparse matrix given by triplets (duplicates summed).
-fn factor<T: faer::traits::ComplexField + Copy>(
-    n: usize,
-    trip: &[Triplet<usize, usize, T>],
-    what: &str,
-) -> Result<Lu<usize, T>, AnalysisError> {
-    let a = SparseColMat::<usize, T>::try_new_from_triplets(n, n, trip)
-        .map_err(|e| AnalysisError::Singular(format!("{what}: {e:?}")))?;
-    a.sp_lu().map_err(|_| singular(what))
+/// Solve `A X = B` in place for the square sparse `A` given by triplets (duplicates summed), with
+/// the solvers' sparse LU, one column of `B` at a time.
+fn solve_sparse(n: usize, a: &[(usize, usize, f64)], b: &mut Mat<f64>, what: &str) -> Result<(), AnalysisError> {
+    let mut lu = SparseLu::default();
+    lu.factor(n, a).map_err(|_| singular(what))?;
+    for k in 0..b.ncols() {
+        let col = b.col_mut(k).try_as_col_major_mut().ok_or_else(|| singular(what))?.as_slice_mut();
+        lu.solve_in_place(col).map_err(|_| singular(what))?;
+    }
+    Ok(())
 }
 
 fn check_finite(m: &Mat<f64>, what: &str) -> Result<(), AnalysisError> {
@@ -118,10 +118,8 @@ impl Linearization {
     /// Steady-state gain `dy/du = −C J⁻¹ B` in SI units (outputs × inputs); `inputs` are input
     /// indices, `outputs` variable indices.
     pub fn steady_gain(&self, inputs: &[usize], outputs: &[usize]) -> Result<Mat<f64>, AnalysisError> {
-        let trip: Vec<Triplet<usize, usize, f64>> = self.jx.iter().map(|&(i, j, v)| Triplet::new(i, j, v)).collect();
-        let lu = factor(self.n, &trip, "the plant Jacobian ∂f/∂x")?;
         let mut x = self.input_columns(inputs);
-        lu.solve_in_place(x.as_mut());
+        solve_sparse(self.n, &self.jx, &mut x, "the plant Jacobian ∂f/∂x")?;
         check_finite(&x, "the plant Jacobian ∂f/∂x")?;
         Ok(Mat::from_fn(outputs.len(), inputs.len(), |i, k| -x[(outputs[i], k)]))
     }
@@ -168,14 +166,14 @@ impl Linearization {
         // Blocks: J_dd, J_da (dense rows, few), J_aa (sparse), J_ad and B_a as right-hand sides.
         let mut a = Mat::<f64>::zeros(nd, nd);
         let mut j_da: Vec<(usize, usize, f64)> = Vec::new();
-        let mut j_aa: Vec<Triplet<usize, usize, f64>> = Vec::new();
+        let mut j_aa: Vec<(usize, usize, f64)> = Vec::new();
         let mut rhs = Mat::<f64>::zeros(na, nd + m);
         for &(i, j, v) in &self.jx {
             match (row_d[i], col_d[j]) {
                 (Some(p), Some(q)) => a[(p, q)] += v,
                 (Some(p), None) => j_da.push((p, col_a[j], v)),
                 (None, Some(q)) => rhs[(row_a[i], q)] += v,
-                (None, None) => j_aa.push(Triplet::new(row_a[i], col_a[j], v)),
+                (None, None) => j_aa.push((row_a[i], col_a[j], v)),
             }
         }
         let bu = self.input_columns(inputs);
@@ -190,8 +188,7 @@ impl Linearization {
         }
         // Z = J_aa⁻¹ [J_ad | B_a].
         if na > 0 {
-            let lu = factor(na, &j_aa, "the algebraic block ∂g/∂x_a of the plant Jacobian")?;
-            lu.solve_in_place(rhs.as_mut());
+            solve_sparse(na, &j_aa, &mut rhs, "the algebraic block ∂g/∂x_a of the plant Jacobian")?;
             check_finite(&rhs, "the algebraic block ∂g/∂x_a of the plant Jacobian")?;
         }
         let z = rhs;
