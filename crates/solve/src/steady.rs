@@ -301,7 +301,8 @@ pub struct ConvergenceFailure {
 }
 
 /// Solve the plant's steady state at inputs `u` from `x0` (or the cold-start guess). The structural
-/// DOF check runs first; if Newton fails, the numerical probe runs to explain an ill-posed plant.
+/// DOF check runs first; a converged point is certified and checked to be isolated (the numerical
+/// probe at the solution); if Newton fails, the numerical probe runs to explain an ill-posed plant.
 pub fn steady_state(
     plant: &Plant,
     u: &[f64],
@@ -329,6 +330,10 @@ pub fn steady_state_observed(
     let report = solve_steady_observed(&sys, &mut x, settings, observer);
     if report.status == NewtonStatus::Converged {
         let warnings = certify(plant, &x, u).map_err(|e| SteadyError::Certificate(Box::new(e)))?;
+        // An isolated steady state only: a Newton step on a singular Jacobian can still land on
+        // one of infinitely many solutions (a free inventory) when round-off leaves a tiny pivot
+        // rather than a zero one; the sparse probe at the solution refuses it.
+        dof_check(plant, u, &x, DofProbe::Numerical)?;
         return Ok(SteadyState { x, u: u.to_vec(), report, warnings });
     }
     if let Err(mut e) = dof_check(plant, u, &x_start, DofProbe::Numerical) {
