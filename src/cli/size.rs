@@ -85,23 +85,22 @@ pub fn run(a: &SizeArgs) -> Result<(), CliError> {
         if let Some(out) = &a.plot {
             plot_designs(out, &s)?;
         }
-        let json = serde_json::to_string_pretty(&s).map_err(|e| CliError::user(e.to_string()))?;
-        if a.json {
-            outln!("{json}")
-        } else {
-            outln!("{}", table(&s))
-        }
-        return Ok(());
+        return print(a.json, &s, table);
     }
     let ranking = rank_candidates(&plant, &x, &a.candidates, &request).map_err(size_error)?;
     if let Some(out) = &a.plot {
         plot_candidates(out, &ranking)?;
     }
-    let json = serde_json::to_string_pretty(&ranking).map_err(|e| CliError::user(e.to_string()))?;
-    if a.json {
-        outln!("{json}")
+    print(a.json, &ranking, ranking_table)
+}
+
+/// `value` as JSON with `--json`, otherwise as the text `table` makes of it.
+fn print<T: serde::Serialize>(json: bool, value: &T, table: impl Fn(&T) -> String) -> Result<(), CliError> {
+    if json {
+        let text = serde_json::to_string_pretty(value).map_err(|e| CliError::user(e.to_string()))?;
+        outln!("{text}");
     } else {
-        outln!("{}", ranking_table(&ranking))
+        outln!("{}", table(value));
     }
     Ok(())
 }
