@@ -54,16 +54,31 @@ pub fn run(file: &Path) -> Result<(), CliError> {
             driven.join(", ")
         );
     }
+    if !plant.specs().is_empty() {
+        outln!("design specs ({}), each with its varied input as one more unknown:", plant.specs().len());
+        for sp in plant.specs() {
+            outln!("  {:<16} {}", sp.origin, sp.label());
+        }
+    }
     let n_diff = plant.differential().iter().filter(|d| **d).count();
-    let free: Vec<&str> = plant.inputs().iter().filter(|i| i.driven_by.is_none()).map(|i| i.path.as_str()).collect();
+    let free: Vec<&str> = plant
+        .inputs()
+        .iter()
+        .enumerate()
+        .filter(|(k, i)| i.driven_by.is_none() && !plant.specs().iter().any(|s| s.input == *k))
+        .map(|(_, i)| i.path.as_str())
+        .collect();
     outln!(
-        "variables: {} ({} differential, {} algebraic); equations: {}; inputs: {} ({} driven by controllers)",
+        "variables: {} ({} differential, {} algebraic){}; equations: {}{}; inputs: {} ({} driven by controllers{})",
         plant.n_vars(),
         n_diff,
         plant.n_vars() - n_diff,
+        specs_note(plant.specs().len(), "varied inputs"),
         plant.n_eqs(),
+        specs_note(plant.specs().len(), "design specs"),
         plant.inputs().len(),
-        plant.inputs().len() - free.len()
+        plant.inputs().iter().filter(|i| i.driven_by.is_some()).count(),
+        specs_note(plant.specs().len(), "varied by specs").replace(" + ", ", ")
     );
     outln!("free inputs (manipulated variables and disturbances): {}", free.join(", "));
     let recycles = plant.recycles();
@@ -99,6 +114,10 @@ pub fn run(file: &Path) -> Result<(), CliError> {
     plantwide::solve::sequential::plan(&plant, &u, &x).describe(&plant).iter().for_each(|l| outln!("{l}"));
     residence(&plant, &u, &x);
     Ok(())
+}
+
+fn specs_note(k: usize, what: &str) -> String {
+    if k == 0 { String::new() } else { format!(" + {k} {what}") }
 }
 
 /// Residence times of the drums, sumps and vessels against the ~5 min rule, at the steady state

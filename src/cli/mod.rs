@@ -68,6 +68,13 @@ enum Command {
         /// Override an input or a unit parameter for this run, e.g. `--set feed.F=1.01kmol/min`.
         #[arg(long = "set", value_name = "PATH=VALUE")]
         set: Vec<String>,
+        /// Design specification: hold a variable at a value, e.g. `--spec distillate.x[light]=0.995`;
+        /// the k-th `--spec` is met by moving the k-th `--vary` input; all are solved together.
+        #[arg(long = "spec", value_name = "PATH=VALUE")]
+        spec: Vec<String>,
+        /// Free input moved to meet the paired `--spec`, e.g. `--vary column.reflux`.
+        #[arg(long = "vary", value_name = "INPUT")]
+        vary: Vec<String>,
         /// How to converge: `eo` whole-plant Newton, `sm` sequential modular (unit by unit,
         /// recycles by tearing), `auto` sequential modular to 1e-4 then Newton.
         #[arg(long, value_enum, default_value = "auto")]
@@ -145,7 +152,9 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
     match cli.command {
         Command::Check { file } => check::run(&file),
         Command::Components { json } => components::run(json),
-        Command::Steady { file, json, set, method } => steady::run(&file, json, &set, method),
+        Command::Steady { file, json, set, spec, vary, method } => {
+            steady::run(&steady::SteadyArgs { file: &file, json, sets: &set, specs: &spec, vary: &vary, method })
+        }
         Command::Run { file, scenario, csv, plot, json, set, resume } => {
             run::run(&run::RunArgs { file, scenario, csv, plot, json, set, resume })
         }

@@ -1,20 +1,60 @@
-//! `plantwide steady FILE [--json] [--set PATH=VALUE ...] [--method eo|sm|auto]`.
+//! `plantwide steady FILE [--json] [--set PATH=VALUE ...] [--spec PATH=VALUE --vary INPUT ...]
+//! [--method eo|sm|auto]`.
 
 use std::path::Path;
 
-use plantwide::flowsheet::{BlockKind, Plant};
+use plantwide::flowsheet::{BlockKind, Plant, SpecEntry};
 use plantwide::model::stream::{F, H, P, T, Z0};
 use plantwide::solve::{Method, Progress, Solution, StrategySettings, converge_observed};
 
 use super::CliError;
 
-/// Load `file`, apply `--set` overrides, return the plant and its input vector.
+/// Load `file`, apply `--set` overrides, return the plant at its design point and its input vector:
+/// design specs in the file are met first and their varied inputs fixed at the values found
+/// ([`Plant::fix_specs`]), so that dynamics and analyses start from the plant the specs define.
 pub fn load_with_overrides(file: &Path, sets: &[String]) -> Result<(Plant, Vec<f64>), CliError> {
-    let user = |e: plantwide::flowsheet::OverrideError| CliError::user(e.to_string());
-    let overrides = sets.iter().map(|s| s.parse()).collect::<Result<Vec<_>, _>>().map_err(user)?;
-    let plant = plantwide::flowsheet::load_with(file, &overrides).map_err(user)?;
+    let mut plant = load_plant(file, sets)?;
+    if !plant.specs().is_empty() {
+        let sol = converge(&plant, &plant.input_values())?;
+        for s in plant.specs() {
+            let dim = plant.inputs()[s.input].dim;
+            eprintln!("note: design spec {} met: `{}` = {}", s.label(), s.vary, with_unit(sol.u[s.input], dim));
+        }
+        plant.fix_specs(&sol.u);
+    }
     let u = plant.input_values();
     Ok((plant, u))
+}
+
+/// Load `file` and apply `--set` overrides; design specs stay to be met.
+pub fn load_plant(file: &Path, sets: &[String]) -> Result<Plant, CliError> {
+    let user = |e: plantwide::flowsheet::OverrideError| CliError::user(e.to_string());
+    let overrides = sets.iter().map(|s| s.parse()).collect::<Result<Vec<_>, _>>().map_err(user)?;
+    plantwide::flowsheet::load_with(file, &overrides).map_err(user)
+}
+
+/// `--spec PATH=VALUE` paired in order with `--vary INPUT`, added to `plant`'s own specs.
+pub fn add_specs(plant: &mut Plant, specs: &[String], vary: &[String]) -> Result<(), CliError> {
+    if specs.len() != vary.len() {
+        return Err(CliError::user(format!(
+            "--spec is given {} time(s) and --vary {} time(s): each spec pairs with one varied input (the k-th --spec with the k-th --vary), e.g. --spec distillate.x[light]=0.995 --vary column.reflux",
+            specs.len(),
+            vary.len()
+        )));
+    }
+    let mut entries = Vec::with_capacity(specs.len());
+    for (s, v) in specs.iter().zip(vary) {
+        let (path, value) = plantwide::flowsheet::overrides::split_assignment(s)
+            .map_err(|e| CliError::user(format!("--spec {}", e.to_string().replace("--set ", ""))))?;
+        entries.push(SpecEntry { path: path.to_string(), value: value.into(), vary: v.clone() });
+    }
+    plant.add_specs(&entries).map_err(|e| CliError::user(format!("{}: {e}", plant.file())))
+}
+
+/// `v` (SI) with its SI unit (none for a dimensionless number).
+fn with_unit(v: f64, dim: plantwide::units::Dimension) -> String {
+    let v = plantwide::model::limits::number(v);
+    if dim == plantwide::units::Dimension::DIMENSIONLESS { v } else { format!("{v} {dim}") }
 }
 
 /// Converge the way `plantwide steady` does by default (sequential-modular pass, then whole-plant
@@ -64,8 +104,27 @@ pub fn converge_by(plant: &Plant, u: &[f64], method: MethodArg) -> Result<Soluti
         .map_err(|e| if e.is_user_error() { CliError::user(e.to_string()) } else { CliError::numerical(e.to_string()) })
 }
 
-pub fn run(file: &Path, json: bool, sets: &[String], method: MethodArg) -> Result<(), CliError> {
-    let (plant, u) = load_with_overrides(file, sets)?;
+/// What `plantwide steady` is asked.
+pub struct SteadyArgs<'a> {
+    /// Flowsheet file.
+    pub file: &'a Path,
+    /// Print JSON.
+    pub json: bool,
+    /// `--set PATH=VALUE`.
+    pub sets: &'a [String],
+    /// `--spec PATH=VALUE`.
+    pub specs: &'a [String],
+    /// `--vary INPUT`, paired in order with `specs`.
+    pub vary: &'a [String],
+    /// `--method`.
+    pub method: MethodArg,
+}
+
+pub fn run(a: &SteadyArgs<'_>) -> Result<(), CliError> {
+    let (json, method) = (a.json, a.method);
+    let mut plant = load_plant(a.file, a.sets)?;
+    add_specs(&mut plant, a.specs, a.vary)?;
+    let u = plant.input_values();
     let sol = converge_by(&plant, &u, method)?;
     let (iterations, residual) = match (&sol.newton, &sol.sm) {
         (Some(n), _) => (n.iterations, n.residual),
@@ -89,6 +148,7 @@ pub fn run(file: &Path, json: bool, sets: &[String], method: MethodArg) -> Resul
             "residual": residual,
             "sequential_modular": sol.sm,
             "warnings": sol.warnings,
+            "specs": specs_json(&plant, &sol),
             "values": values,
         });
         outln!("{}", serde_json::to_string_pretty(&out).map_err(|e| CliError::user(e.to_string()))?);
@@ -113,6 +173,21 @@ pub fn run(file: &Path, json: bool, sets: &[String], method: MethodArg) -> Resul
     }
     for w in &sol.warnings {
         outln!("warning: {}\n", w.message);
+    }
+    for s in plant.specs() {
+        let (was, dim) = (plant.inputs()[s.input].value, plant.inputs()[s.input].dim);
+        outln!(
+            "design spec {}: met with `{}` = {} (from {}), `{}` = {}",
+            s.origin,
+            s.vary,
+            with_unit(sol.u[s.input], dim),
+            with_unit(was, dim),
+            s.path,
+            with_unit(sol.x[s.var], plant.vars()[s.var].spec.dim)
+        );
+    }
+    if !plant.specs().is_empty() {
+        outln!();
     }
     let comps = plant.components();
     out!("{:<14} {:>12} {:>9} {:>10} {:>11}", "stream", "F kmol/h", "T K", "P kPa", "h kJ/mol");
@@ -160,6 +235,24 @@ pub fn run(file: &Path, json: bool, sets: &[String], method: MethodArg) -> Resul
         }
     }
     Ok(())
+}
+
+/// The specs met: each one's variable, target, varied input and the value found (SI).
+fn specs_json(plant: &Plant, sol: &Solution) -> serde_json::Value {
+    plant
+        .specs()
+        .iter()
+        .map(|s| {
+            serde_json::json!({
+                "path": s.path,
+                "target": s.target,
+                "value": sol.x[s.var],
+                "vary": s.vary,
+                "input_value": sol.u[s.input],
+                "origin": s.origin,
+            })
+        })
+        .collect()
 }
 
 fn truncate(s: &str, n: usize) -> String {

@@ -23,5 +23,6 @@ mod recycle;
 mod screen;
 mod size;
 mod snowball;
+mod specs;
 mod tune;
 mod two_column_study;

@@ -12,7 +12,8 @@
 //!    file order) with the dimensions found, and their outputs wired to the inputs they drive;
 //! 7. input aliases, input values within range, the size of the plant;
 //! 8. every block's reads (inlet streams, inputs or the controller outputs driving them, signals)
-//!    and equation offsets, then each unit's check of its input values.
+//!    and equation offsets, then the design specifications and each unit's check of its input
+//!    values.
 //!
 //! The variable order is therefore: per unit, its outlet streams then its internal variables; then
 //! per controller its internal variables. Blocks are units then controllers, in file order.
@@ -542,9 +543,12 @@ impl<'s> Assembler<'s> {
             input_index: self.input_index,
             spec: self.spec.clone(),
             assembled_inputs: Vec::new(),
+            specs: Vec::new(),
         };
         let mut plant = plant;
         plant.assembled_inputs = plant.input_values();
+        plant.specs = crate::design::resolve_file_specs(&plant)
+            .map_err(|diagnostics| LoadError::Invalid { file: plant.file().to_string(), diagnostics })?;
         crate::overrides::check_unit_inputs(&plant, &plant.input_values()).map_err(|e| LoadError::Invalid {
             file: plant.file().to_string(),
             diagnostics: vec![Diagnostic::new(e.path, e.source.to_string())],

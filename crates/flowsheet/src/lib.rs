@@ -7,6 +7,7 @@
 
 pub mod assemble;
 pub mod components;
+pub mod design;
 pub mod edit;
 pub mod error;
 pub mod graph;
@@ -22,6 +23,7 @@ pub mod tears;
 pub mod wiring;
 
 pub use assemble::{assemble, load_file, load_str};
+pub use design::{DesignSpec, SpecEntry, SpecError};
 pub use error::{Diagnostic, Error, LoadError};
 pub use overrides::{Override, OverrideError, load_str_with, load_with};
 pub use parse::{parse_spec, read_text};

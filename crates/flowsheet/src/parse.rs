@@ -13,8 +13,18 @@ use serde_json::Value;
 use crate::error::{Diagnostic, LoadError, did_you_mean};
 use crate::spec::{ComponentSpec, FORMAT_VERSION, FlowsheetSpec, StreamSpec, ThermoSpec};
 
-const TOP_LEVEL: &[&str] =
-    &["format_version", "name", "description", "components", "thermo", "units", "streams", "controllers", "inputs"];
+const TOP_LEVEL: &[&str] = &[
+    "format_version",
+    "name",
+    "description",
+    "components",
+    "thermo",
+    "units",
+    "streams",
+    "controllers",
+    "inputs",
+    "specs",
+];
 
 /// Read a flowsheet or scenario file as text: at most [`Limits::max_file_bytes`] bytes, valid UTF-8
 /// (an invalid byte is reported with its offset, line and column).
@@ -98,6 +108,7 @@ pub fn parse_spec(text: &str, file: &str) -> Result<FlowsheetSpec, LoadError> {
     }
     let streams = plain_map::<StreamSpec>(obj.get("streams"), "streams", true, &mut diags);
     let inputs = plain_map::<String>(obj.get("inputs"), "inputs", false, &mut diags);
+    let specs: Vec<crate::design::SpecEntry> = field(obj, "specs", &mut diags, false).unwrap_or_default();
     match thermo {
         Some(thermo) if diags.is_empty() => Ok(FlowsheetSpec {
             format_version,
@@ -109,6 +120,7 @@ pub fn parse_spec(text: &str, file: &str) -> Result<FlowsheetSpec, LoadError> {
             streams,
             controllers,
             inputs,
+            specs,
         }),
         _ => Err(LoadError::Invalid { file: file.into(), diagnostics: diags }),
     }

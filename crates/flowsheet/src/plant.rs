@@ -130,6 +130,8 @@ pub struct Plant {
     pub(crate) spec: FlowsheetSpec,
     /// The input values as assembled from `spec`: a variant keeps only the values changed since.
     pub(crate) assembled_inputs: Vec<f64>,
+    /// Design specifications still to be met ([`crate::design`]).
+    pub(crate) specs: Vec<crate::design::DesignSpec>,
 }
 
 impl Plant {

@@ -43,6 +43,10 @@ pub struct FlowsheetSpec {
     /// Named inputs and disturbances: a short name for an input path (`"feed_rate": "fresh.F"`).
     #[serde(default)]
     pub inputs: IndexMap<String, String>,
+    /// Design specifications of the steady state: each holds a variable at a target by moving a
+    /// free input (`{"path": "distillate.x[light]", "value": 0.995, "vary": "column.reflux"}`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub specs: Vec<crate::design::SpecEntry>,
 }
 
 /// A component of the flowsheet.

@@ -15,6 +15,7 @@ pub mod newton;
 pub mod rank;
 pub mod sequential;
 pub mod sparse;
+pub mod specs;
 pub mod steady;
 pub mod structure;
 pub mod system;
@@ -26,6 +27,7 @@ pub use newton::{
     solve_steady_observed,
 };
 pub use sequential::{Method, Progress, Solution, SolveError, StrategySettings, converge, converge_observed};
+pub use specs::SteadySystem;
 pub use steady::{
     ConvergenceFailure, DofError, DofProbe, PlantSystem, SteadyError, SteadyState, dof_check, steady_state,
     steady_state_observed,

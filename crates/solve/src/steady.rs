@@ -5,6 +5,7 @@ use plantwide_model::VarKind;
 
 use crate::certify::{CertificateFailure, Warning, certify};
 use crate::rank::{self, Rank};
+use crate::specs::SteadySystem;
 use crate::{NewtonReport, NewtonSettings, NewtonStatus, System, maximum_matching, solve_steady_observed};
 
 /// The plant at fixed inputs `u`, seen as a nonlinear system.
@@ -121,9 +122,11 @@ pub enum DofProbe {
     Numerical,
 }
 
-/// Degrees-of-freedom check at the point `x`: equation count, structural rank (maximum matching)
-/// and, with [`DofProbe::Numerical`], a numerical null-space probe that names the inventory or variable left free (an uncontrolled level, a flow
-/// fixed at both ends).
+/// Degrees-of-freedom check at the point `x` (the varied inputs of design specs at their values in
+/// `u`): equation count, structural rank (maximum matching) and, with [`DofProbe::Numerical`], a
+/// numerical null-space probe that names the inventory or variable left free (an uncontrolled
+/// level, a flow fixed at both ends, a spec its input cannot move). Each design spec adds one
+/// unknown (its input) and one equation ([`crate::specs`]).
 pub fn dof_check(plant: &Plant, u: &[f64], x: &[f64], probe: DofProbe) -> Result<(), DofError> {
     let file = plant.file().to_string();
     let (n_eqs, n_vars) = (plant.n_eqs(), plant.n_vars());
@@ -136,11 +139,14 @@ pub fn dof_check(plant: &Plant, u: &[f64], x: &[f64], probe: DofProbe) -> Result
         };
         return Err(DofError::Count { file, n_eqs, n_vars, hint });
     }
-    let mut r = vec![0.0; n_eqs];
-    let (mut jx, mut ju) = (Vec::new(), Vec::new());
-    plant.jacobian(x, u, 0.0, &mut r, &mut jx, &mut ju);
-    let entries: Vec<(usize, usize)> = jx.iter().map(|&(i, j, _)| (i, j)).collect();
-    let m = maximum_matching(n_eqs, n_vars, &entries);
+    let sys = SteadySystem::new(plant, u);
+    let z = sys.unknowns(x);
+    let n = sys.n();
+    let mut r = vec![0.0; n];
+    let mut jac = Vec::new();
+    sys.jacobian(&z, &mut r, &mut jac);
+    let entries: Vec<(usize, usize)> = jac.iter().map(|&(i, j, _)| (i, j)).collect();
+    let m = maximum_matching(n, n, &entries);
     let loose = m.unmatched_cols();
     if !loose.is_empty() {
         return Err(DofError::Underdetermined {
@@ -149,7 +155,7 @@ pub fn dof_check(plant: &Plant, u: &[f64], x: &[f64], probe: DofProbe) -> Result
             newton: None,
         });
     }
-    if probe == DofProbe::Numerical && n_vars > 0 {
+    if probe == DofProbe::Numerical && n > 0 {
         // A plant that is ill-posed is singular at every consistent point; a guess can be singular
         // by accident (a component absent from a loop's measurement at a linear profile). Only a
         // null direction found at the guess and again after a few pseudo-transient steps (which
@@ -157,10 +163,11 @@ pub fn dof_check(plant: &Plant, u: &[f64], x: &[f64], probe: DofProbe) -> Result
         // reported. The probe removes the controllers' output limits: a clamped output no longer
         // depends on its measurement, which makes a well-posed plant singular (a level loop
         // saturated at a cold start).
-        let Some(_) = null_direction(plant, u, x) else { return Ok(()) };
-        let mut xp = x.to_vec();
-        crate::pseudo_transient_steps(&PlantSystem::new(plant, u), &mut xp, 3, 10.0);
-        if let Some(idx) = null_direction(plant, u, &xp) {
+        let relaxed = SteadySystem::new(plant, u).relaxed();
+        let Some(_) = null_direction(&relaxed, &z) else { return Ok(()) };
+        let mut zp = z.clone();
+        crate::pseudo_transient_steps(&sys, &mut zp, 3, 10.0);
+        if let Some(idx) = null_direction(&relaxed, &zp) {
             return Err(DofError::Underdetermined {
                 file,
                 explanation: explain_loose(
@@ -175,15 +182,15 @@ pub fn dof_check(plant: &Plant, u: &[f64], x: &[f64], probe: DofProbe) -> Result
     Ok(())
 }
 
-/// The variables spanning a numerical null direction of the scaled Jacobian at `x`, largest first,
+/// The unknowns spanning a numerical null direction of the scaled Jacobian at `z`, largest first,
 /// or `None` if the smallest singular value is not negligible (≤ 10⁻¹² of the largest): the sparse
 /// estimate of [`crate::rank`], whose inverse-iteration vector is the direction.
-fn null_direction(plant: &Plant, u: &[f64], x: &[f64]) -> Option<Vec<usize>> {
-    let n = plant.n_vars();
+fn null_direction(sys: &SteadySystem<'_>, z: &[f64]) -> Option<Vec<usize>> {
+    let n = sys.n();
     let mut r = vec![0.0; n];
-    let (mut jx, mut ju) = (Vec::new(), Vec::new());
-    plant.jacobian_without_limits(x, u, &mut r, &mut jx, &mut ju);
-    let a = scaled(plant, jx);
+    let mut jac = Vec::new();
+    sys.jacobian(z, &mut r, &mut jac);
+    let a = scaled(sys, jac);
     let direction = |v: &[f64]| {
         let null: Vec<f64> = v.iter().map(|a| a.abs()).collect();
         let top = null.iter().cloned().fold(0.0, f64::max);
@@ -198,29 +205,29 @@ fn null_direction(plant: &Plant, u: &[f64], x: &[f64]) -> Option<Vec<usize>> {
     }
 }
 
-/// The Jacobian triplets with duplicates summed, columns scaled by their variables' nominal values
+/// The Jacobian triplets with duplicates summed, columns scaled by their unknowns' nominal values
 /// and rows by their largest entry.
-fn scaled(plant: &Plant, mut jx: Vec<(usize, usize, f64)>) -> Vec<(usize, usize, f64)> {
+fn scaled(sys: &SteadySystem<'_>, mut jx: Vec<(usize, usize, f64)>) -> Vec<(usize, usize, f64)> {
     jx.sort_unstable_by_key(|t| (t.0, t.1));
     let mut a: Vec<(usize, usize, f64)> = Vec::with_capacity(jx.len());
     for (i, j, v) in jx {
-        let v = v * plant.vars()[j].spec.nominal;
+        let v = v * sys.nominal(j);
         match a.last_mut() {
             Some(last) if (last.0, last.1) == (i, j) => last.2 += v,
             _ => a.push((i, j, v)),
         }
     }
-    let mut row_max = vec![0.0f64; plant.n_vars()];
+    let mut row_max = vec![0.0f64; sys.n()];
     a.iter().for_each(|&(i, _, v)| row_max[i] = row_max[i].max(v.abs()));
     a.iter_mut().filter(|t| row_max[t.0] > 0.0).for_each(|t| t.2 /= row_max[t.0]);
     a
 }
 
 fn explain_loose(plant: &Plant, vars: &[usize], why: &str) -> String {
-    let paths: Vec<&str> = vars.iter().take(8).map(|&j| plant.vars()[j].path.as_str()).collect();
+    let paths: Vec<String> = vars.iter().take(8).map(|&j| crate::specs::unknown_path(plant, j)).collect();
     let inventories: Vec<&str> = vars
         .iter()
-        .filter(|&&j| plant.vars()[j].spec.kind == VarKind::Differential)
+        .filter(|&&j| j < plant.n_vars() && plant.vars()[j].spec.kind == VarKind::Differential)
         .map(|&j| plant.vars()[j].path.as_str())
         .collect();
     let mut s = if paths.is_empty() {
@@ -241,6 +248,11 @@ fn explain_loose(plant: &Plant, vars: &[usize], why: &str) -> String {
             ". The inventory of {} is uncontrolled at steady state: nothing ties its holdup to a steady value — add a level (or pressure) controller on it, or give it an outflow that depends on its level (a valve)",
             units.iter().map(|u| format!("`{u}`")).collect::<Vec<_>>().join(", ")
         ));
+    }
+    if vars.iter().any(|&j| j >= plant.n_vars()) {
+        s.push_str(
+            ". A varied input is among them: its spec's variable does not respond to it here (or two specs ask the same of their inputs) — vary an input that moves the held variable",
+        );
     }
     s
 }
@@ -275,7 +287,7 @@ pub enum SteadyError {
 /// A steady-state solve that did not converge: where and how it failed.
 #[derive(Debug, Clone, thiserror::Error)]
 #[error(
-    "{file}: steady state not found ({status:?} after {iterations} iterations, scaled residual {residual:.3e}); worst equation: {equation} (variable {variable}, scaled residual {worst:.3e}){}; {}", floor_note(.at_floor), history_summary(.report)
+    "{file}: steady state not found ({status:?} after {iterations} iterations, scaled residual {residual:.3e}); worst equation: {equation} (variable {variable}, scaled residual {worst:.3e}){}{specs}; {}", floor_note(.at_floor), history_summary(.report)
 )]
 pub struct ConvergenceFailure {
     /// Flowsheet file.
@@ -294,6 +306,9 @@ pub struct ConvergenceFailure {
     pub worst: f64,
     /// Total holdups resting on their lower bound at the last iterate.
     pub at_floor: Vec<String>,
+    /// The design specs at the last iterate (empty without specs): each one's residual and its
+    /// varied input's value.
+    pub specs: String,
     /// The full report with the iteration history.
     pub report: NewtonReport,
     /// The last iterate.
@@ -312,7 +327,9 @@ pub fn steady_state(
     steady_state_observed(plant, u, x0, settings, &mut |_| {})
 }
 
-/// [`steady_state`] reporting every iteration to `observer`.
+/// [`steady_state`] reporting every iteration to `observer`. With design specs
+/// ([`Plant::specs`]), the varied inputs are unknowns too, starting from their values in `u`; the
+/// returned `u` carries the values that meet the specs.
 pub fn steady_state_observed(
     plant: &Plant,
     u: &[f64],
@@ -320,21 +337,22 @@ pub fn steady_state_observed(
     settings: &NewtonSettings,
     observer: &mut dyn FnMut(&crate::IterationRecord),
 ) -> Result<SteadyState, SteadyError> {
-    let mut x = match x0 {
+    let x_start = match x0 {
         Some(x0) => x0.to_vec(),
         None => plant.initial_guess_at(u),
     };
-    dof_check(plant, u, &x, DofProbe::Structural)?;
-    let x_start = x.clone();
-    let sys = PlantSystem::new(plant, u);
-    let report = solve_steady_observed(&sys, &mut x, settings, observer);
+    dof_check(plant, u, &x_start, DofProbe::Structural)?;
+    let sys = SteadySystem::new(plant, u);
+    let mut z = sys.unknowns(&x_start);
+    let report = solve_steady_observed(&sys, &mut z, settings, observer);
+    let (x, u_end) = sys.split(&z);
     if report.status == NewtonStatus::Converged {
-        let warnings = certify(plant, &x, u).map_err(|e| SteadyError::Certificate(Box::new(e)))?;
+        let warnings = certify(plant, &x, &u_end).map_err(|e| SteadyError::Certificate(Box::new(e)))?;
         // An isolated steady state only: a Newton step on a singular Jacobian can still land on
         // one of infinitely many solutions (a free inventory) when round-off leaves a tiny pivot
         // rather than a zero one; the sparse probe at the solution refuses it.
-        dof_check(plant, u, &x, DofProbe::Numerical)?;
-        return Ok(SteadyState { x, u: u.to_vec(), report, warnings });
+        dof_check(plant, &u_end, &x, DofProbe::Numerical)?;
+        return Ok(SteadyState { x, u: u_end, report, warnings });
     }
     if let Err(mut e) = dof_check(plant, u, &x_start, DofProbe::Numerical) {
         if let DofError::Underdetermined { newton, .. } = &mut e {
@@ -349,8 +367,11 @@ pub fn steady_state_observed(
         return Err(e.into());
     }
     let (eq, worst) = report.worst.unwrap_or((0, f64::NAN));
-    let equation = plant.equation_name(eq);
-    let variable = plant.equation_variable(eq).map(|j| plant.vars()[j].path.clone()).unwrap_or_else(|| "-".into());
+    let equation = crate::specs::equation_name(plant, eq);
+    let variable = match plant.equation_variable(eq) {
+        Some(j) if eq < plant.n_eqs() => plant.vars()[j].path.clone(),
+        _ => plant.specs().get(eq.wrapping_sub(plant.n_eqs())).map_or_else(|| "-".into(), |s| s.vary.clone()),
+    };
     Err(SteadyError::NotConverged(Box::new(ConvergenceFailure {
         file: plant.file().to_string(),
         status: report.status,
@@ -360,6 +381,7 @@ pub fn steady_state_observed(
         variable,
         worst,
         at_floor: crate::certify::floors_anywhere(plant, &x),
+        specs: crate::specs::note(&sys, &z),
         report,
         x,
     })))

@@ -83,6 +83,16 @@ pub enum SolveError {
     /// From the whole-plant Newton.
     #[error(transparent)]
     Eo(#[from] SteadyError),
+    /// Design specs asked of the sequential-modular method alone.
+    #[error(
+        "{file}: design specs ({specs}) are met by the whole-plant Newton, which `--method sm` leaves out: use `--method auto` (a sequential-modular start, then Newton) or `eo`"
+    )]
+    SpecsNeedNewton {
+        /// Flowsheet file.
+        file: String,
+        /// The specs.
+        specs: String,
+    },
 }
 
 impl SolveError {
@@ -92,11 +102,14 @@ impl SolveError {
             self,
             SolveError::Sm(SmError::Dof(_) | SmError::Settings(_) | SmError::NotInRecycle(_))
                 | SolveError::Eo(SteadyError::Dof(_))
+                | SolveError::SpecsNeedNewton { .. }
         )
     }
 }
 
-/// Find the steady state of `plant` at inputs `u` by `settings.method`, from the cold start.
+/// Find the steady state of `plant` at inputs `u` by `settings.method`, from the cold start. Design
+/// specs are met by the whole-plant Newton (`auto` starts it from a sequential-modular pass at the
+/// inputs' values in `u`); `sm` alone refuses them.
 pub fn steady_state_by(
     plant: &Plant,
     u: &[f64],
@@ -118,6 +131,10 @@ pub fn steady_state_by(
                 warnings: ss.warnings,
             })
         }
+        Method::Sm if !plant.specs().is_empty() => Err(SolveError::SpecsNeedNewton {
+            file: plant.file().to_string(),
+            specs: plant.specs().iter().map(|s| s.label()).collect::<Vec<_>>().join(", "),
+        }),
         Method::Sm => {
             let sol = solve_sequential_observed(plant, u, None, &settings.sm, &mut |p| observer(Progress::Pass(p)))?;
             let tol = (10.0 * settings.sm.tol).max(crate::certify::TOL);
