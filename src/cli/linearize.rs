@@ -123,10 +123,13 @@ pub fn run(a: &LinearizeArgs) -> Result<(), CliError> {
         let cells = || (0..g.nrows()).flat_map(|i| (0..g.ncols()).map(move |j| (i, j)));
         let largest = cells().map(|(i, j)| gd[(i, j)].abs()).fold(0.0, f64::max);
         let diff = cells().map(|(i, j)| (g[(i, j)] - gd[(i, j)]).abs()).fold(0.0, f64::max);
-        let check = if largest > 0.0 {
+        // Below 1e-10 in display units a gain is zero to rounding: an output held by integral action.
+        let check = if largest > 1e-10 {
             format!("agrees with −C J⁻¹ B to {:.1e} of its largest entry", diff / largest)
         } else {
-            format!("−C J⁻¹ B is exactly 0, so the outputs are held at steady state; these are {diff:.1e} off it")
+            format!(
+                "−C J⁻¹ B is 0 to rounding ({largest:.1e}), so the outputs are held at steady state; these are {diff:.1e} off it"
+            )
         };
         outln!("steady-state gain D − C A⁻¹ B ({check}):");
         for (i, o) in outputs.iter().enumerate() {

@@ -16,6 +16,7 @@ mod columns;
 mod columns_rigorous;
 mod core;
 mod dynamics;
+mod fehe;
 mod flowsheets;
 mod fuzz;
 mod hostile;

@@ -29,6 +29,12 @@
 //! (its two outlet temperatures), `F_hot (h_hot[k−1] − h_hot[k]) = Q_k = F_cold (h_cold[k−1] −
 //! h_cold[k])`, `h_s[k] = h_phase_s(T_s[k], z_s)`, `Q = Σ Q_k`. First order: the effectiveness error
 //! is `≈ −0.44/n` at NTU 2, `Cr = 2/3`; crosses and reversed inlets need no special care.
+//!
+//! With `holdup_hot` and `holdup_cold` (and optionally `wall_heat_capacity`), `cells` carry
+//! holdups and the exchanger has dynamics; its variables are then per cell, not per boundary
+//! (see [`dynamic`]). Its steady state is the static `cells` model's.
+
+pub mod dynamic;
 
 use num_dual::Dual64;
 use plantwide_units::{Dimension, QuantityValue};
@@ -84,6 +90,17 @@ pub struct HeatExchangerConfig {
     /// Pressure drop of the cold side [Pa] (default 0).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub dp_cold: Option<QuantityValue>,
+    /// Liquid holdup of the hot side [mol] (e.g. `"2 kmol"`): with `holdup_cold`, gives `cells`
+    /// their dynamics (default: none, the exchanger is algebraic).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub holdup_hot: Option<QuantityValue>,
+    /// Liquid holdup of the cold side [mol].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub holdup_cold: Option<QuantityValue>,
+    /// Heat capacity of the tube wall [J/K] (e.g. `"500 kJ/K"`; dynamic cells only; default: no
+    /// wall, the two fluids exchange directly).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub wall_heat_capacity: Option<QuantityValue>,
 }
 
 /// A two-stream counter-current heat exchanger.
@@ -93,6 +110,7 @@ pub struct HeatExchanger {
     method: HxMethod,
     phase: [Phase; 2],
     dp: [f64; 2],
+    holdups: Option<dynamic::Holdups>,
 }
 
 /// Index of `Q` among the internal variables; cell boundary `k` starts at `1 + 4 (k − 1)`.
@@ -137,7 +155,14 @@ impl HeatExchanger {
         for (d, (field, v)) in dp.iter_mut().zip([("dp_hot", &config.dp_hot), ("dp_cold", &config.dp_cold)]) {
             *d = v.as_ref().map_or(0.0, |v| cx.non_negative(field, v, Dimension::PRESSURE));
         }
-        cx.finish(HeatExchanger { ua, method: config.method, phase: [config.hot_phase, config.cold_phase], dp })
+        let holdups = holdups(config, &mut cx);
+        cx.finish(HeatExchanger {
+            ua,
+            method: config.method,
+            phase: [config.hot_phase, config.cold_phase],
+            dp,
+            holdups,
+        })
     }
 
     fn n_cells(&self) -> usize {
@@ -146,6 +171,30 @@ impl HeatExchanger {
             HxMethod::Cells { n } => n,
         }
     }
+}
+
+/// The holdups of a dynamic `cells` exchanger, if the description gives them.
+fn holdups(config: &HeatExchangerConfig, cx: &mut BuildCx<'_>) -> Option<dynamic::Holdups> {
+    let (hot, cold) = (config.holdup_hot.as_ref(), config.holdup_cold.as_ref());
+    if hot.is_none() && cold.is_none() {
+        if config.wall_heat_capacity.is_some() {
+            cx.error("wall_heat_capacity", "a wall needs the fluids' holdups: give holdup_hot and holdup_cold too");
+        }
+        return None;
+    }
+    if !matches!(config.method, HxMethod::Cells { .. }) {
+        cx.error("method", "holdups need cells: give \"method\": {\"type\": \"cells\", \"n\": 10}");
+    }
+    let mut side = [0.0; 2];
+    for (m, (field, v)) in side.iter_mut().zip([("holdup_hot", hot), ("holdup_cold", cold)]) {
+        match v {
+            Some(v) => *m = cx.positive(field, v, Dimension::AMOUNT),
+            None => cx.error(field, "give both holdups (e.g. \"2 kmol\"), or neither for an algebraic exchanger"),
+        }
+    }
+    let wall =
+        config.wall_heat_capacity.as_ref().map(|c| cx.positive("wall_heat_capacity", c, Dimension::HEAT_CAPACITY));
+    Some(dynamic::Holdups { side, wall })
 }
 
 impl UnitModel for HeatExchanger {
@@ -160,6 +209,10 @@ impl UnitModel for HeatExchanger {
     }
     fn internal_vars(&self) -> Vec<VarSpec> {
         let mut v = vec![VarSpec::algebraic("Q", Dimension::POWER, 1e5)];
+        if let Some(h) = &self.holdups {
+            v.extend(h.vars(self.n_cells()));
+            return v;
+        }
         for k in 1..self.n_cells() {
             for side in ["hot", "cold"] {
                 v.push(
@@ -186,6 +239,9 @@ impl UnitModel for HeatExchanger {
                 rs[Z0 + i] = *zo - *zi;
             }
             rs[T] = out.h() - self.phase[s].enthalpy(io.thermo, out.t(), out.p(), out.z());
+        }
+        if let Some(h) = &self.holdups {
+            return dynamic::eval(self, h, io, r);
         }
         let (hi, ci, ho, co) = (io.inlet(0), io.inlet(1), io.outlet(0), io.outlet(1));
         let (q_row, hot_row, cold_row) = (2 * len + Q, H, len + H);
@@ -255,10 +311,16 @@ impl UnitModel for HeatExchanger {
             let h_cold = ci.h() + (1.0 - f) * dh_cold;
             let t_hot = self.phase[0].temperature(io.thermo, h_hot, hi.p() - self.dp[0], hi.z(), hi.t());
             let t_cold = self.phase[1].temperature(io.thermo, h_cold, ci.p() - self.dp[1], ci.z(), ci.t());
+            if let Some(h) = &self.holdups {
+                // cell k: hot boundary k, cold boundary k − 1 (one cell's width warmer)
+                let h_c = h_cold + dh_cold / n as f64;
+                let t_c = self.phase[1].temperature(io.thermo, h_c, ci.p() - self.dp[1], ci.z(), ci.t());
+                dynamic::guess(h, len, k, (t_hot, h_hot), (t_c, h_c), own);
+            }
             if k == n {
                 own[H] = h_hot;
                 own[T] = t_hot;
-            } else {
+            } else if self.holdups.is_none() {
                 own[2 * len + 1 + 4 * (k - 1)..2 * len + 5 + 4 * (k - 1)]
                     .copy_from_slice(&[t_hot, h_hot, t_cold, h_cold]);
             }
@@ -404,6 +466,99 @@ mod tests {
         assert!((lmtd(-3.0_f64, -4.0) + 3.5).abs() < 1e-12, "both clipped: arithmetic mean");
         let (below, at) = (lmtd(DT_MIN * (1.0 - 1e-9), 10.0), lmtd(DT_MIN, 10.0));
         assert!((below - at).abs() < 1e-9 * at, "continuous at δ");
+    }
+
+    const DYNAMIC: &str = r#"{"ua": 300.0, "method": {"type": "cells", "n": 5}, "holdup_hot": "50 mol", "holdup_cold": "0.08 kmol", "dp_hot": "0.1 bar"}"#;
+
+    fn dynamic_configs() -> [serde_json::Value; 2] {
+        let plain: serde_json::Value = serde_json::from_str(DYNAMIC).unwrap();
+        let mut wall = plain.clone();
+        wall["wall_heat_capacity"] = json!("20 kJ/K");
+        [plain, wall]
+    }
+
+    #[test]
+    fn dynamic_cells_jacobian_matches_finite_differences() {
+        let thermo = binary_package();
+        for cfg in dynamic_configs() {
+            let u = build(cfg.clone()).expect("builds");
+            let (layout, mut x) = local(&u, &thermo, (1.0, 1.5, 300.0), (400.0, 300.0));
+            // off the steady state: every cell state moved
+            x.iter_mut().take(layout.n_own()).enumerate().skip(2 * layout.stream.len() + 1).for_each(|(i, v)| {
+                *v += if i % 2 == 0 { 3.0 } else { -150.0 };
+            });
+            let err = jacobian_error(&u, &layout, &thermo, &x, n_eq(&u, &layout));
+            assert!(err < 1e-6, "{cfg}: {err}");
+        }
+    }
+
+    /// Σ m_s dh_s/dt + Σ c_w dT_wall/dt = F_hot (h_hot,in − h_hot,out) + F_cold (h_cold,in −
+    /// h_cold,out) at any state, to round-off: the cells neither make nor lose energy.
+    #[test]
+    fn dynamic_cells_conserve_energy_at_every_state() {
+        let thermo = binary_package();
+        for cfg in dynamic_configs() {
+            let u = build(cfg.clone()).expect("builds");
+            let (layout, mut x) = local(&u, &thermo, (1.0, 1.5, 300.0), (400.0, 300.0));
+            let len = layout.stream.len();
+            let h = u.holdups.unwrap();
+            for (i, v) in x.iter_mut().enumerate().take(layout.n_own()).skip(2 * len + 1) {
+                *v *= 1.0 + 0.01 * ((i * 7919 % 13) as f64 - 6.0);
+            }
+            let mut r = vec![0.0; n_eq(&u, &layout)];
+            Unit::residual(&u, &UnitIo { local: &x, layout: &layout, thermo: &thermo, time: 0.0 }, &mut r);
+            let n = u.n_cells();
+            let mut accumulation = 0.0;
+            for k in 1..=n {
+                let at = h.at(len, k, 0);
+                accumulation += h.side[0] / n as f64 * r[at + 1] + h.side[1] / n as f64 * r[at + 3];
+                if let Some(c) = h.wall {
+                    accumulation += c / n as f64 * r[at + 4];
+                }
+            }
+            let i0 = layout.inlets_offset();
+            let (hot_out, cold_out) = (x[h.at(len, n, 1)], x[h.at(len, 1, 3)]);
+            let flows = x[i0 + F] * (x[i0 + H] - hot_out) + x[i0 + len + F] * (x[i0 + len + H] - cold_out);
+            assert!((accumulation - flows).abs() < 1e-9 * flows.abs().max(1.0), "{cfg}: {accumulation} vs {flows}");
+        }
+    }
+
+    /// At steady state the holdups and the wall drop out: the dynamic exchanger's outlets and duty
+    /// are the static `cells` model's.
+    #[test]
+    fn dynamic_cells_steady_state_is_the_static_cells_steady_state() {
+        let thermo = binary_package();
+        let static_cells =
+            build(json!({"ua": 300.0, "method": {"type": "cells", "n": 5}, "dp_hot": "0.1 bar"})).unwrap();
+        let solve_own = |u: &HeatExchanger| {
+            let (layout, mut x) = local(u, &thermo, (1.0, 1.5, 300.0), (400.0, 300.0));
+            let res = newton(u, &layout, &thermo, &mut x, &(0..layout.n_own()).collect::<Vec<_>>());
+            assert!(res < 1e-9, "{res}");
+            let len = layout.stream.len();
+            (x[T], x[len + T], x[2 * len + Q])
+        };
+        let reference = solve_own(&static_cells);
+        for cfg in dynamic_configs() {
+            let got = solve_own(&build(cfg.clone()).unwrap());
+            let (a, b) = (reference, got);
+            assert!(
+                (a.0 - b.0).abs() < 1e-9 * a.0 && (a.1 - b.1).abs() < 1e-9 * a.1 && (a.2 - b.2).abs() < 1e-9 * a.2,
+                "{cfg}: static {a:?}, dynamic {b:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn holdups_need_cells_and_each_other() {
+        let errs = build(json!({"ua": 300.0, "holdup_hot": "1 kmol"})).expect_err("lmtd with holdup");
+        assert!(errs.iter().any(|e| e.to_string().contains("holdups need cells")), "{errs:?}");
+        assert!(errs.iter().any(|e| e.to_string().contains("give both holdups")), "{errs:?}");
+        let errs = build(json!({"ua": 300.0, "wall_heat_capacity": "1 kJ/K"})).expect_err("wall alone");
+        assert!(errs.iter().any(|e| e.to_string().contains("a wall needs")), "{errs:?}");
+        let errs =
+            build(json!({"ua": 1.0, "method": {"type": "cells", "n": 2}, "holdup_hot": 0.0, "holdup_cold": 1.0}))
+                .expect_err("zero holdup");
+        assert_eq!(errs.len(), 1, "{errs:?}");
     }
 
     #[test]
