@@ -46,6 +46,9 @@ const NEWTON_MAXITER: usize = 4;
 const MIN_FACTOR: f64 = 0.2;
 /// Largest step growth.
 const MAX_FACTOR: f64 = 10.0;
+/// A Newton correction within this many units of roundoff (ε·|x_i|) of every variable, in the
+/// weighted norm, is rounding noise: a reactor's Arrhenius term alone carries ~10.
+const ROUNDOFF_ULPS: f64 = 100.0;
 /// The iteration matrix `M − cJ` is refactorized when `c` has moved by more than this fraction
 /// since the factorization (CVODE's `DGMAX`), after a Newton failure, or for a new Jacobian.
 const REFACTOR_RATIO: f64 = 0.3;
@@ -331,6 +334,11 @@ impl Bdf {
         let mut rhs = vec![0.0; n];
         let mut dy_norm_old: Option<f64> = None;
         let mut iters = 0;
+        // The rounding level of a correction (at most `tol`): below it the iterate cannot improve,
+        // and the rate of two such corrections is noise of any size (often ≥ 1, read as divergence
+        // at every step size). Above `1e-4 · tol` only for rtol < 4e-7 (it is ≤ 100ε/rtol).
+        let floor: Vec<f64> = x_pred.iter().map(|v| ROUNDOFF_ULPS * f64::EPSILON * v.abs()).collect();
+        let roundoff = rms(&floor, scale, &self.all).min(tol);
         for k in 0..NEWTON_MAXITER {
             iters = k + 1;
             sys.residual(t_new, &x, &mut f);
@@ -353,7 +361,9 @@ impl Bdf {
             }
             let dy_norm = rms(&rhs, scale, &self.all);
             let rate = dy_norm_old.map(|old| dy_norm / old);
-            if let Some(rate) = rate
+            let at_roundoff = dy_norm <= roundoff;
+            if !at_roundoff
+                && let Some(rate) = rate
                 && (rate >= 1.0 || rate.powi((NEWTON_MAXITER - k) as i32) / (1.0 - rate) * dy_norm > tol)
             {
                 return (false, iters, x, d);
@@ -363,9 +373,10 @@ impl Bdf {
             // A first correction far below the tolerance means the prediction already solves the
             // corrector (e.g. a step from an exact steady state): the next correction would be
             // round-off, and the rate of two round-off corrections says nothing (≈ 1, read as
-            // divergence). SUNDIALS IDA accepts such a first iterate the same way (1e-4 · tol).
+            // divergence). SUNDIALS IDA accepts such a first iterate the same way (1e-4 · tol);
+            // at tight tolerances that is below rounding, hence also `at_roundoff`.
             let negligible = k == 0 && dy_norm <= 1e-4 * tol;
-            if dy_norm == 0.0 || negligible || rate.is_some_and(|rate| rate / (1.0 - rate) * dy_norm < tol) {
+            if at_roundoff || negligible || rate.is_some_and(|rate| rate / (1.0 - rate) * dy_norm < tol) {
                 return (true, iters, x, d);
             }
             dy_norm_old = Some(dy_norm);
@@ -798,6 +809,30 @@ mod tests {
         let s = bdf.stats();
         eprintln!("Robertson to 4e5: {s:?}");
         assert!(s.n_steps < 1000, "{s:?}");
+    }
+
+    /// At a steady state and rtol 1e-10, an algebraic variable whose residual carries ~10 ulps of
+    /// rounding noise (as an Arrhenius rate does): the Newton corrections are pure noise, their rate
+    /// is as often above 1 as below, and the step must still be accepted (it used to fail at every
+    /// step size, down to "step size too small").
+    #[test]
+    fn rounding_noise_in_the_corrector_is_not_divergence() {
+        fn noise(v: f64) -> f64 {
+            let b = v.to_bits().wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 11;
+            (b as f64 / (1u64 << 53) as f64 - 0.5) * 20.0 * f64::EPSILON * 80.0
+        }
+        let sys = Closure {
+            n: 2,
+            mass: vec![(0, 0)],
+            f: |_t, x: &[f64], r: &mut [f64]| {
+                r[0] = 1.0 - x[0];
+                r[1] = x[1] - 80.0 * x[0] + noise(x[1]);
+            },
+            jac: |_t, _x: &[f64]| vec![(0, 0, -1.0), (1, 0, -80.0), (1, 1, 1.0)],
+        };
+        let settings = BdfSettings { rtol: 1e-10, atol: 1e-8, ..BdfSettings::default() };
+        let bdf = run(&sys, settings, &[1.0, 80.0], 1000.0);
+        assert!((bdf.x()[1] - 80.0).abs() < 1e-11);
     }
 
     #[test]
