@@ -31,35 +31,7 @@ pub fn run(file: &Path) -> Result<(), CliError> {
             to.unit.inlet_ports()[tp]
         );
     }
-    let ctrls: Vec<_> = plant.blocks().iter().filter(|b| b.kind == BlockKind::Controller).collect();
-    outln!("controllers ({}):", ctrls.len());
-    for b in &ctrls {
-        let measured: Vec<String> = b.unit.signals().iter().map(|s| format!("{}={}", s.role, s.path)).collect();
-        let driven: Vec<&str> = plant
-            .inputs()
-            .iter()
-            .filter(|i| {
-                i.driven_by.is_some_and(|v| {
-                    plant.vars()[v].block
-                        == plant.blocks().iter().position(|x| std::ptr::eq(x, *b)).unwrap_or(usize::MAX)
-                })
-            })
-            .map(|i| i.path.as_str())
-            .collect();
-        outln!(
-            "  {:<16} {:<12} reads {} drives {}",
-            b.name,
-            b.unit.type_name(),
-            measured.join(", "),
-            driven.join(", ")
-        );
-    }
-    if !plant.specs().is_empty() {
-        outln!("design specs ({}), each with its varied input as one more unknown:", plant.specs().len());
-        for sp in plant.specs() {
-            outln!("  {:<16} {}", sp.origin, sp.label());
-        }
-    }
+    print_controllers_and_specs(&plant);
     let n_diff = plant.differential().iter().filter(|d| **d).count();
     let free: Vec<&str> = plant
         .inputs()
@@ -114,6 +86,39 @@ pub fn run(file: &Path) -> Result<(), CliError> {
     plantwide::solve::sequential::plan(&plant, &u, &x).describe(&plant).iter().for_each(|l| outln!("{l}"));
     residence(&plant, &u, &x);
     Ok(())
+}
+
+/// The controllers (what each reads and drives) and the design specs.
+fn print_controllers_and_specs(plant: &plantwide::flowsheet::Plant) {
+    let ctrls: Vec<_> = plant.blocks().iter().filter(|b| b.kind == BlockKind::Controller).collect();
+    outln!("controllers ({}):", ctrls.len());
+    for b in &ctrls {
+        let measured: Vec<String> = b.unit.signals().iter().map(|s| format!("{}={}", s.role, s.path)).collect();
+        let driven: Vec<&str> = plant
+            .inputs()
+            .iter()
+            .filter(|i| {
+                i.driven_by.is_some_and(|v| {
+                    plant.vars()[v].block
+                        == plant.blocks().iter().position(|x| std::ptr::eq(x, *b)).unwrap_or(usize::MAX)
+                })
+            })
+            .map(|i| i.path.as_str())
+            .collect();
+        outln!(
+            "  {:<16} {:<12} reads {} drives {}",
+            b.name,
+            b.unit.type_name(),
+            measured.join(", "),
+            driven.join(", ")
+        );
+    }
+    if !plant.specs().is_empty() {
+        outln!("design specs ({}), each with its varied input as one more unknown:", plant.specs().len());
+        for sp in plant.specs() {
+            outln!("  {:<16} {}", sp.origin, sp.label());
+        }
+    }
 }
 
 fn specs_note(k: usize, what: &str) -> String {

@@ -20,6 +20,7 @@ pub fn write_out(args: std::fmt::Arguments<'_>) {
 }
 
 mod check;
+mod compare;
 mod components;
 mod gains;
 mod linearize;
@@ -125,6 +126,10 @@ enum Command {
     /// averaging) that hold a vessel's level band and its outflow's rate limit, each verified by a
     /// nonlinear run; or a ranking of where surge capacity needs the least volume.
     Size(size::SizeArgs),
+    /// Schemes side by side: energy, the control structure's gains, RGA, NI and condition number,
+    /// open-loop and as-built eigenvalues, recycle loop gains, disturbance sensitivity by
+    /// continuation and closed-loop responses with the quality loops tuned by BLT.
+    Compare(compare::CompareArgs),
 }
 
 /// A failed command: message and exit code.
@@ -165,6 +170,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Tune(a) => tune::run(&a),
         Command::Screen(a) => screen::run(&a),
         Command::Size(a) => size::run(&a),
+        Command::Compare(a) => compare::run(&a),
         Command::Schema => {
             let schema = schemars::schema_for!(plantwide::flowsheet::FlowsheetSpec);
             let text = serde_json::to_string_pretty(&schema).map_err(|e| CliError::user(e.to_string()))?;

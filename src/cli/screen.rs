@@ -209,13 +209,13 @@ fn write_responses(dir: &Path, s: &PairingScreen) -> Result<Vec<String>, CliErro
     Ok(names)
 }
 
-fn time(text: &str, flag: &str) -> Result<f64, CliError> {
+pub(super) fn time(text: &str, flag: &str) -> Result<f64, CliError> {
     plantwide::units::parse_quantity_as(text, Dimension::TIME)
         .map_err(|e| CliError::user(format!("--{flag} {text}: {e}")))
 }
 
 /// `PATH` (+10 %) or `PATH=±x%`.
-fn disturbance(text: &str) -> Result<Disturbance, CliError> {
+pub(super) fn disturbance(text: &str) -> Result<Disturbance, CliError> {
     let Some((path, step)) = text.split_once('=') else {
         return Ok(Disturbance { path: text.trim().to_string(), fraction: 0.1 });
     };
@@ -260,6 +260,7 @@ fn pairings(a: &ScreenArgs, plant: &plantwide::flowsheet::Plant) -> Result<(), C
             duration,
             measurement: plantwide::studies::tune::loops::Measurement { dead_time, lag: 0.0 },
         },
+        record: Vec::new(),
     };
     let screen = screen_pairings(plant, &request).map_err(screen_error)?;
     let json = serde_json::to_string_pretty(&screen).map_err(|e| CliError::user(e.to_string()))?;

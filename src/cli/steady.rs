@@ -132,27 +132,7 @@ pub fn run(a: &SteadyArgs<'_>) -> Result<(), CliError> {
         (None, None) => (0, 0.0),
     };
     if json {
-        let mut values = serde_json::Map::new();
-        for (v, x) in plant.vars().iter().zip(&sol.x) {
-            values.insert(v.path.clone(), (*x).into());
-        }
-        for (i, x) in plant.inputs().iter().zip(&sol.u) {
-            if i.driven_by.is_none() {
-                values.insert(i.path.clone(), (*x).into());
-            }
-        }
-        let out = serde_json::json!({
-            "converged": true,
-            "method": format!("{method:?}").to_lowercase(),
-            "iterations": iterations,
-            "residual": residual,
-            "sequential_modular": sol.sm,
-            "warnings": sol.warnings,
-            "specs": specs_json(&plant, &sol),
-            "values": values,
-        });
-        outln!("{}", serde_json::to_string_pretty(&out).map_err(|e| CliError::user(e.to_string()))?);
-        return Ok(());
+        return print_json(&plant, &sol, method, iterations, residual);
     }
     if let Some(sm) = &sol.sm {
         sm.log().iter().for_each(|l| outln!("{l}"));
@@ -174,21 +154,7 @@ pub fn run(a: &SteadyArgs<'_>) -> Result<(), CliError> {
     for w in &sol.warnings {
         outln!("warning: {}\n", w.message);
     }
-    for s in plant.specs() {
-        let (was, dim) = (plant.inputs()[s.input].value, plant.inputs()[s.input].dim);
-        outln!(
-            "design spec {}: met with `{}` = {} (from {}), `{}` = {}",
-            s.origin,
-            s.vary,
-            with_unit(sol.u[s.input], dim),
-            with_unit(was, dim),
-            s.path,
-            with_unit(sol.x[s.var], plant.vars()[s.var].spec.dim)
-        );
-    }
-    if !plant.specs().is_empty() {
-        outln!();
-    }
+    print_specs(&plant, &sol);
     let comps = plant.components();
     out!("{:<14} {:>12} {:>9} {:>10} {:>11}", "stream", "F kmol/h", "T K", "P kPa", "h kJ/mol");
     for c in comps {
@@ -234,6 +200,56 @@ pub fn run(a: &SteadyArgs<'_>) -> Result<(), CliError> {
             outln!("{kind} {:<14} {:<10} {}", b.name, b.unit.type_name(), internal.join("  "));
         }
     }
+    Ok(())
+}
+
+/// Each spec met: the varied input's value found (and the file's), the held variable's value.
+fn print_specs(plant: &Plant, sol: &Solution) {
+    for s in plant.specs() {
+        let (was, dim) = (plant.inputs()[s.input].value, plant.inputs()[s.input].dim);
+        outln!(
+            "design spec {}: met with `{}` = {} (from {}), `{}` = {}",
+            s.origin,
+            s.vary,
+            with_unit(sol.u[s.input], dim),
+            with_unit(was, dim),
+            s.path,
+            with_unit(sol.x[s.var], plant.vars()[s.var].spec.dim)
+        );
+    }
+    if !plant.specs().is_empty() {
+        outln!();
+    }
+}
+
+/// The steady state as JSON: every variable and free input under its path (SI), the specs met.
+fn print_json(
+    plant: &Plant,
+    sol: &Solution,
+    method: MethodArg,
+    iterations: usize,
+    residual: f64,
+) -> Result<(), CliError> {
+    let mut values = serde_json::Map::new();
+    for (v, x) in plant.vars().iter().zip(&sol.x) {
+        values.insert(v.path.clone(), (*x).into());
+    }
+    for (i, x) in plant.inputs().iter().zip(&sol.u) {
+        if i.driven_by.is_none() {
+            values.insert(i.path.clone(), (*x).into());
+        }
+    }
+    let out = serde_json::json!({
+        "converged": true,
+        "method": format!("{method:?}").to_lowercase(),
+        "iterations": iterations,
+        "residual": residual,
+        "sequential_modular": sol.sm,
+        "warnings": sol.warnings,
+        "specs": specs_json(plant, sol),
+        "values": values,
+    });
+    outln!("{}", serde_json::to_string_pretty(&out).map_err(|e| CliError::user(e.to_string()))?);
     Ok(())
 }
 

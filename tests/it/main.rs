@@ -14,6 +14,7 @@ mod cli;
 mod cli_errors;
 mod columns;
 mod columns_rigorous;
+mod compare;
 mod core;
 mod dynamics;
 mod fehe;

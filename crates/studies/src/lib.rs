@@ -8,6 +8,7 @@
 //! and a dynamic test).
 #![warn(missing_docs)]
 
+pub mod compare;
 pub mod error;
 mod numeric;
 pub mod screen;

@@ -29,7 +29,7 @@ use plantwide_flowsheet::{Override, Plant, StructureEdit};
 use plantwide_solve::{NewtonSettings, StrategySettings, steady_state};
 use serde::Serialize;
 
-pub use dynamic::{CandidateFailure, CvFigures, DisturbanceRun, DynamicResult, DynamicSettings};
+pub use dynamic::{CandidateFailure, CvFigures, DisturbanceRun, DynamicResult, DynamicSettings, Tuning};
 pub use sensitivity::{Watch, WatchResult};
 
 use super::ScreenError;
@@ -59,6 +59,8 @@ pub struct PairingRequest {
     pub watch: Vec<Watch>,
     /// The dynamic test's settings.
     pub dynamic: DynamicSettings,
+    /// Further variables recorded in every run, with figures like the CVs' after them (paths).
+    pub record: Vec<String>,
 }
 
 /// One CV–MV pair and its relative gain.
@@ -184,6 +186,28 @@ pub fn screen_pairings(plant: &Plant, request: &PairingRequest) -> Result<Pairin
         singular,
         structures,
     })
+}
+
+/// One given pairing (CV `i` with MV `pairing[i]`) of `request` on `plant`: the open plant, the
+/// pairing's steady-state measures and, with disturbances, its dynamic test whatever its filters
+/// say, its loops tuned as `tuning` says (a scheme compared as it is built, [`crate::compare`]).
+///
+/// # Errors
+/// As [`screen_pairings`].
+pub fn assess_pairing(
+    plant: &Plant,
+    request: &PairingRequest,
+    pairing: &[usize],
+    tuning: &Tuning,
+) -> Result<(OpenPlant, PairingStructure), ScreenError> {
+    check_request(plant, request)?;
+    let open = open_plant(plant, &request.cvs, &request.mvs)?;
+    let cols: Vec<usize> = (0..request.mvs.len()).collect();
+    let mut s = judge(request, &open.gain, &cols, pairing, None).map_err(|e| analysis(e, None))?;
+    if !request.disturbances.is_empty() {
+        dynamic::test_picked(&open, request, std::slice::from_mut(&mut s), vec![0], tuning)?;
+    }
+    Ok((open, s))
 }
 
 fn analysis(e: plantwide_analysis::AnalysisError, tpm: Option<&String>) -> ScreenError {

@@ -123,15 +123,42 @@ pub(super) fn test(
     r: &PairingRequest,
     structures: &mut [PairingStructure],
 ) -> Result<(), ScreenError> {
+    let picked: Vec<usize> =
+        (0..structures.len()).filter(|&k| structures[k].passed).take(r.dynamic.candidates).collect();
+    test_picked(open, r, structures, picked, &Tuning::Blt)
+}
+
+/// How a tested structure's loops are tuned.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Tuning {
+    /// Together by BLT on the exact linearization (open-loop stable loops only: BLT's Nyquist
+    /// test counts no open-loop poles in the right half-plane).
+    Blt,
+    /// As given, per pair: gain magnitude (SI), reset time \[s\] and action.
+    Given(Vec<(f64, f64, &'static str)>),
+}
+
+/// Test the structures `picked`, in parallel, and score them.
+pub(super) fn test_picked(
+    open: &OpenPlant,
+    r: &PairingRequest,
+    structures: &mut [PairingStructure],
+    picked: Vec<usize>,
+    tuning: &Tuning,
+) -> Result<(), ScreenError> {
     for d in &r.disturbances {
         match open.plant.input(&d.path) {
             Some(i) if open.plant.inputs()[i].driven_by.is_none() => {}
             _ => return Err(ScreenError::Disturbance { path: d.path.clone() }),
         }
     }
-    let picked: Vec<usize> =
-        (0..structures.len()).filter(|&k| structures[k].passed).take(r.dynamic.candidates).collect();
-    let tunings: Vec<TunedCandidate> = picked.par_iter().map(|&k| tuned_plant(open, r, &structures[k])).collect();
+    let tunings: Vec<TunedCandidate> = picked
+        .par_iter()
+        .map(|&k| match tuning {
+            Tuning::Blt => tuned_plant(open, r, &structures[k]),
+            Tuning::Given(loops) => given_plant(open, &structures[k], loops),
+        })
+        .collect();
     // One length for every run, so that IAEs compare: given, or 20 reset times of the best-ranked
     // candidate that could be tuned.
     let longest = tunings.iter().flatten().map(|(_, _, t)| t.tau_i_max).next().unwrap_or(0.0);
@@ -244,6 +271,25 @@ pub(super) fn actions(open: &OpenPlant, r: &PairingRequest, s: &PairingStructure
         .collect()
 }
 
+/// The open plant with the candidate's loops at the settings given.
+fn given_plant(open: &OpenPlant, s: &PairingStructure, loops: &[(f64, f64, &'static str)]) -> TunedCandidate {
+    let kc: Vec<f64> = loops.iter().map(|l| l.0).collect();
+    let ti: Vec<f64> = loops.iter().map(|l| l.1).collect();
+    let actions: Vec<&str> = loops.iter().map(|l| l.2).collect();
+    let (plant, x) = closed_plant(open, s, &kc, &ti, &actions)?;
+    let tuned = (0..s.pairs.len())
+        .map(|i| TunedLoop {
+            cv: s.pairs[i].cv.clone(),
+            mv: s.pairs[i].mv.clone(),
+            kc: kc[i],
+            tau_i: ti[i],
+            action: actions[i].into(),
+        })
+        .collect();
+    let tau_i_max = ti.iter().copied().filter(|t| t.is_finite()).fold(0.0, f64::max);
+    Ok((plant, x, Tuned { detuning: None, loops: tuned, tau_i_max }))
+}
+
 fn tuned_plant(open: &OpenPlant, r: &PairingRequest, s: &PairingStructure) -> TunedCandidate {
     let n = s.pairs.len();
     let build = |kc: &[f64], ti: &[f64], actions: &[&str]| closed_plant(open, s, kc, ti, actions);
@@ -281,7 +327,8 @@ fn run(
 ) -> Result<DisturbanceRun, CandidateFailure> {
     let u0 = plant.input(&d.path).map_or(f64::NAN, |i| plant.inputs()[i].value);
     let ops: Vec<String> = (0..s.pairs.len()).map(|i| format!("pair{}.op", i + 1)).collect();
-    let record: Vec<&String> = r.cvs.iter().chain(&ops).collect();
+    let watched: Vec<&String> = r.cvs.iter().chain(r.record.iter().filter(|p| !r.cvs.contains(p))).collect();
+    let record: Vec<&String> = watched.iter().copied().chain(&ops).collect();
     let text = serde_json::json!({
         "format_version": 1, "name": format!("{} step", d.path), "duration": format!("{duration} s"),
         "integrator": {"rtol": 1e-6},
@@ -293,10 +340,9 @@ fn run(
     let scenario = plantwide_flowsheet::scenario::resolve(&spec, plant, "screen")?;
     let res = simulate(plant, &scenario, Start::Steady(x), "screen", &mut |_| {}).map_err(Box::new)?;
     let figures = summary(&res);
-    let cvs = r
-        .cvs
+    let cvs = watched
         .iter()
-        .map(|cv| {
+        .map(|&cv| {
             let f = figures.iter().find(|f| &f.path == cv);
             CvFigures {
                 cv: cv.clone(),
@@ -308,13 +354,13 @@ fn run(
         .collect();
     let saturated = (0..s.pairs.len())
         .filter(|&i| {
-            let k = r.cvs.len() + i;
+            let k = watched.len() + i;
             let limits = [0.0, 2.0 * res.rows.first().map_or(0.0, |row| row[k])];
             res.rows.iter().any(|row| limits.iter().any(|l| (row[k] - l).abs() <= 1e-9 * l.abs().max(1e-12)))
         })
         .map(|i| s.pairs[i].mv.clone())
         .collect();
-    let series = (0..r.cvs.len()).map(|k| res.rows.iter().map(|row| row[k]).collect()).collect();
+    let series = (0..watched.len()).map(|k| res.rows.iter().map(|row| row[k]).collect()).collect();
     Ok(DisturbanceRun {
         disturbance: format!("{} {:+} %", d.path, 100.0 * d.fraction),
         cvs,

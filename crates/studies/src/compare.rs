@@ -1,0 +1,465 @@
+//! Schemes side by side — "is the energy saved worth the disturbances propagated?" (Luyben (ed.),
+//! *Practical Distillation Control*, 1992, ch. 6: simulate with and without): each flowsheet as
+//! its file builds it, judged on the same disturbances and outputs.
+//!
+//! Per scheme, at its steady state ([`plantwide_solve::converge`]):
+//! 1. **Energy** ([`energy`]): every duty, and the totals of heating, cooling and heat recovered.
+//! 2. **Control structure**: its quality loops — the PI loops whose measurement is not an
+//!    inventory (a level, a holdup or a pressure), or the loops named — opened together, and the
+//!    exact steady-state gains of the open plant from their MVs to their CVs
+//!    ([`crate::screen::pairings::assess_pairing`]): RGA, Niederlinski index and DIC of the file's
+//!    pairing, condition number.
+//! 3. **Stability**: the eigenvalues of the exact linearization as built (loops in auto) and with
+//!    the quality loops in manual (the open loop the operators face when a loop trips): unstable or
+//!    integrating modes, slowest time constants.
+//! 4. **Recycles**: each recycle's tear streams and loop gain (the spectral radius of the secant
+//!    model of its tear map, from the sequential-modular pass).
+//! 5. **Sensitivity** by continuation ([`plantwide_analysis::sensitivity::sweep`]): each output at
+//!    ± each disturbance with the control structure active.
+//! 6. **Closed-loop responses**: the quality loops tuned together by BLT on the exact linearization
+//!    (`plantwide tune --method blt`), then each disturbance stepped on the nonlinear plant: IAE,
+//!    largest deviation and settling time of the CVs and the outputs. Every scheme runs for the
+//!    same time (given, or 20 reset times of the slowest loop of all schemes), so the figures
+//!    compare. BLT assumes open-loop stable loops (its Nyquist test counts no right-half-plane
+//!    poles, and the steady-state gain of an open-loop unstable loop has the wrong sign for the
+//!    controller's action): a scheme unstable with its quality loops in manual keeps the file's
+//!    tuning, and says so; [`CompareRequest::file_tuning`] keeps every file's tuning.
+
+pub mod energy;
+
+use plantwide_analysis::linear::Linearization;
+use plantwide_analysis::measures::{condition_number, svd};
+use plantwide_analysis::sensitivity::{Disturbance as Sweep, SweepSettings, sweep};
+use plantwide_flowsheet::Plant;
+use plantwide_model::ControllerSpec;
+use plantwide_solve::{StrategySettings, converge};
+use plantwide_units::Dimension;
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::screen::ScreenError;
+use crate::screen::pairings::{Disturbance, DynamicSettings, PairingRequest, PairingStructure, Tuning, assess_pairing};
+pub use energy::{Energy, energy};
+
+/// What to compare.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CompareRequest {
+    /// Disturbances, each an input stepped by a fraction of its steady value (the sensitivity
+    /// sweeps go to ± that fraction).
+    pub disturbances: Vec<Disturbance>,
+    /// Outputs watched in every scheme (variable paths every scheme has).
+    pub outputs: Vec<String>,
+    /// Quality loops by controller name (empty: every PI loop on a non-inventory measurement).
+    pub loops: Vec<String>,
+    /// Settings of the closed-loop runs.
+    pub dynamic: DynamicSettings,
+    /// Keep the files' own tuning in every scheme (like for like) instead of BLT where it applies.
+    pub file_tuning: bool,
+}
+
+/// Why a comparison could not be made.
+#[derive(Debug, Clone, thiserror::Error)]
+pub enum CompareError {
+    /// A scheme has no steady state.
+    #[error("{file}: {source}")]
+    Steady {
+        /// Flowsheet file.
+        file: String,
+        /// Why.
+        source: Box<plantwide_solve::SolveError>,
+    },
+    /// An output or a loop the request names is not in a scheme.
+    #[error("{file}: {what}")]
+    Request {
+        /// Flowsheet file.
+        file: String,
+        /// What is missing and what would fix it.
+        what: String,
+    },
+    /// The structure analysis or the closed-loop test failed.
+    #[error("{file}: {source}")]
+    Screen {
+        /// Flowsheet file.
+        file: String,
+        /// Why.
+        source: Box<ScreenError>,
+    },
+    /// A linearization or a sweep failed.
+    #[error("{file}: {source}")]
+    Analysis {
+        /// Flowsheet file.
+        file: String,
+        /// Why.
+        source: Box<plantwide_analysis::AnalysisError>,
+    },
+}
+
+impl CompareError {
+    /// True for a request or a file at fault (exit 1), false for a numerical failure (exit 2).
+    pub fn is_user_error(&self) -> bool {
+        match self {
+            CompareError::Steady { source, .. } => source.is_user_error(),
+            CompareError::Request { .. } => true,
+            CompareError::Screen { source, .. } => source.is_user_error(),
+            CompareError::Analysis { source, .. } => source.is_user_error(),
+        }
+    }
+}
+
+/// A quality loop of a scheme.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct QualityLoop {
+    /// Controller.
+    pub controller: String,
+    /// Its measurement (CV).
+    pub cv: String,
+    /// The input it drives (MV).
+    pub mv: String,
+}
+
+/// Modes of a linearization.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Modes {
+    /// Number of states.
+    pub states: usize,
+    /// Eigenvalues with a non-negative real part (to 1e-12 of the largest), `[re, im]` \[1/s\].
+    pub unstable: Vec<[f64; 2]>,
+    /// The five slowest stable time constants \[s\], slowest first.
+    pub slowest: Vec<f64>,
+}
+
+/// Stability of a scheme.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Stability {
+    /// As built: every loop in auto.
+    pub as_built: Modes,
+    /// The quality loops in manual (their outputs held at the steady values).
+    pub open_loop: Modes,
+    /// The open loop has a growing mode (real part above 1e-9 of the largest modulus).
+    pub open_loop_unstable: bool,
+}
+
+/// A recycle of a scheme.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Recycle {
+    /// Torn streams or signals.
+    pub tears: Vec<String>,
+    /// Loop gain (spectral radius of the tear map's secant model), when estimated (3 passes or
+    /// more).
+    pub loop_gain: Option<f64>,
+    /// Passes of the sequential-modular start.
+    pub passes: usize,
+}
+
+/// An output at ± a disturbance, with the control structure active.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Sensitivity {
+    /// `path ±x %`.
+    pub disturbance: String,
+    /// Output path.
+    pub output: String,
+    /// At the base case.
+    pub base: f64,
+    /// At the disturbance's low end (`None`: no steady state reached there).
+    pub low: Option<f64>,
+    /// At its high end.
+    pub high: Option<f64>,
+    /// Why an end has no value: outside the input's physical range, or where the continuation
+    /// stopped and Newton's verdict there.
+    pub failures: Vec<String>,
+}
+
+/// One scheme, judged.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Scheme {
+    /// Plant name.
+    pub name: String,
+    /// Flowsheet file.
+    pub file: String,
+    /// Energy use.
+    pub energy: Energy,
+    /// Quality loops.
+    pub loops: Vec<QualityLoop>,
+    /// Steady-state gains of the opened quality loops, CVs × MVs (SI).
+    pub gain: Vec<Vec<f64>>,
+    /// Condition number of `gain`.
+    pub condition_number: Option<f64>,
+    /// The file's pairing: relative gains, NI, DIC and its closed-loop runs.
+    pub structure: Option<PairingStructure>,
+    /// How the quality loops of the closed-loop runs are tuned: `blt`, or `file` (asked for, or
+    /// open loop unstable: BLT does not apply).
+    pub tuning: &'static str,
+    /// Stability.
+    pub stability: Stability,
+    /// Recycles.
+    pub recycles: Vec<Recycle>,
+    /// Sensitivity of the outputs.
+    pub sensitivity: Vec<Sensitivity>,
+}
+
+/// The schemes side by side.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Comparison {
+    /// Disturbances (`path ±x %`).
+    pub disturbances: Vec<String>,
+    /// Outputs.
+    pub outputs: Vec<String>,
+    /// Length of every closed-loop run \[s\].
+    pub duration: Option<f64>,
+    /// The schemes, in the order given.
+    pub schemes: Vec<Scheme>,
+}
+
+/// Compare `plants` on `request`; schemes are judged in parallel.
+///
+/// # Errors
+/// [`CompareError`] naming the scheme's file and what failed.
+pub fn compare(plants: &[Plant], request: &CompareRequest) -> Result<Comparison, CompareError> {
+    let first: Vec<Scheme> = plants.par_iter().map(|p| scheme(p, request)).collect::<Result<_, _>>()?;
+    // One run length for all: given, or 20 reset times of the slowest tuned loop of any scheme.
+    let longest = |s: &Scheme| {
+        s.structure
+            .as_ref()
+            .and_then(|t| t.dynamic.as_ref())
+            .map_or(0.0, |d| d.loops.iter().map(|l| l.tau_i).filter(|t| t.is_finite()).fold(0.0, f64::max))
+    };
+    let duration = request.dynamic.duration.or_else(|| {
+        let t = first.iter().map(longest).fold(0.0, f64::max);
+        (t > 0.0).then_some(20.0 * t)
+    });
+    let schemes = match duration {
+        Some(d) if request.dynamic.duration.is_none() && !request.disturbances.is_empty() => {
+            let again =
+                CompareRequest { dynamic: DynamicSettings { duration: Some(d), ..request.dynamic }, ..request.clone() };
+            plants
+                .par_iter()
+                .zip(first)
+                .map(|(p, s)| if (20.0 * longest(&s) - d).abs() <= 1e-9 * d { Ok(s) } else { scheme(p, &again) })
+                .collect::<Result<_, _>>()?
+        }
+        _ => first,
+    };
+    Ok(Comparison {
+        disturbances: request.disturbances.iter().map(|d| format!("{} {:+} %", d.path, 100.0 * d.fraction)).collect(),
+        outputs: request.outputs.clone(),
+        duration,
+        schemes,
+    })
+}
+
+/// One scheme judged on `r`.
+fn scheme(plant: &Plant, r: &CompareRequest) -> Result<Scheme, CompareError> {
+    let file = plant.file().to_string();
+    let outputs: Vec<usize> = r
+        .outputs
+        .iter()
+        .map(|o| {
+            plant.var(o).ok_or_else(|| CompareError::Request {
+                file: file.clone(),
+                what: format!(
+                    "no output `{o}`{}: every scheme must have every output",
+                    plantwide_flowsheet::error::did_you_mean(o, plant.vars().iter().map(|v| v.path.as_str()))
+                ),
+            })
+        })
+        .collect::<Result<_, _>>()?;
+    let sol = converge(plant, &StrategySettings::default())
+        .map_err(|e| CompareError::Steady { file: file.clone(), source: Box::new(e) })?;
+    let loops = quality_loops(plant, &r.loops)?;
+    let analysis = |e| CompareError::Analysis { file: file.clone(), source: Box::new(e) };
+    let stability = stability(plant, &sol.x, &sol.u, &loops).map_err(analysis)?;
+    let keep = r.file_tuning || stability.open_loop_unstable;
+    let tuning = if keep { Tuning::Given(file_tuning(plant, &loops)?) } else { Tuning::Blt };
+    let (gain, condition, structure) = structure(plant, r, &loops, &tuning)?;
+    let recycles = sol
+        .sm
+        .iter()
+        .flat_map(|sm| &sm.sccs)
+        // The secant model needs a few passes to say anything: a pass that starts converged has none.
+        .map(|s| Recycle { tears: s.tears.clone(), loop_gain: s.loop_gain.filter(|_| s.passes >= 3), passes: s.passes })
+        .collect();
+    let sensitivity = sensitivity(plant, &sol.x, &sol.u, r, &outputs).map_err(analysis)?;
+    Ok(Scheme {
+        name: plant.name().to_string(),
+        file,
+        energy: energy(plant, &sol.x, &sol.u),
+        loops,
+        gain,
+        condition_number: condition,
+        structure,
+        tuning: if matches!(tuning, Tuning::Blt) { "blt" } else { "file" },
+        stability,
+        recycles,
+        sensitivity,
+    })
+}
+
+/// The quality loops: those named, or every PID with reset action whose measurement is not an
+/// inventory (its dimension a length, an amount or a pressure).
+fn quality_loops(plant: &Plant, named: &[String]) -> Result<Vec<QualityLoop>, CompareError> {
+    let inventory = [Dimension::LENGTH, Dimension::AMOUNT, Dimension::PRESSURE];
+    let mut loops = Vec::new();
+    for (name, c) in &plant.spec().controllers {
+        let ControllerSpec::Pid(pid) = c else { continue };
+        let Some(mv) = pid.output.clone() else { continue };
+        let dim = plant.var(&pid.pv).map(|v| plant.vars()[v].spec.dim);
+        let quality = pid.tau_i.is_some() && dim.is_some_and(|d| !inventory.contains(&d));
+        if (named.is_empty() && quality) || named.contains(name) {
+            loops.push(QualityLoop { controller: name.clone(), cv: pid.pv.clone(), mv });
+        }
+    }
+    if let Some(n) = named.iter().find(|n| !loops.iter().any(|l| &l.controller == *n)) {
+        return Err(CompareError::Request {
+            file: plant.file().to_string(),
+            what: format!("--loops {n}: no PID controller `{n}` driving an input"),
+        });
+    }
+    Ok(loops)
+}
+
+/// The gains of the opened quality loops, their condition number and the file's pairing judged
+/// (with its closed-loop runs when there are disturbances).
+type StructureParts = (Vec<Vec<f64>>, Option<f64>, Option<PairingStructure>);
+
+fn structure(
+    plant: &Plant,
+    r: &CompareRequest,
+    loops: &[QualityLoop],
+    tuning: &Tuning,
+) -> Result<StructureParts, CompareError> {
+    if loops.is_empty() {
+        return Ok((Vec::new(), None, None));
+    }
+    let request = PairingRequest {
+        cvs: loops.iter().map(|l| l.cv.clone()).collect(),
+        mvs: loops.iter().map(|l| l.mv.clone()).collect(),
+        throughput: Vec::new(),
+        disturbances: r.disturbances.clone(),
+        watch: Vec::new(),
+        dynamic: r.dynamic,
+        record: r.outputs.clone(),
+    };
+    let pairing: Vec<usize> = (0..loops.len()).collect();
+    let screen = |e| CompareError::Screen { file: plant.file().to_string(), source: Box::new(e) };
+    let (open, s) = assess_pairing(plant, &request, &pairing, tuning).map_err(screen)?;
+    let condition = svd(open.gain.as_ref()).ok().map(|d| condition_number(&d.singular_values));
+    Ok((plantwide_analysis::measures::rows(open.gain.as_ref()), condition, Some(s)))
+}
+
+/// The modes as built and with the quality loops in manual: each one's `auto` input 0 and its
+/// `op_manual` at its steady output, so the steady state stays and its integral tracks.
+fn stability(
+    plant: &Plant,
+    x: &[f64],
+    u: &[f64],
+    loops: &[QualityLoop],
+) -> Result<Stability, plantwide_analysis::AnalysisError> {
+    let as_built = modes(plant, x, u)?;
+    let mut manual = plant.clone();
+    for l in loops {
+        let input = |name: &str| manual.input(&format!("{}.{name}", l.controller));
+        if let (Some(auto), Some(op_manual), Some(op)) =
+            (input("auto"), input("op_manual"), plant.var(&format!("{}.op", l.controller)))
+        {
+            manual.set_input_value(auto, 0.0);
+            manual.set_input_value(op_manual, x[op]);
+        }
+    }
+    let open_loop = modes(&manual, x, &manual.input_values())?;
+    let model = Linearization::new(&manual, x, &manual.input_values()).state_space(&[], &[])?;
+    let ev = model.eigenvalues()?;
+    let scale = ev.iter().map(|l| l.norm()).fold(0.0, f64::max);
+    let open_loop_unstable = ev.iter().any(|l| l.re > 1e-9 * scale);
+    Ok(Stability { as_built, open_loop, open_loop_unstable })
+}
+
+/// The file's settings of each quality loop (SI): gain magnitude, reset time and action.
+fn file_tuning(plant: &Plant, loops: &[QualityLoop]) -> Result<Vec<(f64, f64, &'static str)>, CompareError> {
+    let bad = |what: String| CompareError::Request { file: plant.file().to_string(), what };
+    loops
+        .iter()
+        .map(|l| {
+            let Some(ControllerSpec::Pid(c)) = plant.spec().controllers.get(&l.controller) else {
+                return Err(bad(format!("`{}` is not a PID controller", l.controller)));
+            };
+            let (mv, cv) = (plant.input(&l.mv), plant.var(&l.cv));
+            let dim = mv.zip(cv).map(|(i, v)| plant.inputs()[i].dim / plant.vars()[v].spec.dim);
+            let kc = dim
+                .and_then(|d| c.kc.to_si(d).ok())
+                .ok_or_else(|| bad(format!("controllers.{}.kc: not a gain of its loop", l.controller)))?;
+            let ti = c.tau_i.as_ref().and_then(|t| t.to_si(Dimension::TIME).ok()).unwrap_or(f64::INFINITY);
+            let action = match c.action {
+                plantwide_model::controllers::Action::Reverse => "reverse",
+                plantwide_model::controllers::Action::Direct => "direct",
+            };
+            Ok((kc.abs(), ti, action))
+        })
+        .collect()
+}
+
+fn modes(plant: &Plant, x: &[f64], u: &[f64]) -> Result<Modes, plantwide_analysis::AnalysisError> {
+    let model = Linearization::new(plant, x, u).state_space(&[], &[])?;
+    let unstable = model.unstable(1e-12)?.iter().map(|l| [l.re, l.im]).collect();
+    let mut slowest = model.time_constants()?;
+    slowest.sort_by(|a, b| b.total_cmp(a));
+    slowest.truncate(5);
+    Ok(Modes { states: model.states.len(), unstable, slowest })
+}
+
+/// Each output at ± each disturbance, by continuation from the steady state.
+fn sensitivity(
+    plant: &Plant,
+    x: &[f64],
+    u: &[f64],
+    r: &CompareRequest,
+    outputs: &[usize],
+) -> Result<Vec<Sensitivity>, plantwide_analysis::AnalysisError> {
+    let mut rows = Vec::new();
+    for d in &r.disturbances {
+        let f = 100.0 * d.fraction.abs();
+        let mut range = Sweep::parse(plant, u, &format!("{}=-{f}%:+{f}%", d.path))?;
+        // An end outside the input's physical range (a mole fraction above 1) is no steady state
+        // to look for: it is reported as such, and the sweep goes to the other end only.
+        let mut failures = Vec::new();
+        let i = range.signal.index;
+        for end in [range.low, range.high] {
+            if let Err(why) = plantwide_flowsheet::overrides::check_input_value(plant, i, end) {
+                failures.push(format!("{} at {}: {why}", d.path, plantwide_model::limits::number(end)));
+            }
+        }
+        let inside = |v: f64| plantwide_flowsheet::overrides::check_input_value(plant, i, v).is_ok();
+        let (low_ok, high_ok) = (inside(range.low), inside(range.high));
+        range.low = if low_ok { range.low } else { range.base - 1e-9 * range.base.abs().max(1.0) };
+        range.high = if high_ok { range.high } else { range.base + 1e-9 * range.base.abs().max(1.0) };
+        let curve = sweep(
+            plant,
+            x,
+            u,
+            std::slice::from_ref(&range),
+            outputs,
+            &SweepSettings { points: 2, ..Default::default() },
+        )?
+        .remove(0);
+        failures.extend(curve.failures.iter().map(|fl| fl.to_string()));
+        let at = |value: f64, ok: bool| {
+            let failed = curve.failures.iter().any(|fl| (fl.value < range.base) == (value < range.base));
+            if failed || !ok {
+                return None;
+            }
+            let k = if value < range.base { 0 } else { curve.outputs.len() - 1 };
+            curve.outputs.get(k).cloned().flatten()
+        };
+        let (low, high) = (at(range.low, low_ok), at(range.high, high_ok));
+        for (k, o) in r.outputs.iter().enumerate() {
+            rows.push(Sensitivity {
+                disturbance: format!("{} ±{f} %", d.path),
+                output: o.clone(),
+                base: x[outputs[k]],
+                low: low.as_ref().map(|v| v[k]),
+                high: high.as_ref().map(|v| v[k]),
+                failures: failures.clone(),
+            });
+        }
+    }
+    Ok(rows)
+}

@@ -1,0 +1,94 @@
+//! The energy a scheme uses at its steady state: every duty of its units, read from the units'
+//! own variables and inputs, classed as heating (a utility in), cooling (a utility out) or
+//! recovered (heat moved between process streams by an exchanger).
+//!
+//! - `heater` (heater or cooler): its duty `Q` [W], heating when positive, cooling when negative;
+//! - `cstr`: `Q` [W], the heat into the reactor (a jacket's is negative: cooling);
+//! - `heat_exchanger`: `Q` [W], recovered;
+//! - `column` (rigorous): the reboiler duty (input `reboiler_duty`, or the controller output
+//!   driving it) heating, the condenser duty `Qc` [W] cooling; a steam reboiler's `steam_flow`
+//!   [kg/s] and a simple column's `boilup` [mol/s] have no duty in the model and are listed as
+//!   other utilities.
+
+use plantwide_flowsheet::Plant;
+use serde::Serialize;
+
+/// One duty.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Duty {
+    /// Unit and variable (`trim.Q`, `column.Qc`, `column.reboiler_duty`).
+    pub path: String,
+    /// `heating`, `cooling` or `recovered`.
+    pub kind: &'static str,
+    /// Magnitude \[W\].
+    pub duty: f64,
+}
+
+/// A utility the model carries without a duty.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct OtherUtility {
+    /// Input path (`column.boilup`, `column.steam_flow`).
+    pub path: String,
+    /// Its value (SI).
+    pub value: f64,
+    /// Its SI unit.
+    pub unit: String,
+}
+
+/// The energy use of a scheme.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Energy {
+    /// Σ heating duties \[W\].
+    pub heating: f64,
+    /// Σ cooling duties \[W\].
+    pub cooling: f64,
+    /// Σ heat recovered between process streams \[W\].
+    pub recovered: f64,
+    /// Every duty.
+    pub duties: Vec<Duty>,
+    /// Utilities without a duty in the model.
+    pub other: Vec<OtherUtility>,
+}
+
+/// The value of input `path` at the steady state: a free input's value, or the controller output
+/// driving it.
+fn input_value(plant: &Plant, x: &[f64], u: &[f64], path: &str) -> Option<f64> {
+    let i = plant.input(path)?;
+    Some(plant.inputs()[i].driven_by.map_or(u[i], |v| x[v]))
+}
+
+/// The energy use of `plant` at steady state `(x, u)`.
+pub fn energy(plant: &Plant, x: &[f64], u: &[f64]) -> Energy {
+    let mut duties = Vec::new();
+    let mut other = Vec::new();
+    let mut push = |path: String, value: f64, positive: &'static str, negative: &'static str| {
+        if value != 0.0 {
+            duties.push(Duty { path, kind: if value > 0.0 { positive } else { negative }, duty: value.abs() });
+        }
+    };
+    for b in plant.blocks() {
+        let var = |name: &str| plant.var(&format!("{}.{name}", b.name)).map(|v| x[v]);
+        match b.unit.type_name() {
+            "heater" | "cstr" => push(format!("{}.Q", b.name), var("Q").unwrap_or(0.0), "heating", "cooling"),
+            "heat_exchanger" => push(format!("{}.Q", b.name), var("Q").unwrap_or(0.0), "recovered", "recovered"),
+            "column" => {
+                let reboiler = format!("{}.reboiler_duty", b.name);
+                if let Some(q) = input_value(plant, x, u, &reboiler) {
+                    push(reboiler, q, "heating", "cooling");
+                }
+                if let Some(qc) = var("Qc") {
+                    push(format!("{}.Qc", b.name), -qc, "heating", "cooling");
+                }
+                for (name, unit) in [("steam_flow", "kg/s"), ("boilup", "mol/s")] {
+                    let path = format!("{}.{name}", b.name);
+                    if let Some(value) = input_value(plant, x, u, &path) {
+                        other.push(OtherUtility { path, value, unit: unit.into() });
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    let total = |kind: &str| duties.iter().filter(|d| d.kind == kind).map(|d| d.duty).sum::<f64>() + 0.0;
+    Energy { heating: total("heating"), cooling: total("cooling"), recovered: total("recovered"), duties, other }
+}

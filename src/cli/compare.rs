@@ -1,0 +1,327 @@
+//! `plantwide compare A.json B.json … --disturbances … --outputs … [--report DIR]`: schemes side by
+//! side (energy, control structure, stability, recycles, sensitivity, closed-loop responses) as
+//! markdown on stdout (or JSON), and with `--report DIR` as compare.md, compare.json and plots.
+
+use std::path::{Path, PathBuf};
+
+use plantwide::io::plot::{Overlay, write_bars, write_overlays};
+use plantwide::studies::compare::{CompareRequest, Comparison, Scheme, compare};
+use plantwide::studies::screen::pairings::{DynamicResult, DynamicSettings};
+use plantwide::studies::tune::loops::Measurement;
+
+use super::CliError;
+use super::screen::{disturbance, time};
+use super::steady::load_with_overrides;
+
+/// Arguments of `plantwide compare`.
+#[derive(Debug, clap::Args)]
+pub struct CompareArgs {
+    /// Flowsheet files (JSON) of the schemes, two or more.
+    #[arg(value_name = "FILE", num_args = 2.., required = true)]
+    files: Vec<PathBuf>,
+    /// Disturbances, each an input stepped by a fraction of its steady value: `PATH` (+10 %) or
+    /// `PATH=±x%`, comma-separated; the sensitivity sweeps go to ± that fraction.
+    #[arg(long, value_name = "PATH[=±x%],…", value_delimiter = ',', required = true)]
+    disturbances: Vec<String>,
+    /// Outputs watched in every scheme, comma-separated variable paths.
+    #[arg(long, value_name = "P1,P2,…", value_delimiter = ',', required = true)]
+    outputs: Vec<String>,
+    /// Quality loops by controller name (default: every PI loop whose measurement is not a level,
+    /// holdup or pressure).
+    #[arg(long, value_name = "C1,C2,…", value_delimiter = ',')]
+    loops: Vec<String>,
+    /// Measurement dead time the BLT tuning of the quality loops allows for.
+    #[arg(long, value_name = "TIME", default_value = "1 min")]
+    measurement_dead_time: String,
+    /// Tuning of the quality loops in the closed-loop runs: `blt` (BLT where the open loop is
+    /// stable, the file's settings where it is not) or `file` (every file's own settings: like
+    /// for like when the files share them).
+    #[arg(long, value_enum, default_value = "blt")]
+    tuning: TuningArg,
+    /// Length of each closed-loop run (default: 20 reset times of the slowest tuned loop).
+    #[arg(long, value_name = "TIME")]
+    duration: Option<String>,
+    /// Print the comparison as JSON.
+    #[arg(long)]
+    json: bool,
+    /// Write a report here: compare.md, compare.json, energy.png and responses_<k>.png.
+    #[arg(long, value_name = "DIR")]
+    report: Option<PathBuf>,
+}
+
+/// How `compare` tunes the quality loops.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum TuningArg {
+    /// BLT where it applies.
+    Blt,
+    /// The files' own settings.
+    File,
+}
+
+/// Run `plantwide compare`.
+pub fn run(a: &CompareArgs) -> Result<(), CliError> {
+    // Schemes run in parallel; faer's kernels sequential inside each, so no digit depends on the
+    // thread count.
+    plantwide::analysis::faer::set_global_parallelism(plantwide::analysis::faer::Par::Seq);
+    let plants = a.files.iter().map(|f| load_with_overrides(f, &[]).map(|(p, _)| p)).collect::<Result<Vec<_>, _>>()?;
+    let request = CompareRequest {
+        disturbances: a.disturbances.iter().map(|d| disturbance(d)).collect::<Result<_, _>>()?,
+        outputs: a.outputs.clone(),
+        loops: a.loops.clone(),
+        file_tuning: a.tuning == TuningArg::File,
+        dynamic: DynamicSettings {
+            candidates: 1,
+            duration: a.duration.as_deref().map(|d| time(d, "duration")).transpose()?,
+            measurement: Measurement { dead_time: time(&a.measurement_dead_time, "measurement-dead-time")?, lag: 0.0 },
+        },
+    };
+    let c = compare(&plants, &request).map_err(|e| {
+        if e.is_user_error() { CliError::user(e.to_string()) } else { CliError::numerical(e.to_string()) }
+    })?;
+    let json = serde_json::to_string_pretty(&c).map_err(|e| CliError::user(e.to_string()))?;
+    if let Some(dir) = &a.report {
+        write_report(dir, &c, &json)?;
+    }
+    if a.json {
+        outln!("{json}");
+    } else {
+        outln!("{}", markdown(&c));
+    }
+    Ok(())
+}
+
+fn write_report(dir: &Path, c: &Comparison, json: &str) -> Result<(), CliError> {
+    let fail = |e: std::io::Error| CliError::user(format!("--report {}: {e}", dir.display()));
+    let draw = |e: plantwide::io::IoError| CliError::user(format!("--report {}: {e}", dir.display()));
+    std::fs::create_dir_all(dir).map_err(fail)?;
+    std::fs::write(dir.join("compare.json"), json).map_err(fail)?;
+    let bars: Vec<(String, f64)> = c.schemes.iter().map(|s| (s.name.clone(), s.energy.heating / 1e3)).collect();
+    write_bars(&dir.join("energy.png"), "heating duty", "kW", &bars).map_err(draw)?;
+    let mut figures = String::from("\n![heating duty](energy.png)\n");
+    for name in write_responses(dir, c).map_err(draw)? {
+        figures.push_str(&format!("\n![responses]({name})\n"));
+    }
+    std::fs::write(dir.join("compare.md"), format!("{}{figures}", markdown(c))).map_err(fail)
+}
+
+/// A scheme's closed-loop runs, if they ran.
+fn runs(s: &Scheme) -> Option<&DynamicResult> {
+    s.structure.as_ref().and_then(|t| t.dynamic.as_ref()).filter(|d| d.failure.is_none())
+}
+
+/// One figure per disturbance: a panel per CV and output, a curve per scheme (schemes whose runs
+/// share the time grid; all do when the run length is common).
+fn write_responses(dir: &Path, c: &Comparison) -> Result<Vec<String>, plantwide::io::IoError> {
+    let Some(first) = c.schemes.iter().find_map(runs) else { return Ok(Vec::new()) };
+    let mut names = Vec::new();
+    for (d, run) in first.runs.iter().enumerate() {
+        let paths: Vec<&String> = first.runs[d].cvs.iter().map(|f| &f.cv).collect();
+        let panels: Vec<Overlay> = paths
+            .iter()
+            .map(|&p| Overlay {
+                label: format!("{p} (SI)"),
+                curves: c
+                    .schemes
+                    .iter()
+                    .filter_map(|s| {
+                        let r = &runs(s)?.runs[d];
+                        let k = r.cvs.iter().position(|f| &f.cv == p)?;
+                        (r.times.len() == run.times.len()).then(|| (s.name.clone(), r.series[k].clone()))
+                    })
+                    .collect(),
+            })
+            .collect();
+        let times: Vec<f64> = run.times.iter().map(|t| t / 3600.0).collect();
+        let name = format!("responses_{}.png", d + 1);
+        write_overlays(
+            &dir.join(&name),
+            &format!("{}: closed-loop responses (tuning in compare.md)", run.disturbance),
+            "time [h]",
+            &times,
+            &panels,
+        )?;
+        names.push(name);
+    }
+    Ok(names)
+}
+
+fn sig(v: f64) -> String {
+    if v == 0.0 || (v.abs() >= 1e-3 && v.abs() < 1e5) { format!("{v:.4}") } else { format!("{v:.4e}") }
+}
+
+/// The comparison as markdown: one table per question.
+fn markdown(c: &Comparison) -> String {
+    let mut t = String::from("# Schemes compared\n\n");
+    t.push_str(&energy_table(c));
+    t.push_str(&structure_table(c));
+    t.push_str(&stability_table(c));
+    t.push_str(&recycle_table(c));
+    t.push_str(&sensitivity_table(c));
+    t.push_str(&response_table(c));
+    t
+}
+
+fn energy_table(c: &Comparison) -> String {
+    let mut t = String::from(
+        "## Energy at steady state\n\n| scheme | heating kW | cooling kW | recovered kW | duties |\n|---|---|---|---|---|\n",
+    );
+    for s in &c.schemes {
+        let e = &s.energy;
+        let mut items: Vec<String> =
+            e.duties.iter().map(|d| format!("{} {} {:.3} kW", d.path, d.kind, d.duty / 1e3)).collect();
+        items.extend(e.other.iter().map(|o| format!("{} {} {}", o.path, sig(o.value), o.unit)));
+        t.push_str(&format!(
+            "| {} | {:.3} | {:.3} | {:.3} | {} |\n",
+            s.name,
+            e.heating / 1e3,
+            e.cooling / 1e3,
+            e.recovered / 1e3,
+            items.join("; ")
+        ));
+    }
+    t + "\n"
+}
+
+fn structure_table(c: &Comparison) -> String {
+    let mut t = String::from(
+        "## Control structure (quality loops opened together; exact steady-state gains)\n\n| scheme | loops CV ← MV (relative gain) | NI | DIC | condition number |\n|---|---|---|---|---|\n",
+    );
+    for s in &c.schemes {
+        let Some(st) = &s.structure else {
+            t.push_str(&format!("| {} | no quality loops | – | – | – |\n", s.name));
+            continue;
+        };
+        let pairs: Vec<String> =
+            st.pairs.iter().map(|p| format!("{} ← {} ({:.4})", p.cv, p.mv, p.relative_gain)).collect();
+        t.push_str(&format!(
+            "| {} | {} | {:.4} | {} | {} |\n",
+            s.name,
+            pairs.join("; "),
+            st.niederlinski,
+            if st.dic { "yes" } else { "no" },
+            s.condition_number.map_or("–".into(), sig)
+        ));
+    }
+    t + "\n"
+}
+
+fn modes_text(m: &plantwide::studies::compare::Modes) -> String {
+    let unstable = if m.unstable.is_empty() {
+        "stable".to_string()
+    } else {
+        let ev: Vec<String> = m.unstable.iter().map(|l| format!("{:.4e}{:+.4e}j", l[0], l[1])).collect();
+        format!("**unstable or integrating: {} 1/s**", ev.join(", "))
+    };
+    let slow: Vec<String> = m.slowest.iter().map(|t| sig(*t)).collect();
+    format!("{unstable}; slowest τ [s]: {}", slow.join(", "))
+}
+
+fn stability_table(c: &Comparison) -> String {
+    let mut t = String::from(
+        "## Stability (eigenvalues of the exact linearization)\n\n| scheme | as built (loops in auto) | quality loops in manual |\n|---|---|---|\n",
+    );
+    for s in &c.schemes {
+        t.push_str(&format!(
+            "| {} | {} | {} |\n",
+            s.name,
+            modes_text(&s.stability.as_built),
+            modes_text(&s.stability.open_loop)
+        ));
+    }
+    t + "\n"
+}
+
+fn recycle_table(c: &Comparison) -> String {
+    let mut t = String::from("## Recycles\n\n| scheme | tears | loop gain |\n|---|---|---|\n");
+    for s in &c.schemes {
+        if s.recycles.is_empty() {
+            t.push_str(&format!("| {} | none | – |\n", s.name));
+        }
+        for r in &s.recycles {
+            let gain = r.loop_gain.map_or(format!("not estimated ({} passes)", r.passes), sig);
+            t.push_str(&format!("| {} | {} | {gain} |\n", s.name, r.tears.join(", ")));
+        }
+    }
+    t + "\n"
+}
+
+fn sensitivity_table(c: &Comparison) -> String {
+    let mut t = String::from(
+        "## Sensitivity (steady state at ± each disturbance, control structure active)\n\n| disturbance | output | scheme | low | base | high |\n|---|---|---|---|---|---|\n",
+    );
+    let value = |v: Option<f64>| v.map_or("–".into(), sig);
+    let mut notes: Vec<String> = Vec::new();
+    for s in &c.schemes {
+        for r in &s.sensitivity {
+            for f in &r.failures {
+                let note = format!("- {}: {f}", s.name);
+                if !notes.contains(&note) {
+                    notes.push(note);
+                }
+            }
+            t.push_str(&format!(
+                "| {} | {} | {} | {} | {} | {} |\n",
+                r.disturbance,
+                r.output,
+                s.name,
+                value(r.low),
+                sig(r.base),
+                value(r.high)
+            ));
+        }
+    }
+    if !notes.is_empty() {
+        t.push_str(&format!("\nEnds without a steady state (–):\n{}\n", notes.join("\n")));
+    }
+    t + "\n"
+}
+
+fn response_table(c: &Comparison) -> String {
+    let mut t = format!(
+        "## Closed-loop responses (tuning below; runs of {})\n\n| scheme | disturbance | variable | IAE | largest deviation | settling time [s] | MVs at a limit |\n|---|---|---|---|---|---|---|\n",
+        c.duration.map_or("–".into(), |d| format!("{} s", sig(d)))
+    );
+    for s in &c.schemes {
+        let Some(d) = s.structure.as_ref().and_then(|st| st.dynamic.as_ref()) else { continue };
+        if let Some(why) = &d.failure {
+            t.push_str(&format!("| {} | – | – | failed: {why} | | | |\n", s.name));
+            continue;
+        }
+        for run in &d.runs {
+            for f in &run.cvs {
+                t.push_str(&format!(
+                    "| {} | {} | {} | {} | {} | {} | {} |\n",
+                    s.name,
+                    run.disturbance,
+                    f.cv,
+                    sig(f.iae),
+                    sig(f.max_deviation),
+                    f.settling_time.map_or("–".into(), sig),
+                    if run.saturated.is_empty() { "none".to_string() } else { run.saturated.join(", ") }
+                ));
+            }
+        }
+    }
+    let tuned: Vec<String> = c
+        .schemes
+        .iter()
+        .filter_map(|s| {
+            let d = s.structure.as_ref()?.dynamic.as_ref()?;
+            let loops: Vec<String> = d
+                .loops
+                .iter()
+                .map(|l| format!("{} ← {}: Kc {} ({}), τI {} s", l.cv, l.mv, sig(l.kc), l.action, sig(l.tau_i)))
+                .collect();
+            let how = match (s.tuning, s.stability.open_loop_unstable) {
+                ("blt", _) => "BLT",
+                (_, true) => "the file's settings: unstable with its quality loops in manual, where BLT does not apply",
+                _ => "the file's settings",
+            };
+            Some(format!("- {} ({how}): {}", s.name, loops.join("; ")))
+        })
+        .collect();
+    if !tuned.is_empty() {
+        t.push_str(&format!("\nTuning (SI):\n{}\n", tuned.join("\n")));
+    }
+    t
+}

@@ -1,0 +1,134 @@
+//! `plantwide compare`: schemes side by side, each figure against an independent closed form
+//! where the physics gives one — the reactor with and without its feed–effluent exchanger, and
+//! Luyben's snowball plant in structure 1 (fresh feed fixed) and 2 (effluent fixed).
+
+use crate::harness::{flowsheet, plantwide};
+
+fn compare(files: &[&str], extra: &[&str]) -> serde_json::Value {
+    let mut args: Vec<String> = vec!["compare".into()];
+    args.extend(files.iter().map(|f| flowsheet(f)));
+    args.extend(extra.iter().map(|s| s.to_string()));
+    args.push("--json".into());
+    let out = plantwide(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    serde_json::from_slice(&out.stdout).expect("--json prints JSON")
+}
+
+fn f(v: &serde_json::Value) -> f64 {
+    v.as_f64().unwrap_or_else(|| panic!("not a number: {v}"))
+}
+
+/// Energy: both reactors take their feed at 390 K (420 K less the adiabatic rise 37.5 K × 80 %),
+/// so the exchanger's recovered heat plus the trim heater's duty is the heater-only scheme's
+/// 135 kW = F c_p (390 − 300 K), and its cooler removes what the exchanger recovers (same product
+/// temperature). Stability: the exchanger's scheme is open-loop unstable, so it keeps the file's
+/// tuning. Sensitivity: with T and M held, x_A = 1/(1 + kτ) at τ = M/F, F ±10 %.
+#[test]
+fn the_reactor_with_and_without_its_exchanger() {
+    let dir = std::env::temp_dir().join(format!("plantwide_compare_{}", std::process::id()));
+    let c = compare(
+        &["fehe_reactor.json", "fehe_reactor_without_fehe.json"],
+        &[
+            "--disturbances",
+            "feed_T=+1%,feed_rate=+10%",
+            "--outputs",
+            "effluent.T,effluent.x[A]",
+            "--report",
+            dir.to_str().unwrap(),
+        ],
+    );
+    let (with, without) = (&c["schemes"][0], &c["schemes"][1]);
+    let e = |s: &serde_json::Value, k: &str| f(&s["energy"][k]);
+    assert!((e(without, "heating") - 10.0 * 150.0 * 90.0).abs() < 1e-6 * 135e3, "{}", e(without, "heating"));
+    assert!((e(with, "heating") + e(with, "recovered") - e(without, "heating")).abs() < 1e-6 * 135e3);
+    assert!((e(without, "cooling") - e(with, "recovered")).abs() < 1e-6 * e(with, "recovered"));
+    assert!(e(with, "recovered") > 0.8 * 135e3 && e(without, "recovered") == 0.0);
+
+    assert_eq!(with["stability"]["open_loop_unstable"], true);
+    assert_eq!(without["stability"]["open_loop_unstable"], false);
+    assert_eq!((with["tuning"].as_str(), without["tuning"].as_str()), (Some("file"), Some("blt")));
+    for s in [with, without] {
+        assert!(s["stability"]["as_built"]["unstable"].as_array().unwrap().is_empty(), "stable in auto");
+        let rows = s["sensitivity"].as_array().unwrap();
+        let x = rows.iter().find(|r| r["disturbance"] == "feed_rate ±10 %" && r["output"] == "effluent.x[A]").unwrap();
+        let closed = |scale: f64| 1.0 / (1.0 + 0.04 * 100.0 / scale);
+        assert!((f(&x["low"]) - closed(0.9)).abs() < 1e-8 && (f(&x["high"]) - closed(1.1)).abs() < 1e-8, "{x}");
+        let runs = s["structure"]["dynamic"]["runs"].as_array().unwrap();
+        assert_eq!(runs.len(), 2);
+        for run in runs {
+            let t = run["cvs"].as_array().unwrap().iter().find(|v| v["cv"] == "effluent.T").unwrap();
+            assert!(f(&t["max_deviation"]).abs() < 10.0 && !t["settling_time"].is_null(), "{run}");
+        }
+    }
+    for name in ["compare.md", "compare.json", "energy.png", "responses_1.png", "responses_2.png"] {
+        assert!(dir.join(name).is_file(), "{name} written");
+    }
+    let md = std::fs::read_to_string(dir.join("compare.md")).unwrap();
+    assert!(md.contains("## Stability") && md.contains("BLT does not apply"), "{md}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Luyben's rule: structure 1 (fresh feed fixed, reactor holdup held) snowballs — +20 % fresh feed
+/// raises the recycle by the closed form of the same model, `D = F0 (z − xB)/(xD − z)` with
+/// `F0 (1 − xB) = k M z` — while structure 2 (effluent fixed, production by the reactor holdup)
+/// moves production with the recycle going the other way; its recycle loop gain is far lower.
+#[test]
+fn the_snowball_plant_in_its_two_structures() {
+    let c = compare(
+        &["reactor_column_recycle.json", "reactor_column_recycle_fixed_effluent.json"],
+        &["--disturbances", "throughput=+20%", "--outputs", "feed.F,recycle.F"],
+    );
+    let row = |s: usize, out: &str| {
+        let rows = c["schemes"][s]["sensitivity"].as_array().unwrap().clone();
+        rows.into_iter().find(|r| r["output"] == out).unwrap()
+    };
+    let (xd, xb) = (0.95, 0.0105);
+    let (f0, d) = (row(0, "feed.F"), row(0, "recycle.F"));
+    let (f0_b, d_b) = (f(&f0["base"]), f(&d["base"]));
+    let km = f0_b * (1.0 - xb) / ((d_b * xd + f0_b * xb) / (d_b + f0_b));
+    for end in ["low", "high"] {
+        let (f0, d) = (f(&f0[end]), f(&d[end]));
+        let z = f0 * (1.0 - xb) / km;
+        let closed = f0 * (z - xb) / (xd - z);
+        assert!((d - closed).abs() < 0.005 * closed, "{end}: D = {d}, closed form {closed}");
+    }
+    assert!(f(&d["high"]) / d_b > 1.8, "structure 1 snowballs");
+    let (p2, d2) = (row(1, "feed.F"), row(1, "recycle.F"));
+    assert!(f(&p2["high"]) > 1.05 * f(&p2["base"]) && f(&d2["high"]) < f(&d2["base"]), "structure 2 does not");
+    let gain = |s: usize| f(&c["schemes"][s]["recycles"][0]["loop_gain"]);
+    assert!(gain(0) > 10.0 * gain(1), "loop gains {} and {}", gain(0), gain(1));
+}
+
+/// A sweep end outside the input's physical range (pure A feed + 5 %) is said to be so, not
+/// reported as a steady state that could not be found; the other end is swept.
+#[test]
+fn a_sweep_end_outside_the_inputs_range_is_named() {
+    let c = compare(
+        &["reactor_column_recycle.json", "reactor_column_recycle_fixed_effluent.json"],
+        &["--disturbances", "fresh.z[A]=-5%", "--outputs", "recycle.F", "--duration", "1 h"],
+    );
+    for s in c["schemes"].as_array().unwrap() {
+        let r = &s["sensitivity"][0];
+        assert!(r["high"].is_null() && r["low"].is_f64(), "{r}");
+        let why = r["failures"][0].as_str().unwrap();
+        assert!(why.contains("fresh.z[A] at 1.05") && why.contains("z[A]"), "{why}");
+    }
+}
+
+#[test]
+fn compare_mistakes_exit_1_naming_the_scheme() {
+    let out = plantwide(&[
+        "compare",
+        &flowsheet("fehe_reactor.json"),
+        &flowsheet("column_a.json"),
+        "--disturbances",
+        "feed_T",
+        "--outputs",
+        "effluent.T",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("column_a.json") && err.contains("no output `effluent.T`"), "{err}");
+    let out = plantwide(&["compare", &flowsheet("column_a.json"), "--disturbances", "F", "--outputs", "feed.F"]);
+    assert_eq!(out.status.code(), Some(1), "one scheme is no comparison");
+}
