@@ -21,6 +21,7 @@ mod fehe;
 mod flowsheets;
 mod fuzz;
 mod hostile;
+mod pressure;
 mod recycle;
 mod screen;
 mod size;

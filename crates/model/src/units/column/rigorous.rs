@@ -177,6 +177,9 @@ pub struct RigorousColumn {
     condenser: Condenser,
     /// Partial condenser: the distillate is the drum's vapour, `V_N = D`.
     partial: bool,
+    /// Vapour space of condenser and drum [m³]: its component holdups `nV[c]` are states and the top
+    /// pressure `P` their ideal-gas pressure at `T_N`.
+    vapour_volume: Option<f64>,
     comp_names: Vec<String>,
 }
 
@@ -226,6 +229,32 @@ impl RigorousColumn {
     /// Offset of `Qc` in the internal variables.
     fn qc(&self) -> usize {
         self.n_stages * self.per_stage()
+    }
+    /// Offset of the vapour space's component holdups `nV[c]` (pressure state only).
+    fn nv_var(&self) -> usize {
+        self.qc() + 1
+    }
+    /// Offset of `P` (pressure state only) in the internal variables.
+    fn p_var(&self) -> usize {
+        self.nv_var() + self.nc()
+    }
+    /// Pressure of stage `s` [Pa]: fixed, or the top-pressure state plus the trays' drops.
+    fn stage_pressure<S: Scalar>(&self, io: &UnitIo<'_, S>, s: usize) -> S {
+        match self.vapour_volume {
+            Some(_) => io.var(self.p_var()) + (self.pressure[s] - self.pressure[self.n_stages - 1]),
+            None => S::from(self.pressure[s]),
+        }
+    }
+    /// The vapour the condenser condenses [mol/s] and its composition, the vapour space's
+    /// `yv = nV / Σ nV` (pressure state only): its duty over the latent heat of that vapour as it
+    /// arrives, `W = Qc / (h_V(T_N−1, yv) − h_L,N)`; at steady state `W = V_{N−1}`, `yv = y_{N−1}`.
+    fn condensed<S: Scalar>(&self, io: &UnitIo<'_, S>, sh: &Shared<S>) -> (S, Vec<S>) {
+        let n = self.n_stages;
+        let nv = io.vars(self.nv_var(), self.nc());
+        let total = nv.iter().fold(S::from(0.0), |a, b| a + *b);
+        let yv: Vec<S> = nv.iter().map(|v| *v / total).collect();
+        let t_below = io.vars(self.stage(n - 2), self.per_stage())[StageIdx { nc: self.nc() }.t()];
+        (sh.qc / (io.thermo.h_vap(t_below, &yv) - sh.h_l[n - 1]), yv)
     }
     /// Input index of side draw `k`.
     fn draw_input(&self, k: usize) -> usize {
@@ -287,8 +316,16 @@ impl RigorousColumn {
         }
         if s > 0 {
             let dn = st(s - 1);
-            comp_in.iter_mut().enumerate().for_each(|(j, c)| *c += dn[ix.v()] * dn[ix.y(j)]);
-            energy += dn[ix.v()] * (h_v[s - 1] - h_l[s]);
+            // With a pressure state the drum takes in what the condenser condenses; the rest of
+            // the vapour accumulates in the vapour space (the `P` equation).
+            if s + 1 == n && self.vapour_volume.is_some() {
+                let (w, yv) = self.condensed(io, sh);
+                comp_in.iter_mut().zip(&yv).for_each(|(c, y)| *c += w * *y);
+                energy += w * (io.thermo.h_vap(dn[ix.t()], &yv) - h_l[s]);
+            } else {
+                comp_in.iter_mut().enumerate().for_each(|(j, c)| *c += dn[ix.v()] * dn[ix.y(j)]);
+                energy += dn[ix.v()] * (h_v[s - 1] - h_l[s]);
+            }
         }
         for (f, _) in self.feeds.iter().enumerate().filter(|(_, st)| **st == s) {
             let feed = io.inlet(f);
@@ -323,7 +360,7 @@ impl RigorousColumn {
             let rr = &mut r[k * slen..(k + 1) * slen];
             rr[F] = out.f() - flow;
             rr[T] = out.t() - v[ix.t()];
-            rr[P] = out.p() - self.pressure[s];
+            rr[P] = out.p() - self.stage_pressure(io, s);
             rr[H] = out.h() - h;
             for j in 0..self.nc() {
                 rr[Z0 + j] = out.z()[j] - v[z0 + j];
@@ -375,6 +412,15 @@ impl UnitModel for RigorousColumn {
             v.push(VarSpec::algebraic(format!("V[{st}]"), Dimension::MOLAR_FLOW, flow_nom).bounded(0.0, f64::INFINITY));
         }
         v.push(VarSpec::algebraic("Qc", Dimension::POWER, self.q_r(self.reboiler_duty).max(1.0)));
+        if let Some(volume) = self.vapour_volume {
+            let p_top = self.pressure[self.n_stages - 1];
+            let moles = p_top * volume / (plantwide_thermo::R_GAS * 350.0) / nc;
+            for c in &self.comp_names {
+                let spec = VarSpec::differential(format!("nV[{c}]"), Dimension::AMOUNT, moles);
+                v.push(spec.bounded(0.0, f64::INFINITY));
+            }
+            v.push(VarSpec::algebraic("P", Dimension::PRESSURE, p_top).bounded(1.0, f64::INFINITY));
+        }
         v
     }
     fn inputs(&self) -> Vec<InputSpec> {
@@ -403,7 +449,11 @@ impl UnitModel for RigorousColumn {
         v
     }
     fn holdup(&self, io: &UnitIo<'_, f64>) -> Option<Vec<f64>> {
-        Some(super::summed_holdups(io, self.n_stages, self.nc(), |s| self.stage(s)))
+        let mut n = super::summed_holdups(io, self.n_stages, self.nc(), |s| self.stage(s));
+        if self.vapour_volume.is_some() {
+            n.iter_mut().zip(io.vars(self.nv_var(), self.nc())).for_each(|(t, v)| *t += v);
+        }
+        Some(n)
     }
     fn pattern(&self, layout: &LocalLayout) -> Option<Vec<(usize, usize)>> {
         let slen = layout.stream.len();
@@ -437,6 +487,24 @@ impl UnitModel for RigorousColumn {
         }
         p.push((qc, qc));
         p.extend(shared.iter().map(|&c| (qc, c)));
+        if self.vapour_volume.is_some() {
+            // The pressure enters every stage's VLE and every outlet; its own row reads the top
+            // two stages and the duty.
+            let space: Vec<usize> = (internal0 + self.nv_var()..=internal0 + self.p_var()).collect();
+            let rows: Vec<usize> = p.iter().map(|e| e.0).collect();
+            let mut seen = std::collections::BTreeSet::new();
+            let rows: Vec<usize> = rows.into_iter().filter(|r| seen.insert(*r)).chain(space.iter().copied()).collect();
+            for &row in &rows {
+                p.extend(space.iter().map(|&c| (row, c)));
+            }
+            for &row in &space {
+                for t in n.saturating_sub(2)..n {
+                    p.extend(stage_cols(t).map(|c| (row, c)));
+                }
+                p.push((row, qc));
+                p.extend(shared.iter().map(|&c| (row, c)));
+            }
+        }
         Some(p)
     }
     fn eval<S: Scalar>(&self, io: &UnitIo<'_, S>, r: &mut [S]) {
@@ -464,7 +532,7 @@ impl UnitModel for RigorousColumn {
             let o = internal0 + self.stage(s);
             let (t, m, l, vap) = (v[ix.t()], v[ix.m()], v[ix.l()], v[ix.v()]);
             let x = &v[ix.x(0)..ix.x(0) + nc];
-            let p = S::from(self.pressure[s]);
+            let p = self.stage_pressure(io, s);
             let (liquid_out, vapour_out, energy) = self.stage_flows(io, &sh, s, &mut comp_in);
             if s + 1 == n {
                 condenser_energy = energy;
@@ -483,7 +551,9 @@ impl UnitModel for RigorousColumn {
                     v[ix.y(j)] - k[j] * x[j]
                 };
             }
-            let duty_condenser = s + 1 == n && self.condenser.has_input();
+            // A duty-set drum at fixed pressure is subcooled (its energy balance gives T_N); with a
+            // pressure state it sits at its bubble point and the pressure moves instead.
+            let duty_condenser = s + 1 == n && self.condenser.has_input() && self.vapour_volume.is_none();
             r[o + ix.t()] = if duty_condenser {
                 energy
             } else if let VleModel::ConstantAlpha { .. } = th.vle {
@@ -513,6 +583,17 @@ impl UnitModel for RigorousColumn {
                 sh.qc - coolant_duty(io.input(IN_CONDENSER_DUTY), st(n - 1)[ix.t()], t_in, ua, cp)
             }
         };
+        if let Some(volume) = self.vapour_volume {
+            // The vapour space: its component holdups take in the vapour from the top tray and
+            // give the condensed part to the drum; its pressure is the ideal gas's at T_N.
+            let (below, top) = (st(n - 2), st(n - 1));
+            let (w, yv) = self.condensed(io, &sh);
+            for j in 0..nc {
+                r[internal0 + self.nv_var() + j] = below[ix.v()] * below[ix.y(j)] - w * yv[j];
+            }
+            let moles = io.vars(self.nv_var(), nc).iter().fold(S::from(0.0), |a, b| a + *b);
+            r[internal0 + self.p_var()] = io.var(self.p_var()) - moles * top[ix.t()] * plantwide_thermo::R_GAS / volume;
+        }
         self.outlet_residuals(io, &sh, r);
     }
     fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]) {

@@ -82,6 +82,15 @@ pub struct RigorousConfig {
     /// Pressure drop per tray ΔP [Pa] (e.g. `"0.7 kPa"`; default 0): `P_i = P + (N − i) ΔP`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tray_pressure_drop: Option<QuantityValue>,
+    /// Vapour space of the condenser and reflux drum V_vap [m³] (e.g. `"2 m3"`): its component
+    /// holdups `nV[c]` [mol] become states, `dnV_c/dt = V_{N−1} y_{N−1,c} − W yv_c` (`W` the vapour
+    /// the condenser condenses, its duty over the latent heat; `yv` the space's composition), and
+    /// the top pressure `P` [Pa] their ideal-gas pressure, `P V_vap = Σ nV R T_N`, the drum at its
+    /// bubble point at `P`; needs `condenser_duty` or a coolant `condenser`, whose input then holds
+    /// the pressure (a pressure controller on it) or lets it float. Default: the pressure is fixed
+    /// at `P`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub vapour_volume: Option<QuantityValue>,
     /// Outlet weir length l_w [m] (e.g. `"0.8 m"`).
     pub weir_length: QuantityValue,
     /// Outlet weir height h_w [m] (e.g. `"50 mm"`).
@@ -108,7 +117,7 @@ impl RigorousColumn {
         let reflux = cx.non_negative("reflux", &c.reflux, flow);
         let distillate = cx.non_negative("distillate", &c.distillate, flow);
         let bottoms = cx.non_negative("bottoms", &c.bottoms, flow);
-        let RigorousData { reboiler_duty, steam_latent_heat, condenser, partial, efficiency, dp, weir } =
+        let RigorousData { reboiler_duty, steam_latent_heat, condenser, partial, efficiency, dp, weir, vapour_volume } =
             c.rigorous.as_ref().map_or_else(RigorousData::default, |r| rigorous_data(r, &mut cx));
         let (feeds, feed_ports) = feed_stages(c, n, &mut cx);
         let (draws, draw_ports) = side_draws(c, n, &feed_ports, &mut cx);
@@ -137,6 +146,7 @@ impl RigorousColumn {
             bottoms,
             condenser,
             partial,
+            vapour_volume,
             comp_names: cx.components.to_vec(),
         };
         cx.finish(column)
@@ -152,6 +162,7 @@ struct RigorousData {
     efficiency: f64,
     dp: f64,
     weir: Weir,
+    vapour_volume: Option<f64>,
 }
 
 impl Default for RigorousData {
@@ -165,6 +176,7 @@ impl Default for RigorousData {
             efficiency: 1.0,
             dp: 0.0,
             weir: Weir { length: f64::NAN, height: f64::NAN, area: f64::NAN },
+            vapour_volume: None,
         }
     }
 }
@@ -223,6 +235,16 @@ fn rigorous_data(r: &RigorousConfig, cx: &mut BuildCx<'_>) -> RigorousData {
             cx.error("rigorous.murphree_efficiency", format!("must lie in (0, 1] (1 = equilibrium trays); got {e}"));
         }
         d.efficiency = e;
+    }
+    if let Some(v) = &r.vapour_volume {
+        d.vapour_volume = Some(cx.positive("rigorous.vapour_volume", v, Dimension::VOLUME));
+        if !matches!(d.condenser, Condenser::Duty(_) | Condenser::Coolant { .. }) || d.partial {
+            cx.error(
+                "rigorous.vapour_volume",
+                "a pressure state needs a total condenser whose duty is an input: give `condenser_duty` \
+                 (e.g. \"1.1 MW\") or a coolant `condenser`; it then holds the pressure or lets it float",
+            );
+        }
     }
     d.dp = r
         .tray_pressure_drop

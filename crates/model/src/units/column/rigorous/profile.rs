@@ -202,6 +202,15 @@ fn write_own(col: &RigorousColumn, io: &UnitIo<'_, f64>, specs: &Specs, prof: &P
         rr[H] = h;
         rr[Z0..Z0 + nc].copy_from_slice(z);
     }
+    if let Some(volume) = col.vapour_volume {
+        // The vapour space at the top pressure and the drum temperature, of the top tray's vapour.
+        let p_top = col.pressure[n - 1];
+        let moles = p_top * volume / (plantwide_thermo::R_GAS * prof.t[n - 1]);
+        for j in 0..nc {
+            own[internal0 + col.nv_var() + j] = moles * prof.y[n - 2][j];
+        }
+        own[internal0 + col.p_var()] = p_top;
+    }
 }
 
 /// Net feed minus side draws [mol/s].

@@ -514,3 +514,52 @@ fn partial_condenser_and_vapour_draws() {
         }
     }
 }
+
+/// The `rigorous` additions of a column whose top pressure is a state.
+const PRESSURE_STATES: [&str; 2] = [
+    r#", "condenser_duty": QC, "vapour_volume": "1.5 m3", "tray_pressure_drop": "0.8 kPa""#,
+    r#", "condenser": {"coolant_flow": "15 kg/s", "coolant_T_in": "300 K", "ua": "50 kW/K"}, "vapour_volume": "2 m3", "murphree_efficiency": 0.7"#,
+];
+
+/// With a pressure state: the dual-number Jacobian agrees with finite differences, the declared
+/// pattern holds every nonzero of it, and the coloured Jacobian is the dense one.
+#[test]
+fn pressure_state_jacobian_and_pattern() {
+    let mut rng = Lcg(11);
+    for thermo in [binary_package(), ethanol_water()] {
+        for extra in PRESSURE_STATES {
+            let u = build(&config(&thermo, extra), &thermo).unwrap();
+            let (lay, base) = at_guess(&u, &thermo, &feed(&thermo));
+            let pattern = Unit::pattern(&u, &lay).expect("the rigorous column declares its pattern");
+            let coloring = crate::Coloring::new(&pattern, n_eq(&u, &lay), lay.len());
+            let declared: std::collections::HashSet<(usize, usize)> = pattern.iter().copied().collect();
+            for _ in 0..3 {
+                let local: Vec<f64> = base.iter().map(|v| v * rng.range(0.97, 1.03)).collect();
+                let err = jacobian_error(&u, &lay, &thermo, &local, n_eq(&u, &lay));
+                assert!(err < 1e-6, "{extra}: {err}");
+                let (m, n) = (n_eq(&u, &lay), lay.len());
+                let io = UnitIo { local: &local, layout: &lay, thermo: &thermo, time: 0.0 };
+                let (mut r, mut dense, mut colored) = (vec![0.0; m], vec![0.0; m * n], vec![0.0; m * n]);
+                Unit::jacobian(&u, &io, &mut r, &mut dense);
+                Unit::jacobian_colored(&u, &io, &mut r, &mut colored, Some(&coloring));
+                for i in 0..m {
+                    for j in 0..n {
+                        let v = dense[i * n + j];
+                        assert!(v == 0.0 || declared.contains(&(i, j)), "{extra}: ({i}, {j}) = {v} undeclared");
+                        assert!((colored[i * n + j] - v).abs() <= 1e-12 * v.abs().max(1.0), "{extra}: ({i}, {j})");
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// A pressure state needs a condenser whose duty is an input.
+#[test]
+fn pressure_state_needs_a_condenser_input() {
+    let thermo = binary_package();
+    let errs = build(&config(&thermo, r#", "vapour_volume": "1 m3""#), &thermo).unwrap_err();
+    assert!(errs.iter().any(|e| e.to_string().contains("rigorous.vapour_volume")), "{errs:?}");
+    let errs = build(&config(&thermo, r#", "condenser_duty": 1e6, "vapour_volume": "-1 m3""#), &thermo).unwrap_err();
+    assert_eq!(errs.len(), 1, "{errs:?}");
+}
