@@ -277,7 +277,12 @@ fn given_plant(open: &OpenPlant, s: &PairingStructure, loops: &[(f64, f64, &'sta
     let ti: Vec<f64> = loops.iter().map(|l| l.1).collect();
     let actions: Vec<&str> = loops.iter().map(|l| l.2).collect();
     let (plant, x) = closed_plant(open, s, &kc, &ti, &actions)?;
-    let tuned = (0..s.pairs.len())
+    Ok((plant, x, tuned(s, &kc, &ti, &actions, None)))
+}
+
+/// The tuning record of a candidate's loops at gains `kc`, resets `ti` and `actions`.
+fn tuned(s: &PairingStructure, kc: &[f64], ti: &[f64], actions: &[&str], detuning: Option<f64>) -> Tuned {
+    let loops = (0..s.pairs.len())
         .map(|i| TunedLoop {
             cv: s.pairs[i].cv.clone(),
             mv: s.pairs[i].mv.clone(),
@@ -287,7 +292,7 @@ fn given_plant(open: &OpenPlant, s: &PairingStructure, loops: &[(f64, f64, &'sta
         })
         .collect();
     let tau_i_max = ti.iter().copied().filter(|t| t.is_finite()).fold(0.0, f64::max);
-    Ok((plant, x, Tuned { detuning: None, loops: tuned, tau_i_max }))
+    Tuned { detuning, loops, tau_i_max }
 }
 
 fn tuned_plant(open: &OpenPlant, r: &PairingRequest, s: &PairingStructure) -> TunedCandidate {
@@ -300,20 +305,7 @@ fn tuned_plant(open: &OpenPlant, r: &PairingRequest, s: &PairingStructure) -> Tu
     let ti: Vec<f64> = t.loops.iter().map(|l| l.tau_i.unwrap_or(f64::INFINITY)).collect();
     let actions: Vec<&str> = t.loops.iter().map(|l| l.action).collect();
     let (plant, x) = build(&kc, &ti, &actions)?;
-    let tuned = (0..n)
-        .map(|i| TunedLoop {
-            cv: s.pairs[i].cv.clone(),
-            mv: s.pairs[i].mv.clone(),
-            kc: kc[i],
-            tau_i: ti[i],
-            action: actions[i].into(),
-        })
-        .collect();
-    Ok((
-        plant,
-        x,
-        Tuned { detuning: t.detuning_factor, loops: tuned, tau_i_max: ti.iter().copied().fold(0.0, f64::max) },
-    ))
+    Ok((plant, x, tuned(s, &kc, &ti, &actions, t.detuning_factor)))
 }
 
 /// One disturbance step on the tuned plant.
