@@ -99,4 +99,5 @@ registry!(
     "split_range" => SplitRange(controllers::split_range::SplitRangeConfig, controllers::split_range::SplitRange),
     "selector" => Selector(controllers::selector::SelectorConfig, controllers::selector::Selector),
     "averaging_level" => AveragingLevel(controllers::averaging_level::AveragingLevelConfig, controllers::averaging_level::AveragingLevel),
+    "condenser_reboiler" => CondenserReboiler(controllers::condenser_reboiler::CondenserReboilerConfig, controllers::condenser_reboiler::CondenserReboiler),
 ]);

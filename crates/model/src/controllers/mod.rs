@@ -2,6 +2,7 @@
 //! its residual forces the error to zero and a "design spec" is just a controller in the flowsheet.
 
 pub mod averaging_level;
+pub mod condenser_reboiler;
 pub mod delay;
 pub mod lag;
 pub mod pid;

@@ -6,9 +6,12 @@
 //! - `cstr`: `Q` [W], the heat into the reactor (a jacket's is negative: cooling);
 //! - `heat_exchanger`: `Q` [W], recovered;
 //! - `column` (rigorous): the reboiler duty (input `reboiler_duty`, or the controller output
-//!   driving it) heating, the condenser duty `Qc` [W] cooling; a steam reboiler's `steam_flow`
-//!   [kg/s] and a simple column's `boilup` [mol/s] have no duty in the model and are listed as
-//!   other utilities.
+//!   driving it) and an auxiliary reboiler's (`auxiliary_reboiler_duty`) heating, the condenser
+//!   duty `Qc` [W] cooling; a steam reboiler's `steam_flow` [kg/s] and a simple column's `boilup`
+//!   [mol/s] have no duty in the model and are listed as other utilities;
+//! - `condenser_reboiler`: its duty `op` [W] recovered — and not counted again as the driven
+//!   reboiler's heating or the driven condenser's cooling (that condenser's `Qc` less the coupling
+//!   duty is its auxiliary condenser's, cooling).
 
 use plantwide_flowsheet::Plant;
 use serde::Serialize;
@@ -57,6 +60,12 @@ fn input_value(plant: &Plant, x: &[f64], u: &[f64], path: &str) -> Option<f64> {
     Some(plant.inputs()[i].driven_by.map_or(u[i], |v| x[v]))
 }
 
+/// Whether input `path` is driven by a condenser–reboiler (heat recovered, not a utility).
+fn driven_by_coupling(plant: &Plant, path: &str) -> bool {
+    let driver = plant.input(path).and_then(|i| plant.inputs()[i].driven_by);
+    driver.is_some_and(|v| plant.blocks()[plant.vars()[v].block].unit.type_name() == "condenser_reboiler")
+}
+
 /// The energy use of `plant` at steady state `(x, u)`.
 pub fn energy(plant: &Plant, x: &[f64], u: &[f64]) -> Energy {
     let mut duties = Vec::new();
@@ -71,13 +80,21 @@ pub fn energy(plant: &Plant, x: &[f64], u: &[f64]) -> Energy {
         match b.unit.type_name() {
             "heater" | "cstr" => push(format!("{}.Q", b.name), var("Q").unwrap_or(0.0), "heating", "cooling"),
             "heat_exchanger" => push(format!("{}.Q", b.name), var("Q").unwrap_or(0.0), "recovered", "recovered"),
+            "condenser_reboiler" => push(format!("{}.op", b.name), var("op").unwrap_or(0.0), "recovered", "recovered"),
             "column" => {
-                let reboiler = format!("{}.reboiler_duty", b.name);
-                if let Some(q) = input_value(plant, x, u, &reboiler) {
-                    push(reboiler, q, "heating", "cooling");
+                for name in ["reboiler_duty", "auxiliary_reboiler_duty"] {
+                    let path = format!("{}.{name}", b.name);
+                    if let Some(q) = input_value(plant, x, u, &path).filter(|_| !driven_by_coupling(plant, &path)) {
+                        push(path, q, "heating", "cooling");
+                    }
                 }
+                let condenser = format!("{}.condenser_duty", b.name);
+                let coupled = match driven_by_coupling(plant, &condenser) {
+                    true => input_value(plant, x, u, &condenser).unwrap_or(0.0),
+                    false => 0.0,
+                };
                 if let Some(qc) = var("Qc") {
-                    push(format!("{}.Qc", b.name), -qc, "heating", "cooling");
+                    push(format!("{}.Qc", b.name), coupled - qc, "heating", "cooling");
                 }
                 for (name, unit) in [("steam_flow", "kg/s"), ("boilup", "mol/s")] {
                     let path = format!("{}.{name}", b.name);

@@ -75,6 +75,14 @@
 //! [J/(kg K)], default 4184). The duty window above applies: too little coolant for the
 //! bubble-point duty has no steady state.
 //!
+//! **Auxiliary reboiler and condenser** (`rigorous.auxiliary_reboiler_duty` Q_aux,R,
+//! `rigorous.auxiliary_condenser_duty` Q_aux,C [W], inputs of those names): a second heat source on
+//! the reboiler and a second heat sink on the condenser, for a column whose `reboiler_duty` or
+//! `condenser_duty` another unit sets (a condenser–reboiler coupling it to another column): the
+//! reboiler receives `Q_R + Q_aux,R` and the condenser removes `Qc = Q_C + Q_aux,C` (with a
+//! coolant, `Qc` = the coolant's duty + Q_aux,C). The auxiliary condenser needs a condenser whose
+//! duty is an input.
+//!
 //! **Partial condenser** (`rigorous.condenser_type = "partial"`): the drum liquid (the reflux) is
 //! at its bubble point, the distillate is its equilibrium vapour, `D = V_N` with `y_D = y_N =
 //! K(T_N, P_N, x_N) x_N` and `h_D = h_V,N`, and the drum energy balance gives
@@ -177,6 +185,10 @@ pub struct RigorousColumn {
     condenser: Condenser,
     /// Partial condenser: the distillate is the drum's vapour, `V_N = D`.
     partial: bool,
+    /// Auxiliary reboiler duty [W] (its input `auxiliary_reboiler_duty`), if the column has one.
+    aux_reboiler: Option<f64>,
+    /// Auxiliary condenser duty [W] (its input `auxiliary_condenser_duty`), if the column has one.
+    aux_condenser: Option<f64>,
     /// Vapour space of condenser and drum [m³]: its component holdups `nV[c]` are states and the top
     /// pressure `P` their ideal-gas pressure at `T_N`.
     vapour_volume: Option<f64>,
@@ -260,11 +272,30 @@ impl RigorousColumn {
     fn draw_input(&self, k: usize) -> usize {
         IN_CONDENSER_DUTY + usize::from(self.condenser.has_input()) + k
     }
-    /// The reboiler duty Q_R [W] from input 1: the duty itself, or `m_s λ_s` for a steam reboiler.
-    fn q_r<S: Scalar>(&self, input: S) -> S {
-        match self.steam_latent_heat {
+    /// Input index of the auxiliary reboiler duty (after the draws), then of the auxiliary
+    /// condenser duty.
+    fn aux_inputs(&self) -> (usize, usize) {
+        let first = self.draw_input(self.draws.len());
+        (first, first + usize::from(self.aux_reboiler.is_some()))
+    }
+    /// The heat the reboiler receives [W]: from input 1 (the duty itself, or `m_s λ_s` for a
+    /// steam reboiler) plus the auxiliary reboiler's duty.
+    fn q_r<S: Scalar>(&self, io: &UnitIo<'_, S>) -> S {
+        let input = io.input(IN_REBOILER_DUTY);
+        let main = match self.steam_latent_heat {
             Some(lambda) => input * S::from(lambda),
             None => input,
+        };
+        match self.aux_reboiler {
+            Some(_) => main + io.input(self.aux_inputs().0),
+            None => main,
+        }
+    }
+    /// The auxiliary condenser's duty [W] (0 without one).
+    fn q_aux_c<S: Scalar>(&self, io: &UnitIo<'_, S>) -> S {
+        match self.aux_condenser {
+            Some(_) => io.input(self.aux_inputs().1),
+            None => S::from(0.0),
         }
     }
     /// Whether outlet `k` is vapour: the distillate of a partial condenser, a vapour side draw.
@@ -411,7 +442,8 @@ impl UnitModel for RigorousColumn {
             v.push(VarSpec::algebraic(format!("L[{st}]"), Dimension::MOLAR_FLOW, flow_nom).bounded(0.0, f64::INFINITY));
             v.push(VarSpec::algebraic(format!("V[{st}]"), Dimension::MOLAR_FLOW, flow_nom).bounded(0.0, f64::INFINITY));
         }
-        v.push(VarSpec::algebraic("Qc", Dimension::POWER, self.q_r(self.reboiler_duty).max(1.0)));
+        let q_nominal = self.reboiler_duty * self.steam_latent_heat.unwrap_or(1.0) + self.aux_reboiler.unwrap_or(0.0);
+        v.push(VarSpec::algebraic("Qc", Dimension::POWER, q_nominal.max(1.0)));
         if let Some(volume) = self.vapour_volume {
             let p_top = self.pressure[self.n_stages - 1];
             let moles = p_top * volume / (plantwide_thermo::R_GAS * 350.0) / nc;
@@ -445,6 +477,13 @@ impl UnitModel for RigorousColumn {
         }
         for (d, p) in self.draws.iter().zip(&self.draw_ports) {
             v.push(InputSpec { name: p.clone(), dim: flow, value: d.flow });
+        }
+        let power = Dimension::POWER;
+        if let Some(q) = self.aux_reboiler {
+            v.push(InputSpec { name: "auxiliary_reboiler_duty".into(), dim: power, value: q });
+        }
+        if let Some(q) = self.aux_condenser {
+            v.push(InputSpec { name: "auxiliary_condenser_duty".into(), dim: power, value: q });
         }
         v
     }
@@ -516,7 +555,7 @@ impl UnitModel for RigorousColumn {
         let st = |s: usize| io.vars(self.stage(s), self.per_stage());
         let sh = Shared {
             l_in: io.input(IN_REFLUX),
-            q_r: self.q_r(io.input(IN_REBOILER_DUTY)),
+            q_r: self.q_r(io),
             d_in: io.input(IN_DISTILLATE),
             b_in: io.input(IN_BOTTOMS),
             qc: io.var(self.qc()),
@@ -578,9 +617,9 @@ impl UnitModel for RigorousColumn {
         }
         r[internal0 + self.qc()] = match self.condenser {
             Condenser::BubblePoint => condenser_energy,
-            Condenser::Duty(_) => sh.qc - io.input(IN_CONDENSER_DUTY),
+            Condenser::Duty(_) => sh.qc - io.input(IN_CONDENSER_DUTY) - self.q_aux_c(io),
             Condenser::Coolant { t_in, ua, cp, .. } => {
-                sh.qc - coolant_duty(io.input(IN_CONDENSER_DUTY), st(n - 1)[ix.t()], t_in, ua, cp)
+                sh.qc - coolant_duty(io.input(IN_CONDENSER_DUTY), st(n - 1)[ix.t()], t_in, ua, cp) - self.q_aux_c(io)
             }
         };
         if let Some(volume) = self.vapour_volume {

@@ -72,6 +72,16 @@ pub struct RigorousConfig {
     /// balance gives its temperature, as with `condenser_duty`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub condenser: Option<CoolantCondenser>,
+    /// Auxiliary reboiler duty Q_aux,R [W] (input `auxiliary_reboiler_duty`; e.g. `"50 kW"`): heat
+    /// added to the reboiler beside `reboiler_duty`, for a reboiler another unit heats (a
+    /// condenser–reboiler drives `reboiler_duty`). Default: no auxiliary reboiler.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub auxiliary_reboiler_duty: Option<QuantityValue>,
+    /// Auxiliary condenser duty Q_aux,C [W] (input `auxiliary_condenser_duty`; e.g. `"20 kW"`):
+    /// heat removed beside `condenser_duty` or the coolant's, `Qc = Q_C + Q_aux,C`. Needs a
+    /// condenser whose duty is an input. Default: no auxiliary condenser.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub auxiliary_condenser_duty: Option<QuantityValue>,
     /// `total` (default) or `partial` (vapour distillate in equilibrium with the reflux; the drum at
     /// its bubble point, so neither `condenser_duty` nor `condenser`).
     #[serde(default, skip_serializing_if = "is_total")]
@@ -117,7 +127,18 @@ impl RigorousColumn {
         let reflux = cx.non_negative("reflux", &c.reflux, flow);
         let distillate = cx.non_negative("distillate", &c.distillate, flow);
         let bottoms = cx.non_negative("bottoms", &c.bottoms, flow);
-        let RigorousData { reboiler_duty, steam_latent_heat, condenser, partial, efficiency, dp, weir, vapour_volume } =
+        let RigorousData {
+            reboiler_duty,
+            steam_latent_heat,
+            condenser,
+            partial,
+            efficiency,
+            dp,
+            weir,
+            vapour_volume,
+            aux_reboiler,
+            aux_condenser,
+        } =
             c.rigorous.as_ref().map_or_else(RigorousData::default, |r| rigorous_data(r, &mut cx));
         let (feeds, feed_ports) = feed_stages(c, n, &mut cx);
         let (draws, draw_ports) = side_draws(c, n, &feed_ports, &mut cx);
@@ -146,6 +167,8 @@ impl RigorousColumn {
             bottoms,
             condenser,
             partial,
+            aux_reboiler,
+            aux_condenser,
             vapour_volume,
             comp_names: cx.components.to_vec(),
         };
@@ -163,6 +186,8 @@ struct RigorousData {
     dp: f64,
     weir: Weir,
     vapour_volume: Option<f64>,
+    aux_reboiler: Option<f64>,
+    aux_condenser: Option<f64>,
 }
 
 impl Default for RigorousData {
@@ -177,6 +202,8 @@ impl Default for RigorousData {
             dp: 0.0,
             weir: Weir { length: f64::NAN, height: f64::NAN, area: f64::NAN },
             vapour_volume: None,
+            aux_reboiler: None,
+            aux_condenser: None,
         }
     }
 }
@@ -246,6 +273,7 @@ fn rigorous_data(r: &RigorousConfig, cx: &mut BuildCx<'_>) -> RigorousData {
             );
         }
     }
+    auxiliary_duties(r, cx, &mut d);
     d.dp = r
         .tray_pressure_drop
         .as_ref()
@@ -256,6 +284,23 @@ fn rigorous_data(r: &RigorousConfig, cx: &mut BuildCx<'_>) -> RigorousData {
         area: cx.positive("rigorous.tray_area", &r.tray_area, Dimension::AREA),
     };
     d
+}
+
+/// The auxiliary reboiler and condenser duties; the condenser's needs a condenser whose duty is an
+/// input.
+fn auxiliary_duties(r: &RigorousConfig, cx: &mut BuildCx<'_>, d: &mut RigorousData) {
+    let power = Dimension::POWER;
+    d.aux_reboiler =
+        r.auxiliary_reboiler_duty.as_ref().map(|q| cx.non_negative("rigorous.auxiliary_reboiler_duty", q, power));
+    d.aux_condenser =
+        r.auxiliary_condenser_duty.as_ref().map(|q| cx.non_negative("rigorous.auxiliary_condenser_duty", q, power));
+    if d.aux_condenser.is_some() && !d.condenser.has_input() {
+        cx.error(
+            "rigorous.auxiliary_condenser_duty",
+            "an auxiliary condenser adds to a condenser whose duty is an input: give `condenser_duty` (e.g. \"0.5 MW\") \
+             or a coolant `condenser`, or remove it (a drum at its bubble point computes its whole duty)",
+        );
+    }
 }
 
 /// The feeds' stages (0-based) and port names, each stage within the column and each port used once.

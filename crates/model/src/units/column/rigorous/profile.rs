@@ -32,7 +32,7 @@
 
 use plantwide_thermo::ThermoPackage;
 
-use super::{Condenser, IN_CONDENSER_DUTY, IN_REBOILER_DUTY, IN_REFLUX, RigorousColumn, coolant_duty};
+use super::{Condenser, IN_CONDENSER_DUTY, IN_REFLUX, RigorousColumn, coolant_duty};
 use crate::UnitIo;
 use crate::stream::{F, H, P, T, Z0};
 use crate::units::Phase;
@@ -125,13 +125,18 @@ pub(super) fn guess(col: &RigorousColumn, io: &UnitIo<'_, f64>, own: &mut [f64])
             .collect(),
         partial: col.partial,
         reflux: io.input(IN_REFLUX).max(0.0),
-        q_r: col.q_r(io.input(IN_REBOILER_DUTY)).max(0.0),
+        q_r: col.q_r(io).max(0.0),
+        // With a pressure state the profile is that of the drum at its bubble point at the file's
+        // pressure: a duty that condenses more or less than the column boils up moves the pressure
+        // (Newton's task), where at fixed pressure it would subcool the reflux without bound.
         q_c: match col.condenser {
-            Condenser::Duty(_) => Some(io.input(IN_CONDENSER_DUTY)),
+            Condenser::Duty(_) if col.vapour_volume.is_none() => Some(io.input(IN_CONDENSER_DUTY) + col.q_aux_c(io)),
             _ => None,
         },
         coolant: match col.condenser {
-            Condenser::Coolant { t_in, ua, cp, .. } => Some((io.input(IN_CONDENSER_DUTY).max(0.0), t_in, ua, cp)),
+            Condenser::Coolant { t_in, ua, cp, .. } if col.vapour_volume.is_none() => {
+                Some((io.input(IN_CONDENSER_DUTY).max(0.0), t_in, ua, cp))
+            }
             _ => None,
         },
         efficiency: col.efficiency,
