@@ -20,6 +20,7 @@ mod dynamics;
 mod fehe;
 mod flowsheets;
 mod fuzz;
+mod heat_integration;
 mod hostile;
 mod pressure;
 mod recycle;

@@ -108,9 +108,33 @@ impl SolveError {
 }
 
 /// Find the steady state of `plant` at inputs `u` by `settings.method`, from the cold start. Design
-/// specs are met by the whole-plant Newton (`auto` starts it from a sequential-modular pass at the
-/// inputs' values in `u`); `sm` alone refuses them.
+/// specs are met by the whole-plant Newton; `auto` starts it from the plant converged with the
+/// varied inputs held at their values in `u` (a flowsheet converged first, its design-spec loop
+/// closed from there, as sequential simulators do), or from the cold start when that fails; `sm`
+/// alone refuses them.
 pub fn steady_state_by(
+    plant: &Plant,
+    u: &[f64],
+    settings: &StrategySettings,
+    observer: &mut dyn FnMut(Progress<'_>),
+) -> Result<Solution, SolveError> {
+    if settings.method == Method::Auto && !plant.specs().is_empty() {
+        let mut held = plant.clone();
+        held.fix_specs(u);
+        if let Ok(start) = steady_state_by(&held, u, settings, observer)
+            && let Ok(ss) = steady_state_observed(plant, u, Some(&start.x), &settings.newton, &mut |r| {
+                observer(Progress::Newton(r))
+            })
+        {
+            let newton = Some(ss.report);
+            return Ok(Solution { x: ss.x, u: ss.u, sm: start.sm, sm_failure: None, newton, warnings: ss.warnings });
+        }
+    }
+    steady_state_from_cold(plant, u, settings, observer)
+}
+
+/// [`steady_state_by`] in one stage: specs, if any, solved with the plant from the cold start.
+fn steady_state_from_cold(
     plant: &Plant,
     u: &[f64],
     settings: &StrategySettings,

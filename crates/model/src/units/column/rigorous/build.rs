@@ -138,8 +138,7 @@ impl RigorousColumn {
             vapour_volume,
             aux_reboiler,
             aux_condenser,
-        } =
-            c.rigorous.as_ref().map_or_else(RigorousData::default, |r| rigorous_data(r, &mut cx));
+        } = c.rigorous.as_ref().map_or_else(RigorousData::default, |r| rigorous_data(r, &mut cx));
         let (feeds, feed_ports) = feed_stages(c, n, &mut cx);
         let (draws, draw_ports) = side_draws(c, n, &feed_ports, &mut cx);
         check_ranges(&mut cx, &weir, (p_top, dp), n);
