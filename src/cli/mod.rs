@@ -105,8 +105,13 @@ enum Command {
         #[arg(long)]
         resume: Option<PathBuf>,
     },
-    /// Print the JSON Schema of flowsheet files (the shipped flowsheets/plantwide.schema.json).
-    Schema,
+    /// Print the JSON Schema of flowsheet files (the shipped flowsheets/plantwide.schema.json), or
+    /// with `--scenario` of scenario files (flowsheets/scenario.schema.json).
+    Schema {
+        /// The schema of scenario files instead of flowsheet files.
+        #[arg(long)]
+        scenario: bool,
+    },
     /// Steady-state gains (linearization or perturbation) and interaction measures: RGA, SVD,
     /// condition numbers, Niederlinski index, block relative gain; also of a transfer-function model.
     Gains(gains::GainsArgs),
@@ -171,8 +176,11 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Screen(a) => screen::run(&a),
         Command::Size(a) => size::run(&a),
         Command::Compare(a) => compare::run(&a),
-        Command::Schema => {
-            let schema = schemars::schema_for!(plantwide::flowsheet::FlowsheetSpec);
+        Command::Schema { scenario } => {
+            let schema = match scenario {
+                true => plantwide::flowsheet::schema::scenario_schema(),
+                false => plantwide::flowsheet::schema::flowsheet_schema(),
+            };
             let text = serde_json::to_string_pretty(&schema).map_err(|e| CliError::user(e.to_string()))?;
             outln!("{text}");
             Ok(())

@@ -18,6 +18,7 @@ pub mod path;
 pub mod plant;
 pub mod query;
 pub mod scenario;
+pub mod schema;
 pub mod spec;
 pub mod tears;
 pub mod wiring;

@@ -8,10 +8,14 @@ use crate::controllers::{self, ControllerConfig, ControllerLinks};
 use crate::units;
 use crate::{BuildCx, FieldError, SpecError, Unit};
 
-/// What every unit description offers (nothing beyond `Debug` for now).
-pub trait UnitConfig: std::fmt::Debug {}
-
-impl<T: std::fmt::Debug> UnitConfig for T {}
+/// What every unit description offers: its ports, as the schema documents them.
+pub trait UnitConfig: std::fmt::Debug {
+    /// The unit type's ports in words, e.g. ``"inlet `in`, outlet `out`"`` (shown in the JSON
+    /// Schema of flowsheet files, where a stream's `from` and `to` name them).
+    fn ports() -> &'static str
+    where
+        Self: Sized;
+}
 
 macro_rules! registry {
     ($(#[$meta:meta])* $name:ident, $cx:ty, $tr:path, [$($tag:literal => $variant:ident($cfg:ty, $unit:ty)),* $(,)?]) => {
@@ -33,6 +37,15 @@ macro_rules! registry {
             /// Type name as written in flowsheet files.
             pub fn type_name(&self) -> &'static str {
                 match self { $($name::$variant(_) => $tag,)* }
+            }
+
+            /// The ports of type `tag` in words (empty for controllers, which have none), or `None`
+            /// for an unknown type.
+            pub fn ports_of(tag: &str) -> Option<&'static str> {
+                match tag {
+                    $($tag => Some(<$cfg as $tr>::ports()),)*
+                    _ => None,
+                }
             }
 
             /// The description as a trait object.

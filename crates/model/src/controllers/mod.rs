@@ -85,6 +85,13 @@ pub struct ControllerPaths {
 pub trait ControllerConfig: std::fmt::Debug {
     /// The paths it reads and drives.
     fn paths(&self) -> ControllerPaths;
+    /// Ports: none (a controller exchanges signals, not streams).
+    fn ports() -> &'static str
+    where
+        Self: Sized,
+    {
+        ""
+    }
     /// Dimension of the output when the controller drives no input directly (its `op` is read by
     /// a selector, split range or another controller), from its own description; `None` if unknown.
     fn op_dimension(&self, _pv_dim: Dimension) -> Option<Dimension> {

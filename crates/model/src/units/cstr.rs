@@ -121,6 +121,12 @@ pub struct CstrConfig {
     pub t_guess: Option<QuantityValue>,
 }
 
+impl crate::registry::UnitConfig for CstrConfig {
+    fn ports() -> &'static str {
+        "inlet `in`, outlet `out`"
+    }
+}
+
 #[derive(Debug, Clone)]
 struct Reaction {
     nu: Vec<f64>,

@@ -39,7 +39,8 @@ pub struct FeedConfig {
     /// Molar flow (e.g. `"1 kmol/min"`; bare numbers in mol/s).
     #[serde(rename = "F")]
     pub flow: QuantityValue,
-    /// Temperature (e.g. `"350 K"`, `"80 degC"`); omit for a saturated liquid.
+    /// Temperature (e.g. `"350 K"`, `"80 degC"`): required for a `liquid` or `vapour` feed; omit it
+    /// when `condition` is `saturated_liquid` (the feed is then at its bubble point).
     #[serde(rename = "T", default, skip_serializing_if = "Option::is_none")]
     pub temperature: Option<QuantityValue>,
     /// Pressure (e.g. `"1 atm"`; bare numbers in Pa).
@@ -50,6 +51,12 @@ pub struct FeedConfig {
     /// Thermal condition (default `liquid`).
     #[serde(default)]
     pub condition: FeedCondition,
+}
+
+impl crate::registry::UnitConfig for FeedConfig {
+    fn ports() -> &'static str {
+        "outlet `out`"
+    }
 }
 
 /// A feed source.

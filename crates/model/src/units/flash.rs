@@ -66,6 +66,12 @@ pub struct FlashConfig {
     pub level: Option<QuantityValue>,
 }
 
+impl crate::registry::UnitConfig for FlashConfig {
+    fn ports() -> &'static str {
+        "inlet `in`, outlets `vapour` and `liquid`"
+    }
+}
+
 /// A flash drum.
 #[derive(Debug, Clone)]
 pub struct Flash {

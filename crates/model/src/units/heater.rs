@@ -32,6 +32,12 @@ pub struct HeaterConfig {
     pub phase: Phase,
 }
 
+impl crate::registry::UnitConfig for HeaterConfig {
+    fn ports() -> &'static str {
+        "inlet `in`, outlet `out`"
+    }
+}
+
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Mode {
     Duty(f64),

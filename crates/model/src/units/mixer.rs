@@ -37,6 +37,12 @@ pub struct MixerConfig {
     pub pressure: Option<QuantityValue>,
 }
 
+impl crate::registry::UnitConfig for MixerConfig {
+    fn ports() -> &'static str {
+        "inlets `in1`, `in2`, … (`inlets` of them), outlet `out`"
+    }
+}
+
 /// A mixer.
 #[derive(Debug, Clone)]
 pub struct Mixer {

@@ -12,6 +12,12 @@ use crate::{BuildCx, FieldError, Scalar, UnitIo, UnitModel};
 #[serde(deny_unknown_fields)]
 pub struct ProductConfig {}
 
+impl crate::registry::UnitConfig for ProductConfig {
+    fn ports() -> &'static str {
+        "inlet `in`"
+    }
+}
+
 /// A product sink.
 #[derive(Debug, Clone)]
 pub struct Product;

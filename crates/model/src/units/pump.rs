@@ -45,6 +45,12 @@ pub struct PumpConfig {
     pub efficiency: f64,
 }
 
+impl crate::registry::UnitConfig for PumpConfig {
+    fn ports() -> &'static str {
+        "inlet `in`, outlet `out`"
+    }
+}
+
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Mode {
     Rise(f64),

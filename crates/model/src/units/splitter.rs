@@ -22,6 +22,12 @@ pub struct SplitterConfig {
     pub fractions: Vec<f64>,
 }
 
+impl crate::registry::UnitConfig for SplitterConfig {
+    fn ports() -> &'static str {
+        "inlet `in`, outlets `out1`, `out2`, … (one more than `fractions` has entries)"
+    }
+}
+
 /// A splitter.
 #[derive(Debug, Clone)]
 pub struct Splitter {

@@ -52,6 +52,12 @@ pub struct TankConfig {
     pub level: Option<QuantityValue>,
 }
 
+impl crate::registry::UnitConfig for TankConfig {
+    fn ports() -> &'static str {
+        "inlet `in`, outlet `out`"
+    }
+}
+
 /// A surge tank.
 #[derive(Debug, Clone)]
 pub struct Tank {

@@ -87,6 +87,12 @@ pub struct ValveConfig {
     pub phase: Phase,
 }
 
+impl crate::registry::UnitConfig for ValveConfig {
+    fn ports() -> &'static str {
+        "inlet `in`, outlet `out`"
+    }
+}
+
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Mode {
     FlowSet { flow: f64 },

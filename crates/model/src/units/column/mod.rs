@@ -224,6 +224,12 @@ pub struct ColumnConfig {
     pub rigorous: Option<Box<RigorousConfig>>,
 }
 
+impl crate::registry::UnitConfig for ColumnConfig {
+    fn ports() -> &'static str {
+        "inlets named by `feeds[k].port`; outlets `distillate`, `bottoms` and one named by each `side_draws[k].port`"
+    }
+}
+
 impl ColumnConfig {
     /// Report every field the chosen model needs but lacks, or does not use but has.
     fn check_model_fields(&self, cx: &mut BuildCx<'_>) {

@@ -103,6 +103,12 @@ pub struct HeatExchangerConfig {
     pub wall_heat_capacity: Option<QuantityValue>,
 }
 
+impl crate::registry::UnitConfig for HeatExchangerConfig {
+    fn ports() -> &'static str {
+        "inlets `hot_in` and `cold_in`, outlets `hot_out` and `cold_out`"
+    }
+}
+
 /// A two-stream counter-current heat exchanger.
 #[derive(Debug, Clone)]
 pub struct HeatExchanger {
