@@ -105,6 +105,9 @@ fn the_schemas_accept_every_file_the_loader_accepts() {
     }
 }
 
+/// An edit breaking a document.
+type Edit = Box<dyn Fn(&mut serde_json::Value)>;
+
 /// Files broken in their structure (an unknown key, a misspelt or unknown type, a wrong JSON type,
 /// a missing required field) are rejected by the loader and by the schema alike.
 #[test]
@@ -113,7 +116,7 @@ fn the_schemas_reject_what_the_loader_rejects() {
         serde_json::from_str(&std::fs::read_to_string(harness::flowsheet("surge_tank_pi.json")).unwrap()).unwrap();
     let tank = base["units"].as_object().unwrap().iter().find(|(_, u)| u["type"] == "tank").unwrap().0.clone();
     let feed = base["units"].as_object().unwrap().iter().find(|(_, u)| u["type"] == "feed").unwrap().0.clone();
-    let broken: Vec<(&str, Box<dyn Fn(&mut serde_json::Value)>)> = vec![
+    let broken: Vec<(&str, Edit)> = vec![
         ("unknown top-level key", Box::new(|d| d["colour"] = "red".into())),
         ("unknown unit field", Box::new(move |d| d["units"][&tank]["colour"] = "red".into())),
         ("unknown unit type", Box::new(|d| d["units"]["x"] = serde_json::json!({"type": "reactorr"}))),
@@ -133,7 +136,7 @@ fn the_schemas_reject_what_the_loader_rejects() {
         &std::fs::read_to_string(harness::flowsheet("scenarios/surge_tank_inflow_step.json")).unwrap(),
     )
     .unwrap();
-    let broken: Vec<(&str, Box<dyn Fn(&mut serde_json::Value)>)> = vec![
+    let broken: Vec<(&str, Edit)> = vec![
         ("no duration", Box::new(|d| drop(d.as_object_mut().unwrap().remove("duration")))),
         ("unknown event type", Box::new(|d| d["events"] = serde_json::json!([{"type": "jump", "at": "1 min"}]))),
         (
