@@ -37,6 +37,27 @@ use std::path::PathBuf;
 
 use clap::{Parser, Subcommand};
 
+/// Display units of text, tables and plots (`--units`); JSON is always SI.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum UnitsArg {
+    /// Coherent SI: mol/s, K, Pa, W.
+    Si,
+    /// kmol/h, degC, kPa, kW, kmol, m3.
+    Metric,
+    /// lbmol/h, degF, psia, Btu/h, lbmol, ft3.
+    Field,
+}
+
+impl From<UnitsArg> for plantwide::units::UnitSystem {
+    fn from(a: UnitsArg) -> Self {
+        match a {
+            UnitsArg::Si => plantwide::units::UnitSystem::Si,
+            UnitsArg::Metric => plantwide::units::UnitSystem::Metric,
+            UnitsArg::Field => plantwide::units::UnitSystem::Field,
+        }
+    }
+}
+
 /// Plantwide process-control studies: flowsheets, steady state, dynamics and control analysis.
 #[derive(Debug, Parser)]
 #[command(version, about, long_about = None)]
@@ -80,6 +101,9 @@ enum Command {
         /// recycles by tearing), `auto` sequential modular to 1e-4 then Newton.
         #[arg(long, value_enum, default_value = "auto")]
         method: steady::MethodArg,
+        /// Display units of the text (default: streams in kmol/h, K, kPa, kJ/mol, the rest in SI).
+        #[arg(long, value_enum)]
+        units: Option<UnitsArg>,
     },
     /// Simulate the plant through a scenario from its steady state (or a snapshot): CSV of the
     /// recorded paths, a summary (IAE, ISE, max deviation, settling time) and optional trend plots.
@@ -104,6 +128,9 @@ enum Command {
         /// Resume from a snapshot file written by an earlier run.
         #[arg(long)]
         resume: Option<PathBuf>,
+        /// Units of the paths the scenario records without one (CSV, plot, table; JSON stays SI).
+        #[arg(long, value_enum, default_value_t = UnitsArg::Si)]
+        units: UnitsArg,
     },
     /// Print the JSON Schema of flowsheet files (the shipped flowsheets/plantwide.schema.json), or
     /// with `--scenario` of scenario files (flowsheets/scenario.schema.json).
@@ -162,11 +189,12 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
     match cli.command {
         Command::Check { file } => check::run(&file),
         Command::Components { json } => components::run(json),
-        Command::Steady { file, json, set, spec, vary, method } => {
-            steady::run(&steady::SteadyArgs { file: &file, json, sets: &set, specs: &spec, vary: &vary, method })
+        Command::Steady { file, json, set, spec, vary, method, units } => {
+            let units = units.map(Into::into);
+            steady::run(&steady::SteadyArgs { file: &file, json, sets: &set, specs: &spec, vary: &vary, method, units })
         }
-        Command::Run { file, scenario, csv, plot, json, set, resume } => {
-            run::run(&run::RunArgs { file, scenario, csv, plot, json, set, resume })
+        Command::Run { file, scenario, csv, plot, json, set, resume, units } => {
+            run::run(&run::RunArgs { file, scenario, csv, plot, json, set, resume, units: units.into() })
         }
         Command::Gains(a) => gains::run(&a),
         Command::Linearize(a) => linearize::run(&a),

@@ -1,7 +1,9 @@
 //! `plantwide run FILE --scenario SCEN --csv OUT.csv [--plot OUT.png|OUT.svg] [--json]
-//! [--set PATH=VALUE ...] [--resume SNAPSHOT]`: dynamic simulation from the converged steady state
-//! (or a snapshot), with a progress bar on stderr, recorded trends as CSV, a summary (table, or
-//! JSON with `--json`) and an optional trend plot.
+//! [--set PATH=VALUE ...] [--resume SNAPSHOT] [--units si|metric|field]`: dynamic simulation from
+//! the converged steady state (or a snapshot), with a progress bar on stderr, recorded trends as
+//! CSV, a summary (table, or JSON with `--json`) and an optional trend plot. Each recorded path is
+//! shown (CSV, plot, table) in the unit its scenario asked for, else in the `--units` system's;
+//! JSON stays in SI.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -12,7 +14,7 @@ use plantwide::io::plot::{Trend, write_trends};
 use plantwide::solve::dynamic::{
     CONSERVATION_TOL, Conservation, Progress, SimError, SimulationResult, Snapshot, Start, simulate,
 };
-use plantwide::units::convert_from_si;
+use plantwide::units::{Display, UnitSystem, convert_from_si, unit_dimension};
 
 use super::CliError;
 use super::steady::{converge, load_with_overrides};
@@ -34,6 +36,8 @@ pub struct RunArgs {
     pub set: Vec<String>,
     /// Snapshot to resume from.
     pub resume: Option<PathBuf>,
+    /// Display units of the paths the scenario recorded without one.
+    pub units: UnitSystem,
 }
 
 /// FNV-1a hash of the flowsheet text and the overrides: identifies the plant in snapshots.
@@ -93,10 +97,11 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
     });
     bar.finish_and_clear();
     let title = if sc.name.is_empty() { plant.name().to_string() } else { format!("{}: {}", plant.name(), sc.name) };
-    let res = match result {
+    let mut res = match result {
         Ok(res) => res,
         Err(e @ (SimError::Snapshot { .. } | SimError::Wiring(_))) => return Err(CliError::user(e.to_string())),
-        Err(SimError::Conservation { file, source, result }) => {
+        Err(SimError::Conservation { file, source, mut result }) => {
+            display_units(&mut result, args.units);
             // The whole run is there: write and summarize it, then fail on the balance.
             write_trends_files(args, &result, &title, &sc.time_unit, time_factor)?;
             print_summary(&result, args.json, started.elapsed().as_secs_f64(), time_factor, &sc.time_unit)?;
@@ -108,7 +113,9 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
         Err(e) => {
             // The trends up to the failure show what led to it (a vessel draining, a loop saturating).
             let SimError::Integration { partial, .. } = &e else { return Err(CliError::numerical(e.to_string())) };
-            let written = write_trends_files(args, partial, &title, &sc.time_unit, time_factor);
+            let mut partial = partial.clone();
+            display_units(&mut partial, args.units);
+            let written = write_trends_files(args, &partial, &title, &sc.time_unit, time_factor);
             let at = format!("{:.6} {}", partial.t * time_factor, sc.time_unit);
             return Err(CliError::numerical(match written {
                 Ok(()) => format!("{e}; the trends up to t = {at} are in {}", args.csv.display()),
@@ -119,9 +126,19 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
     if let Some(e) = write_error {
         return Err(e);
     }
+    display_units(&mut res, args.units);
     write_trends_files(args, &res, &title, &sc.time_unit, time_factor)?;
     let wall = started.elapsed().as_secs_f64();
     print_summary(&res, args.json, wall, time_factor, &sc.time_unit)
+}
+
+/// Every column recorded in SI (no unit asked for) shown in `units`' unit of its dimension.
+fn display_units(res: &mut SimulationResult, units: UnitSystem) {
+    for c in res.columns.iter_mut().filter(|c| c.unit == c.si_unit) {
+        if let Ok(dim) = unit_dimension(&c.si_unit) {
+            c.unit = units.unit_for(dim);
+        }
+    }
 }
 
 /// The CSV file and, if asked for, the plot of the recorded trends.
@@ -212,27 +229,31 @@ fn print_summary(
         s.n_restarts
     );
     outln!(
-        "{:<28} {:>10} {:>14} {:>14} {:>12} {:>12} {:>14} {:>12}",
-        "path (SI units)",
+        "{:<28} {:<10} {:>10} {:>14} {:>14} {:>14} {:>14} {:>14} {:>12}",
+        "path",
+        "unit",
         "reference",
         "initial",
         "final",
-        "IAE",
-        "ISE",
+        format!("IAE [u·{time_unit}]"),
+        format!("ISE [u²·{time_unit}]"),
         "max deviation",
         "settling"
     );
-    for p in &summary {
+    for (p, c) in summary.iter().zip(&res.columns) {
+        let d =
+            Display::new(&c.unit).or_else(|_| Display::new(&c.si_unit)).map_err(|e| CliError::user(e.to_string()))?;
         let settling = p.settling_time.map_or("-".to_string(), |t| format!("{:.4} {time_unit}", t * time_factor));
         outln!(
-            "{:<28} {:>10} {:>14.7e} {:>14.7e} {:>12.4e} {:>12.4e} {:>14.4e} {:>12}",
+            "{:<28} {:<10} {:>10} {:>14.7e} {:>14.7e} {:>14.4e} {:>14.4e} {:>14.4e} {:>12}",
             p.path,
+            d.unit(),
             p.reference,
-            p.initial,
-            p.last,
-            p.iae,
-            p.ise,
-            p.max_deviation,
+            d.value(p.initial),
+            d.value(p.last),
+            d.difference(p.iae) * time_factor,
+            d.difference(d.difference(p.ise)) * time_factor,
+            d.difference(p.max_deviation),
             settling
         );
     }

@@ -1,11 +1,13 @@
 //! `plantwide steady FILE [--json] [--set PATH=VALUE ...] [--spec PATH=VALUE --vary INPUT ...]
-//! [--method eo|sm|auto]`.
+//! [--method eo|sm|auto] [--units si|metric|field]`: the text shows every quantity with its unit
+//! (SI, or the `--units` system's); JSON stays in SI.
 
 use std::path::Path;
 
 use plantwide::flowsheet::{BlockKind, Plant, SpecEntry};
 use plantwide::model::stream::{F, H, P, T, Z0};
 use plantwide::solve::{Method, Progress, Solution, StrategySettings, converge_observed};
+use plantwide::units::{Display, UnitSystem};
 
 use super::CliError;
 
@@ -118,6 +120,9 @@ pub struct SteadyArgs<'a> {
     pub vary: &'a [String],
     /// `--method`.
     pub method: MethodArg,
+    /// `--units`: display units of the text (default: the stream table in kmol/h, K, kPa, kJ/mol
+    /// and every other quantity in SI).
+    pub units: Option<UnitSystem>,
 }
 
 pub fn run(a: &SteadyArgs<'_>) -> Result<(), CliError> {
@@ -155,9 +160,25 @@ pub fn run(a: &SteadyArgs<'_>) -> Result<(), CliError> {
         outln!("warning: {}\n", w.message);
     }
     print_specs(&plant, &sol);
-    let comps = plant.components();
-    out!("{:<14} {:>12} {:>9} {:>10} {:>11}", "stream", "F kmol/h", "T K", "P kPa", "h kJ/mol");
-    for c in comps {
+    print_streams(&plant, &sol, a.units);
+    print_blocks(&plant, &sol, a.units);
+    Ok(())
+}
+
+/// The stream table: F, T, P, h in the `--units` system (default kmol/h, K, kPa, kJ/mol), then the
+/// mole fractions.
+fn print_streams(plant: &Plant, sol: &Solution, units: Option<UnitSystem>) {
+    use plantwide::units::Dimension as D;
+    let default = ["kmol/h", "K", "kPa", "kJ/mol"];
+    let shown: Vec<Display> = [D::MOLAR_FLOW, D::TEMPERATURE, D::PRESSURE, D::MOLAR_ENERGY]
+        .iter()
+        .zip(default)
+        .map(|(&d, u)| units.map_or(u.to_string(), |s| s.unit_for(d)))
+        .map(|u| Display::new(&u).unwrap_or_else(|_| Display::new("1").expect("the unit 1")))
+        .collect();
+    let head = |k: usize, name: &str| format!("{name} {}", shown[k].unit());
+    out!("{:<14} {:>12} {:>9} {:>10} {:>11}", "stream", head(0, "F"), head(1, "T"), head(2, "P"), head(3, "h"));
+    for c in plant.components() {
         out!(" {:>10}", format!("x[{}]", truncate(c, 7)));
     }
     outln!();
@@ -166,10 +187,10 @@ pub fn run(a: &SteadyArgs<'_>) -> Result<(), CliError> {
         out!(
             "{:<14} {:>12.4} {:>9.3} {:>10.3} {:>11.4}",
             truncate(&s.name, 14),
-            v[F] * 3.6,
-            v[T],
-            v[P] / 1e3,
-            v[H] / 1e3
+            shown[0].value(v[F]),
+            shown[1].value(v[T]),
+            shown[2].value(v[P]),
+            shown[3].value(v[H])
         );
         for z in &v[Z0..] {
             out!(" {:>10.6}", z);
@@ -177,15 +198,24 @@ pub fn run(a: &SteadyArgs<'_>) -> Result<(), CliError> {
         outln!();
     }
     outln!();
+}
+
+/// Each unit's and controller's own variables outside the streams, with their units (SI, or the
+/// `--units` system's).
+fn print_blocks(plant: &Plant, sol: &Solution, units: Option<UnitSystem>) {
     let slen = plant.stream_layout().len();
     let mut in_stream = vec![false; plant.n_vars()];
     plant.streams().iter().for_each(|s| in_stream[s.offset..s.offset + slen].fill(true));
+    let system = units.unwrap_or_default();
     for b in plant.blocks() {
         let own = b.own_offset..b.own_offset + b.layout.n_own();
         let prefix = format!("{}.", b.name);
         let internal: Vec<String> = own
             .filter(|&j| !in_stream[j])
-            .map(|j| format!("{}={:.6}", plant.vars()[j].path.trim_start_matches(&prefix), sol.x[j]))
+            .map(|j| {
+                let v = &plant.vars()[j];
+                format!("{}={}", v.path.trim_start_matches(&prefix), shown(sol.x[j], v.spec.dim, system))
+            })
             .collect();
         let kind = if b.kind == BlockKind::Controller { "controller" } else { "unit" };
         if internal.len() > 12 {
@@ -200,7 +230,17 @@ pub fn run(a: &SteadyArgs<'_>) -> Result<(), CliError> {
             outln!("{kind} {:<14} {:<10} {}", b.name, b.unit.type_name(), internal.join("  "));
         }
     }
-    Ok(())
+}
+
+/// `v` (SI) of dimension `dim` in `system`'s unit, with the unit (none for a dimensionless number).
+fn shown(v: f64, dim: plantwide::units::Dimension, system: UnitSystem) -> String {
+    if dim == plantwide::units::Dimension::DIMENSIONLESS {
+        return format!("{v:.6}");
+    }
+    match Display::new(&system.unit_for(dim)) {
+        Ok(d) => format!("{:.6} {}", d.value(v), d.unit()),
+        Err(_) => format!("{v:.6} {dim}"),
+    }
 }
 
 /// Each spec met: the varied input's value found (and the file's), the held variable's value.

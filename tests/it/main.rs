@@ -16,6 +16,7 @@ mod columns;
 mod columns_rigorous;
 mod compare;
 mod core;
+mod display_units;
 mod dynamics;
 mod fehe;
 mod flowsheets;

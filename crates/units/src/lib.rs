@@ -51,6 +51,7 @@ mod dimension;
 mod error;
 mod named;
 mod parse;
+mod preset;
 mod quantity;
 mod suggest;
 mod table;
@@ -62,6 +63,7 @@ pub use error::UnitError;
 /// The crate-level error: every public fallible function of this crate returns a [`UnitError`].
 pub use error::UnitError as Error;
 pub use named::{NamedDimension, named_dimensions};
+pub use preset::{Display, UnitSystem};
 pub use quantity::{
     Quantity, convert_from_si, convert_to_si, parse_difference, parse_difference_as, parse_quantity, parse_quantity_as,
     unit_dimension,

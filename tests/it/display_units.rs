@@ -1,0 +1,120 @@
+//! Text in the units asked for: `run`'s table in the unit a recorded path asked for, else in the
+//! `--units` system's (values with the scale's zero, deviations and integrals without it, per the
+//! scenario's time unit); `steady`'s variables with their units. Each figure is checked against
+//! the same run's SI JSON, converted by hand.
+
+use crate::harness::{flowsheet, plantwide};
+
+/// The table rows of `run`'s text output, by path: (unit, initial, final, IAE, max deviation).
+fn table(stdout: &str) -> Vec<(String, String, f64, f64, f64, f64)> {
+    stdout
+        .lines()
+        .skip_while(|l| !l.starts_with("path "))
+        .skip(1)
+        .take_while(|l| !l.starts_with("conservation"))
+        .map(|l| {
+            let f: Vec<&str> = l.split_whitespace().collect();
+            let num = |k: usize| f[k].parse::<f64>().unwrap_or_else(|_| panic!("{l}"));
+            (f[0].to_string(), f[1].to_string(), num(3), num(4), num(5), num(7))
+        })
+        .collect()
+}
+
+fn scenario_with(dir: &std::path::Path, paths: serde_json::Value) -> String {
+    let text = std::fs::read_to_string(flowsheet("scenarios/fehe_reactor_feed_temperature.json")).unwrap();
+    let mut sc: serde_json::Value = serde_json::from_str(&text).unwrap();
+    sc["record"]["paths"] = paths;
+    let path = dir.join("scenario.json");
+    std::fs::write(&path, sc.to_string()).unwrap();
+    path.display().to_string()
+}
+
+#[test]
+fn run_shows_each_path_in_the_unit_it_asked_for_or_in_the_chosen_system() {
+    let dir = std::env::temp_dir().join(format!("plantwide_display_units_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let sc = scenario_with(
+        &dir,
+        serde_json::json!(["effluent.T", {"path": "trim.duty", "unit": "MW"}, "feed.F", "effluent.x[A]"]),
+    );
+    let csv = dir.join("run.csv").display().to_string();
+    let file = flowsheet("fehe_reactor.json");
+    let json = plantwide(&["run", &file, "--scenario", &sc, "--csv", &csv, "--json"]);
+    assert!(json.status.success(), "{}", String::from_utf8_lossy(&json.stderr));
+    let si: serde_json::Value = serde_json::from_slice(&json.stdout).unwrap();
+    let si = |k: usize, what: &str| si["paths"][k][what].as_f64().unwrap();
+    for (system, t_unit, flow_unit, t_zero, t_step, flow_factor) in [
+        ("si", "K", "mol/s", 0.0, 1.0, 1.0),
+        ("metric", "degC", "kmol/h", 273.15, 1.0, 3.6),
+        ("field", "degF", "lbmol/h", 459.67, 1.8, 3600.0 / 453.59237),
+    ] {
+        let out = plantwide(&["run", &file, "--scenario", &sc, "--csv", &csv, "--units", system]);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let text = String::from_utf8_lossy(&out.stdout).to_string();
+        assert!(text.contains("IAE [u·s]"), "{text}");
+        let rows = table(&text);
+        assert_eq!(rows.len(), 4, "{text}");
+        // effluent.T: the value with the scale's zero, the deviation and IAE without.
+        let (path, unit, initial, _, iae, dev) = rows[0].clone();
+        assert_eq!((path.as_str(), unit.as_str()), ("effluent.T", t_unit), "{system}");
+        // Printed with 8 significant digits (values) or 5 (integrals and deviations).
+        let near = |a: f64, b: f64, tol: f64, what: &str| {
+            assert!((a - b).abs() <= tol * b.abs(), "{system} {what}: {a} vs {b}")
+        };
+        let close = |a: f64, b: f64, what: &str| near(a, b, 1e-7, what);
+        let rough = |a: f64, b: f64, what: &str| near(a, b, 6e-5, what);
+        close(initial, si(0, "initial") * t_step - t_zero, "T initial");
+        rough(iae, si(0, "iae") * t_step, "T IAE");
+        rough(dev, si(0, "max_deviation") * t_step, "T max deviation");
+        // trim.duty asked for MW: MW whatever the system.
+        let (_, unit, initial, last, _, _) = rows[1].clone();
+        assert_eq!(unit, "MW", "{system}");
+        close(initial, si(1, "initial") / 1e6, "duty initial");
+        close(last, si(1, "last") / 1e6, "duty final");
+        let (_, unit, initial, _, _, _) = rows[2].clone();
+        assert_eq!(unit, flow_unit, "{system}");
+        close(initial, si(2, "initial") * flow_factor, "flow");
+        // A mole fraction stays a mole fraction.
+        assert_eq!(rows[3].1, "1", "{system}");
+        close(rows[3].2, si(3, "initial"), "x");
+        // The CSV header carries the same units.
+        let header = std::fs::read_to_string(&csv).unwrap().lines().next().unwrap().to_string();
+        assert!(header.contains(&format!("effluent.T [{t_unit}]")) && header.contains("trim.duty [MW]"), "{header}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn steady_shows_every_variable_with_its_unit() {
+    let file = flowsheet("fehe_reactor.json");
+    let out = plantwide(&["steady", &file, "--json"]);
+    let si: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let q = si["values"]["trim.Q"].as_f64().unwrap();
+    let op = si["values"]["temperature_control.op"].as_f64().unwrap();
+    for (system, factor, unit) in
+        [(None, 1.0, "W"), (Some("metric"), 1e-3, "kW"), (Some("field"), 3.412141633, "Btu/h")]
+    {
+        let mut args = vec!["steady", file.as_str()];
+        if let Some(s) = system {
+            args.extend(["--units", s]);
+        }
+        let out = plantwide(&args);
+        assert!(out.status.success());
+        let text = String::from_utf8_lossy(&out.stdout).to_string();
+        for (line_start, name, value) in [("unit trim", "Q=", q), ("controller temperature_control", "op=", op)] {
+            let line = text.lines().find(|l| l.starts_with(line_start)).unwrap_or_else(|| panic!("{text}"));
+            let rest = &line[line.find(name).unwrap() + name.len()..];
+            let mut words = rest.split_whitespace();
+            let v: f64 = words.next().unwrap().parse().unwrap();
+            assert_eq!(words.next(), Some(unit), "{system:?}: {line}");
+            assert!(
+                (v - value * factor).abs() < 1e-5 * (value * factor).abs(),
+                "{system:?}: {v} vs {}",
+                value * factor
+            );
+        }
+    }
+    let metric = plantwide(&["steady", &file, "--units", "metric"]);
+    let text = String::from_utf8_lossy(&metric.stdout);
+    assert!(text.contains("T degC") && text.contains("F kmol/h"), "{text}");
+}
