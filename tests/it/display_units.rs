@@ -118,3 +118,27 @@ fn steady_shows_every_variable_with_its_unit() {
     let text = String::from_utf8_lossy(&metric.stdout);
     assert!(text.contains("T degC") && text.contains("F kmol/h"), "{text}");
 }
+
+/// An input a controller drives is addressable as an output (`trim.duty`, read as the output of
+/// the controller that drives it, `temperature_control.op`), in the unit asked for; its gain equals
+/// the central difference of two steady states (a second route) to 1e-6.
+#[test]
+fn a_driven_input_is_an_output_in_the_unit_asked_for() {
+    let file = flowsheet("fehe_reactor.json");
+    let gain = |output: &str| {
+        let out = plantwide(&["gains", &file, "--inputs", "feed_T", "--outputs", output, "--json"]);
+        assert!(out.status.success(), "{output}: {}", String::from_utf8_lossy(&out.stderr));
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(v["outputs"][0]["unit"], "kW");
+        v["gain"][0][0].as_f64().unwrap()
+    };
+    let (driven, op) = (gain("trim.duty@kW"), gain("temperature_control.op@kW"));
+    assert_eq!(driven, op);
+    let duty = |t: &str| {
+        let out = plantwide(&["steady", &file, "--json", "--set", &format!("feed_T={t}")]);
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        v["values"]["trim.Q"].as_f64().unwrap()
+    };
+    let central = (duty("300.5 K") - duty("299.5 K")) / 1e3;
+    assert!((driven - central).abs() < 1e-6 * central.abs(), "gain {driven} kW/K, central difference {central} kW/K");
+}

@@ -110,10 +110,12 @@ pub fn select_outputs(plant: &Plant, texts: &[String]) -> Result<Vec<Signal>, An
     texts.iter().map(|t| select_output(plant, t)).collect()
 }
 
-/// Resolve one output variable written as `path[@unit]`.
+/// Resolve one output variable written as `path[@unit]`: a variable, or an input a controller
+/// drives (`column.reboiler_duty`), read as the controller output that drives it.
 pub fn select_output(plant: &Plant, text: &str) -> Result<Signal, AnalysisError> {
     let (path, unit) = split_unit(text);
-    let Some(index) = plant.var(path) else {
+    let driven = || resolve_input(plant, path).and_then(|i| plant.inputs()[i].driven_by);
+    let Some(index) = plant.var(path).or_else(driven) else {
         let hint = did_you_mean(path, plant.vars().iter().map(|v| v.path.as_str()));
         return Err(request(format!(
             "{}: no variable `{path}`{hint}; `plantwide steady {} --json` lists every variable path",
