@@ -6,8 +6,9 @@ use std::path::{Path, PathBuf};
 
 use plantwide::analysis::AnalysisError;
 use plantwide::analysis::faer::{Mat, c64};
+use plantwide::analysis::frequency::{self, FrequencyResults};
 use plantwide::analysis::linear::Linearization;
-use plantwide::analysis::measures::{rga_complex, rows};
+use plantwide::analysis::measures::rows;
 use plantwide::analysis::perturb::{PerturbSettings, perturb_gains};
 use plantwide::analysis::report::{GainJson, GainReport, ReportOptions};
 use plantwide::analysis::select::{Signal, SignalLabel, parse_block, parse_pairing, select_inputs, select_outputs};
@@ -38,11 +39,13 @@ pub struct GainsArgs {
     /// Analyse a transfer-function model (`*.tf.json`) instead of a flowsheet.
     #[arg(long, value_name = "MODEL")]
     tf: Option<PathBuf>,
-    /// Manipulated inputs, comma-separated, each `PATH[@unit]` (e.g. `column.reflux@kmol/min`).
-    #[arg(long, value_delimiter = ',', required_unless_present = "tf", conflicts_with = "tf")]
+    /// Manipulated inputs, comma-separated, each `PATH[@unit]` (e.g. `column.reflux@kmol/min`);
+    /// with `--tf`, the model's input names to keep, in this order (default all).
+    #[arg(long, value_delimiter = ',', required_unless_present = "tf")]
     inputs: Vec<String>,
-    /// Outputs, comma-separated variable paths, each `PATH[@unit]`.
-    #[arg(long, value_delimiter = ',', required_unless_present = "tf", conflicts_with = "tf")]
+    /// Outputs, comma-separated variable paths, each `PATH[@unit]`; with `--tf`, the model's
+    /// output names to keep, in this order (default all).
+    #[arg(long, value_delimiter = ',', required_unless_present = "tf")]
     outputs: Vec<String>,
     /// Pairing for the Niederlinski index and RGA number: `OUT=IN,…` or input positions in output
     /// order (`2,1`); default: diagonal.
@@ -74,7 +77,9 @@ pub struct GainsArgs {
     #[arg(long, default_value = "s")]
     time_unit: String,
     /// Print exactly `{"method","inputs","outputs","gain","rga","singular_values","condition_number","niederlinski"}`,
-    /// and for `--method perturb` also `"perturbation": {"step","steps","check","max_relative_difference",…}`.
+    /// for `--method perturb` also `"perturbation": {"step","steps","check","max_relative_difference",…}`, and
+    /// with `--frequencies` also `"frequency": {"time_unit", "points": [{"omega", "g", "singular_values", "rga",
+    /// "rga_number"}]}` (complex entries as `{"re","im","magnitude","phase_deg"}`).
     #[arg(long)]
     json: bool,
     /// Override an input or a unit parameter first, e.g. `--set feed_source.F=1.01kmol/min`.
@@ -183,24 +188,38 @@ pub fn run(a: &GainsArgs) -> Result<(), CliError> {
     let gain = display_gain(&si, &inputs, &outputs);
     let labels = |s: &[Signal]| s.iter().map(Signal::label).collect::<Vec<_>>();
     let report = GainReport::new(method, labels(&inputs), labels(&outputs), gain, &opts).map_err(analysis_error)?;
+    let frequency = match &a.frequencies {
+        Some(text) => {
+            let tu = TimeUnit::parse(&a.time_unit)?;
+            let omegas = frequency_grid(text, &tu)?;
+            let responses = lin.frequency_response(&ii, &oo, &omegas).map_err(analysis_error)?;
+            let scale = |g: &Mat<c64>| {
+                Mat::from_fn(g.nrows(), g.ncols(), |i, j| g[(i, j)] * (inputs[j].factor / outputs[i].factor))
+            };
+            let scaled: Vec<Mat<c64>> = responses.iter().map(scale).collect();
+            Some(frequency_results(&report, &omegas, &scaled, &tu))
+        }
+        None => None,
+    };
     if a.json {
-        let json = GainJson { perturbation: check.as_ref(), ..report.json() };
+        let json = GainJson { perturbation: check.as_ref(), frequency: frequency.as_ref(), ..report.json() };
         outln!("{}", serde_json::to_string_pretty(&json).map_err(|e| CliError::user(e.to_string()))?);
         return Ok(());
     }
     outln!("steady-state gains of `{}` ({note})\n", plant.name());
     print_report(&report);
-    if let Some(text) = &a.frequencies {
-        let tu = TimeUnit::parse(&a.time_unit)?;
-        let omegas = frequency_grid(text, &tu)?;
-        let responses = lin.frequency_response(&ii, &oo, &omegas).map_err(analysis_error)?;
-        let scaled: Vec<Mat<c64>> = responses
-            .iter()
-            .map(|g| Mat::from_fn(g.nrows(), g.ncols(), |i, j| g[(i, j)] * (inputs[j].factor / outputs[i].factor)))
-            .collect();
-        print_frequency_table(&report, &omegas, &scaled, &tu);
+    if let Some(f) = &frequency {
+        print_frequency_table(&report, f);
     }
     Ok(())
+}
+
+/// The frequency results at `omegas` [rad/s] of the responses (display units), ω reported per
+/// `tu`.
+fn frequency_results(r: &GainReport, omegas: &[f64], responses: &[Mat<c64>], tu: &TimeUnit) -> FrequencyResults {
+    let pairing = r.pairing.clone().unwrap_or_default();
+    let points = omegas.iter().zip(responses).map(|(w, g)| frequency::point(w * tu.seconds, g, &pairing)).collect();
+    FrequencyResults { time_unit: tu.name.clone(), points }
 }
 
 /// SI gains → display units: `G_ij · f_uj / f_yi`.
@@ -212,6 +231,7 @@ fn run_tf(a: &GainsArgs, file: &Path) -> Result<(), CliError> {
     let name = file.display().to_string();
     let text = plantwide::flowsheet::read_text(file).map_err(|e| CliError::user(e.to_string()))?;
     let model = tf::parse(&text, &name).map_err(|e| CliError::user(e.to_string()))?;
+    let model = model.select(&a.inputs, &a.outputs).map_err(|e| CliError::user(format!("{name}: {e}")))?;
     if a.method == Method::Perturb {
         return Err(CliError::user(
             "--method perturb needs a flowsheet; a transfer-function model's gains are its element gains",
@@ -229,8 +249,18 @@ fn run_tf(a: &GainsArgs, file: &Path) -> Result<(), CliError> {
         &opts,
     )
     .map_err(analysis_error)?;
+    let frequency = match &a.frequencies {
+        Some(text) => {
+            let tu = TimeUnit::parse(&a.time_unit)?;
+            let omegas = frequency_grid(text, &tu)?;
+            let responses: Vec<Mat<c64>> = omegas.iter().map(|&w| model.response(w)).collect();
+            Some(frequency_results(&report, &omegas, &responses, &tu))
+        }
+        None => None,
+    };
     if a.json {
-        outln!("{}", serde_json::to_string_pretty(&report.json()).map_err(|e| CliError::user(e.to_string()))?);
+        let json = GainJson { frequency: frequency.as_ref(), ..report.json() };
+        outln!("{}", serde_json::to_string_pretty(&json).map_err(|e| CliError::user(e.to_string()))?);
         return Ok(());
     }
     outln!("steady-state gains of `{}` (transfer-function model {name})\n", model.name);
@@ -244,11 +274,8 @@ fn run_tf(a: &GainsArgs, file: &Path) -> Result<(), CliError> {
             outln!("  {:<24} {}", o.name, cells.join("  "));
         }
     }
-    if let Some(text) = &a.frequencies {
-        let tu = TimeUnit::parse(&a.time_unit)?;
-        let omegas = frequency_grid(text, &tu)?;
-        let responses: Vec<Mat<c64>> = omegas.iter().map(|&w| model.response(w)).collect();
-        print_frequency_table(&report, &omegas, &responses, &tu);
+    if let Some(f) = &frequency {
+        print_frequency_table(&report, f);
     }
     Ok(())
 }
@@ -339,35 +366,50 @@ fn print_report(r: &GainReport) {
     }
 }
 
-fn print_frequency_table(r: &GainReport, omegas: &[f64], responses: &[Mat<c64>], tu: &TimeUnit) {
-    outln!("\nfrequency response (ω in rad/{}):", tu.name);
+fn print_frequency_table(r: &GainReport, f: &FrequencyResults) {
+    outln!("\nfrequency response (ω in rad/{}):", f.time_unit);
     let pairing = r.pairing.clone().unwrap_or_default();
     out!("{:>12} {:>14} {:>14}", "ω", "σ_max", "σ_min");
     for (i, &j) in pairing.iter().enumerate() {
         out!(" {:>12}", format!("|λ{}{}|", i + 1, j + 1));
     }
     outln!(" {:>12}", if pairing.is_empty() { "" } else { "RGA number" });
-    for (w, g) in omegas.iter().zip(responses) {
-        let sv = g.singular_values().unwrap_or_default();
+    for p in &f.points {
+        let sv = &p.singular_values;
         let (smax, smin) = (sv.first().copied().unwrap_or(f64::NAN), sv.last().copied().unwrap_or(f64::NAN));
-        out!("{:>12} {:>14} {:>14}", sig(w * tu.seconds), sig(smax), sig(smin));
-        match rga_complex(g.as_ref()) {
-            Ok(l) if !pairing.is_empty() => {
-                let mut number = 0.0;
-                for i in 0..l.nrows() {
-                    for j in 0..l.ncols() {
-                        let p = if pairing[i] == j { 1.0 } else { 0.0 };
-                        number += (l[(i, j)] - c64::new(p, 0.0)).norm();
-                    }
-                }
+        out!("{:>12} {:>14} {:>14}", sig(p.omega), sig(smax), sig(smin));
+        match (&p.rga, p.rga_number) {
+            (Some(l), Some(number)) => {
                 for (i, &j) in pairing.iter().enumerate() {
-                    out!(" {:>12}", sig(l[(i, j)].norm()));
+                    out!(" {:>12}", sig(l[i][j].magnitude));
                 }
                 outln!(" {:>12}", sig(number));
             }
             _ => outln!(),
         }
     }
+    outln!("\nG(jω) elements, |g| and phase [deg]:");
+    out!("{:>12}", "ω");
+    for o in &r.outputs {
+        for i in &r.inputs {
+            out!(" {:>26}", format!("{} ← {}", truncate(&o.path, 11), truncate(&i.path, 11)));
+        }
+    }
+    outln!();
+    for p in &f.points {
+        out!("{:>12}", sig(p.omega));
+        for row in &p.g {
+            for z in row {
+                out!(" {:>26}", format!("{} ∠{:.2}", sig(z.magnitude), z.phase_deg));
+            }
+        }
+        outln!();
+    }
+}
+
+/// The first `n` characters of `s`.
+fn truncate(s: &str, n: usize) -> String {
+    s.chars().take(n).collect()
 }
 
 /// Arguments of `plantwide sensors`.

@@ -546,3 +546,79 @@ fn sensitivity_writes_csv_and_plots() {
     assert!(String::from_utf8_lossy(&bad.stderr).contains("LOW:HIGH"));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `gains --tf … --frequencies … --json` carries G(jω) element by element, its RGA and RGA number:
+/// Wood–Berry's elements K e^(−θs)/(τs + 1) at ω = 0.1 rad/min and the 2×2 closed form
+/// λ11 = 1/(1 − g12 g21/(g11 g22)) evaluated by hand, to 1e-12; `--inputs/--outputs` select and
+/// order channels.
+#[test]
+fn transfer_function_frequency_results_are_complete_in_json_and_channels_select() {
+    let tf = flowsheet("transfer_functions/wood_berry.tf.json");
+    let out = plantwide(&["gains", "--tf", &tf, "--frequencies", "0.1:1:2", "--time-unit", "min", "--json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let f = &v["frequency"];
+    assert_eq!(f["time_unit"], "min");
+    let p = &f["points"][0];
+    assert_eq!(p["omega"].as_f64(), Some(0.1));
+    let w = 0.1;
+    let g = |k: f64, tau: f64, theta: f64| c64::new(0.0, -theta * w).exp() * k / c64::new(1.0, tau * w);
+    let exact = [[g(12.8, 16.7, 1.0), g(-18.9, 21.0, 3.0)], [g(6.6, 10.9, 7.0), g(-19.4, 14.4, 3.0)]];
+    for i in 0..2 {
+        for j in 0..2 {
+            let e = &p["g"][i][j];
+            let z = c64::new(e["re"].as_f64().unwrap(), e["im"].as_f64().unwrap());
+            assert!(
+                (z - exact[i][j]).norm() < 1e-12 * exact[i][j].norm(),
+                "g{}{}: {z} vs {}",
+                i + 1,
+                j + 1,
+                exact[i][j]
+            );
+            assert!((e["magnitude"].as_f64().unwrap() - exact[i][j].norm()).abs() < 1e-12);
+            let phase = exact[i][j].im.atan2(exact[i][j].re).to_degrees();
+            assert!((e["phase_deg"].as_f64().unwrap() - phase).abs() < 1e-9);
+        }
+    }
+    let lambda = c64::new(1.0, 0.0) / (c64::new(1.0, 0.0) - exact[0][1] * exact[1][0] / (exact[0][0] * exact[1][1]));
+    let l11 = c64::new(p["rga"][0][0]["re"].as_f64().unwrap(), p["rga"][0][0]["im"].as_f64().unwrap());
+    assert!((l11 - lambda).norm() < 1e-12 * lambda.norm(), "{l11} vs {lambda}");
+    // RGA number of the diagonal pairing: Σ|Λ − I| = 2|λ11 − 1| + 2|1 − λ11| for a 2×2.
+    assert!((p["rga_number"].as_f64().unwrap() - 4.0 * (lambda - 1.0).norm()).abs() < 1e-10);
+
+    let out = plantwide(&["gains", "--tf", &tf, "--inputs", "S", "--outputs", "xB,xD", "--json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["gain"], serde_json::json!([[-19.4], [-18.9]]));
+    assert!(v.get("frequency").is_none());
+    let bad = plantwide(&["gains", "--tf", &tf, "--inputs", "Q"]);
+    assert_eq!(bad.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("no input `Q`"));
+}
+
+/// A flowsheet's `gains --frequencies --json` carries the same block: at a frequency far below the
+/// slowest mode G(jω) is G(0), the `gain` the same command prints.
+#[test]
+fn flowsheet_frequency_results_tend_to_the_steady_state_gains() {
+    let out = plantwide(&[
+        "gains",
+        &flowsheet("column_a.json"),
+        "--inputs",
+        "L,V",
+        "--outputs",
+        "distillate.x[light],bottoms.x[light]",
+        "--frequencies",
+        "1e-9:1e-8:2",
+        "--json",
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    for i in 0..2 {
+        for j in 0..2 {
+            let g0 = v["gain"][i][j].as_f64().unwrap();
+            let z = &v["frequency"]["points"][0]["g"][i][j];
+            assert!((z["re"].as_f64().unwrap() - g0).abs() < 1e-6 * g0.abs(), "{i}{j}");
+            assert!(z["im"].as_f64().unwrap().abs() < 1e-3 * g0.abs(), "{i}{j}");
+        }
+    }
+}

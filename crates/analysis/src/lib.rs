@@ -22,6 +22,7 @@
 
 pub mod error;
 pub mod figures;
+pub mod frequency;
 pub mod linear;
 pub mod measures;
 pub mod min_cond;

@@ -135,6 +135,7 @@ impl GainReport {
             condition_number: self.condition_number.is_finite().then_some(self.condition_number),
             niederlinski: self.niederlinski,
             perturbation: None,
+            frequency: None,
         }
     }
 }
@@ -161,6 +162,10 @@ pub struct GainJson<'a> {
     /// How perturbation gains were verified (`gains --method perturb` only; absent otherwise).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub perturbation: Option<&'a PerturbCheck>,
+    /// `G(jω)`, its singular values and RGA at each frequency (`--frequencies` only; absent
+    /// otherwise).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub frequency: Option<&'a crate::frequency::FrequencyResults>,
 }
 
 #[cfg(test)]

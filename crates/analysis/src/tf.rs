@@ -113,6 +113,40 @@ impl TfModel {
     pub fn response(&self, omega: f64) -> Mat<c64> {
         self.matrix(0..self.inputs.len(), omega)
     }
+
+    /// The model restricted to the channels `inputs` → `outputs`, named as in the model and in
+    /// the order given (an empty list keeps all); disturbances stay.
+    ///
+    /// # Errors
+    /// A name the model does not have, with the names it has.
+    pub fn select(&self, inputs: &[String], outputs: &[String]) -> Result<TfModel, AnalysisError> {
+        let pick = |names: &[String], signals: &[TfSignal], what: &str| -> Result<Vec<usize>, AnalysisError> {
+            if names.is_empty() {
+                return Ok((0..signals.len()).collect());
+            }
+            names
+                .iter()
+                .map(|n| {
+                    signals.iter().position(|s| s.name == *n).ok_or_else(|| {
+                        let all: Vec<&str> = signals.iter().map(|s| s.name.as_str()).collect();
+                        request(format!("model `{}` has no {what} `{n}`; its {what}s: {}", self.name, all.join(", ")))
+                    })
+                })
+                .collect()
+        };
+        let (ii, oo) = (pick(inputs, &self.inputs, "input")?, pick(outputs, &self.outputs, "output")?);
+        let n = self.inputs.len();
+        let cols: Vec<usize> = ii.iter().copied().chain(n..n + self.disturbances.len()).collect();
+        let elements = oo.iter().map(|&i| cols.iter().map(|&j| self.elements[i][j].clone()).collect()).collect();
+        Ok(TfModel {
+            name: self.name.clone(),
+            description: self.description.clone(),
+            inputs: ii.iter().map(|&j| self.inputs[j].clone()).collect(),
+            outputs: oo.iter().map(|&i| self.outputs[i].clone()).collect(),
+            disturbances: self.disturbances.clone(),
+            elements,
+        })
+    }
 }
 
 #[cfg(test)]
@@ -121,6 +155,26 @@ mod tests {
 
     fn signal(name: &str) -> TfSignal {
         TfSignal { name: name.into(), unit: String::new(), description: String::new() }
+    }
+
+    #[test]
+    fn channels_are_selected_by_name_in_the_order_given() {
+        let e = |k: f64| Some(Element { gain: k, lags: vec![], leads: vec![], dead_time: 0.0 });
+        let m = TfModel::new(
+            "m".into(),
+            String::new(),
+            vec![signal("u1"), signal("u2")],
+            vec![signal("y1"), signal("y2")],
+            vec![signal("d")],
+            vec![vec![e(1.0), e(2.0), e(5.0)], vec![e(3.0), e(4.0), e(6.0)]],
+        )
+        .unwrap();
+        let s = m.select(&["u2".into()], &["y2".into(), "y1".into()]).unwrap();
+        let g = s.gain();
+        assert_eq!((g.nrows(), g.ncols(), g[(0, 0)], g[(1, 0)]), (2, 1, 4.0, 2.0));
+        assert_eq!(s.disturbance_gain()[(0, 0)], 6.0);
+        let err = m.select(&["u3".into()], &[]).unwrap_err().to_string();
+        assert!(err.contains("no input `u3`") && err.contains("u1, u2"), "{err}");
     }
 
     #[test]
