@@ -1,10 +1,13 @@
 //! `plantwide linearize FILE --inputs P1,P2 --outputs Q1,Q2 --out model.json [--time-unit min]
 //! [--frequencies LOW:HIGH:N]`: the state-space model at the steady state, for MATLAB and
-//! python-control (see `plantwide_io::export` for how to load it).
+//! python-control (see `plantwide_io::export` for how to load it); `plantwide linearize --tf
+//! MODEL.tf.json [--inputs …] [--outputs …]`: a transfer-function model's elements as numerator,
+//! denominator and dead time, its poles and gains (see `plantwide_io::tf::export`).
 
 use std::path::PathBuf;
 
 use plantwide::analysis::faer::{Mat, c64};
+use plantwide::analysis::frequency::{self, FrequencyResults};
 use plantwide::analysis::linear::Linearization;
 use plantwide::analysis::select::{select_inputs, select_outputs};
 use plantwide::io::export::ModelExport;
@@ -18,12 +21,18 @@ use super::steady::{converge, load_with_overrides};
 #[derive(Debug, clap::Args)]
 pub struct LinearizeArgs {
     /// Flowsheet file (JSON).
-    file: PathBuf,
-    /// Inputs, comma-separated, each `PATH[@unit]`.
-    #[arg(long, value_delimiter = ',', required = true)]
+    #[arg(required_unless_present = "tf", conflicts_with = "tf")]
+    file: Option<PathBuf>,
+    /// A transfer-function model (`*.tf.json`) instead of a flowsheet.
+    #[arg(long, value_name = "MODEL")]
+    tf: Option<PathBuf>,
+    /// Inputs, comma-separated, each `PATH[@unit]`; with `--tf`, the model's input names to keep
+    /// (default all).
+    #[arg(long, value_delimiter = ',', required_unless_present = "tf")]
     inputs: Vec<String>,
-    /// Outputs, comma-separated variable paths, each `PATH[@unit]`.
-    #[arg(long, value_delimiter = ',', required = true)]
+    /// Outputs, comma-separated variable paths, each `PATH[@unit]`; with `--tf`, the model's
+    /// output names to keep (default all).
+    #[arg(long, value_delimiter = ',', required_unless_present = "tf")]
     outputs: Vec<String>,
     /// Write the model (JSON) here.
     #[arg(long, value_name = "MODEL.json")]
@@ -75,9 +84,65 @@ pub fn frequency_grid(text: &str, tu: &TimeUnit) -> Result<Vec<f64>, CliError> {
     Ok((0..n).map(|k| lo * (hi / lo).powf(k as f64 / (n - 1) as f64) / tu.seconds).collect())
 }
 
+/// `linearize --tf`: the elements (numerator, denominator, dead time), poles and gains of a
+/// transfer-function model, printed and, with `--out`, written as JSON.
+fn run_tf(a: &LinearizeArgs, file: &std::path::Path, tu: &TimeUnit) -> Result<(), CliError> {
+    let name = file.display().to_string();
+    let text = plantwide::flowsheet::read_text(file).map_err(|e| CliError::user(e.to_string()))?;
+    let model = plantwide::io::tf::parse(&text, &name).map_err(|e| CliError::user(e.to_string()))?;
+    let model = model.select(&a.inputs, &a.outputs).map_err(|e| CliError::user(format!("{name}: {e}")))?;
+    let omegas = a.frequencies.as_deref().map(|f| frequency_grid(f, tu)).transpose()?;
+    let frequency = omegas.map(|w| FrequencyResults {
+        time_unit: tu.name.clone(),
+        points: w.iter().map(|&w| frequency::point(w * tu.seconds, &model.response(w), &[])).collect(),
+    });
+    let doc = plantwide::io::tf::export(&model, (&tu.name, tu.seconds), frequency.as_ref());
+    outln!(
+        "transfer-function model `{}`: {} inputs, {} outputs (s in rad/{}, times in {})",
+        model.name,
+        model.inputs.len(),
+        model.outputs.len(),
+        tu.name,
+        tu.name
+    );
+    for (i, o) in model.outputs.iter().enumerate() {
+        for (j, inp) in model.inputs.iter().enumerate() {
+            let e = &doc["elements"][i][j];
+            if e.is_null() {
+                continue;
+            }
+            outln!(
+                "  {} ← {}: num {} / den {} · e^(−{} s)",
+                o.name,
+                inp.name,
+                e["num"],
+                e["den"],
+                sig(e["dead_time"].as_f64().unwrap_or(f64::NAN))
+            );
+        }
+    }
+    let poles: Vec<String> =
+        doc["poles"].as_array().into_iter().flatten().filter_map(|p| p.as_f64()).map(sig).collect();
+    outln!("poles [1/{}]: {}", tu.name, poles.join(", "));
+    if let Some(out) = &a.out {
+        let text = serde_json::to_string_pretty(&doc).map_err(|e| CliError::user(e.to_string()))?;
+        std::fs::write(out, text + "\n")
+            .map_err(|e| CliError::user(format!("{}: cannot write: {e}", out.display())))?;
+        outln!(
+            "wrote {} (per element `num`, `den`, `dead_time`: python-control `control.tf(num, den)`)",
+            out.display()
+        );
+    }
+    Ok(())
+}
+
 pub fn run(a: &LinearizeArgs) -> Result<(), CliError> {
     let tu = TimeUnit::parse(&a.time_unit)?;
-    let (plant, u) = load_with_overrides(&a.file, &a.set)?;
+    if let Some(tf) = &a.tf {
+        return run_tf(a, tf, &tu);
+    }
+    let Some(file) = &a.file else { return Err(CliError::user("give a flowsheet FILE or --tf MODEL")) };
+    let (plant, u) = load_with_overrides(file, &a.set)?;
     let map = |e: plantwide::analysis::AnalysisError| {
         if e.is_user_error() { CliError::user(e.to_string()) } else { CliError::numerical(e.to_string()) }
     };

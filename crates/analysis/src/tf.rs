@@ -36,7 +36,36 @@ pub struct Element {
     pub dead_time: f64,
 }
 
+/// `Π_k (τ_k s + 1)` as coefficients in descending powers of `s`, times in `per` seconds.
+fn polynomial(taus: &[f64], per: f64) -> Vec<f64> {
+    let mut c = vec![1.0];
+    for t in taus {
+        // (τ s + 1) · c(s)
+        let mut next = vec![0.0; c.len() + 1];
+        for (k, a) in c.iter().enumerate() {
+            next[k] += a * t / per;
+            next[k + 1] += a;
+        }
+        c = next;
+    }
+    c
+}
+
 impl Element {
+    /// Numerator `K Π(τ_lead s + 1)`, coefficients in descending powers of `s` with `s` in
+    /// rad per `per` seconds (`per = 60` for minutes): python-control's and MATLAB's `tf(num, den)`.
+    pub fn numerator(&self, per: f64) -> Vec<f64> {
+        polynomial(&self.leads, per).into_iter().map(|c| c * self.gain).collect()
+    }
+    /// Denominator `Π(τ_lag s + 1)`, as [`Element::numerator`].
+    pub fn denominator(&self, per: f64) -> Vec<f64> {
+        polynomial(&self.lags, per)
+    }
+    /// The poles `−1/τ_lag` [1/s].
+    pub fn poles(&self) -> Vec<f64> {
+        self.lags.iter().map(|t| -1.0 / t).collect()
+    }
+
     /// `g(jω)` at `ω` [rad/s].
     pub fn response(&self, omega: f64) -> c64 {
         let num: c64 = self.leads.iter().map(|t| c64::new(1.0, t * omega)).product();
@@ -155,6 +184,15 @@ mod tests {
 
     fn signal(name: &str) -> TfSignal {
         TfSignal { name: name.into(), unit: String::new(), description: String::new() }
+    }
+
+    #[test]
+    fn polynomials_multiply_out_the_time_constants() {
+        let e = Element { gain: 2.0, lags: vec![60.0, 120.0], leads: vec![-30.0], dead_time: 60.0 };
+        // In minutes: 2 (−0.5 s + 1) / ((s + 1)(2 s + 1)) = (−s + 2) / (2 s² + 3 s + 1).
+        assert_eq!(e.numerator(60.0), vec![-1.0, 2.0]);
+        assert_eq!(e.denominator(60.0), vec![2.0, 3.0, 1.0]);
+        assert_eq!(e.poles(), vec![-1.0 / 60.0, -1.0 / 120.0]);
     }
 
     #[test]

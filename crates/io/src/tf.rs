@@ -193,6 +193,60 @@ fn element(e: &ElementSpec, file: &str, at: &dyn Fn(&str) -> String) -> Result<E
     Ok(Element { gain: e.gain, lags, leads, dead_time })
 }
 
+/// A transfer-function model as JSON for python-control and MATLAB: per element its numerator
+/// and denominator in descending powers of `s` (rad per `time_unit`) and its dead time (in
+/// `time_unit`), with the poles, the steady-state gain and, if asked, `G(jω)`:
+///
+/// ```python
+/// import json, control
+/// m = json.load(open("wood_berry.model.json")); e = m["elements"][0][0]
+/// g11 = control.tf(e["num"], e["den"])          # times e^(-e["dead_time"] s), e.g. control.pade
+/// ```
+pub fn export(
+    model: &TfModel,
+    time_unit: (&str, f64),
+    frequency: Option<&plantwide_analysis::frequency::FrequencyResults>,
+) -> serde_json::Value {
+    let (unit, per) = time_unit;
+    let signal = |s: &TfSignal| serde_json::json!({"name": s.name, "unit": s.unit});
+    let elements: Vec<Vec<serde_json::Value>> = (0..model.outputs.len())
+        .map(|i| {
+            (0..model.inputs.len())
+                .map(|j| match model.element(i, j) {
+                    Some(e) => serde_json::json!({
+                        "gain": e.gain,
+                        "num": e.numerator(per),
+                        "den": e.denominator(per),
+                        "dead_time": e.dead_time / per,
+                        "poles": e.poles().iter().map(|p| p * per).collect::<Vec<_>>(),
+                    }),
+                    None => serde_json::Value::Null,
+                })
+                .collect()
+        })
+        .collect();
+    let mut poles: Vec<f64> = (0..model.outputs.len())
+        .flat_map(|i| (0..model.inputs.len()).filter_map(move |j| model.element(i, j)))
+        .flat_map(|e| e.poles())
+        .map(|p| p * per)
+        .collect();
+    poles.sort_by(|a, b| b.total_cmp(a));
+    poles.dedup();
+    let mut doc = serde_json::json!({
+        "name": model.name,
+        "time_unit": unit,
+        "inputs": model.inputs.iter().map(signal).collect::<Vec<_>>(),
+        "outputs": model.outputs.iter().map(signal).collect::<Vec<_>>(),
+        "steady_state_gain": plantwide_analysis::measures::rows(model.gain().as_ref()),
+        "elements": elements,
+        "poles": poles,
+    });
+    if let Some(f) = frequency {
+        doc["frequency"] = serde_json::to_value(f).unwrap_or(serde_json::Value::Null);
+    }
+    doc
+}
+
 #[cfg(test)]
 mod tests {
     use faer::c64;
