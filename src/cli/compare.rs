@@ -4,8 +4,12 @@
 
 use std::path::{Path, PathBuf};
 
-use plantwide::io::plot::{Overlay, write_bars, write_overlays};
+use plantwide::analysis::faer::Mat;
+use plantwide::analysis::measures::{rga, rows};
+use plantwide::io::html::markdown_to_html;
+use plantwide::io::plot::{LabelledMatrix, Overlay, write_bars, write_matrices, write_overlays};
 use plantwide::studies::compare::{CompareRequest, Comparison, Scheme, compare};
+use plantwide::studies::screen::pairings::STEP_AT;
 use plantwide::studies::screen::pairings::{DynamicResult, DynamicSettings};
 use plantwide::studies::tune::loops::Measurement;
 
@@ -98,10 +102,39 @@ fn write_report(dir: &Path, c: &Comparison, json: &str) -> Result<(), CliError> 
     let bars: Vec<(String, f64)> = c.schemes.iter().map(|s| (s.name.clone(), s.energy.heating / 1e3)).collect();
     write_bars(&dir.join("energy.png"), "heating duty", "kW", &bars).map_err(draw)?;
     let mut figures = String::from("\n![heating duty](energy.png)\n");
+    if write_rga(&dir.join("rga.png"), c).map_err(draw)? {
+        figures.push_str("\n![relative gains](rga.png)\n");
+    }
     for name in write_responses(dir, c).map_err(draw)? {
         figures.push_str(&format!("\n![responses]({name})\n"));
     }
-    std::fs::write(dir.join("compare.md"), format!("{}{figures}", markdown(c))).map_err(fail)
+    let md = format!("{}{figures}", markdown(c));
+    std::fs::write(dir.join("compare.html"), markdown_to_html("Schemes compared", &md)).map_err(fail)?;
+    std::fs::write(dir.join("compare.md"), md).map_err(fail)
+}
+
+/// The quality loops' relative gains of every scheme that has loops, side by side; false (and no
+/// file) when none has.
+fn write_rga(file: &Path, c: &Comparison) -> Result<bool, plantwide::io::IoError> {
+    let matrices: Vec<LabelledMatrix> = c
+        .schemes
+        .iter()
+        .filter(|s| !s.gain.is_empty())
+        .map(|s| {
+            let g = Mat::from_fn(s.gain.len(), s.gain[0].len(), |i, j| s.gain[i][j]);
+            LabelledMatrix {
+                label: s.name.clone(),
+                values: rga(g.as_ref()).ok().map(|l| rows(l.as_ref())),
+                rows: s.loops.iter().map(|l| l.cv.clone()).collect(),
+                cols: s.loops.iter().map(|l| l.mv.clone()).collect(),
+            }
+        })
+        .collect();
+    if matrices.is_empty() {
+        return Ok(false);
+    }
+    write_matrices(file, "relative gains of the quality loops", &matrices)?;
+    Ok(true)
 }
 
 /// A scheme's closed-loop runs, if they ran.
@@ -129,16 +162,19 @@ fn write_responses(dir: &Path, c: &Comparison) -> Result<Vec<String>, plantwide:
                         (r.times.len() == run.times.len()).then(|| (s.name.clone(), r.series[k].clone()))
                     })
                     .collect(),
+                ..Overlay::default()
             })
             .collect();
         let times: Vec<f64> = run.times.iter().map(|t| t / 3600.0).collect();
         let name = format!("responses_{}.png", d + 1);
+        let step = STEP_AT * times.last().copied().unwrap_or(0.0);
         write_overlays(
             &dir.join(&name),
             &format!("{}: closed-loop responses (tuning in compare.md)", run.disturbance),
             "time [h]",
             &times,
             &panels,
+            &[(step, run.disturbance.clone())],
         )?;
         names.push(name);
     }

@@ -14,6 +14,7 @@ use plantwide::analysis::report::{GainJson, GainReport, ReportOptions};
 use plantwide::analysis::select::{Signal, SignalLabel, parse_block, parse_pairing, select_inputs, select_outputs};
 use plantwide::analysis::sensors::select_temperature_sensors;
 use plantwide::analysis::tf::TfSignal;
+use plantwide::io::plot::{LabelledMatrix, write_matrices};
 use plantwide::io::tf;
 use plantwide::units::{Dimension, parse_quantity_as};
 
@@ -85,6 +86,20 @@ pub struct GainsArgs {
     /// Override an input or a unit parameter first, e.g. `--set feed_source.F=1.01kmol/min`.
     #[arg(long = "set", value_name = "PATH=VALUE")]
     set: Vec<String>,
+    /// Draw the relative gain array as a heat map here (`.png` or `.svg`).
+    #[arg(long, value_name = "RGA.png")]
+    plot: Option<PathBuf>,
+}
+
+/// The RGA heat map of `r` into `file`, titled by `name`.
+fn plot_rga(file: &Path, name: &str, r: &GainReport) -> Result<(), CliError> {
+    let matrix = LabelledMatrix {
+        label: "Λ(0)".into(),
+        values: r.rga.as_ref().map(|l| rows(l.as_ref())),
+        rows: r.outputs.iter().map(|s| s.path.clone()).collect(),
+        cols: r.inputs.iter().map(|s| s.path.clone()).collect(),
+    };
+    write_matrices(file, &format!("relative gains of `{name}`"), &[matrix]).map_err(|e| CliError::user(e.to_string()))
 }
 
 fn analysis_error(e: AnalysisError) -> CliError {
@@ -201,6 +216,9 @@ pub fn run(a: &GainsArgs) -> Result<(), CliError> {
         }
         None => None,
     };
+    if let Some(p) = &a.plot {
+        plot_rga(p, plant.name(), &report)?;
+    }
     if a.json {
         let json = GainJson { perturbation: check.as_ref(), frequency: frequency.as_ref(), ..report.json() };
         outln!("{}", serde_json::to_string_pretty(&json).map_err(|e| CliError::user(e.to_string()))?);
@@ -258,6 +276,9 @@ fn run_tf(a: &GainsArgs, file: &Path) -> Result<(), CliError> {
         }
         None => None,
     };
+    if let Some(p) = &a.plot {
+        plot_rga(p, &model.name, &report)?;
+    }
     if a.json {
         let json = GainJson { frequency: frequency.as_ref(), ..report.json() };
         outln!("{}", serde_json::to_string_pretty(&json).map_err(|e| CliError::user(e.to_string()))?);

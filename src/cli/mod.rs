@@ -25,6 +25,7 @@ mod components;
 mod gains;
 mod linearize;
 mod run;
+mod run_plot;
 mod screen;
 mod sensitivity;
 mod size;
@@ -131,6 +132,9 @@ enum Command {
         /// Units of the paths the scenario records without one (CSV, plot, table; JSON stays SI).
         #[arg(long, value_enum, default_value_t = UnitsArg::Si)]
         units: UnitsArg,
+        /// Overlay an earlier run's CSV on the plot (dashed; the same paths and units); repeatable.
+        #[arg(long, value_name = "OTHER.csv")]
+        compare: Vec<PathBuf>,
     },
     /// Print the JSON Schema of flowsheet files (the shipped flowsheets/plantwide.schema.json), or
     /// with `--scenario` of scenario files (flowsheets/scenario.schema.json).
@@ -193,8 +197,8 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             let units = units.map(Into::into);
             steady::run(&steady::SteadyArgs { file: &file, json, sets: &set, specs: &spec, vary: &vary, method, units })
         }
-        Command::Run { file, scenario, csv, plot, json, set, resume, units } => {
-            run::run(&run::RunArgs { file, scenario, csv, plot, json, set, resume, units: units.into() })
+        Command::Run { file, scenario, csv, plot, json, set, resume, units, compare } => {
+            run::run(&run::RunArgs { file, scenario, csv, plot, json, set, resume, units: units.into(), compare })
         }
         Command::Gains(a) => gains::run(&a),
         Command::Linearize(a) => linearize::run(&a),

@@ -9,8 +9,10 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use plantwide::flowsheet::Plant;
+use plantwide::flowsheet::scenario::ScenarioSpec;
 use plantwide::flowsheet::scenario::{Limits, parse_scenario, resolve_with};
-use plantwide::io::plot::{Trend, write_trends};
+use plantwide::io::plot::write_overlays;
 use plantwide::solve::dynamic::{
     CONSERVATION_TOL, Conservation, Progress, SimError, SimulationResult, Snapshot, Start, simulate,
 };
@@ -38,6 +40,8 @@ pub struct RunArgs {
     pub resume: Option<PathBuf>,
     /// Display units of the paths the scenario recorded without one.
     pub units: UnitSystem,
+    /// Earlier runs' CSV files whose trends the plot overlays, dashed.
+    pub compare: Vec<PathBuf>,
 }
 
 /// FNV-1a hash of the flowsheet text and the overrides: identifies the plant in snapshots.
@@ -97,13 +101,14 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
     });
     bar.finish_and_clear();
     let title = if sc.name.is_empty() { plant.name().to_string() } else { format!("{}: {}", plant.name(), sc.name) };
+    let plot_cx = PlotContext { plant: &plant, spec: &spec, title: &title };
     let mut res = match result {
         Ok(res) => res,
         Err(e @ (SimError::Snapshot { .. } | SimError::Wiring(_))) => return Err(CliError::user(e.to_string())),
         Err(SimError::Conservation { file, source, mut result }) => {
             display_units(&mut result, args.units);
             // The whole run is there: write and summarize it, then fail on the balance.
-            write_trends_files(args, &result, &title, &sc.time_unit, time_factor)?;
+            write_trends_files(args, &result, &plot_cx, &sc.time_unit, time_factor)?;
             print_summary(&result, args.json, started.elapsed().as_secs_f64(), time_factor, &sc.time_unit)?;
             return Err(CliError::numerical(format!(
                 "{file}: {source}; the integration is not to be trusted (trends in {})",
@@ -115,7 +120,7 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
             let SimError::Integration { partial, .. } = &e else { return Err(CliError::numerical(e.to_string())) };
             let mut partial = partial.clone();
             display_units(&mut partial, args.units);
-            let written = write_trends_files(args, &partial, &title, &sc.time_unit, time_factor);
+            let written = write_trends_files(args, &partial, &plot_cx, &sc.time_unit, time_factor);
             let at = format!("{:.6} {}", partial.t * time_factor, sc.time_unit);
             return Err(CliError::numerical(match written {
                 Ok(()) => format!("{e}; the trends up to t = {at} are in {}", args.csv.display()),
@@ -127,7 +132,7 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
         return Err(e);
     }
     display_units(&mut res, args.units);
-    write_trends_files(args, &res, &title, &sc.time_unit, time_factor)?;
+    write_trends_files(args, &res, &plot_cx, &sc.time_unit, time_factor)?;
     let wall = started.elapsed().as_secs_f64();
     print_summary(&res, args.json, wall, time_factor, &sc.time_unit)
 }
@@ -141,24 +146,28 @@ fn display_units(res: &mut SimulationResult, units: UnitSystem) {
     }
 }
 
+/// What the plot is drawn from besides the result: the plant (controller limits), the scenario
+/// (panels, event labels) and the plot's title.
+struct PlotContext<'a> {
+    plant: &'a Plant,
+    spec: &'a ScenarioSpec,
+    title: &'a str,
+}
+
 /// The CSV file and, if asked for, the plot of the recorded trends.
 fn write_trends_files(
     args: &RunArgs,
     res: &SimulationResult,
-    title: &str,
+    cx: &PlotContext<'_>,
     time_unit: &str,
     time_factor: f64,
 ) -> Result<(), CliError> {
     write_csv(&args.csv, res, time_unit, time_factor)?;
     if let Some(p) = &args.plot {
         let times: Vec<f64> = res.times.iter().map(|t| t * time_factor).collect();
-        let trends: Vec<Trend> = (0..res.columns.len())
-            .map(|k| Trend {
-                label: format!("{} [{}]", res.columns[k].path, res.columns[k].unit),
-                values: res.rows.iter().map(|r| to_unit(r[k], &res.columns[k].unit)).collect(),
-            })
-            .collect();
-        write_trends(p, title, &format!("time [{time_unit}]"), &times, &trends)
+        let panels = super::run_plot::panels(res, cx.plant, cx.spec, &args.compare)?;
+        let events = super::run_plot::events(res, cx.spec, time_factor);
+        write_overlays(p, cx.title, &format!("time [{time_unit}]"), &times, &panels, &events)
             .map_err(|e| CliError::user(e.to_string()))?;
     }
     Ok(())

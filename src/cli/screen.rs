@@ -5,7 +5,9 @@
 
 use std::path::{Path, PathBuf};
 
+use plantwide::io::html::markdown_to_html;
 use plantwide::io::plot::{LabelledMatrix, Overlay, write_bars, write_matrices, write_overlays};
+use plantwide::studies::screen::pairings::STEP_AT;
 use plantwide::studies::screen::pairings::{Disturbance, DynamicSettings, PairingRequest, PairingScreen, Watch};
 use plantwide::studies::screen::{ColumnScreen, ScreenError, screen_column, screen_pairings};
 use plantwide::units::Dimension;
@@ -124,6 +126,7 @@ fn write_report(dir: &Path, file: &Path, s: &ColumnScreen, json: &str) -> Result
         .map(|c| LabelledMatrix {
             label: format!("{} ({})", c.name, c.rank.map_or("not ranked".to_string(), |r| format!("rank {r}"))),
             values: c.rga.clone(),
+            ..LabelledMatrix::default()
         })
         .collect();
     let title = format!("relative gains of column `{}`: {} (row 1), {} (row 2)", s.column, s.outputs[0], s.outputs[1]);
@@ -144,6 +147,7 @@ fn write_report(dir: &Path, file: &Path, s: &ColumnScreen, json: &str) -> Result
         s.column,
         table(s, file)
     );
+    std::fs::write(dir.join("screen.html"), markdown_to_html("Column configurations", &md)).map_err(fail)?;
     std::fs::write(dir.join("screen.md"), md).map_err(fail)
 }
 
@@ -197,12 +201,14 @@ fn write_responses(dir: &Path, s: &PairingScreen) -> Result<Vec<String>, CliErro
                             .map(|t| (format!("rank {}", c.rank.unwrap_or(0)), t.runs[d].series[k].clone()))
                     })
                     .collect(),
+                ..Overlay::default()
             })
             .collect();
         let times: Vec<f64> = run.times.iter().map(|t| t / 3600.0).collect();
         let name = format!("responses_{}.png", d + 1);
         let title = format!("{}: the best structures' responses", run.disturbance);
-        write_overlays(&dir.join(&name), &title, "time [h]", &times, &panels)
+        let step = [(STEP_AT * times.last().copied().unwrap_or(0.0), run.disturbance.clone())];
+        write_overlays(&dir.join(&name), &title, "time [h]", &times, &panels, &step)
             .map_err(|e| CliError::user(e.to_string()))?;
         names.push(name);
     }
@@ -273,8 +279,9 @@ fn pairings(a: &ScreenArgs, plant: &plantwide::flowsheet::Plant) -> Result<(), C
         if write_ranking(dir, &screen)? {
             figures.push_str("\n![ranking](ranking.png)\n");
         }
-        std::fs::write(dir.join("screen.md"), format!("# Pairings\n\n{}{figures}", pairing_table(&screen)))
-            .map_err(fail)?;
+        let md = format!("# Pairings\n\n{}{figures}", pairing_table(&screen));
+        std::fs::write(dir.join("screen.html"), markdown_to_html("Pairings", &md)).map_err(fail)?;
+        std::fs::write(dir.join("screen.md"), md).map_err(fail)?;
     }
     if a.json {
         outln!("{json}");

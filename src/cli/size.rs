@@ -280,12 +280,13 @@ fn plot_designs(out: &Path, s: &VesselSizing) -> Result<(), CliError> {
     let tr = &s.current.trace;
     flow.push(("as in the file".to_string(), at(&tr.times, &tr.outflow)));
     let panels = [
-        Overlay { label: "level deviation [m]".into(), curves: level },
-        Overlay { label: format!("{} [mol/s]", s.outflow), curves: flow },
+        Overlay { label: "level deviation [m]".into(), curves: level, ..Overlay::default() },
+        Overlay { label: format!("{} [mol/s]", s.outflow), curves: flow, ..Overlay::default() },
     ];
     let hours: Vec<f64> = grid.iter().map(|t| t / 3600.0).collect();
     let title = format!("surge designs of `{}` for {} (band ±{} m)", s.vessel, s.disturbance, s.level_band);
-    write_overlays(out, &title, "time after the step [h]", &hours, &panels).map_err(|e| CliError::user(e.to_string()))
+    write_overlays(out, &title, "time after the step [h]", &hours, &panels, &[])
+        .map_err(|e| CliError::user(e.to_string()))
 }
 
 fn interpolate(times: &[f64], ys: &[f64], t: f64) -> f64 {

@@ -207,7 +207,7 @@ pub struct RecordSpec {
     /// Unit of the time column (default `min`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub time_unit: Option<String>,
-    /// Variable or input paths, each a string (SI units) or `{"path": …, "unit": …}`.
+    /// Variable or input paths, each a string (SI units) or `{"path": …, "unit": …, "panel": …}`.
     #[serde(default)]
     pub paths: Vec<RecordPathSpec>,
     /// Streams whose cumulative component amounts `∫ F x_c dt` [mol] are integrated with the
@@ -222,12 +222,17 @@ pub struct RecordSpec {
 pub enum RecordPathSpec {
     /// In SI units.
     Path(String),
-    /// In a given unit.
+    /// In a given unit, or on a named plot panel.
     WithUnit {
         /// Variable or input path.
         path: String,
-        /// Unit (e.g. `"kmol/min"`).
-        unit: String,
+        /// Unit (e.g. `"kmol/min"`; default SI, or the `--units` system's).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        unit: Option<String>,
+        /// Plot panel (e.g. `"temperatures"`): the paths that name one panel are drawn together,
+        /// in one unit (default: a panel of its own).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        panel: Option<String>,
     },
 }
 
@@ -632,7 +637,7 @@ fn recorded(cx: &mut Cx<'_>, rec: &RecordSpec, events: &[Event]) -> Vec<Recorded
             .iter()
             .map(|p| match p {
                 RecordPathSpec::Path(p) => (p.clone(), None),
-                RecordPathSpec::WithUnit { path, unit } => (path.clone(), Some(unit.clone())),
+                RecordPathSpec::WithUnit { path, unit, .. } => (path.clone(), unit.clone()),
             })
             .collect()
     };

@@ -17,6 +17,7 @@
 pub mod csv;
 pub mod error;
 pub mod export;
+pub mod html;
 pub mod plot;
 pub mod tf;
 

@@ -212,6 +212,11 @@ pub trait UnitModel: Send + Sync + std::fmt::Debug {
     {
         None
     }
+    /// A controller's output limits `(op_min, op_max)` (SI; infinite where there is none), drawn
+    /// on trend plots of its output (default: none).
+    fn output_limits(&self) -> Option<(f64, f64)> {
+        None
+    }
 }
 
 /// Object-safe view of a [`UnitModel`], used by assembly and solvers.
@@ -250,6 +255,8 @@ pub trait Unit: Send + Sync + std::fmt::Debug {
     fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]);
     /// See [`UnitModel::without_limits`].
     fn without_limits(&self) -> Option<Box<dyn Unit>>;
+    /// See [`UnitModel::output_limits`].
+    fn output_limits(&self) -> Option<(f64, f64)>;
     /// See [`UnitModel::holdup`].
     fn holdup(&self, io: &UnitIo<'_, f64>) -> Option<Vec<f64>>;
     /// See [`UnitModel::reacts`].
@@ -362,6 +369,9 @@ impl<U: UnitModel + 'static> Unit for U {
     }
     fn without_limits(&self) -> Option<Box<dyn Unit>> {
         UnitModel::without_limits(self).map(|u| Box::new(u) as Box<dyn Unit>)
+    }
+    fn output_limits(&self) -> Option<(f64, f64)> {
+        UnitModel::output_limits(self)
     }
     fn holdup(&self, io: &UnitIo<'_, f64>) -> Option<Vec<f64>> {
         UnitModel::holdup(self, io)

@@ -12,18 +12,28 @@ use super::{Figure, write_figure};
 use crate::error::IoError;
 
 /// One matrix of the figure.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 pub struct LabelledMatrix {
     /// Title above it (e.g. `LV (rank 6)`).
     pub label: String,
     /// Rows of values, `None` when there are none (drawn as `singular`).
     pub values: Option<Vec<Vec<f64>>>,
+    /// Row labels (outputs), drawn left of the rows; may be empty.
+    pub rows: Vec<String>,
+    /// Column labels (inputs), drawn above the columns; may be empty.
+    pub cols: Vec<String>,
 }
 
-/// Write the matrices side by side to `file` (`.png` or `.svg`), 240 × 300 pixels each.
+/// Room [px] for row and column labels when a matrix has them.
+const LABELS: (i32, i32) = (130, 22);
+
+/// Write the matrices side by side to `file` (`.png` or `.svg`), 240 × 300 pixels each (more
+/// with row and column labels).
 pub fn write_matrices(file: &Path, title: &str, matrices: &[LabelledMatrix]) -> Result<(), IoError> {
-    let width = 40 + 240 * matrices.len().max(1) as u32;
-    write_figure(file, (width, 330), &Matrices { title, matrices })
+    let labelled = matrices.iter().any(|m| !m.rows.is_empty() || !m.cols.is_empty());
+    let (dx, dy) = if labelled { (LABELS.0 as u32, LABELS.1 as u32) } else { (0, 0) };
+    let width = 40 + (240 + dx) * matrices.len().max(1) as u32;
+    write_figure(file, (width, 330 + dy), &Matrices { title, matrices })
 }
 
 struct Matrices<'a> {
@@ -55,19 +65,31 @@ impl Figure for Matrices<'_> {
         let root = root.margin(10, 10, 20, 20);
         for (panel, m) in root.split_evenly((1, self.matrices.len().max(1))).iter().zip(self.matrices) {
             let panel = panel.titled(&m.label, ("sans-serif", 16).into_font()).map_err(err)?;
+            let labelled = !m.rows.is_empty() || !m.cols.is_empty();
+            let (ox, oy) = if labelled { (10 + LABELS.0, 10 + LABELS.1) } else { (10, 10) };
             let (w, h) = panel.dim_in_pixel();
-            let side = (w.min(h) as i32 - 20).max(20);
+            let side = ((w as i32 - ox).min(h as i32 - oy) - 10).max(20);
             let Some(values) = &m.values else {
-                panel.draw(&Rectangle::new([(10, 10), (10 + side, 10 + side)], BLACK.stroke_width(1))).map_err(err)?;
+                panel.draw(&Rectangle::new([(ox, oy), (ox + side, oy + side)], BLACK.stroke_width(1))).map_err(err)?;
                 let style = ("sans-serif", 16).into_font().color(&BLACK);
                 panel.draw(&Text::new("singular", (side / 2 - 25, side / 2), style)).map_err(err)?;
                 continue;
             };
-            let n = values.len().max(1) as i32;
+            let n = values.len().max(values.first().map_or(1, Vec::len)).max(1) as i32;
             let cell = side / n;
+            let small = ("sans-serif", 12).into_font().color(&BLACK);
+            let short = |s: &str| s.chars().take(18).collect::<String>();
+            for (i, r) in m.rows.iter().enumerate() {
+                let y = oy + i as i32 * cell + cell / 2 - 6;
+                panel.draw(&Text::new(short(r), (4, y), small.clone())).map_err(err)?;
+            }
+            for (j, c) in m.cols.iter().enumerate() {
+                let x = ox + j as i32 * cell + 4;
+                panel.draw(&Text::new(short(c), (x, oy - 16), small.clone())).map_err(err)?;
+            }
             for (i, row) in values.iter().enumerate() {
                 for (j, &v) in row.iter().enumerate() {
-                    let (x0, y0) = (10 + j as i32 * cell, 10 + i as i32 * cell);
+                    let (x0, y0) = (ox + j as i32 * cell, oy + i as i32 * cell);
                     panel.draw(&Rectangle::new([(x0, y0), (x0 + cell, y0 + cell)], colour(v).filled())).map_err(err)?;
                     panel
                         .draw(&Rectangle::new([(x0, y0), (x0 + cell, y0 + cell)], WHITE.stroke_width(2)))
@@ -91,13 +113,19 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("plantwide_matrices_{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let m = [
-            LabelledMatrix { label: "LV".into(), values: Some(vec![vec![35.9, -34.9], vec![-34.9, 35.9]]) },
-            LabelledMatrix { label: "DB".into(), values: None },
+            LabelledMatrix {
+                label: "LV".into(),
+                values: Some(vec![vec![35.9, -34.9], vec![-34.9, 35.9]]),
+                rows: vec!["yD".into(), "xB".into()],
+                cols: vec!["reflux".into(), "boilup".into()],
+            },
+            LabelledMatrix { label: "DB".into(), values: None, ..LabelledMatrix::default() },
         ];
         let file = dir.join("rga.svg");
         write_matrices(&file, "relative gains", &m).unwrap();
         let svg = std::fs::read_to_string(&file).unwrap();
         assert!(svg.contains("35.900") && svg.contains("-34.900") && svg.contains("singular"), "{svg}");
+        assert!(svg.contains("reflux") && svg.contains("xB"), "labels drawn");
         write_matrices(&dir.join("rga.png"), "relative gains", &m).unwrap();
         assert!(std::fs::metadata(dir.join("rga.png")).unwrap().len() > 1000);
         std::fs::remove_dir_all(&dir).unwrap();

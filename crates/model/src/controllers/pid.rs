@@ -233,6 +233,10 @@ impl UnitModel for Pid {
         let limited = self.op_min > f64::NEG_INFINITY || self.op_max < f64::INFINITY;
         limited.then(|| Pid { op_min: f64::NEG_INFINITY, op_max: f64::INFINITY, ..self.clone() })
     }
+    fn output_limits(&self) -> Option<(f64, f64)> {
+        let limited = self.op_min > f64::NEG_INFINITY || self.op_max < f64::INFINITY;
+        limited.then_some((self.op_min, self.op_max))
+    }
     /// In auto with the output within 1e-9 (relative) of a limit and the error beyond 1e-6 of the
     /// measurement's scale: the loop has lost control of its measurement.
     fn saturation(&self, io: &UnitIo<'_, f64>) -> Option<crate::Saturation> {

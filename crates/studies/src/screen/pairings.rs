@@ -29,7 +29,7 @@ use plantwide_flowsheet::{Override, Plant, StructureEdit};
 use plantwide_solve::{NewtonSettings, StrategySettings, steady_state};
 use serde::Serialize;
 
-pub use dynamic::{CandidateFailure, CvFigures, DisturbanceRun, DynamicResult, DynamicSettings, Tuning};
+pub use dynamic::{CandidateFailure, CvFigures, DisturbanceRun, DynamicResult, DynamicSettings, STEP_AT, Tuning};
 pub use sensitivity::{Watch, WatchResult};
 
 use super::ScreenError;

@@ -308,6 +308,9 @@ fn tuned_plant(open: &OpenPlant, r: &PairingRequest, s: &PairingStructure) -> Tu
     Ok((plant, x, tuned(s, &kc, &ti, &actions, t.detuning_factor)))
 }
 
+/// Where in a run its disturbance steps, as a fraction of the run's duration.
+pub const STEP_AT: f64 = 0.02;
+
 /// One disturbance step on the tuned plant.
 fn run(
     plant: &Plant,
@@ -324,7 +327,7 @@ fn run(
     let text = serde_json::json!({
         "format_version": 1, "name": format!("{} step", d.path), "duration": format!("{duration} s"),
         "integrator": {"rtol": 1e-6},
-        "events": [{"type": "step", "at": format!("{} s", 0.02 * duration), "path": d.path, "by": d.fraction * u0}],
+        "events": [{"type": "step", "at": format!("{} s", STEP_AT * duration), "path": d.path, "by": d.fraction * u0}],
         "record": {"interval": format!("{} s", duration / 500.0), "paths": record}
     })
     .to_string();

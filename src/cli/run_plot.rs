@@ -1,0 +1,184 @@
+//! The trend plot of `plantwide run`: the recorded paths grouped into panels (`"panel"` in the
+//! scenario's record), each with its setpoint dashed, its controller's output limits dotted and
+//! the same paths of earlier runs (`--compare OTHER.csv`) dashed, and the events as markers.
+
+use std::path::{Path, PathBuf};
+
+use plantwide::flowsheet::Plant;
+use plantwide::flowsheet::scenario::{EventSpec, RecordPathSpec, ScenarioSpec};
+use plantwide::io::plot::Overlay;
+use plantwide::solve::dynamic::SimulationResult;
+use plantwide::units::{Display, convert_from_si, convert_to_si};
+
+use super::CliError;
+
+/// A unit as an axis label shows it: a dimensionless one as `-`.
+pub fn axis_unit(unit: &str) -> &str {
+    if unit == "1" { "-" } else { unit }
+}
+
+/// The panel each recorded column belongs to: its `"panel"` in the scenario, else its own.
+fn panel_names(spec: &ScenarioSpec, n: usize) -> Vec<String> {
+    (0..n)
+        .map(|k| match spec.record.paths.get(k) {
+            Some(RecordPathSpec::WithUnit { panel: Some(p), .. }) => p.clone(),
+            _ => format!("\u{0}{k}"),
+        })
+        .collect()
+}
+
+/// An earlier run's CSV: its time column converted to seconds, and each column by header.
+struct OtherRun {
+    name: String,
+    times: Vec<f64>,
+    columns: Vec<(String, Vec<f64>)>,
+}
+
+fn read_other(path: &Path) -> Result<OtherRun, CliError> {
+    let bad = |why: String| CliError::user(format!("--compare {}: {why}", path.display()));
+    let text = std::fs::read_to_string(path).map_err(|e| bad(e.to_string()))?;
+    let mut lines = text.lines();
+    let header: Vec<String> = lines
+        .next()
+        .ok_or_else(|| bad("empty file".into()))?
+        .split(',')
+        .map(|h| h.trim_matches('"').to_string())
+        .collect();
+    let time_unit = header[0].strip_prefix("time [").and_then(|h| h.strip_suffix(']'));
+    let time_unit = time_unit.ok_or_else(|| {
+        bad(format!("the first column is `{}`, not `time [unit]`: not a `plantwide run` CSV", header[0]))
+    })?;
+    let mut rows: Vec<Vec<f64>> = Vec::new();
+    for (i, l) in lines.enumerate() {
+        let row: Result<Vec<f64>, _> = l.split(',').map(str::parse).collect();
+        let row = row.map_err(|_| bad(format!("line {} is not numbers", i + 2)))?;
+        if row.len() != header.len() {
+            return Err(bad(format!("line {} has {} fields for {} columns", i + 2, row.len(), header.len())));
+        }
+        rows.push(row);
+    }
+    let times = rows
+        .iter()
+        .map(|r| convert_to_si(r[0], time_unit))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| bad(e.to_string()))?;
+    let columns = (1..header.len()).map(|k| (header[k].clone(), rows.iter().map(|r| r[k]).collect())).collect();
+    let name = path.file_stem().map_or_else(|| path.display().to_string(), |s| s.to_string_lossy().to_string());
+    Ok(OtherRun { name, times, columns })
+}
+
+/// `values` at `times` (s) linearly interpolated to `at` (s); NaN outside.
+fn resample(times: &[f64], values: &[f64], at: &[f64]) -> Vec<f64> {
+    at.iter()
+        .map(|&t| match times.partition_point(|&x| x < t) {
+            0 if times.first() == Some(&t) => values[0],
+            i if i == 0 || i >= times.len() => f64::NAN,
+            i => {
+                let w = (t - times[i - 1]) / (times[i] - times[i - 1]);
+                values[i - 1] + w * (values[i] - values[i - 1])
+            }
+        })
+        .collect()
+}
+
+/// The output limits of the controller whose output `path` is (or drives, for an input path).
+fn limits(plant: &Plant, path: &str) -> Option<(f64, f64)> {
+    let var = plant.var(path).or_else(|| plant.input(path).and_then(|i| plant.inputs()[i].driven_by))?;
+    plant.blocks()[plant.vars()[var].block].unit.output_limits()
+}
+
+/// The panels of the run's plot.
+pub fn panels(
+    res: &SimulationResult,
+    plant: &Plant,
+    spec: &ScenarioSpec,
+    compare: &[PathBuf],
+) -> Result<Vec<Overlay>, CliError> {
+    let others = compare.iter().map(|p| read_other(p)).collect::<Result<Vec<_>, _>>()?;
+    let names = panel_names(spec, res.columns.len());
+    let mut order: Vec<&String> = Vec::new();
+    names.iter().for_each(|n| {
+        if !order.contains(&n) {
+            order.push(n)
+        }
+    });
+    let mut out = Vec::new();
+    for name in order {
+        let members: Vec<usize> = (0..names.len()).filter(|&k| &names[k] == name).collect();
+        let unit = &res.columns[members[0]].unit;
+        if let Some(&k) = members.iter().find(|&&k| &res.columns[k].unit != unit) {
+            return Err(CliError::user(format!(
+                "record.paths[{k}].panel `{name}`: `{}` is in {} and `{}` in {}; a panel has one axis: give them one unit",
+                res.columns[members[0]].path, unit, res.columns[k].path, res.columns[k].unit
+            )));
+        }
+        let d = Display::new(unit).map_err(|e| CliError::user(e.to_string()))?;
+        let single = members.len() == 1;
+        let mut o = Overlay {
+            label: match single {
+                true => format!("{} [{}]", res.columns[members[0]].path, axis_unit(unit)),
+                false => format!("{name} [{}]", axis_unit(unit)),
+            },
+            ..Overlay::default()
+        };
+        for (m, &k) in members.iter().enumerate() {
+            let c = &res.columns[k];
+            let label = |what: &str| if single { what.to_string() } else { format!("{} {what}", c.path) };
+            o.curves.push((
+                if single { String::new() } else { c.path.clone() },
+                res.rows.iter().map(|r| d.value(r[k])).collect(),
+            ));
+            if let Some(r) = &res.references[k] {
+                o.dashed.push((label("setpoint"), Some(m), r.iter().map(|v| d.value(*v)).collect()));
+            }
+            for other in &others {
+                let header = format!("{} [{}]", c.path, c.unit);
+                if let Some((_, v)) = other.columns.iter().find(|(h, _)| *h == header) {
+                    o.dashed.push((label(&other.name), Some(m), resample(&other.times, v, &res.times)));
+                }
+            }
+            if let Some((lo, hi)) = limits(plant, &c.path) {
+                for (what, v) in [("op_min", lo), ("op_max", hi)].into_iter().filter(|(_, v)| v.is_finite()) {
+                    o.limits.push((label(what), convert_from_si(v, unit).unwrap_or(v)));
+                }
+            }
+        }
+        if single && !o.dashed.is_empty() {
+            o.curves[0].0 = "this run".into();
+        }
+        out.push(o);
+    }
+    Ok(out)
+}
+
+/// The scenario's applied events as `(time in the plot's unit, label)`.
+pub fn events(res: &SimulationResult, spec: &ScenarioSpec, time_factor: f64) -> Vec<(f64, String)> {
+    let label = |origin: &str| {
+        let k: Option<usize> =
+            origin.strip_prefix("events[").and_then(|s| s.strip_suffix(']')).and_then(|s| s.parse().ok());
+        match k.and_then(|k| spec.events.get(k)) {
+            Some(EventSpec::Step { path, .. }) => format!("step {path}"),
+            Some(EventSpec::Ramp { path, .. }) => format!("ramp {path}"),
+            Some(EventSpec::Pulse { path, .. }) => format!("pulse {path}"),
+            Some(EventSpec::Sinusoid { path, .. }) => format!("sinusoid {path}"),
+            Some(EventSpec::Mode { controller, mode, .. }) => format!("{controller} {mode:?}").to_lowercase(),
+            Some(EventSpec::ValveStuck { path, .. }) => format!("{path} stuck"),
+            Some(EventSpec::FeedLost { unit, .. }) => format!("{unit} lost"),
+            None => origin.to_string(),
+        }
+    };
+    res.events.iter().map(|(t, o)| (t * time_factor, label(o))).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn resampling_interpolates_inside_and_leaves_nan_outside() {
+        let v = resample(&[0.0, 10.0, 20.0], &[1.0, 2.0, 4.0], &[0.0, 5.0, 15.0, 25.0]);
+        assert_eq!(&v[..3], &[1.0, 1.5, 3.0]);
+        assert!(v[3].is_nan());
+        assert_eq!(axis_unit("1"), "-");
+    }
+}
