@@ -138,8 +138,15 @@ impl Trends<'_> {
             let s = chart.draw_series(line).map_err(err)?;
             s.label(name.as_str()).legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c));
         }
+        let mut others = COLOURS[1..].iter().cycle();
         for (name, of, values) in &trend.dashed {
-            let c = of.filter(|_| trend.curves.len() > 1).map_or(BLACK, |k| COLOURS[k % COLOURS.len()]);
+            // One curve: its setpoint grey, other runs in colours of their own; several: each in
+            // its curve's colour.
+            let c = match of.filter(|_| trend.curves.len() > 1) {
+                Some(k) => COLOURS[k % COLOURS.len()],
+                None if name.ends_with("setpoint") => GREY,
+                None => *others.next().unwrap_or(&BLACK),
+            };
             let line = DashedLineSeries::new(points(times, values), 8, 5, c.stroke_width(1));
             let s = chart.draw_series(line).map_err(err)?;
             s.label(name.as_str()).legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c));
