@@ -11,11 +11,14 @@ use plantwide::analysis::linear::Linearization;
 use plantwide::analysis::measures::rows;
 use plantwide::analysis::perturb::{PerturbSettings, perturb_gains};
 use plantwide::analysis::report::{GainJson, GainReport, ReportOptions};
-use plantwide::analysis::select::{Signal, SignalLabel, parse_block, parse_pairing, select_inputs, select_outputs};
+use plantwide::analysis::select::{
+    Signal, SignalLabel, in_system, parse_block, parse_pairing, select_inputs, select_outputs,
+};
 use plantwide::analysis::sensors::select_temperature_sensors;
 use plantwide::analysis::tf::TfSignal;
 use plantwide::io::plot::{LabelledMatrix, write_matrices};
 use plantwide::io::tf;
+use plantwide::units::UnitSystem;
 use plantwide::units::{Dimension, parse_quantity_as};
 
 use super::CliError;
@@ -159,14 +162,14 @@ fn options(
     Ok(ReportOptions { pairing, blocks, scaling })
 }
 
-pub fn run(a: &GainsArgs) -> Result<(), CliError> {
+pub fn run(a: &GainsArgs, units: UnitSystem) -> Result<(), CliError> {
     if let Some(tf) = &a.tf {
         return run_tf(a, tf);
     }
     let Some(file) = &a.file else { return Err(CliError::user("give a flowsheet FILE or --tf MODEL")) };
     let (plant, u) = load_with_overrides(file, &a.set)?;
-    let inputs = select_inputs(&plant, &a.inputs).map_err(analysis_error)?;
-    let outputs = select_outputs(&plant, &a.outputs).map_err(analysis_error)?;
+    let inputs = select_inputs(&plant, &in_system(&plant, &a.inputs, units)).map_err(analysis_error)?;
+    let outputs = select_outputs(&plant, &in_system(&plant, &a.outputs, units)).map_err(analysis_error)?;
     let dims = (
         inputs.iter().map(|s| (plant.inputs()[s.index].dim, s.factor)).collect(),
         outputs.iter().map(|s| (plant.vars()[s.index].spec.dim, s.factor)).collect(),

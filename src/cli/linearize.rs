@@ -9,8 +9,9 @@ use std::path::PathBuf;
 use plantwide::analysis::faer::{Mat, c64};
 use plantwide::analysis::frequency::{self, FrequencyResults};
 use plantwide::analysis::linear::Linearization;
-use plantwide::analysis::select::{select_inputs, select_outputs};
+use plantwide::analysis::select::{in_system, select_inputs, select_outputs};
 use plantwide::io::export::ModelExport;
+use plantwide::units::UnitSystem;
 use plantwide::units::{Dimension, Unit};
 
 use super::CliError;
@@ -136,7 +137,7 @@ fn run_tf(a: &LinearizeArgs, file: &std::path::Path, tu: &TimeUnit) -> Result<()
     Ok(())
 }
 
-pub fn run(a: &LinearizeArgs) -> Result<(), CliError> {
+pub fn run(a: &LinearizeArgs, units: UnitSystem) -> Result<(), CliError> {
     let tu = TimeUnit::parse(&a.time_unit)?;
     if let Some(tf) = &a.tf {
         return run_tf(a, tf, &tu);
@@ -146,8 +147,8 @@ pub fn run(a: &LinearizeArgs) -> Result<(), CliError> {
     let map = |e: plantwide::analysis::AnalysisError| {
         if e.is_user_error() { CliError::user(e.to_string()) } else { CliError::numerical(e.to_string()) }
     };
-    let inputs = select_inputs(&plant, &a.inputs).map_err(map)?;
-    let outputs = select_outputs(&plant, &a.outputs).map_err(map)?;
+    let inputs = select_inputs(&plant, &in_system(&plant, &a.inputs, units)).map_err(map)?;
+    let outputs = select_outputs(&plant, &in_system(&plant, &a.outputs, units)).map_err(map)?;
     let omegas = a.frequencies.as_deref().map(|f| frequency_grid(f, &tu)).transpose()?.unwrap_or_default();
     let ss = converge(&plant, &u)?;
     let (ii, oo): (Vec<usize>, Vec<usize>) =

@@ -65,6 +65,13 @@ impl From<UnitsArg> for plantwide::units::UnitSystem {
 pub struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// Display units for every quantity whose path names no unit (`si`: mol/s, K, Pa, W;
+    /// `metric`: kmol/h, degC, kPa, kW; `field`: lbmol/h, degF, psia, Btu/h): `steady` and `run`
+    /// text, tables, CSV and plots (their `--json` stays SI); `gains`, `linearize` and
+    /// `sensitivity` signals (their JSON labels each with its unit). Default: SI (`steady`'s stream
+    /// table: kmol/h, K, kPa, kJ/mol).
+    #[arg(long, value_enum, global = true)]
+    units: Option<UnitsArg>,
 }
 
 #[derive(Debug, Subcommand)]
@@ -102,9 +109,6 @@ enum Command {
         /// recycles by tearing), `auto` sequential modular to 1e-4 then Newton.
         #[arg(long, value_enum, default_value = "auto")]
         method: steady::MethodArg,
-        /// Display units of the text (default: streams in kmol/h, K, kPa, kJ/mol, the rest in SI).
-        #[arg(long, value_enum)]
-        units: Option<UnitsArg>,
     },
     /// Simulate the plant through a scenario from its steady state (or a snapshot): CSV of the
     /// recorded paths, a summary (IAE, ISE, max deviation, settling time) and optional trend plots.
@@ -129,9 +133,6 @@ enum Command {
         /// Resume from a snapshot file written by an earlier run.
         #[arg(long)]
         resume: Option<PathBuf>,
-        /// Units of the paths the scenario records without one (CSV, plot, table; JSON stays SI).
-        #[arg(long, value_enum, default_value_t = UnitsArg::Si)]
-        units: UnitsArg,
         /// Overlay an earlier run's CSV on the plot (dashed; the same paths and units); repeatable.
         #[arg(long, value_name = "OTHER.csv")]
         compare: Vec<PathBuf>,
@@ -193,16 +194,17 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
     match cli.command {
         Command::Check { file } => check::run(&file),
         Command::Components { json } => components::run(json),
-        Command::Steady { file, json, set, spec, vary, method, units } => {
-            let units = units.map(Into::into);
+        Command::Steady { file, json, set, spec, vary, method } => {
+            let units = cli.units.map(Into::into);
             steady::run(&steady::SteadyArgs { file: &file, json, sets: &set, specs: &spec, vary: &vary, method, units })
         }
-        Command::Run { file, scenario, csv, plot, json, set, resume, units, compare } => {
-            run::run(&run::RunArgs { file, scenario, csv, plot, json, set, resume, units: units.into(), compare })
+        Command::Run { file, scenario, csv, plot, json, set, resume, compare } => {
+            let units = cli.units.unwrap_or(UnitsArg::Si).into();
+            run::run(&run::RunArgs { file, scenario, csv, plot, json, set, resume, units, compare })
         }
-        Command::Gains(a) => gains::run(&a),
-        Command::Linearize(a) => linearize::run(&a),
-        Command::Sensitivity(a) => sensitivity::run(&a),
+        Command::Gains(a) => gains::run(&a, cli.units.unwrap_or(UnitsArg::Si).into()),
+        Command::Linearize(a) => linearize::run(&a, cli.units.unwrap_or(UnitsArg::Si).into()),
+        Command::Sensitivity(a) => sensitivity::run(&a, cli.units.unwrap_or(UnitsArg::Si).into()),
         Command::Sensors(a) => gains::run_sensors(&a),
         Command::Tune(a) => tune::run(&a),
         Command::Screen(a) => screen::run(&a),

@@ -4,11 +4,12 @@
 use std::path::PathBuf;
 
 use plantwide::analysis::AnalysisError;
-use plantwide::analysis::select::select_outputs;
+use plantwide::analysis::select::{in_system, select_outputs};
 use plantwide::analysis::sensitivity::{Disturbance, SweepSettings, sweep};
 use plantwide::io::IoError;
 use plantwide::io::csv::sensitivity_csv;
 use plantwide::io::plot::write_sensitivity;
+use plantwide::units::UnitSystem;
 
 use super::CliError;
 use super::gains::sig;
@@ -44,7 +45,7 @@ fn analysis_error(e: AnalysisError) -> CliError {
     if e.is_user_error() { CliError::user(e.to_string()) } else { CliError::numerical(e.to_string()) }
 }
 
-pub fn run(a: &SensitivityArgs) -> Result<(), CliError> {
+pub fn run(a: &SensitivityArgs, units: UnitSystem) -> Result<(), CliError> {
     // Checked before any work (the plot is drawn last).
     if let Some(p) = &a.plot
         && !matches!(p.extension().and_then(|e| e.to_str()), Some("svg" | "png"))
@@ -58,7 +59,7 @@ pub fn run(a: &SensitivityArgs) -> Result<(), CliError> {
         .map(|d| Disturbance::parse(&plant, &u, d))
         .collect::<Result<Vec<_>, _>>()
         .map_err(analysis_error)?;
-    let outputs = select_outputs(&plant, &a.outputs).map_err(analysis_error)?;
+    let outputs = select_outputs(&plant, &in_system(&plant, &a.outputs, units)).map_err(analysis_error)?;
     let ss = converge(&plant, &u)?;
     let settings = SweepSettings { points: a.points, ..SweepSettings::default() };
     let idx: Vec<usize> = outputs.iter().map(|s| s.index).collect();

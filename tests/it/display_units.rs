@@ -142,3 +142,21 @@ fn a_driven_input_is_an_output_in_the_unit_asked_for() {
     let central = (duty("300.5 K") - duty("299.5 K")) / 1e3;
     assert!((driven - central).abs() < 1e-6 * central.abs(), "gain {driven} kW/K, central difference {central} kW/K");
 }
+
+/// `--units` reaches the analysis commands: a gain printed per lbmol/h (field) is the SI gain per
+/// mol/s times the size of one lbmol/h in mol/s, and a path that names its unit keeps it.
+#[test]
+fn gains_take_the_unit_system_for_paths_that_name_no_unit() {
+    let file = flowsheet("column_a.json");
+    let args = ["gains", &file, "--inputs", "L,V@kmol/min", "--outputs", "distillate.x[light]", "--json"];
+    let si = plantwide(&args);
+    let field = plantwide(&[&args[..], &["--units", "field"]].concat());
+    let (si, field): (serde_json::Value, serde_json::Value) =
+        (serde_json::from_slice(&si.stdout).unwrap(), serde_json::from_slice(&field.stdout).unwrap());
+    assert_eq!(field["inputs"][0]["unit"], "lbmol/h");
+    assert_eq!(field["inputs"][1]["unit"], "kmol/min");
+    let lbmol_h = 0.45359237 / 3600.0 * 1000.0; // mol/s
+    let (g_si, g_field) = (si["gain"][0][0].as_f64().unwrap(), field["gain"][0][0].as_f64().unwrap());
+    assert!((g_field - g_si * lbmol_h).abs() < 1e-12 * g_si.abs(), "{g_field} vs {}", g_si * lbmol_h);
+    assert_eq!(si["gain"][0][1], field["gain"][0][1]);
+}

@@ -74,6 +74,24 @@ fn display_unit(what: &str, unit: Option<&str>, dim: Dimension) -> Result<(Strin
     Ok((unit.to_string(), parsed.factor()))
 }
 
+/// `texts` (`path[@unit]`) with each path that names no unit given `system`'s unit of its
+/// dimension (`--units metric`: `column.reflux` → `column.reflux@kmol/h`); a path that names one,
+/// or that resolves to nothing (reported later), is kept as written.
+pub fn in_system(plant: &Plant, texts: &[String], system: plantwide_units::UnitSystem) -> Vec<String> {
+    texts
+        .iter()
+        .map(|t| {
+            let (path, unit) = split_unit(t);
+            let var = || plant.var(path).map(|v| plant.vars()[v].spec.dim);
+            let dim = var().or_else(|| resolve_input(plant, path).map(|i| plant.inputs()[i].dim));
+            match (unit, dim) {
+                (None, Some(d)) if system.unit_for(d) != d.to_string() => format!("{path}@{}", system.unit_for(d)),
+                _ => t.clone(),
+            }
+        })
+        .collect()
+}
+
 /// Resolve free inputs written as `path[@unit]`.
 pub fn select_inputs(plant: &Plant, texts: &[String]) -> Result<Vec<Signal>, AnalysisError> {
     texts.iter().map(|t| select_input(plant, t)).collect()
