@@ -2,8 +2,13 @@
 
 use crate::harness;
 
+/// The shipped flowsheets: every JSON file in flowsheets/ but the schemas.
 fn shipped() -> Vec<std::path::PathBuf> {
-    let dir = harness::flowsheet("");
+    json_files(std::path::Path::new(&harness::flowsheet("")))
+}
+
+/// The JSON files of `dir` (not its subfolders) but the schemas, sorted.
+fn json_files(dir: &std::path::Path) -> Vec<std::path::PathBuf> {
     let mut v: Vec<_> = std::fs::read_dir(dir)
         .unwrap()
         .map(|e| e.unwrap().path())
@@ -65,16 +70,6 @@ fn shipped_scenario_schema_matches_the_types() {
 fn validator(name: &str) -> jsonschema::Validator {
     let text = std::fs::read_to_string(harness::flowsheet(name)).unwrap();
     jsonschema::validator_for(&serde_json::from_str(&text).unwrap()).unwrap()
-}
-
-fn json_files(dir: &std::path::Path) -> Vec<std::path::PathBuf> {
-    let mut v: Vec<_> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "json") && !p.to_string_lossy().ends_with(".schema.json"))
-        .collect();
-    v.sort();
-    v
 }
 
 /// An independent JSON Schema validator (the `jsonschema` crate, draft 2020-12) accepts every
