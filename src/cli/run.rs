@@ -10,8 +10,8 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use plantwide::flowsheet::Plant;
-use plantwide::flowsheet::scenario::ScenarioSpec;
 use plantwide::flowsheet::scenario::{Limits, parse_scenario, resolve_with};
+use plantwide::flowsheet::scenario::{RecordPathSpec, ScenarioSpec};
 use plantwide::io::plot::write_overlays;
 use plantwide::solve::dynamic::{
     CONSERVATION_TOL, Conservation, Progress, SimError, SimulationResult, Snapshot, Start, simulate,
@@ -106,7 +106,7 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
         Ok(res) => res,
         Err(e @ (SimError::Snapshot { .. } | SimError::Wiring(_))) => return Err(CliError::user(e.to_string())),
         Err(SimError::Conservation { file, source, mut result }) => {
-            display_units(&mut result, args.units);
+            display_units(&mut result, args.units, &spec);
             // The whole run is there: write and summarize it, then fail on the balance.
             write_trends_files(args, &result, &plot_cx, &sc.time_unit, time_factor)?;
             print_summary(&result, args.json, started.elapsed().as_secs_f64(), time_factor, &sc.time_unit)?;
@@ -119,7 +119,7 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
             // The trends up to the failure show what led to it (a vessel draining, a loop saturating).
             let SimError::Integration { partial, .. } = &e else { return Err(CliError::numerical(e.to_string())) };
             let mut partial = partial.clone();
-            display_units(&mut partial, args.units);
+            display_units(&mut partial, args.units, &spec);
             let written = write_trends_files(args, &partial, &plot_cx, &sc.time_unit, time_factor);
             let at = format!("{:.6} {}", partial.t * time_factor, sc.time_unit);
             return Err(CliError::numerical(match written {
@@ -131,15 +131,17 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
     if let Some(e) = write_error {
         return Err(e);
     }
-    display_units(&mut res, args.units);
+    display_units(&mut res, args.units, &spec);
     write_trends_files(args, &res, &plot_cx, &sc.time_unit, time_factor)?;
     let wall = started.elapsed().as_secs_f64();
     print_summary(&res, args.json, wall, time_factor, &sc.time_unit)
 }
 
-/// Every column recorded in SI (no unit asked for) shown in `units`' unit of its dimension.
-fn display_units(res: &mut SimulationResult, units: UnitSystem) {
-    for c in res.columns.iter_mut().filter(|c| c.unit == c.si_unit) {
+/// Every column whose scenario entry names no unit shown in `units`' unit of its dimension; a unit
+/// the scenario names (SI ones too) is kept.
+fn display_units(res: &mut SimulationResult, units: UnitSystem, spec: &ScenarioSpec) {
+    let asked = |k: usize| matches!(spec.record.paths.get(k), Some(RecordPathSpec::WithUnit { unit: Some(_), .. }));
+    for (_, c) in res.columns.iter_mut().enumerate().filter(|(k, _)| !asked(*k)) {
         if let Ok(dim) = unit_dimension(&c.si_unit) {
             c.unit = units.unit_for(dim);
         }

@@ -35,7 +35,7 @@ fn run_shows_each_path_in_the_unit_it_asked_for_or_in_the_chosen_system() {
     std::fs::create_dir_all(&dir).unwrap();
     let sc = scenario_with(
         &dir,
-        serde_json::json!(["effluent.T", {"path": "trim.duty", "unit": "MW"}, "feed.F", "effluent.x[A]"]),
+        serde_json::json!(["effluent.T", {"path": "trim.duty", "unit": "MW"}, "feed.F", "effluent.x[A]", {"path": "heated.T", "unit": "K"}]),
     );
     let csv = dir.join("run.csv").display().to_string();
     let file = flowsheet("fehe_reactor.json");
@@ -53,7 +53,7 @@ fn run_shows_each_path_in_the_unit_it_asked_for_or_in_the_chosen_system() {
         let text = String::from_utf8_lossy(&out.stdout).to_string();
         assert!(text.contains("IAE [u·s]"), "{text}");
         let rows = table(&text);
-        assert_eq!(rows.len(), 4, "{text}");
+        assert_eq!(rows.len(), 5, "{text}");
         // effluent.T: the value with the scale's zero, the deviation and IAE without.
         let (path, unit, initial, _, iae, dev) = rows[0].clone();
         assert_eq!((path.as_str(), unit.as_str()), ("effluent.T", t_unit), "{system}");
@@ -77,6 +77,9 @@ fn run_shows_each_path_in_the_unit_it_asked_for_or_in_the_chosen_system() {
         // A mole fraction stays a mole fraction.
         assert_eq!(rows[3].1, "1", "{system}");
         close(rows[3].2, si(3, "initial"), "x");
+        // A unit the scenario names, even an SI one, is kept whatever the system.
+        assert_eq!(rows[4].1, "K", "{system}");
+        close(rows[4].2, si(4, "initial"), "heated.T in K");
         // The CSV header carries the same units.
         let header = std::fs::read_to_string(&csv).unwrap().lines().next().unwrap().to_string();
         assert!(header.contains(&format!("effluent.T [{t_unit}]")) && header.contains("trim.duty [MW]"), "{header}");

@@ -123,3 +123,33 @@ fn a_compare_report_is_also_an_html_page_with_its_tables_and_figures() {
     assert!(std::fs::metadata(dir.join("rga.png")).unwrap().len() > 1000);
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A `--compare` file that is not a run's CSV (no time column, ragged rows) exits 1 naming it.
+#[test]
+fn a_compare_file_that_is_not_a_run_csv_is_named() {
+    let dir = temp("bad_compare");
+    let (csv, svg) = (dir.join("run.csv"), dir.join("run.svg"));
+    let file = flowsheet("fehe_reactor.json");
+    let sc = flowsheet("scenarios/fehe_reactor_feed_temperature.json");
+    for (text, why) in [("a,b\n1,2\n", "not a `plantwide run` CSV"), ("time [s],x [K]\n0,1,2\n", "line 2 has 3 fields")]
+    {
+        let other = dir.join("other.csv");
+        std::fs::write(&other, text).unwrap();
+        let out = plantwide(&[
+            "run",
+            &file,
+            "--scenario",
+            &sc,
+            "--csv",
+            csv.to_str().unwrap(),
+            "--plot",
+            svg.to_str().unwrap(),
+            "--compare",
+            other.to_str().unwrap(),
+        ]);
+        assert_eq!(out.status.code(), Some(1));
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains("--compare") && err.contains(why), "{err}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
