@@ -23,6 +23,7 @@ mod check;
 mod compare;
 mod components;
 mod gains;
+mod identify;
 mod linearize;
 mod run;
 mod run_plot;
@@ -167,6 +168,10 @@ enum Command {
     /// open-loop and as-built eigenvalues, recycle loop gains, disturbance sensitivity by
     /// continuation and closed-loop responses with the quality loops tuned by BLT.
     Compare(compare::CompareArgs),
+    /// Identification by a plant test on the nonlinear model (PRBS, GBN or directional design,
+    /// open or closed loop, measurement noise), FIR/ARX/OE fits validated on fresh data; the
+    /// identified gains and RGA beside the exact linearization's.
+    Identify(identify::IdentifyArgs),
 }
 
 /// A failed command: message and exit code.
@@ -210,6 +215,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Screen(a) => screen::run(&a),
         Command::Size(a) => size::run(&a),
         Command::Compare(a) => compare::run(&a),
+        Command::Identify(a) => identify::run(&a, cli.units.unwrap_or(UnitsArg::Si).into()),
         Command::Schema { scenario } => {
             let schema = match scenario {
                 true => plantwide::flowsheet::schema::scenario_schema(),

@@ -5,11 +5,12 @@
 //! (ultimate gain and frequency, relay and step tests, Ziegler–Nichols, Tyreus–Luyben, SIMC, IMC,
 //! averaging level, Luyben's BLT detuning of n diagonal PI loops); [`screen`], control-structure
 //! screening (a column's inventory configurations; plantwide pairings with steady-state filters
-//! and a dynamic test).
+//! and a dynamic test); [`identify`], test design, plant test and FIR/ARX/OE fits (ch. 7).
 #![warn(missing_docs)]
 
 pub mod compare;
 pub mod error;
+pub mod identify;
 mod numeric;
 pub mod screen;
 pub mod size;

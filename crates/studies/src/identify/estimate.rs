@@ -1,0 +1,241 @@
+//! Estimation and validation per output: FIR (ridge), ARX (order by AIC), OE (Levenberg–Marquardt
+//! from the ARX fit), each simulated on the fresh validation inputs and judged there.
+
+use plantwide_analysis::select::Signal;
+use plantwide_ident::{arx_select, fir, oe, simulate_arx, simulate_oe, validate};
+use serde::Serialize;
+
+use super::IdentifyError;
+use super::design::TestDesign;
+use super::plant_test::TestData;
+
+/// Highest ARX order tried, and the OE order's cap.
+const MAX_ARX_ORDER: usize = 4;
+const MAX_OE_ORDER: usize = 2;
+/// Lags of the residual correlation tests.
+const MAX_LAG: usize = 20;
+
+/// One fitted model of one output.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ModelSummary {
+    /// Output path.
+    pub output: String,
+    /// Structure: `fir`, `arx` or `oe`.
+    pub model: String,
+    /// Orders as in Eq. 7-27: `na`/`nb`/`nf` (and `n` coefficients of a FIR), `nk` per input.
+    pub orders: String,
+    /// Steady-state gain per input (display units).
+    pub gain: Vec<f64>,
+    /// Standard error of each gain from the parameter covariance (delta method; OE only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub gain_std: Option<Vec<f64>>,
+    /// False when a denominator is (nearly) zero at z = 1, `|F(1)|` or `|A(1)| < 1e-3`: a pole at
+    /// the unit circle makes the gain meaningless. Such a model is never the chosen one.
+    pub reliable: bool,
+    /// Fit on the validation data \[%\].
+    pub fit_percent: f64,
+    /// Residuals white at 95 % (validation data).
+    pub white: bool,
+    /// Residuals uncorrelated with every input at 95 % (validation data).
+    pub independent: bool,
+}
+
+/// Validation of the chosen structure on one output.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct OutputValidation {
+    /// Output path.
+    pub output: String,
+    /// Fit on the validation data \[%\]: `100 (1 − ‖y − ŷ‖/‖y − ȳ‖)`.
+    pub fit_percent: f64,
+    /// Residual autocorrelation at lags 0 … 20 (Eq. 7-59).
+    pub autocorrelation: Vec<f64>,
+    /// Residual–input cross-correlation per input at lags 0 … 20 (Eq. 7-60).
+    pub cross_correlation: Vec<Vec<f64>>,
+    /// The 95 % bound `1.96/√N`.
+    pub bound: f64,
+    /// Residuals white at 95 %.
+    pub white: bool,
+    /// Residuals uncorrelated with the inputs at 95 %.
+    pub independent: bool,
+    /// The model's simulated output on the validation inputs (deviation from the steady state,
+    /// SI), for plots.
+    #[serde(skip)]
+    pub predicted: Vec<f64>,
+}
+
+/// Every fit: the chosen structure's gains (SI), every model, and the chosen one's validation.
+pub(super) struct Fits {
+    pub gain: Vec<Vec<f64>>,
+    pub models: Vec<ModelSummary>,
+    pub chosen: String,
+    pub validation: Vec<OutputValidation>,
+}
+
+fn fit_error(e: impl std::fmt::Display) -> IdentifyError {
+    IdentifyError::Estimation(format!("identification: {e}"))
+}
+
+/// One structure fitted to one output: its gains (SI) and validation.
+struct Fitted {
+    model: &'static str,
+    orders: String,
+    gain: Vec<f64>,
+    gain_std: Option<Vec<f64>>,
+    reliable: bool,
+    validation: OutputValidation,
+}
+
+/// Least `|F(1)|` (or `|A(1)|`) of a model whose gain is reported as reliable.
+const MIN_DENOMINATOR: f64 = 1e-3;
+
+/// The standard error of each OE gain `g_j = B_j(1)/F_j(1)` by the delta method,
+/// `∂g/∂b = 1/F(1)`, `∂g/∂f = −B(1)/F(1)²`, over the input's block of the covariance.
+fn oe_gain_std(m: &plantwide_ident::OeModel) -> Option<Vec<f64>> {
+    let p = m.covariance.as_ref()?;
+    let block = m.nb + m.nf;
+    let std = (0..m.b.len())
+        .map(|j| {
+            let (bs, fs) = (m.b[j].iter().sum::<f64>(), 1.0 + m.f[j].iter().sum::<f64>());
+            let grad: Vec<f64> =
+                std::iter::repeat_n(1.0 / fs, m.nb).chain(std::iter::repeat_n(-bs / (fs * fs), m.nf)).collect();
+            let o = j * block;
+            let var: f64 =
+                (0..block).map(|a| (0..block).map(|b| grad[a] * p[o + a][o + b] * grad[b]).sum::<f64>()).sum();
+            var.max(0.0).sqrt()
+        })
+        .collect();
+    Some(std)
+}
+
+/// Ridge parameters tried for the FIR fit, relative to the mean input energy per column of X
+/// (`c = c_rel Σu²/n_u`): the one with the best validation fit is kept.
+const FIR_RIDGE: [f64; 4] = [0.0, 1e-8, 1e-6, 1e-4];
+
+type Judge<'a> = dyn Fn(Result<Vec<f64>, plantwide_ident::IdentError>) -> Result<OutputValidation, IdentifyError> + 'a;
+
+/// The FIR fit of output `i` whose ridge parameter validates best, its validation and `c_rel`.
+fn best_fir(
+    est: &TestData,
+    val: &TestData,
+    i: usize,
+    n_fir: usize,
+    judge: &Judge<'_>,
+) -> Result<(plantwide_ident::FirModel, OutputValidation, f64), IdentifyError> {
+    let power: f64 = est.u.iter().flatten().map(|v| v * v).sum::<f64>() / est.u.len().max(1) as f64;
+    let mut best: Option<(plantwide_ident::FirModel, OutputValidation, f64)> = None;
+    for c in FIR_RIDGE {
+        let m = fir(&est.u, &est.y[i], n_fir, 1, c * power).map_err(fit_error)?;
+        let v = judge(m.simulate(&val.u))?;
+        if best.as_ref().is_none_or(|b| v.fit_percent > b.1.fit_percent) {
+            best = Some((m, v, c));
+        }
+    }
+    best.ok_or_else(|| IdentifyError::Estimation("identification: no FIR fit".into()))
+}
+
+/// Fit FIR, ARX and OE to output `i`.
+fn fit_output(
+    est: &TestData,
+    val: &TestData,
+    i: usize,
+    n_fir: usize,
+    output: &str,
+) -> Result<Vec<Fitted>, IdentifyError> {
+    let nu = est.u.len();
+    let nk = vec![1; nu];
+    let (ye, yv) = (&est.y[i], &val.y[i]);
+    let judge = |yhat: Result<Vec<f64>, plantwide_ident::IdentError>| -> Result<OutputValidation, IdentifyError> {
+        let yhat = yhat.map_err(fit_error)?;
+        let v = validate(yv, &yhat, &val.u, MAX_LAG).map_err(fit_error)?;
+        Ok(OutputValidation {
+            output: output.to_string(),
+            fit_percent: v.fit_percent,
+            autocorrelation: v.autocorrelation,
+            cross_correlation: v.cross_correlation,
+            bound: v.bound,
+            white: v.white,
+            independent: v.independent,
+            predicted: yhat,
+        })
+    };
+    let (arx, _) = arx_select((&est.u, ye), (&val.u, yv), MAX_ARX_ORDER, &nk).map_err(fit_error)?;
+    let n = arx.na.clamp(1, MAX_OE_ORDER);
+    let init =
+        if arx.na == n { arx.clone() } else { plantwide_ident::arx(&est.u, ye, n, n, &nk).map_err(fit_error)? };
+    let oe_model = oe(&est.u, ye, n, n, &nk, Some(&init)).map_err(fit_error)?;
+    let (fir_model, fir_validation, ridge) = best_fir(est, val, i, n_fir, &judge)?;
+    Ok(vec![
+        Fitted {
+            model: "fir",
+            orders: format!("n={n_fir}, nk=1, ridge={ridge:.0e}"),
+            gain: fir_model.gain.clone(),
+            gain_std: None,
+            reliable: true,
+            validation: fir_validation,
+        },
+        Fitted {
+            model: "arx",
+            orders: format!("na={}, nb={}, nk=1", arx.na, arx.nb),
+            gain: arx.gain.clone(),
+            gain_std: None,
+            reliable: (1.0 + arx.a.iter().sum::<f64>()).abs() > MIN_DENOMINATOR,
+            validation: judge(simulate_arx(&arx, &val.u))?,
+        },
+        Fitted {
+            model: "oe",
+            orders: format!("nb={n}, nf={n}, nk=1"),
+            gain: oe_model.gain.clone(),
+            gain_std: oe_gain_std(&oe_model),
+            reliable: oe_model.f.iter().all(|f| (1.0 + f.iter().sum::<f64>()).abs() > MIN_DENOMINATOR),
+            validation: judge(simulate_oe(&oe_model, &val.u))?,
+        },
+    ])
+}
+
+/// Fit every output of the estimation data and validate on the validation data; the structure
+/// with the best mean validation fit is chosen.
+pub(super) fn fit_all(
+    est: &TestData,
+    val: &TestData,
+    design: &TestDesign,
+    inputs: &[Signal],
+    outputs: &[Signal],
+) -> Result<Fits, IdentifyError> {
+    let t99 = 4.6 * design.tau_dom;
+    let n_samples = est.y.first().map_or(0, Vec::len);
+    let n_fir = ((t99 / design.sample_time).ceil() as usize).clamp(5, (n_samples / (4 * inputs.len().max(1))).max(5));
+    let per_output: Vec<Vec<Fitted>> =
+        outputs.iter().enumerate().map(|(i, o)| fit_output(est, val, i, n_fir, &o.path)).collect::<Result<_, _>>()?;
+    let n_structures = per_output[0].len();
+    // A structure unreliable on any output scores below every reliable one.
+    let mean_fit = |s: usize| {
+        let fit = per_output.iter().map(|f| f[s].validation.fit_percent).sum::<f64>() / per_output.len() as f64;
+        if per_output.iter().all(|f| f[s].reliable) { fit } else { fit - 1e6 }
+    };
+    let best = (0..n_structures).max_by(|&a, &b| mean_fit(a).total_cmp(&mean_fit(b))).unwrap_or(0);
+    let display =
+        |o: &Signal, g: &[f64]| -> Vec<f64> { g.iter().zip(inputs).map(|(g, s)| g * s.factor / o.factor).collect() };
+    let models = per_output
+        .iter()
+        .zip(outputs)
+        .flat_map(|(fits, o)| {
+            fits.iter().map(move |f| ModelSummary {
+                output: o.path.clone(),
+                model: f.model.to_string(),
+                orders: f.orders.clone(),
+                gain: display(o, &f.gain),
+                gain_std: f.gain_std.as_ref().map(|g| display(o, g)),
+                reliable: f.reliable,
+                fit_percent: f.validation.fit_percent,
+                white: f.validation.white,
+                independent: f.validation.independent,
+            })
+        })
+        .collect();
+    Ok(Fits {
+        gain: per_output.iter().map(|f| f[best].gain.clone()).collect(),
+        models,
+        chosen: per_output[0][best].model.to_string(),
+        validation: per_output.into_iter().map(|mut f| f.swap_remove(best).validation).collect(),
+    })
+}
