@@ -104,7 +104,9 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
     let plot_cx = PlotContext { plant: &plant, spec: &spec, title: &title };
     let mut res = match result {
         Ok(res) => res,
-        Err(e @ (SimError::Snapshot { .. } | SimError::Wiring(_))) => return Err(CliError::user(e.to_string())),
+        Err(e @ (SimError::Snapshot { .. } | SimError::Wiring(_) | SimError::Mpc { partial: None, .. })) => {
+            return Err(CliError::user(e.to_string()));
+        }
         Err(SimError::Conservation { file, source, mut result }) => {
             display_units(&mut result, args.units, &spec);
             // The whole run is there: write and summarize it, then fail on the balance.
@@ -224,6 +226,7 @@ fn print_summary(
                 "max_relative_error": res.conservation.worst(),
                 "balances": res.conservation.balances,
             },
+            "mpc": res.mpc,
         });
         outln!("{}", serde_json::to_string_pretty(&out).map_err(|e| CliError::user(e.to_string()))?);
         return Ok(());
@@ -269,6 +272,21 @@ fn print_summary(
         );
     }
     print_conservation(&res.conservation);
+    for m in &res.mpc {
+        let statuses: Vec<String> = m.statuses.iter().map(|(k, v)| format!("{k} {v}")).collect();
+        outln!(
+            "mpc {}: {} samples (QP {}), solve time mean {:.3} ms, max {:.3} ms, {:.1} iterations, an input at a limit in {} samples, largest soft-limit slack {:.3e}; model: {}",
+            m.controller,
+            m.samples,
+            statuses.join(", "),
+            1e3 * m.mean_solve_time,
+            1e3 * m.max_solve_time,
+            m.mean_iterations,
+            m.samples_at_limit,
+            m.max_slack,
+            m.model
+        );
+    }
     Ok(())
 }
 

@@ -89,6 +89,7 @@ mod tests {
             t: 2.0,
             stats: BdfStats::default(),
             conservation: Conservation::new(&[], None, [&[], &[]], &[], &[]),
+            mpc: Vec::new(),
         }
     }
 

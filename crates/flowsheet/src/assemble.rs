@@ -431,7 +431,20 @@ impl<'s> Assembler<'s> {
             Some(i) => self.inputs[i].dim,
             None => c.config.config().op_dimension(pv_dim).unwrap_or(Dimension::DIMENSIONLESS),
         };
-        ControllerLinks { pv_dim, op_dim, op_value: first.map_or(0.0, |i| self.inputs[i].value), pv_nominal: 1.0 }
+        let measured_dims = c
+            .measured
+            .iter()
+            .map(|p| p.find(&self.var_index).map_or(Dimension::DIMENSIONLESS, |i| self.vars[i].spec.dim))
+            .collect();
+        let driven = c.driven.iter().map(|&i| (self.inputs[i].dim, self.inputs[i].value)).collect();
+        ControllerLinks {
+            pv_dim,
+            op_dim,
+            op_value: first.map_or(0.0, |i| self.inputs[i].value),
+            pv_nominal: 1.0,
+            measured_dims,
+            driven,
+        }
     }
 
     /// Phase 6c: controller outputs drive inputs: driven input k takes output k

@@ -113,4 +113,5 @@ registry!(
     "selector" => Selector(controllers::selector::SelectorConfig, controllers::selector::Selector),
     "averaging_level" => AveragingLevel(controllers::averaging_level::AveragingLevelConfig, controllers::averaging_level::AveragingLevel),
     "condenser_reboiler" => CondenserReboiler(controllers::condenser_reboiler::CondenserReboilerConfig, controllers::condenser_reboiler::CondenserReboiler),
+    "mpc" => Mpc(controllers::mpc::MpcConfig, controllers::mpc::Mpc),
 ]);

@@ -39,11 +39,13 @@ use crate::dae::{BdfStats, DaeError};
 mod adapter;
 pub mod conservation;
 mod driver;
+mod mpc;
 mod session;
 mod snapshot;
 mod waveform;
 
 pub use conservation::{CONSERVATION_TOL, Conservation, ConservationError};
+pub use mpc::{MpcError, MpcLog, StepModelFile};
 pub use session::{Session, SessionError};
 pub use snapshot::{DriverState, SNAPSHOT_VERSION, Snapshot};
 pub use waveform::Waveform;
@@ -107,6 +109,17 @@ pub enum SimError {
     /// The scenario's analyzers do not fit the plant's wiring.
     #[error(transparent)]
     Wiring(#[from] WiringError),
+    /// A model predictive controller could not be built (its model) or its QP failed during the
+    /// run (with the run up to there, if it had started).
+    #[error("{file}: {source}")]
+    Mpc {
+        /// Flowsheet file.
+        file: String,
+        /// The controller and what failed.
+        source: MpcError,
+        /// The run up to the failure.
+        partial: Option<Box<SimulationResult>>,
+    },
     /// A snapshot does not fit this plant.
     #[error("{file}: the snapshot does not fit this plant: {reason}")]
     Snapshot {
@@ -150,6 +163,8 @@ pub struct SimulationResult {
     pub stats: BdfStats,
     /// Material balances from the start of the run (or the resumed snapshot) to `t`.
     pub conservation: Conservation,
+    /// Per model predictive controller: its QP statuses and solve times.
+    pub mpc: Vec<MpcLog>,
 }
 
 /// Run `scenario` on `plant` from `start`. A copy of the plant is rewired for sampled
@@ -170,9 +185,15 @@ pub fn simulate(
 ) -> Result<SimulationResult, SimError> {
     let file = plant.file().to_string();
     let mut d = Driver::new(plant, scenario, start, fingerprint)?;
-    if let Err(source) = d.run(observer) {
-        let detail = failure_detail(plant, &source);
-        return Err(SimError::Integration { file, source, detail, partial: Box::new(d.finish()) });
+    match d.run(observer) {
+        Ok(()) => {}
+        Err(driver::RunError::Dae(source)) => {
+            let detail = failure_detail(plant, &source);
+            return Err(SimError::Integration { file, source, detail, partial: Box::new(d.finish()) });
+        }
+        Err(driver::RunError::Mpc(source)) => {
+            return Err(SimError::Mpc { file, source, partial: Some(Box::new(d.finish())) });
+        }
     }
     let res = d.finish();
     match res.conservation.check(CONSERVATION_TOL) {

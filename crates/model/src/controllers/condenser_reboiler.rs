@@ -169,7 +169,14 @@ mod tests {
     use crate::testing::{binary_package, controller_eval as eval, controller_layout as layout, jacobian_error};
 
     fn links(pv_dim: Dimension, op_dim: Dimension) -> ControllerLinks {
-        ControllerLinks { pv_dim, op_dim, op_value: 1.0e6, pv_nominal: 1.0 }
+        ControllerLinks {
+            measured_dims: Vec::new(),
+            driven: Vec::new(),
+            pv_dim,
+            op_dim,
+            op_value: 1.0e6,
+            pv_nominal: 1.0,
+        }
     }
 
     fn config() -> serde_json::Value {

@@ -148,6 +148,8 @@ mod tests {
         let thermo = binary_package();
         let comps = vec!["light".to_string(), "heavy".to_string()];
         let links = ControllerLinks {
+            measured_dims: Vec::new(),
+            driven: Vec::new(),
             pv_dim: Dimension::MOLAR_FLOW,
             op_dim: Dimension::MOLAR_FLOW,
             op_value: 0.0,

@@ -120,6 +120,8 @@ mod tests {
         let thermo = binary_package();
         let comps = vec!["light".to_string(), "heavy".to_string()];
         let links = ControllerLinks {
+            measured_dims: Vec::new(),
+            driven: Vec::new(),
             pv_dim: Dimension::DIMENSIONLESS,
             op_dim: Dimension::DIMENSIONLESS,
             op_value: 0.5,

@@ -5,6 +5,7 @@ pub mod averaging_level;
 pub mod condenser_reboiler;
 pub mod delay;
 pub mod lag;
+pub mod mpc;
 pub mod pid;
 pub mod ratio;
 pub mod selector;
@@ -33,6 +34,12 @@ pub struct ControllerLinks {
     /// unit of the measurement) for every controller: a plant's numbers are pinned to that scale,
     /// and the measurement's value is not known before the plant is assembled and guessed.
     pub pv_nominal: f64,
+    /// Dimension of every measured path, in the order of [`ControllerPaths::measured`] (for
+    /// controllers that read several: a model predictive controller's controlled variables).
+    pub measured_dims: Vec<Dimension>,
+    /// Dimension and file value (SI) of every driven input, in the order of
+    /// [`ControllerPaths::driven`].
+    pub driven: Vec<(Dimension, f64)>,
 }
 
 /// A setpoint: a value (an input `sp` that analyses and scenarios may move) or another controller's

@@ -287,7 +287,14 @@ mod tests {
 
     /// A level (m) controller moving a molar flow (mol/s) whose flowsheet value is 5 mol/s.
     fn links() -> ControllerLinks {
-        ControllerLinks { pv_dim: Dimension::LENGTH, op_dim: Dimension::MOLAR_FLOW, op_value: 5.0, pv_nominal: 1.2 }
+        ControllerLinks {
+            measured_dims: Vec::new(),
+            driven: Vec::new(),
+            pv_dim: Dimension::LENGTH,
+            op_dim: Dimension::MOLAR_FLOW,
+            op_value: 5.0,
+            pv_nominal: 1.2,
+        }
     }
 
     fn build(extra: serde_json::Value) -> Pid {

@@ -182,7 +182,14 @@ mod tests {
     use crate::testing::{controller_eval as eval, controller_layout as layout};
 
     fn links(pv_dim: Dimension, op_dim: Dimension) -> ControllerLinks {
-        ControllerLinks { pv_dim, op_dim, op_value: 3.0, pv_nominal: 1.0 }
+        ControllerLinks {
+            measured_dims: Vec::new(),
+            driven: Vec::new(),
+            pv_dim,
+            op_dim,
+            op_value: 3.0,
+            pv_nominal: 1.0,
+        }
     }
 
     fn build(config: serde_json::Value, links: &ControllerLinks) -> Result<Ratio, Vec<FieldError>> {

@@ -217,7 +217,14 @@ mod tests {
     use crate::testing::{binary_package, jacobian_error};
 
     fn links(pv_dim: Dimension, op_dim: Dimension) -> ControllerLinks {
-        ControllerLinks { pv_dim, op_dim, op_value: 0.5, pv_nominal: 1.0 }
+        ControllerLinks {
+            measured_dims: Vec::new(),
+            driven: Vec::new(),
+            pv_dim,
+            op_dim,
+            op_value: 0.5,
+            pv_nominal: 1.0,
+        }
     }
 
     fn build(config: serde_json::Value, links: &ControllerLinks) -> Result<SplitRange, Vec<FieldError>> {

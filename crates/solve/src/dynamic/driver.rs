@@ -11,6 +11,7 @@ use plantwide_flowsheet::scenario::{Action, Scenario};
 use plantwide_flowsheet::{Plant, Read};
 
 use super::adapter::{DaeShape, PlantDae, Quadratures};
+use super::mpc::{self, MpcError, MpcLog, MpcRun};
 use super::snapshot::{self, DriverState, SNAPSHOT_VERSION, Snapshot};
 use super::waveform::{Waveform, values_at};
 use super::{Column, Conservation, Progress, SimError, SimulationResult, Start, conservation};
@@ -40,6 +41,25 @@ pub(super) struct Driver<'p> {
     t0: f64,
     quad: Quadratures,
     shape: DaeShape,
+    /// The model predictive controllers, executed at their samples.
+    mpcs: Vec<MpcRun>,
+    /// The first controller failure, which ends the run.
+    failure: Option<MpcError>,
+}
+
+/// Why a run stopped early.
+#[derive(Debug)]
+pub(super) enum RunError {
+    /// The integrator failed.
+    Dae(DaeError),
+    /// A model predictive controller's QP failed.
+    Mpc(MpcError),
+}
+
+impl From<DaeError> for RunError {
+    fn from(e: DaeError) -> Self {
+        RunError::Dae(e)
+    }
 }
 
 /// The state a run starts from, extended by the quadratures (0 at a steady start).
@@ -93,9 +113,22 @@ impl<'p> Driver<'p> {
         start: Start<'_>,
         fingerprint: &str,
     ) -> Result<Driver<'p>, SimError> {
+        let quad = Quadratures::new(plant, &sc.totals);
+        let x0 = initial_state(plant, &quad, start);
+        let mpcs = mpc::build_all(plant, &x0[..plant.n_vars()]).map_err(|e| SimError::Mpc {
+            file: plant.file().to_string(),
+            source: e,
+            partial: None,
+        })?;
+        if !mpcs.is_empty() && matches!(start, Start::Snapshot(_)) {
+            return Err(SimError::Snapshot {
+                file: plant.file().to_string(),
+                reason: "a run with model predictive controllers does not resume from a snapshot (their predictions \
+                         are not saved): run the scenario from the steady state"
+                    .into(),
+            });
+        }
         let mut plant = plant.clone();
-        let quad = Quadratures::new(&plant, &sc.totals);
-        let x0 = initial_state(&plant, &quad, start);
         // Which controller measures each recorded path: read before the analyzers rewire it.
         let refs = sc.record.iter().map(|r| reference_of(&plant, r.source)).collect();
         let analyzers = hold_analyzers(&mut plant, sc, &x0)?;
@@ -126,6 +159,8 @@ impl<'p> Driver<'p> {
             x0,
             t0,
             quad,
+            mpcs,
+            failure: None,
         })
     }
 
@@ -148,6 +183,9 @@ impl<'p> Driver<'p> {
                 next = next.min(release);
             }
         }
+        for m in &self.mpcs {
+            next = next.min(m.next_time());
+        }
         next.max(t)
     }
 
@@ -164,7 +202,30 @@ impl<'p> Driver<'p> {
         let scenario_event = self.apply_events(t, x);
         let scanned = self.apply_scans(t, x);
         let sampled = self.apply_samples(t, x);
-        scanned || sampled || scenario_event
+        let moved = self.apply_mpc(t, x);
+        scanned || sampled || scenario_event || moved
+    }
+
+    /// The model predictive controllers due at `t`: each solves its QP at the state `x` and holds
+    /// its moves on its inputs; true if one changed. A failure is kept and ends the run.
+    fn apply_mpc(&mut self, t: f64, x: &[f64]) -> bool {
+        let mut changed = false;
+        for k in 0..self.mpcs.len() {
+            let waves = &self.st.waveforms;
+            match self.mpcs[k].execute(t, x, |i| waves[i].at(t)) {
+                Ok(Some(moves)) => {
+                    for (i, v) in moves {
+                        changed |= self.st.waveforms[i] != Waveform::Constant(v);
+                        self.st.waveforms[i] = Waveform::Constant(v);
+                    }
+                }
+                Ok(None) => {}
+                Err(e) => {
+                    self.failure.get_or_insert(e);
+                }
+            }
+        }
+        changed
     }
 
     /// Apply the scenario events due at `t` (a row just before the first); true if any was.
@@ -302,12 +363,18 @@ impl<'p> Driver<'p> {
     }
 
     /// Run to the scenario's end, reporting steps and snapshots to `observer`.
-    pub(super) fn run(&mut self, observer: &mut dyn FnMut(Progress<'_>)) -> Result<(), DaeError> {
+    pub(super) fn run(&mut self, observer: &mut dyn FnMut(Progress<'_>)) -> Result<(), RunError> {
         let mut x = self.start()?;
         loop {
+            if let Some(e) = self.failure.take() {
+                return Err(RunError::Mpc(e));
+            }
             let t = self.t();
             x.copy_from_slice(self.bdf.x());
             self.restart_after_due(t, &mut x)?;
+            if let Some(e) = self.failure.take() {
+                return Err(RunError::Mpc(e));
+            }
             if t >= self.sc.duration {
                 return Ok(());
             }
@@ -420,6 +487,7 @@ impl<'p> Driver<'p> {
             t: self.bdf.t(),
             stats: self.bdf.stats(),
             conservation,
+            mpc: self.mpcs.into_iter().map(|m| m.log).collect::<Vec<MpcLog>>(),
         }
     }
 }

@@ -1,0 +1,283 @@
+//! Model predictive controllers in a run: each `"type": "mpc"` controller of the flowsheet gets a
+//! [`Dmc`] built at the run's start, its step-response model measured by step tests on the
+//! nonlinear plant at the starting state (or read from a file), and executes every `sample_time`:
+//! it reads its CVs, solves its QP (clarabel) and holds its moves on its `mv<k>` inputs until the
+//! next sample. The QP's status and solve time are logged per controller ([`MpcLog`]).
+
+use std::collections::BTreeMap;
+
+use plantwide_flowsheet::Plant;
+use plantwide_model::BuildCx;
+use plantwide_model::controllers::mpc::{MpcConfig, MpcModelSource, MpcPlan, plan};
+use plantwide_model::registry::ControllerSpec;
+use plantwide_mpc::{Dmc, StepModel};
+use serde::{Deserialize, Serialize};
+
+use super::session::Session;
+
+/// What a model predictive controller did over a run.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct MpcLog {
+    /// Controller name.
+    pub controller: String,
+    /// Where its model came from (`step_test` or the file).
+    pub model: String,
+    /// The model's steady-state gain (its last step coefficient, SI), CVs × MVs.
+    pub model_gain: Vec<Vec<f64>>,
+    /// Executions.
+    pub samples: usize,
+    /// Executions per QP status (`Solved`, `AlmostSolved`, …).
+    pub statuses: BTreeMap<String, usize>,
+    /// Mean QP solve time \[s\].
+    pub mean_solve_time: f64,
+    /// Largest QP solve time \[s\].
+    pub max_solve_time: f64,
+    /// Mean interior-point iterations.
+    pub mean_iterations: f64,
+    /// Largest soft-limit slack used (in the CVs' scales).
+    pub max_slack: f64,
+    /// Executions with an input at a hard limit (within 1e-9 relative).
+    pub samples_at_limit: usize,
+}
+
+/// A step-response model file: the model with the names of its inputs and outputs.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct StepModelFile {
+    /// Input paths, in column order.
+    #[serde(default)]
+    pub inputs: Vec<String>,
+    /// Output paths, in row order.
+    #[serde(default)]
+    pub outputs: Vec<String>,
+    /// The model (SI, deviation variables).
+    #[serde(flatten)]
+    pub model: StepModel,
+}
+
+/// One controller in a run.
+pub(super) struct MpcRun {
+    pub name: String,
+    pub dmc: Dmc,
+    pub sample_time: f64,
+    /// Next execution number (time = k · sample_time).
+    pub next: u64,
+    pub cvs: Vec<usize>,
+    pub mv_inputs: Vec<usize>,
+    pub sp_inputs: Vec<usize>,
+    cv_scales: Vec<f64>,
+    mv_scales: Vec<f64>,
+    pub log: MpcLog,
+    solve_times: f64,
+    iterations: f64,
+}
+
+/// Why a model predictive controller could not run.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("controller `{controller}`: {reason}")]
+pub struct MpcError {
+    /// Controller name.
+    pub controller: String,
+    /// What failed and what to change.
+    pub reason: String,
+}
+
+/// Every model predictive controller of `plant`, built at state `x`.
+pub(super) fn build_all(plant: &Plant, x: &[f64]) -> Result<Vec<MpcRun>, MpcError> {
+    plant
+        .spec()
+        .controllers
+        .iter()
+        .filter_map(|(name, c)| match c {
+            ControllerSpec::Mpc(cfg) => Some(build(plant, x, name, cfg)),
+            _ => None,
+        })
+        .collect()
+}
+
+fn fail(name: &str, reason: impl Into<String>) -> MpcError {
+    MpcError { controller: name.to_string(), reason: reason.into() }
+}
+
+/// A controller resolved against the plant: its plan, CV variables, MV inputs and setpoint inputs.
+type Resolved = (MpcPlan, Vec<usize>, Vec<usize>, Vec<usize>);
+
+/// The plan of `cfg` in SI with its CVs, MV inputs and setpoint inputs.
+fn resolve(plant: &Plant, name: &str, cfg: &MpcConfig) -> Result<Resolved, MpcError> {
+    let cvs: Vec<usize> = cfg
+        .cvs
+        .iter()
+        .map(|c| plant.var(&c.pv).ok_or_else(|| fail(name, format!("no variable `{}`", c.pv))))
+        .collect::<Result<_, _>>()?;
+    let input = |p: String| plant.input(&p).ok_or_else(|| fail(name, format!("no input `{p}`")));
+    let mv_inputs: Vec<usize> =
+        (1..=cfg.mvs.len()).map(|k| input(format!("{name}.mv{k}"))).collect::<Result<_, _>>()?;
+    let sp_inputs: Vec<usize> =
+        (1..=cfg.cvs.len()).map(|k| input(format!("{name}.sp{k}"))).collect::<Result<_, _>>()?;
+    let cv_dims: Vec<_> = cvs.iter().map(|&v| plant.vars()[v].spec.dim).collect();
+    let mvs: Vec<_> = mv_inputs.iter().map(|&i| (plant.inputs()[i].dim, plant.inputs()[i].value)).collect();
+    let mut cx = BuildCx::new(plant.components(), plant.thermo(), format!("controllers.{name}"));
+    let p = plan(cfg, &mut cx, &cv_dims, &mvs);
+    let p = cx.finish(p).map_err(|e| {
+        fail(name, e.iter().map(|e| format!("{}: {}", e.path, e.message)).collect::<Vec<_>>().join("; "))
+    })?;
+    Ok((p, cvs, mv_inputs, sp_inputs))
+}
+
+fn build(plant: &Plant, x: &[f64], name: &str, cfg: &MpcConfig) -> Result<MpcRun, MpcError> {
+    let (p, cvs, mv_inputs, sp_inputs) = resolve(plant, name, cfg)?;
+    let (model, source) = match &p.model {
+        MpcModelSource::Builtin(_) => (step_test(plant, x, name, &p, &cvs, &mv_inputs)?, "step_test".to_string()),
+        MpcModelSource::File { file } => (model_file(plant, name, file, &p, cvs.len(), mv_inputs.len())?, file.clone()),
+    };
+    let u0: Vec<f64> = mv_inputs.iter().zip(&p.mv_scales).map(|(&i, s)| plant.inputs()[i].value / s).collect();
+    let y0: Vec<f64> = cvs.iter().zip(&p.cv_scales).map(|(&v, s)| x[v] / s).collect();
+    let dmc = Dmc::new(scaled(&model, &p), p.settings.clone(), &u0, &y0).map_err(|e| fail(name, e.to_string()))?;
+    let log = MpcLog {
+        controller: name.to_string(),
+        model: source,
+        model_gain: model.gain(),
+        samples: 0,
+        statuses: BTreeMap::new(),
+        mean_solve_time: 0.0,
+        max_solve_time: 0.0,
+        mean_iterations: 0.0,
+        max_slack: 0.0,
+        samples_at_limit: 0,
+    };
+    Ok(MpcRun {
+        name: name.to_string(),
+        dmc,
+        sample_time: p.sample_time,
+        next: 0,
+        cvs,
+        mv_inputs,
+        sp_inputs,
+        cv_scales: p.cv_scales,
+        mv_scales: p.mv_scales,
+        log,
+        solve_times: 0.0,
+        iterations: 0.0,
+    })
+}
+
+/// The model in the QP's scaled variables: `S_ij · scale_u,j / scale_y,i`.
+fn scaled(m: &StepModel, p: &MpcPlan) -> StepModel {
+    let (ny, nu) = (m.ny, m.nu);
+    let steps = m
+        .steps
+        .iter()
+        .map(|row| (0..ny * nu).map(|k| row[k] * p.mv_scales[k % nu] / p.cv_scales[k / nu]).collect())
+        .collect();
+    StepModel { ts: m.ts, ny, nu, steps }
+}
+
+/// The step-response model by step tests on the nonlinear plant from `x`: each MV moved `+h` and
+/// `−h` in turn (the others held, every other controller as the file has it), the CVs sampled
+/// every `sample_time` for `model_length` samples, `S_k = (y⁺(kT) − y⁻(kT))/(2h)`: central
+/// differences, whose error is of second order in `h` (the plant's curvature cancels).
+fn step_test(
+    plant: &Plant,
+    x: &[f64],
+    name: &str,
+    p: &MpcPlan,
+    cvs: &[usize],
+    mvs: &[usize],
+) -> Result<StepModel, MpcError> {
+    let (ny, nu, n) = (cvs.len(), mvs.len(), p.model_length);
+    let mut steps = vec![vec![0.0; ny * nu]; n];
+    for (j, &mv) in mvs.iter().enumerate() {
+        let h = p.steps[j];
+        let mut runs = Vec::new();
+        for sign in [1.0, -1.0] {
+            let mut s = Session::new(plant, x).map_err(|e| fail(name, format!("step test: {e}")))?;
+            s.set_input(mv, plant.inputs()[mv].value + sign * h);
+            let mut y = Vec::with_capacity(n);
+            for k in 1..=n {
+                s.advance_to(k as f64 * p.sample_time)
+                    .map_err(|e| fail(name, format!("step test of mvs[{j}]: {e}")))?;
+                y.push(cvs.iter().map(|&v| s.state()[v]).collect::<Vec<f64>>());
+            }
+            runs.push(y);
+        }
+        for (k, row) in steps.iter_mut().enumerate() {
+            for i in 0..ny {
+                row[i * nu + j] = (runs[0][k][i] - runs[1][k][i]) / (2.0 * h);
+            }
+        }
+    }
+    StepModel::new(p.sample_time, ny, nu, steps).map_err(|e| fail(name, e.to_string()))
+}
+
+/// A step-response model file, relative to the flowsheet's folder, checked against the controller.
+fn model_file(plant: &Plant, name: &str, file: &str, p: &MpcPlan, ny: usize, nu: usize) -> Result<StepModel, MpcError> {
+    let base = std::path::Path::new(plant.file()).parent().unwrap_or(std::path::Path::new("."));
+    let path = base.join(file);
+    let text = std::fs::read_to_string(&path).map_err(|e| fail(name, format!("model file {}: {e}", path.display())))?;
+    let m: StepModelFile =
+        serde_json::from_str(&text).map_err(|e| fail(name, format!("model file {}: {e}", path.display())))?;
+    m.model.validate().map_err(|e| fail(name, format!("model file {}: {e}", path.display())))?;
+    if m.model.ny != ny || m.model.nu != nu {
+        return Err(fail(
+            name,
+            format!(
+                "model file {} is {}×{} but the controller has {ny} CVs and {nu} MVs",
+                path.display(),
+                m.model.ny,
+                m.model.nu
+            ),
+        ));
+    }
+    if (m.model.ts - p.sample_time).abs() > 1e-9 * p.sample_time {
+        return Err(fail(
+            name,
+            format!(
+                "model file {} is sampled every {} s but the controller executes every {} s: give sample_time = {} s",
+                path.display(),
+                m.model.ts,
+                p.sample_time,
+                m.model.ts
+            ),
+        ));
+    }
+    Ok(m.model)
+}
+
+impl MpcRun {
+    /// Time of the next execution \[s\].
+    pub fn next_time(&self) -> f64 {
+        self.next as f64 * self.sample_time
+    }
+
+    /// Execute at `t` if due: read the CVs in `x` and the setpoints, solve, and return the moves
+    /// as `(input, value)`; `None` if not due.
+    pub fn execute(
+        &mut self,
+        t: f64,
+        x: &[f64],
+        setpoint: impl Fn(usize) -> f64,
+    ) -> Result<Option<Vec<(usize, f64)>>, MpcError> {
+        if self.next_time() > t {
+            return Ok(None);
+        }
+        let y: Vec<f64> = self.cvs.iter().zip(&self.cv_scales).map(|(&v, s)| x[v] / s).collect();
+        let sp: Vec<f64> = self.sp_inputs.iter().zip(&self.cv_scales).map(|(&i, s)| setpoint(i) / s).collect();
+        let m = self.dmc.step(&y, &sp).map_err(|e| fail(&self.name, format!("at t = {t:.6e} s: {e}")))?;
+        self.next = (t / self.sample_time).floor() as u64 + 1;
+        let log = &mut self.log;
+        log.samples += 1;
+        *log.statuses.entry(m.status.clone()).or_insert(0) += 1;
+        self.solve_times += m.solve_time;
+        self.iterations += f64::from(m.iterations);
+        log.mean_solve_time = self.solve_times / log.samples as f64;
+        log.mean_iterations = self.iterations / log.samples as f64;
+        log.max_solve_time = log.max_solve_time.max(m.solve_time);
+        log.max_slack = log.max_slack.max(m.slack);
+        let s = self.dmc.settings();
+        let at_limit = m.u.iter().enumerate().any(|(j, &u)| {
+            let tol = 1e-9 * u.abs().max(1.0);
+            (u - s.u_min[j]).abs() <= tol || (u - s.u_max[j]).abs() <= tol
+        });
+        log.samples_at_limit += usize::from(at_limit);
+        Ok(Some(self.mv_inputs.iter().copied().zip(m.u.iter().zip(&self.mv_scales).map(|(u, s)| u * s)).collect()))
+    }
+}
