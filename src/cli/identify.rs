@@ -76,7 +76,8 @@ pub struct IdentifyArgs {
     /// Print `{"gain","rga","models","validation","design",…}` as JSON.
     #[arg(long)]
     json: bool,
-    /// Write identify.md, identify.html, identify.json and the validation plot here.
+    /// Write identify.md, identify.html, identify.json, the validation plot and step_model.json (the
+    /// chosen models' step responses, a model for an `mpc` controller's `"model": {"file": …}`) here.
     #[arg(long, value_name = "DIR")]
     report: Option<PathBuf>,
     /// Override an input or a unit parameter first, e.g. `--set feed_source.F=1.01kmol/min`.
@@ -212,6 +213,8 @@ fn write_report(dir: &Path, file: &Path, id: &Identification, outputs: &[Signal]
     let fail = |e: std::io::Error| CliError::user(format!("--report {}: {e}", dir.display()));
     std::fs::create_dir_all(dir).map_err(fail)?;
     std::fs::write(dir.join("identify.json"), json).map_err(fail)?;
+    let model = serde_json::to_string_pretty(&id.step_model).map_err(|e| CliError::user(e.to_string()))?;
+    std::fs::write(dir.join("step_model.json"), model).map_err(fail)?;
     let ts = id.design.sample_time;
     let n = id.measured.first().map_or(0, Vec::len);
     let times: Vec<f64> = (0..n).map(|k| k as f64 * ts / 60.0).collect();

@@ -192,6 +192,10 @@ pub struct Identification {
     /// sampled every `design.sample_time`, for plots.
     #[serde(skip)]
     pub measured: Vec<Vec<f64>>,
+    /// The chosen structure's step responses as a model for a model predictive controller
+    /// (`"model": {"file": …}`; SI, sampled every `design.sample_time`).
+    #[serde(skip)]
+    pub step_model: plantwide_solve::dynamic::StepModelFile,
 }
 
 /// Display gains: `dy/du · f_u / f_y`.
@@ -277,6 +281,26 @@ pub fn identify(
         design: test.design,
         exact: comparison(&exact, &gain, inputs, outputs),
         measured: validation.y,
+        step_model: step_model(&fits.step, ts, inputs, outputs)?,
+    })
+}
+
+/// The step responses (per output, per input) as a step-response model file.
+fn step_model(
+    step: &[Vec<Vec<f64>>],
+    ts: f64,
+    inputs: &[Signal],
+    outputs: &[Signal],
+) -> Result<plantwide_solve::dynamic::StepModelFile, IdentifyError> {
+    let (ny, nu) = (outputs.len(), inputs.len());
+    let n = step.first().and_then(|s| s.first()).map_or(0, Vec::len);
+    let steps = (0..n).map(|k| (0..ny * nu).map(|e| step[e / nu][e % nu][k]).collect()).collect();
+    let model =
+        plantwide_mpc::StepModel::new(ts, ny, nu, steps).map_err(|e| IdentifyError::Estimation(e.to_string()))?;
+    Ok(plantwide_solve::dynamic::StepModelFile {
+        inputs: inputs.iter().map(|s| s.path.clone()).collect(),
+        outputs: outputs.iter().map(|s| s.path.clone()).collect(),
+        model,
     })
 }
 

@@ -2,7 +2,7 @@
 //! from the ARX fit), each simulated on the fresh validation inputs and judged there.
 
 use plantwide_analysis::select::Signal;
-use plantwide_ident::{arx_select, fir, oe, simulate_arx, simulate_oe, validate};
+use plantwide_ident::{StepResponse, arx_select, fir, oe, simulate_arx, simulate_oe, validate};
 use serde::Serialize;
 
 use super::IdentifyError;
@@ -66,6 +66,8 @@ pub struct OutputValidation {
 /// Every fit: the chosen structure's gains (SI), every model, and the chosen one's validation.
 pub(super) struct Fits {
     pub gain: Vec<Vec<f64>>,
+    /// The chosen structure's step responses, per output per input (SI).
+    pub step: Vec<Vec<Vec<f64>>>,
     pub models: Vec<ModelSummary>,
     pub chosen: String,
     pub validation: Vec<OutputValidation>,
@@ -83,6 +85,8 @@ struct Fitted {
     gain_std: Option<Vec<f64>>,
     reliable: bool,
     validation: OutputValidation,
+    /// Step response per input over the settling samples (SI).
+    step: Vec<Vec<f64>>,
 }
 
 /// Least `|F(1)|` (or `|A(1)|`) of a model whose gain is reported as reliable.
@@ -171,6 +175,7 @@ fn fit_output(
             gain: fir_model.gain.clone(),
             gain_std: None,
             reliable: true,
+            step: fir_model.step_response(n_fir).map_err(fit_error)?,
             validation: fir_validation,
         },
         Fitted {
@@ -179,6 +184,7 @@ fn fit_output(
             gain: arx.gain.clone(),
             gain_std: None,
             reliable: (1.0 + arx.a.iter().sum::<f64>()).abs() > MIN_DENOMINATOR,
+            step: arx.step_response(n_fir).map_err(fit_error)?,
             validation: judge(simulate_arx(&arx, &val.u))?,
         },
         Fitted {
@@ -187,6 +193,7 @@ fn fit_output(
             gain: oe_model.gain.clone(),
             gain_std: oe_gain_std(&oe_model),
             reliable: oe_model.f.iter().all(|f| (1.0 + f.iter().sum::<f64>()).abs() > MIN_DENOMINATOR),
+            step: oe_model.step_response(n_fir).map_err(fit_error)?,
             validation: judge(simulate_oe(&oe_model, &val.u))?,
         },
     ])
@@ -234,6 +241,7 @@ pub(super) fn fit_all(
         .collect();
     Ok(Fits {
         gain: per_output.iter().map(|f| f[best].gain.clone()).collect(),
+        step: per_output.iter().map(|f| f[best].step.clone()).collect(),
         models,
         chosen: per_output[0][best].model.to_string(),
         validation: per_output.into_iter().map(|mut f| f.swap_remove(best).validation).collect(),
