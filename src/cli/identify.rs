@@ -183,9 +183,9 @@ fn markdown(file: &Path, id: &Identification) -> String {
     md.push_str(&format!("\n## Gains ({} model)\n\n", id.validation.model));
     md.push_str(&format!("- identified G(0) = {}\n- exact G(0) = {}\n", matrix(&id.gain), matrix(&id.exact.gain)));
     md.push_str(&format!("- relative errors {}\n", matrix(&id.exact.gain_relative_error)));
-    if let (Some(r), Some(e)) = (&id.rga, &id.rga) {
-        let _ = e;
-        md.push_str(&format!("- identified RGA = {}\n", matrix(r)));
+    match &id.rga {
+        Some(r) => md.push_str(&format!("- identified RGA = {}\n", matrix(r))),
+        None => md.push_str("- identified RGA: none (the identified gain is singular)\n"),
     }
     if let Some(r) = &id.exact.rga {
         md.push_str(&format!("- exact RGA = {}\n", matrix(r)));

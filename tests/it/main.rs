@@ -23,6 +23,7 @@ mod flowsheets;
 mod fuzz;
 mod heat_integration;
 mod hostile;
+mod identify;
 mod mpc;
 mod plots;
 mod pressure;
