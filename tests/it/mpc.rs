@@ -236,3 +236,27 @@ fn an_identified_step_model_drives_the_controller() {
     let (header, rows) = read_csv(&dir.join("run.csv"));
     assert!(column(&header, &rows, "column.boilup").iter().all(|v| *v <= 3.5 + 1e-9));
 }
+
+/// `compare` and `screen` do not model a model predictive controller yet: a scheme with one is
+/// refused with the controller named (exit 1), not compared as if its MVs were held.
+#[test]
+fn compare_and_screen_refuse_an_mpc_scheme_by_name() {
+    let lv = flowsheet("column_a_lv.json");
+    let mpc = flowsheet("column_a_mpc.json");
+    let compare = plantwide(&[
+        "compare",
+        &lv,
+        &mpc,
+        "--disturbances",
+        "feed_source.F=+20%",
+        "--outputs",
+        "distillate.x[light],bottoms.x[light]",
+    ]);
+    let screen =
+        plantwide(&["screen", &mpc, "--column", "column", "--outputs", "distillate.x[light],bottoms.x[light]"]);
+    for (what, out) in [("compare", compare), ("screen", screen)] {
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{what}: {err}");
+        assert!(err.contains("quality_mpc") && err.contains("model predictive"), "{what}: {err}");
+    }
+}

@@ -215,6 +215,10 @@ pub struct Comparison {
 /// # Errors
 /// [`CompareError`] naming the scheme's file and what failed.
 pub fn compare(plants: &[Plant], request: &CompareRequest) -> Result<Comparison, CompareError> {
+    for p in plants {
+        crate::screen::without_mpc(p, "compare")
+            .map_err(|e| CompareError::Screen { file: p.file().to_string(), source: Box::new(e) })?;
+    }
     let first: Vec<Scheme> = plants.par_iter().map(|p| scheme(p, request)).collect::<Result<_, _>>()?;
     // One run length for all: given, or 20 reset times of the slowest tuned loop of any scheme.
     let longest = |s: &Scheme| {

@@ -150,6 +150,19 @@ pub enum ScreenError {
         /// Its value in the plant as written.
         base: f64,
     },
+    /// The plant has a model predictive controller, which the steady-state and closed-loop parts
+    /// of a screening or comparison do not model yet.
+    #[error(
+        "controller `{controller}` is a model predictive controller: {study} does not take one yet (its steady states \
+         and closed-loop runs would treat it as holding its MVs); run it with `plantwide run`, or remove it to {study} \
+         the PID structure"
+    )]
+    ModelPredictive {
+        /// The controller.
+        controller: String,
+        /// The study refused (`screen`, `compare`).
+        study: &'static str,
+    },
     /// A linear-algebra step failed.
     #[error("configuration {structure}: {source}")]
     Analysis {
@@ -158,6 +171,16 @@ pub enum ScreenError {
         /// Why.
         source: Box<plantwide_analysis::AnalysisError>,
     },
+}
+
+/// Refuse a plant with a model predictive controller for `study`.
+pub(crate) fn without_mpc(plant: &plantwide_flowsheet::Plant, study: &'static str) -> Result<(), ScreenError> {
+    let mpc =
+        plant.spec().controllers.iter().find(|(_, c)| matches!(c, plantwide_model::registry::ControllerSpec::Mpc(_)));
+    match mpc {
+        Some((name, _)) => Err(ScreenError::ModelPredictive { controller: name.clone(), study }),
+        None => Ok(()),
+    }
 }
 
 impl ScreenError {

@@ -141,6 +141,7 @@ pub fn screen_column(plant: &Plant, column: &str, outputs: &[String]) -> Result<
     if outputs.len() != 2 {
         return Err(ScreenError::OutputCount(outputs.len()));
     }
+    super::without_mpc(plant, "screen")?;
     let h = handles(plant, column)?;
     let out: Vec<usize> = outputs.iter().map(|p| output_var(plant, p)).collect::<Result<_, _>>()?;
     let steady = |e| ScreenError::Steady { structure: "file".into(), source: Box::new(e) };

@@ -143,6 +143,7 @@ pub struct OpenPlant {
 /// [`ScreenError`] naming the CV, MV or throughput choice that is wrong, or the inventory that
 /// opening the loops leaves uncontrolled.
 pub fn screen_pairings(plant: &Plant, request: &PairingRequest) -> Result<PairingScreen, ScreenError> {
+    super::without_mpc(plant, "screen")?;
     check_request(plant, request)?;
     let open = open_plant(plant, &request.cvs, &request.mvs)?;
     let choices: Vec<Option<&String>> =
