@@ -154,8 +154,8 @@ fn mpc_keeps_column_a_within_limits_where_pi_loses_the_bottoms() {
 /// An edit of the controller's description.
 type Edit = Box<dyn Fn(&mut serde_json::Value)>;
 
-/// Bad descriptions exit 1 naming the field: a control horizon beyond the prediction horizon, an
-/// MV starting outside its limits, a model file that is missing or of the wrong shape.
+/// Bad descriptions exit 1 naming the field: a control horizon beyond the prediction horizon,
+/// horizons whose dense QP would not fit a bounded allocation, an MV starting outside its limits, a model file that is missing or of the wrong shape.
 #[test]
 fn bad_mpc_descriptions_are_refused_by_field() {
     let dir = tempdir("mpc_bad");
@@ -164,6 +164,14 @@ fn bad_mpc_descriptions_are_refused_by_field() {
     let scenario = flowsheet("scenarios/column_a_feed_rate_20.json");
     let cases: Vec<(&str, Edit, &str)> = vec![
         ("horizon", Box::new(|c| c["control_horizon"] = 50.into()), "control_horizon"),
+        (
+            "huge",
+            Box::new(|c| {
+                c["prediction_horizon"] = 2000.into();
+                c["control_horizon"] = 2000.into();
+            }),
+            "exceeds 10000000 entries",
+        ),
         ("start", Box::new(|c| c["mvs"][1]["max"] = "3 kmol/min".into()), "mvs[1]"),
         ("missing", Box::new(|c| c["model"] = serde_json::json!({"file": "no_such_model.json"})), "no_such_model.json"),
         ("shape", Box::new(|c| c["model"] = serde_json::json!({"file": "shape_model.json"})), "2 CVs and 2 MVs"),

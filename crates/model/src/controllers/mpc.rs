@@ -187,6 +187,10 @@ fn scale(cx: &mut BuildCx<'_>, field: String, v: &Option<QuantityValue>, dim: Di
     v.as_ref().map_or(1.0, |q| cx.positive(&field, q, dim))
 }
 
+/// Largest dense prediction matrix `(P·n_cv) × (M·n_mv)` and step model `N·n_cv·n_mv` accepted
+/// (entries): a bound on what a file can make the controller allocate (80 MB each).
+pub const MAX_ENTRIES: usize = 10_000_000;
+
 /// The horizons and model length, checked.
 fn horizons(c: &MpcConfig, cx: &mut BuildCx<'_>) -> (usize, usize, usize) {
     let (p, m) = (c.prediction_horizon, c.control_horizon);
@@ -199,6 +203,16 @@ fn horizons(c: &MpcConfig, cx: &mut BuildCx<'_>) -> (usize, usize, usize) {
     let n = c.model_length.unwrap_or(2 * p);
     if !(1..=MAX_HORIZON).contains(&n) {
         cx.error("model_length", format!("must be 1 … {MAX_HORIZON} samples (got {n})"));
+    }
+    let (ny, nu) = (c.cvs.len(), c.mvs.len());
+    if p.saturating_mul(ny).saturating_mul(m).saturating_mul(nu) > MAX_ENTRIES {
+        cx.error(
+            "prediction_horizon",
+            format!("P·n_cv × M·n_mv = {p}·{ny} × {m}·{nu} exceeds {MAX_ENTRIES} entries: shorten the horizons"),
+        );
+    }
+    if n.saturating_mul(ny).saturating_mul(nu) > MAX_ENTRIES {
+        cx.error("model_length", format!("N·n_cv·n_mv = {n}·{ny}·{nu} exceeds {MAX_ENTRIES} entries"));
     }
     (p.clamp(1, MAX_HORIZON), m.clamp(1, p.clamp(1, MAX_HORIZON)), n.clamp(1, MAX_HORIZON))
 }

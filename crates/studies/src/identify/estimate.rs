@@ -210,7 +210,10 @@ pub(super) fn fit_all(
 ) -> Result<Fits, IdentifyError> {
     let t99 = 4.6 * design.tau_dom;
     let n_samples = est.y.first().map_or(0, Vec::len);
-    let n_fir = ((t99 / design.sample_time).ceil() as usize).clamp(5, (n_samples / (4 * inputs.len().max(1))).max(5));
+    // The settling time in samples, at most a quarter of the data per input and the FIR fit's cap.
+    let n_fir = ((t99 / design.sample_time).ceil() as usize)
+        .clamp(5, (n_samples / (4 * inputs.len().max(1))).max(5))
+        .min(plantwide_ident::data::MAX_FIR);
     let per_output: Vec<Vec<Fitted>> =
         outputs.iter().enumerate().map(|(i, o)| fit_output(est, val, i, n_fir, &o.path)).collect::<Result<_, _>>()?;
     let n_structures = per_output[0].len();
