@@ -155,7 +155,8 @@ fn mpc_keeps_column_a_within_limits_where_pi_loses_the_bottoms() {
 type Edit = Box<dyn Fn(&mut serde_json::Value)>;
 
 /// Bad descriptions exit 1 naming the field: a control horizon beyond the prediction horizon,
-/// horizons whose dense QP would not fit a bounded allocation, an MV starting outside its limits, a model file that is missing or of the wrong shape.
+/// horizons whose dense QP would not fit a bounded allocation, an MV starting outside its limits,
+/// a scenario sampling the controller (it executes on its own clock), a model file that is missing or of the wrong shape.
 #[test]
 fn bad_mpc_descriptions_are_refused_by_field() {
     let dir = tempdir("mpc_bad");
@@ -178,6 +179,21 @@ fn bad_mpc_descriptions_are_refused_by_field() {
     ];
     std::fs::write(dir.join("shape_model.json"), r#"{"ts": 300.0, "ny": 1, "nu": 1, "steps": [[0.1], [0.2]]}"#)
         .unwrap();
+    let sampled = dir.join("sampled.json");
+    std::fs::write(&sampled, r#"{"format_version": 1, "duration": "10 min", "sampling": {"quality_mpc": "1 min"}}"#)
+        .unwrap();
+    let csv = dir.join("sampled.csv");
+    let out = plantwide(&[
+        "run",
+        &flowsheet("column_a_mpc.json"),
+        "--scenario",
+        sampled.to_str().unwrap(),
+        "--csv",
+        csv.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("quality_mpc") && err.contains("sampling"), "{err}");
     for (name, edit, expected) in cases {
         let mut fs = base.clone();
         edit(&mut fs["controllers"]["quality_mpc"]);

@@ -120,6 +120,18 @@ impl<'p> Driver<'p> {
             source: e,
             partial: None,
         })?;
+        let discrete = sc.sampling.iter().map(|&(b, _)| b).chain(sc.analyzers.iter().map(|&(b, _, _)| b));
+        if let Some(name) = discrete.map(|b| &plant.blocks()[b].name).find(|n| mpcs.iter().any(|m| &m.name == *n)) {
+            let reason = format!(
+                "the scenario samples `{name}` (sampling or analyzers), a model predictive controller, which executes \
+                 every sample_time of its own and reads its CVs then: remove it from the scenario's sampling and analyzers"
+            );
+            return Err(SimError::Mpc {
+                file: plant.file().to_string(),
+                source: MpcError { controller: name.clone(), reason },
+                partial: None,
+            });
+        }
         if !mpcs.is_empty() && matches!(start, Start::Snapshot(_)) {
             return Err(SimError::Snapshot {
                 file: plant.file().to_string(),
