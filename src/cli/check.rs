@@ -1,13 +1,14 @@
-//! `plantwide check FILE`: validate and summarize.
+//! `plantwide check FILE`: validate and summarize; values in the `--units` system (default SI).
 
 use std::path::Path;
 
 use plantwide::flowsheet::{BlockKind, load_file};
 use plantwide::solve::{DofProbe, dof_check};
+use plantwide::units::{Dimension, UnitSystem};
 
 use super::CliError;
 
-pub fn run(file: &Path) -> Result<(), CliError> {
+pub fn run(file: &Path, system: UnitSystem) -> Result<(), CliError> {
     let plant = load_file(file).map_err(|e| CliError::user(e.to_string()))?;
     outln!("flowsheet `{}` ({})", plant.name(), file.display());
     outln!("components ({}): {}", plant.components().len(), plant.components().join(", "));
@@ -33,12 +34,12 @@ pub fn run(file: &Path) -> Result<(), CliError> {
     }
     print_controllers_and_specs(&plant);
     let n_diff = plant.differential().iter().filter(|d| **d).count();
-    let free: Vec<&str> = plant
+    let free: Vec<String> = plant
         .inputs()
         .iter()
         .enumerate()
         .filter(|(k, i)| i.driven_by.is_none() && !plant.specs().iter().any(|s| s.input == *k))
-        .map(|(_, i)| i.path.as_str())
+        .map(|(_, i)| format!("{} = {}", i.path, super::steady::shown(i.value, i.dim, system)))
         .collect();
     outln!(
         "variables: {} ({} differential, {} algebraic){}; equations: {}{}; inputs: {} ({} driven by controllers{})",
@@ -52,7 +53,10 @@ pub fn run(file: &Path) -> Result<(), CliError> {
         plant.inputs().iter().filter(|i| i.driven_by.is_some()).count(),
         specs_note(plant.specs().len(), "varied by specs").replace(" + ", ", ")
     );
-    outln!("free inputs (manipulated variables and disturbances): {}", free.join(", "));
+    outln!("free inputs (manipulated variables and disturbances), with the file's values:");
+    for f in &free {
+        outln!("  {f}");
+    }
     let recycles = plant.recycles();
     if recycles.is_empty() {
         outln!("recycles: none");
@@ -84,7 +88,7 @@ pub fn run(file: &Path) -> Result<(), CliError> {
         if numerical { ", numerically nonsingular at the initial guess" } else { "" }
     );
     plantwide::solve::sequential::plan(&plant, &u, &x).describe(&plant).iter().for_each(|l| outln!("{l}"));
-    residence(&plant, &u, &x);
+    residence(&plant, &u, &x, system);
     Ok(())
 }
 
@@ -127,7 +131,7 @@ fn specs_note(k: usize, what: &str) -> String {
 
 /// Residence times of the drums, sumps and vessels against the ~5 min rule, at the steady state
 /// (or, when the plant does not converge, at the initial guess, said so).
-fn residence(plant: &plantwide::flowsheet::Plant, u: &[f64], guess: &[f64]) {
+fn residence(plant: &plantwide::flowsheet::Plant, u: &[f64], guess: &[f64], units: UnitSystem) {
     use plantwide::studies::size::residence::{RULE_OF_THUMB, residence_times};
     let (x, basis) = match super::steady::converge(plant, u) {
         Ok(s) => (s.x, "at the steady state"),
@@ -143,11 +147,11 @@ fn residence(plant: &plantwide::flowsheet::Plant, u: &[f64], guess: &[f64]) {
     );
     for r in times {
         outln!(
-            "  {:<16} {:>9.2} min  (holdup {:.4e} mol, leaving {:.4e} mol/s){}",
+            "  {:<16} {:>9.2} min  (holdup {}, leaving {}){}",
             r.vessel,
             r.time / 60.0,
-            r.holdup,
-            r.throughput,
+            super::steady::shown(r.holdup, Dimension::AMOUNT, units),
+            super::steady::shown(r.throughput, Dimension::MOLAR_FLOW, units),
             if r.short { "  — short: little surge capacity (Practical Distillation Control ch. 1)" } else { "" }
         );
     }

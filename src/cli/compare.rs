@@ -12,9 +12,11 @@ use plantwide::studies::compare::{CompareRequest, Comparison, Scheme, compare};
 use plantwide::studies::screen::pairings::STEP_AT;
 use plantwide::studies::screen::pairings::{DynamicResult, DynamicSettings};
 use plantwide::studies::tune::loops::Measurement;
+use plantwide::units::UnitSystem;
 
 use super::CliError;
 use super::screen::{disturbance, time};
+use super::shown::Shown;
 use super::steady::load_with_overrides;
 
 /// Arguments of `plantwide compare`.
@@ -63,14 +65,22 @@ pub enum TuningArg {
 }
 
 /// Run `plantwide compare`.
-pub fn run(a: &CompareArgs) -> Result<(), CliError> {
+pub fn run(a: &CompareArgs, system: UnitSystem) -> Result<(), CliError> {
     // Schemes run in parallel; faer's kernels sequential inside each, so no digit depends on the
     // thread count.
     plantwide::analysis::faer::set_global_parallelism(plantwide::analysis::faer::Par::Seq);
     let plants = a.files.iter().map(|f| load_with_overrides(f, &[]).map(|(p, _)| p)).collect::<Result<Vec<_>, _>>()?;
+    let outputs: Vec<(String, Option<String>)> = a
+        .outputs
+        .iter()
+        .map(|o| {
+            let (p, u) = plantwide::analysis::select::split_unit(o);
+            (p.to_string(), u.map(String::from))
+        })
+        .collect();
     let request = CompareRequest {
         disturbances: a.disturbances.iter().map(|d| disturbance(d)).collect::<Result<_, _>>()?,
-        outputs: a.outputs.clone(),
+        outputs: outputs.iter().map(|(p, _)| p.clone()).collect(),
         loops: a.loops.clone(),
         file_tuning: a.tuning == TuningArg::File,
         dynamic: DynamicSettings {
@@ -83,18 +93,21 @@ pub fn run(a: &CompareArgs) -> Result<(), CliError> {
         if e.is_user_error() { CliError::user(e.to_string()) } else { CliError::numerical(e.to_string()) }
     })?;
     let json = serde_json::to_string_pretty(&c).map_err(|e| CliError::user(e.to_string()))?;
+    let loops =
+        c.schemes.iter().flat_map(|s| s.loops.iter().flat_map(|l| [(l.cv.clone(), None), (l.mv.clone(), None)]));
+    let shown = Shown::new(&plants, outputs.iter().cloned().chain(loops), system)?;
     if let Some(dir) = &a.report {
-        write_report(dir, &c, &json)?;
+        write_report(dir, &c, &json, &shown)?;
     }
     if a.json {
         outln!("{json}");
     } else {
-        outln!("{}", markdown(&c));
+        outln!("{}", markdown(&c, &shown));
     }
     Ok(())
 }
 
-fn write_report(dir: &Path, c: &Comparison, json: &str) -> Result<(), CliError> {
+fn write_report(dir: &Path, c: &Comparison, json: &str, shown: &Shown) -> Result<(), CliError> {
     let fail = |e: std::io::Error| CliError::user(format!("--report {}: {e}", dir.display()));
     let draw = |e: plantwide::io::IoError| CliError::user(format!("--report {}: {e}", dir.display()));
     std::fs::create_dir_all(dir).map_err(fail)?;
@@ -105,10 +118,10 @@ fn write_report(dir: &Path, c: &Comparison, json: &str) -> Result<(), CliError> 
     if write_rga(&dir.join("rga.png"), c).map_err(draw)? {
         figures.push_str("\n![relative gains](rga.png)\n");
     }
-    for name in write_responses(dir, c).map_err(draw)? {
+    for name in write_responses(dir, c, shown).map_err(draw)? {
         figures.push_str(&format!("\n![responses]({name})\n"));
     }
-    let md = format!("{}{figures}", markdown(c));
+    let md = format!("{}{figures}", markdown(c, shown));
     std::fs::write(dir.join("compare.html"), markdown_to_html("Schemes compared", &md)).map_err(fail)?;
     std::fs::write(dir.join("compare.md"), md).map_err(fail)
 }
@@ -144,7 +157,7 @@ fn runs(s: &Scheme) -> Option<&DynamicResult> {
 
 /// One figure per disturbance: a panel per CV and output, a curve per scheme (schemes whose runs
 /// share the time grid; all do when the run length is common).
-fn write_responses(dir: &Path, c: &Comparison) -> Result<Vec<String>, plantwide::io::IoError> {
+fn write_responses(dir: &Path, c: &Comparison, shown: &Shown) -> Result<Vec<String>, plantwide::io::IoError> {
     let Some(first) = c.schemes.iter().find_map(runs) else { return Ok(Vec::new()) };
     let mut names = Vec::new();
     for (d, run) in first.runs.iter().enumerate() {
@@ -152,14 +165,15 @@ fn write_responses(dir: &Path, c: &Comparison) -> Result<Vec<String>, plantwide:
         let panels: Vec<Overlay> = paths
             .iter()
             .map(|&p| Overlay {
-                label: format!("{p} (SI)"),
+                label: shown.label(p),
                 curves: c
                     .schemes
                     .iter()
                     .filter_map(|s| {
                         let r = &runs(s)?.runs[d];
                         let k = r.cvs.iter().position(|f| &f.cv == p)?;
-                        (r.times.len() == run.times.len()).then(|| (s.name.clone(), r.series[k].clone()))
+                        let series = r.series[k].iter().map(|v| shown.value(p, *v)).collect();
+                        (r.times.len() == run.times.len()).then(|| (s.name.clone(), series))
                     })
                     .collect(),
                 ..Overlay::default()
@@ -186,14 +200,14 @@ fn sig(v: f64) -> String {
 }
 
 /// The comparison as markdown: one table per question.
-fn markdown(c: &Comparison) -> String {
+fn markdown(c: &Comparison, shown: &Shown) -> String {
     let mut t = String::from("# Schemes compared\n\n");
     t.push_str(&energy_table(c));
     t.push_str(&structure_table(c));
     t.push_str(&stability_table(c));
     t.push_str(&recycle_table(c));
-    t.push_str(&sensitivity_table(c));
-    t.push_str(&response_table(c));
+    t.push_str(&sensitivity_table(c, shown));
+    t.push_str(&response_table(c, shown));
     t
 }
 
@@ -281,11 +295,11 @@ fn recycle_table(c: &Comparison) -> String {
     t + "\n"
 }
 
-fn sensitivity_table(c: &Comparison) -> String {
+fn sensitivity_table(c: &Comparison, shown: &Shown) -> String {
     let mut t = String::from(
         "## Sensitivity (steady state at ± each disturbance, control structure active)\n\n| disturbance | output | scheme | low | base | high |\n|---|---|---|---|---|---|\n",
     );
-    let value = |v: Option<f64>| v.map_or("–".into(), sig);
+    let value = |p: &str, v: Option<f64>| v.map_or("–".into(), |v| sig(shown.value(p, v)));
     let mut notes: Vec<String> = Vec::new();
     for s in &c.schemes {
         for r in &s.sensitivity {
@@ -298,11 +312,11 @@ fn sensitivity_table(c: &Comparison) -> String {
             t.push_str(&format!(
                 "| {} | {} | {} | {} | {} | {} |\n",
                 r.disturbance,
-                r.output,
+                shown.label(&r.output),
                 s.name,
-                value(r.low),
-                sig(r.base),
-                value(r.high)
+                value(&r.output, r.low),
+                sig(shown.value(&r.output, r.base)),
+                value(&r.output, r.high)
             ));
         }
     }
@@ -312,9 +326,9 @@ fn sensitivity_table(c: &Comparison) -> String {
     t + "\n"
 }
 
-fn response_table(c: &Comparison) -> String {
+fn response_table(c: &Comparison, shown: &Shown) -> String {
     let mut t = format!(
-        "## Closed-loop responses (tuning below; runs of {})\n\n| scheme | disturbance | variable | IAE | largest deviation | settling time [s] | MVs at a limit |\n|---|---|---|---|---|---|---|\n",
+        "## Closed-loop responses (tuning below; runs of {})\n\n| scheme | disturbance | variable [unit] | IAE [unit·s] | largest deviation [unit] | settling time [s] | MVs at a limit |\n|---|---|---|---|---|---|---|\n",
         c.duration.map_or("–".into(), |d| format!("{} s", sig(d)))
     );
     for s in &c.schemes {
@@ -329,9 +343,9 @@ fn response_table(c: &Comparison) -> String {
                     "| {} | {} | {} | {} | {} | {} | {} |\n",
                     s.name,
                     run.disturbance,
-                    f.cv,
-                    sig(f.iae),
-                    sig(f.max_deviation),
+                    shown.label(&f.cv),
+                    sig(shown.difference(&f.cv, f.iae)),
+                    sig(shown.difference(&f.cv, f.max_deviation)),
                     f.settling_time.map_or("–".into(), sig),
                     if run.saturated.is_empty() { "none".to_string() } else { run.saturated.join(", ") }
                 ));
@@ -346,7 +360,12 @@ fn response_table(c: &Comparison) -> String {
             let loops: Vec<String> = d
                 .loops
                 .iter()
-                .map(|l| format!("{} ← {}: Kc {} ({}), τI {} s", l.cv, l.mv, sig(l.kc), l.action, sig(l.tau_i)))
+                .map(|l| {
+                    // u = Kc e in SI: in the display units, Kc · (one unit of the CV) / (one unit of the MV).
+                    let kc = l.kc * shown.difference(&l.mv, 1.0) / shown.difference(&l.cv, 1.0);
+                    let unit = format!("{}/{}", shown.unit(&l.mv), shown.unit(&l.cv));
+                    format!("{} ← {}: Kc {} {unit} ({}), τI {} s", l.cv, l.mv, sig(kc), l.action, sig(l.tau_i))
+                })
                 .collect();
             let how = match (s.tuning, s.stability.open_loop_unstable) {
                 ("blt", _) => "BLT",
@@ -357,7 +376,7 @@ fn response_table(c: &Comparison) -> String {
         })
         .collect();
     if !tuned.is_empty() {
-        t.push_str(&format!("\nTuning (SI):\n{}\n", tuned.join("\n")));
+        t.push_str(&format!("\nTuning:\n{}\n", tuned.join("\n")));
     }
     t
 }

@@ -172,7 +172,7 @@ fn markdown(file: &Path, id: &Identification) -> String {
         serde_json::to_value(d.design).ok().and_then(|v| v.as_str().map(String::from)).unwrap_or_default(),
         d.tau_dom / 60.0, d.alpha, d.beta, d.sample_time / 60.0, d.clock_period / 60.0, d.registers, d.period_clocks,
         d.period / 60.0, d.band[0] * 60.0, d.band[1] * 60.0, d.duration / 60.0, d.validation_duration / 60.0,
-        d.amplitude.iter().map(|v| format!("{v:.4e}")).collect::<Vec<_>>().join(", "),
+        d.amplitude.iter().zip(&id.inputs).map(|(v, s)| format!("{v:.4e} {}", s.unit)).collect::<Vec<_>>().join(", "),
     ));
     if let Some(dir) = &d.directions {
         md.push_str(&format!(

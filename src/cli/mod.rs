@@ -29,6 +29,7 @@ mod run;
 mod run_plot;
 mod screen;
 mod sensitivity;
+mod shown;
 mod size;
 mod steady;
 mod tune;
@@ -197,7 +198,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
     // A limit set in the environment but not a number is a user error, said before any work.
     plantwide::model::limits::Limits::from_env().map_err(|e| CliError::user(e.to_string()))?;
     match cli.command {
-        Command::Check { file } => check::run(&file),
+        Command::Check { file } => check::run(&file, cli.units.unwrap_or(UnitsArg::Si).into()),
         Command::Components { json } => components::run(json),
         Command::Steady { file, json, set, spec, vary, method } => {
             let units = cli.units.map(Into::into);
@@ -212,9 +213,9 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Sensitivity(a) => sensitivity::run(&a, cli.units.unwrap_or(UnitsArg::Si).into()),
         Command::Sensors(a) => gains::run_sensors(&a),
         Command::Tune(a) => tune::run(&a),
-        Command::Screen(a) => screen::run(&a),
-        Command::Size(a) => size::run(&a),
-        Command::Compare(a) => compare::run(&a),
+        Command::Screen(a) => screen::run(&a, cli.units.unwrap_or(UnitsArg::Si).into()),
+        Command::Size(a) => size::run(&a, cli.units.unwrap_or(UnitsArg::Si).into()),
+        Command::Compare(a) => compare::run(&a, cli.units.unwrap_or(UnitsArg::Si).into()),
         Command::Identify(a) => identify::run(&a, cli.units.unwrap_or(UnitsArg::Si).into()),
         Command::Schema { scenario } => {
             let schema = match scenario {

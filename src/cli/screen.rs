@@ -12,7 +12,10 @@ use plantwide::studies::screen::pairings::{Disturbance, DynamicSettings, Pairing
 use plantwide::studies::screen::{ColumnScreen, ScreenError, screen_column, screen_pairings};
 use plantwide::units::Dimension;
 
+use plantwide::units::UnitSystem;
+
 use super::CliError;
+use super::shown::Shown;
 use super::steady::load_with_overrides;
 
 /// Arguments of `plantwide screen`.
@@ -68,12 +71,12 @@ fn screen_error(e: ScreenError) -> CliError {
 }
 
 /// Run `plantwide screen`.
-pub fn run(a: &ScreenArgs) -> Result<(), CliError> {
+pub fn run(a: &ScreenArgs, system: UnitSystem) -> Result<(), CliError> {
     // The candidates run in parallel (rayon); faer's kernels then run sequentially inside each, so
     // that no reduction's order, and no digit of the results, depends on the number of threads.
     plantwide::analysis::faer::set_global_parallelism(plantwide::analysis::faer::Par::Seq);
     let (plant, _) = load_with_overrides(&a.file, &a.set)?;
-    let Some(column) = &a.column else { return pairings(a, &plant) };
+    let Some(column) = &a.column else { return pairings(a, &plant, system) };
     let screen = screen_column(&plant, column, &a.outputs).map_err(screen_error)?;
     let json = serde_json::to_string_pretty(&screen).map_err(|e| CliError::user(e.to_string()))?;
     if let Some(dir) = &a.report {
@@ -176,7 +179,7 @@ fn write_ranking(dir: &Path, s: &PairingScreen) -> Result<bool, CliError> {
 }
 
 /// One figure per disturbance: each CV's response under the (up to three) best tested candidates.
-fn write_responses(dir: &Path, s: &PairingScreen) -> Result<Vec<String>, CliError> {
+fn write_responses(dir: &Path, s: &PairingScreen, shown: &Shown) -> Result<Vec<String>, CliError> {
     let mut best: Vec<_> = s
         .structures
         .iter()
@@ -192,13 +195,14 @@ fn write_responses(dir: &Path, s: &PairingScreen) -> Result<Vec<String>, CliErro
             .iter()
             .enumerate()
             .map(|(k, cv)| Overlay {
-                label: format!("{cv} (SI)"),
+                label: shown.label(cv),
                 curves: best
                     .iter()
                     .filter_map(|c| {
-                        c.dynamic
-                            .as_ref()
-                            .map(|t| (format!("rank {}", c.rank.unwrap_or(0)), t.runs[d].series[k].clone()))
+                        c.dynamic.as_ref().map(|t| {
+                            let series = t.runs[d].series[k].iter().map(|v| shown.value(cv, *v)).collect();
+                            (format!("rank {}", c.rank.unwrap_or(0)), series)
+                        })
                     })
                     .collect(),
                 ..Overlay::default()
@@ -252,11 +256,19 @@ fn watch(plant: &plantwide::flowsheet::Plant, text: &str) -> Result<Watch, CliEr
     Ok(Watch { path: path.trim().to_string(), low, high })
 }
 
-fn pairings(a: &ScreenArgs, plant: &plantwide::flowsheet::Plant) -> Result<(), CliError> {
+fn pairings(a: &ScreenArgs, plant: &plantwide::flowsheet::Plant, system: UnitSystem) -> Result<(), CliError> {
     let dead_time = time(&a.measurement_dead_time, "measurement-dead-time")?;
     let duration = a.duration.as_deref().map(|d| time(d, "duration")).transpose()?;
+    let cvs: Vec<(String, Option<String>)> = a
+        .cvs
+        .iter()
+        .map(|c| {
+            let (p, u) = plantwide::analysis::select::split_unit(c);
+            (p.to_string(), u.map(String::from))
+        })
+        .collect();
     let request = PairingRequest {
-        cvs: a.cvs.clone(),
+        cvs: cvs.iter().map(|(p, _)| p.clone()).collect(),
         mvs: a.mvs.clone(),
         throughput: a.throughput.clone(),
         disturbances: a.disturbances.iter().map(|d| disturbance(d)).collect::<Result<_, _>>()?,
@@ -269,30 +281,32 @@ fn pairings(a: &ScreenArgs, plant: &plantwide::flowsheet::Plant) -> Result<(), C
         record: Vec::new(),
     };
     let screen = screen_pairings(plant, &request).map_err(screen_error)?;
+    let watched = request.watch.iter().map(|w| (w.path.clone(), None));
+    let shown = Shown::new(std::slice::from_ref(plant), cvs.iter().cloned().chain(watched), system)?;
     let json = serde_json::to_string_pretty(&screen).map_err(|e| CliError::user(e.to_string()))?;
     if let Some(dir) = &a.report {
         let fail = |e: std::io::Error| CliError::user(format!("--report {}: {e}", dir.display()));
         std::fs::create_dir_all(dir).map_err(fail)?;
         std::fs::write(dir.join("screen.json"), &json).map_err(fail)?;
         let mut figures: String =
-            write_responses(dir, &screen)?.iter().map(|n| format!("\n![responses]({n})\n")).collect();
+            write_responses(dir, &screen, &shown)?.iter().map(|n| format!("\n![responses]({n})\n")).collect();
         if write_ranking(dir, &screen)? {
             figures.push_str("\n![ranking](ranking.png)\n");
         }
-        let md = format!("# Pairings\n\n{}{figures}", pairing_table(&screen));
+        let md = format!("# Pairings\n\n{}{figures}", pairing_table(&screen, &shown));
         std::fs::write(dir.join("screen.html"), markdown_to_html("Pairings", &md)).map_err(fail)?;
         std::fs::write(dir.join("screen.md"), md).map_err(fail)?;
     }
     if a.json {
         outln!("{json}");
     } else {
-        outln!("{}", pairing_table(&screen));
+        outln!("{}", pairing_table(&screen, &shown));
     }
     Ok(())
 }
 
 /// The candidate structures as a markdown table, ranked first.
-fn pairing_table(s: &PairingScreen) -> String {
+fn pairing_table(s: &PairingScreen, shown: &Shown) -> String {
     let mut t = format!(
         "{} complete pairings examined, {} partial ones cut for a non-positive relative gain; loops opened: {}\n\n",
         s.enumerated,
@@ -313,11 +327,12 @@ fn pairing_table(s: &PairingScreen) -> String {
                 .iter()
                 .map(|w| {
                     format!(
-                        "{} over {}: {:.6e} … {:.6e} ({})",
+                        "{} over {}: {:.6e} … {:.6e} {} ({})",
                         w.path,
                         w.disturbance,
-                        w.min,
-                        w.max,
+                        shown.value(&w.path, w.min),
+                        shown.value(&w.path, w.max),
+                        shown.unit(&w.path),
                         if w.within { "in band" } else { "OUT of band" }
                     )
                 })

@@ -12,7 +12,7 @@ use plantwide::studies::size::{
     Attenuation, CandidateRanking, Disturbance, Shape, SizeError, SizeRequest, VesselSizing, rank_candidates,
     size_vessel,
 };
-use plantwide::units::{Dimension, parse_quantity_as};
+use plantwide::units::{Dimension, Display, UnitSystem, parse_quantity_as};
 
 use super::CliError;
 use super::steady::{converge, load_with_overrides};
@@ -75,7 +75,8 @@ fn size_error(e: SizeError) -> CliError {
 }
 
 /// Run `plantwide size`.
-pub fn run(a: &SizeArgs) -> Result<(), CliError> {
+pub fn run(a: &SizeArgs, system: UnitSystem) -> Result<(), CliError> {
+    let units = SizeUnits::new(system)?;
     plantwide::analysis::faer::set_global_parallelism(plantwide::analysis::faer::Par::Seq);
     let (plant, u) = load_with_overrides(&a.file, &a.set)?;
     let request = request(a, &plant)?;
@@ -83,15 +84,15 @@ pub fn run(a: &SizeArgs) -> Result<(), CliError> {
     if let Some(v) = &a.vessel {
         let s = size_vessel(&plant, &x, v, &request).map_err(size_error)?;
         if let Some(out) = &a.plot {
-            plot_designs(out, &s)?;
+            plot_designs(out, &s, &units)?;
         }
-        return print(a.json, &s, table);
+        return print(a.json, &s, |s| table(s, &units));
     }
     let ranking = rank_candidates(&plant, &x, &a.candidates, &request).map_err(size_error)?;
     if let Some(out) = &a.plot {
         plot_candidates(out, &ranking)?;
     }
-    print(a.json, &ranking, ranking_table)
+    print(a.json, &ranking, |r| ranking_table(r, &units))
 }
 
 /// `value` as JSON with `--json`, otherwise as the text `table` makes of it.
@@ -171,33 +172,76 @@ fn opt(v: Option<f64>, scale: f64) -> String {
     v.map_or("–".into(), |v| format!("{:.4}", v * scale))
 }
 
+/// The display units of `size`: flows, levels, areas, volumes and amounts in the `--units`
+/// system (a rate of change of a flow per minute).
+struct SizeUnits {
+    flow: Display,
+    length: Display,
+    area: Display,
+    volume: Display,
+    amount: Display,
+}
+
+impl SizeUnits {
+    fn new(system: UnitSystem) -> Result<SizeUnits, CliError> {
+        let d = |dim: Dimension| Display::new(&system.unit_for(dim)).map_err(|e| CliError::user(e.to_string()));
+        Ok(SizeUnits {
+            flow: d(Dimension::MOLAR_FLOW)?,
+            length: d(Dimension::LENGTH)?,
+            area: d(Dimension::AREA)?,
+            volume: d(Dimension::VOLUME)?,
+            amount: d(Dimension::AMOUNT)?,
+        })
+    }
+    /// A flow's rate of change \[mol/s²\] per minute, and its unit.
+    fn rate(&self, si: f64) -> f64 {
+        self.flow.difference(si) * 60.0
+    }
+    fn rate_unit(&self) -> String {
+        format!("{}/min", self.flow.unit())
+    }
+    /// A level controller's gain \[mol/s per m\] in flow per length.
+    fn kc(&self, si: f64) -> f64 {
+        self.flow.difference(si) / self.length.difference(1.0)
+    }
+}
+
 /// The designs as a markdown table.
-fn table(s: &VesselSizing) -> String {
+fn table(s: &VesselSizing, u: &SizeUnits) -> String {
+    let (f, l) = (u.flow.unit(), u.length.unit());
     let mut t = format!(
-        "surge sizing of `{}` ({}; level controller `{}` on `{}`) for {}: outflow change {:.4e} mol/s, \
-         level band ±{} m, rate limit {:.4e} mol/s², liquid {:.4e} m³/mol\n\n",
+        "surge sizing of `{}` ({}; level controller `{}` on `{}`) for {}: outflow change {:.4e} {f}, \
+         level band ±{:.4} {l}, rate limit {:.4e} {}, liquid {:.4e} {}/{}\n\n",
         s.vessel,
         s.kind,
         s.level_controller,
         s.outflow,
         s.disturbance,
-        s.flow_change,
-        s.level_band,
-        s.max_outflow_rate,
-        s.liquid_molar_volume
+        u.flow.difference(s.flow_change),
+        u.length.difference(s.level_band),
+        u.rate(s.max_outflow_rate),
+        u.rate_unit(),
+        u.volume.difference(s.liquid_molar_volume) / u.amount.difference(1.0),
+        u.volume.unit(),
+        u.amount.unit()
     );
-    t.push_str("| controller | area [m²] | band volume [m³] | kc [SI] | τI [min] | max level deviation [m] | max outflow rate [mol/s²] | meets |\n");
+    t.push_str(&format!(
+        "| controller | area [{}] | band volume [{}] | kc [{f}/{l}] | τI [min] | max level deviation [{l}] | max outflow rate [{}] | meets |\n",
+        u.area.unit(),
+        u.volume.unit(),
+        u.rate_unit()
+    ));
     t.push_str("|---|---|---|---|---|---|---|---|\n");
     for d in &s.designs {
         t.push_str(&format!(
             "| {} | {:.4} | {:.4} | {} | {} | {:.6} | {:.4e} | {} |\n",
             d.controller.name(),
-            d.area,
-            d.band_volume,
-            opt(d.kc, 1.0),
+            u.area.difference(d.area),
+            u.volume.difference(d.band_volume),
+            d.kc.map_or("–".into(), |k| format!("{:.4}", u.kc(k))),
             opt(d.tau_i, 1.0 / 60.0),
-            d.verified.max_level_deviation,
-            d.verified.max_outflow_rate,
+            u.length.difference(d.verified.max_level_deviation),
+            u.rate(d.verified.max_outflow_rate),
             if d.verified.meets { "yes" } else { "NO" }
         ));
     }
@@ -209,10 +253,10 @@ fn table(s: &VesselSizing) -> String {
         ));
         for d in &s.designs {
             t.push_str(&format!(
-                "  {:<8} attenuation {}, level amplitude {} m\n",
+                "  {:<8} attenuation {}, level amplitude {} {l}\n",
                 d.controller.name(),
                 opt(d.verified.attenuation, 1.0),
-                opt(d.verified.level_amplitude, 1.0)
+                opt(d.verified.level_amplitude.map(|a| u.length.difference(a)), 1.0)
             ));
         }
     }
@@ -221,10 +265,11 @@ fn table(s: &VesselSizing) -> String {
     }
     let c = &s.current;
     t.push_str(&format!(
-        "\nas the file has it{}: max deviation {}, max outflow rate {:.4e} mol/s² — {}\n",
-        c.area.map_or(String::new(), |a| format!(" (area {a:.4} m²)")),
-        opt(c.max_deviation, 1.0),
-        c.max_outflow_rate,
+        "\nas the file has it{}: max deviation {} {l}, max outflow rate {:.4e} {} — {}\n",
+        c.area.map_or(String::new(), |a| format!(" (area {:.4} {})", u.area.difference(a), u.area.unit())),
+        opt(c.max_deviation.map(|d| u.length.difference(d)), 1.0),
+        u.rate(c.max_outflow_rate),
+        u.rate_unit(),
         if c.meets { "meets the limits" } else { "exceeds them" }
     ));
     if let Some(why) = &c.failure {
@@ -234,9 +279,12 @@ fn table(s: &VesselSizing) -> String {
 }
 
 /// The candidates, best first.
-fn ranking_table(r: &CandidateRanking) -> String {
-    let mut t = String::from(
-        "| rank | candidate | kind | outflow change [mol/s] | now: max rate [mol/s²] | needs surge | optimal band volume [m³] | P band volume [m³] |\n|---|---|---|---|---|---|---|---|\n",
+fn ranking_table(r: &CandidateRanking, u: &SizeUnits) -> String {
+    let mut t = format!(
+        "| rank | candidate | kind | outflow change [{}] | now: max rate [{}] | needs surge | optimal band volume [{v}] | P band volume [{v}] |\n|---|---|---|---|---|---|---|---|\n",
+        u.flow.unit(),
+        u.rate_unit(),
+        v = u.volume.unit()
     );
     for c in &r.candidates {
         let Some(s) = &c.sizing else {
@@ -247,14 +295,14 @@ fn ranking_table(r: &CandidateRanking) -> String {
             ));
             continue;
         };
-        let vol = |k: usize| s.designs.get(k).map_or(f64::NAN, |d| d.band_volume);
+        let vol = |k: usize| s.designs.get(k).map_or(f64::NAN, |d| u.volume.difference(d.band_volume));
         t.push_str(&format!(
             "| {} | {} | {} | {:.4e} | {:.4e} | {} | {:.4} | {:.4} |\n",
             c.rank.unwrap_or(0),
             s.vessel,
             s.kind,
-            s.flow_change,
-            s.current.max_outflow_rate,
+            u.flow.difference(s.flow_change),
+            u.rate(s.current.max_outflow_rate),
             if c.needs_surge == Some(true) { "yes" } else { "no" },
             vol(2),
             vol(0)
@@ -265,7 +313,7 @@ fn ranking_table(r: &CandidateRanking) -> String {
 
 /// Level deviation and outflow of the designs and the file's vessel, on one time grid (each
 /// record held at its last value after it ends).
-fn plot_designs(out: &Path, s: &VesselSizing) -> Result<(), CliError> {
+fn plot_designs(out: &Path, s: &VesselSizing, u: &SizeUnits) -> Result<(), CliError> {
     let end = s.designs.iter().map(|d| d.verified.duration).fold(0.0, f64::max);
     let grid: Vec<f64> = (0..=1000).map(|k| end * k as f64 / 1000.0).collect();
     let at = |times: &[f64], ys: &[f64]| -> Vec<f64> { grid.iter().map(|&t| interpolate(times, ys, t)).collect() };
@@ -273,18 +321,22 @@ fn plot_designs(out: &Path, s: &VesselSizing) -> Result<(), CliError> {
     let mut flow = Vec::new();
     for d in &s.designs {
         let tr = &d.verified.trace;
-        let name = format!("{} (A = {:.3} m²)", d.controller.name(), d.area);
-        level.push((name.clone(), at(&tr.times, &tr.deviation)));
-        flow.push((name, at(&tr.times, &tr.outflow)));
+        let name = format!("{} (A = {:.3} {})", d.controller.name(), u.area.difference(d.area), u.area.unit());
+        let deviation: Vec<f64> = tr.deviation.iter().map(|v| u.length.difference(*v)).collect();
+        let outflow: Vec<f64> = tr.outflow.iter().map(|v| u.flow.value(*v)).collect();
+        level.push((name.clone(), at(&tr.times, &deviation)));
+        flow.push((name, at(&tr.times, &outflow)));
     }
     let tr = &s.current.trace;
-    flow.push(("as in the file".to_string(), at(&tr.times, &tr.outflow)));
+    let outflow: Vec<f64> = tr.outflow.iter().map(|v| u.flow.value(*v)).collect();
+    flow.push(("as in the file".to_string(), at(&tr.times, &outflow)));
     let panels = [
-        Overlay { label: "level deviation [m]".into(), curves: level, ..Overlay::default() },
-        Overlay { label: format!("{} [mol/s]", s.outflow), curves: flow, ..Overlay::default() },
+        Overlay { label: format!("level deviation [{}]", u.length.unit()), curves: level, ..Overlay::default() },
+        Overlay { label: format!("{} [{}]", s.outflow, u.flow.unit()), curves: flow, ..Overlay::default() },
     ];
     let hours: Vec<f64> = grid.iter().map(|t| t / 3600.0).collect();
-    let title = format!("surge designs of `{}` for {} (band ±{} m)", s.vessel, s.disturbance, s.level_band);
+    let band = u.length.difference(s.level_band);
+    let title = format!("surge designs of `{}` for {} (band ±{band:.4} {})", s.vessel, s.disturbance, u.length.unit());
     write_overlays(out, &title, "time after the step [h]", &hours, &panels, &[])
         .map_err(|e| CliError::user(e.to_string()))
 }

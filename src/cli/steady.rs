@@ -233,7 +233,7 @@ fn print_blocks(plant: &Plant, sol: &Solution, units: Option<UnitSystem>) {
 }
 
 /// `v` (SI) of dimension `dim` in `system`'s unit, with the unit (none for a dimensionless number).
-fn shown(v: f64, dim: plantwide::units::Dimension, system: UnitSystem) -> String {
+pub(super) fn shown(v: f64, dim: plantwide::units::Dimension, system: UnitSystem) -> String {
     if dim == plantwide::units::Dimension::DIMENSIONLESS {
         return format!("{v:.6}");
     }

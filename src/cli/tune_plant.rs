@@ -131,23 +131,24 @@ fn print_table(t: &FlowsheetTuning, plant: &Plant, tu: &TimeUnit) {
     }
     let u = &tu.name;
     outln!(
-        "{:<18} {:<18} {:>11} {:>11} {:>22} {:>11} {:>11}  action",
+        "{:<18} {:<18} {:>22} {:>11} {:>22} {:>11} {:>11}  action",
         "controller",
         "measurement",
-        "Ku (SI)",
+        "Ku",
         format!("Pu [{u}]"),
         "Kc",
         format!("τI [{u}]"),
         format!("τD [{u}]")
     );
     let opt = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.5}"));
+    // Ku is written like Kc: in the unit of the file's `kc`.
     for l in &t.loops {
         let warn = l.file_action.map_or(String::new(), |f| format!("  (the file has {f}: the loop would run away)"));
         outln!(
-            "{:<18} {:<18} {:>11} {:>11} {:>22} {:>11} {:>11}  {}{warn}",
+            "{:<18} {:<18} {:>22} {:>11} {:>22} {:>11} {:>11}  {}{warn}",
             l.controller,
             l.output,
-            opt(l.ku),
+            l.ku.map_or("-".to_string(), |ku| kc_text(plant, &l.controller, ku)),
             opt(l.pu),
             kc_text(plant, &l.controller, l.kc),
             opt(l.tau_i),

@@ -163,3 +163,78 @@ fn gains_take_the_unit_system_for_paths_that_name_no_unit() {
     assert!((g_field - g_si * lbmol_h).abs() < 1e-12 * g_si.abs(), "{g_field} vs {}", g_si * lbmol_h);
     assert_eq!(si["gain"][0][1], field["gain"][0][1]);
 }
+
+fn stdout_of(args: &[&str]) -> String {
+    let out = plantwide(args);
+    assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+/// `check` lists the free inputs with the file's values and the residence times' holdups and
+/// flows in the chosen system: column A's reflux 2.70629 kmol/min is 162.3774 kmol/h, its drum
+/// holdup 0.5 kmol; in SI 45.10483 mol/s and 500 mol.
+#[test]
+fn check_shows_values_in_the_chosen_system() {
+    let metric = stdout_of(&["--units", "metric", "check", &flowsheet("column_a.json")]);
+    assert!(metric.contains("column.reflux = 162.377400 kmol/h"), "{metric}");
+    assert!(metric.contains("feed_source.P = 101.325000 kPa"), "{metric}");
+    assert!(metric.contains("holdup 0.500000 kmol"), "{metric}");
+    let si = stdout_of(&["check", &flowsheet("column_a.json")]);
+    assert!(si.contains("column.reflux = 45.104833 mol/s"), "{si}");
+    assert!(si.contains("holdup 500.000000 mol"), "{si}");
+}
+
+/// `size` in the chosen system: the outflow change 10 mol/s is 36 kmol/h, the rate limit
+/// 3 mol/s per min is 10.8 kmol/h per min, the P controller's gain (outflow change over half
+/// the band, 10 mol/s / 0.2 m = 50 mol/s/m) is 180 kmol/h/m; in SI the same numbers as given.
+#[test]
+fn size_shows_flows_rates_and_gains_in_the_chosen_system() {
+    let file = flowsheet("surge_tank_pi.json");
+    let run = |units: &str| {
+        stdout_of(&[
+            "--units",
+            units,
+            "size",
+            &file,
+            "--vessel",
+            "tank",
+            "--disturbance",
+            "F_in=+10 mol/s",
+            "--level-band",
+            "0.2 m",
+            "--max-outflow-rate",
+            "3 mol/s/min",
+        ])
+    };
+    let metric = run("metric");
+    assert!(metric.contains("outflow change 3.6000e1 kmol/h"), "{metric}");
+    assert!(metric.contains("rate limit 1.0800e1 kmol/h/min"), "{metric}");
+    assert!(metric.contains("| p | 0.1811 | 0.0362 | 180.0000 |"), "{metric}");
+    let si = run("si");
+    assert!(si.contains("for F_in +1.000000e1 mol/s"), "{si}");
+    assert!(si.contains("| p | 0.1811 | 0.0362 | 50.0000 |"), "{si}");
+}
+
+/// `compare` shows its outputs in the unit each `--outputs` entry asks for, else in the chosen
+/// system, and the tuning in display units: the FEHE reactor's effluent at 420 K is 146.85 °C;
+/// the trim heater's file gain 3 kW/K is 3 kW/degC.
+#[test]
+fn compare_shows_outputs_and_tuning_in_display_units() {
+    let text = stdout_of(&[
+        "--units",
+        "metric",
+        "compare",
+        &flowsheet("fehe_reactor.json"),
+        &flowsheet("fehe_reactor_without_fehe.json"),
+        "--disturbances",
+        "feed_T=+1%",
+        "--outputs",
+        "effluent.T,effluent.x[A]@1",
+        "--tuning",
+        "file",
+    ]);
+    assert!(text.contains("| effluent.T [degC] | fehe_reactor | 146.8500 | 146.8500 | 146.8500 |"), "{text}");
+    assert!(text.contains("effluent.x[A] [-]"), "{text}");
+    assert!(text.contains("Kc 3.0000 kW/degC"), "{text}");
+    assert!(!text.contains("(SI)"), "{text}");
+}

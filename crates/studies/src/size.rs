@@ -416,9 +416,10 @@ pub fn size_vessel(plant: &Plant, x: &[f64], name: &str, r: &SizeRequest) -> Res
         level_controller: v.controller.clone(),
         outflow: v.outflow.clone(),
         disturbance: format!(
-            "{} {:+.6e} (SI), {}",
+            "{} {:+.6e} {}, {}",
             r.disturbance.path,
             r.disturbance.change,
+            plant.input(&r.disturbance.path).map_or("(SI)".to_string(), |i| plant.inputs()[i].dim.to_string()),
             r.disturbance.shape.describe()
         ),
         flow_change,

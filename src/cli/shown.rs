@@ -1,0 +1,65 @@
+//! Display units of the paths a study's text and figures show (`compare`, `screen`).
+
+use plantwide::flowsheet::Plant;
+use plantwide::units::{Dimension, Display, UnitSystem};
+
+use super::CliError;
+
+/// Display units of the paths a study shows (outputs, loops' CVs and MVs, watched variables): the
+/// unit a `PATH@unit` entry names, else the `--units` system's unit of the path's dimension.
+pub struct Shown {
+    by_path: std::collections::HashMap<String, Display>,
+}
+
+impl Shown {
+    /// The display of each `(path, unit asked for)`, looked up in the first plant that has it
+    /// (paths that name nothing are shown in SI).
+    pub fn new(
+        plants: &[Plant],
+        paths: impl IntoIterator<Item = (String, Option<String>)>,
+        system: UnitSystem,
+    ) -> Result<Shown, CliError> {
+        let dim = |path: &str| {
+            plants.iter().find_map(|p| {
+                p.var(path).map(|v| p.vars()[v].spec.dim).or_else(|| p.input(path).map(|i| p.inputs()[i].dim))
+            })
+        };
+        let system_unit =
+            |d: Dimension| if d == Dimension::DIMENSIONLESS { "1".to_string() } else { system.unit_for(d) };
+        let mut by_path = std::collections::HashMap::new();
+        for (path, unit) in paths {
+            if by_path.contains_key(&path) {
+                continue;
+            }
+            let Some(d) = dim(&path) else { continue };
+            let unit = unit.unwrap_or_else(|| system_unit(d));
+            let shown = Display::new(&unit).map_err(|e| CliError::user(format!("--outputs {path}@{unit}: {e}")))?;
+            if plantwide::units::unit_dimension(&unit).ok() != Some(d) {
+                return Err(CliError::user(format!(
+                    "--outputs {path}@{unit}: `{unit}` is not a unit of {}",
+                    d.describe()
+                )));
+            }
+            by_path.insert(path, shown);
+        }
+        Ok(Shown { by_path })
+    }
+
+    /// The path with its unit, `path [unit]`.
+    pub fn label(&self, path: &str) -> String {
+        format!("{path} [{}]", self.unit(path))
+    }
+    pub fn value(&self, path: &str, si: f64) -> f64 {
+        self.by_path.get(path).map_or(si, |d| d.value(si))
+    }
+    pub fn difference(&self, path: &str, si: f64) -> f64 {
+        self.by_path.get(path).map_or(si, |d| d.difference(si))
+    }
+    pub fn unit(&self, path: &str) -> String {
+        match self.by_path.get(path).map(Display::unit) {
+            Some("1") => "-".to_string(),
+            Some(u) => u.to_string(),
+            None => "SI".to_string(),
+        }
+    }
+}
