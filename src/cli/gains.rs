@@ -455,9 +455,12 @@ pub struct SensorsArgs {
     set: Vec<String>,
 }
 
-pub fn run_sensors(a: &SensorsArgs) -> Result<(), CliError> {
+pub fn run_sensors(a: &SensorsArgs, units: UnitSystem) -> Result<(), CliError> {
     let (plant, u) = load_with_overrides(&a.file, &a.set)?;
-    let inputs = select_inputs(&plant, &a.inputs).map_err(analysis_error)?;
+    let inputs = select_inputs(&plant, &in_system(&plant, &a.inputs, units)).map_err(analysis_error)?;
+    let temperature = plantwide::units::Display::new(&units.unit_for(Dimension::TEMPERATURE))
+        .map_err(|e| CliError::user(e.to_string()))?;
+    let tu = temperature.unit().to_string();
     let ss = converge(&plant, &u)?;
     let s = select_temperature_sensors(&plant, &ss.x, &ss.u, &a.column, &inputs).map_err(analysis_error)?;
     if a.json {
@@ -476,10 +479,10 @@ pub fn run_sensors(a: &SensorsArgs) -> Result<(), CliError> {
         outln!("{}", serde_json::to_string_pretty(&doc).map_err(|e| CliError::user(e.to_string()))?);
         return Ok(());
     }
-    outln!("temperature-sensor selection for `{}` in `{}` (gains in K per input unit)\n", a.column, plant.name());
-    out!("{:>6} {:>10} {:>9}", "stage", "T [K]", "ΔT [K]");
+    outln!("temperature-sensor selection for `{}` in `{}` (gains in {tu} per input unit)\n", a.column, plant.name());
+    out!("{:>6} {:>10} {:>9}", "stage", format!("T [{tu}]"), format!("ΔT [{tu}]"));
     for i in &inputs {
-        out!(" {:>22}", format!("dT/d{} [K/{}]", i.path.rsplit('.').next().unwrap_or(&i.path), i.unit));
+        out!(" {:>22}", format!("dT/d{} [{tu}/{}]", i.path.rsplit('.').next().unwrap_or(&i.path), i.unit));
     }
     for k in 0..s.singular_values.len() {
         out!(" {:>8}", format!("|U{}|", k + 1));
@@ -487,13 +490,13 @@ pub fn run_sensors(a: &SensorsArgs) -> Result<(), CliError> {
     outln!();
     for (r, stage) in s.stages.iter().enumerate() {
         let dt = if r + 1 < s.stages.len() {
-            format!("{:.4}", s.temperatures[r + 1] - s.temperatures[r])
+            format!("{:.4}", temperature.difference(s.temperatures[r + 1] - s.temperatures[r]))
         } else {
             String::new()
         };
-        out!("{:>6} {:>10.4} {:>9}", stage, s.temperatures[r], dt);
+        out!("{:>6} {:>10.4} {:>9}", stage, temperature.value(s.temperatures[r]), dt);
         for j in 0..inputs.len() {
-            out!(" {:>22}", sig(s.gains[(r, j)]));
+            out!(" {:>22}", sig(temperature.difference(s.gains[(r, j)])));
         }
         for k in 0..s.singular_values.len() {
             out!(" {:>8.4}", s.u[(r, k)].abs());
@@ -506,10 +509,10 @@ pub fn run_sensors(a: &SensorsArgs) -> Result<(), CliError> {
     outln!("SVD criterion (largest |U| per singular direction): stages {}", stages(&s.svd_stages));
     outln!("sensitivity criterion (largest |gain| per input): stages {}", stages(&s.sensitivity_stages));
     outln!(
-        "slope criterion (largest ΔT between adjacent stages): stages {} and {} ({:.4} K)",
+        "slope criterion (largest ΔT between adjacent stages): stages {} and {} ({:.4} {tu})",
         s.slope.0.0,
         s.slope.0.1,
-        s.slope.1
+        temperature.difference(s.slope.1)
     );
     Ok(())
 }

@@ -197,7 +197,9 @@ pub fn run(a: &LinearizeArgs, units: UnitSystem) -> Result<(), CliError> {
                 "−C J⁻¹ B is 0 to rounding ({largest:.1e}), so the outputs are held at steady state; these are {diff:.1e} off it"
             )
         };
-        outln!("steady-state gain D − C A⁻¹ B ({check}):");
+        outln!("steady-state gain D − C A⁻¹ B ({check}), output unit per input unit:");
+        let heads: Vec<String> = inputs.iter().map(|i| format!("{:>14}", format!("{} [{}]", i.path, i.unit))).collect();
+        outln!("  {:<28} {}", "", heads.join(" "));
         for (i, o) in outputs.iter().enumerate() {
             let cells: Vec<String> = (0..g.ncols()).map(|j| format!("{:>14}", sig(g[(i, j)]))).collect();
             outln!("  {:<28} {}", format!("{} [{}]", o.path, o.unit), cells.join(" "));

@@ -211,7 +211,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Gains(a) => gains::run(&a, cli.units.unwrap_or(UnitsArg::Si).into()),
         Command::Linearize(a) => linearize::run(&a, cli.units.unwrap_or(UnitsArg::Si).into()),
         Command::Sensitivity(a) => sensitivity::run(&a, cli.units.unwrap_or(UnitsArg::Si).into()),
-        Command::Sensors(a) => gains::run_sensors(&a),
+        Command::Sensors(a) => gains::run_sensors(&a, cli.units.unwrap_or(UnitsArg::Si).into()),
         Command::Tune(a) => tune::run(&a),
         Command::Screen(a) => screen::run(&a, cli.units.unwrap_or(UnitsArg::Si).into()),
         Command::Size(a) => size::run(&a, cli.units.unwrap_or(UnitsArg::Si).into()),

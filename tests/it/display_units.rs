@@ -238,3 +238,52 @@ fn compare_shows_outputs_and_tuning_in_display_units() {
     assert!(text.contains("Kc 3.0000 kW/degC"), "{text}");
     assert!(!text.contains("(SI)"), "{text}");
 }
+
+/// `sensors` and `linearize` in the chosen system: column A's reboiler at 355.2255 K is
+/// 82.0755 °C, the temperature gains per kmol/h are those per mol/s over 3.6; the linear model's
+/// gain table names its input's unit (kmol/h), the gain 0.8754 per kmol/min being 0.01459 per kmol/h.
+#[test]
+fn sensors_and_linearize_show_the_chosen_system() {
+    let file = flowsheet("column_a.json");
+    let si = stdout_of(&["sensors", &file, "--column", "column", "--inputs", "column.reflux,column.boilup"]);
+    let metric = stdout_of(&[
+        "--units",
+        "metric",
+        "sensors",
+        &file,
+        "--column",
+        "column",
+        "--inputs",
+        "column.reflux,column.boilup",
+    ]);
+    let stage1 = |text: &str| -> Vec<f64> {
+        let line = text.lines().find(|l| l.trim_start().starts_with("1 ")).unwrap().to_string();
+        line.split_whitespace().skip(1).take(4).map(|v| v.parse().unwrap()).collect()
+    };
+    let (s, m) = (stage1(&si), stage1(&metric));
+    assert!(metric.contains("T [degC]") && metric.contains("[degC/kmol/h]"), "{metric}");
+    assert!((m[0] - (s[0] - 273.15)).abs() < 1e-4, "{m:?} vs {s:?}");
+    assert!((m[1] - s[1]).abs() < 1e-4);
+    assert!(((m[2] - s[2] / 3.6) / m[2]).abs() < 1e-5, "{m:?} vs {s:?}");
+    let lin = stdout_of(&[
+        "--units",
+        "metric",
+        "linearize",
+        &file,
+        "--inputs",
+        "column.reflux",
+        "--outputs",
+        "distillate.x[light]",
+    ]);
+    assert!(lin.contains("column.reflux [kmol/h]"), "{lin}");
+    let g: f64 = lin
+        .lines()
+        .find(|l| l.contains("distillate.x[light] [-]"))
+        .unwrap()
+        .split_whitespace()
+        .last()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!((g - 0.8754 / 60.0).abs() < 1e-4, "{g}");
+}
