@@ -80,6 +80,23 @@ impl Plant {
         }
     }
 
+    /// The plant variables controller `b` reads as its signals, in order, with their positions
+    /// among the signals (a model predictive controller's CVs; a PID's measurement first).
+    pub fn measured_vars(&self, b: usize) -> Vec<(usize, usize)> {
+        let block = &self.blocks[b];
+        if block.kind != BlockKind::Controller {
+            return Vec::new();
+        }
+        let signals = block.reads.iter().skip(block.layout.n_inputs).take(block.layout.n_signals);
+        signals
+            .enumerate()
+            .filter_map(|(k, r)| match *r {
+                Read::Var(v) => Some((k, v)),
+                _ => None,
+            })
+            .collect()
+    }
+
     /// Hold input `i`: every block reads the input's own value instead of the controller output
     /// that drives it. Returns that output variable, or `None` if the input was free already.
     pub fn hold_input(&mut self, i: usize) -> Option<usize> {

@@ -527,11 +527,15 @@ fn row_at(
     (row, refs.iter().map(|r| r.map_or(f64::NAN, |i| waves[i].at(t))).collect())
 }
 
-/// The setpoint input of the controller that measures `source`, if any.
+/// The setpoint input of the controller that measures `source`, if any: `<ctrl>.sp` of a loop,
+/// `<ctrl>.sp<k>` of a model predictive controller's k-th CV.
 fn reference_of(plant: &Plant, source: Read) -> Option<usize> {
     let Read::Var(v) = source else { return None };
     (0..plant.blocks().len()).find_map(|b| {
-        let measures = plant.measured_var(b) == Some(v);
-        measures.then(|| plant.input(&format!("{}.sp", plant.blocks()[b].name))).flatten()
+        let name = &plant.blocks()[b].name;
+        let (k, _) = plant.measured_vars(b).into_iter().find(|&(_, m)| m == v)?;
+        plant
+            .input(&format!("{name}.sp{}", k + 1))
+            .or_else(|| (k == 0).then(|| plant.input(&format!("{name}.sp"))).flatten())
     })
 }
