@@ -214,8 +214,20 @@ pub(super) fn fit_all(
     let n_fir = ((t99 / design.sample_time).ceil() as usize)
         .clamp(5, (n_samples / (4 * inputs.len().max(1))).max(5))
         .min(plantwide_ident::data::MAX_FIR);
-    let per_output: Vec<Vec<Fitted>> =
-        outputs.iter().enumerate().map(|(i, o)| fit_output(est, val, i, n_fir, &o.path)).collect::<Result<_, _>>()?;
+    let explain = |o: &Signal, e: IdentifyError| match e {
+        IdentifyError::Estimation(m) => IdentifyError::Estimation(format!(
+            "{m}; output `{}`, sample time {:.4e} s against τ_dom {:.4e} s: a test that does not excite the plant \
+             (a sample time far above its dynamics, an input that does not move this output, noise swamping the \
+             response) leaves the regression singular",
+            o.path, design.sample_time, design.tau_dom
+        )),
+        e => e,
+    };
+    let per_output: Vec<Vec<Fitted>> = outputs
+        .iter()
+        .enumerate()
+        .map(|(i, o)| fit_output(est, val, i, n_fir, &o.path).map_err(|e| explain(o, e)))
+        .collect::<Result<_, _>>()?;
     let n_structures = per_output[0].len();
     // A structure unreliable on any output scores below every reliable one.
     let mean_fit = |s: usize| {
