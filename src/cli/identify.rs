@@ -41,7 +41,7 @@ pub struct IdentifyArgs {
     design: DesignArg,
     /// White measurement noise σ per output, in the output's display unit (one for all, or one
     /// per output, comma-separated).
-    #[arg(long, value_delimiter = ',', value_name = "σ")]
+    #[arg(long, value_delimiter = ',', value_name = "σ", action = clap::ArgAction::Set)]
     noise: Vec<f64>,
     /// Seed of the test signals and the noise.
     #[arg(long, default_value_t = 1)]
@@ -57,7 +57,7 @@ pub struct IdentifyArgs {
     tau_dom: Option<String>,
     /// Largest move per input, in the input's display unit (one for all, or one per input;
     /// default 1 % of the steady value).
-    #[arg(long, value_delimiter = ',')]
+    #[arg(long, value_delimiter = ',', action = clap::ArgAction::Set)]
     amplitude: Vec<f64>,
     /// Closed-loop speed factor α of the PRBS design (Eq. 7-7).
     #[arg(long, default_value_t = 2.0)]

@@ -296,4 +296,7 @@ fn bad_requests_exit_1_naming_the_problem() {
     assert!(err.contains("feed_source.z[light]") && err.contains("cannot move"), "{err}");
     let err = run(INPUTS, "column.x[41][light],column.x[41][light]", &[]);
     assert!(err.contains("singular"), "{err}");
+    // A list flag given twice is refused, not appended to (0.02 then 0.002 would move the inputs by both).
+    let err = run(INPUTS, OUTPUTS, &["--amplitude", "0.02", "--amplitude", "0.002"]);
+    assert!(err.contains("--amplitude") && err.contains("multiple times"), "{err}");
 }
