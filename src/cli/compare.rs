@@ -10,6 +10,7 @@ use plantwide::io::html::markdown_to_html;
 use plantwide::io::plot::{LabelledMatrix, Overlay, write_bars, write_matrices, write_overlays};
 use plantwide::studies::compare::{CompareRequest, Comparison, Scheme, compare};
 use plantwide::studies::screen::pairings::STEP_AT;
+use plantwide::studies::screen::pairings::mpc::MpcAlternative;
 use plantwide::studies::screen::pairings::{DynamicResult, DynamicSettings};
 use plantwide::studies::tune::loops::Measurement;
 use plantwide::units::UnitSystem;
@@ -93,8 +94,11 @@ pub fn run(a: &CompareArgs, system: UnitSystem) -> Result<(), CliError> {
         if e.is_user_error() { CliError::user(e.to_string()) } else { CliError::numerical(e.to_string()) }
     })?;
     let json = serde_json::to_string_pretty(&c).map_err(|e| CliError::user(e.to_string()))?;
-    let loops =
-        c.schemes.iter().flat_map(|s| s.loops.iter().flat_map(|l| [(l.cv.clone(), None), (l.mv.clone(), None)]));
+    let loops = c.schemes.iter().flat_map(|s| {
+        let pi = s.loops.iter().flat_map(|l| [l.cv.clone(), l.mv.clone()]);
+        let mpc = s.mpc.iter().flat_map(|m| m.cvs.iter().chain(&m.mvs).cloned());
+        pi.chain(mpc).map(|p| (p, None)).collect::<Vec<_>>()
+    });
     let shown = Shown::new(&plants, outputs.iter().cloned().chain(loops), system)?;
     if let Some(dir) = &a.report {
         write_report(dir, &c, &json, &shown)?;
@@ -150,9 +154,18 @@ fn write_rga(file: &Path, c: &Comparison) -> Result<bool, plantwide::io::IoError
     Ok(true)
 }
 
-/// A scheme's closed-loop runs, if they ran.
+/// A scheme's closed-loop runs, if they ran: its PI loops', else its first model predictive
+/// controller's.
 fn runs(s: &Scheme) -> Option<&DynamicResult> {
-    s.structure.as_ref().and_then(|t| t.dynamic.as_ref()).filter(|d| d.failure.is_none())
+    tests(s).into_iter().map(|(_, d)| d).find(|d| d.failure.is_none())
+}
+
+/// Every closed-loop test of a scheme with its label: the file's PI pairing, then each model
+/// predictive controller.
+fn tests(s: &Scheme) -> Vec<(String, &DynamicResult)> {
+    let pi = s.structure.as_ref().and_then(|t| t.dynamic.as_ref()).map(|d| (s.name.clone(), d));
+    let mpc = s.mpc.iter().filter_map(|m| Some((format!("{} (MPC `{}`)", s.name, m.controller), m.dynamic.as_ref()?)));
+    pi.into_iter().chain(mpc).collect()
 }
 
 /// One figure per disturbance: a panel per CV and output, a curve per scheme (schemes whose runs
@@ -237,8 +250,20 @@ fn structure_table(c: &Comparison) -> String {
         "## Control structure (quality loops opened together; exact steady-state gains)\n\n| scheme | loops CV ← MV (relative gain) | NI | DIC | condition number |\n|---|---|---|---|---|\n",
     );
     for s in &c.schemes {
+        for m in &s.mpc {
+            t.push_str(&format!(
+                "| {} | model predictive control `{}`: CVs {} by MVs {} (multivariable: no pairing) | – | – | {} |\n",
+                s.name,
+                m.controller,
+                m.cvs.join(", "),
+                m.mvs.join(", "),
+                m.condition_number.map_or("–".into(), sig)
+            ));
+        }
         let Some(st) = &s.structure else {
-            t.push_str(&format!("| {} | no quality loops | – | – | – |\n", s.name));
+            if s.mpc.is_empty() {
+                t.push_str(&format!("| {} | no quality loops | – | – | – |\n", s.name));
+            }
             continue;
         };
         let pairs: Vec<String> =
@@ -331,17 +356,16 @@ fn response_table(c: &Comparison, shown: &Shown) -> String {
         "## Closed-loop responses (tuning below; runs of {})\n\n| scheme | disturbance | variable [unit] | IAE [unit·s] | largest deviation [unit] | settling time [s] | MVs at a limit |\n|---|---|---|---|---|---|---|\n",
         c.duration.map_or("–".into(), |d| format!("{} s", sig(d)))
     );
-    for s in &c.schemes {
-        let Some(d) = s.structure.as_ref().and_then(|st| st.dynamic.as_ref()) else { continue };
+    for (label, d) in c.schemes.iter().flat_map(tests) {
         if let Some(why) = &d.failure {
-            t.push_str(&format!("| {} | – | – | failed: {why} | | | |\n", s.name));
+            t.push_str(&format!("| {label} | – | – | failed: {why} | | | |\n"));
             continue;
         }
         for run in &d.runs {
             for f in &run.cvs {
                 t.push_str(&format!(
                     "| {} | {} | {} | {} | {} | {} | {} |\n",
-                    s.name,
+                    label,
                     run.disturbance,
                     shown.label(&f.cv),
                     sig(shown.difference(&f.cv, f.iae)),
@@ -375,8 +399,29 @@ fn response_table(c: &Comparison, shown: &Shown) -> String {
             Some(format!("- {} ({how}): {}", s.name, loops.join("; ")))
         })
         .collect();
+    let mpc = c.schemes.iter().flat_map(|s| s.mpc.iter().map(move |m| mpc_note(&s.name, m)));
+    let tuned: Vec<String> = tuned.into_iter().chain(mpc).collect();
     if !tuned.is_empty() {
         t.push_str(&format!("\nTuning:\n{}\n", tuned.join("\n")));
     }
     t
+}
+
+/// A model predictive controller's settings and what its QP did over the runs.
+fn mpc_note(scheme: &str, m: &MpcAlternative) -> String {
+    let samples: usize = m.qp.iter().map(|l| l.samples).sum();
+    let solved: usize = m.qp.iter().map(|l| l.statuses.get("Solved").copied().unwrap_or(0)).sum();
+    let mean = m.qp.iter().map(|l| l.mean_solve_time * l.samples as f64).sum::<f64>() / samples.max(1) as f64;
+    let max = m.qp.iter().map(|l| l.max_solve_time).fold(0.0, f64::max);
+    let at_limit: usize = m.qp.iter().map(|l| l.samples_at_limit).sum();
+    format!(
+        "- {scheme}: model predictive control `{}` every {} s, horizons P = {}, M = {}; over the runs {samples} QPs, \
+         {solved} solved, mean solve time {:.3} ms (largest {:.3} ms), {at_limit} samples with an MV at a hard limit",
+        m.controller,
+        sig(m.sample_time),
+        m.prediction_horizon,
+        m.control_horizon,
+        1e3 * mean,
+        1e3 * max
+    )
 }

@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 use plantwide::io::html::markdown_to_html;
 use plantwide::io::plot::{LabelledMatrix, Overlay, write_bars, write_matrices, write_overlays};
 use plantwide::studies::screen::pairings::STEP_AT;
+use plantwide::studies::screen::pairings::mpc::MpcAlternative;
 use plantwide::studies::screen::pairings::{Disturbance, DynamicSettings, PairingRequest, PairingScreen, Watch};
 use plantwide::studies::screen::{ColumnScreen, ScreenError, screen_column, screen_pairings};
 use plantwide::units::Dimension;
@@ -55,6 +56,11 @@ pub struct ScreenArgs {
     /// Length of each dynamic run (default: 20 × the longest reset time of the tuned loops).
     #[arg(long, value_name = "TIME")]
     duration: Option<String>,
+    /// A model predictive controller to judge beside the PI candidates on the same runs: a JSON
+    /// file with one `"type": "mpc"` controller description (as in a flowsheet's `controllers`)
+    /// on the --cvs and some of the --mvs; a CV's `sp` defaults to its steady value.
+    #[arg(long, value_name = "FILE", requires = "cvs")]
+    mpc: Option<PathBuf>,
     /// Override an input or unit field before converging (repeatable).
     #[arg(long = "set", value_name = "PATH=VALUE")]
     set: Vec<String>,
@@ -279,6 +285,7 @@ fn pairings(a: &ScreenArgs, plant: &plantwide::flowsheet::Plant, system: UnitSys
             measurement: plantwide::studies::tune::loops::Measurement { dead_time, lag: 0.0 },
         },
         record: Vec::new(),
+        mpc: a.mpc.as_deref().map(mpc_description).transpose()?,
     };
     let screen = screen_pairings(plant, &request).map_err(screen_error)?;
     let watched = request.watch.iter().map(|w| (w.path.clone(), None));
@@ -303,6 +310,36 @@ fn pairings(a: &ScreenArgs, plant: &plantwide::flowsheet::Plant, system: UnitSys
         outln!("{}", pairing_table(&screen, &shown));
     }
     Ok(())
+}
+
+/// The `--mpc` file's controller description.
+fn mpc_description(file: &Path) -> Result<serde_json::Value, CliError> {
+    let text = plantwide::flowsheet::read_text(file).map_err(|e| CliError::user(e.to_string()))?;
+    serde_json::from_str(&text).map_err(|e| CliError::user(format!("--mpc {}: {e}", file.display())))
+}
+
+/// The model predictive controller's row of the pairing table.
+fn mpc_row(m: &MpcAlternative) -> String {
+    let dynamic = m.dynamic.as_ref();
+    let score = dynamic
+        .map_or("–".to_string(), |d| if d.failure.is_some() { "failed".into() } else { format!("{:.3}", d.score) });
+    let samples: usize = m.qp.iter().map(|l| l.samples).sum();
+    let mean = m.qp.iter().map(|l| l.mean_solve_time * l.samples as f64).sum::<f64>() / samples.max(1) as f64;
+    let note = dynamic.and_then(|d| d.failure.clone()).unwrap_or_else(|| {
+        format!(
+            "every {} s, P = {}, M = {}; {samples} QPs, mean solve {:.3} ms; condition number {}",
+            m.sample_time,
+            m.prediction_horizon,
+            m.control_horizon,
+            1e3 * mean,
+            m.condition_number.map_or("–".into(), |c| format!("{c:.3}"))
+        )
+    });
+    format!(
+        "| MPC | – | model predictive control: {} by {} | – | – | – | {score} | {note} |\n",
+        m.cvs.join(", "),
+        m.mvs.join(", ")
+    )
 }
 
 /// The candidate structures as a markdown table, ranked first.
@@ -360,6 +397,9 @@ fn pairing_table(s: &PairingScreen, shown: &Shown) -> String {
             if c.dic { "yes" } else { "no" },
             c.rga_number
         ));
+    }
+    if let Some(m) = &s.mpc {
+        t.push_str(&mpc_row(m));
     }
     t
 }

@@ -5,13 +5,16 @@
 //! Each sweep walks outward from the base case in both directions, every point started from its
 //! converged neighbour (natural-parameter continuation); a point that does not converge is
 //! approached in halved steps (down to 1/64 of the spacing) before the walk on that side stops and
-//! the failure is recorded. The `2 × disturbances` walks are independent and run in parallel.
+//! the failure is recorded. The `2 × disturbances` walks are independent and run in parallel. The
+//! plant's design specifications are solved with it at each point (their varied inputs are
+//! unknowns, [`SteadySystem`]): a model predictive controller holding its CVs is one.
 //!
 //! Ranges are written `PATH[@unit]=LOW:HIGH`, each end a percentage of the base value (`-10%`,
 //! `+10%`) or a quantity (`0.9 kmol/min`).
 
 use plantwide_flowsheet::Plant;
-use plantwide_solve::{NewtonSettings, NewtonStatus, PlantSystem, solve_steady};
+use plantwide_solve::specs::equation_name;
+use plantwide_solve::{NewtonSettings, NewtonStatus, SteadySystem, solve_steady};
 use plantwide_units::parse_quantity_as;
 use rayon::prelude::*;
 
@@ -141,19 +144,22 @@ fn walk(
     settings: &NewtonSettings,
 ) -> Walk {
     let mut x = x0.to_vec();
+    // The inputs a design spec varies are unknowns: each point starts from the last one's values.
+    let mut u = u0.to_vec();
     let mut at = d.base;
     let mut res = Vec::with_capacity(targets.len());
-    let solve = |x: &mut Vec<f64>, value: f64| -> Result<(), NewtonFailure> {
-        let mut u = u0.to_vec();
-        u[d.signal.index] = value;
-        let mut trial = x.clone();
-        let report = solve_steady(&PlantSystem::new(plant, &u), &mut trial, settings);
+    let solve = |x: &mut Vec<f64>, u: &mut Vec<f64>, value: f64| -> Result<(), NewtonFailure> {
+        let mut trial_u = u.clone();
+        trial_u[d.signal.index] = value;
+        let sys = SteadySystem::new(plant, &trial_u);
+        let mut z = sys.unknowns(x);
+        let report = solve_steady(&sys, &mut z, settings);
         if report.status == NewtonStatus::Converged {
-            *x = trial;
+            (*x, *u) = sys.split(&z);
             Ok(())
         } else {
             let (eq, residual) = report.worst.unwrap_or((0, f64::NAN));
-            Err(NewtonFailure { status: report.status, equation: plant.equation_name(eq), residual })
+            Err(NewtonFailure { status: report.status, equation: equation_name(plant, eq), residual })
         }
     };
     for (k, &target) in targets.iter().enumerate() {
@@ -162,7 +168,7 @@ fn walk(
         let mut halvings = 0;
         while at != target {
             let next = if (target - at).abs() <= step.abs() { target } else { at + step };
-            match solve(&mut x, next) {
+            match solve(&mut x, &mut u, next) {
                 Ok(()) => at = next,
                 Err(newton) if halvings >= 6 => {
                     res.extend(std::iter::repeat_n(None, targets.len() - k));

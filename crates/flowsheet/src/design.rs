@@ -97,6 +97,55 @@ impl Plant {
     }
 }
 
+impl Plant {
+    /// The plant at the steady state its model predictive controllers drive it to: each one's
+    /// CVs at their setpoints (`<mpc>.sp<k>`, SI), its MVs free (design specs `cv_k = sp_k`
+    /// varying `<mpc>.mv<k>`, solved together). A DMC with a constant output-disturbance estimate
+    /// is offset-free: once the plant settles with no constraint active, its predicted errors are
+    /// zero, so a square controller with a nonsingular gain holds every CV on its setpoint —
+    /// the steady state a PI loop's integral gives. In the DAE an MPC holds its MVs instead (its
+    /// moves are discrete, made by the dynamic driver), so that steady-state studies with the
+    /// control structure active (sensitivity) need this plant. Whether the MVs found lie within
+    /// the controller's limits is for the caller to check.
+    ///
+    /// # Errors
+    /// [`SpecError`] for a controller with more CVs than MVs or fewer (its steady state depends on
+    /// its weights, or on the path it took), or whose setpoints do not resolve.
+    pub fn with_mpc_at_setpoints(&self) -> Result<Plant, SpecError> {
+        let mut held = self.clone();
+        let mut entries = Vec::new();
+        for (name, c) in &self.spec.controllers {
+            let plantwide_model::registry::ControllerSpec::Mpc(cfg) = c else { continue };
+            if cfg.cvs.len() != cfg.mvs.len() {
+                return Err(SpecError {
+                    origin: format!("controllers.{name}"),
+                    why: format!(
+                        "a model predictive controller with {} CVs and {} MVs has no steady state set by its \
+                         setpoints alone (it depends on its weights, or on its path); give it as many CVs as MVs \
+                         for steady-state studies",
+                        cfg.cvs.len(),
+                        cfg.mvs.len()
+                    ),
+                });
+            }
+            for (k, cv) in cfg.cvs.iter().enumerate() {
+                let sp = format!("{name}.sp{}", k + 1);
+                let sp = self.input(&sp).map(|i| self.inputs[i].value).ok_or_else(|| SpecError {
+                    origin: format!("controllers.{name}.cvs[{k}]"),
+                    why: format!("no input `{sp}`"),
+                })?;
+                entries.push(SpecEntry {
+                    path: cv.pv.clone(),
+                    value: QuantityValue::Number(sp),
+                    vary: format!("{name}.mv{}", k + 1),
+                });
+            }
+        }
+        held.add_specs(&entries)?;
+        Ok(held)
+    }
+}
+
 fn quantity_text(v: &QuantityValue) -> String {
     match v {
         QuantityValue::Number(x) => x.to_string(),

@@ -45,7 +45,7 @@ mod snapshot;
 mod waveform;
 
 pub use conservation::{CONSERVATION_TOL, Conservation, ConservationError};
-pub use mpc::{MpcError, MpcLog, StepModelFile};
+pub use mpc::{MpcError, MpcLog, StepModelFile, mv_limits};
 pub use session::{Session, SessionError};
 pub use snapshot::{DriverState, SNAPSHOT_VERSION, Snapshot};
 pub use waveform::Waveform;

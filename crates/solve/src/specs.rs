@@ -142,7 +142,7 @@ pub(crate) fn unknown_path(plant: &Plant, j: usize) -> String {
 }
 
 /// Name of equation `eq` of [`SteadySystem`]: the plant's name, or the spec's.
-pub(crate) fn equation_name(plant: &Plant, eq: usize) -> String {
+pub fn equation_name(plant: &Plant, eq: usize) -> String {
     let n = plant.n_eqs();
     match plant.specs().get(eq.wrapping_sub(n)) {
         Some(s) if eq >= n => format!("design spec {} ({})", s.label(), s.origin),

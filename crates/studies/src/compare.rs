@@ -32,12 +32,15 @@ use plantwide_analysis::measures::{condition_number, svd};
 use plantwide_analysis::sensitivity::{Disturbance as Sweep, SweepSettings, sweep};
 use plantwide_flowsheet::Plant;
 use plantwide_model::ControllerSpec;
-use plantwide_solve::{StrategySettings, converge};
+use plantwide_solve::dynamic::mv_limits;
+use plantwide_solve::{NewtonSettings, StrategySettings, converge, steady_state};
 use plantwide_units::Dimension;
 use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::screen::ScreenError;
+use crate::screen::pairings::dynamic::Limited;
+use crate::screen::pairings::mpc::{MpcAlternative, assess_mpc, controllers};
 use crate::screen::pairings::{Disturbance, DynamicSettings, PairingRequest, PairingStructure, Tuning, assess_pairing};
 pub use energy::{Energy, energy};
 
@@ -186,6 +189,8 @@ pub struct Scheme {
     pub condition_number: Option<f64>,
     /// The file's pairing: relative gains, NI, DIC and its closed-loop runs.
     pub structure: Option<PairingStructure>,
+    /// Its model predictive controllers: gains, condition number and closed-loop runs.
+    pub mpc: Vec<MpcAlternative>,
     /// How the quality loops of the closed-loop runs are tuned: `blt`, or `file` (asked for, or
     /// open loop unstable: BLT does not apply).
     pub tuning: &'static str,
@@ -215,10 +220,6 @@ pub struct Comparison {
 /// # Errors
 /// [`CompareError`] naming the scheme's file and what failed.
 pub fn compare(plants: &[Plant], request: &CompareRequest) -> Result<Comparison, CompareError> {
-    for p in plants {
-        crate::screen::without_mpc(p, "compare")
-            .map_err(|e| CompareError::Screen { file: p.file().to_string(), source: Box::new(e) })?;
-    }
     let first: Vec<Scheme> = plants.par_iter().map(|p| scheme(p, request)).collect::<Result<_, _>>()?;
     // One run length for all: given, or 20 reset times of the slowest tuned loop of any scheme.
     let longest = |s: &Scheme| {
@@ -243,6 +244,16 @@ pub fn compare(plants: &[Plant], request: &CompareRequest) -> Result<Comparison,
         }
         _ => first,
     };
+    if let Some(s) =
+        schemes.iter().find(|s| !s.mpc.is_empty() && duration.is_none() && !request.disturbances.is_empty())
+    {
+        return Err(CompareError::Request {
+            file: s.file.clone(),
+            what: "give --duration: no scheme has a PI quality loop whose reset time sets the length of the \
+                   closed-loop runs, and a model predictive controller has none"
+                .into(),
+        });
+    }
     Ok(Comparison {
         disturbances: request.disturbances.iter().map(|d| format!("{} {:+} %", d.path, 100.0 * d.fraction)).collect(),
         outputs: request.outputs.clone(),
@@ -275,6 +286,7 @@ fn scheme(plant: &Plant, r: &CompareRequest) -> Result<Scheme, CompareError> {
     let keep = r.file_tuning || stability.open_loop_unstable;
     let tuning = if keep { Tuning::Given(file_tuning(plant, &loops)?) } else { Tuning::Blt };
     let (gain, condition, structure) = structure(plant, r, &loops, &tuning)?;
+    let mpc = mpc(plant, &sol.x, r)?;
     let recycles = sol
         .sm
         .iter()
@@ -282,7 +294,11 @@ fn scheme(plant: &Plant, r: &CompareRequest) -> Result<Scheme, CompareError> {
         // The secant model needs a few passes to say anything: a pass that starts converged has none.
         .map(|s| Recycle { tears: s.tears.clone(), loop_gain: s.loop_gain.filter(|_| s.passes >= 3), passes: s.passes })
         .collect();
-    let sensitivity = sensitivity(plant, &sol.x, &sol.u, r, &outputs).map_err(analysis)?;
+    let sensitivity = match held_by_mpc(plant, &sol.x)? {
+        Some((held, x, ops)) => sensitivity(&held, &x, &held.input_values(), r, &outputs, &ops),
+        None => sensitivity(plant, &sol.x, &sol.u, r, &outputs, &[]),
+    }
+    .map_err(analysis)?;
     Ok(Scheme {
         name: plant.name().to_string(),
         file,
@@ -291,6 +307,7 @@ fn scheme(plant: &Plant, r: &CompareRequest) -> Result<Scheme, CompareError> {
         gain,
         condition_number: condition,
         structure,
+        mpc,
         tuning: if matches!(tuning, Tuning::Blt) { "blt" } else { "file" },
         stability,
         recycles,
@@ -342,12 +359,35 @@ fn structure(
         watch: Vec::new(),
         dynamic: r.dynamic,
         record: r.outputs.clone(),
+        mpc: None,
     };
     let pairing: Vec<usize> = (0..loops.len()).collect();
     let screen = |e| CompareError::Screen { file: plant.file().to_string(), source: Box::new(e) };
     let (open, s) = assess_pairing(plant, &request, &pairing, tuning).map_err(screen)?;
     let condition = svd(open.gain.as_ref()).ok().map(|d| condition_number(&d.singular_values));
     Ok((plantwide_analysis::measures::rows(open.gain.as_ref()), condition, Some(s)))
+}
+
+/// Each model predictive controller of the scheme judged at its steady state `x` on `r`'s
+/// disturbances, its runs recording the controller's CVs and `r`'s outputs.
+fn mpc(plant: &Plant, x: &[f64], r: &CompareRequest) -> Result<Vec<MpcAlternative>, CompareError> {
+    let screen = |e| CompareError::Screen { file: plant.file().to_string(), source: Box::new(e) };
+    controllers(plant)
+        .iter()
+        .map(|(name, cfg)| {
+            let request = PairingRequest {
+                cvs: cfg.cvs.iter().map(|c| c.pv.clone()).collect(),
+                mvs: cfg.mvs.iter().map(|m| m.output.clone()).collect(),
+                throughput: Vec::new(),
+                disturbances: r.disturbances.clone(),
+                watch: Vec::new(),
+                dynamic: r.dynamic,
+                record: r.outputs.clone(),
+                mpc: None,
+            };
+            assess_mpc(plant, x, name, &request, r.dynamic.duration).map_err(screen)
+        })
+        .collect()
 }
 
 /// The modes as built and with the quality loops in manual: each one's `auto` input 0 and its
@@ -410,14 +450,46 @@ fn modes(plant: &Plant, x: &[f64], u: &[f64]) -> Result<Modes, plantwide_analysi
     Ok(Modes { states: model.states.len(), unstable, slowest })
 }
 
-/// Each output at ± each disturbance, by continuation from the steady state.
+/// A plant held by its model predictive controllers, its steady state and their outputs.
+type Held = (Plant, Vec<f64>, Vec<Limited>);
+
+/// The scheme's steady state with its model predictive controllers holding their CVs on their
+/// setpoints ([`Plant::with_mpc_at_setpoints`]), from its steady state `x`, and their outputs with
+/// their limits; `None` for a scheme without one.
+fn held_by_mpc(plant: &Plant, x: &[f64]) -> Result<Option<Held>, CompareError> {
+    let mpcs = controllers(plant);
+    if mpcs.is_empty() {
+        return Ok(None);
+    }
+    let file = || plant.file().to_string();
+    let held =
+        plant.with_mpc_at_setpoints().map_err(|e| CompareError::Request { file: file(), what: e.to_string() })?;
+    let st = steady_state(&held, &held.input_values(), Some(x), &NewtonSettings::default())
+        .map_err(|e| CompareError::Steady { file: file(), source: Box::new(e.into()) })?;
+    let mut ops = Vec::new();
+    for (name, cfg) in mpcs {
+        let limits = mv_limits(plant, name).map_err(|e| CompareError::Request { file: file(), what: e.to_string() })?;
+        for (k, (mv, (lo, hi))) in cfg.mvs.iter().zip(limits).enumerate() {
+            let op = if k == 0 { format!("{name}.op") } else { format!("{name}.op{}", k + 1) };
+            ops.push(Limited { op, mv: mv.output.clone(), lo, hi });
+        }
+    }
+    Ok(Some((held, st.x, ops)))
+}
+
+/// Each output at ± each disturbance, by continuation from the steady state; an end where a model
+/// predictive controller's output (`ops`) would lie outside its limits has no value: the
+/// controller cannot hold its CVs there.
 fn sensitivity(
     plant: &Plant,
     x: &[f64],
     u: &[f64],
     r: &CompareRequest,
     outputs: &[usize],
+    ops: &[Limited],
 ) -> Result<Vec<Sensitivity>, plantwide_analysis::AnalysisError> {
+    let op_vars: Vec<usize> = ops.iter().filter_map(|o| plant.var(&o.op)).collect();
+    let watched: Vec<usize> = outputs.iter().chain(&op_vars).copied().collect();
     let mut rows = Vec::new();
     for d in &r.disturbances {
         let f = 100.0 * d.fraction.abs();
@@ -440,18 +512,29 @@ fn sensitivity(
             x,
             u,
             std::slice::from_ref(&range),
-            outputs,
+            &watched,
             &SweepSettings { points: 2, ..Default::default() },
         )?
         .remove(0);
         failures.extend(curve.failures.iter().map(|fl| fl.to_string()));
-        let at = |value: f64, ok: bool| {
+        let mut at = |value: f64, ok: bool| {
             let failed = curve.failures.iter().any(|fl| (fl.value < range.base) == (value < range.base));
             if failed || !ok {
                 return None;
             }
             let k = if value < range.base { 0 } else { curve.outputs.len() - 1 };
-            curve.outputs.get(k).cloned().flatten()
+            let v = curve.outputs.get(k).cloned().flatten()?;
+            let beyond: Vec<String> = ops_beyond(ops, &v[outputs.len()..]);
+            if beyond.is_empty() {
+                return Some(v);
+            }
+            let end = plantwide_model::limits::number(value);
+            failures.push(format!(
+                "{} at {end}: {}; the controller cannot hold its CVs there",
+                d.path,
+                beyond.join(", ")
+            ));
+            None
         };
         let (low, high) = (at(range.low, low_ok), at(range.high, high_ok));
         for (k, o) in r.outputs.iter().enumerate() {
@@ -466,4 +549,17 @@ fn sensitivity(
         }
     }
     Ok(rows)
+}
+
+/// The controller outputs of `ops` whose steady values `v` lie outside their limits, described.
+fn ops_beyond(ops: &[Limited], v: &[f64]) -> Vec<String> {
+    ops.iter()
+        .zip(v)
+        .filter(|(o, v)| **v < o.lo || **v > o.hi)
+        .map(|(o, v)| {
+            let (side, l) = if *v < o.lo { ("min", o.lo) } else { ("max", o.hi) };
+            let n = plantwide_model::limits::number;
+            format!("`{}` (driving `{}`) would need {}, beyond its {side} {}", o.op, o.mv, n(*v), n(l))
+        })
+        .collect()
 }

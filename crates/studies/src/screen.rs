@@ -150,18 +150,26 @@ pub enum ScreenError {
         /// Its value in the plant as written.
         base: f64,
     },
-    /// The plant has a model predictive controller, which the steady-state and closed-loop parts
-    /// of a screening or comparison do not model yet.
+    /// The plant has a model predictive controller: a screening opens loops around the CVs and
+    /// MVs and pairs them, which a controller already there would fight.
     #[error(
-        "controller `{controller}` is a model predictive controller: {study} does not take one yet (its steady states \
-         and closed-loop runs would treat it as holding its MVs); run it with `plantwide run`, or remove it to {study} \
-         the PID structure"
+        "controller `{controller}` is a model predictive controller: {study} takes no flowsheet with one; screen \
+         the PID structure (remove `{controller}`) and give the controller with --mpc FILE to judge it beside the \
+         pairings, or compare the two files with `plantwide compare`"
     )]
     ModelPredictive {
         /// The controller.
         controller: String,
         /// The study refused (`screen`, `compare`).
         study: &'static str,
+    },
+    /// A model predictive controller of the study does not resolve or cannot take part.
+    #[error("controller `{controller}`: {why}")]
+    Mpc {
+        /// The controller.
+        controller: String,
+        /// What is wrong and what would fix it.
+        why: String,
     },
     /// A linear-algebra step failed.
     #[error("configuration {structure}: {source}")]

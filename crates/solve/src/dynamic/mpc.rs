@@ -123,6 +123,20 @@ fn resolve(plant: &Plant, name: &str, cfg: &MpcConfig) -> Result<Resolved, MpcEr
     Ok((p, cvs, mv_inputs, sp_inputs))
 }
 
+/// The hard limits `(min, max)` of controller `name`'s MVs (SI; infinite where none is given),
+/// for the studies that check a steady state against them.
+///
+/// # Errors
+/// [`MpcError`] when `name` is not a model predictive controller of `plant` or does not resolve.
+pub fn mv_limits(plant: &Plant, name: &str) -> Result<Vec<(f64, f64)>, MpcError> {
+    let Some(ControllerSpec::Mpc(cfg)) = plant.spec().controllers.get(name) else {
+        return Err(fail(name, "not a model predictive controller of the plant"));
+    };
+    let (p, ..) = resolve(plant, name, cfg)?;
+    let s = &p.settings;
+    Ok(p.mv_scales.iter().enumerate().map(|(k, sc)| (s.u_min[k] * sc, s.u_max[k] * sc)).collect())
+}
+
 fn build(plant: &Plant, x: &[f64], name: &str, cfg: &MpcConfig) -> Result<MpcRun, MpcError> {
     let (p, cvs, mv_inputs, sp_inputs) = resolve(plant, name, cfg)?;
     let (model, source) = match &p.model {

@@ -20,6 +20,7 @@
 //!    plant; ranked by their IAE relative to the best candidate's, per CV and disturbance.
 
 pub mod dynamic;
+pub mod mpc;
 pub mod sensitivity;
 
 use faer::Mat;
@@ -61,6 +62,9 @@ pub struct PairingRequest {
     pub dynamic: DynamicSettings,
     /// Further variables recorded in every run, with figures like the CVs' after them (paths).
     pub record: Vec<String>,
+    /// A model predictive controller to judge beside the PI candidates: a `"type": "mpc"`
+    /// controller description on the CVs and (some of) the MVs ([`mpc::screen_mpc`]).
+    pub mpc: Option<serde_json::Value>,
 }
 
 /// One CV–MV pair and its relative gain.
@@ -119,6 +123,9 @@ pub struct PairingScreen {
     pub singular: Vec<Option<String>>,
     /// The structures that reached a leaf, best first.
     pub structures: Vec<PairingStructure>,
+    /// The model predictive controller asked for, judged on the same runs (its `score` relative
+    /// to the best of all tested).
+    pub mpc: Option<mpc::MpcAlternative>,
 }
 
 /// The open plant: the loops on the CVs and MVs removed, its steady state and gains.
@@ -173,8 +180,13 @@ pub fn screen_pairings(plant: &Plant, request: &PairingRequest) -> Result<Pairin
             (!a.passed, a.rga_number).partial_cmp(&(!b.passed, b.rga_number)).unwrap_or(std::cmp::Ordering::Equal)
         });
     }
-    if !request.disturbances.is_empty() {
-        dynamic::test(&open, request, &mut structures)?;
+    let duration =
+        if request.disturbances.is_empty() { None } else { Some(dynamic::test(&open, request, &mut structures)?) };
+    let mut mpc = request.mpc.as_ref().map(|m| mpc::screen_mpc(&open, request, m, duration)).transpose()?;
+    if let Some(d) = mpc.as_mut().and_then(|m| m.dynamic.as_mut()) {
+        let mut all: Vec<&mut DynamicResult> = structures.iter_mut().filter_map(|s| s.dynamic.as_mut()).collect();
+        all.push(d);
+        dynamic::score(&mut all, request.disturbances.len(), request.cvs.len());
     }
     rank(&mut structures);
     Ok(PairingScreen {
@@ -186,6 +198,7 @@ pub fn screen_pairings(plant: &Plant, request: &PairingRequest) -> Result<Pairin
         pruned,
         singular,
         structures,
+        mpc,
     })
 }
 

@@ -117,12 +117,13 @@ pub struct DynamicResult {
     pub failure: Option<String>,
 }
 
-/// Test the first `r.dynamic.candidates` structures that passed, in parallel, and score them.
+/// Test the first `r.dynamic.candidates` structures that passed, in parallel, and score them; the
+/// length of the runs \[s\].
 pub(super) fn test(
     open: &OpenPlant,
     r: &PairingRequest,
     structures: &mut [PairingStructure],
-) -> Result<(), ScreenError> {
+) -> Result<f64, ScreenError> {
     let picked: Vec<usize> =
         (0..structures.len()).filter(|&k| structures[k].passed).take(r.dynamic.candidates).collect();
     test_picked(open, r, structures, picked, &Tuning::Blt)
@@ -138,14 +139,14 @@ pub enum Tuning {
     Given(Vec<(f64, f64, &'static str)>),
 }
 
-/// Test the structures `picked`, in parallel, and score them.
+/// Test the structures `picked`, in parallel, and score them; the length of the runs \[s\].
 pub(super) fn test_picked(
     open: &OpenPlant,
     r: &PairingRequest,
     structures: &mut [PairingStructure],
     picked: Vec<usize>,
     tuning: &Tuning,
-) -> Result<(), ScreenError> {
+) -> Result<f64, ScreenError> {
     for d in &r.disturbances {
         match open.plant.input(&d.path) {
             Some(i) if open.plant.inputs()[i].driven_by.is_none() => {}
@@ -163,31 +164,40 @@ pub(super) fn test_picked(
     // candidate that could be tuned.
     let longest = tunings.iter().flatten().map(|(_, _, t)| t.tau_i_max).next().unwrap_or(0.0);
     let duration = r.dynamic.duration.unwrap_or(20.0 * longest);
-    let results: Vec<DynamicResult> =
-        picked.par_iter().zip(tunings).map(|(&k, tuned)| candidate(tuned, r, &structures[k], duration)).collect();
-    let best: Vec<Vec<f64>> = (0..r.disturbances.len())
-        .map(|d| {
-            let ok = || results.iter().filter(|t| t.failure.is_none());
-            (0..r.cvs.len()).map(|c| ok().map(|t| t.runs[d].cvs[c].iae).fold(f64::INFINITY, f64::min)).collect()
-        })
+    let results: Vec<DynamicResult> = picked
+        .par_iter()
+        .zip(tunings)
+        .map(|(&k, tuned)| candidate(tuned, r, &pair_outputs(open, &structures[k]), duration))
         .collect();
-    let best = |d: usize, c: usize| best[d][c];
-    for (k, mut t) in picked.into_iter().zip(results) {
-        if t.failure.is_none() {
-            let n = (r.disturbances.len() * r.cvs.len()).max(1) as f64;
-            let sum: f64 = (0..r.disturbances.len())
-                .flat_map(|d| (0..r.cvs.len()).map(move |c| (d, c)))
-                .map(|(d, c)| t.runs[d].cvs[c].iae / best(d, c).max(f64::MIN_POSITIVE))
-                .sum();
-            t.score = sum / n;
-        }
+    let mut results = results;
+    score(&mut results.iter_mut().collect::<Vec<_>>(), r.disturbances.len(), r.cvs.len());
+    for (k, t) in picked.into_iter().zip(results) {
         structures[k].dynamic = Some(t);
     }
-    Ok(())
+    Ok(duration)
+}
+
+/// Score each result that ran: the mean over disturbances and CVs of its IAE over the best IAE of
+/// all `results` there (1 when best everywhere); a failed result keeps an infinite score.
+pub(crate) fn score(results: &mut [&mut DynamicResult], disturbances: usize, cvs: usize) {
+    let best: Vec<Vec<f64>> = (0..disturbances)
+        .map(|d| {
+            let ok = || results.iter().filter(|t| t.failure.is_none());
+            (0..cvs).map(|c| ok().map(|t| t.runs[d].cvs[c].iae).fold(f64::INFINITY, f64::min)).collect()
+        })
+        .collect();
+    for t in results.iter_mut().filter(|t| t.failure.is_none()) {
+        let n = (disturbances * cvs).max(1) as f64;
+        let sum: f64 = (0..disturbances)
+            .flat_map(|d| (0..cvs).map(move |c| (d, c)))
+            .map(|(d, c)| t.runs[d].cvs[c].iae / best[d][c].max(f64::MIN_POSITIVE))
+            .sum();
+        t.score = sum / n;
+    }
 }
 
 /// Run one tuned candidate; a failure is recorded, not returned (the other candidates go on).
-fn candidate(tuned: TunedCandidate, r: &PairingRequest, s: &PairingStructure, duration: f64) -> DynamicResult {
+fn candidate(tuned: TunedCandidate, r: &PairingRequest, ops: &[Limited], duration: f64) -> DynamicResult {
     let failed = |why: String| DynamicResult {
         detuning_factor: None,
         loops: Vec::new(),
@@ -201,8 +211,8 @@ fn candidate(tuned: TunedCandidate, r: &PairingRequest, s: &PairingStructure, du
     };
     let mut runs = Vec::new();
     for d in &r.disturbances {
-        match run(&plant, &x, r, s, d, duration) {
-            Ok(run) => runs.push(run),
+        match run(&plant, &x, r, d, duration, ops) {
+            Ok((run, _)) => runs.push(run),
             Err(why) => {
                 return DynamicResult {
                     detuning_factor: tuned.detuning,
@@ -229,9 +239,7 @@ struct Tuned {
 /// The controller description of pair `i` with gain `kc` and reset `tau_i` (SI).
 fn loop_spec(open: &OpenPlant, s: &PairingStructure, i: usize, kc: f64, tau_i: f64, action: &str) -> serde_json::Value {
     let p = &s.pairs[i];
-    // The open plant holds every MV at its steady value.
-    let u0 = open.plant.input(&p.mv).map_or(0.0, |m| open.plant.inputs()[m].value);
-    let (lo, hi) = (f64::min(0.0, 2.0 * u0), f64::max(0.0, 2.0 * u0));
+    let Limited { lo, hi, .. } = pair_outputs(open, s).swap_remove(i);
     let c = open.plant.var(&p.cv).map_or(f64::NAN, |v| open.x[v]);
     serde_json::json!({"type": "pid", "pv": p.cv, "output": p.mv, "sp": c, "kc": kc, "tau_i": tau_i,
                        "action": action, "op_min": lo, "op_max": hi})
@@ -311,19 +319,47 @@ fn tuned_plant(open: &OpenPlant, r: &PairingRequest, s: &PairingStructure) -> Tu
 /// Where in a run its disturbance steps, as a fraction of the run's duration.
 pub const STEP_AT: f64 = 0.02;
 
-/// One disturbance step on the tuned plant.
-fn run(
+/// A controller output a run watches for saturation: its variable, the MV it drives and its
+/// limits (SI).
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Limited {
+    /// The controller's output variable (`pair1.op`, `mpc.op2`).
+    pub op: String,
+    /// The input it drives.
+    pub mv: String,
+    /// Lower limit.
+    pub lo: f64,
+    /// Upper limit.
+    pub hi: f64,
+}
+
+/// The outputs of a candidate's loops with their limits: `[0, 2 u₀]` (or `[2 u₀, 0]`) for an MV
+/// whose steady value in the open plant (which holds every MV) is `u₀`.
+fn pair_outputs(open: &OpenPlant, s: &PairingStructure) -> Vec<Limited> {
+    (0..s.pairs.len())
+        .map(|i| {
+            let mv = &s.pairs[i].mv;
+            let u0 = open.plant.input(mv).map_or(0.0, |m| open.plant.inputs()[m].value);
+            let (lo, hi) = (f64::min(0.0, 2.0 * u0), f64::max(0.0, 2.0 * u0));
+            Limited { op: format!("pair{}.op", i + 1), mv: mv.clone(), lo, hi }
+        })
+        .collect()
+}
+
+/// One disturbance step on a controlled plant from its steady state `x`: the figures of `r`'s CVs
+/// and recorded outputs, the MVs of `ops` that reached a limit, and what the plant's model
+/// predictive controllers did.
+pub(crate) fn run(
     plant: &Plant,
     x: &[f64],
     r: &PairingRequest,
-    s: &PairingStructure,
     d: &super::Disturbance,
     duration: f64,
-) -> Result<DisturbanceRun, CandidateFailure> {
+    ops: &[Limited],
+) -> Result<(DisturbanceRun, Vec<plantwide_solve::dynamic::MpcLog>), CandidateFailure> {
     let u0 = plant.input(&d.path).map_or(f64::NAN, |i| plant.inputs()[i].value);
-    let ops: Vec<String> = (0..s.pairs.len()).map(|i| format!("pair{}.op", i + 1)).collect();
     let watched: Vec<&String> = r.cvs.iter().chain(r.record.iter().filter(|p| !r.cvs.contains(p))).collect();
-    let record: Vec<&String> = watched.iter().copied().chain(&ops).collect();
+    let record: Vec<&String> = watched.iter().copied().chain(ops.iter().map(|o| &o.op)).collect();
     let text = serde_json::json!({
         "format_version": 1, "name": format!("{} step", d.path), "duration": format!("{duration} s"),
         "integrator": {"rtol": 1e-6},
@@ -347,20 +383,23 @@ fn run(
             }
         })
         .collect();
-    let saturated = (0..s.pairs.len())
-        .filter(|&i| {
+    let at = |v: f64, l: f64| l.is_finite() && (v - l).abs() <= 1e-9 * l.abs().max(1e-12);
+    let saturated = ops
+        .iter()
+        .enumerate()
+        .filter(|(i, o)| {
             let k = watched.len() + i;
-            let limits = [0.0, 2.0 * res.rows.first().map_or(0.0, |row| row[k])];
-            res.rows.iter().any(|row| limits.iter().any(|l| (row[k] - l).abs() <= 1e-9 * l.abs().max(1e-12)))
+            res.rows.iter().any(|row| at(row[k], o.lo) || at(row[k], o.hi))
         })
-        .map(|i| s.pairs[i].mv.clone())
+        .map(|(_, o)| o.mv.clone())
         .collect();
     let series = (0..watched.len()).map(|k| res.rows.iter().map(|row| row[k]).collect()).collect();
-    Ok(DisturbanceRun {
+    let run = DisturbanceRun {
         disturbance: format!("{} {:+} %", d.path, 100.0 * d.fraction),
         cvs,
         saturated,
         times: res.times.clone(),
         series,
-    })
+    };
+    Ok((run, res.mpc))
 }
