@@ -40,7 +40,7 @@ use serde::Serialize;
 
 use crate::screen::ScreenError;
 use crate::screen::pairings::dynamic::Limited;
-use crate::screen::pairings::mpc::{MpcAlternative, assess_mpc, controllers};
+use crate::screen::pairings::mpc::{MpcAlternative, assess_mpc, controllers, output_name};
 use crate::screen::pairings::{Disturbance, DynamicSettings, PairingRequest, PairingStructure, Tuning, assess_pairing};
 pub use energy::{Energy, energy};
 
@@ -58,6 +58,23 @@ pub struct CompareRequest {
     pub dynamic: DynamicSettings,
     /// Keep the files' own tuning in every scheme (like for like) instead of BLT where it applies.
     pub file_tuning: bool,
+}
+
+impl CompareRequest {
+    /// The closed-loop runs of this request on a scheme's `cvs` and `mvs`: its disturbances, its
+    /// outputs recorded.
+    fn runs_of(&self, cvs: Vec<String>, mvs: Vec<String>) -> PairingRequest {
+        PairingRequest {
+            cvs,
+            mvs,
+            throughput: Vec::new(),
+            disturbances: self.disturbances.clone(),
+            watch: Vec::new(),
+            dynamic: self.dynamic,
+            record: self.outputs.clone(),
+            mpc: None,
+        }
+    }
 }
 
 /// Why a comparison could not be made.
@@ -351,16 +368,7 @@ fn structure(
     if loops.is_empty() {
         return Ok((Vec::new(), None, None));
     }
-    let request = PairingRequest {
-        cvs: loops.iter().map(|l| l.cv.clone()).collect(),
-        mvs: loops.iter().map(|l| l.mv.clone()).collect(),
-        throughput: Vec::new(),
-        disturbances: r.disturbances.clone(),
-        watch: Vec::new(),
-        dynamic: r.dynamic,
-        record: r.outputs.clone(),
-        mpc: None,
-    };
+    let request = r.runs_of(loops.iter().map(|l| l.cv.clone()).collect(), loops.iter().map(|l| l.mv.clone()).collect());
     let pairing: Vec<usize> = (0..loops.len()).collect();
     let screen = |e| CompareError::Screen { file: plant.file().to_string(), source: Box::new(e) };
     let (open, s) = assess_pairing(plant, &request, &pairing, tuning).map_err(screen)?;
@@ -375,16 +383,8 @@ fn mpc(plant: &Plant, x: &[f64], r: &CompareRequest) -> Result<Vec<MpcAlternativ
     controllers(plant)
         .iter()
         .map(|(name, cfg)| {
-            let request = PairingRequest {
-                cvs: cfg.cvs.iter().map(|c| c.pv.clone()).collect(),
-                mvs: cfg.mvs.iter().map(|m| m.output.clone()).collect(),
-                throughput: Vec::new(),
-                disturbances: r.disturbances.clone(),
-                watch: Vec::new(),
-                dynamic: r.dynamic,
-                record: r.outputs.clone(),
-                mpc: None,
-            };
+            let cvs = cfg.cvs.iter().map(|c| c.pv.clone()).collect();
+            let request = r.runs_of(cvs, cfg.mvs.iter().map(|m| m.output.clone()).collect());
             assess_mpc(plant, x, name, &request, r.dynamic.duration).map_err(screen)
         })
         .collect()
@@ -470,8 +470,7 @@ fn held_by_mpc(plant: &Plant, x: &[f64]) -> Result<Option<Held>, CompareError> {
     for (name, cfg) in mpcs {
         let limits = mv_limits(plant, name).map_err(|e| CompareError::Request { file: file(), what: e.to_string() })?;
         for (k, (mv, (lo, hi))) in cfg.mvs.iter().zip(limits).enumerate() {
-            let op = if k == 0 { format!("{name}.op") } else { format!("{name}.op{}", k + 1) };
-            ops.push(Limited { op, mv: mv.output.clone(), lo, hi });
+            ops.push(Limited { op: output_name(name, k), mv: mv.output.clone(), lo, hi });
         }
     }
     Ok(Some((held, st.x, ops)))

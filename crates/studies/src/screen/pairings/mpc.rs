@@ -173,7 +173,7 @@ pub(crate) fn screen_mpc(
 }
 
 /// Output `k` (0-based) of controller `name`: `name.op`, `name.op2`, ….
-fn output_name(name: &str, k: usize) -> String {
+pub(crate) fn output_name(name: &str, k: usize) -> String {
     if k == 0 { format!("{name}.op") } else { format!("{name}.op{}", k + 1) }
 }
 
