@@ -29,6 +29,7 @@ mod run;
 mod run_plot;
 mod screen;
 mod sensitivity;
+mod shard;
 mod shown;
 mod size;
 mod steady;
@@ -173,6 +174,9 @@ enum Command {
     /// open or closed loop, measurement noise), FIR/ARX/OE fits validated on fresh data; the
     /// identified gains and RGA beside the exact linearization's.
     Identify(identify::IdentifyArgs),
+    /// Put together the part files of a job sharded with `--shard I/N` (sensitivity, screen) and
+    /// finish it as the one-process run would: the same text, JSON, CSV, plots and report.
+    Merge(shard::MergeArgs),
 }
 
 /// A failed command: message and exit code.
@@ -217,6 +221,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Size(a) => size::run(&a, cli.units.unwrap_or(UnitsArg::Si).into()),
         Command::Compare(a) => compare::run(&a, cli.units.unwrap_or(UnitsArg::Si).into()),
         Command::Identify(a) => identify::run(&a, cli.units.unwrap_or(UnitsArg::Si).into()),
+        Command::Merge(a) => shard::run(&a),
         Command::Schema { scenario } => {
             let schema = match scenario {
                 true => plantwide::flowsheet::schema::scenario_schema(),

@@ -1,7 +1,8 @@
 //! `plantwide screen FILE --column COL --outputs TOP,BOTTOM [--json] [--report DIR]`: the inventory
 //! configurations of a column, built through the library and judged by their steady-state gains;
 //! `plantwide screen FILE --cvs … --mvs … [--disturbances …] [--throughput …]`: the pairings of CVs
-//! to MVs, filtered at steady state and the best tested dynamically.
+//! to MVs, filtered at steady state and the best tested dynamically; `--shard I/N` runs a share of
+//! the dynamic tests (task `t`: the `t`-th candidate tested), `plantwide merge` scores them all.
 
 use std::path::{Path, PathBuf};
 
@@ -9,13 +10,16 @@ use plantwide::io::html::markdown_to_html;
 use plantwide::io::plot::{LabelledMatrix, Overlay, write_bars, write_matrices, write_overlays};
 use plantwide::studies::screen::pairings::STEP_AT;
 use plantwide::studies::screen::pairings::mpc::MpcAlternative;
-use plantwide::studies::screen::pairings::{Disturbance, DynamicSettings, PairingRequest, PairingScreen, Watch};
+use plantwide::studies::screen::pairings::{
+    CandidateTask, Disturbance, DynamicResult, DynamicSettings, PairingRequest, PairingScreen, Watch,
+};
 use plantwide::studies::screen::{ColumnScreen, ScreenError, screen_column, screen_pairings};
 use plantwide::units::Dimension;
 
 use plantwide::units::UnitSystem;
 
 use super::CliError;
+use super::shard::ShardArgs;
 use super::shown::Shown;
 use super::steady::load_with_overrides;
 
@@ -70,6 +74,9 @@ pub struct ScreenArgs {
     /// Write a report here: screen.md and screen.json.
     #[arg(long, value_name = "DIR")]
     report: Option<PathBuf>,
+    /// Sharding of the pairings' dynamic tests over processes.
+    #[command(flatten)]
+    pub shard: ShardArgs,
 }
 
 fn screen_error(e: ScreenError) -> CliError {
@@ -83,6 +90,12 @@ pub fn run(a: &ScreenArgs, system: UnitSystem) -> Result<(), CliError> {
     plantwide::analysis::faer::set_global_parallelism(plantwide::analysis::faer::Par::Seq);
     let (plant, _) = load_with_overrides(&a.file, &a.set)?;
     let Some(column) = &a.column else { return pairings(a, &plant, system) };
+    if a.shard.is_shard() {
+        return Err(CliError::user(
+            "--shard splits the pairings' dynamic tests (--cvs … --mvs … --disturbances …); a column's seven \
+             configurations are steady solves that run in one process: drop --shard",
+        ));
+    }
     let screen = screen_column(&plant, column, &a.outputs).map_err(screen_error)?;
     let json = serde_json::to_string_pretty(&screen).map_err(|e| CliError::user(e.to_string()))?;
     if let Some(dir) = &a.report {
@@ -286,8 +299,17 @@ fn pairings(a: &ScreenArgs, plant: &plantwide::flowsheet::Plant, system: UnitSys
         },
         record: Vec::new(),
         mpc: a.mpc.as_deref().map(mpc_description).transpose()?,
+        share: a.shard.share_as::<CandidateTask, DynamicResult>()?,
     };
     let screen = screen_pairings(plant, &request).map_err(screen_error)?;
+    if a.shard.is_shard() {
+        let done = screen
+            .tested
+            .iter()
+            .enumerate()
+            .filter_map(|(t, &k)| screen.structures[k].dynamic.as_ref().map(|d| (t, CandidateTask::from(d))));
+        return a.shard.write_part("screen", &a.file, screen.tested.len(), done);
+    }
     let watched = request.watch.iter().map(|w| (w.path.clone(), None));
     let shown = Shown::new(std::slice::from_ref(plant), cvs.iter().cloned().chain(watched), system)?;
     let json = serde_json::to_string_pretty(&screen).map_err(|e| CliError::user(e.to_string()))?;

@@ -1,11 +1,12 @@
 //! `plantwide sensitivity FILE --disturb PATH=-10%:+10% … --outputs Q1,Q2 [--points N] [--csv OUT]
-//! [--plot OUT.png|OUT.svg]`: disturbance sweeps with the flowsheet's control structure active.
+//! [--plot OUT.png|OUT.svg] [--shard I/N [--part FILE]]`: disturbance sweeps with the flowsheet's
+//! control structure active. Its tasks are the walks (each disturbance up and down from the base).
 
 use std::path::PathBuf;
 
 use plantwide::analysis::AnalysisError;
 use plantwide::analysis::select::{in_system, select_outputs};
-use plantwide::analysis::sensitivity::{Disturbance, SweepSettings, sweep};
+use plantwide::analysis::sensitivity::{Disturbance, SweepSettings, Walk, curves, walks};
 use plantwide::io::IoError;
 use plantwide::io::csv::sensitivity_csv;
 use plantwide::io::plot::write_sensitivity;
@@ -13,6 +14,7 @@ use plantwide::units::UnitSystem;
 
 use super::CliError;
 use super::gains::sig;
+use super::shard::ShardArgs;
 use super::steady::{converge, load_with_overrides};
 
 /// Arguments of `plantwide sensitivity`.
@@ -39,6 +41,9 @@ pub struct SensitivityArgs {
     /// Override an input or a unit parameter first.
     #[arg(long = "set", value_name = "PATH=VALUE")]
     set: Vec<String>,
+    /// Sharding over processes.
+    #[command(flatten)]
+    pub shard: ShardArgs,
 }
 
 fn analysis_error(e: AnalysisError) -> CliError {
@@ -63,7 +68,15 @@ pub fn run(a: &SensitivityArgs, units: UnitSystem) -> Result<(), CliError> {
     let ss = converge(&plant, &u)?;
     let settings = SweepSettings { points: a.points, ..SweepSettings::default() };
     let idx: Vec<usize> = outputs.iter().map(|s| s.index).collect();
-    let curves = sweep(&plant, &ss.x, &ss.u, &disturbances, &idx, &settings).map_err(analysis_error)?;
+    let share = a.shard.share::<Walk>()?;
+    let walks = walks(&plant, &ss.x, &ss.u, &disturbances, &idx, &settings, &share).map_err(analysis_error)?;
+    if share.is_shard() {
+        let done = walks.iter().enumerate().filter_map(|(t, w)| w.as_ref().map(|w| (t, w)));
+        return a.shard.write_part("sensitivity", &a.file, walks.len(), done);
+    }
+    let walks: Vec<Walk> = walks.into_iter().flatten().collect();
+    let base: Vec<f64> = idx.iter().map(|&i| ss.x[i]).collect();
+    let curves = curves(&disturbances, settings.points, &base, &walks);
     outln!(
         "sensitivity of `{}` (control structure as in the flowsheet, each point re-converged from its neighbour)",
         plant.name()

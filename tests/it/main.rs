@@ -29,6 +29,7 @@ mod plots;
 mod pressure;
 mod recycle;
 mod screen;
+mod shard;
 mod size;
 mod snowball;
 mod specs;

@@ -32,6 +32,7 @@ pub mod response;
 pub mod select;
 pub mod sensitivity;
 pub mod sensors;
+pub mod shard;
 pub mod tf;
 
 pub use error::AnalysisError;

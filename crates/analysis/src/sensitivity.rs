@@ -5,7 +5,9 @@
 //! Each sweep walks outward from the base case in both directions, every point started from its
 //! converged neighbour (natural-parameter continuation); a point that does not converge is
 //! approached in halved steps (down to 1/64 of the spacing) before the walk on that side stops and
-//! the failure is recorded. The `2 × disturbances` walks are independent and run in parallel. The
+//! the failure is recorded. The `2 × disturbances` walks are independent and run in parallel (task
+//! `2k` walks disturbance `k` up from the base, task `2k + 1` down; [`walks`] computes a
+//! [`Share`] of them for a sharded job and [`curves`] puts them together). The
 //! plant's design specifications are solved with it at each point (their varied inputs are
 //! unknowns, [`SteadySystem`]): a model predictive controller holding its CVs is one.
 //!
@@ -20,6 +22,7 @@ use rayon::prelude::*;
 
 use crate::error::{AnalysisError, request};
 use crate::select::{Signal, select_input};
+use crate::shard::Share;
 
 /// A disturbance and its range (SI).
 #[derive(Debug, Clone, PartialEq)]
@@ -105,7 +108,7 @@ pub struct Curve {
 
 /// Why a sweep stopped early on one side: the point it could not reach, from where, and Newton's
 /// verdict at the last halving of the step.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[derive(Debug, Clone, PartialEq, thiserror::Error, serde::Serialize, serde::Deserialize)]
 #[error("`{path}` = {value:.6e} (SI): not converged from {from:.6e}: {newton}")]
 pub struct SweepFailure {
     /// Path of the disturbance.
@@ -119,7 +122,7 @@ pub struct SweepFailure {
 }
 
 /// A Newton iteration that did not converge: its verdict and where the residual is worst.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[derive(Debug, Clone, PartialEq, thiserror::Error, serde::Serialize, serde::Deserialize)]
 #[error("{status:?} (worst: {equation}, scaled residual {residual:.2e})")]
 pub struct NewtonFailure {
     /// Newton's verdict.
@@ -130,8 +133,14 @@ pub struct NewtonFailure {
     pub residual: f64,
 }
 
-/// Outputs at each target of one walk (`None` past a failure) and why it stopped, if it did.
-type Walk = (Vec<Option<Vec<f64>>>, Option<SweepFailure>);
+/// One walk of a sweep, away from the base case on one side of one disturbance.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Walk {
+    /// Outputs (SI) at each target, ordered away from the base (`None` past a failure).
+    pub outputs: Vec<Option<Vec<f64>>>,
+    /// Why it stopped early, if it did.
+    pub failure: Option<SweepFailure>,
+}
 
 /// Walk from `(x0, base)` through `targets` (ordered away from the base), each from its neighbour.
 fn walk(
@@ -173,7 +182,7 @@ fn walk(
                 Err(newton) if halvings >= 6 => {
                     res.extend(std::iter::repeat_n(None, targets.len() - k));
                     let why = SweepFailure { path: d.signal.path.clone(), value: next, from: at, newton };
-                    return (res, Some(why));
+                    return Walk { outputs: res, failure: Some(why) };
                 }
                 Err(_) => {
                     step /= 2.0;
@@ -183,7 +192,7 @@ fn walk(
         }
         res.push(Some(outputs.iter().map(|&i| x[i]).collect()));
     }
-    (res, None)
+    Walk { outputs: res, failure: None }
 }
 
 /// Sweep each disturbance over its range at `points` values (plus the base case) with the other
@@ -196,49 +205,73 @@ pub fn sweep(
     outputs: &[usize],
     settings: &SweepSettings,
 ) -> Result<Vec<Curve>, AnalysisError> {
+    let walks = walks(plant, x0, u0, disturbances, outputs, settings, &Share::All)?;
+    let walks: Vec<Walk> = walks.into_iter().flatten().collect();
+    let base: Vec<f64> = outputs.iter().map(|&i| x0[i]).collect();
+    Ok(curves(disturbances, settings.points, &base, &walks))
+}
+
+/// The values disturbance `d` is swept through: `n` over its range, ends included, and the base.
+fn grid(d: &Disturbance, n: usize) -> Vec<f64> {
+    let mut g: Vec<f64> = (0..n).map(|k| d.low + (d.high - d.low) * k as f64 / (n - 1) as f64).collect();
+    if !g.iter().any(|v| (v - d.base).abs() <= 1e-12 * d.base.abs()) {
+        g.push(d.base);
+    }
+    g.sort_by(f64::total_cmp);
+    g
+}
+
+/// The walks of a sweep that `share` asks for, in parallel: task `2k` walks disturbance `k` up
+/// from the base, task `2k + 1` down (`None` for another shard's task).
+///
+/// # Errors
+/// [`AnalysisError::Request`] for fewer than 2 points.
+pub fn walks(
+    plant: &Plant,
+    x0: &[f64],
+    u0: &[f64],
+    disturbances: &[Disturbance],
+    outputs: &[usize],
+    settings: &SweepSettings,
+    share: &Share<Walk>,
+) -> Result<Vec<Option<Walk>>, AnalysisError> {
     if settings.points < 2 {
         return Err(request(format!("--points must be at least 2 (got {})", settings.points)));
     }
-    let n = settings.points;
-    let grids: Vec<Vec<f64>> = disturbances
-        .iter()
-        .map(|d| {
-            let mut g: Vec<f64> = (0..n).map(|k| d.low + (d.high - d.low) * k as f64 / (n - 1) as f64).collect();
-            if !g.iter().any(|v| (v - d.base).abs() <= 1e-12 * d.base.abs()) {
-                g.push(d.base);
-            }
-            g.sort_by(f64::total_cmp);
-            g
-        })
-        .collect();
-    let base_out: Vec<f64> = outputs.iter().map(|&i| x0[i]).collect();
-    // Tasks: (disturbance, side), side 0 walks up from the base, side 1 walks down.
-    let tasks: Vec<(usize, usize)> = (0..disturbances.len()).flat_map(|k| [(k, 0), (k, 1)]).collect();
-    let walks: Vec<Walk> = tasks
+    let tasks: Vec<usize> = (0..2 * disturbances.len()).collect();
+    Ok(tasks
         .par_iter()
-        .map(|&(k, side)| {
-            let d = &disturbances[k];
-            let targets: Vec<f64> = if side == 0 {
-                grids[k].iter().copied().filter(|v| *v > d.base).collect()
-            } else {
-                grids[k].iter().rev().copied().filter(|v| *v < d.base).collect()
-            };
-            walk(plant, u0, x0, d, &targets, outputs, &settings.newton)
+        .map(|&t| {
+            share.run(t, || {
+                let d = &disturbances[t / 2];
+                let g = grid(d, settings.points);
+                let targets: Vec<f64> = if t % 2 == 0 {
+                    g.iter().copied().filter(|v| *v > d.base).collect()
+                } else {
+                    g.iter().rev().copied().filter(|v| *v < d.base).collect()
+                };
+                walk(plant, u0, x0, d, &targets, outputs, &settings.newton)
+            })
         })
-        .collect();
+        .collect())
+}
+
+/// The curves of a sweep from all its walks (task order, as [`walks`] numbers them) and the
+/// outputs at the base case.
+pub fn curves(disturbances: &[Disturbance], points: usize, base: &[f64], walks: &[Walk]) -> Vec<Curve> {
     let mut curves = Vec::new();
     for (k, d) in disturbances.iter().enumerate() {
-        let (up, up_fail) = &walks[2 * k];
-        let (down, down_fail) = &walks[2 * k + 1];
-        let mut out: Vec<Option<Vec<f64>>> = down.iter().rev().cloned().collect();
-        out.extend(grids[k].iter().filter(|v| **v == d.base).map(|_| Some(base_out.clone())));
-        out.extend(up.iter().cloned());
+        let (up, down) = (&walks[2 * k], &walks[2 * k + 1]);
+        let g = grid(d, points);
+        let mut out: Vec<Option<Vec<f64>>> = down.outputs.iter().rev().cloned().collect();
+        out.extend(g.iter().filter(|v| **v == d.base).map(|_| Some(base.to_vec())));
+        out.extend(up.outputs.iter().cloned());
         curves.push(Curve {
             disturbance: d.clone(),
-            values: grids[k].clone(),
+            values: g,
             outputs: out,
-            failures: [down_fail, up_fail].into_iter().flatten().cloned().collect(),
+            failures: [&down.failure, &up.failure].into_iter().flatten().cloned().collect(),
         });
     }
-    Ok(curves)
+    curves
 }

@@ -18,6 +18,7 @@ pub mod csv;
 pub mod error;
 pub mod export;
 pub mod html;
+pub mod part;
 pub mod plot;
 pub mod tf;
 

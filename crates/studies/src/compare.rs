@@ -73,6 +73,7 @@ impl CompareRequest {
             dynamic: self.dynamic,
             record: self.outputs.clone(),
             mpc: None,
+            share: Default::default(),
         }
     }
 }

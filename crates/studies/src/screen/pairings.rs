@@ -26,11 +26,14 @@ pub mod sensitivity;
 use faer::Mat;
 use plantwide_analysis::linear::Linearization;
 use plantwide_analysis::measures::{niederlinski, rga};
+use plantwide_analysis::shard::Share;
 use plantwide_flowsheet::{Override, Plant, StructureEdit};
 use plantwide_solve::{NewtonSettings, StrategySettings, steady_state};
 use serde::Serialize;
 
-pub use dynamic::{CandidateFailure, CvFigures, DisturbanceRun, DynamicResult, DynamicSettings, STEP_AT, Tuning};
+pub use dynamic::{
+    CandidateFailure, CandidateTask, CvFigures, DisturbanceRun, DynamicResult, DynamicSettings, STEP_AT, Tuning,
+};
 pub use sensitivity::{Watch, WatchResult};
 
 use super::ScreenError;
@@ -65,6 +68,10 @@ pub struct PairingRequest {
     /// A model predictive controller to judge beside the PI candidates: a `"type": "mpc"`
     /// controller description on the CVs and (some of) the MVs ([`mpc::screen_mpc`]).
     pub mpc: Option<serde_json::Value>,
+    /// Which candidates' dynamic tests this process runs (task `t`: the `t`-th candidate tested):
+    /// all, a shard's (then nothing is scored or ranked, and no MPC is run), or none, their
+    /// results given by the shards' parts.
+    pub share: Share<DynamicResult>,
 }
 
 /// One CV–MV pair and its relative gain.
@@ -126,6 +133,9 @@ pub struct PairingScreen {
     /// The model predictive controller asked for, judged on the same runs (its `score` relative
     /// to the best of all tested).
     pub mpc: Option<mpc::MpcAlternative>,
+    /// The structures tested dynamically, in task order (indices into `structures`).
+    #[serde(skip)]
+    pub tested: Vec<usize>,
 }
 
 /// The open plant: the loops on the CVs and MVs removed, its steady state and gains.
@@ -180,9 +190,12 @@ pub fn screen_pairings(plant: &Plant, request: &PairingRequest) -> Result<Pairin
             (!a.passed, a.rga_number).partial_cmp(&(!b.passed, b.rga_number)).unwrap_or(std::cmp::Ordering::Equal)
         });
     }
-    let duration =
-        if request.disturbances.is_empty() { None } else { Some(dynamic::test(&open, request, &mut structures)?) };
-    let mut mpc = request.mpc.as_ref().map(|m| mpc::screen_mpc(&open, request, m, duration)).transpose()?;
+    let (duration, tested) = match request.disturbances.is_empty() {
+        true => (None, Vec::new()),
+        false => dynamic::test(&open, request, &mut structures).map(|(d, t)| (Some(d), t))?,
+    };
+    let mpc_here = request.mpc.as_ref().filter(|_| !request.share.is_shard());
+    let mut mpc = mpc_here.map(|m| mpc::screen_mpc(&open, request, m, duration)).transpose()?;
     if let Some(d) = mpc.as_mut().and_then(|m| m.dynamic.as_mut()) {
         let mut all: Vec<&mut DynamicResult> = structures.iter_mut().filter_map(|s| s.dynamic.as_mut()).collect();
         all.push(d);
@@ -199,6 +212,7 @@ pub fn screen_pairings(plant: &Plant, request: &PairingRequest) -> Result<Pairin
         singular,
         structures,
         mpc,
+        tested,
     })
 }
 

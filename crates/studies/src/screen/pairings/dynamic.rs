@@ -7,13 +7,15 @@
 //! candidate is the mean over disturbances and CVs of its IAE over the best candidate's, so 1 is
 //! best everywhere; a failed run scores infinity. Candidates run in parallel (rayon); each is a pure
 //! function of the plant and the request, so the results do not depend on the thread count.
+//! They are also the tasks of a sharded screening (task `t` the `t`-th candidate tested,
+//! [`PairingRequest::share`]): each shard runs its own, a merge scores them all.
 
 use plantwide_analysis::figures::summary;
 use plantwide_flowsheet::{Plant, StructureEdit};
 use plantwide_solve::dynamic::{Start, simulate};
 use plantwide_solve::{NewtonSettings, steady_state};
 use rayon::prelude::*;
-use serde::Serialize;
+use serde::{Deserialize, Deserializer, Serialize};
 
 use super::{OpenPlant, PairingRequest, PairingStructure};
 use crate::screen::ScreenError;
@@ -58,7 +60,7 @@ impl Default for DynamicSettings {
 }
 
 /// A loop of a tested candidate, as tuned.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct TunedLoop {
     /// Controlled variable.
     pub cv: String,
@@ -66,27 +68,30 @@ pub struct TunedLoop {
     pub mv: String,
     /// Gain magnitude (SI).
     pub kc: f64,
-    /// Reset time \[s\].
+    /// Reset time \[s\] (infinite, written `null`, for a loop without integral action).
+    #[serde(deserialize_with = "infinite_if_null")]
     pub tau_i: f64,
     /// `direct` or `reverse`.
     pub action: String,
 }
 
 /// Figures of one CV in one run.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CvFigures {
     /// Controlled variable.
     pub cv: String,
-    /// Integral of the absolute error (SI unit × s).
+    /// Integral of the absolute error (SI unit × s; NaN, written `null`, when not recorded).
+    #[serde(deserialize_with = "nan_if_null")]
     pub iae: f64,
-    /// Largest deviation from the setpoint.
+    /// Largest deviation from the setpoint (NaN, written `null`, when not recorded).
+    #[serde(deserialize_with = "nan_if_null")]
     pub max_deviation: f64,
     /// Time from the step until it stays within 2 % of its excursion \[s\].
     pub settling_time: Option<f64>,
 }
 
 /// One disturbance run.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct DisturbanceRun {
     /// `path +x %`.
     pub disturbance: String,
@@ -103,7 +108,7 @@ pub struct DisturbanceRun {
 }
 
 /// A candidate's dynamic test.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct DynamicResult {
     /// BLT's detuning factor.
     pub detuning_factor: Option<f64>,
@@ -111,22 +116,63 @@ pub struct DynamicResult {
     pub loops: Vec<TunedLoop>,
     /// One run per disturbance.
     pub runs: Vec<DisturbanceRun>,
-    /// Mean IAE relative to the best candidate's (1 best; infinite when a run failed).
+    /// Mean IAE relative to the best candidate's (1 best; infinite, written `null`, when a run
+    /// failed or before the candidates are scored together).
+    #[serde(deserialize_with = "infinite_if_null")]
     pub score: f64,
     /// Why the test failed (tuning or a run), if it did.
     pub failure: Option<String>,
 }
 
+/// A candidate's dynamic test as the task of a sharded screening: the result and the records of
+/// its runs that plots need (which the result's JSON leaves out).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CandidateTask {
+    /// The result.
+    pub result: DynamicResult,
+    /// Each run's recorded times and CV series.
+    pub traces: Vec<(Vec<f64>, Vec<Vec<f64>>)>,
+}
+
+impl From<&DynamicResult> for CandidateTask {
+    fn from(r: &DynamicResult) -> Self {
+        let traces = r.runs.iter().map(|run| (run.times.clone(), run.series.clone())).collect();
+        CandidateTask { result: r.clone(), traces }
+    }
+}
+
+impl From<CandidateTask> for DynamicResult {
+    fn from(t: CandidateTask) -> Self {
+        let mut r = t.result;
+        for (run, (times, series)) in r.runs.iter_mut().zip(t.traces) {
+            (run.times, run.series) = (times, series);
+        }
+        r
+    }
+}
+
+/// A number written `null` (non-finite in JSON) read back as NaN.
+fn nan_if_null<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
+}
+
+/// A number written `null` read back as +∞ (a reset time without integral action, the score of
+/// a failed or unscored candidate).
+fn infinite_if_null<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::INFINITY))
+}
+
 /// Test the first `r.dynamic.candidates` structures that passed, in parallel, and score them; the
-/// length of the runs \[s\].
+/// length of the runs \[s\] and the structures tested, in task order.
 pub(super) fn test(
     open: &OpenPlant,
     r: &PairingRequest,
     structures: &mut [PairingStructure],
-) -> Result<f64, ScreenError> {
+) -> Result<(f64, Vec<usize>), ScreenError> {
     let picked: Vec<usize> =
         (0..structures.len()).filter(|&k| structures[k].passed).take(r.dynamic.candidates).collect();
-    test_picked(open, r, structures, picked, &Tuning::Blt)
+    let duration = test_picked(open, r, structures, picked.clone(), &Tuning::Blt)?;
+    Ok((duration, picked))
 }
 
 /// How a tested structure's loops are tuned.
@@ -153,26 +199,39 @@ pub(super) fn test_picked(
             _ => return Err(ScreenError::Disturbance { path: d.path.clone() }),
         }
     }
-    let tunings: Vec<TunedCandidate> = picked
-        .par_iter()
-        .map(|&k| match tuning {
-            Tuning::Blt => tuned_plant(open, r, &structures[k]),
-            Tuning::Given(loops) => given_plant(open, &structures[k], loops),
-        })
-        .collect();
+    let tune = |k: usize| match tuning {
+        Tuning::Blt => tuned_plant(open, r, &structures[k]),
+        Tuning::Given(loops) => given_plant(open, &structures[k], loops),
+    };
+    // The candidates this process runs (all, a shard's, or none when merging a sharded screening).
+    let tunings: Vec<Option<TunedCandidate>> =
+        picked.par_iter().enumerate().map(|(t, &k)| r.share.computes(t).then(|| tune(k))).collect();
     // One length for every run, so that IAEs compare: given, or 20 reset times of the best-ranked
-    // candidate that could be tuned.
-    let longest = tunings.iter().flatten().map(|(_, _, t)| t.tau_i_max).next().unwrap_or(0.0);
-    let duration = r.dynamic.duration.unwrap_or(20.0 * longest);
-    let results: Vec<DynamicResult> = picked
+    // candidate that could be tuned (tuned here when another process runs it).
+    let duration = match r.dynamic.duration {
+        Some(d) => d,
+        None => {
+            let tau = |t: usize| match &tunings[t] {
+                Some(tuned) => tuned.as_ref().ok().map(|c| c.2.tau_i_max),
+                None => tune(picked[t]).ok().map(|c| c.2.tau_i_max),
+            };
+            20.0 * (0..picked.len()).find_map(tau).unwrap_or(0.0)
+        }
+    };
+    let mut results: Vec<Option<DynamicResult>> = picked
         .par_iter()
         .zip(tunings)
-        .map(|(&k, tuned)| candidate(tuned, r, &pair_outputs(open, &structures[k]), duration))
+        .enumerate()
+        .map(|(t, (&k, tuned))| match tuned {
+            Some(tuned) => Some(candidate(tuned, r, &pair_outputs(open, &structures[k]), duration)),
+            None => r.share.given(t),
+        })
         .collect();
-    let mut results = results;
-    score(&mut results.iter_mut().collect::<Vec<_>>(), r.disturbances.len(), r.cvs.len());
+    if !r.share.is_shard() {
+        score(&mut results.iter_mut().flatten().collect::<Vec<_>>(), r.disturbances.len(), r.cvs.len());
+    }
     for (k, t) in picked.into_iter().zip(results) {
-        structures[k].dynamic = Some(t);
+        structures[k].dynamic = t;
     }
     Ok(duration)
 }
