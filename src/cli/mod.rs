@@ -29,6 +29,7 @@ mod run;
 mod run_plot;
 mod screen;
 mod sensitivity;
+mod serve;
 mod shown;
 mod size;
 mod steady;
@@ -173,6 +174,10 @@ enum Command {
     /// open or closed loop, measurement noise), FIR/ARX/OE fits validated on fresh data; the
     /// identified gains and RGA beside the exact linearization's.
     Identify(identify::IdentifyArgs),
+    /// The browser simulator: a local server running the plant live (the `run` integrator) with a
+    /// page of the flowsheet, trends, faceplates, clock controls, disturbances and snapshots, and
+    /// the JSON API the page uses.
+    Serve(serve::ServeArgs),
 }
 
 /// A failed command: message and exit code.
@@ -217,6 +222,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Size(a) => size::run(&a, cli.units.unwrap_or(UnitsArg::Si).into()),
         Command::Compare(a) => compare::run(&a, cli.units.unwrap_or(UnitsArg::Si).into()),
         Command::Identify(a) => identify::run(&a, cli.units.unwrap_or(UnitsArg::Si).into()),
+        Command::Serve(a) => serve::run(&a),
         Command::Schema { scenario } => {
             let schema = match scenario {
                 true => plantwide::flowsheet::schema::scenario_schema(),

@@ -29,6 +29,7 @@ mod plots;
 mod pressure;
 mod recycle;
 mod screen;
+mod serve;
 mod size;
 mod snowball;
 mod specs;
