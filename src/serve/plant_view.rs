@@ -55,9 +55,9 @@ fn depths(plant: &Plant) -> Vec<usize> {
     let n = plant.blocks().len();
     let mut depth = vec![usize::MAX; n];
     let mut queue = VecDeque::new();
-    for b in 0..n {
+    for (b, d) in depth.iter_mut().enumerate() {
         if plant.blocks()[b].kind == BlockKind::Unit && !plant.streams().iter().any(|s| s.to.0 == b) {
-            depth[b] = 0;
+            *d = 0;
             queue.push_back(b);
         }
     }
@@ -106,6 +106,7 @@ fn controller(plant: &Plant, b: usize) -> Value {
     json!({
         "name": name,
         "type": block.unit.type_name(),
+        "settings": settings(plant, name),
         "pv": pv,
         "pv_unit": pv_unit,
         "sp": sp.map(|i| plant.inputs()[i].path.clone()),
@@ -116,6 +117,19 @@ fn controller(plant: &Plant, b: usize) -> Value {
         "op_manual": input("op_manual").map(|i| plant.inputs()[i].path.clone()),
         "tuning": tuning,
     })
+}
+
+/// A controller's settings as the flowsheet writes them (gain, reset, action, limits): its
+/// description without what the faceplate shows live (measurement, output, setpoint).
+fn settings(plant: &Plant, name: &str) -> Value {
+    let Some(spec) = plant.spec().controllers.get(name) else { return json!({}) };
+    let mut v = serde_json::to_value(spec).unwrap_or_else(|_| json!({}));
+    if let Value::Object(m) = &mut v {
+        for k in ["type", "pv", "output", "outputs", "sp"] {
+            m.remove(k);
+        }
+    }
+    v
 }
 
 /// Every controller's measurement, setpoint and first output.

@@ -114,13 +114,10 @@ impl Sim {
             if next_tick < now {
                 next_tick = now;
             }
-            // Requests until the next tick; each command is published at once.
+            // Requests until the next tick; each command's effect is published at once.
             loop {
                 match rx.recv_timeout(next_tick.saturating_duration_since(Instant::now())) {
-                    Ok(req) => {
-                        self.handle(req);
-                        self.publish();
-                    }
+                    Ok(req) => self.handle(req),
                     Err(RecvTimeoutError::Timeout) => break,
                     Err(RecvTimeoutError::Disconnected) => return,
                 }
@@ -183,7 +180,10 @@ impl Sim {
     fn handle(&mut self, req: Request) {
         match req {
             Request::Command(c, reply) => {
-                let _ = reply.send(self.command(c));
+                let result = self.command(c);
+                // Published before the answer: a client reading the state after it sees the command.
+                self.publish();
+                let _ = reply.send(result);
             }
             Request::AtSync(reply) => {
                 let _ = reply.send(self.snapshot_at(self.live.sync_time()));

@@ -119,7 +119,7 @@ function drawFlowsheet(plant) {
     const home = pos[c.pv_unit] || pos[(c.drives[0] || {}).unit];
     if (!home) continue;
     const k = (count[home.u.name] = (count[home.u.name] || 0) + 1) - 1;
-    const cx = home.x + 90 + 30 * Math.floor(k / 4), cy = home.y + 18 + 44 * (k % 4);
+    const cx = home.x + 110 + 34 * Math.floor(k / 4), cy = home.y - 6 + 44 * (k % 4);
     const target = pos[(c.drives[0] || {}).unit];
     if (target) {
       el('line', { x1: cx, y1: cy, x2: target.x + 40, y2: target.y + target.h / 2, stroke: '#a33', 'stroke-dasharray': '3 3' }, svg);
@@ -166,6 +166,10 @@ function faceplate(c) {
   }
   const tune = document.createElement('div');
   tune.className = 'tune';
+  const settings = Object.entries(c.settings || {}).filter(([, v]) => typeof v !== 'object');
+  if (settings.length) {
+    tune.insertAdjacentHTML('beforeend', '<div>' + settings.map(([k, v]) => `${k} ${v}`).join(' · ') + '</div>');
+  }
   for (const p of c.tuning.slice(0, 4)) {
     const short = p.slice(c.name.length + 1);
     tune.insertAdjacentHTML('beforeend', `<div>${short} = <span data-path="${p}">—</span> <input data-set="${p}" placeholder="new"></div>`);
@@ -241,16 +245,18 @@ function drawTrend() {
     const x = L + ((W - L - R) * k) / 5, y = T + ((H - T - B) * k) / 5;
     ctx.beginPath(); ctx.moveTo(x, T); ctx.lineTo(x, H - B); ctx.stroke();
     ctx.beginPath(); ctx.moveTo(L, y); ctx.lineTo(W - R, y); ctx.stroke();
-    ctx.fillText(((t0 + ((t1 - t0) * k) / 5) / 60).toFixed(1), x - 10, H - 8);
+    ctx.fillText(((t0 + ((t1 - t0) * k) / 5) / 60).toFixed(1), Math.min(x - 10, W - R - 60), H - 8);
   }
-  ctx.fillText('min', W - R - 20, H - 8);
+  ctx.fillText('time [min]', W - R - 50, H - 8);
   const legend = $('legend');
   legend.innerHTML = '';
   live.pens.forEach((p, k) => {
     const pts = live.data[p] || [];
     let lo = Infinity, hi = -Infinity;
     for (const [, v] of pts) { lo = Math.min(lo, v); hi = Math.max(hi, v); }
-    if (!(hi > lo)) { const m = Math.abs(lo) * 1e-6 || 1e-9; lo -= m; hi += m; }
+    // A pen at rest is drawn flat: its scale spans at least 0.1 % of its value.
+    const span = Math.max(hi - lo, 1e-3 * Math.max(Math.abs(hi), Math.abs(lo)), 1e-12);
+    const mid = (hi + lo) / 2; lo = mid - span / 2; hi = mid + span / 2;
     const pad = 0.05 * (hi - lo); lo -= pad; hi += pad;
     ctx.strokeStyle = COLORS[k % COLORS.length]; ctx.lineWidth = 1.6; ctx.beginPath();
     pts.forEach(([t, v], i) => {
@@ -273,7 +279,7 @@ async function refreshState() {
   try {
     const s = await getJson('api/state');
     live.state = s;
-    $('clock').textContent = clockText(s.time) + '  ×' + s.speed;
+    $('clock').textContent = clockText(s.time) + '  ×' + s.speed + (s.pending ? '  (' + s.pending + ' command(s) at the next step)' : '');
     const st = $('status');
     st.textContent = s.failure ? 'STOPPED' : s.running ? (s.behind ? 'RUNNING (behind)' : 'RUNNING') : 'PAUSED';
     st.className = 'status' + (s.failure ? ' failed' : s.running ? '' : ' paused');
@@ -328,7 +334,9 @@ async function main() {
   drawFlowsheet(plant);
   const fps = $('faceplates');
   for (const c of plant.controllers) { fps.appendChild(faceplate(c)); bindFaceplate(c); }
-  live.pens = plant.trend.slice(0, MAX_PENS);
+  // `?pens=a,b` chooses the trend pens (default: every controller's measurement and setpoint).
+  const asked = new URLSearchParams(location.search).get('pens');
+  live.pens = (asked ? asked.split(',') : plant.trend).slice(0, MAX_PENS);
   bindControls();
   openStream();
   await refreshState();

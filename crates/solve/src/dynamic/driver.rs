@@ -172,6 +172,11 @@ impl Driver {
         })
     }
 
+    /// No budget of steps (a live run's duration is endless); before [`Driver::start`].
+    pub(super) fn endless(&mut self) {
+        self.bdf = Bdf::new(BdfSettings { max_steps: usize::MAX, ..bdf_settings(&self.sc) });
+    }
+
     /// The integrator's time \[s\]: the last step's end (a sync point).
     pub(super) fn t(&self) -> f64 {
         self.bdf.t()

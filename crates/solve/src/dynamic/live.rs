@@ -20,8 +20,8 @@ use std::collections::BTreeMap;
 use std::time::Instant;
 
 use plantwide_flowsheet::Plant;
-use plantwide_flowsheet::overrides::{check_input_value, set_input};
-use plantwide_flowsheet::scenario::{Action, Event, EventSpec, Scenario, ScenarioSpec, resolve};
+use plantwide_flowsheet::overrides::set_input;
+use plantwide_flowsheet::scenario::{Event, EventSpec, Scenario, ScenarioSpec, resolve};
 use plantwide_flowsheet::{Diagnostic, LoadError};
 use plantwide_model::controllers::Mode;
 use plantwide_units::QuantityValue;
@@ -93,7 +93,7 @@ struct Saved {
 pub struct Live {
     /// The caller's plant (commands are resolved against it).
     plant: Plant,
-    /// The scenario file's text as read, and its resolution with an endless duration.
+    /// The scenario as written (the journal extends it) and as resolved, with an endless duration.
     spec: ScenarioSpec,
     base: Scenario,
     fingerprint: String,
@@ -131,6 +131,7 @@ impl Live {
             spec.integrator.max_step = Some(QuantityValue::Number(LIVE_MAX_STEP));
         }
         let mut driver = Driver::new(plant, &base, Start::Steady(x0), fingerprint)?;
+        driver.endless();
         driver.start().map_err(|e| LiveError::Failed(failure(plant, RunError::Dae(e))))?;
         Ok(Live {
             plant: plant.clone(),
@@ -189,7 +190,6 @@ impl Live {
             PlantCommand::Event(e) => at_time(e, 0.0),
         };
         let events = self.resolve_one(&spec)?;
-        self.check_from_now(&events)?;
         let target = events.first().map(|e| e.action.target());
         self.pending.retain(|q| q.events.first().map(|e| e.action.target()) != target);
         self.pending.push(Queued { spec, events });
@@ -211,8 +211,13 @@ impl Live {
         Ok(())
     }
 
-    /// The events of one command at time 0, resolved as a file's would be.
+    /// The events of one command at time 0, resolved as a file's would be against the plant at
+    /// its inputs' values now (a change `by` an amount is checked from the live value).
     fn resolve_one(&self, e: &EventSpec) -> Result<Vec<Event>, LiveError> {
+        let t = self.driver.t();
+        let mut plant = self.plant.clone();
+        let now: Vec<f64> = (0..plant.inputs().len()).map(|i| self.driver.input_value(i, t)).collect();
+        plant.set_input_values(&now);
         let spec = ScenarioSpec {
             format_version: self.spec.format_version,
             name: String::new(),
@@ -225,29 +230,11 @@ impl Live {
             record: Default::default(),
             snapshots: Vec::new(),
         };
-        match resolve(&spec, &self.plant, "command") {
+        match resolve(&spec, &plant, "command") {
             Ok(sc) => Ok(sc.events),
             Err(LoadError::Invalid { diagnostics, .. }) => Err(LiveError::Refused(message(&diagnostics))),
             Err(e) => Err(LiveError::Refused(e.to_string())),
         }
-    }
-
-    /// A change `by` an amount, checked against the input's current value (the file check
-    /// follows the flowsheet's values, not the live ones).
-    fn check_from_now(&self, events: &[Event]) -> Result<(), LiveError> {
-        let t = self.driver.t();
-        for e in events {
-            if let Action::Step { input, change }
-            | Action::Ramp { input, change, .. }
-            | Action::Pulse { input, change } = e.action
-            {
-                let v = change.apply(self.driver.input_value(input, t));
-                check_input_value(&self.plant, input, v).map_err(|why| {
-                    LiveError::Refused(format!("takes `{}` to {why}", self.plant.inputs()[input].path))
-                })?;
-            }
-        }
-        Ok(())
     }
 
     /// Apply the queued commands at the sync point: each becomes a scenario event at its time.
@@ -360,6 +347,7 @@ impl Live {
         sc.events.extend(saved.journal.iter().flat_map(|q| q.events.iter().cloned()));
         sc.events.sort_by(|a, b| a.t.total_cmp(&b.t));
         let mut driver = Driver::new(&self.plant, &sc, Start::Snapshot(&saved.snapshot), &self.fingerprint)?;
+        driver.endless();
         driver.start().map_err(|e| LiveError::Failed(failure(&self.plant, RunError::Dae(e))))?;
         self.driver = driver;
         self.journal = saved.journal;
