@@ -24,7 +24,11 @@ pub fn describe(plant: &Plant, paths: &[String]) -> Value {
     let streams: Vec<Value> = plant
         .streams()
         .iter()
-        .map(|s| json!({ "name": s.name, "from": plant.blocks()[s.from.0].name, "to": plant.blocks()[s.to.0].name }))
+        .map(|s| {
+            let (from, to) = (&plant.blocks()[s.from.0], &plant.blocks()[s.to.0]);
+            json!({ "name": s.name, "from": from.name, "from_port": s.from.1, "from_ports": from.layout.n_outlets,
+                    "to": to.name, "to_port": s.to.1, "to_ports": to.layout.n_inlets })
+        })
         .collect();
     let controllers: Vec<Value> = (0..plant.blocks().len())
         .filter(|&b| plant.blocks()[b].kind == BlockKind::Controller)

@@ -107,7 +107,9 @@ function drawFlowsheet(plant) {
   for (const s of plant.streams) {
     const a = pos[s.from], b = pos[s.to];
     if (!a || !b) continue;
-    const x1 = a.x + 70, y1 = a.y + a.h / 2, x2 = b.x + 10, y2 = b.y + b.h / 2;
+    // Ports spread down the unit's side in their order (a column's distillate above its bottoms).
+    const port = (p, k, n) => p.y + (p.h * (k + 1)) / ((n || 1) + 1);
+    const x1 = a.x + 70, y1 = port(a, s.from_port, s.from_ports), x2 = b.x + 10, y2 = port(b, s.to_port, s.to_ports);
     const xm = (x1 + x2) / 2;
     const d = x2 > x1 ? `M${x1},${y1} H${xm} V${y2} H${x2}` : `M${x1},${y1} H${x1 + 15} V${Math.max(y1, y2) + 70} H${x2 - 15} V${y2} H${x2}`;
     el('path', { d, fill: 'none', stroke: '#223', 'stroke-width': 2, 'marker-end': 'url(#arrow)' }, svg);
@@ -126,7 +128,8 @@ function drawFlowsheet(plant) {
     }
     el('line', { x1: cx, y1: cy, x2: home.x + 60, y2: home.y + Math.min(home.h / 2, 20 + 44 * (k % 4)), stroke: '#36a', 'stroke-dasharray': '3 3' }, svg);
     el('circle', { cx, cy, r: 14, fill: '#fff', stroke: '#333', 'stroke-width': 1.5 }, svg);
-    el('text', { x: cx, y: cy + 4, 'text-anchor': 'middle', 'font-size': 8 }, svg, c.name.slice(0, 6));
+    el('text', { x: cx, y: cy + 3, 'text-anchor': 'middle', 'font-size': 7 }, svg, c.name.slice(0, 7));
+    el('title', {}, svg.lastChild, c.name);
     el('text', { x: cx + 17, y: cy + 4, 'font-size': 9, fill: '#06c', id: 'bubble-' + c.name }, svg, '');
   }
 }
@@ -245,9 +248,9 @@ function drawTrend() {
     const x = L + ((W - L - R) * k) / 5, y = T + ((H - T - B) * k) / 5;
     ctx.beginPath(); ctx.moveTo(x, T); ctx.lineTo(x, H - B); ctx.stroke();
     ctx.beginPath(); ctx.moveTo(L, y); ctx.lineTo(W - R, y); ctx.stroke();
-    ctx.fillText(((t0 + ((t1 - t0) * k) / 5) / 60).toFixed(1), Math.min(x - 10, W - R - 60), H - 8);
+    ctx.fillText(((t0 + ((t1 - t0) * k) / 5) / 60).toFixed(1), Math.min(x - 10, W - R - 40), H - 8);
   }
-  ctx.fillText('time [min]', W - R - 50, H - 8);
+  ctx.fillText('time [min]', W - R - 52, T + 10);
   const legend = $('legend');
   legend.innerHTML = '';
   live.pens.forEach((p, k) => {
