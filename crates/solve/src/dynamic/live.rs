@@ -478,3 +478,28 @@ impl Clock {
         self.w0 = now;
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use std::time::Duration;
+
+    use super::*;
+
+    #[test]
+    fn the_clock_runs_at_its_speed_stops_when_paused_and_never_jumps_back() {
+        let w0 = Instant::now();
+        let at = |s: f64| w0 + Duration::from_secs_f64(s);
+        let mut c = Clock::new(100.0, w0);
+        assert_eq!(c.shown(at(2.0)), 102.0);
+        c.set_speed(60.0, at(2.0)).expect("a valid speed");
+        assert_eq!(c.shown(at(3.0)), 162.0);
+        c.pause(at(3.0));
+        assert_eq!((c.shown(at(10.0)), c.running()), (162.0, false));
+        c.resume(at(10.0));
+        assert_eq!(c.shown(at(11.0)), 222.0);
+        for bad in [0.0, -1.0, f64::NAN, f64::INFINITY, 2.0 * Clock::MAX_SPEED] {
+            assert!(matches!(c.set_speed(bad, at(11.0)), Err(LiveError::Refused(_))), "{bad}");
+        }
+        assert_eq!(c.speed(), 60.0);
+    }
+}
