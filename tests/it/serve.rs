@@ -14,7 +14,7 @@ use plantwide::solve::dynamic::{Start, simulate};
 use plantwide::solve::{Method, StrategySettings, converge};
 use serde_json::{Value, json};
 
-use crate::harness::{command, fixture, flowsheet, plantwide};
+use crate::harness::{command, flowsheet, plantwide};
 
 /// A server process, killed when dropped (and stopping by itself after 15 min in any case).
 struct Server {
@@ -253,7 +253,7 @@ fn max_difference(plant: &plantwide::flowsheet::Plant, values: &Value, x: &[f64]
 
 #[test]
 fn a_live_feed_step_equals_the_scenario_run_and_settles_on_the_steady_state() {
-    let scenario = fixture("data/serve_column_a.json");
+    let scenario = flowsheet("scenarios/column_a_live.json");
     let s = Server::start(&flowsheet("column_a.json"), &["--scenario", &scenario, "--paused"]);
     for _ in 0..5 {
         s.ok(json!({"step": true}));
