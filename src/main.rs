@@ -2,6 +2,7 @@
 //! 2 numerical failure (no convergence).
 
 mod cli;
+mod serve;
 
 use plantwide as _;
 

@@ -30,6 +30,7 @@ mod run_plot;
 mod screen;
 mod sensitivity;
 mod shard;
+mod serve;
 mod shown;
 mod size;
 mod steady;
@@ -177,6 +178,10 @@ enum Command {
     /// Put together the part files of a job sharded with `--shard I/N` (sensitivity, screen) and
     /// finish it as the one-process run would: the same text, JSON, CSV, plots and report.
     Merge(shard::MergeArgs),
+    /// The browser simulator: a local server running the plant live (the `run` integrator) with a
+    /// page of the flowsheet, trends, faceplates, clock controls, disturbances and snapshots, and
+    /// the JSON API the page uses.
+    Serve(serve::ServeArgs),
 }
 
 /// A failed command: message and exit code.
@@ -222,6 +227,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Compare(a) => compare::run(&a, cli.units.unwrap_or(UnitsArg::Si).into()),
         Command::Identify(a) => identify::run(&a, cli.units.unwrap_or(UnitsArg::Si).into()),
         Command::Merge(a) => shard::run(&a),
+        Command::Serve(a) => serve::run(&a),
         Command::Schema { scenario } => {
             let schema = match scenario {
                 true => plantwide::flowsheet::schema::scenario_schema(),

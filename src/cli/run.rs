@@ -45,7 +45,7 @@ pub struct RunArgs {
 }
 
 /// FNV-1a hash of the flowsheet text and the overrides: identifies the plant in snapshots.
-fn fingerprint(text: &str, sets: &[String]) -> String {
+pub(super) fn fingerprint(text: &str, sets: &[String]) -> String {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
     for b in text.bytes().chain(sets.iter().flat_map(|s| std::iter::once(0u8).chain(s.bytes()))) {
         h = (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3);

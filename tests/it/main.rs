@@ -30,6 +30,7 @@ mod pressure;
 mod recycle;
 mod screen;
 mod shard;
+mod serve;
 mod size;
 mod snowball;
 mod specs;

@@ -331,6 +331,14 @@ pub enum Action {
     },
 }
 
+impl Action {
+    /// What the action changes: an input, or a controller's mode (by its `auto` input). Two
+    /// events at one time on one target would let their order decide the result.
+    pub fn target(&self) -> usize {
+        target(self)
+    }
+}
+
 /// An event at a time.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Event {

@@ -26,7 +26,8 @@
 //! restarts at order 1 from consistent algebraic variables.
 //!
 //! Layout: `waveform` (input waveforms), `adapter` (the DAE over the plant and the quadratures of
-//! the integrated streams), `driver` (the event driver), `snapshot` (the snapshot format),
+//! the integrated streams), `driver` (the event driver), `live` (the driver advanced by an
+//! interactive clock, commands applied as events), `snapshot` (the snapshot format),
 //! [`conservation`] (the material balance checked at the end); this file is the public face.
 
 use serde::Serialize;
@@ -39,12 +40,14 @@ use crate::dae::{BdfStats, DaeError};
 mod adapter;
 pub mod conservation;
 mod driver;
+mod live;
 mod mpc;
 mod session;
 mod snapshot;
 mod waveform;
 
 pub use conservation::{CONSERVATION_TOL, Conservation, ConservationError};
+pub use live::{Clock, LIVE_MAX_STEP, Live, LiveError, MAX_SNAPSHOTS, PlantCommand};
 pub use mpc::{MpcError, MpcLog, StepModelFile, mv_limits};
 pub use session::{Session, SessionError};
 pub use snapshot::{DriverState, SNAPSHOT_VERSION, Snapshot};

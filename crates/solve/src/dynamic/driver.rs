@@ -7,7 +7,7 @@
 //! analyzer's controller reads a held copy of its measurement ([`Plant::hold_measurement`]), and a
 //! stuck valve's input is held at its last value ([`Plant::hold_input`]).
 
-use plantwide_flowsheet::scenario::{Action, Scenario};
+use plantwide_flowsheet::scenario::{Action, Event, Scenario};
 use plantwide_flowsheet::{Plant, Read};
 
 use super::adapter::{DaeShape, PlantDae, Quadratures};
@@ -18,10 +18,11 @@ use super::{Column, Conservation, Progress, SimError, SimulationResult, Start, c
 use crate::dae::{Bdf, BdfSettings, BdfState, DaeError, DaeIntegrator};
 
 /// One run in progress.
-pub(super) struct Driver<'p> {
+pub(super) struct Driver {
     /// The caller's plant, rewired for this run.
     plant: Plant,
-    sc: &'p Scenario,
+    /// The scenario (its own copy: a live run adds events to it as commands arrive).
+    sc: Scenario,
     st: DriverState,
     bdf: Bdf,
     fingerprint: String,
@@ -104,15 +105,10 @@ fn bdf_settings(sc: &Scenario) -> BdfSettings {
     }
 }
 
-impl<'p> Driver<'p> {
+impl Driver {
     /// A run of `sc` on a copy of `plant` from `start`; `fingerprint` identifies the plant
     /// description in snapshots.
-    pub(super) fn new(
-        plant: &Plant,
-        sc: &'p Scenario,
-        start: Start<'_>,
-        fingerprint: &str,
-    ) -> Result<Driver<'p>, SimError> {
+    pub(super) fn new(plant: &Plant, sc: &Scenario, start: Start<'_>, fingerprint: &str) -> Result<Driver, SimError> {
         let quad = Quadratures::new(plant, &sc.totals);
         let x0 = initial_state(plant, &quad, start);
         let mpcs = mpc::build_all(plant, &x0[..plant.n_vars()]).map_err(|e| SimError::Mpc {
@@ -156,7 +152,7 @@ impl<'p> Driver<'p> {
         Ok(Driver {
             shape,
             plant,
-            sc,
+            sc: sc.clone(),
             st,
             bdf: Bdf::new(bdf_settings(sc)),
             fingerprint: fingerprint.to_string(),
@@ -176,8 +172,65 @@ impl<'p> Driver<'p> {
         })
     }
 
-    fn t(&self) -> f64 {
+    /// No budget of steps (a live run's duration is endless); before [`Driver::start`].
+    pub(super) fn endless(&mut self) {
+        self.bdf = Bdf::new(BdfSettings { max_steps: usize::MAX, ..bdf_settings(&self.sc) });
+    }
+
+    /// The integrator's time \[s\]: the last step's end (a sync point).
+    pub(super) fn t(&self) -> f64 {
         self.bdf.t()
+    }
+
+    /// The state at the last sync point (plant variables, then totals).
+    pub(super) fn x(&self) -> &[f64] {
+        self.bdf.x()
+    }
+
+    /// The state at `t` (within the last step) interpolated by the BDF polynomial into `out`.
+    pub(super) fn interpolate(&self, t: f64, out: &mut [f64]) {
+        let t = t.clamp(self.bdf.t_prev().min(self.bdf.t()), self.bdf.t());
+        if t == self.bdf.t() {
+            out.copy_from_slice(self.bdf.x());
+        } else {
+            self.bdf.interpolate(t, out);
+        }
+    }
+
+    /// The value of input `i` at `t` (SI).
+    pub(super) fn input_value(&self, i: usize, t: f64) -> f64 {
+        self.st.waveforms[i].at(t)
+    }
+
+    /// Add `events` (none before the integrator's time) to the scenario, each after the events
+    /// at or before its time: where a file listing them last would sort them.
+    pub(super) fn insert_events(&mut self, events: &[Event]) {
+        for e in events {
+            let tail = &self.sc.events[self.st.next_event..];
+            let at = self.st.next_event + tail.iter().take_while(|f| f.t <= e.t).count();
+            self.sc.events.insert(at, e.clone());
+        }
+    }
+
+    /// Drop the rows recorded so far (a live run hands out values itself and keeps no history).
+    pub(super) fn forget_records(&mut self) {
+        self.times.clear();
+        self.rows.clear();
+        self.ref_rows.clear();
+        self.events.clear();
+    }
+
+    /// Everything needed to continue the run from here.
+    pub(super) fn snapshot(&self) -> Snapshot {
+        Snapshot {
+            format_version: SNAPSHOT_VERSION,
+            fingerprint: self.fingerprint.clone(),
+            t: self.bdf.t(),
+            paths: self.quad.state_paths(&self.plant),
+            inputs: self.plant.inputs().iter().map(|i| i.path.clone()).collect(),
+            driver: self.st.clone(),
+            integrator: self.bdf.state().clone(),
+        }
     }
 
     /// The earliest discrete time after `t`.
@@ -202,7 +255,7 @@ impl<'p> Driver<'p> {
     }
 
     fn push_row(&mut self, t: f64, x: &[f64]) {
-        let (row, refs) = row_at(&self.plant, self.sc, &self.refs, &self.st.waveforms, t, x);
+        let (row, refs) = row_at(&self.plant, &self.sc, &self.refs, &self.st.waveforms, t, x);
         self.times.push(t);
         self.rows.push(row);
         self.ref_rows.push(refs);
@@ -243,12 +296,12 @@ impl<'p> Driver<'p> {
     /// Apply the scenario events due at `t` (a row just before the first); true if any was.
     fn apply_events(&mut self, t: f64, x: &[f64]) -> bool {
         let mut scenario_event = false;
-        while let Some(e) = self.sc.events.get(self.st.next_event).filter(|e| e.t <= t) {
+        while let Some(e) = self.sc.events.get(self.st.next_event).filter(|e| e.t <= t).cloned() {
             if !scenario_event && self.times.last() != Some(&t) {
                 self.push_row(t, x);
             }
             scenario_event = true;
-            let (action, origin) = (e.action.clone(), e.origin.clone());
+            let (action, origin) = (e.action, e.origin);
             self.apply(&action, t, x);
             self.events.push((t, origin));
             self.st.next_event += 1;
@@ -350,7 +403,7 @@ impl<'p> Driver<'p> {
 
     /// Start the integrator: restore a snapshot's history, or record the start, apply what is
     /// due at it and make one consistent start. Returns the state.
-    fn start(&mut self) -> Result<Vec<f64>, DaeError> {
+    pub(super) fn start(&mut self) -> Result<Vec<f64>, DaeError> {
         let mut x = self.x0.clone();
         if let Some(state) = self.restore.take() {
             let sys = PlantDae::new(&self.plant, &self.st.waveforms, &self.shape);
@@ -376,31 +429,35 @@ impl<'p> Driver<'p> {
 
     /// Run to the scenario's end, reporting steps and snapshots to `observer`.
     pub(super) fn run(&mut self, observer: &mut dyn FnMut(Progress<'_>)) -> Result<(), RunError> {
-        let mut x = self.start()?;
-        loop {
-            if let Some(e) = self.failure.take() {
-                return Err(RunError::Mpc(e));
-            }
-            let t = self.t();
-            x.copy_from_slice(self.bdf.x());
-            self.restart_after_due(t, &mut x)?;
-            if let Some(e) = self.failure.take() {
-                return Err(RunError::Mpc(e));
-            }
-            if t >= self.sc.duration {
-                return Ok(());
-            }
-            let t_stop = self.next_stop(t);
-            let mut xi = vec![0.0; x.len()];
-            while self.bdf.t() < t_stop {
-                let sys = PlantDae::new(&self.plant, &self.st.waveforms, &self.shape);
-                self.bdf.step(&sys, t_stop)?;
-                let now = self.bdf.t();
-                self.record_through(now, &mut xi);
-                self.offer_snapshots(now, observer);
-                observer(Progress::Step { t: now, duration: self.sc.duration });
-            }
+        self.start()?;
+        while self.step_once(observer)? {}
+        Ok(())
+    }
+
+    /// Apply what is due at the integrator's time (restarting it if an input changed), then take
+    /// one step towards the next discrete time; false once the run's end is reached. Taking the
+    /// steps one call at a time changes nothing: with nothing due, the application is a no-op.
+    pub(super) fn step_once(&mut self, observer: &mut dyn FnMut(Progress<'_>)) -> Result<bool, RunError> {
+        if let Some(e) = self.failure.take() {
+            return Err(RunError::Mpc(e));
         }
+        let t = self.t();
+        let mut x = self.bdf.x().to_vec();
+        self.restart_after_due(t, &mut x)?;
+        if let Some(e) = self.failure.take() {
+            return Err(RunError::Mpc(e));
+        }
+        if t >= self.sc.duration {
+            return Ok(false);
+        }
+        let t_stop = self.next_stop(t);
+        let sys = PlantDae::new(&self.plant, &self.st.waveforms, &self.shape);
+        self.bdf.step(&sys, t_stop)?;
+        let now = self.bdf.t();
+        self.record_through(now, &mut x);
+        self.offer_snapshots(now, observer);
+        observer(Progress::Step { t: now, duration: self.sc.duration });
+        Ok(true)
     }
 
     /// Record every row due by `now` (and by the end), interpolated within the last step.
@@ -415,7 +472,7 @@ impl<'p> Driver<'p> {
             } else {
                 self.bdf.interpolate(tr, xi);
             }
-            let (row, refs) = row_at(&self.plant, self.sc, &self.refs, &self.st.waveforms, tr, xi);
+            let (row, refs) = row_at(&self.plant, &self.sc, &self.refs, &self.st.waveforms, tr, xi);
             self.times.push(tr);
             self.rows.push(row);
             self.ref_rows.push(refs);
@@ -428,15 +485,7 @@ impl<'p> Driver<'p> {
         for k in 0..self.sc.snapshots.len() {
             if !self.st.snapshots_done[k] && self.sc.snapshots[k].0 <= now {
                 self.st.snapshots_done[k] = true;
-                let snap = Snapshot {
-                    format_version: SNAPSHOT_VERSION,
-                    fingerprint: self.fingerprint.clone(),
-                    t: now,
-                    paths: self.quad.state_paths(&self.plant),
-                    inputs: self.plant.inputs().iter().map(|i| i.path.clone()).collect(),
-                    driver: self.st.clone(),
-                    integrator: self.bdf.state().clone(),
-                };
+                let snap = self.snapshot();
                 observer(Progress::Snapshot { file: &self.sc.snapshots[k].1, snapshot: &snap });
             }
         }

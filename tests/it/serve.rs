@@ -1,0 +1,307 @@
+//! `plantwide serve`: the server started on a loopback address and an ephemeral port, driven
+//! over HTTP (a raw `TcpStream` client): every command and every bad input, the token beyond
+//! 127.0.0.1, the rate limit, the trend stream; and on column A a live feed step that equals the
+//! scenario-file run of the same event and settles on the steady state `steady --set` gives.
+
+use std::io::{BufRead, BufReader, Read, Write};
+use std::net::TcpStream;
+use std::process::{Child, Stdio};
+use std::time::{Duration, Instant};
+
+use plantwide::flowsheet::scenario::{ScenarioSpec, resolve};
+use plantwide::flowsheet::{Override, load_with};
+use plantwide::solve::dynamic::{Start, simulate};
+use plantwide::solve::{Method, StrategySettings, converge};
+use serde_json::{Value, json};
+
+use crate::harness::{command, flowsheet, plantwide};
+
+/// A server process, killed when dropped (and stopping by itself after 15 min in any case).
+struct Server {
+    child: Child,
+    addr: String,
+    token: Option<String>,
+}
+
+impl Server {
+    fn start(file: &str, extra: &[&str]) -> Server {
+        let mut child = command()
+            .args(["serve", file, "--port", "0", "--exit-after", "900"])
+            .args(extra)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::null())
+            .spawn()
+            .expect("plantwide serve starts");
+        let mut out = BufReader::new(child.stdout.take().expect("stdout"));
+        let (mut addr, mut token) = (None, None);
+        let mut line = String::new();
+        while addr.is_none() || (extra.contains(&"--bind") && token.is_none()) {
+            line.clear();
+            assert!(out.read_line(&mut line).expect("reads stdout") > 0, "the server ended before listening");
+            if let Some(rest) = line.split("http://").nth(1) {
+                addr = Some(rest.split('/').next().expect("host:port").to_string());
+            }
+            if let Some(t) = line.trim().strip_prefix("token: ") {
+                token = Some(t.to_string());
+            }
+        }
+        Server { child, addr: addr.expect("address"), token }
+    }
+
+    /// One request; the status and the body.
+    fn request(&self, method: &str, path: &str, body: &str, auth: bool) -> (u16, String) {
+        let mut s = TcpStream::connect(&self.addr).expect("connects");
+        s.set_read_timeout(Some(Duration::from_secs(60))).expect("timeout");
+        let bearer = match (&self.token, auth) {
+            (Some(t), true) => format!("Authorization: Bearer {t}\r\n"),
+            _ => String::new(),
+        };
+        let head = format!(
+            "{method} {path} HTTP/1.1\r\nHost: {}\r\nConnection: close\r\n{bearer}Content-Type: application/json\r\nContent-Length: {}\r\n\r\n",
+            self.addr,
+            body.len()
+        );
+        s.write_all(head.as_bytes()).and_then(|()| s.write_all(body.as_bytes())).expect("writes");
+        let mut text = String::new();
+        s.read_to_string(&mut text).expect("reads the response");
+        let status = text.split(' ').nth(1).and_then(|c| c.parse().ok()).expect("a status line");
+        let body = text.split_once("\r\n\r\n").map(|(_, b)| b.to_string()).unwrap_or_default();
+        (status, body)
+    }
+
+    fn get(&self, path: &str) -> Value {
+        let (status, body) = self.request("GET", path, "", true);
+        assert_eq!(status, 200, "GET {path}: {body}");
+        serde_json::from_str(&body).unwrap_or_else(|e| panic!("GET {path}: {e}: {body}"))
+    }
+
+    /// POST a command; the status and the JSON answer.
+    fn command(&self, cmd: &str) -> (u16, Value) {
+        let (status, body) = self.request("POST", "/api/command", cmd, true);
+        (status, serde_json::from_str(&body).unwrap_or_else(|e| panic!("{cmd}: {e}: {body}")))
+    }
+
+    fn ok(&self, cmd: Value) -> Value {
+        let (status, v) = self.command(&cmd.to_string());
+        assert_eq!(status, 200, "{cmd}: {v}");
+        v
+    }
+}
+
+impl Drop for Server {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+/// A command refused with HTTP 400 whose message holds `needle`.
+fn refused(s: &Server, cmd: &str, needle: &str) {
+    let (status, v) = s.command(cmd);
+    assert_eq!(status, 400, "{cmd}: {v}");
+    let msg = v["error"].as_str().expect("an error message");
+    assert!(msg.contains(needle), "{cmd}: `{msg}` does not mention `{needle}`");
+}
+
+#[test]
+fn serve_applies_every_command_and_refuses_every_bad_input_with_400() {
+    let s = Server::start(&flowsheet("column_a.json"), &["--paused"]);
+    let st = s.get("/api/state");
+    assert_eq!(st["time"], json!(0.0));
+    assert_eq!(st["running"], json!(false));
+    // `values` holds every path `steady --json` lists.
+    let out = plantwide(&["steady", &flowsheet("column_a.json"), "--json"]);
+    let steady: Value = serde_json::from_slice(&out.stdout).expect("steady --json");
+    let keys = |v: &Value| v.as_object().expect("object").keys().cloned().collect::<Vec<_>>();
+    assert_eq!(keys(&st["values"]), keys(&steady["values"]));
+
+    s.ok(json!({"set": {"feed_source.F": "1.005 kmol/min"}}));
+    s.ok(json!({"set": {"condenser_level.sp": "0.55 kmol", "zF": "0.51"}}));
+    s.ok(json!({"speed": 100}));
+    s.ok(json!({"resume": true}));
+    s.ok(json!({"pause": true}));
+    s.ok(json!({"step": true}));
+    s.ok(json!({"mode": {"reboiler_level": "manual"}}));
+    s.ok(json!({"mode": {"reboiler_level": "auto"}}));
+    s.ok(json!({"event": {"type": "ramp", "path": "column.reflux", "by": "0.01 kmol/min", "duration": "5 min"}}));
+    s.ok(json!({"event": {"type": "pulse", "path": "column.boilup", "to": "3.3 kmol/min", "width": "1 min"}}));
+    s.ok(json!({"snapshot": "before"}));
+    s.ok(json!({"step": true}));
+    let t_step = s.get("/api/state")["time"].as_f64().expect("time");
+    assert!(t_step > 0.0, "the steps moved the clock");
+    s.ok(json!({"load": "before"}));
+    assert!(s.get("/api/state")["time"].as_f64().expect("time") < t_step, "load went back");
+    assert_eq!(s.get("/api/snapshots"), json!(["before"]));
+
+    refused(&s, r#"{"set": {"feed_source.Q": "1 kmol/min"}}"#, "no input `feed_source.Q`");
+    refused(&s, r#"{"set": {"nowhere.F": "1 kmol/min"}}"#, "no input `nowhere.F`");
+    refused(&s, r#"{"set": {"feed_source.F": "1 kPa"}}"#, "feed_source.F");
+    refused(&s, r#"{"set": {"feed_source.F": "1 furlong"}}"#, "feed_source.F");
+    refused(&s, r#"{"set": {"feed_source.F": "-1 kmol/min"}}"#, "feed_source.F=-1 kmol/min");
+    refused(&s, r#"{"set": {"feed_source.F": "fast"}}"#, "feed_source.F");
+    refused(&s, r#"{"set": {"column.distillate": "0.5 kmol/min"}}"#, "driven by a controller");
+    refused(&s, r#"{"set": {"feed_source.F": 1.0}}"#, "give a string");
+    refused(&s, r#"{"set": {}}"#, "empty");
+    refused(&s, r#"{"set": "feed_source.F=1"}"#, "give an object");
+    refused(&s, r#"{"mode": {"condenser_level": "cascade"}}"#, "give \"auto\" or \"manual\"");
+    refused(&s, r#"{"mode": {"no_such_loop": "manual"}}"#, "no controller `no_such_loop`");
+    refused(&s, r#"{"speed": 0}"#, "speed 0");
+    refused(&s, r#"{"speed": -5}"#, "speed -5");
+    refused(&s, r#"{"speed": 1e9}"#, "at most");
+    refused(&s, r#"{"speed": "fast"}"#, "give a number");
+    refused(&s, r#"{"pause": false}"#, "pause: give true");
+    refused(&s, r#"{"resume": 1}"#, "resume: give true");
+    refused(&s, r#"{"step": "yes"}"#, "step: give true");
+    refused(&s, r#"{"snapshot": "../etc/passwd"}"#, "snapshot name");
+    refused(&s, r#"{"snapshot": 3}"#, "give a name");
+    refused(&s, r#"{"load": "never_saved"}"#, "no snapshot named `never_saved`");
+    refused(&s, r#"{"event": {"type": "explode", "path": "feed_source.F"}}"#, "event:");
+    refused(&s, r#"{"event": {"type": "feed_lost", "unit": "column"}}"#, "no feed unit `column`");
+    refused(
+        &s,
+        r#"{"event": {"type": "step", "path": "feed_source.F", "by": "-2 kmol/min"}}"#,
+        "takes `feed_source.F`",
+    );
+    refused(&s, r#"{"launch": true}"#, "unknown command `launch`");
+    refused(&s, r#"{"pause": true, "resume": true}"#, "exactly one");
+    refused(&s, r#"[1, 2]"#, "one JSON object");
+    refused(&s, r#"{"set": "#, "malformed JSON");
+    let (status, _) = s.request("POST", "/api/command", &format!("{{\"snapshot\": \"{}\"}}", "x".repeat(20_000)), true);
+    assert_eq!(status, 413, "a body over the limit");
+    let (status, _) = s.request("GET", "/api/state?at=yesterday", "", true);
+    assert_eq!(status, 400);
+    let (status, body) = s.request("GET", "/api/stream?paths=no.such.path", "", true);
+    assert_eq!((status, body.contains("no path `no.such.path`")), (400, true));
+
+    // The run goes on: commands still apply, the clock still steps.
+    let st = s.get("/api/state");
+    assert!(st["failure"].is_null(), "{}", st["failure"]);
+    s.ok(json!({"step": true}));
+    assert!(s.get("/api/state")["time"].as_f64().expect("time") > st["time"].as_f64().expect("time"));
+    // The page and its assets.
+    let (status, page) = s.request("GET", "/", "", false);
+    assert!(status == 200 && page.contains("faceplates"), "{status}");
+    assert_eq!(s.request("GET", "/app.js", "", false).0, 200);
+}
+
+/// Read the trend stream until `n` samples arrived; the paths event and the samples.
+fn stream_samples(s: &Server, paths: &str, n: usize) -> (Value, Vec<Value>) {
+    let mut sock = TcpStream::connect(&s.addr).expect("connects");
+    sock.set_read_timeout(Some(Duration::from_secs(30))).expect("timeout");
+    write!(sock, "GET /api/stream?paths={paths} HTTP/1.1\r\nHost: x\r\n\r\n").expect("writes");
+    let mut r = BufReader::new(sock);
+    let (mut head, mut samples, mut event) = (Value::Null, Vec::new(), String::new());
+    let mut line = String::new();
+    while samples.len() < n {
+        line.clear();
+        assert!(r.read_line(&mut line).expect("reads") > 0, "the stream ended");
+        if let Some(e) = line.strip_prefix("event: ") {
+            event = e.trim().to_string();
+        } else if let Some(d) = line.strip_prefix("data: ") {
+            let v: Value = serde_json::from_str(d.trim()).expect("JSON data");
+            if event == "paths" {
+                head = v
+            } else {
+                samples.push(v)
+            }
+            event.clear();
+        }
+    }
+    (head, samples)
+}
+
+#[test]
+fn serve_streams_trend_samples_to_several_clients() {
+    let s = Server::start(&flowsheet("column_a.json"), &["--speed", "60"]);
+    let a = std::thread::scope(|sc| {
+        let one = sc.spawn(|| stream_samples(&s, "column.M[41],bottoms.x[light]", 3));
+        let two = stream_samples(&s, "condenser_level.sp", 3);
+        assert_eq!(two.0, json!(["condenser_level.sp"]));
+        one.join().expect("first client")
+    });
+    assert_eq!(a.0, json!(["column.M[41]", "bottoms.x[light]"]));
+    let t: Vec<f64> = a.1.iter().map(|v| v["t"].as_f64().expect("t")).collect();
+    assert!(t.windows(2).all(|w| w[1] >= w[0]) && t[2] > t[0], "time runs: {t:?}");
+    assert_eq!(a.1[0]["v"].as_array().expect("values").len(), 2);
+}
+
+#[test]
+fn serve_beyond_127_0_0_1_asks_for_the_token_and_limits_the_rate() {
+    let s = Server::start(&flowsheet("column_a.json"), &["--bind", "127.0.0.2", "--paused", "--rate", "5"]);
+    let token = s.token.clone().expect("a token printed at start");
+    assert_eq!(token.len(), 32);
+    let (status, body) = s.request("GET", "/api/state", "", false);
+    assert_eq!(status, 401, "{body}");
+    assert!(body.contains("token"), "{body}");
+    assert_eq!(s.request("POST", "/api/command", r#"{"resume": true}"#, false).0, 401);
+    assert_eq!(s.request("GET", &format!("/api/state?token={token}"), "", false).0, 200);
+    assert_eq!(s.request("GET", "/api/state?token=0123456789abcdef0123456789abcdef", "", false).0, 401);
+    // 5 per second, 10 in a burst: 30 at once meet 429s.
+    let statuses: Vec<u16> = (0..30).map(|_| s.request("GET", "/api/state", "", true).0).collect();
+    assert!(statuses.contains(&200) && statuses.contains(&429), "{statuses:?}");
+}
+
+/// The largest difference between the live values and a state vector, over the plant variables.
+fn max_difference(plant: &plantwide::flowsheet::Plant, values: &Value, x: &[f64]) -> f64 {
+    plant
+        .vars()
+        .iter()
+        .zip(x)
+        .map(|(v, xv)| (values[&v.path].as_f64().expect("a value") - xv).abs())
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn a_live_feed_step_equals_the_scenario_run_and_settles_on_the_steady_state() {
+    let scenario = flowsheet("scenarios/column_a_live.json");
+    let s = Server::start(&flowsheet("column_a.json"), &["--scenario", &scenario, "--paused"]);
+    for _ in 0..5 {
+        s.ok(json!({"step": true}));
+    }
+    let at = s.ok(json!({"set": {"feed_source.F": "1.01 kmol/min"}}))["at"].as_f64().expect("at");
+    assert!(at > 0.0);
+    s.ok(json!({"speed": 1e6}));
+    s.ok(json!({"resume": true}));
+    let started = Instant::now();
+    while s.get("/api/state")["time"].as_f64().expect("time") < 3000.0 * 60.0 {
+        assert!(started.elapsed() < Duration::from_secs(300), "the live run reaches 3000 min");
+        std::thread::sleep(Duration::from_millis(200));
+    }
+    s.ok(json!({"pause": true}));
+    // Pause stops the clock.
+    let (a, b) = (s.get("/api/state"), {
+        std::thread::sleep(Duration::from_millis(700));
+        s.get("/api/state")
+    });
+    assert_eq!(a["time"], b["time"]);
+    assert_eq!(a["running"], json!(false));
+    let live = s.get("/api/state?at=sync");
+    let journal: ScenarioSpec = serde_json::from_value(s.get("/api/journal")).expect("a scenario");
+    assert_eq!(journal.events.len(), 1);
+
+    // The same event in a scenario file, run by the library as `run` runs it.
+    let plant = load_with(std::path::Path::new(&flowsheet("column_a.json")), &[]).expect("loads");
+    let settings = StrategySettings { method: Method::Auto, ..StrategySettings::default() };
+    let x0 = converge(&plant, &settings).expect("converges").x;
+    let sc = resolve(&journal, &plant, "journal").expect("the journal resolves");
+    let res = simulate(&plant, &sc, Start::Steady(&x0), "test", &mut |_| {}).expect("runs");
+    assert_eq!(res.t, live["time"].as_f64().expect("time"));
+    let diff = max_difference(&plant, &live["values"], &res.x);
+    eprintln!("live vs scenario file at t = {} s: max |Δx| = {diff:.3e}", res.t);
+    assert!(diff <= 1e-10, "live and scenario-file runs differ by {diff:e}");
+
+    // And the steady state of the stepped plant.
+    let stepped = load_with(
+        std::path::Path::new(&flowsheet("column_a.json")),
+        &[Override::new("feed_source.F", "1.01 kmol/min")],
+    )
+    .expect("loads");
+    let ss = converge(&stepped, &settings).expect("converges");
+    let xb = stepped.var("bottoms.x[light]").expect("xB");
+    let (live_xb, steady_xb) = (live["values"]["bottoms.x[light]"].as_f64().expect("xB"), ss.x[xb]);
+    eprintln!(
+        "xB live at 3000 min {live_xb:.10}, steady --set {steady_xb:.10}, |Δ| = {:.3e}",
+        (live_xb - steady_xb).abs()
+    );
+    assert!((live_xb - steady_xb).abs() <= 1e-6 * steady_xb, "xB {live_xb} against the steady state {steady_xb}");
+}
