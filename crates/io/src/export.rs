@@ -13,38 +13,43 @@
 //! m = jsondecode(fileread('model.json'));  sys = ss(m.A, m.B, m.C, m.D);   % dcgain(sys)
 //! ```
 
-use faer::{Mat, c64};
+use faer::Mat;
 use serde::Serialize;
 
-use plantwide_analysis::linear::StateSpace;
 use plantwide_analysis::measures::rows;
+use plantwide_analysis::plant_model::PlantModel;
 use plantwide_analysis::select::Signal;
 
-/// A state-space model with its labels, ready to serialize.
+/// A plant's linear model with its labels, ready to serialize.
 #[derive(Debug, Clone)]
 pub struct ModelExport<'a> {
     /// Flowsheet name.
     pub name: &'a str,
-    /// The model (SI: per second, inputs and outputs in SI).
-    pub model: &'a StateSpace,
-    /// State paths (one per row of `A`).
-    pub states: Vec<String>,
-    /// Steady-state values of the states (SI).
-    pub state_values: Vec<f64>,
+    /// The model, its steady values, eigenvalues and frequency response (SI; `G(jω)` in display
+    /// units).
+    pub model: &'a PlantModel,
     /// Inputs with display units.
     pub inputs: &'a [Signal],
-    /// Steady-state input values (SI).
-    pub input_values: Vec<f64>,
     /// Outputs with display units.
     pub outputs: &'a [Signal],
-    /// Steady-state output values (SI).
-    pub output_values: Vec<f64>,
     /// Time unit name and its length in seconds.
     pub time_unit: (&'a str, f64),
-    /// Eigenvalues of `A` [1/s].
-    pub eigenvalues: &'a [c64],
-    /// Frequency response `(ω [rad/s], G(jω) in display units)`.
-    pub frequency_response: &'a [(f64, Mat<c64>)],
+}
+
+/// `A, B, C, D` and the steady-state gain as row arrays: `A` and `B` per time unit, inputs and
+/// outputs in their display units, states in SI.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Matrices {
+    /// State matrix.
+    pub a: Vec<Vec<f64>>,
+    /// Input matrix.
+    pub b: Vec<Vec<f64>>,
+    /// Output matrix.
+    pub c: Vec<Vec<f64>>,
+    /// Feedthrough matrix.
+    pub d: Vec<Vec<f64>>,
+    /// `D − C A⁻¹ B` (`None` when `A` is singular: an integrating mode).
+    pub steady_state_gain: Option<Vec<Vec<f64>>>,
 }
 
 #[derive(Serialize)]
@@ -97,15 +102,29 @@ struct Document<'a> {
 }
 
 impl ModelExport<'_> {
-    /// The JSON document, pretty-printed with every matrix row on one line.
-    pub fn to_json_string(&self) -> String {
-        let (tu, ts) = self.time_unit;
-        let m = self.model;
+    /// The matrices in the export's units.
+    pub fn matrices(&self) -> Matrices {
+        let ts = self.time_unit.1;
+        let m = &self.model.model;
         let (fi, fo) = (|j: usize| self.inputs[j].factor, |i: usize| self.outputs[i].factor);
         // Per time unit: A·ts, B·ts; inputs and outputs in display units.
         let scaled = |x: &Mat<f64>, f: &dyn Fn(usize, usize) -> f64| {
             rows(Mat::from_fn(x.nrows(), x.ncols(), |i, j| x[(i, j)] * f(i, j)).as_ref())
         };
+        Matrices {
+            a: scaled(&m.a, &|_, _| ts),
+            b: scaled(&m.b, &|_, j| ts * fi(j)),
+            c: scaled(&m.c, &|i, _| 1.0 / fo(i)),
+            d: scaled(&m.d, &|i, j| fi(j) / fo(i)),
+            steady_state_gain: m.steady_gain().ok().map(|g| scaled(&g, &|i, j| fi(j) / fo(i))),
+        }
+    }
+
+    /// The JSON document, pretty-printed with every matrix row on one line.
+    pub fn to_json_string(&self) -> String {
+        let (tu, ts) = self.time_unit;
+        let pm = self.model;
+        let Matrices { a, b, c, d, steady_state_gain } = self.matrices();
         let doc = Document {
             format: "plantwide-state-space",
             format_version: 1,
@@ -114,28 +133,28 @@ impl ModelExport<'_> {
                 "dx/dt = A x + B u, y = C x + D u in deviations from the steady state; states in SI units, inputs and outputs in the units listed, time in {tu}"
             ),
             time_unit: tu,
-            states: self
+            states: pm
                 .states
                 .iter()
-                .zip(&self.state_values)
+                .zip(&pm.state_values)
                 .map(|(p, v)| Labelled { path: p, unit: None, value: *v })
                 .collect(),
-            inputs: signals(self.inputs, &self.input_values),
-            outputs: signals(self.outputs, &self.output_values),
-            A: scaled(&m.a, &|_, _| ts),
-            B: scaled(&m.b, &|_, j| ts * fi(j)),
-            C: scaled(&m.c, &|i, _| 1.0 / fo(i)),
-            D: scaled(&m.d, &|i, j| fi(j) / fo(i)),
-            steady_state_gain: m.steady_gain().ok().map(|g| scaled(&g, &|i, j| fi(j) / fo(i))),
-            eigenvalues: self.eigenvalues.iter().map(|l| Complex { re: l.re * ts, im: l.im * ts }).collect(),
-            time_constants: self
+            inputs: signals(self.inputs, &pm.input_values),
+            outputs: signals(self.outputs, &pm.output_values),
+            A: a,
+            B: b,
+            C: c,
+            D: d,
+            steady_state_gain,
+            eigenvalues: pm.eigenvalues.iter().map(|l| Complex { re: l.re * ts, im: l.im * ts }).collect(),
+            time_constants: pm
                 .eigenvalues
                 .iter()
                 .filter(|l| l.re < 0.0 && l.im >= 0.0)
                 .map(|l| -1.0 / (l.re * ts))
                 .collect(),
-            frequency_response: self
-                .frequency_response
+            frequency_response: pm
+                .responses
                 .iter()
                 .map(|(w, g)| Response {
                     omega: w * ts,
