@@ -34,8 +34,8 @@ pub struct LinearizeArgs {
     /// output names to keep (default all).
     #[arg(long, value_delimiter = ',', required_unless_present = "tf")]
     outputs: Vec<String>,
-    /// Write the model (JSON) here.
-    #[arg(long, value_name = "MODEL.json")]
+    /// Write the model here: JSON, or a NumPy archive when the name ends in `.npz`.
+    #[arg(long, value_name = "MODEL.json|MODEL.npz")]
     out: Option<PathBuf>,
     /// Time unit of the exported A and B, eigenvalues and time constants (default s).
     #[arg(long, default_value = "s")]
@@ -192,19 +192,28 @@ pub fn run(a: &LinearizeArgs, units: UnitSystem) -> Result<(), CliError> {
         }
     }
     if let Some(out) = &a.out {
-        let doc = ModelExport {
+        let export = ModelExport {
             name: plant.name(),
             model: &pm,
             inputs: &inputs,
             outputs: &outputs,
             time_unit: (&tu.name, tu.seconds),
-        }
-        .to_json_string();
-        std::fs::write(out, doc + "\n").map_err(|e| CliError::user(format!("{}: cannot write: {e}", out.display())))?;
-        outln!(
-            "wrote {} (A, B, C, D; load with python-control `control.ss(A, B, C, D)` or MATLAB `ss(m.A, m.B, m.C, m.D)`)",
-            out.display()
-        );
+        };
+        let npz = out.extension().is_some_and(|e| e == "npz");
+        let bytes = match npz {
+            true => plantwide::io::npz::archive(&plantwide::io::npz::linear_model(&export)),
+            false => (export.to_json_string() + "\n").into_bytes(),
+        };
+        std::fs::write(out, bytes).map_err(|e| CliError::user(format!("{}: cannot write: {e}", out.display())))?;
+        let how = match npz {
+            true => {
+                "numpy `np.load`; `state_names`, `input_names`, `output_names` are python-control-safe, `*_paths` the paths they stand for"
+            }
+            false => {
+                "A, B, C, D; load with python-control `control.ss(A, B, C, D)` or MATLAB `ss(m.A, m.B, m.C, m.D)`; `names` are python-control-safe signal names, `labels` their paths"
+            }
+        };
+        outln!("wrote {} ({how})", out.display());
     }
     Ok(())
 }

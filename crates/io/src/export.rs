@@ -7,7 +7,9 @@
 //! ```python
 //! import json, numpy as np, control
 //! m = json.load(open("model.json"))
-//! sys = control.ss(*(np.array(m[k]) for k in "ABCD"))   # control.dcgain(sys) == m["steady_state_gain"]
+//! n = m["names"]   # python-control-safe signal names; m["labels"] maps each back to its path
+//! sys = control.ss(*(np.array(m[k]) for k in "ABCD"), states=n["states"], inputs=n["inputs"], outputs=n["outputs"])
+//! # control.dcgain(sys) == m["steady_state_gain"]
 //! ```
 //! ```matlab
 //! m = jsondecode(fileread('model.json'));  sys = ss(m.A, m.B, m.C, m.D);   % dcgain(sys)
@@ -50,6 +52,52 @@ pub struct Matrices {
     pub d: Vec<Vec<f64>>,
     /// `D − C A⁻¹ B` (`None` when `A` is singular: an integrating mode).
     pub steady_state_gain: Option<Vec<Vec<f64>>>,
+}
+
+/// python-control-safe names of the states, inputs and outputs (each list free of repeats) and
+/// the path each stands for: python-control reads `.` in a signal name as `system.signal` and
+/// `[…]` as an index range, which paths such as `distillate.x[light]` are full of.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SignalNames {
+    /// One per state (row of `A`).
+    pub states: Vec<String>,
+    /// One per input (column of `B`).
+    pub inputs: Vec<String>,
+    /// One per output (row of `C`).
+    pub outputs: Vec<String>,
+}
+
+/// `paths` as identifiers (`[A-Za-z_][A-Za-z0-9_]*`): every run of other characters becomes one
+/// `_` (`distillate.x[light]` → `distillate_x_light`, a trailing one dropped), a leading digit is
+/// prefixed by `s_`, and a name met before gets `_2`, `_3`, … until it is new.
+pub fn safe_names(paths: &[String]) -> Vec<String> {
+    let mut seen = std::collections::HashSet::new();
+    paths
+        .iter()
+        .map(|p| {
+            let mut base = String::with_capacity(p.len());
+            for c in p.chars() {
+                if c.is_ascii_alphanumeric() {
+                    base.push(c);
+                } else if !base.ends_with('_') {
+                    base.push('_');
+                }
+            }
+            let trimmed = base.trim_end_matches('_');
+            let base = match trimmed.chars().next() {
+                Some(c) if c.is_ascii_digit() => format!("s_{trimmed}"),
+                Some(_) => trimmed.to_string(),
+                None => "s".to_string(),
+            };
+            let mut name = base.clone();
+            let mut k = 2;
+            while !seen.insert(name.clone()) {
+                name = format!("{base}_{k}");
+                k += 1;
+            }
+            name
+        })
+        .collect()
 }
 
 #[derive(Serialize)]
@@ -99,9 +147,29 @@ struct Document<'a> {
     eigenvalues: Vec<Complex>,
     time_constants: Vec<f64>,
     frequency_response: Vec<Response>,
+    names: SignalNames,
+    labels: Labels,
+}
+
+/// Each safe name's path, per list.
+#[derive(Serialize)]
+struct Labels {
+    states: std::collections::BTreeMap<String, String>,
+    inputs: std::collections::BTreeMap<String, String>,
+    outputs: std::collections::BTreeMap<String, String>,
 }
 
 impl ModelExport<'_> {
+    /// The python-control-safe names of the states, inputs and outputs.
+    pub fn names(&self) -> SignalNames {
+        let paths = |s: &[Signal]| s.iter().map(|s| s.path.clone()).collect::<Vec<_>>();
+        SignalNames {
+            states: safe_names(&self.model.states),
+            inputs: safe_names(&paths(self.inputs)),
+            outputs: safe_names(&paths(self.outputs)),
+        }
+    }
+
     /// The matrices in the export's units.
     pub fn matrices(&self) -> Matrices {
         let ts = self.time_unit.1;
@@ -125,6 +193,13 @@ impl ModelExport<'_> {
         let (tu, ts) = self.time_unit;
         let pm = self.model;
         let Matrices { a, b, c, d, steady_state_gain } = self.matrices();
+        let names = self.names();
+        let map = |n: &[String], p: &mut dyn Iterator<Item = &String>| n.iter().cloned().zip(p.cloned()).collect();
+        let labels = Labels {
+            states: map(&names.states, &mut pm.states.iter()),
+            inputs: map(&names.inputs, &mut self.inputs.iter().map(|s| &s.path)),
+            outputs: map(&names.outputs, &mut self.outputs.iter().map(|s| &s.path)),
+        };
         let doc = Document {
             format: "plantwide-state-space",
             format_version: 1,
@@ -162,6 +237,8 @@ impl ModelExport<'_> {
                     im: (0..g.nrows()).map(|i| (0..g.ncols()).map(|j| g[(i, j)].im).collect()).collect(),
                 })
                 .collect(),
+            names,
+            labels,
         };
         // Serializing plain numbers and strings cannot fail.
         let text = serde_json::to_string_pretty(&doc).unwrap_or_default();
@@ -199,6 +276,19 @@ pub fn collapse_number_arrays(text: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn safe_names_are_identifiers_without_repeats() {
+        let paths: Vec<String> =
+            ["distillate.x[light]", "distillate_x_light", "column.T[21]", "1st.F", "..."].map(String::from).to_vec();
+        let names = safe_names(&paths);
+        assert_eq!(names, ["distillate_x_light", "distillate_x_light_2", "column_T_21", "s_1st_F", "s"]);
+        let ident = |n: &String| {
+            n.chars().next().is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
+                && n.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')
+        };
+        assert!(names.iter().all(ident), "{names:?}");
+    }
 
     #[test]
     fn number_arrays_go_on_one_line() {
