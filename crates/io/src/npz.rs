@@ -99,7 +99,7 @@ pub fn archive(arrays: &[Array]) -> Vec<u8> {
         central.extend(0x0201_4b50u32.to_le_bytes());
         central.extend(20u16.to_le_bytes());
         entry_fields(&mut central, crc, data.len() as u32, name.len() as u16);
-        central.extend([0u8; 8]); // comment length, disk, internal and
+        central.extend([0u8; 6]); // comment length, disk number, internal attributes
         central.extend([0u8; 4]); // external attributes
         central.extend(offset.to_le_bytes());
         central.extend(name.as_bytes());
@@ -193,6 +193,8 @@ mod tests {
         let end = bytes.len() - 22;
         assert_eq!(u32::from_le_bytes(bytes[end..end + 4].try_into().unwrap()), 0x0605_4b50);
         assert_eq!(u16::from_le_bytes([bytes[end + 10], bytes[end + 11]]), 2);
+        let size = u32::from_le_bytes(bytes[end + 12..end + 16].try_into().unwrap()) as usize;
+        assert_eq!(size, 2 * (46 + "x.npy".len()), "two central entries of 46 bytes and a name each");
         let text = String::from_utf8_lossy(&bytes);
         assert_eq!(text.matches("x.npy").count(), 2, "local header and central directory");
     }
