@@ -21,6 +21,15 @@ def test_steady_equals_the_cli_bit_for_bit(cli_json, sets):
     assert ss.warnings == [w["message"] for w in cli["warnings"]]
 
 
+def test_numbers_are_si_and_exact(cli_json):
+    np = pytest.importorskip("numpy")
+    reflux = 2.75 * 1000 / 60  # mol/s
+    plant = pw.load(COLUMN_A)
+    a = plant.steady(set={"column.reflux": reflux}).to_dict()
+    assert a == plant.steady(set={"column.reflux": np.float64(reflux)}).to_dict()
+    assert a == cli_values(cli_json, [f"column.reflux={reflux!r}"])["values"]
+
+
 def test_methods_are_the_cli_methods(cli_json):
     plant = pw.load(COLUMN_A)
     for method in ["eo", "sm"]:

@@ -24,7 +24,8 @@ def assignments(set: Mapping[str, Any] | None) -> list[str]:
     for path, value in set.items():
         if not isinstance(path, str):
             raise TypeError(f"set: a path must be a string, got {path!r}")
-        out.append(f"{path}={value!r}" if isinstance(value, float) else f"{path}={value}")
+        # float.__repr__ round-trips every double (numpy's float64 repr would add its type name).
+        out.append(f"{path}={float.__repr__(value)}" if isinstance(value, float) else f"{path}={value}")
     return out
 
 
