@@ -6,15 +6,18 @@ use pyo3::PyErr;
 use pyo3::create_exception;
 use pyo3::exceptions::PyException;
 
-create_exception!(_plantwide, PlantwideError, PyException, "An error reported by the plantwide library.");
+// Named in the package `plantwide` (which re-exports them), so that pickle finds them there: an
+// error raised on a Dask worker reaches the client as the same class.
+
+create_exception!(plantwide, PlantwideError, PyException, "An error reported by the plantwide library.");
 create_exception!(
-    _plantwide,
+    plantwide,
     InputError,
     PlantwideError,
     "A bad flowsheet, scenario, field, path or value, or an ill-posed plant (the CLI's exit 1)."
 );
 create_exception!(
-    _plantwide,
+    plantwide,
     ConvergenceError,
     PlantwideError,
     "A numerical failure: no steady state, an integration or a perturbation that failed (the CLI's exit 2)."

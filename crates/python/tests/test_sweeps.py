@@ -64,3 +64,8 @@ def test_screening_with_and_without_a_client(cluster_client, cli_json):
     assert here == there and len(here) == 2
     cli = cli_json(["screen", COLUMN_A, "--column", "column", "--outputs", ",".join(args["outputs"]), "--json"])
     assert here[0] == cli
+
+
+def test_an_error_on_a_worker_reaches_the_client_as_the_same_exception(cluster_client):
+    with pytest.raises(pw.InputError, match="feed_source.Fx"):
+        pw.sweep(COLUMN_A, sets=[{}, {"feed_source.Fx": "1 kmol/min"}], outputs=OUTPUTS, client=cluster_client)
