@@ -9,7 +9,8 @@ use plantwide::analysis::faer::{Mat, c64};
 use plantwide::analysis::frequency::{self, FrequencyResults};
 use plantwide::analysis::linear::Linearization;
 use plantwide::analysis::measures::rows;
-use plantwide::analysis::perturb::{PerturbSettings, perturb_gains};
+use plantwide::analysis::perturb::PerturbGains;
+use plantwide::analysis::plant_model::{GainMethod, PlantGains, plant_gains};
 use plantwide::analysis::report::{GainJson, GainReport, ReportOptions};
 use plantwide::analysis::select::{
     Signal, SignalLabel, in_system, parse_block, parse_pairing, select_inputs, select_outputs,
@@ -176,40 +177,22 @@ pub fn run(a: &GainsArgs, units: UnitSystem) -> Result<(), CliError> {
     );
     let opts = options(a, &a.inputs, &a.outputs, Some(dims))?;
     let ss = converge(&plant, &u)?;
-    let (ii, oo): (Vec<usize>, Vec<usize>) =
-        (inputs.iter().map(|s| s.index).collect(), outputs.iter().map(|s| s.index).collect());
-    let lin = Linearization::new(&plant, &ss.x, &ss.u);
-    let mut check = None;
-    let (si, method, note) = match a.method {
-        Method::Linear => (
-            lin.steady_gain(&ii, &oo).map_err(analysis_error)?,
-            "linear",
-            "linearization at the steady state, G(0) = −C J⁻¹ B".to_string(),
-        ),
-        Method::Perturb => {
-            let settings = PerturbSettings { step: a.step, ..PerturbSettings::default() };
-            let p = perturb_gains(&plant, &ss.x, &ss.u, &ii, &oo, &settings).map_err(analysis_error)?;
-            let c = &p.check;
-            let note = format!(
-                "perturbation: each input ± h and ± h/2 (relative h ≤ {:.1e}), re-converged, central differences extrapolated (Richardson); h vs h/2 differ by ≤ {:.1e}{} ({} attempt(s), {} Newton iterations; convergence error ≤ {:.1e} of the effect)",
-                c.step,
-                c.max_relative_difference,
-                c.linear_relative_difference.map_or(String::new(), |d| format!(", linearization by {d:.1e}")),
-                c.attempts,
-                p.newton_iterations,
-                p.error_ratio
-            );
-            check = Some(p.check);
-            (p.gain, "perturb", note)
-        }
+    let method = match a.method {
+        Method::Linear => GainMethod::Linear,
+        Method::Perturb => GainMethod::Perturb { step: a.step },
     };
-    let gain = display_gain(&si, &inputs, &outputs);
-    let labels = |s: &[Signal]| s.iter().map(Signal::label).collect::<Vec<_>>();
-    let report = GainReport::new(method, labels(&inputs), labels(&outputs), gain, &opts).map_err(analysis_error)?;
+    let PlantGains { report, perturbation } =
+        plant_gains(&plant, (&ss.x, &ss.u), (&inputs, &outputs), method, &opts).map_err(analysis_error)?;
+    let note =
+        perturbation.as_ref().map_or("linearization at the steady state, G(0) = −C J⁻¹ B".to_string(), perturb_note);
+    let check = perturbation.map(|p| p.check);
     let frequency = match &a.frequencies {
         Some(text) => {
             let tu = TimeUnit::parse(&a.time_unit)?;
             let omegas = frequency_grid(text, &tu)?;
+            let (ii, oo): (Vec<usize>, Vec<usize>) =
+                (inputs.iter().map(|s| s.index).collect(), outputs.iter().map(|s| s.index).collect());
+            let lin = Linearization::new(&plant, &ss.x, &ss.u);
             let responses = lin.frequency_response(&ii, &oo, &omegas).map_err(analysis_error)?;
             let scale = |g: &Mat<c64>| {
                 Mat::from_fn(g.nrows(), g.ncols(), |i, j| g[(i, j)] * (inputs[j].factor / outputs[i].factor))
@@ -235,17 +218,26 @@ pub fn run(a: &GainsArgs, units: UnitSystem) -> Result<(), CliError> {
     Ok(())
 }
 
+/// How perturbation gains were found and verified, in words.
+fn perturb_note(p: &PerturbGains) -> String {
+    let c = &p.check;
+    format!(
+        "perturbation: each input ± h and ± h/2 (relative h ≤ {:.1e}), re-converged, central differences extrapolated (Richardson); h vs h/2 differ by ≤ {:.1e}{} ({} attempt(s), {} Newton iterations; convergence error ≤ {:.1e} of the effect)",
+        c.step,
+        c.max_relative_difference,
+        c.linear_relative_difference.map_or(String::new(), |d| format!(", linearization by {d:.1e}")),
+        c.attempts,
+        p.newton_iterations,
+        p.error_ratio
+    )
+}
+
 /// The frequency results at `omegas` [rad/s] of the responses (display units), ω reported per
 /// `tu`.
 fn frequency_results(r: &GainReport, omegas: &[f64], responses: &[Mat<c64>], tu: &TimeUnit) -> FrequencyResults {
     let pairing = r.pairing.clone().unwrap_or_default();
     let points = omegas.iter().zip(responses).map(|(w, g)| frequency::point(w * tu.seconds, g, &pairing)).collect();
     FrequencyResults { time_unit: tu.name.clone(), points }
-}
-
-/// SI gains → display units: `G_ij · f_uj / f_yi`.
-pub fn display_gain(si: &Mat<f64>, inputs: &[Signal], outputs: &[Signal]) -> Mat<f64> {
-    Mat::from_fn(si.nrows(), si.ncols(), |i, j| si[(i, j)] * inputs[j].factor / outputs[i].factor)
 }
 
 fn run_tf(a: &GainsArgs, file: &Path) -> Result<(), CliError> {

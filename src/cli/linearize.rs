@@ -6,16 +6,15 @@
 
 use std::path::PathBuf;
 
-use plantwide::analysis::faer::{Mat, c64};
 use plantwide::analysis::frequency::{self, FrequencyResults};
-use plantwide::analysis::linear::Linearization;
+use plantwide::analysis::plant_model::{PlantModel, display_gain};
 use plantwide::analysis::select::{in_system, select_inputs, select_outputs};
 use plantwide::io::export::ModelExport;
 use plantwide::units::UnitSystem;
 use plantwide::units::{Dimension, Unit};
 
 use super::CliError;
-use super::gains::{display_gain, sig};
+use super::gains::sig;
 use super::steady::{converge, load_with_overrides};
 
 /// Arguments of `plantwide linearize`.
@@ -35,8 +34,8 @@ pub struct LinearizeArgs {
     /// output names to keep (default all).
     #[arg(long, value_delimiter = ',', required_unless_present = "tf")]
     outputs: Vec<String>,
-    /// Write the model (JSON) here.
-    #[arg(long, value_name = "MODEL.json")]
+    /// Write the model here: JSON, or a NumPy archive when the name ends in `.npz`.
+    #[arg(long, value_name = "MODEL.json|MODEL.npz")]
     out: Option<PathBuf>,
     /// Time unit of the exported A and B, eigenvalues and time constants (default s).
     #[arg(long, default_value = "s")]
@@ -151,21 +150,8 @@ pub fn run(a: &LinearizeArgs, units: UnitSystem) -> Result<(), CliError> {
     let outputs = select_outputs(&plant, &in_system(&plant, &a.outputs, units)).map_err(map)?;
     let omegas = a.frequencies.as_deref().map(|f| frequency_grid(f, &tu)).transpose()?.unwrap_or_default();
     let ss = converge(&plant, &u)?;
-    let (ii, oo): (Vec<usize>, Vec<usize>) =
-        (inputs.iter().map(|s| s.index).collect(), outputs.iter().map(|s| s.index).collect());
-    let lin = Linearization::new(&plant, &ss.x, &ss.u);
-    let model = lin.state_space(&ii, &oo).map_err(map)?;
-    let direct = lin.steady_gain(&ii, &oo).map_err(map)?;
-    let eigenvalues = model.eigenvalues().map_err(map)?;
-    let responses: Vec<(f64, Mat<c64>)> = lin
-        .frequency_response(&ii, &oo, &omegas)
-        .map_err(map)?
-        .into_iter()
-        .zip(&omegas)
-        .map(|(g, &w)| {
-            (w, Mat::from_fn(g.nrows(), g.ncols(), |i, j| g[(i, j)] * (inputs[j].factor / outputs[i].factor)))
-        })
-        .collect();
+    let pm = PlantModel::at(&plant, (&ss.x, &ss.u), (&inputs, &outputs), &omegas).map_err(map)?;
+    let (model, direct) = (&pm.model, &pm.direct_gain);
     outln!(
         "linear model of `{}` at its steady state: {} states, {} inputs, {} outputs",
         plant.name(),
@@ -183,7 +169,7 @@ pub fn run(a: &LinearizeArgs, units: UnitSystem) -> Result<(), CliError> {
     }
     if unstable.is_empty() {
         let g = display_gain(&model.steady_gain().map_err(map)?, &inputs, &outputs);
-        let gd = display_gain(&direct, &inputs, &outputs);
+        let gd = display_gain(direct, &inputs, &outputs);
         // Relative to the largest gain: an output held by integral action has a gain of rounding size,
         // which no relative difference of its own describes.
         let cells = || (0..g.nrows()).flat_map(|i| (0..g.ncols()).map(move |j| (i, j)));
@@ -206,25 +192,28 @@ pub fn run(a: &LinearizeArgs, units: UnitSystem) -> Result<(), CliError> {
         }
     }
     if let Some(out) = &a.out {
-        let doc = ModelExport {
+        let export = ModelExport {
             name: plant.name(),
-            model: &model,
-            states: model.states.iter().map(|&i| plant.vars()[i].path.clone()).collect(),
-            state_values: model.states.iter().map(|&i| ss.x[i]).collect(),
+            model: &pm,
             inputs: &inputs,
-            input_values: ii.iter().map(|&i| ss.u[i]).collect(),
             outputs: &outputs,
-            output_values: oo.iter().map(|&i| ss.x[i]).collect(),
             time_unit: (&tu.name, tu.seconds),
-            eigenvalues: &eigenvalues,
-            frequency_response: &responses,
-        }
-        .to_json_string();
-        std::fs::write(out, doc + "\n").map_err(|e| CliError::user(format!("{}: cannot write: {e}", out.display())))?;
-        outln!(
-            "wrote {} (A, B, C, D; load with python-control `control.ss(A, B, C, D)` or MATLAB `ss(m.A, m.B, m.C, m.D)`)",
-            out.display()
-        );
+        };
+        let npz = out.extension().is_some_and(|e| e == "npz");
+        let bytes = match npz {
+            true => plantwide::io::npz::archive(&plantwide::io::npz::linear_model(&export)),
+            false => (export.to_json_string() + "\n").into_bytes(),
+        };
+        std::fs::write(out, bytes).map_err(|e| CliError::user(format!("{}: cannot write: {e}", out.display())))?;
+        let how = match npz {
+            true => {
+                "numpy `np.load`; `state_names`, `input_names`, `output_names` are python-control-safe, `*_paths` the paths they stand for"
+            }
+            false => {
+                "A, B, C, D; load with python-control `control.ss(A, B, C, D)` or MATLAB `ss(m.A, m.B, m.C, m.D)`; `names` are python-control-safe signal names, `labels` their paths"
+            }
+        };
+        outln!("wrote {} ({how})", out.display());
     }
     Ok(())
 }

@@ -104,9 +104,7 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
     let plot_cx = PlotContext { plant: &plant, spec: &spec, title: &title };
     let mut res = match result {
         Ok(res) => res,
-        Err(e @ (SimError::Snapshot { .. } | SimError::Wiring(_) | SimError::Mpc { partial: None, .. })) => {
-            return Err(CliError::user(e.to_string()));
-        }
+        Err(e) if e.is_user_error() => return Err(CliError::user(e.to_string())),
         Err(SimError::Conservation { file, source, mut result }) => {
             display_units(&mut result, args.units, &spec);
             // The whole run is there: write and summarize it, then fail on the balance.

@@ -16,13 +16,13 @@ use super::CliError;
 /// ([`Plant::fix_specs`]), so that dynamics and analyses start from the plant the specs define.
 pub fn load_with_overrides(file: &Path, sets: &[String]) -> Result<(Plant, Vec<f64>), CliError> {
     let mut plant = load_plant(file, sets)?;
-    if !plant.specs().is_empty() {
-        let sol = converge(&plant, &plant.input_values())?;
-        for s in plant.specs() {
-            let dim = plant.inputs()[s.input].dim;
-            eprintln!("note: design spec {} met: `{}` = {}", s.label(), s.vary, with_unit(sol.u[s.input], dim));
+    let specs: Vec<(String, String, usize)> =
+        plant.specs().iter().map(|s| (s.label(), s.vary.clone(), s.input)).collect();
+    if let Some(sol) = plantwide::solve::fix_design_point(&mut plant).map_err(solve_error)? {
+        for (label, vary, input) in specs {
+            let dim = plant.inputs()[input].dim;
+            eprintln!("note: design spec {label} met: `{vary}` = {}", with_unit(sol.u[input], dim));
         }
-        plant.fix_specs(&sol.u);
     }
     let u = plant.input_values();
     Ok((plant, u))
@@ -102,8 +102,12 @@ pub fn converge_by(plant: &Plant, u: &[f64], method: MethodArg) -> Result<Soluti
     debug_assert_eq!(plant.input_values(), u, "the plant carries the input values it is converged at");
     let result = converge_observed(plant, &settings, &mut observer);
     bar.finish_and_clear();
-    result
-        .map_err(|e| if e.is_user_error() { CliError::user(e.to_string()) } else { CliError::numerical(e.to_string()) })
+    result.map_err(solve_error)
+}
+
+/// A failed convergence: an ill-posed plant is the user's error (exit 1), else numerical (exit 2).
+fn solve_error(e: plantwide::solve::SolveError) -> CliError {
+    if e.is_user_error() { CliError::user(e.to_string()) } else { CliError::numerical(e.to_string()) }
 }
 
 /// What `plantwide steady` is asked.
@@ -270,15 +274,8 @@ fn print_json(
     iterations: usize,
     residual: f64,
 ) -> Result<(), CliError> {
-    let mut values = serde_json::Map::new();
-    for (v, x) in plant.vars().iter().zip(&sol.x) {
-        values.insert(v.path.clone(), (*x).into());
-    }
-    for (i, x) in plant.inputs().iter().zip(&sol.u) {
-        if i.driven_by.is_none() {
-            values.insert(i.path.clone(), (*x).into());
-        }
-    }
+    let values: serde_json::Map<String, serde_json::Value> =
+        sol.values(plant).into_iter().map(|(path, v)| (path, v.into())).collect();
     let out = serde_json::json!({
         "converged": true,
         "method": format!("{method:?}").to_lowercase(),

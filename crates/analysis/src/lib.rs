@@ -14,6 +14,8 @@
 //! - [`sensitivity`]: disturbance sweeps with the control structure active, by continuation.
 //! - [`sensors`]: tray-temperature sensor selection (SVD and slope criteria).
 //! - [`report`]: the gain report shared by flowsheets and transfer-function models.
+//! - [`plant_model`]: a flowsheet's gain report and state-space model between chosen signals, as
+//!   every face shows them.
 //!
 //! **Architecture Invariant:** nothing here reads or writes files or the terminal, parses a file
 //! format or draws: file formats and plots are `plantwide_io`'s, files and the terminal the CLI's.
@@ -27,6 +29,7 @@ pub mod linear;
 pub mod measures;
 pub mod min_cond;
 pub mod perturb;
+pub mod plant_model;
 pub mod report;
 pub mod response;
 pub mod select;

@@ -2,7 +2,9 @@
 //! besides flowsheets and scenarios (those are `plantwide_flowsheet`'s).
 //!
 //! - [`tf`]: the transfer-function model file (`*.tf.json`) → [`TfModel`](plantwide_analysis::tf::TfModel).
-//! - [`export`]: the state-space model as JSON for MATLAB and python-control.
+//! - [`export`]: the state-space model as JSON for MATLAB and python-control, with python-control-safe
+//!   signal names and the path each stands for.
+//! - [`npz`]: named arrays as a NumPy `.npz` archive (the state-space export's second format).
 //! - [`csv`]: sensitivity sweeps as CSV.
 //! - [`plot`]: trend plots of dynamic runs and sensitivity plots, PNG or SVG, with one embedded
 //!   font (DejaVu Sans) registered once, so no system font library is needed.
@@ -18,6 +20,7 @@ pub mod csv;
 pub mod error;
 pub mod export;
 pub mod html;
+pub mod npz;
 pub mod part;
 pub mod plot;
 pub mod tf;

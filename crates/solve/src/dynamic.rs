@@ -133,6 +133,15 @@ pub enum SimError {
     },
 }
 
+impl SimError {
+    /// True when the run never started for a reason the caller can fix (a snapshot or analyzer
+    /// that does not fit the plant, an MPC whose model cannot be built): the CLI's exit 1; a run
+    /// that failed on its way is numerical (exit 2).
+    pub fn is_user_error(&self) -> bool {
+        matches!(self, SimError::Snapshot { .. } | SimError::Wiring(_) | SimError::Mpc { partial: None, .. })
+    }
+}
+
 /// One recorded column.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Column {

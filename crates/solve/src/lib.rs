@@ -26,7 +26,9 @@ pub use newton::{
     IterationRecord, NewtonReport, NewtonSettings, NewtonStatus, pseudo_transient_steps, solve_steady,
     solve_steady_observed,
 };
-pub use sequential::{Method, Progress, Solution, SolveError, StrategySettings, converge, converge_observed};
+pub use sequential::{
+    Method, Progress, Solution, SolveError, StrategySettings, converge, converge_observed, fix_design_point,
+};
 pub use specs::SteadySystem;
 pub use steady::{
     ConvergenceFailure, DofError, DofProbe, PlantSystem, SteadyError, SteadyState, dof_check, steady_state,

@@ -51,7 +51,8 @@ pub use groups::{SolveGroup, solve_groups};
 pub use plan::{SequentialPlan, plan};
 pub use report::{PassRecord, SccReport, SmReport};
 pub use strategy::{
-    Method, Progress, Solution, SolveError, StrategySettings, converge, converge_observed, steady_state_by,
+    Method, Progress, Solution, SolveError, StrategySettings, converge, converge_observed, fix_design_point,
+    steady_state_by,
 };
 
 use crate::newton::solve_steady_reusing;

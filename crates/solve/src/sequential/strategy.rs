@@ -74,6 +74,28 @@ pub struct Solution {
     pub warnings: Vec<Warning>,
 }
 
+impl Solution {
+    /// Every variable and every free input (one no controller drives) under its path, in SI: the
+    /// `values` of `plantwide steady --json` and the mapping the Python face returns.
+    pub fn values(&self, plant: &Plant) -> Vec<(String, f64)> {
+        let vars = plant.vars().iter().zip(&self.x).map(|(v, x)| (v.path.clone(), *x));
+        let free = plant.inputs().iter().zip(&self.u).filter(|(i, _)| i.driven_by.is_none());
+        vars.chain(free.map(|(i, u)| (i.path.clone(), *u))).collect()
+    }
+}
+
+/// Meet `plant`'s design specs (converged the default way, [`converge`]) and fix their varied
+/// inputs at the values found ([`Plant::fix_specs`]), so that dynamics and analyses start from the
+/// plant the specs define. `None` (and `plant` unchanged) when it has no specs.
+pub fn fix_design_point(plant: &mut Plant) -> Result<Option<Solution>, SolveError> {
+    if plant.specs().is_empty() {
+        return Ok(None);
+    }
+    let sol = converge(plant, &StrategySettings::default())?;
+    plant.fix_specs(&sol.u);
+    Ok(Some(sol))
+}
+
 /// Why no steady state was found.
 #[derive(Debug, Clone, thiserror::Error)]
 pub enum SolveError {

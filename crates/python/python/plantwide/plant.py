@@ -1,0 +1,254 @@
+"""A flowsheet loaded from Python, and the results of its steady state, gains, linear model and runs."""
+
+from __future__ import annotations
+
+import json
+import os
+from collections.abc import Mapping
+from typing import Any, Iterator
+
+import numpy as np
+
+from . import _plantwide as _native
+
+
+def assignments(set: Mapping[str, Any] | None) -> list[str]:
+    """``{path: "value unit"}`` as the CLI's ``--set PATH=VALUE`` strings, in order.
+
+    A number is taken in SI; a string is parsed like the CLI's value (``"1.01 kmol/min"``)."""
+    if set is None:
+        return []
+    if not isinstance(set, Mapping):
+        raise TypeError(f"set: expected a mapping {{path: value}}, got {type(set).__name__}")
+    out = []
+    for path, value in set.items():
+        if not isinstance(path, str):
+            raise TypeError(f"set: a path must be a string, got {path!r}")
+        # float.__repr__ round-trips every double (numpy's float64 repr would add its type name).
+        out.append(f"{path}={float.__repr__(value)}" if isinstance(value, float) else f"{path}={value}")
+    return out
+
+
+class SteadyState(Mapping):
+    """A steady state: every variable and free input path → its SI value (a read-only mapping).
+
+    ``.warnings`` lists the library's warnings (loops saturated off setpoint); ``.to_dict()``
+    gives a plain dict."""
+
+    def __init__(self, values: list[tuple[str, float]], warnings: list[str]):
+        self._values = dict(values)
+        self.warnings = list(warnings)
+
+    def __getitem__(self, path: str) -> float:
+        try:
+            return self._values[path]
+        except KeyError:
+            raise KeyError(f"`{path}`: not a variable or free input of this steady state") from None
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._values)
+
+    def __len__(self) -> int:
+        return len(self._values)
+
+    def to_dict(self) -> dict[str, float]:
+        """A plain dict path → SI value."""
+        return dict(self._values)
+
+    def __repr__(self) -> str:
+        return f"<SteadyState: {len(self)} values, {len(self.warnings)} warnings>"
+
+
+class Gains:
+    """Steady-state gains in display units and their interaction measures (numpy arrays).
+
+    ``gain`` (outputs × inputs), ``rga`` (None when the gain is singular), ``svd`` =
+    ``(U, singular values, V)``, ``singular_values``, ``condition_number`` (inf when singular),
+    ``niederlinski`` and ``rga_number`` of the pairing (None unless square and regular),
+    ``inputs``/``outputs`` as ``(path, unit)``; ``perturbation`` the check of perturbation gains."""
+
+    def __init__(self, d: dict):
+        self.method: str = d["method"]
+        self.inputs: list[tuple[str, str]] = [tuple(s) for s in d["inputs"]]
+        self.outputs: list[tuple[str, str]] = [tuple(s) for s in d["outputs"]]
+        self.gain = np.array(d["gain"], dtype=float)
+        self.rga = None if d["rga"] is None else np.array(d["rga"], dtype=float)
+        self.singular_values = np.array(d["singular_values"], dtype=float)
+        self.svd = (np.array(d["u"], dtype=float), self.singular_values, np.array(d["v"], dtype=float))
+        self.condition_number: float = d["condition_number"]
+        self.min_condition_number: float | None = d["min_condition_number"]
+        self.niederlinski: float | None = d["niederlinski"]
+        self.rga_number: float | None = d["rga_number"]
+        self.pairing: list[int] | None = d["pairing"]
+        self.perturbation: dict | None = None if d["perturbation"] is None else json.loads(d["perturbation"])
+
+    def __repr__(self) -> str:
+        return f"<Gains ({self.method}) {self.gain.shape[0]}×{self.gain.shape[1]}: NI {self.niederlinski}>"
+
+
+class LinearModel:
+    """``dx/dt = A x + B u``, ``y = C x + D u`` in deviations from the steady state (time in s,
+    states in SI, inputs and outputs in their display units), as ``plantwide linearize --out``
+    exports it.
+
+    ``A, B, C, D`` are numpy arrays; ``states``, ``inputs``, ``outputs`` the paths (with units for
+    inputs and outputs); ``state_names``, ``input_names``, ``output_names`` python-control-safe
+    names and ``labels`` the path of each safe name."""
+
+    def __init__(self, d: dict):
+        self.name: str = d["name"]
+        self.A, self.B, self.C, self.D = (np.array(d[k], dtype=float).reshape(_shape(d, k)) for k in "ABCD")
+        g = d["steady_state_gain"]
+        self.steady_state_gain = None if g is None else np.array(g, dtype=float)
+        self.states: list[str] = list(d["states"])
+        self.inputs: list[tuple[str, str]] = [tuple(s) for s in d["inputs"]]
+        self.outputs: list[tuple[str, str]] = [tuple(s) for s in d["outputs"]]
+        self.state_names: list[str] = list(d["state_names"])
+        self.input_names: list[str] = list(d["input_names"])
+        self.output_names: list[str] = list(d["output_names"])
+        self.labels: dict[str, dict[str, str]] = {
+            "states": dict(zip(self.state_names, self.states)),
+            "inputs": dict(zip(self.input_names, (p for p, _ in self.inputs))),
+            "outputs": dict(zip(self.output_names, (p for p, _ in self.outputs))),
+        }
+        self.state_values = np.array(d["state_values"], dtype=float)
+        self.input_values = np.array(d["input_values"], dtype=float)
+        self.output_values = np.array(d["output_values"], dtype=float)
+        self.eigenvalues = np.array([complex(re, im) for re, im in d["eigenvalues"]], dtype=complex)
+        self._json: str = d["json"]
+
+    def __iter__(self):
+        """``A, B, C, D = plant.linearize(...)``."""
+        return iter((self.A, self.B, self.C, self.D))
+
+    def to_control(self):
+        """A python-control ``StateSpace`` with the safe signal names (``labels`` maps them back)."""
+        try:
+            import control
+        except ImportError as e:
+            raise ImportError("to_control() needs python-control: pip install control") from e
+        return control.ss(
+            self.A,
+            self.B,
+            self.C,
+            self.D,
+            states=self.state_names,
+            inputs=self.input_names,
+            outputs=self.output_names,
+            name=_safe_system_name(self.name),
+        )
+
+    def to_json(self, path: str | os.PathLike) -> None:
+        """Write the export ``plantwide linearize --out model.json`` writes."""
+        with open(path, "w", encoding="utf-8") as f:
+            f.write(self._json + "\n")
+
+    def to_npz(self, path: str | os.PathLike) -> None:
+        """Write ``A, B, C, D``, the names, paths, units and steady values as a numpy ``.npz``
+        (the keys ``plantwide linearize --out model.npz`` writes)."""
+        arrays = {"A": self.A, "B": self.B, "C": self.C, "D": self.D, "eigenvalues": self.eigenvalues}
+        if self.steady_state_gain is not None:
+            arrays["steady_state_gain"] = self.steady_state_gain
+        arrays.update(
+            state_names=np.array(self.state_names, dtype=str),
+            input_names=np.array(self.input_names, dtype=str),
+            output_names=np.array(self.output_names, dtype=str),
+            state_paths=np.array(self.states, dtype=str),
+            input_paths=np.array([p for p, _ in self.inputs], dtype=str),
+            output_paths=np.array([p for p, _ in self.outputs], dtype=str),
+            input_units=np.array([u for _, u in self.inputs], dtype=str),
+            output_units=np.array([u for _, u in self.outputs], dtype=str),
+            state_values=self.state_values,
+            input_values=self.input_values,
+            output_values=self.output_values,
+            time_unit=np.array("s"),
+        )
+        np.savez(path, **arrays)
+
+    def __repr__(self) -> str:
+        return f"<LinearModel of {self.name}: {len(self.states)} states, {len(self.inputs)} inputs, {len(self.outputs)} outputs>"
+
+
+def _shape(d: dict, key: str) -> tuple[int, int]:
+    """The shape of matrix ``key`` (empty rows keep their width: a model without states)."""
+    n, m, p = len(d["states"]), len(d["inputs"]), len(d["outputs"])
+    return {"A": (n, n), "B": (n, m), "C": (p, n), "D": (p, m)}[key]
+
+
+def _safe_system_name(name: str) -> str:
+    return "".join(c if c.isalnum() else "_" for c in name) or "plant"
+
+
+class Plant:
+    """A flowsheet, loaded and validated. Every method applies its ``set`` overrides to the file's
+    description and calls the library as the matching CLI command does."""
+
+    def __init__(self, text: str, name: str):
+        self._text, self._name = text, name
+        self.name, self.inputs, self.variables = _native.check(text, name)
+
+    @property
+    def file(self) -> str:
+        """The flowsheet's file name, as messages give it."""
+        return self._name
+
+    @property
+    def text(self) -> str:
+        """The flowsheet's text (what a task sent to another process carries)."""
+        return self._text
+
+    def steady(self, set: Mapping[str, Any] | None = None, method: str = "auto") -> SteadyState:
+        """``plantwide steady --json --set …``: path → SI value (``method``: auto, eo or sm)."""
+        values, warnings = _native.steady(self._text, self._name, assignments(set), method)
+        return SteadyState(values, warnings)
+
+    def gains(
+        self,
+        inputs: list[str],
+        outputs: list[str],
+        method: str = "linear",
+        *,
+        set: Mapping[str, Any] | None = None,
+        pairing: str | None = None,
+        step: float | None = None,
+    ) -> Gains:
+        """``plantwide gains``: inputs and outputs as ``PATH[@unit]`` (``method``: linear or perturb)."""
+        d = _native.gains(self._text, self._name, assignments(set), list(inputs), list(outputs), method, step, pairing)
+        return Gains(d)
+
+    def linearize(self, inputs: list[str], outputs: list[str], *, set: Mapping[str, Any] | None = None) -> LinearModel:
+        """``plantwide linearize``: the state-space model at the steady state (time in s)."""
+        return LinearModel(_native.linearize(self._text, self._name, assignments(set), list(inputs), list(outputs)))
+
+    def run(self, scenario: str | os.PathLike | Mapping, *, set: Mapping[str, Any] | None = None):
+        """``plantwide run``: the scenario (a file, or its description as a dict) from the steady
+        state. Returns a pandas DataFrame indexed by time [s] with one SI column per recorded path
+        when pandas is installed, else a dict ``{"time": array, path: array, …}``."""
+        if isinstance(scenario, Mapping):
+            text, name = json.dumps(scenario), "<scenario>"
+        else:
+            name = os.fspath(scenario)
+            text = _native.read_text(name)
+        d = _native.run(self._text, self._name, assignments(set), text, name)
+        columns = {"time": np.array(d["time"], dtype=float)}
+        rows = np.array(d["rows"], dtype=float).reshape(len(d["time"]), len(d["columns"]))
+        for k, (path, _unit) in enumerate(d["columns"]):
+            columns[path] = rows[:, k]
+        try:
+            import pandas as pd
+        except ImportError:
+            return columns
+        frame = pd.DataFrame(columns).set_index("time")
+        frame.attrs["units"] = {path: unit for path, unit in d["columns"]}
+        frame.attrs["events"] = d["events"]
+        return frame
+
+    def __repr__(self) -> str:
+        return f"<Plant {self.name} ({self._name}): {len(self.variables)} variables, {len(self.inputs)} free inputs>"
+
+
+def load(path: str | os.PathLike) -> Plant:
+    """Read and validate the flowsheet at ``path`` (``InputError`` lists every problem with its
+    JSON path)."""
+    name = os.fspath(path)
+    return Plant(_native.read_text(name), name)

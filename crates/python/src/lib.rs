@@ -1,0 +1,175 @@
+//! `plantwide._plantwide`: the extension module under the Python package `plantwide`
+//! (`python/plantwide`). Each function takes flowsheet text and `--set` assignments, calls the
+//! library the way the CLI does (`plant.rs`), releases the GIL while it works, and hands back
+//! plain Python values (`convert.rs`); numpy arrays, DataFrames, python-control systems and Dask
+//! tasks are built on the Python side. Library errors arrive as `InputError` or
+//! `ConvergenceError` (both `PlantwideError`) with the library's message.
+
+mod convert;
+mod error;
+mod plant;
+
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use rayon::prelude::*;
+
+use error::{ConvergenceError, FaceError, InputError, PlantwideError};
+use plant::Source;
+use plantwide_analysis::plant_model::GainMethod;
+
+/// The flowsheet file at `path`, read by the library (its size limit, its messages).
+#[pyfunction]
+fn read_text(py: Python<'_>, path: String) -> PyResult<String> {
+    py.detach(|| plantwide_flowsheet::read_text(std::path::Path::new(&path)).map_err(|e| FaceError::input(e).into()))
+}
+
+/// Load and validate (every problem with its JSON path); returns the plant's name, its free
+/// inputs and its variable paths.
+#[pyfunction]
+fn check(py: Python<'_>, text: String, name: String) -> PyResult<(String, Vec<String>, Vec<String>)> {
+    py.detach(|| {
+        let plant = Source { text, name }.load(&[])?;
+        let free = plant.inputs().iter().filter(|i| i.driven_by.is_none()).map(|i| i.path.clone()).collect();
+        let vars = plant.vars().iter().map(|v| v.path.clone()).collect();
+        Ok((plant.name().to_string(), free, vars))
+    })
+    .map_err(|e: FaceError| e.into())
+}
+
+/// `plantwide steady --set …`: `(path, SI value)` of every variable and free input, and the
+/// warnings.
+#[pyfunction]
+#[pyo3(signature = (text, name, sets, method = "auto"))]
+fn steady(py: Python<'_>, text: String, name: String, sets: Vec<String>, method: &str) -> PyResult<plant::Steady> {
+    let method = plant::method(method)?;
+    Ok(py.detach(|| plant::steady(&Source { text, name }, &sets, method))?)
+}
+
+/// One steady state per entry of `sets` (in parallel, rayon), the values of `outputs` in each, in
+/// order. A point that fails raises, naming it.
+#[pyfunction]
+#[pyo3(signature = (text, name, sets, outputs, method = "auto"))]
+fn sweep(
+    py: Python<'_>,
+    text: String,
+    name: String,
+    sets: Vec<Vec<String>>,
+    outputs: Vec<String>,
+    method: &str,
+) -> PyResult<Vec<Vec<f64>>> {
+    let method = plant::method(method)?;
+    let src = Source { text, name };
+    let results: Vec<Result<Vec<f64>, FaceError>> =
+        py.detach(|| sets.par_iter().map(|s| plant::steady_outputs(&src, s, &outputs, method)).collect());
+    let named = |k: usize, e: FaceError| match e {
+        FaceError::Input(m) => FaceError::Input(format!("sweep point {k} ({}): {m}", sets[k].join(", "))),
+        FaceError::Convergence(m) => FaceError::Convergence(format!("sweep point {k} ({}): {m}", sets[k].join(", "))),
+    };
+    Ok(results.into_iter().enumerate().map(|(k, r)| r.map_err(|e| named(k, e))).collect::<Result<_, _>>()?)
+}
+
+/// `plantwide gains`: the gains and every measure, as a dict.
+#[pyfunction]
+#[pyo3(signature = (text, name, sets, inputs, outputs, method = "linear", step = None, pairing = None))]
+#[allow(clippy::too_many_arguments)] // one per keyword of the Python method
+fn gains<'py>(
+    py: Python<'py>,
+    text: String,
+    name: String,
+    sets: Vec<String>,
+    inputs: Vec<String>,
+    outputs: Vec<String>,
+    method: &str,
+    step: Option<f64>,
+    pairing: Option<String>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let method = match method {
+        "linear" => GainMethod::Linear,
+        "perturb" => GainMethod::Perturb { step },
+        _ => return Err(InputError::new_err(format!("method `{method}`: expected `linear` or `perturb`"))),
+    };
+    let src = Source { text, name };
+    let g = py.detach(|| plant::gains(&src, &sets, (&inputs, &outputs), method, pairing.as_deref()))?;
+    convert::gains(py, &g)
+}
+
+/// `plantwide linearize`: `A, B, C, D` (per second, display units), labels and the export.
+#[pyfunction]
+fn linearize<'py>(
+    py: Python<'py>,
+    text: String,
+    name: String,
+    sets: Vec<String>,
+    inputs: Vec<String>,
+    outputs: Vec<String>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let src = Source { text, name };
+    let (plant_name, model, ins, outs) = py.detach(|| plant::linearize(&src, &sets, (&inputs, &outputs)))?;
+    convert::linear_model(py, &plant_name, &model, &ins, &outs)
+}
+
+/// `plantwide run`: the recorded trends of the scenario (text `scenario`, named `scenario_name`).
+#[pyfunction]
+fn run<'py>(
+    py: Python<'py>,
+    text: String,
+    name: String,
+    sets: Vec<String>,
+    scenario: String,
+    scenario_name: String,
+) -> PyResult<Bound<'py, PyDict>> {
+    let (src, scen) = (Source { text, name }, Source { text: scenario, name: scenario_name });
+    let res = py.detach(|| plant::run(&src, &sets, &scen))?;
+    convert::trends(py, &res)
+}
+
+/// `plantwide sensitivity`: one curve per disturbance.
+#[pyfunction]
+#[pyo3(signature = (text, name, sets, disturb, outputs, points = 21))]
+fn sensitivity<'py>(
+    py: Python<'py>,
+    text: String,
+    name: String,
+    sets: Vec<String>,
+    disturb: Vec<String>,
+    outputs: Vec<String>,
+    points: usize,
+) -> PyResult<Vec<Bound<'py, PyDict>>> {
+    let src = Source { text, name };
+    let (curves, outs) = py.detach(|| plant::sensitivity(&src, &sets, &disturb, &outputs, points))?;
+    curves.iter().map(|c| convert::curve(py, c, &outs)).collect()
+}
+
+/// `plantwide screen --column --json`: the column's inventory configurations, as JSON text.
+#[pyfunction]
+fn screen(
+    py: Python<'_>,
+    text: String,
+    name: String,
+    sets: Vec<String>,
+    column: String,
+    outputs: Vec<String>,
+) -> PyResult<String> {
+    let src = Source { text, name };
+    let s = py.detach(|| plant::screen(&src, &sets, &column, &outputs))?;
+    serde_json::to_string(&s).map_err(|e| PlantwideError::new_err(e.to_string()))
+}
+
+/// The module `plantwide._plantwide`.
+#[pymodule]
+fn _plantwide(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = m.py();
+    m.add("PlantwideError", py.get_type::<PlantwideError>())?;
+    m.add("InputError", py.get_type::<InputError>())?;
+    m.add("ConvergenceError", py.get_type::<ConvergenceError>())?;
+    m.add_function(wrap_pyfunction!(read_text, m)?)?;
+    m.add_function(wrap_pyfunction!(check, m)?)?;
+    m.add_function(wrap_pyfunction!(steady, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep, m)?)?;
+    m.add_function(wrap_pyfunction!(gains, m)?)?;
+    m.add_function(wrap_pyfunction!(linearize, m)?)?;
+    m.add_function(wrap_pyfunction!(run, m)?)?;
+    m.add_function(wrap_pyfunction!(sensitivity, m)?)?;
+    m.add_function(wrap_pyfunction!(screen, m)?)?;
+    Ok(())
+}

@@ -1,0 +1,161 @@
+//! Plants loaded the way the CLI loads them, and the library calls behind each Python method.
+//! Every function here runs without the GIL (the callers in `lib.rs` detach) and touches no file:
+//! flowsheet and scenario text arrive read, so that a task sent to another process carries
+//! everything it needs.
+
+use plantwide_analysis::plant_model::{GainMethod, PlantGains, PlantModel, plant_gains};
+use plantwide_analysis::report::ReportOptions;
+use plantwide_analysis::select::{Signal, parse_pairing, select_output, select_outputs};
+use plantwide_analysis::sensitivity::{Curve, Disturbance, SweepSettings, sweep};
+use plantwide_flowsheet::scenario::{Limits, parse_scenario, resolve_with};
+use plantwide_flowsheet::{Override, Plant};
+use plantwide_solve::dynamic::{SimulationResult, Start, simulate};
+use plantwide_solve::{Method, Solution, StrategySettings, converge, fix_design_point};
+use plantwide_studies::screen::{ColumnScreen, screen_column};
+
+use crate::error::FaceError;
+
+/// A flowsheet's text and the name messages call it by (the path as given, as the CLI's).
+#[derive(Debug, Clone)]
+pub struct Source {
+    /// The flowsheet (JSON).
+    pub text: String,
+    /// Its name in messages.
+    pub name: String,
+}
+
+impl Source {
+    /// The plant with `sets` (`PATH=VALUE`, as `--set`) applied; design specs still to be met.
+    pub fn load(&self, sets: &[String]) -> Result<Plant, FaceError> {
+        let overrides = sets.iter().map(|s| s.parse::<Override>()).collect::<Result<Vec<_>, _>>()?;
+        Ok(plantwide_flowsheet::load_str_with(&self.text, &self.name, &overrides)?)
+    }
+
+    /// The plant at its design point (specs met, their inputs fixed) and its steady state there:
+    /// where `gains`, `linearize`, `run` and `sensitivity` start.
+    pub fn at_steady_state(&self, sets: &[String]) -> Result<(Plant, Solution), FaceError> {
+        let mut plant = self.load(sets)?;
+        fix_design_point(&mut plant)?;
+        let sol = converge(&plant, &StrategySettings::default())?;
+        Ok((plant, sol))
+    }
+}
+
+/// `--method`: `auto`, `eo` or `sm`.
+pub fn method(name: &str) -> Result<Method, FaceError> {
+    match name {
+        "auto" => Ok(Method::Auto),
+        "eo" => Ok(Method::Eo),
+        "sm" => Ok(Method::Sm),
+        _ => Err(FaceError::Input(format!("method `{name}`: expected `auto`, `eo` or `sm`"))),
+    }
+}
+
+/// A steady state as the Python face returns it: `(path, SI value)` of every variable and free
+/// input, and the warnings' messages.
+pub type Steady = (Vec<(String, f64)>, Vec<String>);
+
+/// `plantwide steady --set …`: every variable and free input (SI), and the warnings.
+pub fn steady(src: &Source, sets: &[String], method: Method) -> Result<Steady, FaceError> {
+    let plant = src.load(sets)?;
+    let sol = converge(&plant, &StrategySettings { method, ..StrategySettings::default() })?;
+    Ok((sol.values(&plant), sol.warnings.iter().map(|w| w.message.clone()).collect()))
+}
+
+/// The steady values of `outputs` (variables or free inputs) with `sets` applied.
+pub fn steady_outputs(
+    src: &Source,
+    sets: &[String],
+    outputs: &[String],
+    method: Method,
+) -> Result<Vec<f64>, FaceError> {
+    let (values, _) = steady(src, sets, method)?;
+    outputs
+        .iter()
+        .map(|o| match values.iter().rev().find(|(p, _)| p == o) {
+            Some((_, v)) => Ok(*v),
+            // Not a path of the steady state: the library says why, with the nearest names.
+            None => match src.load(sets).map(|p| select_output(&p, o).map(|_| ())) {
+                Ok(Err(e)) => Err(FaceError::input(e)),
+                Ok(Ok(())) | Err(_) => Err(FaceError::Input(format!("`{o}`: not a variable or free input"))),
+            },
+        })
+        .collect()
+}
+
+/// The chosen inputs and outputs (`PATH[@unit]`) of `plant`.
+fn signals(plant: &Plant, inputs: &[String], outputs: &[String]) -> Result<(Vec<Signal>, Vec<Signal>), FaceError> {
+    let i = plantwide_analysis::select::select_inputs(plant, inputs)?;
+    let o = select_outputs(plant, outputs)?;
+    Ok((i, o))
+}
+
+/// `plantwide gains`: the gain report by `method` (`pairing` as `--pairing`).
+pub fn gains(
+    src: &Source,
+    sets: &[String],
+    (inputs, outputs): (&[String], &[String]),
+    method: GainMethod,
+    pairing: Option<&str>,
+) -> Result<PlantGains, FaceError> {
+    let (plant, ss) = src.at_steady_state(sets)?;
+    let (ins, outs) = signals(&plant, inputs, outputs)?;
+    let pairing = pairing.map(|p| parse_pairing(p, outputs, inputs)).transpose()?;
+    let options = ReportOptions { pairing, ..ReportOptions::default() };
+    Ok(plant_gains(&plant, (&ss.x, &ss.u), (&ins, &outs), method, &options)?)
+}
+
+/// `plantwide linearize`: the model and its signals, with the plant's name.
+pub fn linearize(
+    src: &Source,
+    sets: &[String],
+    (inputs, outputs): (&[String], &[String]),
+) -> Result<(String, PlantModel, Vec<Signal>, Vec<Signal>), FaceError> {
+    let (plant, ss) = src.at_steady_state(sets)?;
+    let (ins, outs) = signals(&plant, inputs, outputs)?;
+    let model = PlantModel::at(&plant, (&ss.x, &ss.u), (&ins, &outs), &[])?;
+    Ok((plant.name().to_string(), model, ins, outs))
+}
+
+/// `plantwide run`: the scenario (text, named `scenario_name`) from the steady state.
+pub fn run(src: &Source, sets: &[String], scenario: &Source) -> Result<SimulationResult, FaceError> {
+    let (plant, ss) = src.at_steady_state(sets)?;
+    let spec = parse_scenario(&scenario.text, &scenario.name).map_err(FaceError::input)?;
+    let limits = Limits::from_env().map_err(FaceError::input)?;
+    let sc = resolve_with(&spec, &plant, &scenario.name, &limits).map_err(FaceError::input)?;
+    simulate(&plant, &sc, Start::Steady(&ss.x), "", &mut |_| {}).map_err(|e| {
+        let user = e.is_user_error();
+        FaceError::classify(e, user)
+    })
+}
+
+/// `plantwide sensitivity`: each `disturb` (`PATH=LOW:HIGH`) swept over `points` values.
+pub fn sensitivity(
+    src: &Source,
+    sets: &[String],
+    disturb: &[String],
+    outputs: &[String],
+    points: usize,
+) -> Result<(Vec<Curve>, Vec<Signal>), FaceError> {
+    let (plant, ss) = src.at_steady_state(sets)?;
+    let u = plant.input_values();
+    let disturbances = disturb.iter().map(|d| Disturbance::parse(&plant, &u, d)).collect::<Result<Vec<_>, _>>()?;
+    let outs = select_outputs(&plant, outputs)?;
+    let idx: Vec<usize> = outs.iter().map(|s| s.index).collect();
+    let settings = SweepSettings { points, ..SweepSettings::default() };
+    Ok((sweep(&plant, &ss.x, &ss.u, &disturbances, &idx, &settings)?, outs))
+}
+
+/// `plantwide screen --column`: the column's inventory configurations. As the CLI does, faer's
+/// kernels run sequentially meanwhile (the candidates run in parallel), so that no digit depends
+/// on the thread count; the process's setting is restored afterwards.
+pub fn screen(src: &Source, sets: &[String], column: &str, outputs: &[String]) -> Result<ColumnScreen, FaceError> {
+    use plantwide_analysis::faer::{Par, get_global_parallelism, set_global_parallelism};
+    let mut plant = src.load(sets)?;
+    fix_design_point(&mut plant)?;
+    let before = get_global_parallelism();
+    set_global_parallelism(Par::Seq);
+    let result = screen_column(&plant, column, outputs);
+    set_global_parallelism(before);
+    Ok(result?)
+}
