@@ -245,15 +245,7 @@ pub(super) fn time(text: &str, flag: &str) -> Result<f64, CliError> {
 
 /// `PATH` (+10 %) or `PATH=±x%`.
 pub(super) fn disturbance(text: &str) -> Result<Disturbance, CliError> {
-    let Some((path, step)) = text.split_once('=') else {
-        return Ok(Disturbance { path: text.trim().to_string(), fraction: 0.1 });
-    };
-    let pct =
-        step.trim().strip_suffix('%').and_then(|v| v.trim().parse::<f64>().ok()).filter(|v| v.is_finite() && *v != 0.0);
-    let Some(pct) = pct else {
-        return Err(CliError::user(format!("--disturbances {text}: expected PATH or PATH=±x% (e.g. fresh_A.F=+10%)")));
-    };
-    Ok(Disturbance { path: path.trim().to_string(), fraction: pct / 100.0 })
+    text.parse().map_err(CliError::user)
 }
 
 /// `PATH=LOW:HIGH`, the ends in the variable's unit (SI when bare).

@@ -155,6 +155,34 @@ fn screen(
     serde_json::to_string(&s).map_err(|e| PlantwideError::new_err(e.to_string()))
 }
 
+/// `plantwide screen --cvs … --mvs … --json` (`args`: the options as JSON), all of it, shard
+/// `(I, N)` of its dynamic tests (their results as JSON), or finished from the shards' results
+/// (`merged`: JSON by task number), which a Dask sweep gathers.
+#[pyfunction]
+#[pyo3(signature = (text, name, sets, args, shard = None, merged = None))]
+fn screen_pairings(
+    py: Python<'_>,
+    text: String,
+    name: String,
+    sets: Vec<String>,
+    args: String,
+    shard: Option<(usize, usize)>,
+    merged: Option<String>,
+) -> PyResult<String> {
+    let share = match (shard, merged) {
+        (Some(_), Some(_)) => return Err(InputError::new_err("screen_pairings: a shard or merged results, not both")),
+        (Some((index, count)), None) => {
+            let s: plantwide_analysis::shard::Shard =
+                format!("{index}/{count}").parse().map_err(|e| InputError::new_err(format!("{e}")))?;
+            plant::PairingShare::Shard(s)
+        }
+        (None, Some(m)) => plant::PairingShare::Merge(m),
+        (None, None) => plant::PairingShare::All,
+    };
+    let src = Source { text, name };
+    Ok(py.detach(|| plant::pairings(&src, &sets, &args, share))?)
+}
+
 /// The module `plantwide._plantwide`.
 #[pymodule]
 fn _plantwide(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -171,5 +199,6 @@ fn _plantwide(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(sensitivity, m)?)?;
     m.add_function(wrap_pyfunction!(screen, m)?)?;
+    m.add_function(wrap_pyfunction!(screen_pairings, m)?)?;
     Ok(())
 }

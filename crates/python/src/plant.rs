@@ -7,11 +7,14 @@ use plantwide_analysis::plant_model::{GainMethod, PlantGains, PlantModel, plant_
 use plantwide_analysis::report::ReportOptions;
 use plantwide_analysis::select::{Signal, parse_pairing, select_output, select_outputs};
 use plantwide_analysis::sensitivity::{Curve, Disturbance, SweepSettings, sweep};
+use plantwide_analysis::shard::{Shard, Share};
 use plantwide_flowsheet::scenario::{Limits, parse_scenario, resolve_with};
 use plantwide_flowsheet::{Override, Plant};
 use plantwide_solve::dynamic::{SimulationResult, Start, simulate};
 use plantwide_solve::{Method, Solution, StrategySettings, converge, fix_design_point};
-use plantwide_studies::screen::{ColumnScreen, screen_column};
+use plantwide_studies::screen::pairings::{self, CandidateTask, DynamicSettings, PairingRequest};
+use plantwide_studies::screen::{ColumnScreen, screen_column, screen_pairings};
+use plantwide_studies::tune::loops::Measurement;
 
 use crate::error::FaceError;
 
@@ -158,4 +161,104 @@ pub fn screen(src: &Source, sets: &[String], column: &str, outputs: &[String]) -
     let result = screen_column(&plant, column, outputs);
     set_global_parallelism(before);
     Ok(result?)
+}
+
+/// A pairing screen as Python asks for it (the CLI's `screen --cvs …` options by name).
+#[derive(Debug, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PairingArgs {
+    cvs: Vec<String>,
+    mvs: Vec<String>,
+    #[serde(default)]
+    throughput: Vec<String>,
+    #[serde(default)]
+    disturbances: Vec<String>,
+    candidates: usize,
+    duration: Option<String>,
+    measurement_dead_time: String,
+}
+
+/// How much of a pairing screen's dynamic tests this call runs.
+pub enum PairingShare {
+    /// All of them.
+    All,
+    /// Shard `I` of `N`.
+    Shard(Shard),
+    /// None: every task's result, as the shards returned them (JSON by task number).
+    Merge(String),
+}
+
+/// A time quantity of a pairing request (`duration`, `measurement_dead_time`).
+fn time(text: &str, field: &str) -> Result<f64, FaceError> {
+    plantwide_units::parse_quantity_as(text, plantwide_units::Dimension::TIME)
+        .map_err(|e| FaceError::Input(format!("{field} `{text}`: {e}")))
+}
+
+/// `plantwide screen --cvs … --mvs … --json`, or a shard of its dynamic tests: JSON text, the
+/// screen's (as the CLI prints it) or `{"tasks": N, "results": {t: …}}` for a shard. As the CLI
+/// does, faer's kernels run sequentially meanwhile (the candidates run in parallel), so that no
+/// digit depends on the thread count or on the shard a candidate ran in.
+pub fn pairings(src: &Source, sets: &[String], args: &str, share: PairingShare) -> Result<String, FaceError> {
+    use plantwide_analysis::faer::{Par, get_global_parallelism, set_global_parallelism};
+    let a: PairingArgs = serde_json::from_str(args).map_err(|e| FaceError::Input(format!("screen_pairings: {e}")))?;
+    let share = match share {
+        PairingShare::All => Share::All,
+        PairingShare::Shard(s) => Share::Shard(s),
+        PairingShare::Merge(text) => {
+            let given: std::collections::BTreeMap<usize, CandidateTask> = serde_json::from_str(&text)
+                .map_err(|e| FaceError::Input(format!("screen_pairings: the shards' results: {e}")))?;
+            Share::Merge(given.into_iter().map(|(t, c)| (t, c.into())).collect())
+        }
+    };
+    let merging = matches!(share, Share::Merge(_));
+    let request = PairingRequest {
+        disturbances: a
+            .disturbances
+            .iter()
+            .map(|d| d.parse::<pairings::Disturbance>())
+            .collect::<Result<_, _>>()
+            .map_err(FaceError::Input)?,
+        dynamic: DynamicSettings {
+            candidates: a.candidates,
+            duration: a.duration.as_deref().map(|d| time(d, "duration")).transpose()?,
+            measurement: Measurement { dead_time: time(&a.measurement_dead_time, "measurement_dead_time")?, lag: 0.0 },
+        },
+        cvs: a.cvs,
+        mvs: a.mvs,
+        throughput: a.throughput,
+        watch: Vec::new(),
+        record: Vec::new(),
+        mpc: None,
+        share,
+    };
+    let mut plant = src.load(sets)?;
+    fix_design_point(&mut plant)?;
+    let before = get_global_parallelism();
+    set_global_parallelism(Par::Seq);
+    let result = screen_pairings(&plant, &request);
+    set_global_parallelism(before);
+    let screen = result?;
+    if request.share.is_shard() {
+        let results: std::collections::BTreeMap<usize, CandidateTask> = screen
+            .tested
+            .iter()
+            .enumerate()
+            .filter_map(|(t, &k)| screen.structures[k].dynamic.as_ref().map(|d| (t, CandidateTask::from(d))))
+            .collect();
+        return to_json(&serde_json::json!({"tasks": screen.tested.len(), "results": results}));
+    }
+    if let Some(t) =
+        (0..screen.tested.len()).find(|&t| merging && screen.structures[screen.tested[t]].dynamic.is_none())
+    {
+        return Err(FaceError::Input(format!(
+            "screen_pairings: the shards' results miss task {t} of {}",
+            screen.tested.len()
+        )));
+    }
+    to_json(&screen)
+}
+
+/// `v` as JSON text.
+fn to_json(v: &impl serde::Serialize) -> Result<String, FaceError> {
+    serde_json::to_string(v).map_err(|e| FaceError::Input(e.to_string()))
 }

@@ -69,3 +69,22 @@ def test_screening_with_and_without_a_client(cluster_client, cli_json):
 def test_an_error_on_a_worker_reaches_the_client_as_the_same_exception(cluster_client):
     with pytest.raises(pw.InputError, match="feed_source.Fx"):
         pw.sweep(COLUMN_A, sets=[{}, {"feed_source.Fx": "1 kmol/min"}], outputs=OUTPUTS, client=cluster_client)
+
+
+def test_pairing_screen_on_a_cluster_equals_the_cli(cluster_client, cli_json):
+    """The dynamic tests split one shard per worker and scored together here give the CLI's
+    one-process screen: three throughput choices of column A with its quality loops, all tested."""
+    lv = COLUMN_A.replace("column_a.json", "column_a_lv.json")
+    cvs, mvs = ["distillate.x[light]", "bottoms.x[light]"], ["column.reflux", "column.boilup", "feed_source.F"]
+    opts = dict(throughput=mvs, disturbances=["feed_source.z[light]=+5%"], duration="100 min")
+    there = pw.screen_pairings(lv, cvs, mvs, client=cluster_client, **opts)
+    here = pw.screen_pairings(lv, cvs, mvs, **opts)
+    cli = cli_json(
+        ["screen", lv, "--cvs", ",".join(cvs), "--mvs", ",".join(mvs), "--throughput", ",".join(mvs),
+         "--disturbances", "feed_source.z[light]=+5%", "--duration", "100 min", "--json"]
+    )
+    assert there == cli and here == cli
+    tested = [s for s in cli["structures"] if s["dynamic"] is not None]
+    assert len(tested) == 3 and sorted(s["rank"] for s in tested) == [1, 2, 3]
+    # The best candidate scores 1 on the one CV pair it is best on everywhere; scores are relative.
+    assert min(s["dynamic"]["score"] for s in tested) >= 1.0

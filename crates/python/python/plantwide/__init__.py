@@ -15,7 +15,7 @@ value; an ill-posed plant), :class:`ConvergenceError` where it exits 2, with the
 
 from ._plantwide import ConvergenceError, InputError, PlantwideError
 from .plant import Gains, LinearModel, Plant, SteadyState, load
-from .sweeps import screen, sensitivity, sweep
+from .sweeps import screen, screen_pairings, sensitivity, sweep
 
 __all__ = [
     "ConvergenceError",
@@ -27,6 +27,7 @@ __all__ = [
     "SteadyState",
     "load",
     "screen",
+    "screen_pairings",
     "sensitivity",
     "sweep",
 ]

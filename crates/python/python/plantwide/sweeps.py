@@ -107,3 +107,52 @@ def screen(
     if client is None:
         return [_screen_task(*a) for a in args]
     return _gather(client, _screen_task, args)
+
+
+def _pairing_shard_task(text: str, name: str, sets: list[str], args: str, shard: tuple[int, int]) -> dict:
+    """One shard of a pairing screen's dynamic tests (runs on a worker)."""
+    return json.loads(_native.screen_pairings(text, name, sets, args, shard))
+
+
+def screen_pairings(
+    path: str | os.PathLike | Plant,
+    cvs: Sequence[str],
+    mvs: Sequence[str],
+    *,
+    throughput: Sequence[str] = (),
+    disturbances: Sequence[str] = (),
+    candidates: int = 4,
+    duration: str | None = None,
+    measurement_dead_time: str = "1 min",
+    set: Mapping[str, Any] | None = None,
+    client=None,
+) -> dict:
+    """``plantwide screen --cvs … --mvs … --json``: the pairings of ``cvs`` to ``mvs`` filtered at
+    steady state and the best ``candidates`` tested dynamically (each disturbance ``PATH`` or
+    ``PATH=±x%`` stepped on the nonlinear plant). With ``client``, the dynamic tests are split
+    into one shard per worker (as ``--shard I/N``), run on the cluster, and scored together here
+    (as ``plantwide merge``): the result equals the one-process screen."""
+    text, name = _source(path)
+    sets = assignments(set)
+    args = json.dumps(
+        {
+            "cvs": list(cvs),
+            "mvs": list(mvs),
+            "throughput": list(throughput),
+            "disturbances": list(disturbances),
+            "candidates": int(candidates),
+            "duration": duration,
+            "measurement_dead_time": measurement_dead_time,
+        }
+    )
+    if client is None or not disturbances:
+        return json.loads(_native.screen_pairings(text, name, sets, args))
+    n = max(1, min(int(candidates), len(client.scheduler_info()["workers"])))
+    parts = _gather(client, _pairing_shard_task, [(text, name, sets, args, (i, n)) for i in range(n)])
+    merged: dict[str, Any] = {}
+    for p in parts:
+        merged.update(p["results"])
+    tasks = parts[0]["tasks"]
+    if sorted(int(t) for t in merged) != list(range(tasks)):
+        raise RuntimeError(f"screen_pairings: the shards returned tasks {sorted(merged)} of {tasks}")
+    return json.loads(_native.screen_pairings(text, name, sets, args, None, json.dumps(merged)))

@@ -48,6 +48,26 @@ pub struct Disturbance {
     pub fraction: f64,
 }
 
+impl std::str::FromStr for Disturbance {
+    type Err = String;
+
+    /// `PATH` (a +10 % step) or `PATH=±x%`; the error is the message for `--disturbances`.
+    fn from_str(text: &str) -> Result<Self, Self::Err> {
+        let Some((path, step)) = text.split_once('=') else {
+            return Ok(Disturbance { path: text.trim().to_string(), fraction: 0.1 });
+        };
+        let pct = step
+            .trim()
+            .strip_suffix('%')
+            .and_then(|v| v.trim().parse::<f64>().ok())
+            .filter(|v| v.is_finite() && *v != 0.0);
+        match pct {
+            Some(pct) => Ok(Disturbance { path: path.trim().to_string(), fraction: pct / 100.0 }),
+            None => Err(format!("--disturbances {text}: expected PATH or PATH=±x% (e.g. fresh_A.F=+10%)")),
+        }
+    }
+}
+
 /// What to screen.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PairingRequest {
