@@ -11,14 +11,12 @@ use serde_json::{Value, json};
 pub fn describe(plant: &Plant, paths: &[String]) -> Value {
     let units: Vec<usize> = (0..plant.blocks().len()).filter(|&b| plant.blocks()[b].kind == BlockKind::Unit).collect();
     let depth = depths(plant);
-    let mut rows = vec![0usize; plant.blocks().len() + 1];
+    let row = rows(plant, &units, &depth);
     let units_json: Vec<Value> = units
         .iter()
         .map(|&b| {
-            let d = depth[b];
-            let row = rows[d];
-            rows[d] += 1;
-            json!({ "name": plant.blocks()[b].name, "type": plant.blocks()[b].unit.type_name(), "col": d, "row": row })
+            let (name, kind) = (&plant.blocks()[b].name, plant.blocks()[b].unit.type_name());
+            json!({ "name": name, "type": kind, "col": depth[b], "row": row[b] })
         })
         .collect();
     let streams: Vec<Value> = plant
@@ -52,6 +50,27 @@ pub fn describe(plant: &Plant, paths: &[String]) -> Value {
         "si_units": si,
         "trend": default_trend(plant),
     })
+}
+
+/// Each unit's row within its column: ordered by where its stream leaves the column before
+/// (that unit's row, then its outlet port), so that a column's distillate (port 0) goes to the
+/// unit drawn above the one its bottoms go to and no two streams from one unit cross; units fed
+/// from no earlier column keep the file's order.
+fn rows(plant: &Plant, units: &[usize], depth: &[usize]) -> Vec<usize> {
+    let mut row = vec![0usize; plant.blocks().len()];
+    let deepest = units.iter().map(|&b| depth[b]).max().unwrap_or(0);
+    for d in 0..=deepest {
+        let mut here: Vec<usize> = units.iter().copied().filter(|&b| depth[b] == d).collect();
+        let key = |b: usize| {
+            let upstream = plant.streams().iter().filter(|s| s.to.0 == b && depth[s.from.0] < d);
+            upstream.map(|s| (row[s.from.0], s.from.1)).min().unwrap_or((0, 0))
+        };
+        here.sort_by_key(|&b| key(b));
+        for (r, &b) in here.iter().enumerate() {
+            row[b] = r;
+        }
+    }
+    row
 }
 
 /// Each block's distance (in streams) from a unit without inlets.

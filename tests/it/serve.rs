@@ -223,6 +223,16 @@ fn serve_streams_trend_samples_to_several_clients() {
     let t: Vec<f64> = a.1.iter().map(|v| v["t"].as_f64().expect("t")).collect();
     assert!(t.windows(2).all(|w| w[1] >= w[0]) && t[2] > t[0], "time runs: {t:?}");
     assert_eq!(a.1[0]["v"].as_array().expect("values").len(), 2);
+    // The drawing: the column's distillate (its first outlet) goes to the unit drawn above the one
+    // its bottoms go to, so the two product lines do not cross (the blocks come in name order).
+    let plant = s.get("/api/plant");
+    let at = |name: &str| {
+        let u = plant["units"].as_array().expect("units").iter().find(|u| u["name"] == name).expect("unit");
+        (u["col"].as_u64().expect("col"), u["row"].as_u64().expect("row"))
+    };
+    let (top, bottom) = (at("top_product"), at("bottom_product"));
+    assert_eq!(top.0, bottom.0);
+    assert!(top.1 < bottom.1, "top_product {top:?}, bottom_product {bottom:?}");
 }
 
 #[test]
