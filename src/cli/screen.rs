@@ -302,6 +302,7 @@ fn pairings(a: &ScreenArgs, plant: &plantwide::flowsheet::Plant, system: UnitSys
             .filter_map(|(t, &k)| screen.structures[k].dynamic.as_ref().map(|d| (t, CandidateTask::from(d))));
         return a.shard.write_part("screen", &a.file, screen.tested.len(), done);
     }
+    a.shard.check_merged(screen.tested.len())?;
     let watched = request.watch.iter().map(|w| (w.path.clone(), None));
     let shown = Shown::new(std::slice::from_ref(plant), cvs.iter().cloned().chain(watched), system)?;
     let json = serde_json::to_string_pretty(&screen).map_err(|e| CliError::user(e.to_string()))?;

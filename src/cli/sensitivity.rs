@@ -68,6 +68,7 @@ pub fn run(a: &SensitivityArgs, units: UnitSystem) -> Result<(), CliError> {
     let ss = converge(&plant, &u)?;
     let settings = SweepSettings { points: a.points, ..SweepSettings::default() };
     let idx: Vec<usize> = outputs.iter().map(|s| s.index).collect();
+    a.shard.check_merged(2 * disturbances.len())?;
     let share = a.shard.share::<Walk>()?;
     let walks = walks(&plant, &ss.x, &ss.u, &disturbances, &idx, &settings, &share).map_err(analysis_error)?;
     if share.is_shard() {

@@ -57,6 +57,18 @@ impl ShardArgs {
         Ok(self.shard.map_or(Share::All, Share::Shard))
     }
 
+    /// When merging, that the parts hold exactly the job's `tasks` tasks (a part file edited by
+    /// hand could claim another count than the command line gives).
+    pub fn check_merged(&self, tasks: usize) -> Result<(), CliError> {
+        match &self.merged {
+            Some(given) if given.len() != tasks || given.keys().any(|&t| t >= tasks) => Err(CliError::user(format!(
+                "merge: the parts hold {} task results, but the command line makes {tasks} tasks; run the shards again",
+                given.len()
+            ))),
+            _ => Ok(()),
+        }
+    }
+
     /// Whether this process is a shard.
     pub fn is_shard(&self) -> bool {
         self.shard.is_some()

@@ -170,6 +170,16 @@ fn parts_that_do_not_make_one_job_are_refused_by_name() {
         &["screen", fs, "--column", "column", "--outputs", "distillate.x[light],bottoms.x[light]", "--shard", "0/2"],
         "drop --shard",
     );
+    // Parts edited by hand to claim fewer tasks than the command line makes.
+    for (from, to, drop) in [("a0.json", "c0.json", None), ("a1.json", "c1.json", Some("1"))] {
+        let mut p: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join(from)).unwrap()).unwrap();
+        p["tasks"] = 1.into();
+        if let Some(t) = drop {
+            p["results"].as_object_mut().unwrap().remove(t);
+        }
+        std::fs::write(dir.join(to), p.to_string()).unwrap();
+    }
+    refused(&["merge", "c0.json", "c1.json"], "the parts hold 1 task results, but the command line makes 2 tasks");
     // The flowsheet edited between the shards and the merge.
     let text = std::fs::read_to_string(fs).unwrap();
     std::fs::write(fs, format!("{text}\n")).unwrap();
