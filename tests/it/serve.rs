@@ -25,7 +25,13 @@ struct Server {
 
 impl Server {
     fn start(file: &str, extra: &[&str]) -> Server {
+        Server::start_with(file, extra, &[])
+    }
+
+    /// [`Server::start`] with environment variables set.
+    fn start_with(file: &str, extra: &[&str], env: &[(&str, &str)]) -> Server {
         let mut child = command()
+            .envs(env.iter().copied())
             .args(["serve", file, "--port", "0", "--exit-after", "900"])
             .args(extra)
             .stdout(Stdio::piped())
@@ -314,4 +320,14 @@ fn a_live_feed_step_equals_the_scenario_run_and_settles_on_the_steady_state() {
         (live_xb - steady_xb).abs()
     );
     assert!((live_xb - steady_xb).abs() <= 1e-6 * steady_xb, "xB {live_xb} against the steady state {steady_xb}");
+}
+
+#[test]
+fn the_live_journal_holds_no_more_events_than_a_scenario_may() {
+    // PLANTWIDE_MAX_EVENTS bounds what a command can make the server keep: the journal is a scenario.
+    let s = Server::start_with(&flowsheet("column_a.json"), &["--paused"], &[("PLANTWIDE_MAX_EVENTS", "2")]);
+    s.ok(json!({"set": {"feed_source.F": "1.01 kmol/min"}}));
+    s.ok(json!({"set": {"column.reflux": "2.7 kmol/min"}}));
+    refused(&s, r#"{"set": {"column.boilup": "3.2 kmol/min"}}"#, "journal holds 2 events, the most a scenario may");
+    assert_eq!(s.get("/api/state")["running"], json!(false), "the run goes on, paused as it was");
 }

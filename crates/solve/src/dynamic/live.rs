@@ -189,6 +189,17 @@ impl Live {
             PlantCommand::Mode { controller, mode } => EventSpec::Mode { at: zero, controller, mode, output: None },
             PlantCommand::Event(e) => at_time(e, 0.0),
         };
+        // The journal is a scenario file: it may hold no more events than a scenario may.
+        let limits = plantwide_model::limits::Limits::get();
+        let held: usize = self.journal.iter().chain(&self.pending).map(|q| q.events.len()).sum();
+        if held >= limits.max_events {
+            return Err(LiveError::Refused(format!(
+                "the live run's journal holds {held} events, the most a scenario may ({} = {}); save a snapshot's \
+                 journal if needed and restart the server to command it further",
+                plantwide_model::limits::Limits::MAX_EVENTS,
+                limits.max_events
+            )));
+        }
         let events = self.resolve_one(&spec)?;
         let target = events.first().map(|e| e.action.target());
         self.pending.retain(|q| q.events.first().map(|e| e.action.target()) != target);
