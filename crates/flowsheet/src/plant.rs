@@ -236,7 +236,7 @@ impl Plant {
 
     /// Residuals `f(x, u)` at time `t` into `r` (length `n_eqs`).
     pub fn residual(&self, x: &[f64], u: &[f64], t: f64, r: &mut [f64]) {
-        let mut local = Vec::new();
+        let mut local = Vec::with_capacity(self.blocks.iter().map(|b| b.layout.len()).max().unwrap_or(0));
         for b in &self.blocks {
             self.gather(b, x, u, &mut local);
             let io = UnitIo { local: &local, layout: &b.layout, thermo: &self.thermo, time: t };
@@ -329,10 +329,26 @@ impl Plant {
         let mut local = Vec::new();
         self.gather(b, x, u, &mut local);
         let n = local.len();
-        let mut jac = vec![0.0; b.n_eq * n];
-        let mut out = BlockJacobian { r: vec![0.0; b.n_eq], jx: Vec::new(), ju: Vec::new() };
-        let io = UnitIo { local: &local, layout: &b.layout, thermo: &self.thermo, time: t };
-        unit.jacobian_colored(&io, &mut out.r, &mut jac, b.coloring.as_ref());
+        DENSE_JACOBIAN.with_borrow_mut(|jac| {
+            // With a colouring only the declared entries are written and read: the buffer is reused
+            // as it is (a column's block is 1.5 MB, zeroed at every evaluation it was a tenth of a
+            // dynamic run). Without one every entry is written.
+            let need = b.n_eq * n;
+            if jac.len() < need {
+                jac.resize(need, 0.0);
+            }
+            self.block_entries(b, unit, &local, t, &mut jac[..need])
+        })
+    }
+
+    /// [`Plant::block_jacobian`] on the gathered `local` vector with `jac` (`n_eq × local.len()`,
+    /// row-major) as the unit's dense Jacobian buffer.
+    fn block_entries(&self, b: &Block, unit: &dyn Unit, local: &[f64], t: f64, jac: &mut [f64]) -> BlockJacobian {
+        let n = local.len();
+        let cap = b.pattern.as_ref().map_or(b.n_eq * n, Vec::len);
+        let mut out = BlockJacobian { r: vec![0.0; b.n_eq], jx: Vec::with_capacity(cap), ju: Vec::new() };
+        let io = UnitIo { local, layout: &b.layout, thermo: &self.thermo, time: t };
+        unit.jacobian_colored(&io, &mut out.r, jac, b.coloring.as_ref());
         let n_own = b.layout.n_own();
         let mut push = |k: usize, j: usize| {
             let (row, v) = (b.eq_offset + k, jac[k * n + j]);
@@ -351,6 +367,11 @@ impl Plant {
         }
         out
     }
+}
+
+thread_local! {
+    /// The dense block Jacobian buffer of [`Plant::block_jacobian`], one per thread.
+    static DENSE_JACOBIAN: std::cell::RefCell<Vec<f64>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
 /// Work (Σ equations × local length) above which block Jacobians are evaluated in parallel.

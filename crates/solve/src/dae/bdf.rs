@@ -35,7 +35,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{DaeError, DaeIntegrator, DaeSystem, consistent_algebraic, rms};
+use super::{DaeError, DaeIntegrator, DaeSystem, consistent_algebraic, rms, rms_of};
 use crate::sparse::SparseLu;
 
 /// Highest order.
@@ -118,6 +118,14 @@ pub struct BdfState {
     pub current_jac: bool,
     /// `c = h/γ_q` of the held LU factors, if any.
     pub lu_c: Option<f64>,
+    /// The held factors' row permutation ([`SparseLu::pivots`]): factors are refactorized on held
+    /// pivots, so a restored run needs them to factorize exactly as the interrupted one. Filled by
+    /// [`Bdf::state`]; empty in snapshots written before it existed.
+    #[serde(default)]
+    pub lu_pivots: Vec<usize>,
+    /// The held factors' live pattern ([`SparseLu::live_slots`]), for the same reason.
+    #[serde(default)]
+    pub lu_live: Vec<bool>,
     /// Counters.
     pub stats: BdfStats,
 }
@@ -137,12 +145,15 @@ pub struct Bdf {
     diff_var: Vec<usize>,
     /// Whether `st.jac` is the matrix loaded into the LU (a new Jacobian must be loaded again).
     jac_loaded: bool,
+    /// `atol · nominal_i`: the absolute part of each variable's error weight.
+    abs_weight: Vec<f64>,
+    w: Work,
 }
 
 /// `R(ρ)` of the module documentation, `(order+1)²` row-major.
-fn compute_r(order: usize, factor: f64) -> Vec<f64> {
+fn compute_r(order: usize, factor: f64) -> [f64; (MAX_ORDER + 1) * (MAX_ORDER + 1)] {
     let n = order + 1;
-    let mut m = vec![0.0; n * n];
+    let mut m = [0.0; (MAX_ORDER + 1) * (MAX_ORDER + 1)];
     m[..n].fill(1.0);
     for i in 1..n {
         for j in 1..n {
@@ -158,21 +169,21 @@ fn compute_r(order: usize, factor: f64) -> Vec<f64> {
     m
 }
 
-/// Re-interpolate the differences `d[0..=order]` for a step changed by `factor`.
-fn change_d(d: &mut [Vec<f64>], order: usize, factor: f64) {
+/// Re-interpolate the differences `d[0..=order]` for a step changed by `factor` (`scratch`: at
+/// least `order + 1` rows of the state's length, overwritten).
+fn change_d(d: &mut [Vec<f64>], order: usize, factor: f64, scratch: &mut [Vec<f64>]) {
     let n = order + 1;
     let r = compute_r(order, factor);
     let u = compute_r(order, 1.0);
-    let mut ru = vec![0.0; n * n];
+    let mut ru = [0.0; (MAX_ORDER + 1) * (MAX_ORDER + 1)];
     for i in 0..n {
         for j in 0..n {
             ru[i * n + j] = (0..n).map(|k| r[i * n + k] * u[k * n + j]).sum();
         }
     }
-    let len = d[0].len();
-    let mut out = vec![vec![0.0; len]; n];
     // D[:n] = RUᵀ D[:n]: out[j] = Σ_i RU[i][j] D[i].
-    for (j, o) in out.iter_mut().enumerate() {
+    for (j, o) in scratch.iter_mut().enumerate().take(n) {
+        o.iter_mut().for_each(|v| *v = 0.0);
         for (i, di) in d.iter().enumerate().take(n) {
             let c = ru[i * n + j];
             if c != 0.0 {
@@ -180,29 +191,31 @@ fn change_d(d: &mut [Vec<f64>], order: usize, factor: f64) {
             }
         }
     }
-    for (di, o) in d.iter_mut().zip(out) {
-        *di = o;
+    for (di, o) in d.iter_mut().zip(scratch.iter_mut()).take(n) {
+        std::mem::swap(di, o);
     }
 }
 
-/// One corrector problem: at `t_new`, from the predictor `x_pred`, with `c = h/γ_q`, `ψ`, the
-/// error weights `scale` and the Newton tolerance `tol`.
-/// A converged corrector: the Newton iterations it took, the new state and the correction
-/// `d = x − x⁽⁰⁾`.
-struct Corrected {
-    iters: usize,
+/// The vectors of a step, held between steps (no allocation per step): the predictor `x⁽⁰⁾`, `ψ`,
+/// the error weights, the iterate `x`, the correction `d = x − x⁽⁰⁾`, `f(t, x)` and the Newton
+/// right-hand side; `diffs` is the scratch of [`change_d`].
+#[derive(Debug, Default)]
+struct Work {
+    x_pred: Vec<f64>,
+    psi: Vec<f64>,
+    scale: Vec<f64>,
     x: Vec<f64>,
     d: Vec<f64>,
+    f: Vec<f64>,
+    rhs: Vec<f64>,
+    diffs: Vec<Vec<f64>>,
 }
 
-#[derive(Clone, Copy)]
-struct Corrector<'a> {
-    t_new: f64,
-    x_pred: &'a [f64],
-    c: f64,
-    psi: &'a [f64],
-    scale: &'a [f64],
-    tol: f64,
+impl Work {
+    fn new(n: usize) -> Work {
+        let v = || vec![0.0; n];
+        Work { x_pred: v(), psi: v(), scale: v(), x: v(), d: v(), f: v(), rhs: v(), diffs: vec![v(); MAX_ORDER + 1] }
+    }
 }
 
 impl Bdf {
@@ -226,6 +239,8 @@ impl Bdf {
             jac: Vec::new(),
             current_jac: false,
             lu_c: None,
+            lu_pivots: Vec::new(),
+            lu_live: Vec::new(),
             stats: BdfStats::default(),
         };
         Bdf {
@@ -238,6 +253,8 @@ impl Bdf {
             all: Vec::new(),
             diff_var: Vec::new(),
             jac_loaded: false,
+            abs_weight: Vec::new(),
+            w: Work::default(),
         }
     }
 
@@ -257,8 +274,11 @@ impl Bdf {
     }
 
     /// The full state, for a snapshot.
-    pub fn state(&self) -> &BdfState {
-        &self.st
+    pub fn state(&self) -> BdfState {
+        let mut st = self.st.clone();
+        st.lu_pivots = self.lu.pivots().map(<[usize]>::to_vec).unwrap_or_default();
+        st.lu_live = self.lu.live_slots().to_vec();
+        st
     }
 
     /// Continue from a saved state (the same system): the trajectory continues exactly as it would
@@ -275,8 +295,13 @@ impl Bdf {
         self.st = state;
         self.lu.invalidate();
         if let Some(c) = self.st.lu_c {
-            self.factor(n, sys, c)?;
-            self.st.stats.n_lu -= 1;
+            let (pivots, live) = (std::mem::take(&mut self.st.lu_pivots), std::mem::take(&mut self.st.lu_live));
+            let time = self.st.t;
+            let err = |source| DaeError::Singular { time, source };
+            self.lu.load_with_live(n, &self.st.jac, sys.mass(), &live).map_err(err)?;
+            self.jac_loaded = true;
+            let entry = Self::entry(&self.diff_var, c);
+            self.lu.factor_mapped_on(entry, &pivots).map_err(err)?;
         }
         Ok(())
     }
@@ -288,13 +313,17 @@ impl Bdf {
         self.diff_var = vec![usize::MAX; n];
         sys.mass().iter().for_each(|&(i, j)| self.diff_var[i] = j);
         self.jac_loaded = false;
+        self.abs_weight = (0..n).map(|i| self.settings.atol * sys.nominal(i).abs().max(1e-300)).collect();
+        if self.w.x.len() != n {
+            self.w = Work::new(n);
+        }
     }
 
-    fn scale(&self, sys: &dyn DaeSystem, x: &[f64]) -> Vec<f64> {
-        x.iter()
-            .enumerate()
-            .map(|(i, v)| self.settings.atol * sys.nominal(i).abs().max(1e-300) + self.settings.rtol * v.abs())
-            .collect()
+    /// The error weights `atol·nominal_i + rtol·|x_i|` into `out`.
+    fn scale_into(abs_weight: &[f64], rtol: f64, x: &[f64], out: &mut [f64]) {
+        for ((o, a), v) in out.iter_mut().zip(abs_weight).zip(x) {
+            *o = a + rtol * v.abs();
+        }
     }
 
     /// Factorize `M − cJ` (algebraic rows: `−J`). The Jacobian is loaded into the LU once per
@@ -306,16 +335,20 @@ impl Bdf {
             self.lu.load_pinned(n, &self.st.jac, sys.mass()).map_err(|source| DaeError::Singular { time, source })?;
             self.jac_loaded = true;
         }
-        let diff_var = &self.diff_var;
-        let entry = |i: usize, j: usize, v: f64| match diff_var[i] {
-            usize::MAX => -v,
-            m if m == j => 1.0 - c * v,
-            _ => -c * v,
-        };
+        let entry = Self::entry(&self.diff_var, c);
         self.lu.factor_mapped(entry).map_err(|source| DaeError::Singular { time, source })?;
         self.st.lu_c = Some(c);
         self.st.stats.n_lu += 1;
         Ok(())
+    }
+
+    /// The entry of `M − cJ` (algebraic rows: `−J`) at `(i, j)` for `J_ij = v`.
+    fn entry(diff_var: &[usize], c: f64) -> impl Fn(usize, usize, f64) -> f64 + '_ {
+        move |i: usize, j: usize, v: f64| match diff_var[i] {
+            usize::MAX => -v,
+            m if m == j => 1.0 - c * v,
+            _ => -c * v,
+        }
     }
 
     /// Simplified Newton for the corrector; returns (converged, iterations, x, d). The held
@@ -323,53 +356,51 @@ impl Bdf {
     /// differential rows' residual is then taken at `c_lu` and the correction scaled by
     /// `2/(1 + c_lu/c)`, as SUNDIALS IDA does with its `cj` ratio (Hindmarsh et al. 2005, §3.1 of
     /// the IDA documentation), so that stiff and non-stiff directions err equally.
-    fn newton(&mut self, sys: &dyn DaeSystem, corr: &Corrector<'_>) -> (bool, usize, Vec<f64>, Vec<f64>) {
-        let Corrector { t_new, x_pred, c, psi, scale, tol } = *corr;
-        let n = x_pred.len();
+    fn newton(&mut self, sys: &dyn DaeSystem, t_new: f64, c: f64, tol: f64) -> (bool, usize) {
         let c_lu = self.st.lu_c.unwrap_or(c);
         let (ratio, damping) = (c_lu / c, 2.0 / (1.0 + c_lu / c));
-        let mut x = x_pred.to_vec();
-        let mut d = vec![0.0; n];
-        let mut f = vec![0.0; n];
-        let mut rhs = vec![0.0; n];
+        let w = &mut self.w;
+        w.x.copy_from_slice(&w.x_pred);
+        w.d.iter_mut().for_each(|v| *v = 0.0);
         let mut dy_norm_old: Option<f64> = None;
-        let mut iters = 0;
         // The rounding level of a correction (at most `tol`): below it the iterate cannot improve,
         // and the rate of two such corrections is noise of any size (often ≥ 1, read as divergence
         // at every step size). Above `1e-4 · tol` only for rtol < 4e-7 (it is ≤ 100ε/rtol).
-        let floor: Vec<f64> = x_pred.iter().map(|v| ROUNDOFF_ULPS * f64::EPSILON * v.abs()).collect();
-        let roundoff = rms(&floor, scale, &self.all).min(tol);
+        let roundoff =
+            rms_of(w.x_pred.iter().map(|v| ROUNDOFF_ULPS * f64::EPSILON * v.abs()), &w.scale, &self.all).min(tol);
         for k in 0..NEWTON_MAXITER {
-            iters = k + 1;
-            sys.residual(t_new, &x, &mut f);
+            let iters = k + 1;
+            sys.residual(t_new, &w.x, &mut w.f);
             self.st.stats.n_residual_evals += 1;
             self.st.stats.n_newton_iters += 1;
-            if !f.iter().all(|v| v.is_finite()) {
-                return (false, iters, x, d);
+            if !w.f.iter().all(|v| v.is_finite()) {
+                return (false, iters);
             }
-            for i in 0..n {
-                rhs[i] = match self.diff_var[i] {
-                    usize::MAX => f[i],
-                    j => ratio * (c * f[i] - psi[j] - d[j]),
+            for (i, r) in w.rhs.iter_mut().enumerate() {
+                *r = match self.diff_var[i] {
+                    usize::MAX => w.f[i],
+                    j => ratio * (c * w.f[i] - w.psi[j] - w.d[j]),
                 };
             }
-            if self.lu.solve_in_place(&mut rhs).is_err() {
-                return (false, iters, x, d);
+            if self.lu.solve_in_place(&mut w.rhs).is_err() {
+                return (false, iters);
             }
             if ratio != 1.0 {
-                rhs.iter_mut().for_each(|v| *v *= damping);
+                w.rhs.iter_mut().for_each(|v| *v *= damping);
             }
-            let dy_norm = rms(&rhs, scale, &self.all);
+            let dy_norm = rms(&w.rhs, &w.scale, &self.all);
             let rate = dy_norm_old.map(|old| dy_norm / old);
             let at_roundoff = dy_norm <= roundoff;
             if !at_roundoff
                 && let Some(rate) = rate
                 && (rate >= 1.0 || rate.powi((NEWTON_MAXITER - k) as i32) / (1.0 - rate) * dy_norm > tol)
             {
-                return (false, iters, x, d);
+                return (false, iters);
             }
-            x.iter_mut().zip(&rhs).for_each(|(a, b)| *a += b);
-            d.iter_mut().zip(&rhs).for_each(|(a, b)| *a += b);
+            for ((x, d), r) in w.x.iter_mut().zip(w.d.iter_mut()).zip(&w.rhs) {
+                *x += r;
+                *d += r;
+            }
             // A first correction far below the tolerance means the prediction already solves the
             // corrector (e.g. a step from an exact steady state): the next correction would be
             // round-off, and the rate of two round-off corrections says nothing (≈ 1, read as
@@ -377,11 +408,11 @@ impl Bdf {
             // at tight tolerances that is below rounding, hence also `at_roundoff`.
             let negligible = k == 0 && dy_norm <= 1e-4 * tol;
             if at_roundoff || negligible || rate.is_some_and(|rate| rate / (1.0 - rate) * dy_norm < tol) {
-                return (true, iters, x, d);
+                return (true, iters);
             }
             dy_norm_old = Some(dy_norm);
         }
-        (false, iters, x, d)
+        (false, NEWTON_MAXITER)
     }
 
     /// The planned step size brought within `[min_step, max_step]` (the differences re-interpolated
@@ -390,11 +421,11 @@ impl Bdf {
         let max_step = self.settings.max_step;
         let mut h_abs = self.st.h_abs;
         if h_abs > max_step {
-            change_d(&mut self.st.d, self.st.order, max_step / h_abs);
+            change_d(&mut self.st.d, self.st.order, max_step / h_abs, &mut self.w.diffs);
             h_abs = max_step;
             self.st.n_equal_steps = 0;
         } else if h_abs < min_step {
-            change_d(&mut self.st.d, self.st.order, min_step / h_abs);
+            change_d(&mut self.st.d, self.st.order, min_step / h_abs, &mut self.w.diffs);
             h_abs = min_step;
             self.st.n_equal_steps = 0;
         }
@@ -404,20 +435,20 @@ impl Bdf {
     /// Multiply the step `h_abs` by `factor` and re-interpolate the differences of `order`.
     fn scale_step(&mut self, h_abs: &mut f64, order: usize, factor: f64) {
         *h_abs *= factor;
-        change_d(&mut self.st.d, order, factor);
+        change_d(&mut self.st.d, order, factor, &mut self.w.diffs);
         self.st.n_equal_steps = 0;
     }
 
     /// Attempt steps from the current time, shrinking `h_abs` after a Newton failure or a failed
-    /// error test, until one is accepted; returns (its end time, the new state, the correction `d`,
-    /// the Newton iterations).
+    /// error test, until one is accepted; returns its end time and Newton iterations (the new
+    /// state in `w.x`, the correction `d` in `w.d`).
     fn accepted_step(
         &mut self,
         sys: &dyn DaeSystem,
         t_stop: f64,
         min_step: f64,
         h_abs: &mut f64,
-    ) -> Result<(f64, Vec<f64>, Vec<f64>, usize), DaeError> {
+    ) -> Result<(f64, usize), DaeError> {
         let t = self.st.t;
         let order = self.st.order;
         let rtol = self.settings.rtol;
@@ -431,25 +462,25 @@ impl Bdf {
             if t_new >= t_stop {
                 t_new = t_stop;
                 let factor = (t_new - t) / *h_abs;
-                change_d(&mut self.st.d, order, factor);
+                change_d(&mut self.st.d, order, factor, &mut self.w.diffs);
                 self.st.n_equal_steps = 0;
                 *h_abs = t_new - t;
             }
             let h = t_new - t;
-            let (x_pred, psi) = self.predict(order);
-            let scale = self.scale(sys, &x_pred);
+            self.predict(order);
+            Self::scale_into(&self.abs_weight, rtol, &self.w.x_pred, &mut self.w.scale);
             let c = h / self.gamma[order];
-            let corrector = Corrector { t_new, x_pred: &x_pred, c, psi: &psi, scale: &scale, tol: newton_tol };
-            let Some(Corrected { iters, x: x_new, d }) = self.correct(sys, &corrector, &mut lu_ok)? else {
+            let Some(iters) = self.correct(sys, t_new, c, newton_tol, &mut lu_ok)? else {
                 self.st.stats.n_newton_failures += 1;
                 self.scale_step(h_abs, order, 0.5);
                 lu_ok = false;
                 continue;
             };
             let safety = 0.9 * (2 * NEWTON_MAXITER + 1) as f64 / (2 * NEWTON_MAXITER + iters) as f64;
-            let scale = self.scale(sys, &x_new);
-            let err: Vec<f64> = d.iter().map(|v| self.error_const[order] * v).collect();
-            let error_norm = rms(&err, &scale, &self.controlled);
+            let w = &mut self.w;
+            Self::scale_into(&self.abs_weight, rtol, &w.x, &mut w.scale);
+            let e = self.error_const[order];
+            let error_norm = rms_of(w.d.iter().map(|v| e * v), &w.scale, &self.controlled);
             if error_norm > 1.0 {
                 self.st.stats.n_error_test_failures += 1;
                 let factor = MIN_FACTOR.max(safety * error_norm.powf(-1.0 / (order as f64 + 1.0)));
@@ -457,51 +488,52 @@ impl Bdf {
                 self.scale_step(h_abs, order, factor);
                 continue;
             }
-            return Ok((t_new, x_new, d, iters));
+            return Ok((t_new, iters));
         }
     }
 
-    /// The predictor `x⁽⁰⁾ = Σ_{k=0}^{q} D[k]` and `ψ = (1/γ_q) Σ_{k=1}^{q} γ_k D[k]`.
-    fn predict(&self, order: usize) -> (Vec<f64>, Vec<f64>) {
-        let n = self.st.d[0].len();
+    /// The predictor `x⁽⁰⁾ = Σ_{k=0}^{q} D[k]` and `ψ = (1/γ_q) Σ_{k=1}^{q} γ_k D[k]` into `w`.
+    fn predict(&mut self, order: usize) {
         let alpha = self.gamma[order];
-        let mut x_pred = vec![0.0; n];
-        for row in &self.st.d[..=order] {
-            x_pred.iter_mut().zip(row).for_each(|(a, b)| *a += b);
-        }
-        let mut psi = vec![0.0; n];
+        let w = &mut self.w;
+        w.x_pred.copy_from_slice(&self.st.d[0]);
+        w.psi.iter_mut().for_each(|v| *v = 0.0);
         for k in 1..=order {
             let g = self.gamma[k] / alpha;
-            psi.iter_mut().zip(&self.st.d[k]).for_each(|(a, b)| *a += g * b);
+            for ((x, p), b) in w.x_pred.iter_mut().zip(w.psi.iter_mut()).zip(&self.st.d[k]) {
+                *x += b;
+                *p += g * b;
+            }
         }
-        (x_pred, psi)
     }
 
-    /// Solve the corrector, refactorizing `M − cJ` when `c` or the Jacobian changed
-    /// (`lu_ok` false) and re-evaluating a stale Jacobian once after a Newton failure; returns
-    /// the converged corrector, or `None` if Newton failed with a current Jacobian.
+    /// Solve the corrector at `t_new` with `c = h/γ_q` from the predictor in `w`, refactorizing
+    /// `M − cJ` when `c` or the Jacobian changed (`lu_ok` false) and re-evaluating a stale Jacobian
+    /// once after a Newton failure; returns the Newton iterations of the converged corrector, or
+    /// `None` if Newton failed with a current Jacobian.
     fn correct(
         &mut self,
         sys: &dyn DaeSystem,
-        corr: &Corrector<'_>,
+        t_new: f64,
+        c: f64,
+        tol: f64,
         lu_ok: &mut bool,
-    ) -> Result<Option<Corrected>, DaeError> {
-        let n = corr.x_pred.len();
+    ) -> Result<Option<usize>, DaeError> {
+        let n = self.w.x.len();
         loop {
-            let stale = self.st.lu_c.is_none_or(|c_lu| (corr.c / c_lu - 1.0).abs() > REFACTOR_RATIO);
+            let stale = self.st.lu_c.is_none_or(|c_lu| (c / c_lu - 1.0).abs() > REFACTOR_RATIO);
             if !*lu_ok || stale {
-                self.factor(n, sys, corr.c)?;
+                self.factor(n, sys, c)?;
                 *lu_ok = true;
             }
-            let (converged, iters, x, d) = self.newton(sys, corr);
+            let (converged, iters) = self.newton(sys, t_new, c, tol);
             if converged {
-                return Ok(Some(Corrected { iters, x, d }));
+                return Ok(Some(iters));
             }
             if self.st.current_jac {
                 return Ok(None);
             }
-            let mut f = vec![0.0; n];
-            sys.jacobian(corr.t_new, corr.x_pred, &mut f, &mut self.st.jac);
+            sys.jacobian(t_new, &self.w.x_pred, &mut self.w.f, &mut self.st.jac);
             self.st.stats.n_jacobian_evals += 1;
             self.st.current_jac = true;
             self.jac_loaded = false;
@@ -509,27 +541,43 @@ impl Bdf {
         }
     }
 
-    /// After an accepted step of `order` with correction `d`: `D[q+2] = d − D[q+1]`,
+    /// After an accepted step of `order` with correction `d` (in `w.d`): `D[q+2] = d − D[q+1]`,
     /// `D[q+1] = d`, `D[i] += D[i+1]` for `i = q … 0`.
-    fn update_differences(&mut self, order: usize, d: Vec<f64>) {
+    fn update_differences(&mut self, order: usize) {
         let dd = &mut self.st.d;
-        let next: Vec<f64> = d.iter().zip(&dd[order + 1]).map(|(a, b)| a - b).collect();
-        dd[order + 2] = next;
-        dd[order + 1] = d;
+        let (lo, hi) = dd.split_at_mut(order + 2);
+        for ((next, prev), d) in hi[0].iter_mut().zip(lo[order + 1].iter_mut()).zip(&self.w.d) {
+            *next = d - *prev;
+            *prev = *d;
+        }
         for i in (0..=order).rev() {
             let (lo, hi) = dd.split_at_mut(i + 1);
             lo[i].iter_mut().zip(&hi[0]).for_each(|(a, b)| *a += b);
         }
     }
 
+    /// The weights of the dense output at `t`: `p_k = Π_{m=0}^{k−1} (t − t_n + m h)/((m + 1) h)`
+    /// for `k = 1 … q` (`p_0` unused).
+    fn interpolation_weights(&self, t: f64) -> [f64; MAX_ORDER + 1] {
+        let h = self.st.h_abs;
+        let mut p = [0.0; MAX_ORDER + 1];
+        let mut acc = 1.0;
+        for (k, pk) in p.iter_mut().enumerate().take(self.st.order + 1).skip(1) {
+            let m = (k - 1) as f64;
+            acc *= (t - (self.st.t - h * m)) / (h * k as f64);
+            *pk = acc;
+        }
+        p
+    }
+
     /// After `q + 1` steps at one size: move to the order among `q − 1, q, q + 1` whose error
     /// estimate promises the longest step, and grow or shrink the step accordingly (at most
     /// [`MAX_FACTOR`], safety scaled by the `n_iter` Newton iterations of the last step).
-    fn adapt_order_and_step(&mut self, sys: &dyn DaeSystem, order: usize, n_iter: usize) {
-        let scale = self.scale(sys, &self.st.d[0]);
+    fn adapt_order_and_step(&mut self, order: usize, n_iter: usize) {
+        Self::scale_into(&self.abs_weight, self.settings.rtol, &self.st.d[0], &mut self.w.scale);
         let norm_of = |k: usize, row: usize| {
-            let e: Vec<f64> = self.st.d[row].iter().map(|v| self.error_const[k] * v).collect();
-            rms(&e, &scale, &self.controlled)
+            let e = self.error_const[k];
+            rms_of(self.st.d[row].iter().map(|v| e * v), &self.w.scale, &self.controlled)
         };
         let error_m = if order > 1 { norm_of(order - 1, order) } else { f64::INFINITY };
         let error = norm_of(order, order + 1);
@@ -545,7 +593,7 @@ impl Bdf {
         let factor = MAX_FACTOR.min(safety * factors[best]);
         self.st.order = new_order;
         self.st.h_abs *= factor;
-        change_d(&mut self.st.d, new_order, factor);
+        change_d(&mut self.st.d, new_order, factor, &mut self.w.diffs);
         self.st.n_equal_steps = 0;
     }
 }
@@ -567,7 +615,8 @@ impl DaeIntegrator for Bdf {
         for &(i, j) in sys.mass() {
             xdot[j] = f[i];
         }
-        let scale = self.scale(sys, &x);
+        let mut scale = vec![0.0; n];
+        Self::scale_into(&self.abs_weight, self.settings.rtol, &x, &mut scale);
         // First step: 1 % of the time the differential variables take to change by their own
         // size (SciPy's first estimate), and after an event no longer than the last step taken.
         let h = match self.settings.first_step {
@@ -604,19 +653,19 @@ impl DaeIntegrator for Bdf {
         let min_step = 10.0 * (t.next_up() - t).abs();
         let mut h_abs = self.bounded_step(min_step);
         let order = self.st.order;
-        let (t_new, x_new, d, n_iter) = self.accepted_step(sys, t_stop, min_step, &mut h_abs)?;
+        let (t_new, n_iter) = self.accepted_step(sys, t_stop, min_step, &mut h_abs)?;
         self.st.stats.n_steps += 1;
         self.st.n_equal_steps += 1;
         self.st.t_prev = t;
         self.st.t = t_new;
         self.st.h_abs = h_abs;
         self.st.current_jac = false;
-        self.update_differences(order, d);
-        debug_assert!(x_new.iter().zip(&self.st.d[0]).all(|(a, b)| (a - b).abs() <= 1e-9 * (1.0 + a.abs())));
+        self.update_differences(order);
+        debug_assert!(self.w.x.iter().zip(&self.st.d[0]).all(|(a, b)| (a - b).abs() <= 1e-9 * (1.0 + a.abs())));
         if self.st.n_equal_steps < order + 1 {
             return Ok(());
         }
-        self.adapt_order_and_step(sys, order, n_iter);
+        self.adapt_order_and_step(order, n_iter);
         Ok(())
     }
 
@@ -633,13 +682,17 @@ impl DaeIntegrator for Bdf {
     }
 
     fn interpolate(&self, t: f64, out: &mut [f64]) {
-        let h = self.st.h_abs;
+        let p = self.interpolation_weights(t);
         out.copy_from_slice(&self.st.d[0]);
-        let mut p = 1.0;
-        for k in 1..=self.st.order {
-            let m = (k - 1) as f64;
-            p *= (t - (self.st.t - h * m)) / (h * k as f64);
-            out.iter_mut().zip(&self.st.d[k]).for_each(|(a, b)| *a += p * b);
+        for (k, pk) in p.iter().enumerate().take(self.st.order + 1).skip(1) {
+            out.iter_mut().zip(&self.st.d[k]).for_each(|(a, b)| *a += pk * b);
+        }
+    }
+
+    fn interpolate_at(&self, t: f64, indices: &[usize], out: &mut [f64]) {
+        let p = self.interpolation_weights(t);
+        for &i in indices {
+            out[i] = self.st.d[0][i] + (1..=self.st.order).map(|k| p[k] * self.st.d[k][i]).sum::<f64>();
         }
     }
 
@@ -706,7 +759,7 @@ mod tests {
             vec![vec![v[0]], vec![v[0] - v[1]], vec![v[0] - 2.0 * v[1] + v[2]], vec![0.0]]
         };
         let mut d = diffs(0.1);
-        change_d(&mut d, 3, 0.37);
+        change_d(&mut d, 3, 0.37, &mut vec![vec![0.0]; MAX_ORDER + 1]);
         let want = diffs(0.037);
         for k in 0..3 {
             assert!((d[k][0] - want[k][0]).abs() < 1e-14, "{k}: {} vs {}", d[k][0], want[k][0]);
@@ -879,7 +932,7 @@ mod tests {
             a.step(&sys, 50.0).unwrap();
         }
         let mut b = Bdf::new(settings);
-        b.restore(&sys, a.state().clone()).unwrap();
+        b.restore(&sys, a.state()).unwrap();
         while a.t() < 50.0 {
             a.step(&sys, 50.0).unwrap();
             b.step(&sys, 50.0).unwrap();

@@ -99,14 +99,22 @@ pub trait DaeIntegrator {
     fn t_prev(&self) -> f64;
     /// The state at `t` within the last step, from the integrator's interpolating polynomial.
     fn interpolate(&self, t: f64, out: &mut [f64]);
+    /// [`DaeIntegrator::interpolate`] of the entries `indices` of the state only (the other
+    /// entries of `out` are left as they are).
+    fn interpolate_at(&self, t: f64, indices: &[usize], out: &mut [f64]);
     /// Counters.
     fn stats(&self) -> BdfStats;
 }
 
 /// Weighted root-mean-square norm `√(Σ (v_i/s_i)² / n)` over the indices where `mask` is true.
 fn rms(v: &[f64], scale: &[f64], mask: &[bool]) -> f64 {
+    rms_of(v.iter().copied(), scale, mask)
+}
+
+/// [`rms`] of the values `v` yields.
+fn rms_of(v: impl Iterator<Item = f64>, scale: &[f64], mask: &[bool]) -> f64 {
     let (mut sum, mut n) = (0.0, 0usize);
-    for ((a, s), m) in v.iter().zip(scale).zip(mask) {
+    for ((a, s), m) in v.zip(scale).zip(mask) {
         if *m {
             sum += (a / s) * (a / s);
             n += 1;

@@ -25,6 +25,8 @@ pub(super) struct Driver {
     sc: Scenario,
     st: DriverState,
     bdf: Bdf,
+    /// The state entries the recorded rows read: only they are interpolated between steps.
+    recorded: Vec<usize>,
     fingerprint: String,
     /// Per sampled controller: (driven input, its controller output variable).
     sampled: Vec<Vec<(usize, usize)>>,
@@ -149,8 +151,10 @@ impl Driver {
             (st, restore, t0) = (resumed.driver, resumed.integrator, s.t);
         }
         let shape = DaeShape::new(&plant, &quad.streams);
+        let recorded = recorded_state(&plant, sc);
         Ok(Driver {
             shape,
+            recorded,
             plant,
             sc: sc.clone(),
             st,
@@ -229,7 +233,7 @@ impl Driver {
             paths: self.quad.state_paths(&self.plant),
             inputs: self.plant.inputs().iter().map(|i| i.path.clone()).collect(),
             driver: self.st.clone(),
-            integrator: self.bdf.state().clone(),
+            integrator: self.bdf.state(),
         }
     }
 
@@ -470,7 +474,7 @@ impl Driver {
             if tr == now {
                 xi.copy_from_slice(self.bdf.x());
             } else {
-                self.bdf.interpolate(tr, xi);
+                self.bdf.interpolate_at(tr, &self.recorded, xi);
             }
             let (row, refs) = row_at(&self.plant, &self.sc, &self.refs, &self.st.waveforms, tr, xi);
             self.times.push(tr);
@@ -551,6 +555,22 @@ impl Driver {
             mpc: self.mpcs.into_iter().map(|m| m.log).collect::<Vec<MpcLog>>(),
         }
     }
+}
+
+/// The state entries a recorded row reads ([`row_at`]): the recorded variables, the controller
+/// outputs that drive recorded inputs, and the recorded totals.
+fn recorded_state(plant: &Plant, sc: &Scenario) -> Vec<usize> {
+    let np = plant.n_vars();
+    let mut v: Vec<usize> = sc
+        .record
+        .iter()
+        .filter_map(|r| match r.source {
+            Read::Var(v) => Some(v),
+            Read::Input(i) => plant.inputs()[i].driven_by,
+        })
+        .collect();
+    v.extend(np..np + sc.totals.len() * plant.components().len());
+    v
 }
 
 /// One recorded row at `t` from the state `x`, and the references. An input driven by a

@@ -182,16 +182,17 @@ impl SimpleColumn {
         s * self.per_stage()
     }
 
-    /// Per stage: the feeds' component flows `Σ F z_j` and their vapour `Σ (1 − q) F`, with
-    /// `q = (h_V − h_F)/(h_V − h_L)` at the feed stage where it is not given.
-    fn feed_terms<S: Scalar>(&self, io: &UnitIo<'_, S>) -> (Vec<Vec<S>>, Vec<S>) {
+    /// Per stage: the feeds' component flows `Σ F z_j` (stage `s`, component `j` at `s·nc + j`)
+    /// and their vapour `Σ (1 − q) F`, with `q = (h_V − h_F)/(h_V − h_L)` at the feed stage where
+    /// it is not given.
+    fn feed_terms<S: Scalar>(&self, io: &UnitIo<'_, S>) -> (Vec<S>, Vec<S>) {
         let (nc, n, ix) = (self.nc(), self.n_stages, StageIdx { nc: self.nc() });
         let st = |s: usize| io.vars(self.stage(s), self.per_stage());
-        let mut feed_comp = vec![vec![S::from(0.0); nc]; n];
+        let mut feed_comp = vec![S::from(0.0); n * nc];
         let mut feed_vap = vec![S::from(0.0); n];
         for (k, f) in self.feeds.iter().enumerate() {
             let s = io.inlet(k);
-            for (acc, z) in feed_comp[f.stage].iter_mut().zip(s.z()) {
+            for (acc, z) in feed_comp[f.stage * nc..(f.stage + 1) * nc].iter_mut().zip(s.z()) {
                 *acc += s.f() * *z;
             }
             let q = match f.q {
@@ -377,7 +378,7 @@ impl UnitModel for SimpleColumn {
             let m = v[ix.m()];
             // Component balances.
             for j in 0..nc {
-                let mut acc = feed_comp[s][j] - v[ix.l()] * v[ix.x(j)] - v[ix.v()] * v[ix.y(j)];
+                let mut acc = feed_comp[s * nc + j] - v[ix.l()] * v[ix.x(j)] - v[ix.v()] * v[ix.y(j)];
                 if s + 1 < n {
                     let up = st(s + 1);
                     acc += up[ix.l()] * up[ix.x(j)];

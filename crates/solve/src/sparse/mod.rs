@@ -10,23 +10,29 @@
 //! that returns to zero stays, as an explicit zero. The live pattern is therefore exact wherever the
 //! Jacobian has been evaluated, and never loses a value.
 //!
-//! **Work per factorization.** The triplet → compressed-column map, the column ordering (COLAMD)
-//! and the symbolic factorization are computed once per live pattern; a refactorization sums the
-//! triplet values into the held matrix in place and runs faer's simplicial (left-looking,
-//! partial-pivoting) numeric LU into held storage and a held workspace. Solves run in place, with
-//! `A` or `Aᵀ`, on the factors directly. Everything runs on the calling thread
-//! (the solvers parallelize over independent solves instead).
+//! **Work per factorization.** The triplet → compressed-column map and the column ordering
+//! (COLAMD) are computed once per live pattern. The first factorization of a pattern runs faer's
+//! simplicial (left-looking, partial-pivoting) numeric LU; later ones sum the triplet values into
+//! the held matrix in place and refactorize on the held pivot sequence and `L`/`U` pattern
+//! (`factors.rs`), falling back to faer's pivoting factorization when a held pivot has become too
+//! small. Solves run in place, with `A` or `Aᵀ`, on the held factors. Everything runs on the
+//! calling thread (the solvers parallelize over independent solves instead).
+
+mod factors;
 
 use std::mem::MaybeUninit;
 
 use faer::dyn_stack::{MemStack, StackReq};
+use faer::perm::PermRef;
 use faer::sparse::linalg::LuError;
 use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::linalg::lu::simplicial::{
     SimplicialLu, factorize_simplicial_numeric_lu, factorize_simplicial_numeric_lu_scratch,
 };
-use faer::sparse::linalg::lu::{LuSymbolicParams, SymbolicLu, factorize_symbolic_lu};
+use faer::sparse::linalg::lu::{LuSymbolicParams, factorize_symbolic_lu};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+
+use factors::{Factors, Source};
 
 /// Why a sparse factorization failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -164,7 +170,8 @@ struct Live {
     /// The loaded (summed) values, and the values factorized (mapped from them).
     base: Vec<f64>,
     values: Vec<f64>,
-    symbolic: SymbolicLu<usize>,
+    /// The fill-reducing column order `(forward, inverse)`.
+    col_perm: (Vec<usize>, Vec<usize>),
 }
 
 impl Live {
@@ -182,13 +189,22 @@ impl Live {
         }
         let nnz = row.len();
         let pattern = SymbolicSparseColMatRef::new_checked(n, n, &col_ptr, None, &row);
-        let params = LuSymbolicParams {
-            supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SIMPLICIAL,
-            ..Default::default()
-        };
-        let symbolic = factorize_symbolic_lu(pattern, params).map_err(|_| SparseError::Resources { n, nnz })?;
-        Ok(Live { col_ptr, row, col, from, base: vec![0.0; nnz], values: vec![0.0; nnz], symbolic })
+        let col_perm = column_order(pattern).ok_or(SparseError::Resources { n, nnz })?;
+        Ok(Live { col_ptr, row, col, from, base: vec![0.0; nnz], values: vec![0.0; nnz], col_perm })
     }
+}
+
+/// The fill-reducing column order `(forward, inverse)` of `pattern`: COLAMD, which bounds the fill
+/// whatever rows partial pivoting picks (an order for `A + Aᵀ` such as AMD assumes diagonal pivots:
+/// on column A's iteration matrix it gave 38 627 entries in `L + U` against COLAMD's 4 480).
+fn column_order(pattern: SymbolicSparseColMatRef<'_, usize>) -> Option<(Vec<usize>, Vec<usize>)> {
+    let params = LuSymbolicParams {
+        supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SIMPLICIAL,
+        ..Default::default()
+    };
+    let symbolic = factorize_symbolic_lu(pattern, params).ok()?;
+    let (fwd, inv) = symbolic.col_perm().arrays();
+    Some((fwd.to_vec(), inv.to_vec()))
 }
 
 /// A sparse LU that keeps its pattern, symbolic analysis, factors and workspace between
@@ -202,12 +218,13 @@ pub struct SparseLu {
     /// and its row permutation `(forward, inverse)`.
     numeric: SimplicialLu<usize, f64>,
     row_perm: (Vec<usize>, Vec<usize>),
-    /// Scratch of the solves.
-    tmp: Vec<f64>,
+    /// The factors in our own arrays (solves, and refactorizations on the same pivots), for the
+    /// current live pattern.
+    factors: Option<Factors>,
     factored: bool,
     work: Vec<MaybeUninit<u8>>,
-    /// Symbolic analyses and numeric factorizations done, for benchmarks.
-    counts: (usize, usize),
+    /// Symbolic analyses, factorizations with pivoting and refactorizations, for tests and benchmarks.
+    counts: (usize, usize, usize),
 }
 
 impl SparseLu {
@@ -232,13 +249,35 @@ impl SparseLu {
         triplets: &[(usize, usize, f64)],
         pinned: &[(usize, usize)],
     ) -> Result<(), SparseError> {
+        self.load_with_live(n, triplets, pinned, &[])
+    }
+
+    /// [`SparseLu::load_pinned`] with the structural slots marked in `live` (as
+    /// [`SparseLu::live_slots`] returned them for the same triplet positions) joined to the live
+    /// pattern: a restored integrator factorizes the pattern it had, not the one its current
+    /// Jacobian alone would give.
+    pub fn load_with_live(
+        &mut self,
+        n: usize,
+        triplets: &[(usize, usize, f64)],
+        pinned: &[(usize, usize)],
+        live: &[bool],
+    ) -> Result<(), SparseError> {
         self.factored = false;
         if self.n != n || self.live.is_none() || !self.structure.matches(triplets, pinned) {
             self.structure = Structure::new(n, triplets, pinned)?;
             self.live = None;
             self.n = n;
         }
-        if self.structure.accumulate(triplets) || self.live.is_none() {
+        let mut grew = self.structure.accumulate(triplets);
+        if live.len() == self.structure.live.len() {
+            for (l, &m) in self.structure.live.iter_mut().zip(live) {
+                grew |= m && !*l;
+                *l |= m;
+            }
+        }
+        if grew || self.live.is_none() {
+            self.factors = None;
             self.live = Some(Live::new(n, &self.structure)?);
             self.counts.0 += 1;
         }
@@ -249,16 +288,81 @@ impl SparseLu {
         Ok(())
     }
 
+    /// Which structural slots are in the live pattern (for [`SparseLu::load_with_live`]).
+    pub fn live_slots(&self) -> &[bool] {
+        &self.structure.live
+    }
+
+    /// The row permutation of the held factors (`p[i]`: the matrix row pivoted at step `i`).
+    pub fn pivots(&self) -> Option<&[usize]> {
+        self.factors.as_ref().filter(|_| self.factored).map(|f| f.pivots())
+    }
+
     /// Factorize the loaded matrix with each entry `(row, col, value)` replaced by
     /// `map(row, col, value)` (the map must keep zero entries' positions meaningful: entries are
     /// those of the live pattern). Cheap to repeat: the BDF iteration matrix `M − cJ` for a new `c`.
     pub fn factor_mapped(&mut self, map: impl Fn(usize, usize, f64) -> f64) -> Result<(), SparseError> {
+        self.map_values(map)?;
+        let Some(live) = &self.live else { return Err(SparseError::NotFactored) };
+        if let Some(f) = &mut self.factors
+            && f.refactor(&live.values, true).is_ok()
+        {
+            self.counts.2 += 1;
+            self.factored = true;
+            return Ok(());
+        }
+        self.factor_pivoting()
+    }
+
+    /// [`SparseLu::factor_mapped`] on the row permutation `pivots` (as [`SparseLu::pivots`] gave
+    /// it for the same live pattern): the factors are then those a run that held these pivots
+    /// computes, bit for bit (a restored integrator). Pivots that do not fit, or give a zero pivot,
+    /// are replaced by a pivoting factorization.
+    pub fn factor_mapped_on(
+        &mut self,
+        map: impl Fn(usize, usize, f64) -> f64,
+        pivots: &[usize],
+    ) -> Result<(), SparseError> {
+        self.map_values(map)?;
+        let (n, Some(live)) = (self.n, &self.live) else { return Err(SparseError::NotFactored) };
+        let mut inv = vec![usize::MAX; n];
+        if pivots.len() == n
+            && pivots.iter().enumerate().all(|(i, &p)| p < n && std::mem::replace(&mut inv[p], i) == usize::MAX)
+        {
+            let source = Source {
+                col_ptr: &live.col_ptr,
+                row: &live.row,
+                col_perm: (&live.col_perm.0, &live.col_perm.1),
+                row_perm: (pivots, &inv),
+            };
+            if let Some(mut f) = Factors::symbolic(&source)
+                && f.refactor(&live.values, false).is_ok()
+            {
+                self.factors = Some(f);
+                self.counts.2 += 1;
+                self.factored = true;
+                return Ok(());
+            }
+        }
+        self.factor_pivoting()
+    }
+
+    /// The loaded values with `map` applied, into the live matrix.
+    fn map_values(&mut self, map: impl Fn(usize, usize, f64) -> f64) -> Result<(), SparseError> {
         self.factored = false;
-        let n = self.n;
         let Some(live) = &mut self.live else { return Err(SparseError::NotFactored) };
         for k in 0..live.values.len() {
             live.values[k] = map(live.row[k], live.col[k], live.base[k]);
         }
+        Ok(())
+    }
+
+    /// Factorize the live matrix with partial pivoting (faer chooses the pivots), then compute the
+    /// held factors on those pivots with [`Factors::refactor`], so that the factors depend on the
+    /// values and the pivots only, however they were reached.
+    fn factor_pivoting(&mut self) -> Result<(), SparseError> {
+        let n = self.n;
+        let Some(live) = &self.live else { return Err(SparseError::NotFactored) };
         let nnz = live.values.len();
         let req = factorize_simplicial_numeric_lu_scratch::<usize, f64>(n, n);
         let stack = workspace(&mut self.work, req).ok_or(SparseError::Resources { n, nnz })?;
@@ -267,11 +371,16 @@ impl SparseLu {
         let (fwd, inv) = &mut self.row_perm;
         fwd.resize(n, 0);
         inv.resize(n, 0);
-        let col_perm = live.symbolic.col_perm();
+        let col_perm = PermRef::new_checked(&live.col_perm.0, &live.col_perm.1, n);
         factorize_simplicial_numeric_lu(fwd, inv, &mut self.numeric, a, col_perm, stack).map_err(|e| match e {
             LuError::SymbolicSingular { index } => SparseError::Singular { index, n },
             LuError::Generic(_) => SparseError::Resources { n, nnz },
         })?;
+        let source =
+            Source { col_ptr: &live.col_ptr, row: &live.row, col_perm: col_perm.arrays(), row_perm: (fwd, inv) };
+        let mut f = Factors::symbolic(&source).ok_or(SparseError::Singular { index: 0, n })?;
+        f.refactor(&live.values, false).map_err(|e| SparseError::Singular { index: e.column, n })?;
+        self.factors = Some(f);
         self.counts.1 += 1;
         self.factored = true;
         Ok(())
@@ -287,47 +396,10 @@ impl SparseLu {
         self.solve_with(b, true)
     }
 
-    /// `P_r A Q = L U` (`L` unit lower with its diagonal stored first in each column, `U` upper
-    /// with its diagonal last): `A x = b` is `x = Q U⁻¹ L⁻¹ P_r b`, `Aᵀ x = b` is
-    /// `x = P_rᵀ L⁻ᵀ U⁻ᵀ Qᵀ b`. Written out rather than through faer's solve, whose two
-    /// permutations through a temporary matrix were half the solve time of a BDF run.
     fn solve_with(&mut self, b: &mut [f64], transpose: bool) -> Result<(), SparseError> {
-        let (Some(live), true) = (&self.live, self.factored) else { return Err(SparseError::NotFactored) };
-        let n = self.n;
-        let (l, u) = (self.numeric.l_factor_unsorted(), self.numeric.u_factor_unsorted());
-        let (l_ptr, l_row, l_val) = (l.symbolic().col_ptr(), l.symbolic().row_idx(), l.val());
-        let (u_ptr, u_row, u_val) = (u.symbolic().col_ptr(), u.symbolic().row_idx(), u.val());
-        let (col_fwd, col_inv) = live.symbolic.col_perm().arrays();
-        let (row_fwd, row_inv) = (&self.row_perm.0, &self.row_perm.1);
-        let t = &mut self.tmp;
-        t.resize(n, 0.0);
-        if !transpose {
-            (0..n).for_each(|i| t[i] = b[row_fwd[i]]);
-            for j in 0..n {
-                let xj = t[j];
-                (l_ptr[j] + 1..l_ptr[j + 1]).for_each(|p| t[l_row[p]] -= l_val[p] * xj);
-            }
-            for j in (0..n).rev() {
-                let last = u_ptr[j + 1] - 1;
-                let xj = t[j] / u_val[last];
-                t[j] = xj;
-                (u_ptr[j]..last).for_each(|p| t[u_row[p]] -= u_val[p] * xj);
-            }
-            (0..n).for_each(|i| b[i] = t[col_inv[i]]);
-        } else {
-            (0..n).for_each(|i| t[i] = b[col_fwd[i]]);
-            for j in 0..n {
-                let last = u_ptr[j + 1] - 1;
-                let s: f64 = (u_ptr[j]..last).map(|p| u_val[p] * t[u_row[p]]).sum();
-                t[j] = (t[j] - s) / u_val[last];
-            }
-            for j in (0..n).rev() {
-                let s: f64 = (l_ptr[j] + 1..l_ptr[j + 1]).map(|p| l_val[p] * t[l_row[p]]).sum();
-                t[j] -= s;
-            }
-            (0..n).for_each(|i| b[i] = t[row_inv[i]]);
-        }
-        if b.iter().all(|v| v.is_finite()) { Ok(()) } else { Err(SparseError::NonFinite { n }) }
+        let (Some(f), true) = (&mut self.factors, self.factored) else { return Err(SparseError::NotFactored) };
+        f.solve(b, transpose);
+        if b.iter().all(|v| v.is_finite()) { Ok(()) } else { Err(SparseError::NonFinite { n: self.n }) }
     }
 
     /// Factorize and solve `A x = b` in place.
@@ -355,11 +427,12 @@ impl SparseLu {
     /// name the column of a [`SparseError::Singular`].
     pub fn pivot_column(&self, index: usize) -> Option<usize> {
         let live = self.live.as_ref()?;
-        live.symbolic.col_perm().arrays().0.get(index).copied()
+        live.col_perm.0.get(index).copied()
     }
 
-    /// Symbolic analyses and numeric factorizations done so far.
-    pub fn counts(&self) -> (usize, usize) {
+    /// Symbolic analyses, numeric factorizations with pivoting and refactorizations on held pivots
+    /// done so far.
+    pub fn counts(&self) -> (usize, usize, usize) {
         self.counts
     }
 }
@@ -417,13 +490,13 @@ mod tests {
         let mut x = b;
         lu.solve(3, &t, &mut x).unwrap();
         assert!(residual(&t, &x, &b) < 1e-14);
-        assert_eq!((lu.live_nnz(), lu.counts()), (8, (2, 2)));
-        // Back to zero: kept as an explicit zero, no new analysis.
+        assert_eq!((lu.live_nnz(), lu.counts()), (8, (2, 2, 0)));
+        // Back to zero: kept as an explicit zero, no new analysis; refactorized on the held pivots.
         let t = triplets(0.0);
         let mut x = b;
         lu.solve(3, &t, &mut x).unwrap();
         assert!(residual(&t, &x, &b) < 1e-14);
-        assert_eq!((lu.live_nnz(), lu.counts()), (8, (2, 3)));
+        assert_eq!((lu.live_nnz(), lu.counts()), (8, (2, 2, 1)));
     }
 
     #[test]
@@ -452,6 +525,85 @@ mod tests {
         assert!(residual(&tt, &y, &b) < 1e-12, "{}", residual(&tt, &y, &b));
         let (fwd, _) = &lu.row_perm;
         assert!(fwd.iter().enumerate().any(|(i, &p)| i != p), "rows were exchanged");
+    }
+
+    /// The 40 × 40 matrix of the test above with its values scaled entry by entry: refactorized on
+    /// the held pivots, the solve is at round-off and equal to a fresh pivoting factorization's.
+    #[test]
+    fn a_refactorization_on_held_pivots_solves_like_a_fresh_factorization() {
+        let n = 40;
+        let mut s: u64 = 777;
+        let mut next = || {
+            s = s.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+            (s >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut t: Vec<(usize, usize, f64)> = (0..n).map(|i| (i, i, 4.0 + next())).collect();
+        for i in 0..n {
+            t.push((i, (i + 1) % n, 1.0 + next()));
+            t.push((i, (i * 7 + 3) % n, next() - 0.5));
+        }
+        let b: Vec<f64> = (0..n).map(|_| next() - 0.5).collect();
+        let mut held = SparseLu::default();
+        let mut x = b.clone();
+        held.solve(n, &t, &mut x).unwrap();
+        let t2: Vec<_> = t.iter().map(|&(i, j, v)| (i, j, v * (0.8 + 0.4 * next()))).collect();
+        let mut x = b.clone();
+        held.solve(n, &t2, &mut x).unwrap();
+        assert_eq!(held.counts(), (1, 1, 1), "the second matrix is refactorized on the held pivots");
+        assert!(residual(&t2, &x, &b) < 1e-13, "{}", residual(&t2, &x, &b));
+        let mut fresh = SparseLu::default();
+        let mut y = b.clone();
+        fresh.solve(n, &t2, &mut y).unwrap();
+        let diff = x.iter().zip(&y).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        assert!(diff < 1e-13, "{diff}");
+        let mut z = b.clone();
+        held.solve_transpose_in_place(&mut z).unwrap();
+        let tt: Vec<_> = t2.iter().map(|&(i, j, v)| (j, i, v)).collect();
+        assert!(residual(&tt, &z, &b) < 1e-13, "{}", residual(&tt, &z, &b));
+    }
+
+    /// A second `SparseLu` given the first one's pivots and live pattern factorizes a matrix into
+    /// the same factors, bit for bit, though the first reached them by refactorizing and the second
+    /// alone would pivot differently (the snapshot of a BDF run is restored this way).
+    #[test]
+    fn factors_on_given_pivots_are_reproduced_bit_for_bit() {
+        let a = |a00: f64, a10: f64| vec![(0, 0, a00), (0, 1, 1.0), (1, 0, a10), (1, 1, 3.0), (1, 2, 1.0), (2, 2, 2.0)];
+        let b = [1.0, 2.0, 3.0];
+        let mut first = SparseLu::default();
+        let mut x = b;
+        first.solve(3, &a(1.0, 0.5), &mut x).unwrap();
+        // Row 1 would be the pivot of column 0 now; the held pivot (row 0) still passes the threshold.
+        let t = a(0.3, 0.6);
+        let mut x = b;
+        first.solve(3, &t, &mut x).unwrap();
+        assert_eq!(first.counts(), (1, 1, 1));
+        let (pivots, live) = (first.pivots().unwrap().to_vec(), first.live_slots().to_vec());
+        let mut fresh = SparseLu::default();
+        let mut y = b;
+        fresh.solve(3, &t, &mut y).unwrap();
+        assert_ne!(fresh.pivots().unwrap(), pivots.as_slice(), "pivoting alone picks another row");
+        let mut restored = SparseLu::default();
+        restored.load_with_live(3, &t, &[], &live).unwrap();
+        restored.factor_mapped_on(|_, _, v| v, &pivots).unwrap();
+        let mut z = b;
+        restored.solve_in_place(&mut z).unwrap();
+        assert_eq!(x.map(f64::to_bits), z.map(f64::to_bits));
+        assert_eq!(restored.pivots().unwrap(), pivots.as_slice());
+    }
+
+    /// A held pivot that has become small against the entries below it is not kept: the matrix
+    /// is factorized afresh with row exchanges (a refactorization would divide by 1e-12).
+    #[test]
+    fn a_pivot_that_became_small_is_replaced_by_pivoting() {
+        let m = |a00: f64, a10: f64| vec![(0, 0, a00), (0, 1, 1.0), (1, 0, a10), (1, 1, 1.0)];
+        let mut lu = SparseLu::default();
+        let mut x = [1.0, 2.0];
+        lu.solve(2, &m(1.0, 0.5), &mut x).unwrap();
+        let t = m(1e-12, 1.0);
+        let mut x = [1.0, 2.0];
+        lu.solve(2, &t, &mut x).unwrap();
+        assert_eq!(lu.counts(), (1, 2, 0), "factorized again with pivoting");
+        assert!(residual(&t, &x, &[1.0, 2.0]) < 1e-15, "{x:?}");
     }
 
     #[test]
