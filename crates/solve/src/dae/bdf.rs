@@ -118,11 +118,14 @@ pub struct BdfState {
     pub current_jac: bool,
     /// `c = h/γ_q` of the held LU factors, if any.
     pub lu_c: Option<f64>,
-    /// The held factors' row permutation ([`SparseLu::pivots`]): factors are refactorized on held
-    /// pivots, so a restored run needs them to factorize exactly as the interrupted one. Filled by
-    /// [`Bdf::state`]; empty in snapshots written before it existed.
+    /// The held factors' row and column permutations ([`SparseLu::pivots`]): factors are
+    /// refactorized on held pivots, so a restored run needs them to factorize exactly as the
+    /// interrupted one. Filled by [`Bdf::state`]; empty in snapshots written before they existed.
     #[serde(default)]
     pub lu_pivots: Vec<usize>,
+    /// See `lu_pivots`.
+    #[serde(default)]
+    pub lu_columns: Vec<usize>,
     /// The held factors' live pattern ([`SparseLu::live_slots`]), for the same reason.
     #[serde(default)]
     pub lu_live: Vec<bool>,
@@ -240,6 +243,7 @@ impl Bdf {
             current_jac: false,
             lu_c: None,
             lu_pivots: Vec::new(),
+            lu_columns: Vec::new(),
             lu_live: Vec::new(),
             stats: BdfStats::default(),
         };
@@ -276,7 +280,7 @@ impl Bdf {
     /// The full state, for a snapshot.
     pub fn state(&self) -> BdfState {
         let mut st = self.st.clone();
-        st.lu_pivots = self.lu.pivots().map(<[usize]>::to_vec).unwrap_or_default();
+        (st.lu_pivots, st.lu_columns) = self.lu.pivots().map(|(r, c)| (r.to_vec(), c.to_vec())).unwrap_or_default();
         st.lu_live = self.lu.live_slots().to_vec();
         st
     }
@@ -295,13 +299,14 @@ impl Bdf {
         self.st = state;
         self.lu.invalidate();
         if let Some(c) = self.st.lu_c {
-            let (pivots, live) = (std::mem::take(&mut self.st.lu_pivots), std::mem::take(&mut self.st.lu_live));
+            let pivots = (std::mem::take(&mut self.st.lu_pivots), std::mem::take(&mut self.st.lu_columns));
+            let live = std::mem::take(&mut self.st.lu_live);
             let time = self.st.t;
             let err = |source| DaeError::Singular { time, source };
             self.lu.load_with_live(n, &self.st.jac, sys.mass(), &live).map_err(err)?;
             self.jac_loaded = true;
             let entry = Self::entry(&self.diff_var, c);
-            self.lu.factor_mapped_on(entry, &pivots).map_err(err)?;
+            self.lu.factor_mapped_on(entry, (&pivots.0, &pivots.1)).map_err(err)?;
         }
         Ok(())
     }

@@ -7,15 +7,15 @@
 //! Newton iterations, both are known already: with the row permutation kept, the pattern of `L`
 //! and `U` is the structural reach and closed under the elimination, so a refactorization is the
 //! left-looking elimination alone (the "refactor" of KLU: T. A. Davis, E. Palamadai Natarajan,
-//! *Algorithm 907: KLU*, ACM TOMS 37 (2010) 36, §2.4). faer 0.24 has no such entry point, hence
-//! this file. For column A's iteration matrix (436 × 436, 1 693 entries, 4 480 in `L + U`) it is
-//! several times cheaper than faer's numeric factorization.
+//! *Algorithm 907: KLU*, ACM TOMS 37 (2010) 36, §2.4). faer 0.24 has no such entry point, nor an
+//! LU on a given pivot sequence, hence this file (with the symbolic analysis for given
+//! permutations that the diagonal order of `order.rs` and a restored run need).
 //!
-//! **Stability.** A pivot kept from an earlier factorization is accepted only if it is at least
-//! [`PIVOT_THRESHOLD`] times the largest entry below it in its column (threshold partial pivoting
-//! with KLU's default tolerance, 10⁻³), finite and nonzero; otherwise the caller factorizes afresh
-//! with pivoting. On column A's feed step, 3 of the 27 iteration matrices are then factorized with
-//! pivoting (8 with a threshold of 0.1).
+//! **Stability.** A pivot kept from an earlier factorization, or proposed by the diagonal order,
+//! is accepted only if it is at least [`PIVOT_THRESHOLD`] times the largest entry below it in its
+//! column, both measured in the row-equilibrated matrix (threshold partial pivoting with KLU's
+//! default tolerance, 10⁻³, and its default scaling by row maxima), finite and nonzero; otherwise
+//! the caller factorizes afresh with partial pivoting.
 //!
 //! Notation: `P_r A Q = L U` with `L` unit lower triangular and `U` upper triangular, both indexed
 //! in the permuted order; `row_fwd[i]` is the original row of permuted row `i`.
@@ -54,6 +54,8 @@ pub(super) struct Factors {
     /// Dense accumulator of the elimination (all zero between calls), and the solves' scratch.
     work: Vec<f64>,
     tmp: Vec<f64>,
+    /// Reciprocal row maxima of the matrix refactorized (permuted rows), for the pivot test.
+    row_scale: Vec<f64>,
 }
 
 /// The matrix pattern and permutations a set of factors was made for.
@@ -124,9 +126,15 @@ impl Factors {
         Some(f)
     }
 
-    /// The row permutation (`row_fwd[i]`: the original row of permuted row `i`).
-    pub(super) fn pivots(&self) -> &[usize] {
-        &self.row_fwd
+    /// Entries of `L + U` (the diagonal counted once).
+    pub(super) fn nnz(&self) -> usize {
+        self.l_row.len() + self.u_row.len() + self.n
+    }
+
+    /// The row and column permutations (`row_fwd[i]`, `col_fwd[i]`: the original row and column
+    /// of pivot `i`).
+    pub(super) fn pivots(&self) -> (&[usize], &[usize]) {
+        (&self.row_fwd, &self.col_fwd)
     }
 
     /// Refactorize for new `values` of the same pattern (indexed as the source's compressed
@@ -137,6 +145,17 @@ impl Factors {
     /// factors are left invalid.
     pub(super) fn refactor(&mut self, values: &[f64], check: bool) -> Result<(), NeedsPivoting> {
         let threshold = if check { PIVOT_THRESHOLD } else { 0.0 };
+        // The test is on the row-equilibrated matrix (KLU's default scaling by row maxima): the
+        // plant's equations have their own units, a pivot is small or large against its row.
+        let scale = &mut self.row_scale;
+        scale.clear();
+        scale.resize(self.n, 0.0);
+        if check {
+            for (&i, &k) in self.a_row.iter().zip(&self.a_idx) {
+                scale[i] = scale[i].max(values[k].abs());
+            }
+            scale.iter_mut().for_each(|s| *s = if *s > 0.0 { 1.0 / *s } else { 1.0 });
+        }
         let x = &mut self.work;
         for j in 0..self.n {
             let a = self.a_ptr[j]..self.a_ptr[j + 1];
@@ -158,8 +177,8 @@ impl Factors {
             let pivot = x[j];
             x[j] = 0.0;
             let l = self.l_ptr[j]..self.l_ptr[j + 1];
-            let largest = self.l_row[l.clone()].iter().fold(0.0f64, |m, &i| m.max(x[i].abs()));
-            if !(pivot.is_finite() && pivot != 0.0 && pivot.abs() >= threshold * largest) {
+            let largest = self.l_row[l.clone()].iter().fold(0.0f64, |m, &i| m.max(x[i].abs() * scale[i]));
+            if !(pivot.is_finite() && pivot != 0.0 && pivot.abs() * scale[j] >= threshold * largest) {
                 x.iter_mut().for_each(|v| *v = 0.0);
                 return Err(NeedsPivoting { column: j });
             }

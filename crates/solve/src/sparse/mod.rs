@@ -19,20 +19,20 @@
 //! calling thread (the solvers parallelize over independent solves instead).
 
 mod factors;
+mod order;
 
 use std::mem::MaybeUninit;
 
 use faer::dyn_stack::{MemStack, StackReq};
 use faer::perm::PermRef;
 use faer::sparse::linalg::LuError;
-use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::linalg::lu::simplicial::{
     SimplicialLu, factorize_simplicial_numeric_lu, factorize_simplicial_numeric_lu_scratch,
 };
-use faer::sparse::linalg::lu::{LuSymbolicParams, factorize_symbolic_lu};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 
 use factors::{Factors, Source};
+use order::{DiagonalOrder, column_order};
 
 /// Why a sparse factorization failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -170,12 +170,15 @@ struct Live {
     /// The loaded (summed) values, and the values factorized (mapped from them).
     base: Vec<f64>,
     values: Vec<f64>,
-    /// The fill-reducing column order `(forward, inverse)`.
-    col_perm: (Vec<usize>, Vec<usize>),
+    /// The fill-reducing column order `(forward, inverse)` for partial pivoting (COLAMD), made
+    /// when partial pivoting is first needed.
+    col_perm: Option<(Vec<usize>, Vec<usize>)>,
+    /// The order for diagonal pivots, tried first (none for a structurally singular pattern).
+    diagonal: Option<DiagonalOrder>,
 }
 
 impl Live {
-    fn new(n: usize, s: &Structure) -> Result<Live, SparseError> {
+    fn new(n: usize, s: &Structure) -> Live {
         let (mut col_ptr, mut row, mut col, mut from) = (vec![0; n + 1], Vec::new(), Vec::new(), Vec::new());
         for j in 0..n {
             for k in s.col_ptr[j]..s.col_ptr[j + 1] {
@@ -188,23 +191,9 @@ impl Live {
             col_ptr[j + 1] = row.len();
         }
         let nnz = row.len();
-        let pattern = SymbolicSparseColMatRef::new_checked(n, n, &col_ptr, None, &row);
-        let col_perm = column_order(pattern).ok_or(SparseError::Resources { n, nnz })?;
-        Ok(Live { col_ptr, row, col, from, base: vec![0.0; nnz], values: vec![0.0; nnz], col_perm })
+        let diagonal = DiagonalOrder::new(n, &col_ptr, &row);
+        Live { col_ptr, row, col, from, base: vec![0.0; nnz], values: vec![0.0; nnz], col_perm: None, diagonal }
     }
-}
-
-/// The fill-reducing column order `(forward, inverse)` of `pattern`: COLAMD, which bounds the fill
-/// whatever rows partial pivoting picks (an order for `A + Aᵀ` such as AMD assumes diagonal pivots:
-/// on column A's iteration matrix it gave 38 627 entries in `L + U` against COLAMD's 4 480).
-fn column_order(pattern: SymbolicSparseColMatRef<'_, usize>) -> Option<(Vec<usize>, Vec<usize>)> {
-    let params = LuSymbolicParams {
-        supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SIMPLICIAL,
-        ..Default::default()
-    };
-    let symbolic = factorize_symbolic_lu(pattern, params).ok()?;
-    let (fwd, inv) = symbolic.col_perm().arrays();
-    Some((fwd.to_vec(), inv.to_vec()))
 }
 
 /// A sparse LU that keeps its pattern, symbolic analysis, factors and workspace between
@@ -278,7 +267,7 @@ impl SparseLu {
         }
         if grew || self.live.is_none() {
             self.factors = None;
-            self.live = Some(Live::new(n, &self.structure)?);
+            self.live = Some(Live::new(n, &self.structure));
             self.counts.0 += 1;
         }
         let Some(live) = &mut self.live else { unreachable!("live pattern built above") };
@@ -293,8 +282,9 @@ impl SparseLu {
         &self.structure.live
     }
 
-    /// The row permutation of the held factors (`p[i]`: the matrix row pivoted at step `i`).
-    pub fn pivots(&self) -> Option<&[usize]> {
+    /// The row and column permutations of the held factors (`rows[i]`, `columns[i]`: the matrix
+    /// row and column of the pivot of elimination step `i`).
+    pub fn pivots(&self) -> Option<(&[usize], &[usize])> {
         self.factors.as_ref().filter(|_| self.factored).map(|f| f.pivots())
     }
 
@@ -321,19 +311,16 @@ impl SparseLu {
     pub fn factor_mapped_on(
         &mut self,
         map: impl Fn(usize, usize, f64) -> f64,
-        pivots: &[usize],
+        (rows, columns): (&[usize], &[usize]),
     ) -> Result<(), SparseError> {
         self.map_values(map)?;
         let (n, Some(live)) = (self.n, &self.live) else { return Err(SparseError::NotFactored) };
-        let mut inv = vec![usize::MAX; n];
-        if pivots.len() == n
-            && pivots.iter().enumerate().all(|(i, &p)| p < n && std::mem::replace(&mut inv[p], i) == usize::MAX)
-        {
+        if let (Some(row_inv), Some(col_inv)) = (inverse(rows, n), inverse(columns, n)) {
             let source = Source {
                 col_ptr: &live.col_ptr,
                 row: &live.row,
-                col_perm: (&live.col_perm.0, &live.col_perm.1),
-                row_perm: (pivots, &inv),
+                col_perm: (columns, &col_inv),
+                row_perm: (rows, &row_inv),
             };
             if let Some(mut f) = Factors::symbolic(&source)
                 && f.refactor(&live.values, false).is_ok()
@@ -357,21 +344,44 @@ impl SparseLu {
         Ok(())
     }
 
-    /// Factorize the live matrix with partial pivoting (faer chooses the pivots), then compute the
-    /// held factors on those pivots with [`Factors::refactor`], so that the factors depend on the
-    /// values and the pivots only, however they were reached.
+    /// Factorize the live matrix afresh: on the diagonal order if its pivots pass the threshold
+    /// test, else with partial pivoting (faer chooses the pivots in COLAMD's column order) and the
+    /// held factors computed on those pivots with [`Factors::refactor`], so that the factors depend
+    /// on the values and the pivots only, however they were reached.
     fn factor_pivoting(&mut self) -> Result<(), SparseError> {
         let n = self.n;
-        let Some(live) = &self.live else { return Err(SparseError::NotFactored) };
+        let Some(live) = &mut self.live else { return Err(SparseError::NotFactored) };
+        if let Some(d) = &live.diagonal {
+            let source = Source {
+                col_ptr: &live.col_ptr,
+                row: &live.row,
+                col_perm: (&d.col.0, &d.col.1),
+                row_perm: (&d.row.0, &d.row.1),
+            };
+            if let Some(mut f) = Factors::symbolic(&source)
+                && f.refactor(&live.values, true).is_ok()
+            {
+                self.factors = Some(f);
+                self.counts.1 += 1;
+                self.factored = true;
+                return Ok(());
+            }
+        }
         let nnz = live.values.len();
+        if live.col_perm.is_none() {
+            let pattern = SymbolicSparseColMatRef::new_checked(n, n, &live.col_ptr, None, &live.row);
+            live.col_perm = Some(column_order(pattern).ok_or(SparseError::Resources { n, nnz })?);
+        }
+        let Some(live) = &self.live else { unreachable!("live pattern checked above") };
+        let Some(live_perm) = &live.col_perm else { unreachable!("column order made above") };
+        let symbolic = SymbolicSparseColMatRef::new_checked(n, n, &live.col_ptr, None, &live.row);
         let req = factorize_simplicial_numeric_lu_scratch::<usize, f64>(n, n);
         let stack = workspace(&mut self.work, req).ok_or(SparseError::Resources { n, nnz })?;
-        let symbolic = SymbolicSparseColMatRef::new_checked(n, n, &live.col_ptr, None, &live.row);
         let a = SparseColMatRef::new(symbolic, &live.values);
         let (fwd, inv) = &mut self.row_perm;
         fwd.resize(n, 0);
         inv.resize(n, 0);
-        let col_perm = PermRef::new_checked(&live.col_perm.0, &live.col_perm.1, n);
+        let col_perm = PermRef::new_checked(&live_perm.0, &live_perm.1, n);
         factorize_simplicial_numeric_lu(fwd, inv, &mut self.numeric, a, col_perm, stack).map_err(|e| match e {
             LuError::SymbolicSingular { index } => SparseError::Singular { index, n },
             LuError::Generic(_) => SparseError::Resources { n, nnz },
@@ -423,11 +433,16 @@ impl SparseLu {
         self.live.as_ref().map_or(0, |l| l.values.len())
     }
 
+    /// Entries of the held factors `L + U` (0 when none are held).
+    pub fn factor_nnz(&self) -> usize {
+        self.factors.as_ref().filter(|_| self.factored).map_or(0, Factors::nnz)
+    }
+
     /// The column eliminated at step `index` of the last analysis (the fill-reducing order), to
     /// name the column of a [`SparseError::Singular`].
     pub fn pivot_column(&self, index: usize) -> Option<usize> {
         let live = self.live.as_ref()?;
-        live.col_perm.0.get(index).copied()
+        live.col_perm.as_ref()?.0.get(index).copied()
     }
 
     /// Symbolic analyses, numeric factorizations with pivoting and refactorizations on held pivots
@@ -435,6 +450,14 @@ impl SparseLu {
     pub fn counts(&self) -> (usize, usize, usize) {
         self.counts
     }
+}
+
+/// The inverse of `p` if it is a permutation of `0..n`.
+fn inverse(p: &[usize], n: usize) -> Option<Vec<usize>> {
+    let mut inv = vec![usize::MAX; n];
+    let ok =
+        p.len() == n && p.iter().enumerate().all(|(i, &v)| v < n && std::mem::replace(&mut inv[v], i) == usize::MAX);
+    ok.then_some(inv)
 }
 
 /// A memory stack over `buf`, grown to hold `req`; `None` if it cannot be allocated.
@@ -571,24 +594,63 @@ mod tests {
         let b = [1.0, 2.0, 3.0];
         let mut first = SparseLu::default();
         let mut x = b;
-        first.solve(3, &a(1.0, 0.5), &mut x).unwrap();
-        // Row 1 would be the pivot of column 0 now; the held pivot (row 0) still passes the threshold.
+        // A negligible a00: the diagonal order is refused, partial pivoting takes row 1 for column 0.
+        first.solve(3, &a(1e-9, 0.6), &mut x).unwrap();
+        // The held pivots still pass; alone, the diagonal order would be taken now.
         let t = a(0.3, 0.6);
         let mut x = b;
         first.solve(3, &t, &mut x).unwrap();
         assert_eq!(first.counts(), (1, 1, 1));
-        let (pivots, live) = (first.pivots().unwrap().to_vec(), first.live_slots().to_vec());
+        let (rows, columns) = first.pivots().map(|(r, c)| (r.to_vec(), c.to_vec())).unwrap();
+        let live = first.live_slots().to_vec();
         let mut fresh = SparseLu::default();
         let mut y = b;
         fresh.solve(3, &t, &mut y).unwrap();
-        assert_ne!(fresh.pivots().unwrap(), pivots.as_slice(), "pivoting alone picks another row");
+        assert_ne!(
+            fresh.pivots().unwrap(),
+            (rows.as_slice(), columns.as_slice()),
+            "a fresh factorization pivots otherwise"
+        );
         let mut restored = SparseLu::default();
         restored.load_with_live(3, &t, &[], &live).unwrap();
-        restored.factor_mapped_on(|_, _, v| v, &pivots).unwrap();
+        restored.factor_mapped_on(|_, _, v| v, (&rows, &columns)).unwrap();
         let mut z = b;
         restored.solve_in_place(&mut z).unwrap();
         assert_eq!(x.map(f64::to_bits), z.map(f64::to_bits));
-        assert_eq!(restored.pivots().unwrap(), pivots.as_slice());
+        assert_eq!(restored.pivots().unwrap(), (rows.as_slice(), columns.as_slice()));
+    }
+
+    /// A tridiagonal matrix with its rows and columns permuted alike: the matching keeps the
+    /// diagonal and AMD finds an order without fill (the partial-pivoting path would fill in).
+    /// With the rows scrambled besides (no structurally nonzero diagonal left), the matching finds
+    /// another diagonal and the solve is still at round-off.
+    #[test]
+    fn the_diagonal_order_factorizes_a_permuted_tridiagonal_matrix_without_fill() {
+        let n = 50;
+        let pi = |i: usize| (i * 17 + 5) % n;
+        let tridiagonal = |sigma: &dyn Fn(usize) -> usize| {
+            let mut t = Vec::new();
+            for i in 0..n {
+                t.push((sigma(pi(i)), pi(i), 4.0 + i as f64 * 0.01));
+                if i + 1 < n {
+                    t.push((sigma(pi(i)), pi(i + 1), -1.0));
+                    t.push((sigma(pi(i + 1)), pi(i), -1.5));
+                }
+            }
+            t
+        };
+        let b: Vec<f64> = (0..n).map(|i| (i as f64).sin()).collect();
+        for (sigma, no_fill) in [(&(|i| i) as &dyn Fn(usize) -> usize, true), (&|i| (i * 31 + 11) % n, false)] {
+            let t = tridiagonal(sigma);
+            let mut lu = SparseLu::default();
+            let mut x = b.clone();
+            lu.solve(n, &t, &mut x).unwrap();
+            assert!(residual(&t, &x, &b) < 1e-14, "{}", residual(&t, &x, &b));
+            assert_eq!(lu.counts(), (1, 1, 0));
+            if no_fill {
+                assert_eq!(lu.factor_nnz(), 3 * n - 2, "no fill");
+            }
+        }
     }
 
     /// A held pivot that has become small against the entries below it is not kept: the matrix
