@@ -178,6 +178,16 @@ struct Live {
 }
 
 impl Live {
+    /// The factors of the live matrix on the row and column permutations `(forward, inverse)`,
+    /// if the permutations reach every diagonal and the refactorization accepts its pivots
+    /// (`check`: against the threshold, else only nonzero and finite).
+    fn factors_on(&self, rows: (&[usize], &[usize]), columns: (&[usize], &[usize]), check: bool) -> Option<Factors> {
+        let source = Source { col_ptr: &self.col_ptr, row: &self.row, col_perm: columns, row_perm: rows };
+        let mut f = Factors::symbolic(&source)?;
+        f.refactor(&self.values, check).ok()?;
+        Some(f)
+    }
+
     fn new(n: usize, s: &Structure) -> Live {
         let (mut col_ptr, mut row, mut col, mut from) = (vec![0; n + 1], Vec::new(), Vec::new(), Vec::new());
         for j in 0..n {
@@ -315,23 +325,24 @@ impl SparseLu {
     ) -> Result<(), SparseError> {
         self.map_values(map)?;
         let (n, Some(live)) = (self.n, &self.live) else { return Err(SparseError::NotFactored) };
-        if let (Some(row_inv), Some(col_inv)) = (inverse(rows, n), inverse(columns, n)) {
-            let source = Source {
-                col_ptr: &live.col_ptr,
-                row: &live.row,
-                col_perm: (columns, &col_inv),
-                row_perm: (rows, &row_inv),
-            };
-            if let Some(mut f) = Factors::symbolic(&source)
-                && f.refactor(&live.values, false).is_ok()
-            {
-                self.factors = Some(f);
-                self.counts.2 += 1;
-                self.factored = true;
-                return Ok(());
-            }
+        if let (Some(row_inv), Some(col_inv)) = (inverse(rows, n), inverse(columns, n))
+            && let Some(f) = live.factors_on((rows, &row_inv), (columns, &col_inv), false)
+        {
+            self.hold(f, false);
+            return Ok(());
         }
         self.factor_pivoting()
+    }
+
+    /// Hold `f` as the factors (`fresh`: a new pivot sequence, else a refactorization).
+    fn hold(&mut self, f: Factors, fresh: bool) {
+        self.factors = Some(f);
+        if fresh {
+            self.counts.1 += 1;
+        } else {
+            self.counts.2 += 1;
+        }
+        self.factored = true;
     }
 
     /// The loaded values with `map` applied, into the live matrix.
@@ -351,21 +362,11 @@ impl SparseLu {
     fn factor_pivoting(&mut self) -> Result<(), SparseError> {
         let n = self.n;
         let Some(live) = &mut self.live else { return Err(SparseError::NotFactored) };
-        if let Some(d) = &live.diagonal {
-            let source = Source {
-                col_ptr: &live.col_ptr,
-                row: &live.row,
-                col_perm: (&d.col.0, &d.col.1),
-                row_perm: (&d.row.0, &d.row.1),
-            };
-            if let Some(mut f) = Factors::symbolic(&source)
-                && f.refactor(&live.values, true).is_ok()
-            {
-                self.factors = Some(f);
-                self.counts.1 += 1;
-                self.factored = true;
-                return Ok(());
-            }
+        if let Some(d) = &live.diagonal
+            && let Some(f) = live.factors_on((&d.row.0, &d.row.1), (&d.col.0, &d.col.1), true)
+        {
+            self.hold(f, true);
+            return Ok(());
         }
         let nnz = live.values.len();
         if live.col_perm.is_none() {
@@ -390,9 +391,7 @@ impl SparseLu {
             Source { col_ptr: &live.col_ptr, row: &live.row, col_perm: col_perm.arrays(), row_perm: (fwd, inv) };
         let mut f = Factors::symbolic(&source).ok_or(SparseError::Singular { index: 0, n })?;
         f.refactor(&live.values, false).map_err(|e| SparseError::Singular { index: e.column, n })?;
-        self.factors = Some(f);
-        self.counts.1 += 1;
-        self.factored = true;
+        self.hold(f, true);
         Ok(())
     }
 
@@ -522,22 +521,31 @@ mod tests {
         assert_eq!((lu.live_nnz(), lu.counts()), (8, (2, 2, 1)));
     }
 
-    #[test]
-    fn a_matrix_that_needs_row_pivots_and_a_fill_reducing_order_is_solved_both_ways() {
-        // 40 × 40, nonsymmetric, tiny diagonal (partial pivoting must exchange rows), random
-        // off-diagonal entries: the residuals of A x = b and Aᵀ y = b are at round-off.
+    /// A 40 × 40 nonsymmetric matrix: diagonal `diag(u)`, a cyclic superdiagonal and one more
+    /// entry per row, the values `u` uniform on [0, 1) from a linear congruential generator seeded
+    /// `seed`; and a right-hand side from the same generator.
+    fn ring_matrix(seed: u64, diag: impl Fn(f64) -> f64) -> (Vec<(usize, usize, f64)>, Vec<f64>) {
         let n = 40;
-        let mut s: u64 = 12345;
+        let mut s = seed;
         let mut next = || {
             s = s.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
             (s >> 11) as f64 / (1u64 << 53) as f64
         };
-        let mut t: Vec<(usize, usize, f64)> = (0..n).map(|i| (i, i, 1e-6 * next())).collect();
+        let mut t: Vec<(usize, usize, f64)> = (0..n).map(|i| (i, i, diag(next()))).collect();
         for i in 0..n {
             t.push((i, (i + 1) % n, 1.0 + next()));
             t.push((i, (i * 7 + 3) % n, next() - 0.5));
         }
-        let b: Vec<f64> = (0..n).map(|_| next() - 0.5).collect();
+        let b = (0..n).map(|_| next() - 0.5).collect();
+        (t, b)
+    }
+
+    #[test]
+    fn a_matrix_that_needs_row_pivots_and_a_fill_reducing_order_is_solved_both_ways() {
+        // Tiny diagonal (partial pivoting must exchange rows), random off-diagonal entries: the
+        // residuals of A x = b and Aᵀ y = b are at round-off.
+        let (t, b) = ring_matrix(12345, |u| 1e-6 * u);
+        let n = b.len();
         let mut lu = SparseLu::default();
         let mut x = b.clone();
         lu.solve(n, &t, &mut x).unwrap();
@@ -550,26 +558,21 @@ mod tests {
         assert!(fwd.iter().enumerate().any(|(i, &p)| i != p), "rows were exchanged");
     }
 
-    /// The 40 × 40 matrix of the test above with its values scaled entry by entry: refactorized on
-    /// the held pivots, the solve is at round-off and equal to a fresh pivoting factorization's.
+    /// A matrix of `ring_matrix`'s shape with a dominant diagonal, then its values scaled entry by
+    /// entry: refactorized on the held pivots, the solve is at round-off and equal to a fresh
+    /// factorization's.
     #[test]
     fn a_refactorization_on_held_pivots_solves_like_a_fresh_factorization() {
-        let n = 40;
-        let mut s: u64 = 777;
-        let mut next = || {
-            s = s.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
-            (s >> 11) as f64 / (1u64 << 53) as f64
-        };
-        let mut t: Vec<(usize, usize, f64)> = (0..n).map(|i| (i, i, 4.0 + next())).collect();
-        for i in 0..n {
-            t.push((i, (i + 1) % n, 1.0 + next()));
-            t.push((i, (i * 7 + 3) % n, next() - 0.5));
-        }
-        let b: Vec<f64> = (0..n).map(|_| next() - 0.5).collect();
+        let (t, b) = ring_matrix(777, |u| 4.0 + u);
+        let n = b.len();
         let mut held = SparseLu::default();
         let mut x = b.clone();
         held.solve(n, &t, &mut x).unwrap();
-        let t2: Vec<_> = t.iter().map(|&(i, j, v)| (i, j, v * (0.8 + 0.4 * next()))).collect();
+        let t2: Vec<_> = t
+            .iter()
+            .enumerate()
+            .map(|(k, &(i, j, v))| (i, j, v * (0.8 + 0.4 * ((k * 37) % 101) as f64 / 101.0)))
+            .collect();
         let mut x = b.clone();
         held.solve(n, &t2, &mut x).unwrap();
         assert_eq!(held.counts(), (1, 1, 1), "the second matrix is refactorized on the held pivots");
