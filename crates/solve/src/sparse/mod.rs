@@ -1,5 +1,5 @@
-//! The one sparse LU of the solvers (Newton, pseudo-transient, BDF, perturbation analysis), on
-//! faer's sparse LU with partial pivoting.
+//! The one sparse LU of the solvers (Newton, pseudo-transient, BDF, perturbation analysis): KLU's
+//! scheme on faer's orderings, with faer's partial-pivoting LU as the fallback.
 //!
 //! **Pattern.** The plant's Jacobian comes as triplets whose positions are the units' declared
 //! structural patterns, the same at every point. Declared patterns are generous (column A:
@@ -10,12 +10,13 @@
 //! that returns to zero stays, as an explicit zero. The live pattern is therefore exact wherever the
 //! Jacobian has been evaluated, and never loses a value.
 //!
-//! **Work per factorization.** The triplet → compressed-column map and the column ordering
-//! (COLAMD) are computed once per live pattern. The first factorization of a pattern runs faer's
-//! simplicial (left-looking, partial-pivoting) numeric LU; later ones sum the triplet values into
-//! the held matrix in place and refactorize on the held pivot sequence and `L`/`U` pattern
-//! (`factors.rs`), falling back to faer's pivoting factorization when a held pivot has become too
-//! small. Solves run in place, with `A` or `Aᵀ`, on the held factors. Everything runs on the
+//! **Work per factorization.** The triplet → compressed-column map and the diagonal order
+//! (matching + AMD, `order.rs`) are computed once per live pattern. A fresh factorization first
+//! pivots on that diagonal; where a pivot fails the threshold test it runs faer's simplicial
+//! (left-looking, partial-pivoting) numeric LU in COLAMD's column order, made on first need. Later
+//! factorizations sum the triplet values into the held matrix in place and refactorize on the held
+//! pivot sequence and `L`/`U` pattern (`factors.rs`), starting afresh when a held pivot has become
+//! too small. Solves run in place, with `A` or `Aᵀ`, on the held factors. Everything runs on the
 //! calling thread (the solvers parallelize over independent solves instead).
 
 mod factors;
@@ -437,8 +438,8 @@ impl SparseLu {
         self.factors.as_ref().filter(|_| self.factored).map_or(0, Factors::nnz)
     }
 
-    /// The column eliminated at step `index` of the last analysis (the fill-reducing order), to
-    /// name the column of a [`SparseError::Singular`].
+    /// The column eliminated at step `index` of the partial-pivoting path (COLAMD's order, where
+    /// every [`SparseError::Singular`] comes from), to name the column of that error.
     pub fn pivot_column(&self, index: usize) -> Option<usize> {
         let live = self.live.as_ref()?;
         live.col_perm.as_ref()?.0.get(index).copied()
