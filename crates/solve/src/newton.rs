@@ -225,7 +225,11 @@ pub fn solve_steady_reusing<S: System>(
         }
     }
     let history = history.records;
-    wk.linearize(x);
+    // `newton_phase` reports convergence only right after linearizing at the final `x`, so the
+    // residual and row weights are current; any other outcome may have moved `x` since.
+    if status != NewtonStatus::Converged {
+        wk.linearize(x);
+    }
     let (residual, worst) = wk.scaled_norm(&wk.r.clone());
     *lu = std::mem::take(&mut wk.lu);
     NewtonReport {
