@@ -164,7 +164,8 @@ impl<S: System> Work<'_, S> {
     }
 }
 
-/// Backtracking line search along `dx`. Returns the accepted step or `None`.
+/// Backtracking line search along `dx`. Returns the accepted step (the residual at the new `x`
+/// left in `wk.r`) or `None`.
 fn line_search<S: System>(wk: &mut Work<'_, S>, x: &mut [f64], dx: &[f64], f0: f64) -> Option<f64> {
     let mut lam = wk.max_step(x, dx);
     if lam < 1e-12 {
@@ -181,6 +182,7 @@ fn line_search<S: System>(wk: &mut Work<'_, S>, x: &mut [f64], dx: &[f64], f0: f
         let f = wk.merit(&trial, &mut r);
         if f.is_finite() && f <= (1.0 - 1e-4 * lam) * f0 {
             x.copy_from_slice(&trial);
+            wk.r = r;
             return Some(lam);
         }
         lam *= 0.5;
@@ -225,8 +227,8 @@ pub fn solve_steady_reusing<S: System>(
         }
     }
     let history = history.records;
-    // `newton_phase` reports convergence only right after linearizing at the final `x`, so the
-    // residual and row weights are current; any other outcome may have moved `x` since.
+    // `newton_phase` reports convergence only with the residual at the final `x` in `wk.r`
+    // (scaled by the last Jacobian's row weights); any other outcome may have moved `x` since.
     if status != NewtonStatus::Converged {
         wk.linearize(x);
     }
@@ -305,6 +307,12 @@ fn newton_phase<S: System>(
         match line_search(wk, x, &dx, f0) {
             Some(step) => history.push(IterationRecord { iter: history.len(), residual: norm, step, pseudo_dt: None }),
             None => return NewtonStatus::LineSearchFailed,
+        }
+        // Converged at the new point by the row weights of the last Jacobian: no Jacobian is
+        // evaluated only to rescale a residual that is already below the tolerance (the weights
+        // are row maxima of `|J|`, which the last, quadratically small step hardly moves).
+        if wk.scaled_norm(&wk.r).0 <= st.tol {
+            return NewtonStatus::Converged;
         }
     }
     wk.linearize(x);
