@@ -55,7 +55,13 @@ impl VapourPressure {
     /// Vapour pressure [Pa] at `t` [K]; the correlations are evaluated (and extrapolated) as
     /// written, `tmin`/`tmax` are informational.
     pub fn eval<S: Scalar>(&self, t: S) -> S {
-        self.ln_psat(t).exp()
+        match self {
+            // p_ref · exp(−hvap/R · (1/T − 1/t_ref)): the same value without `ln p_ref` per call.
+            VapourPressure::ClausiusClapeyron { p_ref, t_ref, hvap } => {
+                ((t.recip() - t_ref.recip()) * (-*hvap / R_GAS)).exp() * *p_ref
+            }
+            _ => self.ln_psat(t).exp(),
+        }
     }
 
     /// `ln(P_sat / Pa)` at `t` [K].
