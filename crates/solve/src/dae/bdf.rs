@@ -35,7 +35,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{DaeError, DaeIntegrator, DaeSystem, consistent_algebraic, rms, rms_of};
+use super::{DaeError, DaeIntegrator, DaeSystem, consistent_algebraic, rms};
 use crate::sparse::SparseLu;
 
 /// Highest order.
@@ -155,9 +155,9 @@ pub struct Bdf {
     lu: SparseLu,
     gamma: [f64; MAX_ORDER + 2],
     error_const: [f64; MAX_ORDER + 2],
-    /// Variables in the error test, and in the Newton convergence test.
-    controlled: Vec<bool>,
-    all: Vec<bool>,
+    /// Variables in the error test, and in the Newton convergence test (indices).
+    controlled: Vec<usize>,
+    all: Vec<usize>,
     /// For each equation, the variable whose derivative it is (`usize::MAX`: algebraic).
     diff_var: Vec<usize>,
     /// Whether `st.jac` is the matrix loaded into the LU (a new Jacobian must be loaded again).
@@ -198,10 +198,11 @@ fn change_d(d: &mut [Vec<f64>], order: usize, factor: f64, scratch: &mut [Vec<f6
             ru[i * n + j] = (0..n).map(|k| r[i * n + k] * u[k * n + j]).sum();
         }
     }
-    // D[:n] = RUᵀ D[:n]: out[j] = Σ_i RU[i][j] D[i].
+    // D[:n] = RUᵀ D[:n]: out[j] = Σ_i RU[i][j] D[i], the first term assigned.
     for (j, o) in scratch.iter_mut().enumerate().take(n) {
-        o.iter_mut().for_each(|v| *v = 0.0);
-        for (i, di) in d.iter().enumerate().take(n) {
+        let c0 = ru[j];
+        o.iter_mut().zip(&d[0]).for_each(|(a, b)| *a = c0 * b);
+        for (i, di) in d.iter().enumerate().take(n).skip(1) {
             let c = ru[i * n + j];
             if c != 0.0 {
                 o.iter_mut().zip(di).for_each(|(a, b)| *a += c * b);
@@ -328,8 +329,8 @@ impl Bdf {
 
     fn bind(&mut self, sys: &dyn DaeSystem) {
         let n = sys.n();
-        self.controlled = (0..n).map(|i| sys.error_controlled(i)).collect();
-        self.all = (0..n).map(|i| !sys.quadrature(i)).collect();
+        self.controlled = (0..n).filter(|&i| sys.error_controlled(i)).collect();
+        self.all = (0..n).filter(|&i| !sys.quadrature(i)).collect();
         self.diff_var = vec![usize::MAX; n];
         sys.mass().iter().for_each(|&(i, j)| self.diff_var[i] = j);
         self.jac_loaded = false;
@@ -391,14 +392,12 @@ impl Bdf {
         let (ratio, damping) = (c_lu / c, 2.0 / (1.0 + c_lu / c));
         let w = &mut self.w;
         w.x.copy_from_slice(&w.x_pred);
-        w.d.iter_mut().for_each(|v| *v = 0.0);
         let mut ss = self.st.newton_ss.unwrap_or(NEWTON_SS_START);
         let mut first_norm = 0.0;
         // The rounding level of a correction (at most `tol`): below it the iterate cannot improve,
         // and the rate of two such corrections is noise of any size (often ≥ 1, read as divergence
         // at every step size).
-        let roundoff =
-            rms_of(w.x_pred.iter().map(|v| ROUNDOFF_ULPS * f64::EPSILON * v.abs()), &w.scale, &self.all).min(tol);
+        let roundoff = (ROUNDOFF_ULPS * f64::EPSILON * rms(&w.x_pred, &w.scale, &self.all)).min(tol);
         for k in 0..NEWTON_MAXITER {
             let iters = k + 1;
             sys.residual(t_new, &w.x, &mut w.f);
@@ -407,10 +406,12 @@ impl Bdf {
             if !w.f.iter().all(|v| v.is_finite()) {
                 return (false, iters);
             }
+            // `d` is zero before the first correction (and not yet written: it is set below).
+            let d_of = |j: usize| if k == 0 { 0.0 } else { w.d[j] };
             for (i, r) in w.rhs.iter_mut().enumerate() {
                 *r = match self.diff_var[i] {
                     usize::MAX => w.f[i],
-                    j => ratio * (c * w.f[i] - w.psi[j] - w.d[j]),
+                    j => ratio * (c * w.f[i] - w.psi[j] - d_of(j)),
                 };
             }
             if self.lu.solve_in_place(&mut w.rhs).is_err() {
@@ -420,10 +421,12 @@ impl Bdf {
                 w.rhs.iter_mut().for_each(|v| *v *= damping);
             }
             let dy_norm = rms(&w.rhs, &w.scale, &self.all);
-            for ((x, d), r) in w.x.iter_mut().zip(w.d.iter_mut()).zip(&w.rhs) {
-                *x += r;
-                *d += r;
+            if k == 0 {
+                w.d.copy_from_slice(&w.rhs);
+            } else {
+                w.d.iter_mut().zip(&w.rhs).for_each(|(d, r)| *d += r);
             }
+            w.x.iter_mut().zip(&w.rhs).for_each(|(x, r)| *x += r);
             if dy_norm <= roundoff {
                 return (true, iters);
             }
@@ -514,7 +517,7 @@ impl Bdf {
             let w = &mut self.w;
             Self::scale_into(&self.abs_weight, rtol, &w.x, &mut w.scale);
             let e = self.error_const[order];
-            let error_norm = rms_of(w.d.iter().map(|v| e * v), &w.scale, &self.controlled);
+            let error_norm = e * rms(&w.d, &w.scale, &self.controlled);
             if error_norm > 1.0 {
                 self.st.stats.n_error_test_failures += 1;
                 let factor = MIN_FACTOR.max(safety * error_norm.powf(-1.0 / (order as f64 + 1.0)));
@@ -611,7 +614,7 @@ impl Bdf {
         Self::scale_into(&self.abs_weight, self.settings.rtol, &self.st.d[0], &mut self.w.scale);
         let norm_of = |k: usize, row: usize| {
             let e = self.error_const[k];
-            rms_of(self.st.d[row].iter().map(|v| e * v), &self.w.scale, &self.controlled)
+            e * rms(&self.st.d[row], &self.w.scale, &self.controlled)
         };
         let error_m = if order > 1 { norm_of(order - 1, order) } else { f64::INFINITY };
         let error = norm_of(order, order + 1);

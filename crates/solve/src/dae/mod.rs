@@ -106,19 +106,16 @@ pub trait DaeIntegrator {
     fn stats(&self) -> BdfStats;
 }
 
-/// Weighted root-mean-square norm `√(Σ (v_i/s_i)² / n)` over the indices where `mask` is true.
-fn rms(v: &[f64], scale: &[f64], mask: &[bool]) -> f64 {
-    rms_of(v.iter().copied(), scale, mask)
-}
-
-/// [`rms`] of the values `v` yields.
-fn rms_of(v: impl Iterator<Item = f64>, scale: &[f64], mask: &[bool]) -> f64 {
-    let (mut sum, mut n) = (0.0, 0usize);
-    for ((a, s), m) in v.zip(scale).zip(mask) {
-        if *m {
-            sum += (a / s) * (a / s);
-            n += 1;
-        }
+/// Weighted root-mean-square norm `√(Σ_{i ∈ over} (v_i/s_i)² / |over|)` (0 over no index).
+fn rms(v: &[f64], scale: &[f64], over: &[usize]) -> f64 {
+    if over.is_empty() {
+        return 0.0;
     }
-    if n == 0 { 0.0 } else { (sum / n as f64).sqrt() }
+    let sq = |a: f64, s: f64| (a / s) * (a / s);
+    let sum: f64 = if over.len() == v.len() {
+        v.iter().zip(scale).map(|(&a, &s)| sq(a, s)).sum()
+    } else {
+        over.iter().map(|&i| sq(v[i], scale[i])).sum()
+    };
+    (sum / over.len() as f64).sqrt()
 }
