@@ -29,62 +29,105 @@ impl Matching {
 
 /// Maximum matching of an `n_rows × n_cols` pattern given as `(row, col)` entries.
 pub fn maximum_matching(n_rows: usize, n_cols: usize, entries: &[(usize, usize)]) -> Matching {
-    let mut adj = vec![Vec::new(); n_rows];
-    for &(i, j) in entries {
-        adj[i].push(j);
-    }
-    for a in &mut adj {
-        a.sort_unstable();
-        a.dedup();
-    }
+    let adj = Adjacency::new(n_rows, entries);
     let mut m = Matching { row_to_col: vec![None; n_rows], col_to_row: vec![None; n_cols] };
     // Cheap greedy start, prefers the diagonal (own variable ↔ own equation).
-    for (i, row) in adj.iter().enumerate() {
-        if i < n_cols && row.binary_search(&i).is_ok() && m.col_to_row[i].is_none() {
+    for i in 0..n_rows.min(n_cols) {
+        if adj.row(i).binary_search(&i).is_ok() && m.col_to_row[i].is_none() {
             m.row_to_col[i] = Some(i);
             m.col_to_row[i] = Some(i);
         }
     }
-    let mut visited = vec![usize::MAX; n_cols];
+    let mut search = Search { visited: vec![usize::MAX; n_cols], stack: Vec::new(), path: Vec::new() };
     for i in 0..n_rows {
-        if m.row_to_col[i].is_some() {
-            continue;
+        if m.row_to_col[i].is_none() {
+            search.augment(i, &adj, &mut m);
         }
-        augment(i, i, &adj, &mut m, &mut visited);
     }
     m
 }
 
-fn augment(root: usize, row: usize, adj: &[Vec<usize>], m: &mut Matching, visited: &mut [usize]) -> bool {
-    // Iterative DFS to avoid deep recursion on long chains (columns with hundreds of trays).
-    let mut stack: Vec<(usize, usize)> = vec![(row, 0)];
-    let mut path: Vec<(usize, usize)> = Vec::new();
-    while let Some(&mut (r, ref mut k)) = stack.last_mut() {
-        if *k >= adj[r].len() {
-            stack.pop();
-            path.pop();
-            continue;
+/// The columns of each row, sorted and without repeats, in one compressed array (one allocation
+/// however many rows: the matching runs at every symbolic analysis of a plant's matrix).
+struct Adjacency {
+    ptr: Vec<usize>,
+    col: Vec<usize>,
+}
+
+impl Adjacency {
+    fn new(n_rows: usize, entries: &[(usize, usize)]) -> Adjacency {
+        let mut ptr = vec![0usize; n_rows + 1];
+        entries.iter().for_each(|&(i, _)| ptr[i + 1] += 1);
+        (0..n_rows).for_each(|i| ptr[i + 1] += ptr[i]);
+        let mut next = ptr.clone();
+        let mut col = vec![0usize; entries.len()];
+        for &(i, j) in entries {
+            col[next[i]] = j;
+            next[i] += 1;
         }
-        let c = adj[r][*k];
-        *k += 1;
-        if visited[c] == root {
-            continue;
-        }
-        visited[c] = root;
-        path.truncate(stack.len() - 1);
-        path.push((r, c));
-        match m.col_to_row[c] {
-            None => {
-                for &(pr, pc) in &path {
-                    m.row_to_col[pr] = Some(pc);
-                    m.col_to_row[pc] = Some(pr);
+        // Sort and deduplicate each row, compacting in place.
+        let mut kept = 0;
+        for i in 0..n_rows {
+            let (start, end) = (ptr[i], ptr[i + 1]);
+            col[start..end].sort_unstable();
+            ptr[i] = kept;
+            for k in start..end {
+                if k == start || col[k] != col[k - 1] {
+                    col[kept] = col[k];
+                    kept += 1;
                 }
-                return true;
             }
-            Some(next) => stack.push((next, 0)),
+        }
+        ptr[n_rows] = kept;
+        col.truncate(kept);
+        Adjacency { ptr, col }
+    }
+
+    fn row(&self, i: usize) -> &[usize] {
+        &self.col[self.ptr[i]..self.ptr[i + 1]]
+    }
+}
+
+/// The scratch of the augmenting-path searches, reused across rows.
+struct Search {
+    visited: Vec<usize>,
+    stack: Vec<(usize, usize)>,
+    path: Vec<(usize, usize)>,
+}
+
+impl Search {
+    /// Look for an augmenting path from the unmatched row `root` (iterative depth-first search:
+    /// columns with hundreds of trays make long chains) and flip it into `m` if found.
+    fn augment(&mut self, root: usize, adj: &Adjacency, m: &mut Matching) {
+        let Search { visited, stack, path } = self;
+        stack.clear();
+        path.clear();
+        stack.push((root, 0));
+        while let Some(&mut (r, ref mut k)) = stack.last_mut() {
+            let Some(&c) = adj.row(r).get(*k) else {
+                stack.pop();
+                path.pop();
+                continue;
+            };
+            *k += 1;
+            if visited[c] == root {
+                continue;
+            }
+            visited[c] = root;
+            path.truncate(stack.len() - 1);
+            path.push((r, c));
+            match m.col_to_row[c] {
+                None => {
+                    for &(pr, pc) in path.iter() {
+                        m.row_to_col[pr] = Some(pc);
+                        m.col_to_row[pc] = Some(pr);
+                    }
+                    return;
+                }
+                Some(next) => stack.push((next, 0)),
+            }
         }
     }
-    false
 }
 
 #[cfg(test)]
