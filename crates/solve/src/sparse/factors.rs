@@ -196,49 +196,75 @@ impl Factors {
     /// (`x = P_rᵀ L⁻ᵀ U⁻ᵀ Qᵀ b`), in place.
     pub(super) fn solve(&mut self, b: &mut [f64], transpose: bool) {
         let t = &mut self.tmp;
-        let n = self.n;
-        let l = (self.l_ptr.as_slice(), self.l_row.as_slice(), self.l_val.as_slice());
-        let u = (self.u_ptr.as_slice(), self.u_row.as_slice(), self.u_val.as_slice());
-        if !transpose {
-            (0..n).for_each(|i| t[i] = b[self.row_fwd[i]]);
-            for j in 0..n {
-                let xj = t[j];
-                if xj != 0.0 {
-                    for (&i, &v) in column(l, j) {
-                        t[i] -= v * xj;
-                    }
-                }
-            }
-            for j in (0..n).rev() {
-                let xj = t[j] * self.u_inv[j];
-                t[j] = xj;
-                if xj != 0.0 {
-                    for (&i, &v) in column(u, j) {
-                        t[i] -= v * xj;
-                    }
-                }
-            }
-            (0..n).for_each(|i| b[i] = t[self.col_inv[i]]);
+        let l = Triangle { ptr: &self.l_ptr, row: &self.l_row, val: &self.l_val };
+        let u = Triangle { ptr: &self.u_ptr, row: &self.u_row, val: &self.u_val };
+        let (into, out) = if transpose { (&self.col_fwd, &self.row_inv) } else { (&self.row_fwd, &self.col_inv) };
+        t.iter_mut().zip(into).for_each(|(ti, &r)| *ti = b[r]);
+        if transpose {
+            u.transposed_forward(t, &self.u_inv);
+            l.transposed_backward(t);
         } else {
-            (0..n).for_each(|i| t[i] = b[self.col_fwd[i]]);
-            for j in 0..n {
-                let s: f64 = column(u, j).map(|(&i, &v)| v * t[i]).sum();
-                t[j] = (t[j] - s) * self.u_inv[j];
-            }
-            for j in (0..n).rev() {
-                let s: f64 = column(l, j).map(|(&i, &v)| v * t[i]).sum();
-                t[j] -= s;
-            }
-            (0..n).for_each(|i| b[i] = t[self.row_inv[i]]);
+            l.forward(t);
+            u.backward(t, &self.u_inv);
         }
+        b.iter_mut().zip(out).for_each(|(bi, &r)| *bi = t[r]);
     }
 }
 
-/// The (row, value) pairs of column `j` of compressed columns `(pointers, rows, values)`.
-fn column<'a>(
-    (ptr, row, val): (&'a [usize], &'a [usize], &'a [f64]),
-    j: usize,
-) -> std::iter::Zip<std::slice::Iter<'a, usize>, std::slice::Iter<'a, f64>> {
-    let r = ptr[j]..ptr[j + 1];
-    row[r.clone()].iter().zip(&val[r])
+/// A triangular factor's strict part in compressed columns (rows ascending).
+struct Triangle<'a> {
+    ptr: &'a [usize],
+    row: &'a [usize],
+    val: &'a [f64],
+}
+
+impl Triangle<'_> {
+    /// The (row, value) pairs of each column in turn.
+    fn columns(&self) -> impl DoubleEndedIterator<Item = (&[usize], &[f64])> + ExactSizeIterator {
+        self.ptr.windows(2).map(|w| (&self.row[w[0]..w[1]], &self.val[w[0]..w[1]]))
+    }
+
+    /// `t ← L⁻¹ t` for unit lower triangular `L` (column-oriented forward substitution).
+    fn forward(&self, t: &mut [f64]) {
+        for (j, w) in self.ptr.windows(2).enumerate() {
+            let xj = t[j];
+            if xj != 0.0 && w[0] < w[1] {
+                self.axpy(t, w, xj);
+            }
+        }
+    }
+
+    /// `t ← U⁻¹ t` for `U` of these strict entries and diagonal reciprocals `inv`.
+    fn backward(&self, t: &mut [f64], inv: &[f64]) {
+        for (j, w) in self.ptr.windows(2).enumerate().rev() {
+            let xj = t[j] * inv[j];
+            t[j] = xj;
+            if xj != 0.0 && w[0] < w[1] {
+                self.axpy(t, w, xj);
+            }
+        }
+    }
+
+    /// `t_i −= v_i·xj` over the entries `w[0]..w[1]` of one column.
+    fn axpy(&self, t: &mut [f64], w: &[usize], xj: f64) {
+        let (rows, vals) = (&self.row[w[0]..w[1]], &self.val[w[0]..w[1]]);
+        rows.iter().zip(vals).for_each(|(&i, &v)| t[i] -= v * xj);
+    }
+
+    /// `t ← U⁻ᵀ t` for `U` of these strict entries and diagonal reciprocals `inv` (the columns
+    /// of `U` are the rows of `Uᵀ`: `t_j ← (t_j − Σ_i U_ij t_i)·inv_j`).
+    fn transposed_forward(&self, t: &mut [f64], inv: &[f64]) {
+        for (j, (rows, vals)) in self.columns().enumerate() {
+            let s: f64 = rows.iter().zip(vals).map(|(&i, &v)| v * t[i]).sum();
+            t[j] = (t[j] - s) * inv[j];
+        }
+    }
+
+    /// `t ← L⁻ᵀ t` for unit lower triangular `L`.
+    fn transposed_backward(&self, t: &mut [f64]) {
+        for (j, (rows, vals)) in self.columns().enumerate().rev() {
+            let s: f64 = rows.iter().zip(vals).map(|(&i, &v)| v * t[i]).sum();
+            t[j] -= s;
+        }
+    }
 }
