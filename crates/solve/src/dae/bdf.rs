@@ -11,8 +11,13 @@
 //! `M (ψ + d) = c f(t + h, x⁽⁰⁾ + d)`, for the differential rows the BDF formula
 //! `Σ_{k=1}^{q} ∇^k x_{n+1}/k = h x'_{n+1}`, and for the algebraic rows `0 = f_a`. Simplified
 //! Newton iterates with `(M − cJ) Δ = c f − M(ψ + d)` (algebraic rows divided by −c), `J` kept
-//! from an earlier point until Newton fails to converge, the LU refactorized only when `c` changes,
-//! at most 4 iterations with the rate test of SciPy.
+//! from an earlier point until Newton fails to converge, the LU refactorized only when `c` has
+//! moved by more than 30 % (CVODE's rule), at most 4 iterations with IDA's convergence test (the
+//! rate carried from step to step, tolerance a tenth of the local error).
+//!
+//! **Start.** At a (re)start the algebraic variables are made consistent by simplified Newton on
+//! the iteration matrix at `c = 0` with the Jacobian the integrator takes anyway, falling back to
+//! [`consistent_algebraic`] (Newton with line search and bounds) when that does not converge.
 //!
 //! **Error.** `err = d/(q + 1)` measured in the weighted RMS norm over the error-controlled
 //! (differential) variables with weights `atol·nominal_i + rtol·|x_i|`; a step is accepted when the
@@ -493,7 +498,6 @@ impl Bdf {
         let t = self.st.t;
         let order = self.st.order;
         let rtol = self.settings.rtol;
-        let newton_tol = NEWTON_TOL;
         let mut lu_ok = self.st.lu_c.is_some() && self.lu.is_factored();
         loop {
             if *h_abs < min_step {
@@ -511,7 +515,7 @@ impl Bdf {
             self.predict(order);
             Self::scale_into(&self.abs_weight, rtol, &self.w.x_pred, &mut self.w.scale);
             let c = h / self.gamma[order];
-            let Some(iters) = self.correct(sys, t_new, c, newton_tol, &mut lu_ok)? else {
+            let Some(iters) = self.correct(sys, t_new, c, NEWTON_TOL, &mut lu_ok)? else {
                 self.st.stats.n_newton_failures += 1;
                 self.scale_step(h_abs, order, 0.5);
                 lu_ok = false;
