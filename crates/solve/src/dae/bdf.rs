@@ -429,12 +429,12 @@ impl Bdf {
                 w.rhs.iter_mut().for_each(|v| *v *= damping);
             }
             let dy_norm = rms(&w.rhs, &w.scale, &self.all);
+            let update = w.x.iter_mut().zip(w.d.iter_mut()).zip(&w.rhs);
             if k == 0 {
-                w.d.copy_from_slice(&w.rhs);
+                update.for_each(|((x, d), r)| (*x, *d) = (*x + r, *r));
             } else {
-                w.d.iter_mut().zip(&w.rhs).for_each(|(d, r)| *d += r);
+                update.for_each(|((x, d), r)| (*x, *d) = (*x + r, *d + r));
             }
-            w.x.iter_mut().zip(&w.rhs).for_each(|(x, r)| *x += r);
             let at_roundoff = dy_norm <= roundoff;
             if k == 0 {
                 first_norm = dy_norm;
@@ -541,9 +541,13 @@ impl Bdf {
     fn predict(&mut self, order: usize) {
         let alpha = self.gamma[order];
         let w = &mut self.w;
-        w.x_pred.copy_from_slice(&self.st.d[0]);
-        w.psi.iter_mut().for_each(|v| *v = 0.0);
-        for k in 1..=order {
+        // k = 1 (every order has it) assigns: no zeroing pass.
+        let g = self.gamma[1] / alpha;
+        for (((x, p), a), b) in w.x_pred.iter_mut().zip(w.psi.iter_mut()).zip(&self.st.d[0]).zip(&self.st.d[1]) {
+            *x = a + b;
+            *p = g * b;
+        }
+        for k in 2..=order {
             let g = self.gamma[k] / alpha;
             for ((x, p), b) in w.x_pred.iter_mut().zip(w.psi.iter_mut()).zip(&self.st.d[k]) {
                 *x += b;
