@@ -114,17 +114,11 @@ struct Work<'a, S: System> {
 }
 
 impl<S: System> Work<'_, S> {
-    /// Residual and Jacobian at `x`; refreshes the row scaling `w_i = 1/max_j |J_ij|·nominal_j`.
+    /// Residual and Jacobian at `x`; refreshes the row scaling (see [`row_weights`]).
     fn linearize(&mut self, x: &[f64]) {
         self.sys.jacobian(x, &mut self.r, &mut self.jac);
         self.n_jac += 1;
-        let mut rowmax = vec![0.0f64; self.n];
-        for &(i, j, v) in &self.jac {
-            rowmax[i] = rowmax[i].max((v * self.sys.nominal(j)).abs());
-        }
-        for (w, m) in self.w.iter_mut().zip(&rowmax) {
-            *w = if *m > 0.0 && m.is_finite() { 1.0 / m } else { 1.0 };
-        }
+        row_weights(&self.jac, |j| self.sys.nominal(j), &mut self.w);
     }
     fn scaled_norm(&self, r: &[f64]) -> (f64, usize) {
         let mut worst = (0.0, 0);
@@ -162,6 +156,17 @@ impl<S: System> Work<'_, S> {
         }
         tau
     }
+}
+
+/// The row scaling of the convergence test, `w_i = 1/max_j |J_ij·nominal_j|` (1 for a row without
+/// a finite nonzero entry), into `w` (its length is the number of rows): a residual is judged
+/// against the largest term of its own equation, whatever that equation's units.
+pub(crate) fn row_weights(jac: &[(usize, usize, f64)], nominal: impl Fn(usize) -> f64, w: &mut [f64]) {
+    w.iter_mut().for_each(|v| *v = 0.0);
+    for &(i, j, v) in jac {
+        w[i] = w[i].max((v * nominal(j)).abs());
+    }
+    w.iter_mut().for_each(|m| *m = if *m > 0.0 && m.is_finite() { 1.0 / *m } else { 1.0 });
 }
 
 /// Backtracking line search along `dx`. Returns the accepted step (the residual at the new `x`

@@ -42,6 +42,7 @@ use serde::{Deserialize, Serialize};
 
 use super::{DaeError, DaeIntegrator, DaeSystem, consistent_algebraic, rms};
 use crate::NewtonSettings;
+use crate::newton::row_weights;
 use crate::sparse::SparseLu;
 
 /// Highest order.
@@ -637,13 +638,8 @@ impl Bdf {
         let n = x.len();
         let tol = NewtonSettings::default().tol;
         let algebraic: Vec<bool> = self.diff_var.iter().map(|&j| j == usize::MAX).collect();
-        let mut weight = vec![0.0f64; n];
-        for &(i, j, v) in &self.st.jac {
-            if algebraic[i] {
-                weight[i] = weight[i].max((v * sys.nominal(j)).abs());
-            }
-        }
-        weight.iter_mut().for_each(|w| *w = if *w > 0.0 && w.is_finite() { 1.0 / *w } else { 1.0 });
+        let mut weight = vec![0.0; n];
+        row_weights(&self.st.jac, |j| sys.nominal(j), &mut weight);
         let norm = |f: &[f64]| {
             (0..n).filter(|&i| algebraic[i]).map(|i| (f[i] * weight[i]).abs()).fold(0.0, |m: f64, v| m.max(v))
         };
