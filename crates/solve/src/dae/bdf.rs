@@ -412,9 +412,7 @@ impl Bdf {
             sys.residual(t_new, &w.x, &mut w.f);
             self.st.stats.n_residual_evals += 1;
             self.st.stats.n_newton_iters += 1;
-            if !w.f.iter().all(|v| v.is_finite()) {
-                return (false, iters);
-            }
+            // A non-finite residual gives a non-finite correction: the solve refuses it below.
             // `d` is zero before the first correction (and not yet written: it is set below).
             let d_of = |j: usize| if k == 0 { 0.0 } else { w.d[j] };
             for (i, r) in w.rhs.iter_mut().enumerate() {

@@ -106,14 +106,18 @@ pub trait DaeIntegrator {
     fn stats(&self) -> BdfStats;
 }
 
-/// Weighted root-mean-square norm `√(Σ_{i ∈ over} (v_i/s_i)² / |over|)` (0 over no index).
+/// Weighted root-mean-square norm `√(Σ_{i ∈ over} (v_i/s_i)² / |over|)` (0 over no index), `over`
+/// ascending without repeats (summed in that order).
 fn rms(v: &[f64], scale: &[f64], over: &[usize]) -> f64 {
     if over.is_empty() {
         return 0.0;
     }
     let sq = |a: f64, s: f64| (a / s) * (a / s);
-    let sum: f64 = if over.len() == v.len() {
-        v.iter().zip(scale).map(|(&a, &s)| sq(a, s)).sum()
+    // `over` ascends without repeats, so it is `0..m` when its last index is `m − 1` (every
+    // variable but the quadratures, which come last).
+    let sum: f64 = if over.last() == Some(&(over.len() - 1)) {
+        let m = over.len();
+        v[..m].iter().zip(&scale[..m]).map(|(&a, &s)| sq(a, s)).sum()
     } else {
         over.iter().map(|&i| sq(v[i], scale[i])).sum()
     };
