@@ -210,8 +210,12 @@ fn a_step_test_of_a_tank_level_fits_its_integrating_gain() {
     let l = &v["loops"][0];
     assert_eq!(l["fit"]["model"]["type"], "integrating");
     let k = l["fit"]["model"]["k"].as_f64().unwrap();
-    assert!((k / k_exact - 1.0).abs() < 1e-6, "{k} vs {k_exact}");
-    assert!(l["fit"]["model"]["theta"].as_f64().unwrap() < 1e-6);
+    assert!((k / k_exact - 1.0).abs() < 1e-8, "{k} vs {k_exact}");
+    // The fit resolves a dead time only to about its residual over the ramp's slope (rmse 7e-9 m
+    // against |k|·Δu = 1.0e-5 · 1.39 mol/s = 1.4e-5 m/s: 5e-4 s); "no dead time" is θ below a
+    // ten-thousandth of the scan.
+    let theta = l["fit"]["model"]["theta"].as_f64().unwrap();
+    assert!(theta < 1e-4 * 10.0, "θ = {theta} s");
     // SIMC for an integrator: Kc = 1/(k (τc + θ)), τI = 4 (τc + θ).
     assert!(
         (l["kc"].as_f64().unwrap() * k * 600.0 - 1.0).abs() < 1e-5

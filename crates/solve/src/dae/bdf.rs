@@ -10,10 +10,13 @@
 //! `ψ = (1/γ_q) Σ_{k=1}^{q} γ_k D[k]` and `c = h/γ_q`, the corrector `d = x − x⁽⁰⁾` solves
 //! `M (ψ + d) = c f(t + h, x⁽⁰⁾ + d)`, for the differential rows the BDF formula
 //! `Σ_{k=1}^{q} ∇^k x_{n+1}/k = h x'_{n+1}`, and for the algebraic rows `0 = f_a`. Simplified
-//! Newton iterates with `(M − cJ) Δ = c f − M(ψ + d)` (algebraic rows divided by −c), `J` kept
-//! from an earlier point until Newton fails to converge, the LU refactorized only when `c` has
-//! moved by more than 30 % (CVODE's rule), at most 4 iterations with IDA's convergence test (the
-//! rate carried from step to step, tolerance a tenth of the local error).
+//! Newton iterates with `(M/c − J) Δ = (c f − M(ψ + d))/c` (the iteration matrix `M − cJ` with
+//! its differential rows divided by `c` and its algebraic rows by `−c`), `J` kept from an
+//! earlier point until Newton fails to converge, the LU refactorized only when `c` has moved by
+//! more than 30 % (CVODE's rule), at most 4 iterations with IDA's convergence test (the rate
+//! carried from step to step, tolerance a tenth of the local error). In that scaling a new `c`
+//! changes the mass diagonal alone, whose columns the sparse LU eliminates last: a
+//! refactorization redoes only them, the Schur complement onto the differential variables.
 //!
 //! **Start.** At a (re)start the algebraic variables are made consistent by simplified Newton on
 //! the iteration matrix at `c = 0` with the Jacobian the integrator takes anyway, falling back to
@@ -356,36 +359,45 @@ impl Bdf {
         }
     }
 
-    /// Factorize `M − cJ` (algebraic rows: `−J`). The Jacobian is loaded into the LU once per
-    /// evaluation (the mass entries pinned in its pattern); a new `c` only maps and refactorizes
-    /// the held values.
+    /// Factorize the iteration matrix `M/c − J` (at `c = 0`: `M − 0·J`, see [`Bdf::entry`]). The
+    /// Jacobian is loaded into the LU once per evaluation (the mass entries pinned in its pattern);
+    /// a new `c` only shifts the mass diagonal and refactorizes its columns.
     fn factor(&mut self, n: usize, sys: &dyn DaeSystem, c: f64) -> Result<(), DaeError> {
         let time = self.st.t;
         if !self.jac_loaded {
             self.lu.load_pinned(n, &self.st.jac, sys.mass()).map_err(|source| DaeError::Singular { time, source })?;
             self.jac_loaded = true;
         }
-        let entry = Self::entry(&self.diff_var, c);
-        self.lu.factor_mapped(entry).map_err(|source| DaeError::Singular { time, source })?;
+        let factored = if c == 0.0 {
+            self.lu.factor_mapped(Self::entry(&self.diff_var, c))
+        } else {
+            self.lu.factor_shifted(-1.0, 1.0 / c)
+        };
+        factored.map_err(|source| DaeError::Singular { time, source })?;
         self.st.lu_c = Some(c);
         self.st.newton_ss = None;
         self.st.stats.n_lu += 1;
         Ok(())
     }
 
-    /// The entry of `M − cJ` (algebraic rows: `−J`) at `(i, j)` for `J_ij = v`.
+    /// The entry of the iteration matrix `M/c − J` at `(i, j)` for `J_ij = v` (the values
+    /// [`SparseLu::factor_shifted`] gives it, for a restored run); at `c = 0`, of `M − 0·J` (the
+    /// consistent start: identity rows for the differential equations); algebraic rows `−J`.
     fn entry(diff_var: &[usize], c: f64) -> impl Fn(usize, usize, f64) -> f64 + '_ {
+        let inv_c = 1.0 / c;
         move |i: usize, j: usize, v: f64| match diff_var[i] {
             usize::MAX => -v,
-            m if m == j => 1.0 - c * v,
-            _ => -c * v,
+            m if c == 0.0 && m == j => 1.0,
+            _ if c == 0.0 => -c * v,
+            m if m == j => inv_c - v,
+            _ => -v,
         }
     }
 
     /// Simplified Newton for the corrector; returns (converged, iterations), the iterate in `w.x`
-    /// and the correction in `w.d`. The held factors may be of `M − c_lu J` with `c_lu ≠ c`
-    /// (within [`REFACTOR_RATIO`]): the differential rows' residual is then taken at `c_lu` and
-    /// the correction scaled by `2/(1 + c_lu/c)`, as SUNDIALS IDA does with its `cj` ratio
+    /// and the correction in `w.d`. The held factors may be of `M/c_lu − J` with `c_lu ≠ c`
+    /// (within [`REFACTOR_RATIO`]): the correction is then scaled by `2/(1 + c_lu/c)`, as
+    /// SUNDIALS IDA does with its `cj` ratio
     /// (Hindmarsh et al. 2005, §3.1 of the IDA documentation), so that stiff and non-stiff
     /// directions err equally.
     ///
@@ -403,7 +415,7 @@ impl Bdf {
     /// 54 on equal steps while its level ramp, exact for BDF, drifted towards 1e-9 at rtol 1e-9.
     fn newton(&mut self, sys: &dyn DaeSystem, t_new: f64, c: f64, tol: f64) -> (bool, usize) {
         let c_lu = self.st.lu_c.unwrap_or(c);
-        let (ratio, damping) = (c_lu / c, 2.0 / (1.0 + c_lu / c));
+        let (ratio, damping, inv_c) = (c_lu / c, 2.0 / (1.0 + c_lu / c), 1.0 / c);
         // The error test's bound on the correction `d` at this order (`‖d‖/(q + 1) ≤ 1`).
         let max_first = 1.0 / self.error_const[self.st.order];
         let w = &mut self.w;
@@ -425,7 +437,8 @@ impl Bdf {
             for (i, r) in w.rhs.iter_mut().enumerate() {
                 *r = match self.diff_var[i] {
                     usize::MAX => w.f[i],
-                    j => ratio * (c * w.f[i] - w.psi[j] - d_of(j)),
+                    // `c f − ψ − d` first: on an exactly predicted step (a ramp) it cancels to 0.
+                    j => (c * w.f[i] - w.psi[j] - d_of(j)) * inv_c,
                 };
             }
             if self.lu.solve_in_place(&mut w.rhs).is_err() {

@@ -15,9 +15,11 @@
 //! pivots on that diagonal; where a pivot fails the threshold test it runs faer's simplicial
 //! (left-looking, partial-pivoting) numeric LU in COLAMD's column order, made on first need. Later
 //! factorizations sum the triplet values into the held matrix in place and refactorize on the held
-//! pivot sequence and `L`/`U` pattern (`factors.rs`), starting afresh when a held pivot has become
-//! too small. Solves run in place, with `A` or `Aᵀ`, on the held factors. Everything runs on the
-//! calling thread (the solvers parallelize over independent solves instead).
+//! pivot sequence and `L`/`U` pattern (`factors.rs`) from the first column whose entries changed,
+//! starting afresh when a held pivot has become too small. Pinned entries (below) are the ones a
+//! caller changes between factorizations ([`SparseLu::factor_shifted`]); the diagonal order puts
+//! their columns last. Solves run in place, with `A` or `Aᵀ`, on the held factors. Everything
+//! runs on the calling thread (the solvers parallelize over independent solves instead).
 
 mod factors;
 mod order;
@@ -176,6 +178,11 @@ struct Live {
     col_perm: Option<(Vec<usize>, Vec<usize>)>,
     /// The order for diagonal pivots, tried first (none for a structurally singular pattern).
     diagonal: Option<DiagonalOrder>,
+    /// The stored entries at pinned positions.
+    pinned: Vec<usize>,
+    /// `Some(a)` while `values` are `a·base`, plus a shift on the pinned entries
+    /// ([`SparseLu::factor_shifted`]): another shift then changes the pinned entries alone.
+    shifted: Option<u64>,
 }
 
 impl Live {
@@ -185,7 +192,7 @@ impl Live {
     fn factors_on(&self, rows: (&[usize], &[usize]), columns: (&[usize], &[usize]), check: bool) -> Option<Factors> {
         let source = Source { col_ptr: &self.col_ptr, row: &self.row, col_perm: columns, row_perm: rows };
         let mut f = Factors::symbolic(&source)?;
-        f.refactor(&self.values, check).ok()?;
+        f.refactor(&self.values, check, None).ok()?;
         Some(f)
     }
 
@@ -202,8 +209,14 @@ impl Live {
             col_ptr[j + 1] = row.len();
         }
         let nnz = row.len();
-        let diagonal = DiagonalOrder::new(n, &col_ptr, &row);
-        Live { col_ptr, row, col, from, base: vec![0.0; nnz], values: vec![0.0; nnz], col_perm: None, diagonal }
+        let mut last = vec![false; n];
+        s.positions[s.n_triplets..].iter().for_each(|&(_, j)| last[j] = true);
+        let diagonal = DiagonalOrder::new(n, &col_ptr, &row, &last);
+        let mut entry_of_slot = vec![usize::MAX; s.row.len()];
+        from.iter().enumerate().for_each(|(k, &slot)| entry_of_slot[slot] = k);
+        let pinned = s.slot[s.n_triplets..].iter().map(|&slot| entry_of_slot[slot]).collect();
+        let values = vec![0.0; nnz];
+        Live { col_ptr, row, col, from, base: values.clone(), values, col_perm: None, diagonal, pinned, shifted: None }
     }
 }
 
@@ -243,6 +256,8 @@ impl SparseLu {
     /// [`SparseLu::load`] with the positions `pinned` in the live pattern whatever their loaded
     /// value (zero unless a triplet is there too): entries that [`SparseLu::factor_mapped`] fills,
     /// such as the mass-matrix diagonal of `M − cJ`, which a loaded `J_ii = −1` must not cancel.
+    /// Their columns come last in the diagonal order, so that a factorization that changes only
+    /// them redoes only those columns.
     pub fn load_pinned(
         &mut self,
         n: usize,
@@ -285,6 +300,7 @@ impl SparseLu {
         for (v, &k) in live.base.iter_mut().zip(&live.from) {
             *v = self.structure.sum[k];
         }
+        live.shifted = None;
         Ok(())
     }
 
@@ -306,7 +322,7 @@ impl SparseLu {
         self.map_values(map)?;
         let Some(live) = &self.live else { return Err(SparseError::NotFactored) };
         if let Some(f) = &mut self.factors
-            && f.refactor(&live.values, true).is_ok()
+            && f.refactor(&live.values, true, None).is_ok()
         {
             self.counts.2 += 1;
             self.factored = true;
@@ -346,10 +362,37 @@ impl SparseLu {
         self.factored = true;
     }
 
+    /// Factorize `a·A + s·P` for the loaded matrix `A` and the pinned positions `P` (ones there):
+    /// the BDF's row-scaled iteration matrix `M/c − J` is `a = −1`, `s = 1/c`. Between two such
+    /// factorizations of one loaded matrix with the same `a` only the pinned entries change, and
+    /// the refactorization redoes only their columns, which the diagonal order puts last.
+    pub fn factor_shifted(&mut self, a: f64, s: f64) -> Result<(), SparseError> {
+        self.factored = false;
+        let Some(live) = &mut self.live else { return Err(SparseError::NotFactored) };
+        let only_pinned = live.shifted == Some(a.to_bits());
+        if !only_pinned {
+            live.values.iter_mut().zip(&live.base).for_each(|(v, b)| *v = a * b);
+            live.shifted = Some(a.to_bits());
+        }
+        for &k in &live.pinned {
+            live.values[k] = a * live.base[k] + s;
+        }
+        let changed = only_pinned.then_some(live.pinned.as_slice());
+        if let Some(f) = &mut self.factors
+            && f.refactor(&live.values, true, changed).is_ok()
+        {
+            self.counts.2 += 1;
+            self.factored = true;
+            return Ok(());
+        }
+        self.factor_pivoting()
+    }
+
     /// The loaded values with `map` applied, into the live matrix.
     fn map_values(&mut self, map: impl Fn(usize, usize, f64) -> f64) -> Result<(), SparseError> {
         self.factored = false;
         let Some(live) = &mut self.live else { return Err(SparseError::NotFactored) };
+        live.shifted = None;
         for k in 0..live.values.len() {
             live.values[k] = map(live.row[k], live.col[k], live.base[k]);
         }
@@ -391,7 +434,7 @@ impl SparseLu {
         let source =
             Source { col_ptr: &live.col_ptr, row: &live.row, col_perm: col_perm.arrays(), row_perm: (fwd, inv) };
         let mut f = Factors::symbolic(&source).ok_or(SparseError::Singular { index: 0, n })?;
-        f.refactor(&live.values, false).map_err(|e| SparseError::Singular { index: e.column, n })?;
+        f.refactor(&live.values, false, None).map_err(|e| SparseError::Singular { index: e.column, n })?;
         self.hold(f, true);
         Ok(())
     }
@@ -670,6 +713,55 @@ mod tests {
         lu.solve(2, &t, &mut x).unwrap();
         assert_eq!(lu.counts(), (1, 2, 0), "factorized again with pivoting");
         assert!(residual(&t, &x, &[1.0, 2.0]) < 1e-15, "{x:?}");
+    }
+
+    /// `M/c − J` of a 6 × 6 `J` whose last three equations carry the time derivatives of the last
+    /// three variables: a new `c` refactorizes only their columns (ordered last), and the factors
+    /// are the ones a fresh factorization at that `c` computes, bit for bit.
+    #[test]
+    fn a_new_shift_refactorizes_only_the_pinned_columns_and_matches_a_fresh_factorization() {
+        let jac = vec![
+            (0, 0, 1.0),
+            (0, 3, -0.5),
+            (1, 1, -2.0),
+            (1, 0, 0.3),
+            (1, 4, 1.0),
+            (2, 2, 1.0),
+            (2, 1, -0.7),
+            (2, 5, 0.2),
+            (3, 0, 0.4),
+            (3, 3, -1.0),
+            (3, 4, 0.5),
+            (4, 1, 0.6),
+            (4, 3, 0.5),
+            (4, 4, -1.5),
+            (5, 2, -0.9),
+            (5, 4, 0.25),
+            (5, 5, -0.8),
+        ];
+        let mass = [(3, 3), (4, 4), (5, 5)];
+        let b = [1.0, -2.0, 0.5, 3.0, -1.0, 2.0];
+        let solve = |lu: &mut SparseLu| {
+            let mut x = b;
+            lu.solve_in_place(&mut x).unwrap();
+            x
+        };
+        let mut held = SparseLu::default();
+        held.load_pinned(6, &jac, &mass).unwrap();
+        held.factor_shifted(-1.0, 1.0 / 0.5).unwrap();
+        let before = held.factors.as_ref().unwrap().eliminated();
+        held.factor_shifted(-1.0, 1.0 / 0.8).unwrap();
+        let again = held.factors.as_ref().unwrap().eliminated() - before;
+        assert_eq!(again, 3, "only the three pinned columns are eliminated again");
+        let mut fresh = SparseLu::default();
+        fresh.load_pinned(6, &jac, &mass).unwrap();
+        fresh.factor_shifted(-1.0, 1.0 / 0.8).unwrap();
+        let (x, y) = (solve(&mut held), solve(&mut fresh));
+        assert!(x.iter().zip(&y).all(|(a, b)| a.to_bits() == b.to_bits()), "{x:?} != {y:?}");
+        // The matrix solved is M/c − J at c = 0.8.
+        let mut a: Vec<(usize, usize, f64)> = jac.iter().map(|&(i, j, v)| (i, j, -v)).collect();
+        a.extend(mass.iter().map(|&(i, j)| (i, j, 1.0 / 0.8)));
+        assert!(residual(&a, &x, &b) < 1e-14, "{x:?}");
     }
 
     #[test]

@@ -13,7 +13,11 @@
 //!   `L + U` against COLAMD's 4 480 with partial pivoting. With AMD and partial pivoting instead,
 //!   the pivots leave the diagonal and the fill explodes (38 627 entries): diagonal pivots are
 //!   used only where they pass the refactorization's threshold test, else COLAMD and partial
-//!   pivoting take over.
+//!   pivoting take over. Columns the caller marks (those of pinned entries: the BDF's mass
+//!   diagonal) keep their AMD order among themselves but come after all others, so that a change
+//!   of the step coefficient, which moves only those entries, is refactorized from the first of
+//!   them on (the Schur complement onto the differential variables, [`super::factors`]): for
+//!   column A 88 of 436 columns at a cost of 2 598 entries of `L + U` instead of 2 469.
 
 use faer::sparse::SymbolicSparseColMatRef;
 use faer::sparse::linalg::SupernodalThreshold;
@@ -43,9 +47,9 @@ pub(super) struct DiagonalOrder {
 }
 
 impl DiagonalOrder {
-    /// The order of the `n × n` compressed-column pattern; `None` if it is structurally singular
-    /// (no perfect matching) or AMD cannot allocate.
-    pub(super) fn new(n: usize, col_ptr: &[usize], row: &[usize]) -> Option<DiagonalOrder> {
+    /// The order of the `n × n` compressed-column pattern, the columns marked `last` after the
+    /// others; `None` if it is structurally singular (no perfect matching) or AMD cannot allocate.
+    pub(super) fn new(n: usize, col_ptr: &[usize], row: &[usize], last: &[bool]) -> Option<DiagonalOrder> {
         let entries: Vec<(usize, usize)> =
             (0..n).flat_map(|j| row[col_ptr[j]..col_ptr[j + 1]].iter().map(move |&i| (i, j))).collect();
         let m = maximum_matching(n, n, &entries);
@@ -61,6 +65,9 @@ impl DiagonalOrder {
         let mut buf = Vec::new();
         amd::order_maybe_unsorted(&mut fwd, &mut inv, pattern, amd::Control::default(), workspace(&mut buf, req)?)
             .ok()?;
+        let (mut fwd, rest): (Vec<usize>, Vec<usize>) = fwd.into_iter().partition(|&c| !last[c]);
+        fwd.extend(rest);
+        fwd.iter().enumerate().for_each(|(i, &c)| inv[c] = i);
         let row_of_col: Vec<usize> = m.col_to_row.iter().map(|r| r.unwrap_or(usize::MAX)).collect();
         let row_fwd: Vec<usize> = fwd.iter().map(|&c| row_of_col[c]).collect();
         let mut row_inv = vec![0usize; n];
