@@ -320,9 +320,16 @@ impl SparseLu {
     /// those of the live pattern). Cheap to repeat: the BDF iteration matrix `M − cJ` for a new `c`.
     pub fn factor_mapped(&mut self, map: impl Fn(usize, usize, f64) -> f64) -> Result<(), SparseError> {
         self.map_values(map)?;
+        self.refactor_or_pivot(false)
+    }
+
+    /// Refactorize the held factors for the live values (`only_pinned`: only the pinned entries
+    /// can have changed since they were computed), else factorize afresh with pivoting.
+    fn refactor_or_pivot(&mut self, only_pinned: bool) -> Result<(), SparseError> {
         let Some(live) = &self.live else { return Err(SparseError::NotFactored) };
+        let changed = only_pinned.then_some(live.pinned.as_slice());
         if let Some(f) = &mut self.factors
-            && f.refactor(&live.values, true, None).is_ok()
+            && f.refactor(&live.values, true, changed).is_ok()
         {
             self.counts.2 += 1;
             self.factored = true;
@@ -377,15 +384,7 @@ impl SparseLu {
         for &k in &live.pinned {
             live.values[k] = a * live.base[k] + s;
         }
-        let changed = only_pinned.then_some(live.pinned.as_slice());
-        if let Some(f) = &mut self.factors
-            && f.refactor(&live.values, true, changed).is_ok()
-        {
-            self.counts.2 += 1;
-            self.factored = true;
-            return Ok(());
-        }
-        self.factor_pivoting()
+        self.refactor_or_pivot(only_pinned)
     }
 
     /// The loaded values with `map` applied, into the live matrix.
