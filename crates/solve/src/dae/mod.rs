@@ -106,20 +106,20 @@ pub trait DaeIntegrator {
     fn stats(&self) -> BdfStats;
 }
 
-/// Weighted root-mean-square norm `√(Σ_{i ∈ over} (v_i/s_i)² / |over|)` (0 over no index), `over`
-/// ascending without repeats (summed in that order).
-fn rms(v: &[f64], scale: &[f64], over: &[usize]) -> f64 {
+/// Weighted root-mean-square norm `√(Σ_{i ∈ over} (v_i·w_i)² / |over|)` (0 over no index), `over`
+/// ascending without repeats (summed in that order); `w` are reciprocal error scales.
+fn rms(v: &[f64], weight: &[f64], over: &[usize]) -> f64 {
     if over.is_empty() {
         return 0.0;
     }
-    let sq = |a: f64, s: f64| (a / s) * (a / s);
+    let sq = |a: f64, w: f64| (a * w) * (a * w);
     // `over` ascends without repeats, so it is `0..m` when its last index is `m − 1` (every
     // variable but the quadratures, which come last).
     let sum: f64 = if over.last() == Some(&(over.len() - 1)) {
         let m = over.len();
-        v[..m].iter().zip(&scale[..m]).map(|(&a, &s)| sq(a, s)).sum()
+        v[..m].iter().zip(&weight[..m]).map(|(&a, &w)| sq(a, w)).sum()
     } else {
-        over.iter().map(|&i| sq(v[i], scale[i])).sum()
+        over.iter().map(|&i| sq(v[i], weight[i])).sum()
     };
     (sum / over.len() as f64).sqrt()
 }
