@@ -32,7 +32,7 @@ pub(super) struct NeedsPivoting {
 
 /// `L` (strictly lower part) and `U` (strictly upper part and diagonal) in compressed columns
 /// with ascending rows, the permutations, and where each entry of the matrix goes.
-#[derive(Debug, Default)]
+#[derive(Debug, Default, Clone)]
 pub(super) struct Factors {
     n: usize,
     l_ptr: Vec<usize>,
@@ -335,10 +335,7 @@ impl Triangle<'_> {
     /// `t ← L⁻¹ t` for unit lower triangular `L` (column-oriented forward substitution).
     fn forward(&self, t: &mut [f64]) {
         for (j, w) in self.ptr.windows(2).enumerate() {
-            let xj = t[j];
-            if xj != 0.0 && w[0] < w[1] {
-                self.axpy(t, w, xj);
-            }
+            self.axpy(t, w, t[j]);
         }
     }
 
@@ -347,9 +344,7 @@ impl Triangle<'_> {
         for (j, w) in self.ptr.windows(2).enumerate().rev() {
             let xj = t[j] * inv[j];
             t[j] = xj;
-            if xj != 0.0 && w[0] < w[1] {
-                self.axpy(t, w, xj);
-            }
+            self.axpy(t, w, xj);
         }
     }
 

@@ -11,7 +11,8 @@
 //! Jacobian has been evaluated, and never loses a value.
 //!
 //! **Work per factorization.** The triplet → compressed-column map and the diagonal order
-//! (matching + AMD, `order.rs`) are computed once per live pattern. A fresh factorization first
+//! (matching + AMD, `order.rs`) are computed once per live pattern, and the order with the
+//! pattern of its factors once per process (`cache.rs`: the next run of the same plant finds it). A fresh factorization first
 //! pivots on that diagonal; where a pivot fails the threshold test it runs faer's simplicial
 //! (left-looking, partial-pivoting) numeric LU in COLAMD's column order, made on first need. Later
 //! factorizations sum the triplet values into the held matrix in place and refactorize on the held
@@ -21,10 +22,12 @@
 //! their columns last. Solves run in place, with `A` or `Aᵀ`, on the held factors. Everything
 //! runs on the calling thread (the solvers parallelize over independent solves instead).
 
+mod cache;
 mod factors;
 mod order;
 
 use std::mem::MaybeUninit;
+use std::sync::Arc;
 
 use faer::dyn_stack::{MemStack, StackReq};
 use faer::perm::PermRef;
@@ -34,8 +37,9 @@ use faer::sparse::linalg::lu::simplicial::{
 };
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 
+use cache::Analysis;
 use factors::{Factors, Source};
-use order::{DiagonalOrder, column_order};
+use order::column_order;
 
 /// Why a sparse factorization failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -176,8 +180,8 @@ struct Live {
     /// The fill-reducing column order `(forward, inverse)` for partial pivoting (COLAMD), made
     /// when partial pivoting is first needed.
     col_perm: Option<(Vec<usize>, Vec<usize>)>,
-    /// The order for diagonal pivots, tried first (none for a structurally singular pattern).
-    diagonal: Option<DiagonalOrder>,
+    /// The order for diagonal pivots, tried first, and the pattern of its factors (`cache.rs`).
+    analysis: Arc<Analysis>,
     /// The stored entries at pinned positions.
     pinned: Vec<usize>,
     /// `Some(a)` while `values` are `a·base`, plus a shift on the pinned entries
@@ -211,12 +215,12 @@ impl Live {
         let nnz = row.len();
         let mut last = vec![false; n];
         s.positions[s.n_triplets..].iter().for_each(|&(_, j)| last[j] = true);
-        let diagonal = DiagonalOrder::new(n, &col_ptr, &row, &last);
+        let analysis = cache::analysis(n, &col_ptr, &row, &last);
         let mut entry_of_slot = vec![usize::MAX; s.row.len()];
         from.iter().enumerate().for_each(|(k, &slot)| entry_of_slot[slot] = k);
         let pinned = s.slot[s.n_triplets..].iter().map(|&slot| entry_of_slot[slot]).collect();
         let values = vec![0.0; nnz];
-        Live { col_ptr, row, col, from, base: values.clone(), values, col_perm: None, diagonal, pinned, shifted: None }
+        Live { col_ptr, row, col, from, base: values.clone(), values, col_perm: None, analysis, pinned, shifted: None }
     }
 }
 
@@ -405,11 +409,12 @@ impl SparseLu {
     fn factor_pivoting(&mut self) -> Result<(), SparseError> {
         let n = self.n;
         let Some(live) = &mut self.live else { return Err(SparseError::NotFactored) };
-        if let Some(d) = &live.diagonal
-            && let Some(f) = live.factors_on((&d.row.0, &d.row.1), (&d.col.0, &d.col.1), true)
-        {
-            self.hold(f, true);
-            return Ok(());
+        if let Some(symbolic) = &live.analysis.factors {
+            let mut f = symbolic.clone();
+            if f.refactor(&live.values, true, None).is_ok() {
+                self.hold(f, true);
+                return Ok(());
+            }
         }
         let nnz = live.values.len();
         if live.col_perm.is_none() {
