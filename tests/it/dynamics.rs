@@ -317,6 +317,38 @@ fn manual_mode_holds_the_output_and_auto_returns_to_setpoint() {
     assert!((level.last().unwrap() - 1.0).abs() < 1e-3 && (out.last().unwrap() - 60.0).abs() < 1e-2);
 }
 
+/// Each recorded path measured by a controller carries its setpoint, the value the scenario gave
+/// it at each recorded time (a step at 100 s, recorded in two rows at 100 s: before and after
+/// it); a path no controller measures, and a total, carry none.
+#[test]
+fn a_measured_path_records_its_setpoint_and_others_none() {
+    let (plant, x0, _) = tank(&[]);
+    let res = run_from(
+        &plant,
+        r#"{"format_version": 1, "duration": "300 s",
+        "events": [{"type": "step", "at": "100 s", "path": "lc.sp", "to": "1.2 m"}],
+        "record": {"interval": "10 s", "time_unit": "s", "paths": ["out.F", "tank.level"], "totals": ["out"]}}"#,
+        Start::Steady(&x0),
+        &mut |_| {},
+    );
+    assert_eq!(res.references.len(), res.columns.len());
+    let level = res.columns.iter().position(|c| c.path == "tank.level").unwrap();
+    for (k, r) in res.references.iter().enumerate() {
+        assert_eq!(r.is_some(), k == level, "reference of {}", res.columns[k].path);
+    }
+    let sp = res.references[level].as_ref().unwrap();
+    assert_eq!(sp.len(), res.times.len());
+    let mut at_step = Vec::new();
+    for (&t, &v) in res.times.iter().zip(sp) {
+        if t == 100.0 {
+            at_step.push(v);
+        } else {
+            assert_eq!(v, if t < 100.0 { 1.0 } else { 1.2 }, "setpoint at {t} s");
+        }
+    }
+    assert_eq!(at_step, [1.0, 1.2]);
+}
+
 /// The outflow's flow setpoint sticks at 200 s; the inflow then rises: the level ramps exactly
 /// while the controller's output (driving nothing any more) winds up.
 #[test]

@@ -36,6 +36,7 @@ pub(super) struct Driver {
     rows: Vec<Vec<f64>>,
     /// Per recorded path: the setpoint input of the controller that measures it.
     refs: Vec<Option<usize>>,
+    /// Per recorded row: the references of the paths that have one (`refs`), in order.
     ref_rows: Vec<Vec<f64>>,
     events: Vec<(f64, String)>,
     /// Start from a snapshot of the same plant: the history to restore instead of restarting.
@@ -538,8 +539,12 @@ impl Driver {
         let references = self
             .refs
             .iter()
-            .enumerate()
-            .map(|(k, r)| r.map(|_| self.ref_rows.iter().map(|row| row[k]).collect()))
+            .scan(0, |m, r| {
+                // `ref_rows` hold the referenced columns only, in order: `m` counts them.
+                let col = r.map(|_| self.ref_rows.iter().map(|row| row[*m]).collect());
+                *m += usize::from(r.is_some());
+                Some(col)
+            })
             .chain(std::iter::repeat_n(None, n_tot))
             .collect();
         SimulationResult {
@@ -573,8 +578,9 @@ fn recorded_state(plant: &Plant, sc: &Scenario) -> Vec<usize> {
     v
 }
 
-/// One recorded row at `t` from the state `x`, and the references. An input driven by a
-/// controller is recorded as the controller's output, the value the plant receives.
+/// One recorded row at `t` from the state `x`, and the references of the recorded paths that
+/// have one (in order; no allocation when none has). An input driven by a controller is recorded
+/// as the controller's output, the value the plant receives.
 fn row_at(
     plant: &Plant,
     sc: &Scenario,
@@ -583,17 +589,14 @@ fn row_at(
     t: f64,
     x: &[f64],
 ) -> (Vec<f64>, Vec<f64>) {
-    let mut row: Vec<f64> = sc
-        .record
-        .iter()
-        .map(|r| match r.source {
-            Read::Var(v) => x[v],
-            Read::Input(i) => plant.inputs()[i].driven_by.map_or_else(|| waves[i].at(t), |v| x[v]),
-        })
-        .collect();
-    let np = plant.n_vars();
-    row.extend_from_slice(&x[np..np + sc.totals.len() * plant.components().len()]);
-    (row, refs.iter().map(|r| r.map_or(f64::NAN, |i| waves[i].at(t))).collect())
+    let (np, n_tot) = (plant.n_vars(), sc.totals.len() * plant.components().len());
+    let mut row = Vec::with_capacity(sc.record.len() + n_tot);
+    row.extend(sc.record.iter().map(|r| match r.source {
+        Read::Var(v) => x[v],
+        Read::Input(i) => plant.inputs()[i].driven_by.map_or_else(|| waves[i].at(t), |v| x[v]),
+    }));
+    row.extend_from_slice(&x[np..np + n_tot]);
+    (row, refs.iter().flatten().map(|&i| waves[i].at(t)).collect())
 }
 
 /// The setpoint input of the controller that measures `source`, if any: `<ctrl>.sp` of a loop,
