@@ -116,10 +116,35 @@ fn rms(v: &[f64], weight: &[f64], over: &[usize]) -> f64 {
     // `over` ascends without repeats, so it is `0..m` when its last index is `m − 1` (every
     // variable but the quadratures, which come last).
     let sum: f64 = if over.last() == Some(&(over.len() - 1)) {
+        // Four partial sums: one running sum is a chain of dependent additions, latency-bound.
         let m = over.len();
-        v[..m].iter().zip(&weight[..m]).map(|(&a, &w)| sq(a, w)).sum()
+        let (v, w) = (v[..m].chunks_exact(4), weight[..m].chunks_exact(4));
+        let tail: f64 = v.remainder().iter().zip(w.remainder()).map(|(&a, &w)| sq(a, w)).sum();
+        let lanes = v.zip(w).fold([0.0; 4], |mut acc, (a, w)| {
+            acc.iter_mut().enumerate().for_each(|(k, s)| *s += sq(a[k], w[k]));
+            acc
+        });
+        (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]) + tail
     } else {
         over.iter().map(|&i| sq(v[i], weight[i])).sum()
     };
     (sum / over.len() as f64).sqrt()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::rms;
+
+    /// The contiguous path (four partial sums and a tail) and the gathered path give the closed
+    /// form `w·√(Σ_{i=1}^{m} i² / m)`: for m = 7, `√(140/7) = √20`.
+    #[test]
+    fn weighted_rms_matches_its_closed_form_on_both_paths() {
+        let v: Vec<f64> = (1..=9).map(f64::from).collect();
+        let w = vec![0.5; 9];
+        let contiguous: Vec<usize> = (0..7).collect();
+        assert!((rms(&v, &w, &contiguous) - 0.5 * 20f64.sqrt()).abs() < 1e-15);
+        // Indices 2, 4, 8 hold 3, 5, 9: √((9 + 25 + 81)/3).
+        assert!((rms(&v, &w, &[2, 4, 8]) - 0.5 * (115.0f64 / 3.0).sqrt()).abs() < 1e-15);
+        assert_eq!(rms(&v, &w, &[]), 0.0);
+    }
 }
