@@ -20,6 +20,7 @@
 
 use std::collections::HashMap;
 use std::path::Path;
+use std::sync::Arc;
 
 use plantwide_model::controllers::ControllerLinks;
 use plantwide_model::limits::Limits;
@@ -548,13 +549,13 @@ impl<'s> Assembler<'s> {
             thermo: self.thermo,
             stream_layout: self.stream_layout,
             blocks: self.blocks,
-            vars: self.vars,
+            vars: Arc::new(self.vars),
             inputs: self.inputs,
             streams: self.streams,
-            aliases: self.aliases,
-            var_index: self.var_index,
+            aliases: Arc::new(self.aliases),
+            var_index: Arc::new(self.var_index),
             input_index: self.input_index,
-            spec: self.spec.clone(),
+            spec: Arc::new(self.spec.clone()),
             assembled_inputs: Vec::new(),
             specs: Vec::new(),
         };

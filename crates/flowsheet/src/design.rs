@@ -10,6 +10,8 @@
 //! Specs define a design point, not a control structure: dynamics, linearization and the studies
 //! see the plant with each varied input fixed at the value its spec found ([`Plant::fix_specs`]).
 
+use std::sync::Arc;
+
 use plantwide_units::QuantityValue;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -81,7 +83,7 @@ impl Plant {
             let origin = format!("--spec {}={} --vary {}", e.path, quantity_text(&e.value), e.vary);
             let spec = resolve(self, e, &origin).map_err(|(_, why)| SpecError { origin: origin.clone(), why })?;
             self.specs.push(spec);
-            self.spec.specs.push(e.clone());
+            Arc::make_mut(&mut self.spec).specs.push(e.clone());
         }
         Ok(())
     }
@@ -93,7 +95,7 @@ impl Plant {
         for s in std::mem::take(&mut self.specs) {
             self.inputs[s.input].value = u[s.input];
         }
-        self.spec.specs.clear();
+        Arc::make_mut(&mut self.spec).specs.clear();
     }
 }
 

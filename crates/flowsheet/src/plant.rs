@@ -115,19 +115,20 @@ pub struct Plant {
     pub(crate) stream_layout: StreamLayout,
     /// Units and controllers.
     pub(crate) blocks: Vec<Block>,
-    /// Global variables.
-    pub(crate) vars: Vec<VarInfo>,
+    /// Global variables (shared between copies: a simulation copies the plant to rewire its
+    /// inputs, never its variables).
+    pub(crate) vars: Arc<Vec<VarInfo>>,
     /// Declared inputs.
     pub(crate) inputs: Vec<InputInfo>,
     /// Streams.
     pub(crate) streams: Vec<StreamInfo>,
     /// Named inputs (`alias → input index`).
-    pub(crate) aliases: HashMap<String, usize>,
-    pub(crate) var_index: HashMap<String, usize>,
+    pub(crate) aliases: Arc<HashMap<String, usize>>,
+    pub(crate) var_index: Arc<HashMap<String, usize>>,
     pub(crate) input_index: HashMap<String, usize>,
     /// The description the plant was assembled from (after field overrides): structure variants
     /// are edits of it, assembled again ([`Plant::variant`]).
-    pub(crate) spec: FlowsheetSpec,
+    pub(crate) spec: Arc<FlowsheetSpec>,
     /// The input values as assembled from `spec`: a variant keeps only the values changed since.
     pub(crate) assembled_inputs: Vec<f64>,
     /// Design specifications still to be met ([`crate::design`]).

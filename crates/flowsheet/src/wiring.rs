@@ -8,6 +8,7 @@
 //! in its place; a held measurement is an input of its own (`<ctrl>.analyzer`), appended after the
 //! declared inputs, so the indices of the declared inputs never move.
 
+use crate::FlowsheetSpec;
 use crate::overrides::{Override, OverrideError};
 use crate::plant::{BlockKind, InputInfo, Plant, Read};
 
@@ -157,7 +158,7 @@ impl Plant {
     /// in order to this plant's description (so a field of a controller added earlier in `edits`
     /// can be set), assembled again, input values carried over as in [`Plant::variant`].
     pub fn restructure(&self, edits: &[StructureEdit]) -> Result<Plant, OverrideError> {
-        let mut spec = self.spec.clone();
+        let mut spec = FlowsheetSpec::clone(&self.spec);
         let mut inputs = Vec::new();
         for e in edits {
             match e {
