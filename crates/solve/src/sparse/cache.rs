@@ -54,6 +54,13 @@ struct Entry {
     analysis: Arc<Analysis>,
 }
 
+impl Entry {
+    /// Whether this is the entry of the key `(n, col_ptr, row, last)`.
+    fn is(&self, n: usize, col_ptr: &[usize], row: &[usize], last: &[bool]) -> bool {
+        self.n == n && self.col_ptr == col_ptr && self.row == row && self.last == last
+    }
+}
+
 /// Most recently used first.
 static CACHE: Mutex<Vec<Entry>> = Mutex::new(Vec::new());
 
@@ -80,7 +87,7 @@ pub(super) fn analysis(n: usize, col_ptr: &[usize], row: &[usize], last: &[bool]
 
 /// The cached analysis of the key, moved to the front.
 fn lookup(cache: &mut Vec<Entry>, n: usize, col_ptr: &[usize], row: &[usize], last: &[bool]) -> Option<Arc<Analysis>> {
-    let k = cache.iter().position(|e| e.n == n && e.col_ptr == col_ptr && e.row == row && e.last == last)?;
+    let k = cache.iter().position(|e| e.is(n, col_ptr, row, last))?;
     let entry = cache.remove(k);
     let analysis = Arc::clone(&entry.analysis);
     cache.insert(0, entry);
@@ -90,8 +97,7 @@ fn lookup(cache: &mut Vec<Entry>, n: usize, col_ptr: &[usize], row: &[usize], la
 /// `entry` at the front (unless another thread put its key there meanwhile), the least recently
 /// used beyond `max` dropped.
 fn insert(cache: &mut Vec<Entry>, entry: Entry, max: usize) {
-    let same = |e: &Entry| e.n == entry.n && e.col_ptr == entry.col_ptr && e.row == entry.row && e.last == entry.last;
-    if !cache.iter().any(same) {
+    if !cache.iter().any(|e| e.is(entry.n, &entry.col_ptr, &entry.row, &entry.last)) {
         cache.insert(0, entry);
         cache.truncate(max);
     }

@@ -12,14 +12,14 @@
 //!
 //! **Work per factorization.** The triplet → compressed-column map and the diagonal order
 //! (matching + AMD, `order.rs`) are computed once per live pattern, and the order with the
-//! pattern of its factors once per process (`cache.rs`: the next run of the same plant finds it). A fresh factorization first
-//! pivots on that diagonal; where a pivot fails the threshold test it runs faer's simplicial
-//! (left-looking, partial-pivoting) numeric LU in COLAMD's column order, made on first need. Later
-//! factorizations sum the triplet values into the held matrix in place and refactorize on the held
-//! pivot sequence and `L`/`U` pattern (`factors.rs`) from the first column whose entries changed,
-//! starting afresh when a held pivot has become too small. Pinned entries (below) are the ones a
-//! caller changes between factorizations ([`SparseLu::factor_shifted`]); the diagonal order puts
-//! their columns last. Solves run in place, with `A` or `Aᵀ`, on the held factors. Everything
+//! pattern of its factors once per process (`cache.rs`: the next run of the same plant finds
+//! it). A fresh factorization first pivots on that diagonal; where a pivot fails the threshold
+//! test it runs faer's simplicial (left-looking, partial-pivoting) numeric LU in COLAMD's column
+//! order, made on first need. Later factorizations sum the triplet values into the held matrix in
+//! place and refactorize on the held pivot sequence and `L`/`U` pattern (`factors.rs`) from the
+//! first column whose entries changed, starting afresh when a held pivot has become too small.
+//! Pinned entries (below) are the ones a caller changes between factorizations
+//! ([`SparseLu::factor_shifted`]); the diagonal order puts their columns last. Solves run in place, with `A` or `Aᵀ`, on the held factors. Everything
 //! runs on the calling thread (the solvers parallelize over independent solves instead).
 
 mod cache;
