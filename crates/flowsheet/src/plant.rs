@@ -237,12 +237,13 @@ impl Plant {
 
     /// Residuals `f(x, u)` at time `t` into `r` (length `n_eqs`).
     pub fn residual(&self, x: &[f64], u: &[f64], t: f64, r: &mut [f64]) {
-        let mut local = Vec::with_capacity(self.blocks.iter().map(|b| b.layout.len()).max().unwrap_or(0));
-        for b in &self.blocks {
-            self.gather(b, x, u, &mut local);
-            let io = UnitIo { local: &local, layout: &b.layout, thermo: &self.thermo, time: t };
-            b.unit.residual(&io, &mut r[b.eq_offset..b.eq_offset + b.n_eq]);
-        }
+        LOCAL.with_borrow_mut(|local| {
+            for b in &self.blocks {
+                self.gather(b, x, u, local);
+                let io = UnitIo { local, layout: &b.layout, thermo: &self.thermo, time: t };
+                b.unit.residual(&io, &mut r[b.eq_offset..b.eq_offset + b.n_eq]);
+            }
+        });
     }
 
     /// Residuals and Jacobians: `∂f/∂x` as triplets `(row, col, value)` into `jx`, and `∂f/∂u`
@@ -373,6 +374,9 @@ impl Plant {
 thread_local! {
     /// The dense block Jacobian buffer of [`Plant::block_jacobian`], one per thread.
     static DENSE_JACOBIAN: std::cell::RefCell<Vec<f64>> = const { std::cell::RefCell::new(Vec::new()) };
+    /// The local vector of [`Plant::residual`], one per thread: a residual is evaluated at every
+    /// Newton iteration of every integrator step, and its allocation was a measurable share.
+    static LOCAL: std::cell::RefCell<Vec<f64>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
 /// Work (Σ equations × local length) above which block Jacobians are evaluated in parallel.

@@ -56,9 +56,11 @@ impl VapourPressure {
     /// written, `tmin`/`tmax` are informational.
     pub fn eval<S: Scalar>(&self, t: S) -> S {
         match self {
-            // p_ref · exp(−hvap/R · (1/T − 1/t_ref)): the same value without `ln p_ref` per call.
+            // p_ref · exp(hvap/R · (T − t_ref)/(T·t_ref)), which is −hvap/R · (1/T − 1/t_ref) with
+            // one division instead of three (the model's hottest call: every stage's bubble point);
+            // without `ln p_ref` per call.
             VapourPressure::ClausiusClapeyron { p_ref, t_ref, hvap } => {
-                ((t.recip() - t_ref.recip()) * (-*hvap / R_GAS)).exp() * *p_ref
+                ((t - *t_ref) / (t * *t_ref) * (*hvap * (1.0 / R_GAS))).exp() * *p_ref
             }
             _ => self.ln_psat(t).exp(),
         }

@@ -146,7 +146,8 @@ impl ThermoPackage {
     pub fn bubble_residual<S: Scalar>(&self, t: S, p: S, x: &[S]) -> S {
         match &self.vle {
             VleModel::ConstantAlpha { .. } => {
-                self.components.iter().zip(x).fold(S::from(-1.0), |acc, (c, xi)| acc + c.psat(t) * *xi / p)
+                let inv_p = p.recip();
+                self.components.iter().zip(x).fold(S::from(-1.0), |acc, (c, xi)| acc + c.psat(t) * *xi * inv_p)
             }
             _ => {
                 let mut k = vec![S::from(0.0); x.len()];

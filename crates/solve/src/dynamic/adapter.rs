@@ -101,6 +101,12 @@ impl DaeShape {
     }
 }
 
+thread_local! {
+    /// The inputs `u(t)` of [`PlantDae::residual`], one buffer per thread (a residual per Newton
+    /// iteration; its allocation was a measurable share of a run).
+    static INPUTS: std::cell::RefCell<Vec<f64>> = const { std::cell::RefCell::new(Vec::new()) };
+}
+
 /// The plant at time-varying inputs, with quadratures of stream component flows appended.
 pub(super) struct PlantDae<'a> {
     plant: &'a Plant,
@@ -121,7 +127,11 @@ impl DaeSystem for PlantDae<'_> {
     }
     fn residual(&self, t: f64, x: &[f64], r: &mut [f64]) {
         let np = self.shape.n_plant;
-        self.plant.residual(&x[..np], &values_at(self.waves, t), t, &mut r[..np]);
+        INPUTS.with_borrow_mut(|u| {
+            u.clear();
+            u.extend(self.waves.iter().map(|w| w.at(t)));
+            self.plant.residual(&x[..np], u, t, &mut r[..np]);
+        });
         for (k, (f, z)) in self.shape.flows.iter().enumerate() {
             for (c, zc) in z.clone().enumerate() {
                 r[np + k * self.shape.nc + c] = x[*f] * x[zc];

@@ -49,6 +49,8 @@ pub(super) struct Driver {
     mpcs: Vec<MpcRun>,
     /// The first controller failure, which ends the run.
     failure: Option<MpcError>,
+    /// The state buffer of [`Driver::step_once`] (events, interpolated rows), kept between steps.
+    state_buf: Vec<f64>,
 }
 
 /// Why a run stopped early.
@@ -174,6 +176,7 @@ impl Driver {
             quad,
             mpcs,
             failure: None,
+            state_buf: Vec::new(),
         })
     }
 
@@ -447,7 +450,9 @@ impl Driver {
             return Err(RunError::Mpc(e));
         }
         let t = self.t();
-        let mut x = self.bdf.x().to_vec();
+        let mut x = std::mem::take(&mut self.state_buf);
+        x.clear();
+        x.extend_from_slice(self.bdf.x());
         self.restart_after_due(t, &mut x)?;
         if let Some(e) = self.failure.take() {
             return Err(RunError::Mpc(e));
@@ -460,6 +465,7 @@ impl Driver {
         self.bdf.step(&sys, t_stop)?;
         let now = self.bdf.t();
         self.record_through(now, &mut x);
+        self.state_buf = x;
         self.offer_snapshots(now, observer);
         observer(Progress::Step { t: now, duration: self.sc.duration });
         Ok(true)
