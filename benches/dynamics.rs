@@ -3,11 +3,18 @@
 //! converged steady state. Prints the median wall time of repeated runs and the integrator's
 //! counters, then one JSON line for `tools/bench_bdf_scipy.py`, which runs the same model and
 //! scenario with SciPy's BDF and reports the ratio. Run with `cargo bench --bench dynamics`.
+//!
+//! Beside it, the same scenario on the 82-state ODE the peers integrate (`column_a_ode.rs`:
+//! everything but the holdups eliminated by hand), on the same BDF and settings from the plant's
+//! steady holdups: the integrator's own cost, and so what the plant's DAE formulation adds.
+
+mod column_a_ode;
 
 use std::time::{Duration, Instant};
 
 use plantwide::flowsheet::load_file;
 use plantwide::flowsheet::scenario::{parse_scenario, resolve};
+use plantwide::solve::dae::{Bdf, BdfSettings, DaeIntegrator};
 use plantwide::solve::dynamic::{SimulationResult, Start, simulate};
 use plantwide::solve::{NewtonSettings, steady_state};
 
@@ -36,20 +43,79 @@ fn main() {
             .map(|k| res.rows.last().map_or(f64::NAN, |r| r[k]))
             .unwrap_or(f64::NAN)
     };
+    let ode = ode_run(&plant, &x0, &spec, &scenario);
     let s = res.stats;
     println!("column A feed step, 2000 min, rtol 1e-6, atol 1e-8·nominal ({} variables)", plant.n_vars());
     println!(
         "median wall {wall:.3?}: {} steps, {} residual evaluations, {} Jacobian evaluations, {} LU factorizations, {} error-test failures",
         s.n_steps, s.n_residual_evals, s.n_jacobian_evals, s.n_lu, s.n_error_test_failures
     );
+    let o = &ode.stats;
     println!(
-        "{{\"wall_s\": {}, \"steps\": {}, \"residual_evals\": {}, \"jacobian_evals\": {}, \"lu\": {}, \"xB\": {}, \"yD\": {}}}",
+        "the same on the peers' 82-state ODE: median wall {:.3?}: {} steps, {} residual evaluations, {} Jacobian evaluations, {} LU factorizations; xB = {:.10}",
+        ode.wall, o.n_steps, o.n_residual_evals, o.n_jacobian_evals, o.n_lu, ode.xb
+    );
+    println!(
+        "{{\"wall_s\": {}, \"steps\": {}, \"residual_evals\": {}, \"jacobian_evals\": {}, \"lu\": {}, \"xB\": {}, \"yD\": {}, \"ode\": {{\"wall_s\": {}, \"steps\": {}, \"residual_evals\": {}, \"jacobian_evals\": {}, \"lu\": {}, \"xB\": {}, \"yD\": {}}}}}",
         wall.as_secs_f64(),
         s.n_steps,
         s.n_residual_evals,
         s.n_jacobian_evals,
         s.n_lu,
         col("bottoms.x[light]"),
-        col("distillate.x[light]")
+        col("distillate.x[light]"),
+        ode.wall.as_secs_f64(),
+        o.n_steps,
+        o.n_residual_evals,
+        o.n_jacobian_evals,
+        o.n_lu,
+        ode.xb,
+        ode.yd
     );
+}
+
+/// The ODE run's median wall time, counters and final compositions.
+struct OdeRun {
+    wall: Duration,
+    stats: plantwide::solve::dae::BdfStats,
+    xb: f64,
+    yd: f64,
+}
+
+/// The scenario (its feed step to 1.01 kmol/min, duration and tolerances) on the peers' ODE from
+/// the plant's steady holdups `x0`, median of 15 runs after one untimed.
+fn ode_run(
+    plant: &plantwide::flowsheet::Plant,
+    x0: &[f64],
+    spec: &plantwide::flowsheet::scenario::ScenarioSpec,
+    file: &str,
+) -> OdeRun {
+    let sc = resolve(spec, plant, file).expect("scenario fits the plant");
+    let holdup = |s: usize, c: &str| x0[plant.var(&format!("column.n[{s}][{c}]")).expect("column A holdup")];
+    let n0: Vec<f64> = (1..=41).flat_map(|s| [holdup(s, "light"), holdup(s, "heavy")]).collect();
+    let sys = column_a_ode::ColumnOde::new(1.01 * 1000.0 / 60.0);
+    let worst = column_a_ode::check_jacobian(&sys, &n0);
+    assert!(worst < 1e-6, "hand-derived Jacobian off its central differences by {worst:e}");
+    let settings = BdfSettings {
+        rtol: sc.rtol,
+        atol: sc.atol,
+        max_step: sc.max_step,
+        first_step: sc.first_step,
+        ..BdfSettings::default()
+    };
+    let once = || {
+        let t = Instant::now();
+        let mut bdf = Bdf::new(settings.clone());
+        bdf.restart(&sys, 0.0, &n0).expect("consistent start");
+        while bdf.t() < sc.duration {
+            bdf.step(&sys, sc.duration).expect("ODE step");
+        }
+        (t.elapsed(), bdf)
+    };
+    let (_, bdf) = once();
+    let mut times: Vec<Duration> = (0..15).map(|_| once().0).collect();
+    times.sort();
+    let x = bdf.x();
+    let frac = |i: usize| x[2 * i] / (x[2 * i] + x[2 * i + 1]);
+    OdeRun { wall: times[times.len() / 2], stats: bdf.stats(), xb: frac(0), yd: frac(40) }
 }

@@ -29,7 +29,9 @@ Peers:
                       is built once outside the timing loop; only the call I(x0=..., p=...) is timed.
   plantwide           `cargo bench --bench dynamics` run once from the repository root (median of 15 runs
                       inside the bench; exact Jacobians by dual numbers); --no-plantwide skips it,
-                      --plantwide-json '<json line>' passes its last line in instead.
+                      --plantwide-json '<json line>' passes its last line in instead. Its line also
+                      carries ("ode") plantwide's BDF on this script's 82-state ODE written in Rust
+                      (benches/column_a_ode.rs), the integrator without the plant's DAE formulation.
 
 The figures are medians on this machine (2 cores, shared with whatever else is running): compare ratios
 from one run, not absolute times across runs.
@@ -239,6 +241,11 @@ def main():
               f"xB = {pw['xB']:.10f}, yD = {pw['yD']:.10f}")
     else:
         print(f"plantwide: {pw}")
+    ode = pw.get("ode", {})
+    if "wall_s" in ode:
+        print(f"plantwide BDF on this script's 82-state ODE (benches/column_a_ode.rs, hand-derived Jacobian; the "
+              f"integrator without the plant DAE): {ode['wall_s'] * 1e3:.2f} ms, {ode['steps']} steps, "
+              f"{ode['residual_evals']} RHS evaluations, {ode['lu']} LU; xB = {ode['xB']:.10f}")
 
     n0 = model.steady_state()
     xb0, yd0 = ends(n0)
@@ -307,6 +314,8 @@ def main():
         for k in ("casadi_cvodes", "casadi_idas"):
             if "wall_s" in result.get(k, {}):
                 ratios[f"plantwide/{k}"] = pw["wall_s"] / result[k]["wall_s"]
+                if "wall_s" in ode:
+                    ratios[f"plantwide_ode/{k}"] = ode["wall_s"] / result[k]["wall_s"]
     result["ratios"] = ratios
     if ratios:
         print("wall-time ratios: " + ", ".join(f"{k} {v:.2f}" for k, v in ratios.items()))
