@@ -29,6 +29,6 @@ pub use error::{Diagnostic, Error, LoadError};
 pub use overrides::{Override, OverrideError, load_str_with, load_with};
 pub use parse::{parse_spec, read_text};
 pub use path::VarPath;
-pub use plant::{Block, BlockKind, InputInfo, Parallelism, Plant, Read, StreamInfo, VarInfo};
+pub use plant::{Block, BlockKind, InputInfo, Parallelism, Plant, Read, StreamInfo, VarInfo, with_dense_jacobian};
 pub use spec::FlowsheetSpec;
 pub use wiring::{StructureEdit, WiringError};

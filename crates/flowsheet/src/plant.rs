@@ -330,17 +330,7 @@ impl Plant {
     fn block_jacobian(&self, b: &Block, unit: &dyn Unit, x: &[f64], u: &[f64], t: f64) -> BlockJacobian {
         let mut local = Vec::new();
         self.gather(b, x, u, &mut local);
-        let n = local.len();
-        DENSE_JACOBIAN.with_borrow_mut(|jac| {
-            // With a colouring only the declared entries are written and read: the buffer is reused
-            // as it is (a column's block is 1.5 MB, zeroed at every evaluation it was a tenth of a
-            // dynamic run). Without one every entry is written.
-            let need = b.n_eq * n;
-            if jac.len() < need {
-                jac.resize(need, 0.0);
-            }
-            self.block_entries(b, unit, &local, t, &mut jac[..need])
-        })
+        with_dense_jacobian(b.n_eq * local.len(), |jac| self.block_entries(b, unit, &local, t, jac))
     }
 
     /// [`Plant::block_jacobian`] on the gathered `local` vector with `jac` (`n_eq × local.len()`,
@@ -377,6 +367,20 @@ thread_local! {
     /// The local vector of [`Plant::residual`], one per thread: a residual is evaluated at every
     /// Newton iteration of every integrator step, and its allocation was a measurable share.
     static LOCAL: std::cell::RefCell<Vec<f64>> = const { std::cell::RefCell::new(Vec::new()) };
+}
+
+/// Run `f` on this thread's dense block-Jacobian buffer (row-major, `need` entries), reused
+/// between calls and never zeroed: [`Unit::jacobian_colored`] writes every entry it is read back
+/// from — all of them without a colouring, the declared ones with one. A column's block is
+/// 1.5 MB: allocated and zeroed at every evaluation it was a tenth of a dynamic run, and of a
+/// sequential pass's group Newton (page faults included).
+pub fn with_dense_jacobian<R>(need: usize, f: impl FnOnce(&mut [f64]) -> R) -> R {
+    DENSE_JACOBIAN.with_borrow_mut(|jac| {
+        if jac.len() < need {
+            jac.resize(need, 0.0);
+        }
+        f(&mut jac[..need])
+    })
 }
 
 /// Work (Σ equations × local length) above which block Jacobians are evaluated in parallel.

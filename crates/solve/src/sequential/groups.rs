@@ -23,7 +23,7 @@
 
 use std::collections::VecDeque;
 
-use plantwide_flowsheet::{BlockKind, Plant, Read};
+use plantwide_flowsheet::{BlockKind, Plant, Read, with_dense_jacobian};
 use plantwide_model::{UnitIo, VarKind};
 
 use crate::System;
@@ -315,33 +315,33 @@ impl System for GroupSystem<'_> {
     }
     fn jacobian(&self, y: &[f64], r: &mut [f64], jac: &mut Vec<(usize, usize, f64)>) {
         jac.clear();
-        let (mut local, mut dense) = (Vec::new(), Vec::new());
+        let mut local = Vec::new();
         for (k, &bi) in self.layout.blocks.iter().enumerate() {
             let b = &self.plant.blocks()[bi];
             self.gather(k, y, &mut local);
             let n = local.len();
-            dense.clear();
-            dense.resize(b.n_eq * n, 0.0);
             let io = UnitIo { local: &local, layout: &b.layout, thermo: self.plant.thermo(), time: 0.0 };
             let (r0, c0, n_own) = (self.layout.row0[k], self.layout.col0[k], b.layout.n_own());
-            b.unit.jacobian_colored(&io, &mut r[r0..r0 + b.n_eq], &mut dense, b.coloring.as_ref());
-            let mut push = |row: usize, j: usize| {
-                let col = if j < n_own {
-                    Some(c0 + j)
-                } else {
-                    match b.reads[j - n_own] {
-                        Read::Var(i) => self.layout.local(self.plant, i),
-                        Read::Input(_) => None,
+            with_dense_jacobian(b.n_eq * n, |dense| {
+                b.unit.jacobian_colored(&io, &mut r[r0..r0 + b.n_eq], dense, b.coloring.as_ref());
+                let mut push = |row: usize, j: usize| {
+                    let col = if j < n_own {
+                        Some(c0 + j)
+                    } else {
+                        match b.reads[j - n_own] {
+                            Read::Var(i) => self.layout.local(self.plant, i),
+                            Read::Input(_) => None,
+                        }
+                    };
+                    if let Some(col) = col {
+                        jac.push((r0 + row, col, dense[row * n + j]));
                     }
                 };
-                if let Some(col) = col {
-                    jac.push((r0 + row, col, dense[row * n + j]));
+                match &b.pattern {
+                    Some(p) => p.iter().for_each(|&(row, j)| push(row, j)),
+                    None => (0..b.n_eq).for_each(|row| (0..n).for_each(|j| push(row, j))),
                 }
-            };
-            match &b.pattern {
-                Some(p) => p.iter().for_each(|&(row, j)| push(row, j)),
-                None => (0..b.n_eq).for_each(|row| (0..n).for_each(|j| push(row, j))),
-            }
+            });
         }
     }
     fn nominal(&self, i: usize) -> f64 {
