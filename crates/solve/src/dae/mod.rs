@@ -12,9 +12,11 @@
 
 pub mod bdf;
 mod init;
+pub(crate) mod reduce;
 
 pub use bdf::{Bdf, BdfSettings, BdfState, BdfStats};
 pub use init::consistent_algebraic;
+pub use reduce::ReduceError;
 
 /// A time-aware semi-explicit DAE `M dx/dt = f(t, x)` with a 0/1 mass matrix.
 pub trait DaeSystem: Sync {
@@ -38,6 +40,23 @@ pub trait DaeSystem: Sync {
     /// variables are left out of the Newton convergence test as well (default: none).
     fn quadrature(&self, _i: usize) -> bool {
         false
+    }
+    /// Algebraic variables the system computes in closed form from the others, as
+    /// `(equation, variable)` pairs in the order [`DaeSystem::complete`] computes them: each
+    /// equation is solved exactly for its variable, reading only kept variables and explicit ones
+    /// earlier in the list. The integrator's Newton iteration then runs on the other variables
+    /// alone (default: none).
+    fn explicit(&self) -> &[(usize, usize)] {
+        &[]
+    }
+    /// Overwrite the [`DaeSystem::explicit`] variables of `x` with their values from the others
+    /// at time `t` (default: nothing).
+    fn complete(&self, _t: f64, _x: &mut [f64]) {}
+    /// [`DaeSystem::residual`] at an `x` that [`DaeSystem::complete`] has just completed: the
+    /// explicit equations hold there and their rows may be left zero without evaluating them
+    /// (default: the residual).
+    fn residual_completed(&self, t: f64, x: &[f64], r: &mut [f64]) {
+        self.residual(t, x, r);
     }
 }
 
@@ -77,6 +96,14 @@ pub enum DaeError {
         time: f64,
         /// What the factorization said.
         source: crate::sparse::SparseError,
+    },
+    /// The explicit variables could not be eliminated from the iteration matrix.
+    #[error("explicit variables at t = {time} s: {source}")]
+    Explicit {
+        /// Time [s].
+        time: f64,
+        /// What the elimination found.
+        source: ReduceError,
     },
     /// A restored state does not fit the system.
     #[error("integrator state does not fit the system: {0}")]
