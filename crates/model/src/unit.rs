@@ -173,6 +173,24 @@ pub trait UnitModel: Send + Sync + std::fmt::Debug {
     }
     /// Residuals at the local vector `io.local` into `r`.
     fn eval<S: Scalar>(&self, io: &UnitIo<'_, S>, r: &mut [S]);
+    /// Own algebraic variables the unit computes in closed form ([`UnitModel::complete`]), in the
+    /// order it computes them: own variable `k` is given by its own equation `k`, which must read
+    /// no explicit variable later in this list (default: none). The dynamic integrator then
+    /// iterates on the other variables only and recomputes these after every update.
+    fn explicit(&self, _layout: &LocalLayout) -> Vec<usize> {
+        Vec::new()
+    }
+    /// Overwrite the [`UnitModel::explicit`] variables of `own` (a copy of the own block of
+    /// `io.local`) so that their equations hold exactly, computing them in the declared order
+    /// from the other own variables (read from `own`), the inlets and the inputs (default:
+    /// nothing).
+    fn complete(&self, _io: &UnitIo<'_, f64>, _own: &mut [f64]) {}
+    /// The residuals of the equations that are not [`UnitModel::explicit`], at a local vector
+    /// whose explicit variables [`UnitModel::complete`] has just set; the explicit equations'
+    /// rows of `r` may be left as they are (default: [`UnitModel::eval`]).
+    fn eval_kept(&self, io: &UnitIo<'_, f64>, r: &mut [f64]) {
+        self.eval(io, r);
+    }
     /// Initial guess of the own variables from the inlets and inputs in `local` (its own block holds
     /// whatever was there before: defaults or a previous solution).
     fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]);
@@ -253,6 +271,12 @@ pub trait Unit: Send + Sync + std::fmt::Debug {
     fn jacobian_colored(&self, io: &UnitIo<'_, f64>, r: &mut [f64], jac: &mut [f64], coloring: Option<&Coloring>);
     /// See [`UnitModel::guess`].
     fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]);
+    /// See [`UnitModel::explicit`].
+    fn explicit(&self, layout: &LocalLayout) -> Vec<usize>;
+    /// See [`UnitModel::complete`].
+    fn complete(&self, io: &UnitIo<'_, f64>, own: &mut [f64]);
+    /// See [`UnitModel::eval_kept`].
+    fn residual_kept(&self, io: &UnitIo<'_, f64>, r: &mut [f64]);
     /// See [`UnitModel::without_limits`].
     fn without_limits(&self) -> Option<Box<dyn Unit>>;
     /// See [`UnitModel::output_limits`].
@@ -366,6 +390,15 @@ impl<U: UnitModel + 'static> Unit for U {
     }
     fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]) {
         UnitModel::guess(self, io, own);
+    }
+    fn explicit(&self, layout: &LocalLayout) -> Vec<usize> {
+        UnitModel::explicit(self, layout)
+    }
+    fn complete(&self, io: &UnitIo<'_, f64>, own: &mut [f64]) {
+        UnitModel::complete(self, io, own);
+    }
+    fn residual_kept(&self, io: &UnitIo<'_, f64>, r: &mut [f64]) {
+        UnitModel::eval_kept(self, io, r);
     }
     fn without_limits(&self) -> Option<Box<dyn Unit>> {
         UnitModel::without_limits(self).map(|u| Box::new(u) as Box<dyn Unit>)

@@ -320,6 +320,15 @@ impl UnitModel for Column {
     fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]) {
         delegate!(self, guess(io, own))
     }
+    fn explicit(&self, layout: &LocalLayout) -> Vec<usize> {
+        delegate!(self, explicit(layout))
+    }
+    fn complete(&self, io: &UnitIo<'_, f64>, own: &mut [f64]) {
+        delegate!(self, complete(io, own))
+    }
+    fn eval_kept(&self, io: &UnitIo<'_, f64>, r: &mut [f64]) {
+        delegate!(self, eval_kept(io, r))
+    }
     fn holdup(&self, io: &UnitIo<'_, f64>) -> Option<Vec<f64>> {
         delegate!(self, holdup(io))
     }

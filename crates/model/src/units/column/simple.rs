@@ -184,10 +184,9 @@ impl SimpleColumn {
 
     /// Per stage: the feeds' component flows `Σ F z_j` (stage `s`, component `j` at `s·nc + j`)
     /// and their vapour `Σ (1 − q) F`, with `q = (h_V − h_F)/(h_V − h_L)` at the feed stage where
-    /// it is not given.
-    fn feed_terms<S: Scalar>(&self, io: &UnitIo<'_, S>) -> (Vec<S>, Vec<S>) {
-        let (nc, n, ix) = (self.nc(), self.n_stages, StageIdx { nc: self.nc() });
-        let st = |s: usize| io.vars(self.stage(s), self.per_stage());
+    /// it is not given; `st(s)` is stage `s`'s variables.
+    fn feed_terms<'v, S: Scalar + 'v>(&self, io: &UnitIo<'_, S>, st: impl Fn(usize) -> &'v [S]) -> (Vec<S>, Vec<S>) {
+        let (nc, n) = (self.nc(), self.n_stages);
         let mut feed_comp = vec![S::from(0.0); n * nc];
         let mut feed_vap = vec![S::from(0.0); n];
         for (k, f) in self.feeds.iter().enumerate() {
@@ -195,18 +194,59 @@ impl SimpleColumn {
             for (acc, z) in feed_comp[f.stage * nc..(f.stage + 1) * nc].iter_mut().zip(s.z()) {
                 *acc += s.f() * *z;
             }
-            let q = match f.q {
-                Some(q) => S::from(q),
-                None => {
-                    let v = st(f.stage);
-                    let hv = io.thermo.h_vap(v[ix.t()], &v[ix.y(0)..ix.y(0) + nc]);
-                    let hl = io.thermo.h_liq(v[ix.t()], &v[ix.x(0)..ix.x(0) + nc]);
-                    (hv - s.h()) / (hv - hl)
-                }
-            };
-            feed_vap[f.stage] += (S::from(1.0) - q) * s.f();
+            feed_vap[f.stage] += self.feed_vapour(io, k, st(f.stage));
         }
         (feed_comp, feed_vap)
+    }
+
+    /// The vapour `(1 − q) F` feed `k` brings to its stage, whose variables are `v` (module
+    /// documentation).
+    fn feed_vapour<S: Scalar>(&self, io: &UnitIo<'_, S>, k: usize, v: &[S]) -> S {
+        let (nc, ix) = (self.nc(), StageIdx { nc: self.nc() });
+        let s = io.inlet(k);
+        let q = match self.feeds[k].q {
+            Some(q) => S::from(q),
+            None => {
+                let hv = io.thermo.h_vap(v[ix.t()], &v[ix.y(0)..ix.y(0) + nc]);
+                let hl = io.thermo.h_liq(v[ix.t()], &v[ix.x(0)..ix.x(0) + nc]);
+                (hv - s.h()) / (hv - hl)
+            }
+        };
+        (S::from(1.0) - q) * s.f()
+    }
+
+    /// `dn_sj/dt` of the component balance of stage `s`, component `j` (module documentation),
+    /// with the feeds' flow `feed` of it, the distillate `d_in` and the side draws' flows.
+    fn component_balance<S: Scalar>(
+        &self,
+        io: &UnitIo<'_, S>,
+        s: usize,
+        j: usize,
+        feed: S,
+        d_in: S,
+        draw_flow: &[S],
+    ) -> S {
+        let (n, ix) = (self.n_stages, StageIdx { nc: self.nc() });
+        let st = |s: usize| io.vars(self.stage(s), self.per_stage());
+        let v = st(s);
+        let mut acc = feed - v[ix.l()] * v[ix.x(j)] - v[ix.v()] * v[ix.y(j)];
+        if s + 1 < n {
+            let up = st(s + 1);
+            acc += up[ix.l()] * up[ix.x(j)];
+        }
+        if s > 0 {
+            let dn = st(s - 1);
+            acc += dn[ix.v()] * dn[ix.y(j)];
+        }
+        if s + 1 == n {
+            acc -= d_in * v[ix.x(j)];
+        }
+        for (d, fl) in self.draws.iter().zip(draw_flow) {
+            if d.stage == s {
+                acc -= *fl * v[ix.x(j)];
+            }
+        }
+        acc
     }
 
     /// Outlet residuals: distillate from the condenser (flow `D`), bottoms from the reboiler (its
@@ -369,33 +409,15 @@ impl UnitModel for SimpleColumn {
         let (l_in, v_in, d_in, b_in) =
             (io.input(IN_REFLUX), io.input(IN_BOILUP), io.input(IN_DISTILLATE), io.input(IN_BOTTOMS));
         let mut kbuf = vec![S::from(0.0); nc];
-        let (feed_comp, feed_vap) = self.feed_terms(io);
+        let (feed_comp, feed_vap) = self.feed_terms(io, st);
         let draw_flow: Vec<S> = (0..self.draws.len()).map(|k| io.input(4 + k)).collect();
 
         for s in 0..n {
             let v = st(s);
             let o = internal0 + self.stage(s);
             let m = v[ix.m()];
-            // Component balances.
             for j in 0..nc {
-                let mut acc = feed_comp[s * nc + j] - v[ix.l()] * v[ix.x(j)] - v[ix.v()] * v[ix.y(j)];
-                if s + 1 < n {
-                    let up = st(s + 1);
-                    acc += up[ix.l()] * up[ix.x(j)];
-                }
-                if s > 0 {
-                    let dn = st(s - 1);
-                    acc += dn[ix.v()] * dn[ix.y(j)];
-                }
-                if s + 1 == n {
-                    acc -= d_in * v[ix.x(j)];
-                }
-                for (d, fl) in self.draws.iter().zip(&draw_flow) {
-                    if d.stage == s {
-                        acc -= *fl * v[ix.x(j)];
-                    }
-                }
-                r[o + ix.n(j)] = acc;
+                r[o + ix.n(j)] = self.component_balance(io, s, j, feed_comp[s * nc + j], d_in, &draw_flow);
                 r[o + ix.x(j)] = v[ix.x(j)] - v[ix.n(j)] / m;
             }
             let x = &v[ix.x(0)..ix.x(0) + nc];
@@ -428,6 +450,103 @@ impl UnitModel for SimpleColumn {
             };
         }
         self.outlet_residuals(io, d_in, &draw_flow, r);
+    }
+    /// Every variable but the holdups `n` and temperatures `T`, in the order
+    /// [`SimpleColumn::complete`] computes them: per stage `M`, `x`, `y`; then the vapour flows
+    /// bottom up, the liquid flows; then the outlet streams.
+    fn explicit(&self, layout: &LocalLayout) -> Vec<usize> {
+        let (nc, n, ix) = (self.nc(), self.n_stages, StageIdx { nc: self.nc() });
+        let outlets = self.n_outlets() * layout.stream.len();
+        let col = |s: usize, k: usize| outlets + self.stage(s) + k;
+        let mut e = Vec::with_capacity(n * (2 * nc + 3) + outlets);
+        for s in 0..n {
+            e.push(col(s, ix.m()));
+            e.extend((0..nc).map(|j| col(s, ix.x(j))));
+            e.extend((0..nc).map(|j| col(s, ix.y(j))));
+        }
+        e.extend((0..n).map(|s| col(s, ix.v())));
+        e.extend((0..n).map(|s| col(s, ix.l())));
+        e.extend(0..outlets);
+        e
+    }
+    /// The component balances and bubble points alone: every other equation is explicit.
+    fn eval_kept(&self, io: &UnitIo<'_, f64>, r: &mut [f64]) {
+        let (nc, ix) = (self.nc(), StageIdx { nc: self.nc() });
+        let internal0 = self.n_outlets() * io.layout.stream.len();
+        let st = |s: usize| io.vars(self.stage(s), self.per_stage());
+        let (feed_comp, _) = self.feed_terms(io, st);
+        let d_in = io.input(IN_DISTILLATE);
+        let draw_flow: Vec<f64> = (0..self.draws.len()).map(|k| io.input(4 + k)).collect();
+        for s in 0..self.n_stages {
+            let (v, o) = (st(s), internal0 + self.stage(s));
+            for j in 0..nc {
+                r[o + ix.n(j)] = self.component_balance(io, s, j, feed_comp[s * nc + j], d_in, &draw_flow);
+            }
+            r[o + ix.t()] = io.thermo.bubble_residual(v[ix.t()], self.pressure, &v[ix.x(0)..ix.x(0) + nc]);
+        }
+    }
+    /// `M = Σ n`, `x = n/M`, `y = K(T, P, x) x`, the CMO vapour flows, the liquid flows and the
+    /// outlets, each from its own equation of [`UnitModel::eval`] (module documentation).
+    fn complete(&self, io: &UnitIo<'_, f64>, own: &mut [f64]) {
+        let (nc, n, ix, ps) = (self.nc(), self.n_stages, StageIdx { nc: self.nc() }, self.per_stage());
+        let (outs, stages) = own.split_at_mut(self.n_outlets() * io.layout.stream.len());
+        let mut k_stack = [0.0; 8];
+        let mut k_heap = Vec::new();
+        let k: &mut [f64] = if nc <= k_stack.len() {
+            &mut k_stack[..nc]
+        } else {
+            k_heap.resize(nc, 0.0);
+            &mut k_heap
+        };
+        // One pass up the column: each stage's M, x, y, then its V (from the V below) and L.
+        let mut v_below = 0.0;
+        for (s, v) in stages[..n * ps].chunks_exact_mut(ps).enumerate() {
+            let m = v[ix.n(0)..ix.n(0) + nc].iter().fold(0.0, |a, b| a + b);
+            v[ix.m()] = m;
+            // One division: `x = n·(1/M)` is within an ulp of `n/M`.
+            let inv_m = 1.0 / m;
+            for j in 0..nc {
+                v[ix.x(j)] = v[ix.n(j)] * inv_m;
+            }
+            io.thermo.k_values(v[ix.t()], self.pressure, &v[ix.x(0)..ix.x(0) + nc], k);
+            for j in 0..nc {
+                v[ix.y(j)] = k[j] * v[ix.x(j)];
+            }
+            // The feed quality may read this stage's x and y, just computed.
+            let fed: f64 =
+                (0..self.feeds.len()).filter(|&f| self.feeds[f].stage == s).map(|f| self.feed_vapour(io, f, v)).sum();
+            v[ix.v()] = match s {
+                0 => io.input(IN_BOILUP) + fed,
+                _ if s + 1 == n => 0.0,
+                _ => v_below + fed,
+            };
+            v[ix.l()] = match s {
+                _ if s + 1 == n => io.input(IN_REFLUX),
+                0 => io.input(IN_BOTTOMS),
+                _ => {
+                    let l = self.l0[s] + (m - self.m0[s]) / self.tau_l;
+                    if self.lambda != 0.0 { l + (v_below - self.v0) * self.lambda } else { l }
+                }
+            };
+            v_below = v[ix.v()];
+        }
+        let slen = io.layout.stream.len();
+        let mut outlet = |k: usize, s: usize, flow: f64| {
+            let v = &stages[self.stage(s)..self.stage(s) + ps];
+            let x = &v[ix.x(0)..ix.x(0) + nc];
+            let out = &mut outs[k * slen..(k + 1) * slen];
+            out[F] = flow;
+            out[T] = v[ix.t()];
+            out[P] = self.pressure;
+            out[H] = io.thermo.h_liq(v[ix.t()], x);
+            out[Z0..Z0 + nc].copy_from_slice(x);
+        };
+        let bottoms = stages[self.stage(0) + ix.l()];
+        outlet(0, n - 1, io.input(IN_DISTILLATE));
+        outlet(1, 0, bottoms);
+        for (k, d) in self.draws.iter().enumerate() {
+            outlet(2 + k, d.stage, io.input(4 + k));
+        }
     }
     fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]) {
         let nc = self.nc();
@@ -582,6 +701,52 @@ mod tests {
                 assert!(jacobian_error(&u, &lay, &thermo, &local, m) < 1e-6, "{f}{extra}");
             }
             eprintln!("{f}{extra}: {} colours for {n} local columns", coloring.n_colors);
+        }
+    }
+
+    /// `complete` solves every explicit equation exactly and leaves the other variables alone,
+    /// and no explicit equation reads an explicit variable computed after it (the dense Jacobian's
+    /// entries there are zero) — the contract the integrator's elimination relies on — for the
+    /// configurations that change what the flows read: q given or from enthalpies, λ ≠ 0 with a
+    /// side draw.
+    #[test]
+    fn complete_solves_the_explicit_equations_in_declared_order() {
+        let thermo = binary_package();
+        let t = thermo.bubble_t(101_325.0, &[0.5, 0.5]).unwrap().t;
+        let feed = [1000.0 / 60.0, t, 101_325.0, thermo.h_liq(t, &[0.5, 0.5]) - 500.0, 0.5, 0.5];
+        let configs = [
+            (r#", "q": 1.0"#, ""),
+            ("", ""),
+            ("", r#", "lambda": 0.3, "side_draws": [{"port": "side", "stage": 5, "flow": "0.1 kmol/min"}]"#),
+        ];
+        let mut rng = Lcg(11);
+        for (f, extra) in configs {
+            let u = column(f, extra);
+            let (lay, guess) = at_guess(&u, &thermo, &feed);
+            let (n, m) = (lay.len(), lay.n_own());
+            let explicit = Unit::explicit(&u, &lay);
+            let mut position = vec![usize::MAX; m];
+            explicit.iter().enumerate().for_each(|(p, &k)| position[k] = p);
+            for _ in 0..3 {
+                let mut local: Vec<f64> =
+                    guess.iter().map(|&v| v * rng.range(0.8, 1.2) + rng.range(0.0, 1e-3)).collect();
+                let mut own = local[..m].to_vec();
+                Unit::complete(&u, &UnitIo { local: &local, layout: &lay, thermo: &thermo, time: 0.0 }, &mut own);
+                for k in (0..m).filter(|&k| position[k] == usize::MAX) {
+                    assert_eq!(own[k], local[k], "{f}{extra}: kept variable {k} changed");
+                }
+                local[..m].copy_from_slice(&own);
+                let io = UnitIo { local: &local, layout: &lay, thermo: &thermo, time: 0.0 };
+                let (mut r, mut jac) = (vec![0.0; m], vec![0.0; m * n]);
+                u.jacobian_colored(&io, &mut r, &mut jac, None);
+                for (p, &k) in explicit.iter().enumerate() {
+                    let scale = 1.0 + own[k].abs();
+                    assert!(r[k].abs() <= 1e-12 * scale, "{f}{extra}: explicit row {k} residual {}", r[k]);
+                    for (q, &later) in explicit.iter().enumerate().skip(p + 1) {
+                        assert_eq!(jac[k * n + later], 0.0, "{f}{extra}: row {k} (#{p}) reads #{q}");
+                    }
+                }
+            }
         }
     }
 }

@@ -1,0 +1,223 @@
+//! The plant's explicit algebraic variables: those its units compute in closed form
+//! ([`plantwide_model::UnitModel::explicit`]), which the dynamic integrator eliminates from its
+//! Newton iteration.
+//!
+//! Completion runs block by block in plant order, each unit in its own declared order, so an
+//! explicit variable may read kept variables, explicit variables of earlier blocks and earlier
+//! explicit variables of its own block. The plan keeps a declared variable explicit only while
+//! that holds, read off each block's Jacobian pattern, and otherwise *demotes* it to a kept
+//! variable, which Newton solves with its equation as before:
+//! - an explicit variable that an earlier block's explicit equation reads is demoted (its value
+//!   would be read before it is computed): a controller output that sets a column's product flow;
+//! - an explicit variable whose equation reads a demoted variable of its own block is demoted (the
+//!   unit computes that one too, and would read its own value, not the kept one).
+//!
+//! Demotion only shrinks the explicit set, so the sweep repeats until nothing changes.
+
+use plantwide_model::{UnitIo, VarKind};
+
+use crate::plant::{Plant, Read};
+
+/// The explicit variables of a plant and the order that computes them.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct ExplicitPlan {
+    /// `(global equation, global variable)` of each explicit variable, in completion order.
+    pairs: Vec<(usize, usize)>,
+    /// The blocks to complete, in plant order.
+    blocks: Vec<PlanBlock>,
+}
+
+/// A block with explicit variables.
+#[derive(Debug, Clone, PartialEq, Eq)]
+struct PlanBlock {
+    /// Block index.
+    block: usize,
+    /// The own (local) indices of its variables that stay explicit, in completion order.
+    keep: Vec<usize>,
+    /// Whether that is every variable the unit declared: its residual at a completed point is
+    /// then [`plantwide_model::Unit::residual_kept`].
+    whole: bool,
+}
+
+impl ExplicitPlan {
+    /// `(global equation, global variable)` of each explicit variable, in completion order.
+    pub fn pairs(&self) -> &[(usize, usize)] {
+        &self.pairs
+    }
+}
+
+/// Whether a variable is kept, explicit, or declared explicit but demoted.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Status {
+    Kept,
+    Explicit,
+    Demoted,
+}
+
+thread_local! {
+    /// The local vector and the own block of [`Plant::complete`], one per thread.
+    static SCRATCH: std::cell::RefCell<(Vec<f64>, Vec<f64>)> = const { std::cell::RefCell::new((Vec::new(), Vec::new())) };
+}
+
+impl Plant {
+    /// The explicit variables of the plant as wired now (module documentation).
+    pub fn explicit_plan(&self) -> ExplicitPlan {
+        let vars = self.vars();
+        let mut status = vec![Status::Kept; vars.len()];
+        // Per block: the declared own indices and, for each, the local columns its equation reads.
+        let declared: Vec<Vec<(usize, Vec<usize>)>> = self
+            .blocks()
+            .iter()
+            .map(|b| {
+                let n_own = b.layout.n_own().min(b.n_eq);
+                let own: Vec<usize> = b.unit.explicit(&b.layout).into_iter().filter(|&k| k < n_own).collect();
+                let mut reads: Vec<Vec<usize>> = vec![Vec::new(); b.n_eq];
+                match &b.pattern {
+                    Some(p) => p.iter().filter(|&&(k, _)| k < b.n_eq).for_each(|&(k, c)| reads[k].push(c)),
+                    None => reads.iter_mut().for_each(|r| r.extend(0..b.layout.len())),
+                }
+                own.into_iter()
+                    .filter(|&k| vars[b.own_offset + k].spec.kind != VarKind::Differential)
+                    .map(|k| (k, std::mem::take(&mut reads[k])))
+                    .collect()
+            })
+            .collect();
+        for (b, list) in self.blocks().iter().zip(&declared) {
+            list.iter().for_each(|&(k, _)| status[b.own_offset + k] = Status::Explicit);
+        }
+        while self.demote(&declared, &mut status) {}
+        let mut plan = ExplicitPlan::default();
+        for (i, (b, list)) in self.blocks().iter().zip(&declared).enumerate() {
+            let keep: Vec<usize> =
+                list.iter().map(|&(k, _)| k).filter(|&k| status[b.own_offset + k] == Status::Explicit).collect();
+            if !keep.is_empty() {
+                plan.pairs.extend(keep.iter().map(|&k| (b.eq_offset + k, b.own_offset + k)));
+                plan.blocks.push(PlanBlock { block: i, whole: keep.len() == list.len(), keep });
+            }
+        }
+        plan
+    }
+
+    /// One sweep of the demotion rules over the `declared` explicit variables (local index and
+    /// the local columns its equation reads, per block); returns whether anything was demoted.
+    fn demote(&self, declared: &[Vec<(usize, Vec<usize>)>], status: &mut [Status]) -> bool {
+        let mut changed = false;
+        for (bi, (b, list)) in self.blocks().iter().zip(declared).enumerate() {
+            let n_own = b.layout.n_own();
+            for (k, reads) in list {
+                if status[b.own_offset + k] != Status::Explicit {
+                    continue;
+                }
+                for &c in reads {
+                    if c < n_own {
+                        if status[b.own_offset + c] == Status::Demoted {
+                            status[b.own_offset + k] = Status::Demoted;
+                            changed = true;
+                            break;
+                        }
+                    } else if let Some(&Read::Var(i)) = b.reads.get(c - n_own)
+                        && status[i] == Status::Explicit
+                        && self.vars()[i].block > bi
+                    {
+                        status[i] = Status::Demoted;
+                        changed = true;
+                    }
+                }
+            }
+        }
+        changed
+    }
+
+    /// Overwrite the explicit variables of `x` (plant variables) with their values from the others
+    /// at inputs `u` and time `t`, block by block in `plan`'s order.
+    pub fn complete(&self, plan: &ExplicitPlan, x: &mut [f64], u: &[f64], t: f64) {
+        SCRATCH.with_borrow_mut(|(local, own)| {
+            for p in &plan.blocks {
+                let b = &self.blocks()[p.block];
+                self.gather(b, x, u, local);
+                own.clear();
+                own.extend_from_slice(&local[..b.layout.n_own()]);
+                let io = UnitIo { local, layout: &b.layout, thermo: self.thermo(), time: t };
+                b.unit.complete(&io, own);
+                p.keep.iter().for_each(|&k| x[b.own_offset + k] = own[k]);
+            }
+        });
+    }
+
+    /// [`Plant::residual`] at a point `x` that [`Plant::complete`] has just completed for `plan`:
+    /// the explicit equations hold there, so their rows are set to zero and a unit whose declared
+    /// explicit variables all are evaluates only its other equations
+    /// ([`plantwide_model::Unit::residual_kept`]).
+    pub fn residual_completed(&self, plan: &ExplicitPlan, x: &[f64], u: &[f64], t: f64, r: &mut [f64]) {
+        SCRATCH.with_borrow_mut(|(local, _)| {
+            let mut next = plan.blocks.iter().peekable();
+            for (i, b) in self.blocks().iter().enumerate() {
+                self.gather(b, x, u, local);
+                let io = UnitIo { local, layout: &b.layout, thermo: self.thermo(), time: t };
+                let rows = &mut r[b.eq_offset..b.eq_offset + b.n_eq];
+                match next.next_if(|p| p.block == i) {
+                    Some(p) if p.whole => {
+                        b.unit.residual_kept(&io, rows);
+                        p.keep.iter().for_each(|&k| rows[k] = 0.0);
+                    }
+                    _ => b.unit.residual(&io, rows),
+                }
+            }
+        });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use serde_json::{Value, json};
+
+    use super::Status;
+    use crate::load_str;
+
+    /// Column A (`column`) fed from the bottoms of a second copy (`lower`), which comes after it
+    /// in the file. The vapour-flow equation of `column`'s feed stage is explicit and reads its
+    /// feed's flow and enthalpy, `lower`'s bottoms outlet — explicit too but computed later — so
+    /// that outlet is demoted, its six variables together (its equations read each other). Every
+    /// other variable both columns declare stays explicit: 2 × 299 − 6.
+    #[test]
+    fn an_explicit_variable_read_before_it_is_computed_is_demoted() {
+        let text = include_str!("../../../flowsheets/column_a.json");
+        let mut fs: Value = serde_json::from_str(text).unwrap();
+        let column = fs["units"]["column"].clone();
+        fs["units"]["lower"] = column;
+        fs["units"]["lower_top"] = json!({"type": "product"});
+        fs["streams"]["feed"] = json!({"from": "feed_source", "to": "lower.feed"});
+        fs["streams"]["lower_bottoms"] = json!({"from": "lower.bottoms", "to": "column.feed"});
+        fs["streams"]["lower_distillate"] = json!({"from": "lower.distillate", "to": "lower_top"});
+        let plant = load_str(&fs.to_string(), "two_columns.json").unwrap();
+        let (upper, lower) = (plant.block_index("column").unwrap(), plant.block_index("lower").unwrap());
+        assert!(upper < lower, "the test needs the fed column first");
+        let plan = plant.explicit_plan();
+        assert_eq!(plan.pairs().len(), 2 * 299 - 6);
+        let explicit: Vec<usize> = plan.pairs().iter().map(|&(_, j)| j).collect();
+        let outlet = plant.stream_flow_var(plant.streams().iter().position(|s| s.name == "lower_bottoms").unwrap());
+        for j in outlet..outlet + 6 {
+            assert!(!explicit.contains(&j), "{} stays explicit", plant.vars()[j].path);
+        }
+        // The plan's order is the completion order: each explicit equation reads only explicit
+        // variables of its own or an earlier block.
+        let mut status = vec![Status::Kept; plant.n_vars()];
+        explicit.iter().for_each(|&j| status[j] = Status::Explicit);
+        for &(eq, j) in plan.pairs() {
+            let b = &plant.blocks()[plant.vars()[j].block];
+            let k = eq - b.eq_offset;
+            let reads = b.pattern.as_ref().unwrap().iter().filter(|&&(r, _)| r == k);
+            for &(_, c) in reads.filter(|&&(_, c)| c >= b.layout.n_own()) {
+                if let crate::Read::Var(i) = b.reads[c - b.layout.n_own()] {
+                    let later = plant.vars()[i].block > plant.vars()[j].block;
+                    assert!(
+                        !(later && status[i] == Status::Explicit),
+                        "{} reads {}",
+                        plant.vars()[j].path,
+                        plant.vars()[i].path
+                    );
+                }
+            }
+        }
+    }
+}
