@@ -155,13 +155,17 @@ impl Driver {
         }
         let shape = DaeShape::new(&plant, &quad.streams);
         let recorded = recorded_state(&plant, sc);
+        // Between steps only the recorded variables are interpolated: the integrator need not
+        // keep the history of the other explicit ones.
+        let mut bdf = Bdf::new(bdf_settings(sc));
+        bdf.watch(&recorded);
         Ok(Driver {
             shape,
             recorded,
             plant,
             sc: sc.clone(),
             st,
-            bdf: Bdf::new(bdf_settings(sc)),
+            bdf,
             fingerprint: fingerprint.to_string(),
             sampled,
             analyzers,
