@@ -204,8 +204,10 @@ pub struct Bdf {
     hist_pos: Vec<usize>,
     /// Whether that is every variable.
     hist_all: bool,
-    /// The explicit variables without a history.
+    /// The explicit variables without a history, and those with one (whose correction the
+    /// history needs).
     untracked: Vec<usize>,
+    tracked_explicit: Vec<usize>,
     /// `(position in hist, variable)` of the error-controlled variables.
     controlled_h: Vec<(usize, usize)>,
     /// The current state of every variable, when not every variable has a history (then `D[0]`
@@ -352,6 +354,7 @@ impl Bdf {
             hist_pos: Vec::new(),
             hist_all: true,
             untracked: Vec::new(),
+            tracked_explicit: Vec::new(),
             controlled_h: Vec::new(),
             x_full: Vec::new(),
             jac_loaded: false,
@@ -452,6 +455,7 @@ impl Bdf {
         }
         self.hist = (0..n).filter(|&j| tracked[j]).collect();
         self.untracked = (0..n).filter(|&j| !tracked[j]).collect();
+        self.tracked_explicit = self.red.explicit_vars().filter(|&j| tracked[j]).collect();
         self.hist_all = self.untracked.is_empty();
         self.hist_pos = vec![usize::MAX; n];
         self.hist.iter().enumerate().for_each(|(r, &j)| self.hist_pos[j] = r);
@@ -568,7 +572,7 @@ impl Bdf {
         w.x.copy_from_slice(&w.x_pred);
         if !red.is_identity() {
             sys.complete(t_new, &mut w.x);
-            red.explicit_vars().for_each(|j| w.d[j] = w.x[j] - w.x_pred[j]);
+            self.tracked_explicit.iter().for_each(|&j| w.d[j] = w.x[j] - w.x_pred[j]);
         }
         let mut ss = self.st.newton_ss.unwrap_or(NEWTON_SS_START);
         let mut first_norm = 0.0;
@@ -604,7 +608,7 @@ impl Bdf {
             }
             if !red.is_identity() {
                 sys.complete(t_new, &mut w.x);
-                red.explicit_vars().for_each(|j| w.d[j] = w.x[j] - w.x_pred[j]);
+                self.tracked_explicit.iter().for_each(|&j| w.d[j] = w.x[j] - w.x_pred[j]);
             }
             let at_roundoff = dy_norm <= roundoff;
             if k == 0 {
