@@ -630,6 +630,8 @@ impl UnitModel for SimpleColumn {
 
 #[cfg(test)]
 mod tests {
+    use plantwide_thermo::ThermoPackage;
+
     use crate::testing::{binary_package, jacobian_error};
     use crate::units::column::{Column, ColumnConfig};
     use crate::units::outflow::test_support::{Lcg, at_guess};
@@ -650,6 +652,22 @@ mod tests {
         Column::build(&c, BuildCx::new(&names, &thermo, "units.column"), ()).unwrap()
     }
 
+    /// The binary test package and a subcooled equimolar feed stream (F, T, P, h, z).
+    fn subcooled_feed() -> (ThermoPackage, [f64; 6]) {
+        let thermo = binary_package();
+        let t = thermo.bubble_t(101_325.0, &[0.5, 0.5]).unwrap().t;
+        let feed = [1000.0 / 60.0, t, 101_325.0, thermo.h_liq(t, &[0.5, 0.5]) - 500.0, 0.5, 0.5];
+        (thermo, feed)
+    }
+
+    /// The configurations that change which rows read what: feed quality given or from
+    /// enthalpies, vapour dynamics (λ ≠ 0) with a side draw.
+    const CONFIGS: [(&str, &str); 3] = [
+        (r#", "q": 1.0"#, ""),
+        ("", ""),
+        ("", r#", "lambda": 0.3, "side_draws": [{"port": "side", "stage": 5, "flow": "0.1 kmol/min"}]"#),
+    ];
+
     /// The declared pattern holds every entry of the dense dual-number Jacobian (one pass per
     /// column, no colouring) at the guess and at randomly perturbed points, for every
     /// configuration that changes which rows read what: feed quality given or from enthalpies, a
@@ -657,16 +675,9 @@ mod tests {
     /// Jacobian; the coloured one also agrees with central differences.
     #[test]
     fn the_declared_pattern_holds_every_nonzero_and_colours_the_jacobian_exactly() {
-        let thermo = binary_package();
-        let t = thermo.bubble_t(101_325.0, &[0.5, 0.5]).unwrap().t;
-        let feed = [1000.0 / 60.0, t, 101_325.0, thermo.h_liq(t, &[0.5, 0.5]) - 500.0, 0.5, 0.5];
-        let configs = [
-            (r#", "q": 1.0"#, ""),
-            ("", ""),
-            ("", r#", "lambda": 0.3, "side_draws": [{"port": "side", "stage": 5, "flow": "0.1 kmol/min"}]"#),
-        ];
+        let (thermo, feed) = subcooled_feed();
         let mut rng = Lcg(7);
-        for (f, extra) in configs {
+        for (f, extra) in CONFIGS {
             let u = column(f, extra);
             let (lay, guess) = at_guess(&u, &thermo, &feed);
             let n = lay.len();
@@ -711,16 +722,9 @@ mod tests {
     /// side draw.
     #[test]
     fn complete_solves_the_explicit_equations_in_declared_order() {
-        let thermo = binary_package();
-        let t = thermo.bubble_t(101_325.0, &[0.5, 0.5]).unwrap().t;
-        let feed = [1000.0 / 60.0, t, 101_325.0, thermo.h_liq(t, &[0.5, 0.5]) - 500.0, 0.5, 0.5];
-        let configs = [
-            (r#", "q": 1.0"#, ""),
-            ("", ""),
-            ("", r#", "lambda": 0.3, "side_draws": [{"port": "side", "stage": 5, "flow": "0.1 kmol/min"}]"#),
-        ];
+        let (thermo, feed) = subcooled_feed();
         let mut rng = Lcg(11);
-        for (f, extra) in configs {
+        for (f, extra) in CONFIGS {
             let u = column(f, extra);
             let (lay, guess) = at_guess(&u, &thermo, &feed);
             let (n, m) = (lay.len(), lay.n_own());
