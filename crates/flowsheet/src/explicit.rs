@@ -16,7 +16,7 @@
 
 use plantwide_model::{UnitIo, VarKind};
 
-use crate::plant::{Plant, Read};
+use crate::plant::{Block, Plant, Read, VarInfo};
 
 /// The explicit variables of a plant and the order that computes them.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
@@ -65,23 +65,7 @@ impl Plant {
         let vars = self.vars();
         let mut status = vec![Status::Kept; vars.len()];
         // Per block: the declared own indices and, for each, the local columns its equation reads.
-        let declared: Vec<Vec<(usize, Vec<usize>)>> = self
-            .blocks()
-            .iter()
-            .map(|b| {
-                let n_own = b.layout.n_own().min(b.n_eq);
-                let own: Vec<usize> = b.unit.explicit(&b.layout).into_iter().filter(|&k| k < n_own).collect();
-                let mut reads: Vec<Vec<usize>> = vec![Vec::new(); b.n_eq];
-                match &b.pattern {
-                    Some(p) => p.iter().filter(|&&(k, _)| k < b.n_eq).for_each(|&(k, c)| reads[k].push(c)),
-                    None => reads.iter_mut().for_each(|r| r.extend(0..b.layout.len())),
-                }
-                own.into_iter()
-                    .filter(|&k| vars[b.own_offset + k].spec.kind != VarKind::Differential)
-                    .map(|k| (k, std::mem::take(&mut reads[k])))
-                    .collect()
-            })
-            .collect();
+        let declared: Vec<Vec<(usize, Vec<usize>)>> = self.blocks().iter().map(|b| Self::declared(b, vars)).collect();
         for (b, list) in self.blocks().iter().zip(&declared) {
             list.iter().for_each(|&(k, _)| status[b.own_offset + k] = Status::Explicit);
         }
@@ -96,6 +80,36 @@ impl Plant {
             }
         }
         plan
+    }
+
+    /// The explicit variables `b` declares (algebraic, with an equation of their own) and, for
+    /// each, the local columns its equation reads (from the declared pattern; all of them for a
+    /// dense unit).
+    fn declared(b: &Block, vars: &[VarInfo]) -> Vec<(usize, Vec<usize>)> {
+        let n_own = b.layout.n_own().min(b.n_eq);
+        let own: Vec<usize> = b
+            .unit
+            .explicit(&b.layout)
+            .into_iter()
+            .filter(|&k| k < n_own && vars[b.own_offset + k].spec.kind != VarKind::Differential)
+            .collect();
+        if own.is_empty() {
+            return Vec::new();
+        }
+        let mut slot = vec![usize::MAX; b.n_eq];
+        own.iter().enumerate().for_each(|(s, &k)| slot[k] = s);
+        let mut reads: Vec<(usize, Vec<usize>)> = own.iter().map(|&k| (k, Vec::new())).collect();
+        match &b.pattern {
+            Some(p) => {
+                for &(k, c) in p {
+                    if let Some(&s) = slot.get(k).filter(|&&s| s != usize::MAX) {
+                        reads[s].1.push(c);
+                    }
+                }
+            }
+            None => reads.iter_mut().for_each(|r| r.1.extend(0..b.layout.len())),
+        }
+        reads
     }
 
     /// One sweep of the demotion rules over the `declared` explicit variables (local index and
