@@ -24,10 +24,11 @@
 //! others ([`DaeSystem::complete`]), so their equations hold exactly at every accepted step, and
 //! the iteration matrix, its factors, the corrections and the convergence test are those of the
 //! kept variables, with the Jacobian reduced by the chain rule through the explicit ones
-//! (`reduce.rs`). The history and the error test are as before: explicit variables keep their
-//! differences, which the dense output interpolates, and like every algebraic variable they are
-//! not error-controlled. Column A's iteration matrix goes from 436 variables (2 598 entries in
-//! its factors) to 137 (655).
+//! (`reduce.rs`). The error test is as before: like every algebraic variable they are not
+//! error-controlled. The history (the difference array) holds the kept variables and the
+//! explicit ones the caller watches ([`Bdf::watch`], by default all of them): the dense output
+//! interpolates those, and holds the others at their value at the step's end. Column A's
+//! iteration matrix goes from 436 variables (2 598 entries in its factors) to 137 (655).
 //!
 //! **Start.** At a (re)start the algebraic variables are made consistent by simplified Newton on
 //! the iteration matrix at `c = 0` with the Jacobian the integrator takes anyway, falling back to
@@ -384,7 +385,7 @@ impl Bdf {
         if !self.hist_all {
             // Full rows: the current value of a variable without a history, zero differences.
             let n = self.hist_pos.len();
-            st.d = self.st.d.iter().map(|row| self.expand(row, 0.0)).collect();
+            st.d = self.st.d.iter().map(|row| self.expand(row)).collect();
             st.d[0] = self.x_full.clone();
             debug_assert!(st.d.iter().all(|r| r.len() == n));
         }
@@ -468,9 +469,9 @@ impl Bdf {
         }
     }
 
-    /// A row over the variables with a history as a row over all, `fill` elsewhere.
-    fn expand(&self, row: &[f64], fill: f64) -> Vec<f64> {
-        let mut full = vec![fill; self.hist_pos.len()];
+    /// A row over the variables with a history as a row over all, zero elsewhere.
+    fn expand(&self, row: &[f64]) -> Vec<f64> {
+        let mut full = vec![0.0; self.hist_pos.len()];
         self.hist.iter().zip(row).for_each(|(&j, v)| full[j] = *v);
         full
     }
@@ -643,27 +644,21 @@ impl Bdf {
         let max_step = self.settings.max_step;
         let mut h_abs = self.st.h_abs;
         if h_abs > max_step {
-            self.rescale(self.st.order, max_step / h_abs);
+            change_d(&mut self.st.d, self.st.order, max_step / h_abs, &mut self.w.diffs);
             h_abs = max_step;
             self.st.n_equal_steps = 0;
         } else if h_abs < min_step {
-            self.rescale(self.st.order, min_step / h_abs);
+            change_d(&mut self.st.d, self.st.order, min_step / h_abs, &mut self.w.diffs);
             h_abs = min_step;
             self.st.n_equal_steps = 0;
         }
         h_abs
     }
 
-    /// Re-interpolate the differences of `order` for a step changed by `factor` (of the tracked
-    /// variables).
-    fn rescale(&mut self, order: usize, factor: f64) {
-        change_d(&mut self.st.d, order, factor, &mut self.w.diffs);
-    }
-
     /// Multiply the step `h_abs` by `factor` and re-interpolate the differences of `order`.
     fn scale_step(&mut self, h_abs: &mut f64, order: usize, factor: f64) {
         *h_abs *= factor;
-        self.rescale(order, factor);
+        change_d(&mut self.st.d, order, factor, &mut self.w.diffs);
         self.st.n_equal_steps = 0;
     }
 
@@ -689,7 +684,7 @@ impl Bdf {
             if t_new >= t_stop {
                 t_new = t_stop;
                 let factor = (t_new - t) / *h_abs;
-                self.rescale(order, factor);
+                change_d(&mut self.st.d, order, factor, &mut self.w.diffs);
                 self.st.n_equal_steps = 0;
                 *h_abs = t_new - t;
             }
@@ -918,7 +913,7 @@ impl Bdf {
         let factor = MAX_FACTOR.min(safety * factors[best]);
         self.st.order = new_order;
         self.st.h_abs *= factor;
-        self.rescale(new_order, factor);
+        change_d(&mut self.st.d, new_order, factor, &mut self.w.diffs);
         self.st.n_equal_steps = 0;
     }
 }
