@@ -153,7 +153,13 @@ impl Plant {
                 own.extend_from_slice(&local[..b.layout.n_own()]);
                 let io = UnitIo { local, layout: &b.layout, thermo: self.thermo(), time: t };
                 b.unit.complete(&io, own);
-                p.keep.iter().for_each(|&k| x[b.own_offset + k] = own[k]);
+                let dst = &mut x[b.own_offset..b.own_offset + own.len()];
+                if p.whole {
+                    // The unit overwrote its explicit variables only; the rest are `x`'s own.
+                    dst.copy_from_slice(own);
+                } else {
+                    p.keep.iter().for_each(|&k| dst[k] = own[k]);
+                }
             }
         });
     }
@@ -171,8 +177,9 @@ impl Plant {
                 let rows = &mut r[b.eq_offset..b.eq_offset + b.n_eq];
                 match next.next_if(|p| p.block == i) {
                     Some(p) if p.whole => {
+                        // `residual_kept` leaves the explicit rows as they are: zero.
+                        rows.fill(0.0);
                         b.unit.residual_kept(&io, rows);
-                        p.keep.iter().for_each(|&k| rows[k] = 0.0);
                     }
                     _ => b.unit.residual(&io, rows),
                 }

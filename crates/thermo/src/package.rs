@@ -16,6 +16,14 @@ impl ThermoPackage {
     pub fn n(&self) -> usize {
         self.components.len()
     }
+    /// The relative volatilities `α_i` of a `ConstantAlpha` package with one per component, for
+    /// callers that evaluate `K_i = α_i / Σ_k α_k x_k` inline in a hot loop; `None` otherwise.
+    pub fn constant_alpha(&self) -> Option<&[f64]> {
+        match &self.vle {
+            VleModel::ConstantAlpha { alpha } if alpha.len() >= self.n() => Some(&alpha[..self.n()]),
+            _ => None,
+        }
+    }
     /// K-values `K_i = y_i / x_i` at `t` [K], `p` [Pa] and liquid composition `x`, into `out`.
     ///
     /// * `ConstantAlpha`: `K_i = α_i / Σ_k α_k x_k` (independent of `t` and `p`);
