@@ -167,6 +167,34 @@ fn column_a_feed_step_settles_on_the_new_steady_state_with_a_200_min_time_consta
     assert!(res.stats.n_steps < 2000, "{:?}", res.stats);
 }
 
+/// Column A's tray temperatures are output-only (constant α: no balance reads them), so the
+/// integrator leaves them out and solves them at the end: every final `T` is the bubble point of
+/// its stage's liquid (the thermo package's own `bubble_t`, an independent solver) to 1e-9, the
+/// outlets' temperature and enthalpy follow from it; recording one makes it a variable the
+/// integrator carries, and its recorded end value agrees with the solve.
+#[test]
+fn column_a_output_temperatures_are_the_final_bubble_points() {
+    let (plant, _, res) = run("column_a.json", &[], COLUMN_A_STEP);
+    let thermo = plant.thermo();
+    let value = |path: &str| harness::value(&plant, &res.x, path);
+    let mut worst = 0.0f64;
+    for s in 1..=41 {
+        let x = [value(&format!("column.x[{s}][light]")), value(&format!("column.x[{s}][heavy]"))];
+        let bubble = thermo.bubble_t(101_325.0, &x).unwrap().t;
+        worst = worst.max((value(&format!("column.T[{s}]")) - bubble).abs() / bubble);
+    }
+    eprintln!("final T against bubble_t: worst relative {worst:.1e}");
+    assert!(worst < 1e-9, "{worst}");
+    let (t41, x41) = (value("column.T[41]"), [value("column.x[41][light]"), value("column.x[41][heavy]")]);
+    assert_eq!(value("distillate.T"), t41);
+    assert_eq!(value("distillate.h"), thermo.h_liq(t41, &x41));
+    let recorded = COLUMN_A_STEP.replace(r#""column.M[41]"]"#, r#""column.M[41]", "column.T[21]"]"#);
+    let (_, _, carried) = run("column_a.json", &[], &recorded);
+    let t21 = *column(&carried, "column.T[21]").last().unwrap();
+    eprintln!("T[21]: carried {t21:.9} K, solved at the end {:.9} K", value("column.T[21]"));
+    assert!((t21 - value("column.T[21]")).abs() < 1e-6, "{t21} vs {}", value("column.T[21]"));
+}
+
 /// Component inventories: Δ(Σ stage holdups) = ∫(feed − distillate − bottoms) dt, the integrals
 /// taken by the integrator's own BDF formula as quadratures.
 #[test]

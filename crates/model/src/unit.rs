@@ -187,8 +187,10 @@ pub trait UnitModel: Send + Sync + std::fmt::Debug {
     fn complete(&self, _io: &UnitIo<'_, f64>, _own: &mut [f64]) {}
     /// The residuals of the equations that are not [`UnitModel::explicit`], at a local vector
     /// whose explicit variables [`UnitModel::complete`] has just set; the explicit equations'
-    /// rows of `r` may be left as they are (default: [`UnitModel::eval`]).
-    fn eval_kept(&self, io: &UnitIo<'_, f64>, r: &mut [f64]) {
+    /// rows of `r` may be left as they are, and so may the rows `k` with `skip[k]` (equations of
+    /// output-only variables the dynamic integrator solves only when they are asked for; `skip`
+    /// empty: none) (default: [`UnitModel::eval`]).
+    fn eval_kept(&self, io: &UnitIo<'_, f64>, r: &mut [f64], _skip: &[bool]) {
         self.eval(io, r);
     }
     /// Initial guess of the own variables from the inlets and inputs in `local` (its own block holds
@@ -276,7 +278,7 @@ pub trait Unit: Send + Sync + std::fmt::Debug {
     /// See [`UnitModel::complete`].
     fn complete(&self, io: &UnitIo<'_, f64>, own: &mut [f64]);
     /// See [`UnitModel::eval_kept`].
-    fn residual_kept(&self, io: &UnitIo<'_, f64>, r: &mut [f64]);
+    fn residual_kept(&self, io: &UnitIo<'_, f64>, r: &mut [f64], skip: &[bool]);
     /// See [`UnitModel::without_limits`].
     fn without_limits(&self) -> Option<Box<dyn Unit>>;
     /// See [`UnitModel::output_limits`].
@@ -397,8 +399,8 @@ impl<U: UnitModel + 'static> Unit for U {
     fn complete(&self, io: &UnitIo<'_, f64>, own: &mut [f64]) {
         UnitModel::complete(self, io, own);
     }
-    fn residual_kept(&self, io: &UnitIo<'_, f64>, r: &mut [f64]) {
-        UnitModel::eval_kept(self, io, r);
+    fn residual_kept(&self, io: &UnitIo<'_, f64>, r: &mut [f64], skip: &[bool]) {
+        UnitModel::eval_kept(self, io, r, skip);
     }
     fn without_limits(&self) -> Option<Box<dyn Unit>> {
         UnitModel::without_limits(self).map(|u| Box::new(u) as Box<dyn Unit>)

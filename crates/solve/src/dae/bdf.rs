@@ -87,6 +87,11 @@ const ROUNDOFF_ULPS: f64 = 100.0;
 /// The iteration matrix `M − cJ` is refactorized when `c` has moved by more than this fraction
 /// since the factorization (CVODE's `DGMAX`), after a Newton failure, or for a new Jacobian.
 const REFACTOR_RATIO: f64 = 0.3;
+/// Chord steps of one solve of the output-only variables ([`Bdf::complete_outputs`]).
+const OUTPUT_MAXITER: usize = 20;
+/// Weighted RMS correction at which the output-only variables are solved: a millionth of the
+/// integrator's own tolerance.
+const OUTPUT_TOL: f64 = 1e-6;
 
 /// Settings of the BDF integrator.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -218,6 +223,10 @@ pub struct Bdf {
     jac_loaded: bool,
     /// `atol · nominal_i`: the absolute part of each variable's error scale.
     abs_tol: Vec<f64>,
+    /// The explicit pairs of the system as bound (those an algebraic equation determines).
+    explicit: Vec<(usize, usize)>,
+    /// Whether the output-only variables hold their solution at the current time.
+    outputs_done: bool,
     w: Work,
 }
 
@@ -360,6 +369,8 @@ impl Bdf {
             x_full: Vec::new(),
             jac_loaded: false,
             abs_tol: Vec::new(),
+            explicit: Vec::new(),
+            outputs_done: false,
             w: Work::default(),
         }
     }
@@ -410,6 +421,7 @@ impl Bdf {
             // Keep the rows of the variables with a history (a snapshot of a run that kept fewer
             // has zero differences for the others: their dense output starts from their value).
             self.x_full = self.st.d[0].clone();
+            self.seed_outputs();
             let hist = &self.hist;
             self.st.d.iter_mut().for_each(|row| *row = hist.iter().map(|&j| row[j]).collect());
         }
@@ -436,13 +448,10 @@ impl Bdf {
         // Only algebraic variables of algebraic equations can be eliminated.
         let mut differential = vec![false; n];
         sys.mass().iter().filter(|&&(_, j)| j < n).for_each(|&(_, j)| differential[j] = true);
-        let explicit: Vec<(usize, usize)> = sys
-            .explicit()
-            .iter()
-            .copied()
-            .filter(|&(i, j)| i < n && j < n && self.diff_var[i] == usize::MAX && !differential[j])
-            .collect();
-        self.red = Reduction::new(n, &explicit);
+        let algebraic = |&(i, j): &(usize, usize)| i < n && j < n && self.diff_var[i] == usize::MAX && !differential[j];
+        self.explicit = sys.explicit().iter().copied().filter(algebraic).collect();
+        let outputs: Vec<(usize, usize)> = sys.outputs().iter().copied().filter(algebraic).collect();
+        self.red = Reduction::new(n, &self.explicit, &outputs);
         let red = &self.red;
         self.red_mass = sys.mass().iter().map(|&(i, j)| (red.row[i], red.col[j])).collect();
         self.red_diff_var =
@@ -454,6 +463,8 @@ impl Bdf {
             red.explicit_vars().for_each(|j| tracked[j] = false);
             watch.iter().filter(|&&j| j < n).for_each(|&j| tracked[j] = true);
         }
+        // Output-only variables do not move between their solves: no history, watched or not.
+        red.outputs().iter().for_each(|&(_, j)| tracked[j] = false);
         self.hist = (0..n).filter(|&j| tracked[j]).collect();
         self.untracked = (0..n).filter(|&j| !tracked[j]).collect();
         self.tracked_explicit = self.red.explicit_vars().filter(|&j| tracked[j]).collect();
@@ -483,6 +494,139 @@ impl Bdf {
     /// [`DaeIntegrator::restart`] or [`Bdf::restore`].
     pub fn watch(&mut self, explicit: &[usize]) {
         self.watch = Some(explicit.to_vec());
+    }
+
+    /// The output-only variables' current values (in [`Bdf::x`]) as the values every iterate
+    /// starts from: Newton leaves them as they are, so the state carries them unchanged.
+    fn seed_outputs(&mut self) {
+        self.outputs_done = false;
+        for &(_, j) in self.red.outputs() {
+            (self.w.x_pred[j], self.w.x[j]) = (self.x_full[j], self.x_full[j]);
+        }
+    }
+
+    /// Solve the output-only variables ([`DaeSystem::outputs`]) at the current time, with every
+    /// other variable held, and complete the explicit ones that read them: afterwards [`Bdf::x`]
+    /// satisfies every equation. Until then the outputs hold the values of the last solve (or the
+    /// start) and the explicit variables computed from them are computed from those.
+    ///
+    /// Chord iteration on the output block `∂F_o/∂x_o` of the reduced Jacobian last evaluated
+    /// (the outputs' equations form the lower block of a block-triangular system, so the other
+    /// variables' values are final), until the weighted correction is [`OUTPUT_TOL`] of the
+    /// integrator's tolerance (or the rounding level); if [`OUTPUT_MAXITER`] chord steps do
+    /// not get there, once more with the Jacobian at the last iterate. The integrator's own Jacobian and factors are
+    /// not touched: the run continues as it would have without the call.
+    ///
+    /// # Errors
+    /// [`DaeError::Outputs`] (the outputs then set to NaN) when the iteration does not converge,
+    /// [`DaeError::Explicit`] or [`DaeError::Singular`] when the block cannot be formed.
+    pub fn complete_outputs(&mut self, sys: &dyn DaeSystem) -> Result<(), DaeError> {
+        if self.red.outputs().is_empty() || self.outputs_done {
+            return Ok(());
+        }
+        let solved = self.solve_outputs(sys);
+        if solved.is_err() {
+            self.red.outputs().iter().for_each(|&(_, j)| self.x_full[j] = f64::NAN);
+        }
+        solved
+    }
+
+    /// [`Bdf::complete_outputs`] but for the NaNs of a failure.
+    fn solve_outputs(&mut self, sys: &dyn DaeSystem) -> Result<(), DaeError> {
+        let (t, n) = (self.st.t, sys.n());
+        let mut x = self.x_full.clone();
+        let mut jac = self.st.jac.clone();
+        let mut f = vec![0.0; n];
+        for fresh in [false, true] {
+            if fresh {
+                // From the chord's last iterate, unless it ran away.
+                if x.iter().any(|v| !v.is_finite()) {
+                    x.copy_from_slice(&self.x_full);
+                }
+                sys.complete(t, &mut x);
+                sys.jacobian(t, &x, &mut f, &mut jac);
+                self.st.stats.n_jacobian_evals += 1;
+            }
+            let mut lu = self.output_block(&jac)?;
+            if self.output_chord(sys, &mut lu, &mut x, &mut f)? {
+                sys.complete(t, &mut x);
+                for &(_, j) in self.red.outputs() {
+                    (self.w.x_pred[j], self.w.x[j]) = (x[j], x[j]);
+                }
+                self.x_full = x;
+                self.outputs_done = true;
+                return Ok(());
+            }
+        }
+        let (equation, residual) = self
+            .red
+            .outputs()
+            .iter()
+            .map(|&(i, _)| (i, f[i].abs()))
+            .fold((0, -1.0), |w, e| if e.1 > w.1 || e.1.is_nan() { e } else { w });
+        Err(DaeError::Outputs { time: t, equation, residual })
+    }
+
+    /// The factors of the output block `∂F_o/∂x_o` of the full Jacobian `jac`, reduced through
+    /// the explicit variables (the outputs taken as kept: their rows and columns are those of a
+    /// reduction without outputs).
+    fn output_block(&self, jac: &[(usize, usize, f64)]) -> Result<SparseLu, DaeError> {
+        let time = self.st.t;
+        let n = self.hist_pos.len();
+        let all = Reduction::new(n, &self.explicit, &[]);
+        let mut red = Vec::new();
+        all.jacobian(jac, &mut red).map_err(|source| DaeError::Explicit { time, source })?;
+        let outputs = self.red.outputs();
+        let (mut row, mut col) = (vec![usize::MAX; all.n()], vec![usize::MAX; all.n()]);
+        for (k, &(i, j)) in outputs.iter().enumerate() {
+            (row[all.row[i]], col[all.col[j]]) = (k, k);
+        }
+        let block: Vec<(usize, usize, f64)> = red
+            .iter()
+            .filter(|&&(r, c, _)| row[r] != usize::MAX && col[c] != usize::MAX)
+            .map(|&(r, c, v)| (row[r], col[c], v))
+            .collect();
+        let mut lu = SparseLu::default();
+        lu.factor(outputs.len(), &block).map_err(|source| DaeError::Singular { time, source })?;
+        Ok(lu)
+    }
+
+    /// Chord steps on the outputs of `x` with the factors `lu` of their block, each after
+    /// completing `x`'s explicit variables; whether the correction fell to [`OUTPUT_TOL`] (its
+    /// weighted RMS, the weights those of the error test). `f` holds the last residual.
+    fn output_chord(
+        &mut self,
+        sys: &dyn DaeSystem,
+        lu: &mut SparseLu,
+        x: &mut [f64],
+        f: &mut [f64],
+    ) -> Result<bool, DaeError> {
+        let (t, rtol) = (self.st.t, self.settings.rtol);
+        let outputs = self.red.outputs();
+        let mut dx = vec![0.0; outputs.len()];
+        for _ in 0..OUTPUT_MAXITER {
+            sys.complete(t, x);
+            sys.residual(t, x, f);
+            self.st.stats.n_residual_evals += 1;
+            dx.iter_mut().zip(outputs).for_each(|(d, &(i, _))| *d = -f[i]);
+            if lu.solve_in_place(&mut dx).is_err() {
+                return Ok(false);
+            }
+            let mut sum = 0.0;
+            for (d, &(_, j)) in dx.iter().zip(outputs) {
+                sum += (d / (self.abs_tol[j] + rtol * x[j].abs())).powi(2);
+                x[j] += d;
+            }
+            let norm = (sum / outputs.len() as f64).sqrt();
+            if !norm.is_finite() {
+                return Ok(false);
+            }
+            // Not below the rounding level of the weighted variables.
+            if norm <= OUTPUT_TOL.max(ROUNDOFF_ULPS * f64::EPSILON / rtol) {
+                return Ok(true);
+            }
+        }
+        Ok(false)
     }
 
     /// The reduced Jacobian of the held one into [`Bdf::red_jac`].
@@ -835,7 +979,8 @@ impl Bdf {
     ) -> Option<bool> {
         let n = x.len();
         let tol = NewtonSettings::default().tol;
-        let algebraic: Vec<bool> = self.diff_var.iter().map(|&j| j == usize::MAX).collect();
+        let mut algebraic: Vec<bool> = self.diff_var.iter().map(|&j| j == usize::MAX).collect();
+        self.red.outputs().iter().for_each(|&(i, _)| algebraic[i] = false);
         let mut weight = vec![0.0; n];
         row_weights(&self.st.jac, |j| sys.nominal(j), &mut weight);
         let norm = |f: &[f64]| {
@@ -984,6 +1129,7 @@ impl DaeIntegrator for Bdf {
         self.st.newton_ss = None;
         self.st.stats.n_restarts += 1;
         self.lu.invalidate();
+        self.seed_outputs();
         Ok(())
     }
 
@@ -1002,6 +1148,7 @@ impl DaeIntegrator for Bdf {
         self.st.t = t_new;
         self.st.h_abs = h_abs;
         self.st.current_jac = false;
+        self.outputs_done = false;
         self.update_differences(order);
         debug_assert!(self.hist.iter().zip(&self.st.d[0]).all(|(&j, b)| {
             let a = self.w.x[j];
@@ -1131,6 +1278,85 @@ mod tests {
         fn complete(&self, _t: f64, x: &mut [f64]) {
             (self.complete)(x)
         }
+    }
+
+    /// `x' = −x` with the output `z³ + z = x` and the explicit `w = z` read by nothing: `z` is
+    /// output-only, `w` explicit but computed from it.
+    struct WithOutput {
+        sys: Closure,
+    }
+
+    impl WithOutput {
+        fn new() -> WithOutput {
+            let f: fn(f64, &[f64], &mut [f64]) = |_, x, r| {
+                r[0] = -x[0];
+                r[1] = x[1].powi(3) + x[1] - x[0];
+                r[2] = x[2] - x[1];
+            };
+            let jac: JacFn =
+                |_, x| vec![(0, 0, -1.0), (1, 1, 3.0 * x[1] * x[1] + 1.0), (1, 0, -1.0), (2, 2, 1.0), (2, 1, -1.0)];
+            WithOutput { sys: Closure { n: 3, mass: vec![(0, 0)], f, jac } }
+        }
+    }
+
+    impl DaeSystem for WithOutput {
+        fn n(&self) -> usize {
+            3
+        }
+        fn residual(&self, t: f64, x: &[f64], r: &mut [f64]) {
+            self.sys.residual(t, x, r)
+        }
+        fn jacobian(&self, t: f64, x: &[f64], r: &mut [f64], jac: &mut Vec<(usize, usize, f64)>) {
+            self.sys.jacobian(t, x, r, jac)
+        }
+        fn mass(&self) -> &[(usize, usize)] {
+            &self.sys.mass
+        }
+        fn nominal(&self, _i: usize) -> f64 {
+            1.0
+        }
+        fn bounds(&self, _i: usize) -> (f64, f64) {
+            (f64::NEG_INFINITY, f64::INFINITY)
+        }
+        fn error_controlled(&self, i: usize) -> bool {
+            i == 0
+        }
+        fn explicit(&self) -> &[(usize, usize)] {
+            &[(2, 2)]
+        }
+        fn outputs(&self) -> &[(usize, usize)] {
+            &[(1, 1)]
+        }
+        fn complete(&self, _t: f64, x: &mut [f64]) {
+            x[2] = x[1];
+        }
+    }
+
+    /// The output-only `z` stays at its start value through the run (Newton never touches it),
+    /// then [`Bdf::complete_outputs`] solves `z³ + z = x(t)` — against bisection to 1e-13 —
+    /// and completes `w = z` from it; a second call does no work. `x(1) = e⁻¹` to the tolerance.
+    #[test]
+    fn output_only_variables_are_solved_when_asked_for() {
+        let sys = WithOutput::new();
+        let settings = BdfSettings { rtol: 1e-8, atol: 1e-10, ..BdfSettings::default() };
+        // z = 0.6823278038280193 solves z³ + z = 1 (the start is consistent).
+        let z0 = 0.682_327_803_828_019_3;
+        let mut bdf = run(&sys, settings, &[1.0, z0, z0], 1.0);
+        assert_eq!(bdf.red.n(), 1, "only x is iterated");
+        assert_eq!(bdf.x()[1], z0, "the output moved before it was asked for");
+        bdf.complete_outputs(&sys).unwrap();
+        let x = bdf.x().to_vec();
+        assert!((x[0] - (-1.0f64).exp()).abs() < 1e-7, "x(1) = {}", x[0]);
+        let (mut lo, mut hi) = (0.0f64, 1.0f64);
+        for _ in 0..200 {
+            let mid = 0.5 * (lo + hi);
+            if mid.powi(3) + mid < x[0] { lo = mid } else { hi = mid }
+        }
+        assert!((x[1] - lo).abs() < 1e-13, "z = {} against bisection {lo}", x[1]);
+        assert_eq!(x[2], x[1], "w completed from the solved z");
+        let evals = bdf.stats().n_residual_evals;
+        bdf.complete_outputs(&sys).unwrap();
+        assert_eq!(bdf.stats().n_residual_evals, evals, "solved twice at the same time");
     }
 
     fn run(sys: &dyn DaeSystem, settings: BdfSettings, x0: &[f64], t_end: f64) -> Bdf {

@@ -49,12 +49,20 @@ pub trait DaeSystem: Sync {
     fn explicit(&self) -> &[(usize, usize)] {
         &[]
     }
+    /// Output-only algebraic variables, as `(equation, variable)` pairs: no equation of the other
+    /// (non-explicit) variables reads them, directly or through an explicit variable. The
+    /// integrator leaves them and their equations out of its iteration, where their values
+    /// stay as they were, and solves them when asked ([`Bdf::complete_outputs`]);
+    /// [`DaeSystem::residual_completed`] may skip their equations (default: none).
+    fn outputs(&self) -> &[(usize, usize)] {
+        &[]
+    }
     /// Overwrite the [`DaeSystem::explicit`] variables of `x` with their values from the others
     /// at time `t` (default: nothing).
     fn complete(&self, _t: f64, _x: &mut [f64]) {}
     /// [`DaeSystem::residual`] at an `x` that [`DaeSystem::complete`] has just completed: the
-    /// explicit equations hold there and their rows may be left zero without evaluating them
-    /// (default: the residual).
+    /// explicit equations hold there and their rows may be left zero without evaluating them,
+    /// and the rows of [`DaeSystem::outputs`] may be left anything (default: the residual).
     fn residual_completed(&self, t: f64, x: &[f64], r: &mut [f64]) {
         self.residual(t, x, r);
     }
@@ -96,6 +104,18 @@ pub enum DaeError {
         time: f64,
         /// What the factorization said.
         source: crate::sparse::SparseError,
+    },
+    /// The output-only variables did not converge when asked for.
+    #[error(
+        "output-only variables at t = {time} s did not converge: equation {equation} keeps a residual of {residual:.3e}"
+    )]
+    Outputs {
+        /// Time [s].
+        time: f64,
+        /// Global index of the equation with the largest residual.
+        equation: usize,
+        /// Its residual.
+        residual: f64,
     },
     /// The explicit variables could not be eliminated from the iteration matrix.
     #[error("explicit variables at t = {time} s: {source}")]

@@ -16,7 +16,17 @@
 //! never forms a dense Schur complement, so its cost is that of the fill it creates (for a
 //! column, a few entries per stage).
 //!
+//! **Output-only variables** ([`DaeSystem::outputs`]) are set aside too: algebraic variables that
+//! no equation of the kept variables reads, through any chain of equations, so that they feed
+//! nothing the integrator solves (a tray temperature the constant-α equilibrium does not use).
+//! Their equations form the lower block of a block-triangular system; the integrator leaves both
+//! out of its iteration and solves that block only when their values are asked for. A kept
+//! equation that reads one is a defect of the system ([`ReduceError::Output`]); an explicit
+//! equation may (its variable is then an output too, recomputed by the completion that follows
+//! the outputs' solve).
+//!
 //! [`DaeSystem::explicit`]: super::DaeSystem::explicit
+//! [`DaeSystem::outputs`]: super::DaeSystem::outputs
 //! [`DaeSystem::complete`]: super::DaeSystem::complete
 
 /// Why a reduced Jacobian could not be formed.
@@ -40,6 +50,15 @@ pub enum ReduceError {
         /// The later explicit variable it reads.
         later: usize,
     },
+    /// A kept equation reads an output-only variable, or an explicit one computed from one: the
+    /// output feeds the iteration after all.
+    #[error("equation {equation} reads variable {var}, an output-only variable or computed from one")]
+    Output {
+        /// Global equation index.
+        equation: usize,
+        /// The output-only variable.
+        var: usize,
+    },
 }
 
 /// The partition of a DAE into kept and explicit variables and equations.
@@ -47,11 +66,15 @@ pub enum ReduceError {
 pub(crate) struct Reduction {
     /// `(equation, variable)` of each explicit variable, in the order the system computes them.
     explicit: Vec<(usize, usize)>,
-    /// Position of each variable among the explicit ones (`usize::MAX`: kept).
+    /// `(equation, variable)` of each output-only variable.
+    outputs: Vec<(usize, usize)>,
+    /// Position of each variable among the explicit ones (`usize::MAX`: kept or output).
     position: Vec<usize>,
-    /// Reduced index of each variable (`usize::MAX`: explicit).
+    /// Whether each variable is output-only.
+    output: Vec<bool>,
+    /// Reduced index of each variable (`usize::MAX`: explicit or output).
     pub(crate) col: Vec<usize>,
-    /// Reduced index of each equation (`usize::MAX`: explicit).
+    /// Reduced index of each equation (`usize::MAX`: explicit or output).
     pub(crate) row: Vec<usize>,
     /// The kept variables, ascending.
     pub(crate) kept_vars: Vec<usize>,
@@ -91,26 +114,41 @@ impl Accumulator {
 }
 
 impl Reduction {
-    /// The partition of an `n`-variable system with the `explicit` `(equation, variable)` pairs.
-    /// Pairs naming an index out of range or one already named are ignored.
-    pub(crate) fn new(n: usize, explicit: &[(usize, usize)]) -> Reduction {
+    /// The partition of an `n`-variable system with the `explicit` and the output-only
+    /// `outputs` `(equation, variable)` pairs. Pairs naming an index out of range or one already
+    /// named are ignored.
+    pub(crate) fn new(n: usize, explicit: &[(usize, usize)], outputs: &[(usize, usize)]) -> Reduction {
         let mut position = vec![usize::MAX; n];
-        let mut eq_explicit = vec![false; n];
+        let mut eq_taken = vec![false; n];
         let mut pairs = Vec::with_capacity(explicit.len());
         for &(i, j) in explicit {
-            if i < n && j < n && position[j] == usize::MAX && !eq_explicit[i] {
+            if i < n && j < n && position[j] == usize::MAX && !eq_taken[i] {
                 position[j] = pairs.len();
-                eq_explicit[i] = true;
+                eq_taken[i] = true;
                 pairs.push((i, j));
             }
         }
-        let kept_vars: Vec<usize> = (0..n).filter(|&j| position[j] == usize::MAX).collect();
-        let kept_eqs: Vec<usize> = (0..n).filter(|&i| !eq_explicit[i]).collect();
+        let mut output = vec![false; n];
+        let mut out_pairs = Vec::with_capacity(outputs.len());
+        for &(i, j) in outputs {
+            if i < n && j < n && position[j] == usize::MAX && !output[j] && !eq_taken[i] {
+                output[j] = true;
+                eq_taken[i] = true;
+                out_pairs.push((i, j));
+            }
+        }
+        let kept_vars: Vec<usize> = (0..n).filter(|&j| position[j] == usize::MAX && !output[j]).collect();
+        let kept_eqs: Vec<usize> = (0..n).filter(|&i| !eq_taken[i]).collect();
         let mut col = vec![usize::MAX; n];
         kept_vars.iter().enumerate().for_each(|(r, &j)| col[j] = r);
         let mut row = vec![usize::MAX; n];
         kept_eqs.iter().enumerate().for_each(|(r, &i)| row[i] = r);
-        Reduction { explicit: pairs, position, col, row, kept_vars, kept_eqs }
+        Reduction { explicit: pairs, outputs: out_pairs, position, output, col, row, kept_vars, kept_eqs }
+    }
+
+    /// The output-only `(equation, variable)` pairs.
+    pub(crate) fn outputs(&self) -> &[(usize, usize)] {
+        &self.outputs
     }
 
     /// Number of kept variables (= kept equations).
@@ -123,9 +161,9 @@ impl Reduction {
         self.explicit.iter().map(|&(_, j)| j)
     }
 
-    /// Whether nothing is eliminated.
+    /// Whether nothing is eliminated or set aside.
     pub(crate) fn is_identity(&self) -> bool {
-        self.explicit.is_empty()
+        self.explicit.is_empty() && self.outputs.is_empty()
     }
 
     /// The reduced Jacobian `J_red` (module documentation) of the full Jacobian `jac` (triplets,
@@ -155,13 +193,21 @@ impl Reduction {
         let mut acc = Accumulator::new(self.n());
         // The gradients `dx_e/dx_k`, one sparse row per explicit variable, in compressed rows.
         let (mut g_ptr, mut g) = (vec![0usize], Vec::<(usize, f64)>::new());
+        let mut reads_output = vec![false; self.explicit.len()];
         for (k, &(i, j)) in self.explicit.iter().enumerate() {
             let mut pivot = 0.0;
+            // An output read by an explicit equation makes its variable an output too (`reads`
+            // marks it): no kept equation may read it (checked below), so the gradient left
+            // without the output's column never reaches the iteration.
             for &(c, v) in row_of(i).iter().filter(|e| e.1 != 0.0) {
                 match self.position[c] {
+                    _ if self.output[c] => reads_output[k] = true,
                     usize::MAX => acc.add(self.col[c], v),
                     p if p == k => pivot += v,
-                    p if p < k => g[g_ptr[p]..g_ptr[p + 1]].iter().for_each(|&(cc, gv)| acc.add(cc, v * gv)),
+                    p if p < k => {
+                        reads_output[k] |= reads_output[p];
+                        g[g_ptr[p]..g_ptr[p + 1]].iter().for_each(|&(cc, gv)| acc.add(cc, v * gv));
+                    }
                     _ => return Err(ReduceError::Order { equation: i, var: j, later: c }),
                 }
             }
@@ -175,6 +221,10 @@ impl Reduction {
         for (r, &i) in self.kept_eqs.iter().enumerate() {
             for &(c, v) in row_of(i).iter().filter(|e| e.1 != 0.0) {
                 match self.position[c] {
+                    p if self.output[c] || (p != usize::MAX && reads_output[p]) => {
+                        acc.drain(|_, _| {});
+                        return Err(ReduceError::Output { equation: i, var: c });
+                    }
                     usize::MAX => acc.add(self.col[c], v),
                     p => g[g_ptr[p]..g_ptr[p + 1]].iter().for_each(|&(cc, gv)| acc.add(cc, v * gv)),
                 }
@@ -234,7 +284,7 @@ mod tests {
             (2, 2, -2.0 * x2),
             (3, 1, 1.0),
         ];
-        let red = Reduction::new(4, &[(1, 2), (2, 3)]);
+        let red = Reduction::new(4, &[(1, 2), (2, 3)], &[]);
         assert_eq!(red.kept_vars, vec![0, 1]);
         assert_eq!(red.kept_eqs, vec![0, 3]);
         let mut out = Vec::new();
@@ -246,18 +296,46 @@ mod tests {
         }
     }
 
+    /// `F = [x0 − 1, x1 − 2 x0, x2³ − x1, x3 − x2]` with `x1`, `x3` explicit and `x2` output-only:
+    /// the iteration keeps `x0` alone (the explicit `x3` reads the output, which no kept
+    /// equation reads); a kept equation that reads the output, directly or through `x3`, is
+    /// reported.
+    #[test]
+    fn outputs_leave_the_iteration_and_a_kept_equation_may_not_read_them() {
+        let x2 = 2f64.cbrt();
+        let jac = vec![
+            (0, 0, 1.0),
+            (1, 1, 1.0),
+            (1, 0, -2.0),
+            (2, 2, 3.0 * x2 * x2),
+            (2, 1, -1.0),
+            (3, 3, 1.0),
+            (3, 2, -1.0),
+        ];
+        let red = Reduction::new(4, &[(1, 1), (3, 3)], &[(2, 2)]);
+        assert_eq!((red.kept_vars.clone(), red.kept_eqs.clone()), (vec![0], vec![0]));
+        let mut out = Vec::new();
+        red.jacobian(&jac, &mut out).unwrap();
+        assert_eq!(dense(1, &out), vec![1.0]);
+        for (c, var) in [(2, 2), (3, 3)] {
+            let mut reads = jac.clone();
+            reads.push((0, c, 0.5));
+            assert_eq!(red.jacobian(&reads, &mut out), Err(ReduceError::Output { equation: 0, var }));
+        }
+    }
+
     /// An explicit equation that reads an explicit variable computed after it is reported, and so
     /// is one that does not contain its own variable.
     #[test]
     fn misordered_or_absent_explicit_variables_are_reported() {
         let jac = vec![(0, 0, 1.0), (1, 1, 1.0), (1, 2, 3.0), (2, 2, 1.0), (2, 0, 1.0)];
         let mut out = Vec::new();
-        let red = Reduction::new(3, &[(1, 1), (2, 2)]);
+        let red = Reduction::new(3, &[(1, 1), (2, 2)], &[]);
         assert_eq!(red.jacobian(&jac, &mut out), Err(ReduceError::Order { equation: 1, var: 1, later: 2 }));
-        let red = Reduction::new(3, &[(2, 1)]);
+        let red = Reduction::new(3, &[(2, 1)], &[]);
         assert_eq!(red.jacobian(&jac, &mut out), Err(ReduceError::ZeroPivot { equation: 2, var: 1 }));
         // In the right order the same matrix reduces to the 1×1 `1` (row 0 reads nothing eliminated).
-        let red = Reduction::new(3, &[(2, 2), (1, 1)]);
+        let red = Reduction::new(3, &[(2, 2), (1, 1)], &[]);
         red.jacobian(&jac, &mut out).unwrap();
         assert_eq!(dense(1, &out), vec![1.0]);
     }

@@ -88,8 +88,12 @@ pub(super) struct DaeShape {
 }
 
 impl DaeShape {
-    /// The shape of `plant` with the component flows of `streams` integrated.
-    pub(super) fn new(plant: &Plant, streams: &[usize]) -> DaeShape {
+    /// The shape of `plant` with the component flows of `streams` integrated. With `reads`, the
+    /// plant variables the caller reads during the run besides the integrated flows, every
+    /// other variable nothing integrated depends on is output-only
+    /// ([`plantwide_flowsheet::ExplicitPlan::outputs`]); `None`: the caller may read anything,
+    /// nothing is output-only.
+    pub(super) fn new(plant: &Plant, streams: &[usize], reads: Option<&[usize]>) -> DaeShape {
         let n_plant = plant.n_vars();
         let nc = plant.components().len();
         let mut mass = PlantSystem::new(plant, &[]).mass();
@@ -98,7 +102,15 @@ impl DaeShape {
         let mut differential = vec![false; n_plant];
         mass.iter().for_each(|&(_, j)| differential[j] = true);
         mass.extend((n_plant..n_plant + flows.len() * nc).map(|k| (k, k)));
-        DaeShape { mass, differential, flows, n_plant, nc, explicit: plant.explicit_plan() }
+        let explicit = match reads {
+            Some(reads) => {
+                let mut roots = reads.to_vec();
+                flows.iter().for_each(|(f, z)| roots.extend(std::iter::once(*f).chain(z.clone())));
+                plant.explicit_plan_for(&roots)
+            }
+            None => plant.explicit_plan(),
+        };
+        DaeShape { mass, differential, flows, n_plant, nc, explicit }
     }
 }
 
@@ -190,6 +202,9 @@ impl DaeSystem for PlantDae<'_> {
     fn explicit(&self) -> &[(usize, usize)] {
         self.shape.explicit.pairs()
     }
+    fn outputs(&self) -> &[(usize, usize)] {
+        self.shape.explicit.outputs()
+    }
     fn complete(&self, t: f64, x: &mut [f64]) {
         let np = self.shape.n_plant;
         INPUTS.with_borrow_mut(|u| {
@@ -219,7 +234,7 @@ mod tests {
         let x0 = crate::steady_state(&plant, &u, None, &NewtonSettings::default()).unwrap().x;
         let waves: Vec<Waveform> = u.iter().map(|&v| Waveform::Constant(v)).collect();
         let quad = Quadratures::new(&plant, &[]);
-        let shape = DaeShape::new(&plant, &quad.streams);
+        let shape = DaeShape::new(&plant, &quad.streams, None);
         let sys = PlantDae::new(&plant, &waves, &shape);
         let n = sys.n();
         assert_eq!((n, sys.explicit().len()), (436, 299));
@@ -232,7 +247,7 @@ mod tests {
         }
         let (mut r, mut jac) = (vec![0.0; n], Vec::new());
         sys.jacobian(0.0, &done, &mut r, &mut jac);
-        let red = Reduction::new(n, sys.explicit());
+        let red = Reduction::new(n, sys.explicit(), &[]);
         let m = red.n();
         assert_eq!(m, 137);
         let mut triplets = Vec::new();

@@ -141,6 +141,8 @@ impl Driver {
                     .into(),
             });
         }
+        // Every controller output (a scan, a stuck valve or a switch to manual reads one).
+        let outputs: Vec<usize> = plant.inputs().iter().filter_map(|i| i.driven_by).collect();
         let mut plant = plant.clone();
         // Which controller measures each recorded path: read before the analyzers rewire it.
         let refs = sc.record.iter().map(|r| reference_of(&plant, r.source)).collect();
@@ -153,8 +155,14 @@ impl Driver {
             let resumed = snapshot::resume(&mut plant, sc, s, fingerprint, &paths, st, &mut sampled)?;
             (st, restore, t0) = (resumed.driver, resumed.integrator, s.t);
         }
-        let shape = DaeShape::new(&plant, &quad.streams);
         let recorded = recorded_state(&plant, sc);
+        // What the driver reads between steps; a model predictive controller reads its model's
+        // states, which may be anything.
+        let mut reads = outputs;
+        reads.extend(recorded.iter().copied().filter(|&v| v < plant.n_vars()));
+        reads.extend(analyzers.iter().map(|&(_, v)| v));
+        reads.extend(sampled.iter().flatten().map(|&(_, op)| op));
+        let shape = DaeShape::new(&plant, &quad.streams, mpcs.is_empty().then_some(reads.as_slice()));
         // Between steps only the recorded variables are interpolated: the integrator need not
         // keep the history of the other explicit ones.
         let mut bdf = Bdf::new(bdf_settings(sc));
@@ -185,8 +193,10 @@ impl Driver {
     }
 
     /// No budget of steps (a live run's duration is endless); before [`Driver::start`].
+    /// A live run reads any variable at any time: none is output-only.
     pub(super) fn endless(&mut self) {
         self.bdf = Bdf::new(BdfSettings { max_steps: usize::MAX, ..bdf_settings(&self.sc) });
+        self.shape = DaeShape::new(&self.plant, &self.quad.streams, None);
     }
 
     /// The integrator's time \[s\]: the last step's end (a sync point).
@@ -443,7 +453,15 @@ impl Driver {
     pub(super) fn run(&mut self, observer: &mut dyn FnMut(Progress<'_>)) -> Result<(), RunError> {
         self.start()?;
         while self.step_once(observer)? {}
+        self.complete_outputs()?;
         Ok(())
+    }
+
+    /// Solve the output-only variables at the integrator's time (before its state is handed
+    /// out whole: the result, a snapshot).
+    fn complete_outputs(&mut self) -> Result<(), DaeError> {
+        let sys = PlantDae::new(&self.plant, &self.st.waveforms, &self.shape);
+        self.bdf.complete_outputs(&sys)
     }
 
     /// Apply what is due at the integrator's time (restarting it if an input changed), then take
@@ -470,7 +488,7 @@ impl Driver {
         let now = self.bdf.t();
         self.record_through(now, &mut x);
         self.state_buf = x;
-        self.offer_snapshots(now, observer);
+        self.offer_snapshots(now, observer)?;
         observer(Progress::Step { t: now, duration: self.sc.duration });
         Ok(true)
     }
@@ -496,14 +514,16 @@ impl Driver {
     }
 
     /// Hand the snapshots due by `now` to `observer`.
-    fn offer_snapshots(&mut self, now: f64, observer: &mut dyn FnMut(Progress<'_>)) {
+    fn offer_snapshots(&mut self, now: f64, observer: &mut dyn FnMut(Progress<'_>)) -> Result<(), DaeError> {
         for k in 0..self.sc.snapshots.len() {
             if !self.st.snapshots_done[k] && self.sc.snapshots[k].0 <= now {
                 self.st.snapshots_done[k] = true;
+                self.complete_outputs()?;
                 let snap = self.snapshot();
                 observer(Progress::Snapshot { file: &self.sc.snapshots[k].1, snapshot: &snap });
             }
         }
+        Ok(())
     }
 
     /// Material balances from `x0` to the integrator's state.
@@ -542,7 +562,11 @@ impl Driver {
     }
 
     /// The run so far as a result.
-    pub(super) fn finish(self) -> SimulationResult {
+    /// The output-only variables are solved first (done already after a completed run); if
+    /// they cannot be (a run that failed), they are NaN in the final state, not stale values.
+    pub(super) fn finish(mut self) -> SimulationResult {
+        // The error, if any, is the run's own failure seen again or left as NaN: nothing to add.
+        let _ = self.complete_outputs();
         let conservation = self.conservation();
         let columns = self.columns();
         let n_tot = columns.len() - self.refs.len();

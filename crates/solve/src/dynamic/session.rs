@@ -50,7 +50,7 @@ impl Session {
     pub fn with_settings(plant: &Plant, x0: &[f64], settings: BdfSettings) -> Result<Session, SessionError> {
         let plant = plant.clone();
         let waves: Vec<Waveform> = plant.inputs().iter().map(|i| Waveform::Constant(i.value)).collect();
-        let shape = DaeShape::new(&plant, &[]);
+        let shape = DaeShape::new(&plant, &[], None);
         let mut s = Session { plant, waves, shape, bdf: Bdf::new(settings), restart: false };
         let sys = PlantDae::new(&s.plant, &s.waves, &s.shape);
         s.bdf.restart(&sys, 0.0, x0).map_err(|source| SessionError {

@@ -57,6 +57,8 @@ pub struct SimpleColumn {
     l0: Vec<f64>,
     tau_l: f64,
     lambda: f64,
+    /// Whether the K-values depend on temperature (all but constant α): `y` then reads `T`.
+    k_reads_t: bool,
     v0: f64,
     reflux: f64,
     boilup: f64,
@@ -157,6 +159,7 @@ impl SimpleColumn {
             l0,
             tau_l,
             lambda: c.lambda.unwrap_or(0.0),
+            k_reads_t: cx.thermo.constant_alpha().is_none(),
             v0: boilup,
             reflux,
             boilup,
@@ -249,6 +252,68 @@ impl SimpleColumn {
         acc
     }
 
+    /// The rows of stage `s` of [`UnitModel::pattern`] (see there) into `p`.
+    fn stage_pattern(&self, s: usize, layout: &LocalLayout, p: &mut Vec<(usize, usize)>) {
+        let (nc, n, ix) = (self.nc(), self.n_stages, StageIdx { nc: self.nc() });
+        let slen = layout.stream.len();
+        let internal0 = self.n_outlets() * slen;
+        let col = |s: usize, k: usize| internal0 + self.stage(s) + k;
+        let input = |k: usize| layout.inputs_offset() + k;
+        let inlet = |f: usize, field: usize| layout.inlets_offset() + f * slen + field;
+        let feeds: Vec<usize> = (0..self.feeds.len()).filter(|&f| self.feeds[f].stage == s).collect();
+        let xs = (0..nc).map(|j| col(s, ix.x(j)));
+        for j in 0..nc {
+            let row = col(s, ix.n(j));
+            p.extend([ix.n(j), ix.l(), ix.x(j), ix.v(), ix.y(j)].map(|k| (row, col(s, k))));
+            if s + 1 < n {
+                p.extend([(row, col(s + 1, ix.l())), (row, col(s + 1, ix.x(j)))]);
+            } else {
+                p.push((row, input(IN_DISTILLATE)));
+            }
+            if s > 0 {
+                p.extend([(row, col(s - 1, ix.v())), (row, col(s - 1, ix.y(j)))]);
+            }
+            let draws = self.draws.iter().enumerate().filter(|(_, d)| d.stage == s);
+            p.extend(draws.map(|(k, _)| (row, input(4 + k))));
+            p.extend(feeds.iter().flat_map(|&f| [(row, inlet(f, F)), (row, inlet(f, Z0 + j))]));
+            let row = col(s, ix.x(j));
+            p.extend([ix.x(j), ix.n(j), ix.m()].map(|k| (row, col(s, k))));
+            let row = col(s, ix.y(j));
+            p.push((row, col(s, ix.y(j))));
+            p.extend(xs.clone().map(|c| (row, c)));
+            if self.k_reads_t {
+                p.push((row, col(s, ix.t())));
+            }
+        }
+        let row = col(s, ix.t());
+        p.push((row, row));
+        p.extend(xs.clone().map(|c| (row, c)));
+        let row = col(s, ix.m());
+        p.push((row, row));
+        p.extend((0..nc).map(|j| (row, col(s, ix.n(j)))));
+        let row = col(s, ix.l());
+        p.push((row, row));
+        match s {
+            _ if s + 1 == n => p.push((row, input(IN_REFLUX))),
+            0 => p.push((row, input(IN_BOTTOMS))),
+            _ => p.extend([(row, col(s, ix.m())), (row, col(s - 1, ix.v()))]),
+        }
+        let row = col(s, ix.v());
+        p.push((row, row));
+        match s {
+            0 => p.push((row, input(IN_BOILUP))),
+            _ if s + 1 == n => {}
+            _ => p.push((row, col(s - 1, ix.v()))),
+        }
+        for &f in &feeds {
+            p.extend([(row, inlet(f, F)), (row, inlet(f, H))]);
+            if self.feeds[f].q.is_none() {
+                p.push((row, col(s, ix.t())));
+                p.extend((0..nc).flat_map(|j| [(row, col(s, ix.x(j))), (row, col(s, ix.y(j)))]));
+            }
+        }
+    }
+
     /// Outlet residuals: distillate from the condenser (flow `D`), bottoms from the reboiler (its
     /// liquid `L_1`), each side draw from its stage; every outlet leaves as the stage's liquid.
     fn outlet_residuals<S: Scalar>(&self, io: &UnitIo<'_, S>, d_in: S, draw_flow: &[S], r: &mut [S]) {
@@ -332,21 +397,25 @@ impl UnitModel for SimpleColumn {
     fn holdup(&self, io: &UnitIo<'_, f64>) -> Option<Vec<f64>> {
         Some(super::summed_holdups(io, self.n_stages, self.nc(), |s| self.stage(s)))
     }
-    /// Structural nonzeros read off [`UnitModel::eval`]: every row of a stage may hold any of its
-    /// own stage's variables; the component balances also read the liquid (`L`, `x`) of the stage
-    /// above, the vapour (`V`, `y`) of the stage below, the distillate (condenser), a side draw (its
-    /// stage) and the flow and composition of a feed (its stage); the `L` rows read the reflux
-    /// (condenser), the bottoms (reboiler) or the vapour below (trays, `λ ≠ 0`); the `V` rows the
-    /// boilup (reboiler), the vapour below (trays) and a feed's flow and enthalpy (its stage). An
-    /// outlet reads its own stream, its stage and its flow. Nothing else: the inputs and feeds
-    /// touch a few rows, not every row, so the Jacobian needs about half the dual passes.
+    /// Structural nonzeros read off [`UnitModel::eval`], row by row. Per stage: the component
+    /// balance of `j` reads its own holdup (the mass matrix's entry), `L`, `x_j`, `V`, `y_j` of
+    /// the stage, `L`, `x_j` of the stage above, `V`, `y_j` of the stage below, the distillate
+    /// (condenser), a side draw (its stage) and a feed's flow and `z_j` (its stage); `x_j` reads
+    /// `n_j` and `M`; `y_j` reads `x` and, unless the K-values are constant-α (independent of
+    /// temperature), `T`; the bubble point reads `T` and `x`; `M` reads `n`; `L` reads the reflux
+    /// (condenser), the bottoms (reboiler) or `M` and the vapour below (trays); `V` reads the
+    /// boilup (reboiler) or the vapour below (trays), a feed's flow and enthalpy, and where the
+    /// feed quality comes from enthalpies the stage's `T`, `x` and `y`. An outlet's flow reads
+    /// its flow variable, its temperature and enthalpy the stage's `T` (and `x`), its
+    /// composition the stage's `x`. Exact rows keep a constant-α tray temperature out of every
+    /// row but its own and the outlets' (so the integrator can leave it out, see
+    /// `DaeSystem::outputs`) and let the Jacobian colour in fewer dual passes.
     fn pattern(&self, layout: &LocalLayout) -> Option<Vec<(usize, usize)>> {
         let (nc, n, ix) = (self.nc(), self.n_stages, StageIdx { nc: self.nc() });
-        let (slen, ps) = (layout.stream.len(), self.per_stage());
+        let slen = layout.stream.len();
         let internal0 = self.n_outlets() * slen;
         let col = |s: usize, k: usize| internal0 + self.stage(s) + k;
         let input = |k: usize| layout.inputs_offset() + k;
-        let inlet = |f: usize, field: usize| layout.inlets_offset() + f * slen + field;
         let mut p = Vec::new();
         for k in 0..self.n_outlets() {
             let (s, flow) = match k {
@@ -354,43 +423,14 @@ impl UnitModel for SimpleColumn {
                 1 => (0, col(0, ix.l())),
                 _ => (self.draws[k - 2].stage, input(4 + k - 2)),
             };
-            for row in k * slen..(k + 1) * slen {
-                p.extend((k * slen..(k + 1) * slen).map(|c| (row, c)));
-                p.extend((0..ps).map(|c| (row, col(s, c))));
-                p.push((row, flow));
-            }
+            let row = |field: usize| k * slen + field;
+            p.extend([(row(F), row(F)), (row(F), flow), (row(T), row(T)), (row(T), col(s, ix.t())), (row(P), row(P))]);
+            p.extend([(row(H), row(H)), (row(H), col(s, ix.t()))]);
+            p.extend((0..nc).map(|j| (row(H), col(s, ix.x(j)))));
+            p.extend((0..nc).flat_map(|j| [(row(Z0 + j), row(Z0 + j)), (row(Z0 + j), col(s, ix.x(j)))]));
         }
         for s in 0..n {
-            for row in col(s, 0)..col(s, ps) {
-                p.extend((0..ps).map(|c| (row, col(s, c))));
-            }
-            let feeds: Vec<usize> = (0..self.feeds.len()).filter(|&f| self.feeds[f].stage == s).collect();
-            for j in 0..nc {
-                let row = col(s, ix.n(j));
-                if s + 1 < n {
-                    p.extend([(row, col(s + 1, ix.l())), (row, col(s + 1, ix.x(j)))]);
-                } else {
-                    p.push((row, input(IN_DISTILLATE)));
-                }
-                if s > 0 {
-                    p.extend([(row, col(s - 1, ix.v())), (row, col(s - 1, ix.y(j)))]);
-                }
-                let draws = self.draws.iter().enumerate().filter(|(_, d)| d.stage == s);
-                p.extend(draws.map(|(k, _)| (row, input(4 + k))));
-                p.extend(feeds.iter().flat_map(|&f| [(row, inlet(f, F)), (row, inlet(f, Z0 + j))]));
-            }
-            let l_row = col(s, ix.l());
-            match s {
-                _ if s + 1 == n => p.push((l_row, input(IN_REFLUX))),
-                0 => p.push((l_row, input(IN_BOTTOMS))),
-                _ => p.push((l_row, col(s - 1, ix.v()))),
-            }
-            let v_row = col(s, ix.v());
-            match s {
-                0 => p.push((v_row, input(IN_BOILUP))),
-                _ => p.push((v_row, col(s - 1, ix.v()))),
-            }
-            p.extend(feeds.iter().flat_map(|&f| [(v_row, inlet(f, F)), (v_row, inlet(f, H))]));
+            self.stage_pattern(s, layout, &mut p);
         }
         // Assembly emits one triplet per declared entry: an entry declared twice (the bottoms'
         // flow is its stage's `L`) would be summed twice.
@@ -469,11 +509,12 @@ impl UnitModel for SimpleColumn {
         e.extend(0..outlets);
         e
     }
-    /// The component balances and bubble points alone: every other equation is explicit. The
+    /// The component balances and bubble points alone (a bubble point in `skip` left out): every
+    /// other equation is explicit. The
     /// terms of each balance are summed in [`SimpleColumn::component_balance`]'s order (the same
     /// values bit for bit), on slices of the stage and its neighbours and without allocation: this
     /// runs at every Newton iteration of the dynamic integrator.
-    fn eval_kept(&self, io: &UnitIo<'_, f64>, r: &mut [f64]) {
+    fn eval_kept(&self, io: &UnitIo<'_, f64>, r: &mut [f64], skip: &[bool]) {
         let (nc, n, ix, ps) = (self.nc(), self.n_stages, StageIdx { nc: self.nc() }, self.per_stage());
         let internal0 = self.n_outlets() * io.layout.stream.len();
         let stages = io.vars(0, n * ps);
@@ -505,7 +546,9 @@ impl UnitModel for SimpleColumn {
                 }
                 r[o + ix.n(j)] = acc;
             }
-            r[o + ix.t()] = io.thermo.bubble_residual(v[ix.t()], self.pressure, &v[ix.x(0)..ix.x(0) + nc]);
+            if !skip.get(o + ix.t()).copied().unwrap_or(false) {
+                r[o + ix.t()] = io.thermo.bubble_residual(v[ix.t()], self.pressure, &v[ix.x(0)..ix.x(0) + nc]);
+            }
         }
     }
     /// `M = Σ n`, `x = n/M`, `y = K(T, P, x) x`, the CMO vapour flows, the liquid flows and the
@@ -666,7 +709,7 @@ impl UnitModel for SimpleColumn {
 
 #[cfg(test)]
 mod tests {
-    use plantwide_thermo::ThermoPackage;
+    use plantwide_thermo::{ThermoPackage, VleModel};
 
     use crate::testing::{binary_package, jacobian_error};
     use crate::units::column::{Column, ColumnConfig};
@@ -676,16 +719,20 @@ mod tests {
     /// A seven-stage column fed on stage 3 with `feed` (`"q": 1.0` or none: q from enthalpies),
     /// `extra` fields (a side draw, λ).
     fn column(feed: &str, extra: &str) -> Column {
+        column_in(&binary_package(), feed, extra)
+    }
+
+    /// [`column`] on the package `thermo`.
+    fn column_in(thermo: &ThermoPackage, feed: &str, extra: &str) -> Column {
         let json = format!(
             r#"{{"stages": 7, "feeds": [{{"stage": 3{feed}}}], "P": "1 atm", "tray_holdup": "0.5 kmol",
             "condenser_holdup": "0.5 kmol", "reboiler_holdup": "0.5 kmol", "tau_l": "0.063 min",
             "reflux": "2.7 kmol/min", "boilup": "3.2 kmol/min", "distillate": "0.5 kmol/min",
             "bottoms": "0.5 kmol/min"{extra}}}"#
         );
-        let thermo = binary_package();
         let names: Vec<String> = thermo.components.iter().map(|c| c.name.clone()).collect();
         let c: ColumnConfig = serde_json::from_str(&json).unwrap();
-        Column::build(&c, BuildCx::new(&names, &thermo, "units.column"), ()).unwrap()
+        Column::build(&c, BuildCx::new(&names, thermo, "units.column"), ()).unwrap()
     }
 
     /// The binary test package and a subcooled equimolar feed stream (F, T, P, h, z).
@@ -711,11 +758,12 @@ mod tests {
     /// Jacobian; the coloured one also agrees with central differences.
     #[test]
     fn the_declared_pattern_holds_every_nonzero_and_colours_the_jacobian_exactly() {
-        let (thermo, feed) = subcooled_feed();
+        let (ideal, feed) = subcooled_feed();
+        let alpha = ThermoPackage { vle: VleModel::ConstantAlpha { alpha: vec![2.0, 1.0] }, ..ideal.clone() };
         let mut rng = Lcg(7);
-        for (f, extra) in CONFIGS {
-            let u = column(f, extra);
-            let (lay, guess) = at_guess(&u, &thermo, &feed);
+        for ((f, extra), thermo) in CONFIGS.into_iter().flat_map(|c| [(c, &ideal), (c, &alpha)]) {
+            let u = column_in(thermo, f, extra);
+            let (lay, guess) = at_guess(&u, thermo, &feed);
             let n = lay.len();
             let m = lay.n_own();
             let pattern = u.pattern(&lay).expect("declared");
@@ -735,7 +783,7 @@ mod tests {
                     .iter()
                     .map(|&v| if trial == 0 { v } else { v * rng.range(0.8, 1.2) + rng.range(0.0, 1e-3) })
                     .collect();
-                let io = UnitIo { local: &local, layout: &lay, thermo: &thermo, time: 0.0 };
+                let io = UnitIo { local: &local, layout: &lay, thermo, time: 0.0 };
                 let (mut r, mut dense) = (vec![0.0; m], vec![0.0; m * n]);
                 u.jacobian_colored(&io, &mut r, &mut dense, None);
                 for (e, (&v, &d)) in dense.iter().zip(&declared).enumerate() {
@@ -745,7 +793,7 @@ mod tests {
                 u.jacobian_colored(&io, &mut r, &mut colored, Some(&coloring));
                 let worst = colored.iter().zip(&dense).fold(0.0f64, |w, (a, b)| w.max((a - b).abs()));
                 assert_eq!(worst, 0.0, "{f}{extra}: coloured and dense Jacobians differ");
-                assert!(jacobian_error(&u, &lay, &thermo, &local, m) < 1e-6, "{f}{extra}");
+                assert!(jacobian_error(&u, &lay, thermo, &local, m) < 1e-6, "{f}{extra}");
             }
             eprintln!("{f}{extra}: {} colours for {n} local columns", coloring.n_colors);
         }
@@ -768,7 +816,7 @@ mod tests {
                 let io = UnitIo { local: &local, layout: &lay, thermo: &thermo, time: 0.0 };
                 let (mut full, mut only) = (vec![0.0; m], vec![f64::NAN; m]);
                 Unit::residual(&u, &io, &mut full);
-                Unit::residual_kept(&u, &io, &mut only);
+                Unit::residual_kept(&u, &io, &mut only, &[]);
                 for k in (0..m).filter(|&k| kept[k]) {
                     assert_eq!(
                         only[k].to_bits(),
