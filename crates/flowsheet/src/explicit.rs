@@ -186,20 +186,37 @@ impl Plant {
         SCRATCH.with_borrow_mut(|(local, own)| {
             for p in &plan.blocks {
                 let b = &self.blocks()[p.block];
-                self.gather(b, x, u, local);
-                own.clear();
-                own.extend_from_slice(&local[..b.layout.n_own()]);
+                let range = b.own_offset..b.own_offset + b.layout.n_own();
+                self.gather_reads(b, x, u, local);
                 let io = UnitIo { local, layout: &b.layout, thermo: self.thermo(), time: t };
-                b.unit.complete(&io, own);
-                let dst = &mut x[b.own_offset..b.own_offset + own.len()];
                 if p.whole {
-                    // The unit overwrote its explicit variables only; the rest are `x`'s own.
-                    dst.copy_from_slice(own);
+                    // The unit overwrites its explicit variables only: in place.
+                    b.unit.complete(&io, &mut x[range]);
                 } else {
-                    p.keep.iter().for_each(|&k| dst[k] = own[k]);
+                    own.clear();
+                    own.extend_from_slice(&x[range.clone()]);
+                    b.unit.complete(&io, own);
+                    p.keep.iter().for_each(|&k| x[range.start + k] = own[k]);
                 }
             }
         });
+    }
+
+    /// [`Plant::gather`] without the own block, which [`plantwide_model::UnitModel::complete`]
+    /// reads from its `own` argument: that part of `local` is left as it was (NaN in builds with
+    /// debug assertions, so that a unit reading it there fails its tests), saving a copy of the
+    /// block per completion.
+    fn gather_reads(&self, b: &Block, x: &[f64], u: &[f64], local: &mut Vec<f64>) {
+        let n_own = b.layout.n_own();
+        if cfg!(debug_assertions) {
+            local.clear();
+        }
+        local.truncate(n_own);
+        local.resize(n_own, f64::NAN);
+        local.extend(b.reads.iter().map(|r| match *r {
+            Read::Var(i) => x[i],
+            Read::Input(j) => u[j],
+        }));
     }
 
     /// [`Plant::residual`] at a point `x` that [`Plant::complete`] has just completed for `plan`:

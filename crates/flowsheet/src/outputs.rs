@@ -78,10 +78,12 @@ impl Rows {
     /// The plant variables equation `k` of block `b` reads (own variables and the variables it
     /// reads through its inlets and signals; inputs are not variables).
     fn reads<'a>(&'a self, b: &'a Block, k: usize) -> impl Iterator<Item = usize> + 'a {
-        let local: Box<dyn Iterator<Item = usize> + 'a> = match &self.0 {
-            Some((ptr, col)) => Box::new(col[ptr[k]..ptr[k + 1]].iter().copied()),
-            None => Box::new(0..b.layout.len()),
+        // A declared row, or (dense) every local column.
+        let (declared, dense) = match &self.0 {
+            Some((ptr, col)) => (&col[ptr[k]..ptr[k + 1]], 0..0),
+            None => (&[][..], 0..b.layout.len()),
         };
+        let local = declared.iter().copied().chain(dense);
         let n_own = b.layout.n_own();
         local.filter_map(move |c| {
             if c < n_own {

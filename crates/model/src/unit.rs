@@ -180,10 +180,10 @@ pub trait UnitModel: Send + Sync + std::fmt::Debug {
     fn explicit(&self, _layout: &LocalLayout) -> Vec<usize> {
         Vec::new()
     }
-    /// Overwrite the [`UnitModel::explicit`] variables of `own` (a copy of the own block of
-    /// `io.local`) so that their equations hold exactly, computing them in the declared order
-    /// from the other own variables (read from `own`), the inlets and the inputs, and leaving
-    /// every other entry of `own` as it is (default: nothing).
+    /// Overwrite the [`UnitModel::explicit`] variables of `own` (the unit's own variables) so
+    /// that their equations hold exactly, computing them in the declared order from the other
+    /// own variables (read from `own`: the own block of `io.local` is not filled here), the
+    /// inlets and the inputs, and leaving every other entry of `own` as it is (default: nothing).
     fn complete(&self, _io: &UnitIo<'_, f64>, _own: &mut [f64]) {}
     /// The residuals of the equations that are not [`UnitModel::explicit`], at a local vector
     /// whose explicit variables [`UnitModel::complete`] has just set; the explicit equations'

@@ -177,10 +177,11 @@ impl Driver {
             fingerprint: fingerprint.to_string(),
             sampled,
             analyzers,
-            times: Vec::new(),
-            rows: Vec::new(),
+            // One row per interval (a few more at events): no regrowth in a run.
+            times: Vec::with_capacity(rows_expected(sc)),
+            rows: Vec::with_capacity(rows_expected(sc)),
             refs,
-            ref_rows: Vec::new(),
+            ref_rows: Vec::with_capacity(rows_expected(sc)),
             events: Vec::new(),
             restore,
             x0,
@@ -594,6 +595,13 @@ impl Driver {
             mpc: self.mpcs.into_iter().map(|m| m.log).collect::<Vec<MpcLog>>(),
         }
     }
+}
+
+/// The rows a run of `sc` records at its interval (capped: an endless or very long run grows
+/// its storage as it goes).
+fn rows_expected(sc: &Scenario) -> usize {
+    let n = sc.duration / sc.interval;
+    if n.is_finite() && n >= 0.0 { (n as usize).saturating_add(2).min(1 << 16) } else { 0 }
 }
 
 /// The state entries a recorded row reads ([`row_at`]): the recorded variables, the controller

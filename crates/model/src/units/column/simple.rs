@@ -850,7 +850,11 @@ mod tests {
                 let mut local: Vec<f64> =
                     guess.iter().map(|&v| v * rng.range(0.8, 1.2) + rng.range(0.0, 1e-3)).collect();
                 let mut own = local[..m].to_vec();
-                Unit::complete(&u, &UnitIo { local: &local, layout: &lay, thermo: &thermo, time: 0.0 }, &mut own);
+                // The own block of `io.local` is not filled for `complete`: NaN here.
+                let mut reads_only = local.clone();
+                reads_only[..m].fill(f64::NAN);
+                Unit::complete(&u, &UnitIo { local: &reads_only, layout: &lay, thermo: &thermo, time: 0.0 }, &mut own);
+                assert!(own.iter().all(|v| v.is_finite()), "{f}{extra}: complete read its own block from io.local");
                 for k in (0..m).filter(|&k| position[k] == usize::MAX) {
                     assert_eq!(own[k], local[k], "{f}{extra}: kept variable {k} changed");
                 }
