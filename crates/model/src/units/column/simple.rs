@@ -341,6 +341,39 @@ impl SimpleColumn {
     }
 }
 
+/// A stage's `M = Σ n`, `x = n/M` and `y = K x` in its variables `v` (returned: `M`), with the
+/// K-values `α_j / Σ α x` inline for constant `alpha` (the operations of
+/// `ThermoPackage::k_values`, in its order) or from `k_values(T, x, k)` (scratch `k`). On
+/// slices of the stage's blocks: this is the inner loop of every completion.
+fn stage_composition(
+    v: &mut [f64],
+    nc: usize,
+    alpha: Option<&[f64]>,
+    k_values: impl Fn(f64, &[f64], &mut [f64]),
+    k: &mut [f64],
+) -> f64 {
+    let ix = StageIdx { nc };
+    let (n, rest) = v.split_at_mut(nc);
+    let (x, rest) = rest.split_at_mut(nc);
+    let (y, tail) = rest.split_at_mut(nc);
+    let m = n.iter().fold(0.0, |a, b| a + b);
+    // One division: `x = n·(1/M)` is within an ulp of `n/M`.
+    let inv_m = 1.0 / m;
+    x.iter_mut().zip(n.iter()).for_each(|(xj, nj)| *xj = nj * inv_m);
+    match alpha {
+        Some(a) => {
+            let inv = x.iter().zip(a).fold(0.0, |d, (xj, aj)| d + xj * aj).recip();
+            y.iter_mut().zip(x.iter().zip(a)).for_each(|(yj, (xj, aj))| *yj = inv * aj * xj);
+        }
+        None => {
+            k_values(tail[0], x, k);
+            y.iter_mut().zip(x.iter().zip(k.iter())).for_each(|(yj, (xj, kj))| *yj = kj * xj);
+        }
+    }
+    v[ix.m()] = m;
+    m
+}
+
 impl UnitModel for SimpleColumn {
     fn type_name(&self) -> &'static str {
         "column"
@@ -568,29 +601,7 @@ impl UnitModel for SimpleColumn {
         // One pass up the column: each stage's M, x, y, then its V (from the V below) and L.
         let mut v_below = 0.0;
         for (s, v) in stages[..n * ps].chunks_exact_mut(ps).enumerate() {
-            let m = v[ix.n(0)..ix.n(0) + nc].iter().fold(0.0, |a, b| a + b);
-            v[ix.m()] = m;
-            // One division: `x = n·(1/M)` is within an ulp of `n/M`.
-            let inv_m = 1.0 / m;
-            for j in 0..nc {
-                v[ix.x(j)] = v[ix.n(j)] * inv_m;
-            }
-            match alpha {
-                // `ThermoPackage::k_values`' operations, in its order, without its dispatch.
-                Some(a) => {
-                    let den = (0..nc).fold(0.0, |d, j| d + v[ix.x(j)] * a[j]);
-                    let inv = den.recip();
-                    for j in 0..nc {
-                        v[ix.y(j)] = inv * a[j] * v[ix.x(j)];
-                    }
-                }
-                None => {
-                    io.thermo.k_values(v[ix.t()], self.pressure, &v[ix.x(0)..ix.x(0) + nc], k);
-                    for j in 0..nc {
-                        v[ix.y(j)] = k[j] * v[ix.x(j)];
-                    }
-                }
-            }
+            let m = stage_composition(v, nc, alpha, |t, x, k| io.thermo.k_values(t, self.pressure, x, k), k);
             // The feed quality may read this stage's x and y, just computed.
             let fed: f64 =
                 (0..self.feeds.len()).filter(|&f| self.feeds[f].stage == s).map(|f| self.feed_vapour(io, f, v)).sum();
