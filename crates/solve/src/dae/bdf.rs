@@ -223,8 +223,6 @@ pub struct Bdf {
     jac_loaded: bool,
     /// `atol · nominal_i`: the absolute part of each variable's error scale.
     abs_tol: Vec<f64>,
-    /// The explicit pairs of the system as bound (those an algebraic equation determines).
-    explicit: Vec<(usize, usize)>,
     /// Whether the output-only variables hold their solution at the current time.
     outputs_done: bool,
     w: Work,
@@ -369,7 +367,6 @@ impl Bdf {
             x_full: Vec::new(),
             jac_loaded: false,
             abs_tol: Vec::new(),
-            explicit: Vec::new(),
             outputs_done: false,
             w: Work::default(),
         }
@@ -449,9 +446,9 @@ impl Bdf {
         let mut differential = vec![false; n];
         sys.mass().iter().filter(|&&(_, j)| j < n).for_each(|&(_, j)| differential[j] = true);
         let algebraic = |&(i, j): &(usize, usize)| i < n && j < n && self.diff_var[i] == usize::MAX && !differential[j];
-        self.explicit = sys.explicit().iter().copied().filter(algebraic).collect();
+        let explicit: Vec<(usize, usize)> = sys.explicit().iter().copied().filter(algebraic).collect();
         let outputs: Vec<(usize, usize)> = sys.outputs().iter().copied().filter(algebraic).collect();
-        self.red = Reduction::new(n, &self.explicit, &outputs);
+        self.red = Reduction::new(n, &explicit, &outputs);
         let red = &self.red;
         self.red_mass = sys.mass().iter().map(|&(i, j)| (red.row[i], red.col[j])).collect();
         self.red_diff_var =
@@ -567,27 +564,13 @@ impl Bdf {
         Err(DaeError::Outputs { time: t, equation, residual })
     }
 
-    /// The factors of the output block `∂F_o/∂x_o` of the full Jacobian `jac`, reduced through
-    /// the explicit variables (the outputs taken as kept: their rows and columns are those of a
-    /// reduction without outputs).
+    /// The factors of the output block `∂F_o/∂x_o` of the full Jacobian `jac`, through the
+    /// explicit variables ([`Reduction::output_block`]).
     fn output_block(&self, jac: &[(usize, usize, f64)]) -> Result<SparseLu, DaeError> {
         let time = self.st.t;
-        let n = self.hist_pos.len();
-        let all = Reduction::new(n, &self.explicit, &[]);
-        let mut red = Vec::new();
-        all.jacobian(jac, &mut red).map_err(|source| DaeError::Explicit { time, source })?;
-        let outputs = self.red.outputs();
-        let (mut row, mut col) = (vec![usize::MAX; all.n()], vec![usize::MAX; all.n()]);
-        for (k, &(i, j)) in outputs.iter().enumerate() {
-            (row[all.row[i]], col[all.col[j]]) = (k, k);
-        }
-        let block: Vec<(usize, usize, f64)> = red
-            .iter()
-            .filter(|&&(r, c, _)| row[r] != usize::MAX && col[c] != usize::MAX)
-            .map(|&(r, c, v)| (row[r], col[c], v))
-            .collect();
+        let block = self.red.output_block(jac).map_err(|source| DaeError::Explicit { time, source })?;
         let mut lu = SparseLu::default();
-        lu.factor(outputs.len(), &block).map_err(|source| DaeError::Singular { time, source })?;
+        lu.factor(self.red.outputs().len(), &block).map_err(|source| DaeError::Singular { time, source })?;
         Ok(lu)
     }
 

@@ -235,6 +235,58 @@ impl Reduction {
     }
 }
 
+impl Reduction {
+    /// The block `dF_o/dx_o` of the output-only equations and variables of the full Jacobian
+    /// `jac`, through the explicit variables computed from outputs (the chain rule of the module
+    /// documentation restricted to the output columns: an explicit variable that reads no output,
+    /// directly or through another, contributes nothing), as triplets in output positions
+    /// (the order of [`Reduction::outputs`]). Its cost is that of the output rows and the
+    /// explicit rows, not of the whole reduction.
+    ///
+    /// # Errors
+    /// [`ReduceError::ZeroPivot`] when an explicit variable computed from an output does not
+    /// appear in its own equation.
+    pub(crate) fn output_block(&self, jac: &[(usize, usize, f64)]) -> Result<Vec<(usize, usize, f64)>, ReduceError> {
+        let n = self.position.len();
+        let (ptr, entries) = by_row(n, jac);
+        let row_of = |i: usize| entries[ptr[i]..ptr[i + 1]].iter().filter(|e| e.1 != 0.0);
+        let mut out_pos = vec![usize::MAX; n];
+        self.outputs.iter().enumerate().for_each(|(k, &(_, j))| out_pos[j] = k);
+        let mut acc = Accumulator::new(self.outputs.len());
+        // `dx_e/dx_o` of each explicit variable (empty: it reads no output).
+        let (mut g_ptr, mut g) = (vec![0usize], Vec::<(usize, f64)>::new());
+        for (k, &(i, j)) in self.explicit.iter().enumerate() {
+            let mut pivot = 0.0;
+            for &(c, v) in row_of(i) {
+                match self.position[c] {
+                    _ if out_pos[c] != usize::MAX => acc.add(out_pos[c], v),
+                    p if p == k => pivot += v,
+                    p if p < k => g[g_ptr[p]..g_ptr[p + 1]].iter().for_each(|&(cc, gv)| acc.add(cc, v * gv)),
+                    _ => {}
+                }
+            }
+            if pivot == 0.0 && !acc.touched.is_empty() {
+                acc.drain(|_, _| {});
+                return Err(ReduceError::ZeroPivot { equation: i, var: j });
+            }
+            acc.drain(|c, v| g.push((c, -v / pivot)));
+            g_ptr.push(g.len());
+        }
+        let mut out = Vec::new();
+        for (r, &(i, _)) in self.outputs.iter().enumerate() {
+            for &(c, v) in row_of(i) {
+                match self.position[c] {
+                    _ if out_pos[c] != usize::MAX => acc.add(out_pos[c], v),
+                    usize::MAX => {}
+                    p => g[g_ptr[p]..g_ptr[p + 1]].iter().for_each(|&(cc, gv)| acc.add(cc, v * gv)),
+                }
+            }
+            acc.drain(|c, v| out.push((r, c, v)));
+        }
+        Ok(out)
+    }
+}
+
 /// The triplets `jac` of an `n`-row matrix grouped by row: row `i`'s `(column, value)` entries
 /// are `entries[ptr[i]..ptr[i + 1]]` (duplicates kept: the reduction sums them).
 fn by_row(n: usize, jac: &[(usize, usize, f64)]) -> (Vec<usize>, Vec<(usize, f64)>) {
@@ -317,6 +369,15 @@ mod tests {
         let mut out = Vec::new();
         red.jacobian(&jac, &mut out).unwrap();
         assert_eq!(dense(1, &out), vec![1.0]);
+        // The output block `d(x2³ − x1)/dx2 = 3 x2²`; with `x3 = x2` and a second output `x4`
+        // whose equation `x4 − x3²` reads it, the chain rule through `x3`: `−2 x3·1`.
+        assert_eq!(red.output_block(&jac).unwrap(), vec![(0, 0, 3.0 * x2 * x2)]);
+        let mut wide = jac.clone();
+        wide.extend([(4, 4, 1.0), (4, 3, -2.0 * x2)]);
+        let red5 = Reduction::new(5, &[(1, 1), (3, 3)], &[(2, 2), (4, 4)]);
+        let mut block = red5.output_block(&wide).unwrap();
+        block.sort_by_key(|e| (e.0, e.1));
+        assert_eq!(block, vec![(0, 0, 3.0 * x2 * x2), (1, 0, -2.0 * x2), (1, 1, 1.0)]);
         for (c, var) in [(2, 2), (3, 3)] {
             let mut reads = jac.clone();
             reads.push((0, c, 0.5));
