@@ -1226,10 +1226,11 @@ mod tests {
     }
 
     /// A [`Closure`] with explicit variables: the `(equation, variable)` pairs and the function
-    /// that computes them.
+    /// that computes them; and output-only pairs.
     struct Explicit<'a> {
         sys: &'a Closure,
         pairs: Vec<(usize, usize)>,
+        outputs: Vec<(usize, usize)>,
         complete: fn(&mut [f64]),
     }
 
@@ -1258,6 +1259,9 @@ mod tests {
         fn explicit(&self) -> &[(usize, usize)] {
             &self.pairs
         }
+        fn outputs(&self) -> &[(usize, usize)] {
+            &self.outputs
+        }
         fn complete(&self, _t: f64, x: &mut [f64]) {
             (self.complete)(x)
         }
@@ -1265,54 +1269,15 @@ mod tests {
 
     /// `x' = −x` with the output `z³ + z = x` and the explicit `w = z` read by nothing: `z` is
     /// output-only, `w` explicit but computed from it.
-    struct WithOutput {
-        sys: Closure,
-    }
-
-    impl WithOutput {
-        fn new() -> WithOutput {
-            let f: fn(f64, &[f64], &mut [f64]) = |_, x, r| {
-                r[0] = -x[0];
-                r[1] = x[1].powi(3) + x[1] - x[0];
-                r[2] = x[2] - x[1];
-            };
-            let jac: JacFn =
-                |_, x| vec![(0, 0, -1.0), (1, 1, 3.0 * x[1] * x[1] + 1.0), (1, 0, -1.0), (2, 2, 1.0), (2, 1, -1.0)];
-            WithOutput { sys: Closure { n: 3, mass: vec![(0, 0)], f, jac } }
-        }
-    }
-
-    impl DaeSystem for WithOutput {
-        fn n(&self) -> usize {
-            3
-        }
-        fn residual(&self, t: f64, x: &[f64], r: &mut [f64]) {
-            self.sys.residual(t, x, r)
-        }
-        fn jacobian(&self, t: f64, x: &[f64], r: &mut [f64], jac: &mut Vec<(usize, usize, f64)>) {
-            self.sys.jacobian(t, x, r, jac)
-        }
-        fn mass(&self) -> &[(usize, usize)] {
-            &self.sys.mass
-        }
-        fn nominal(&self, _i: usize) -> f64 {
-            1.0
-        }
-        fn bounds(&self, _i: usize) -> (f64, f64) {
-            (f64::NEG_INFINITY, f64::INFINITY)
-        }
-        fn error_controlled(&self, i: usize) -> bool {
-            i == 0
-        }
-        fn explicit(&self) -> &[(usize, usize)] {
-            &[(2, 2)]
-        }
-        fn outputs(&self) -> &[(usize, usize)] {
-            &[(1, 1)]
-        }
-        fn complete(&self, _t: f64, x: &mut [f64]) {
-            x[2] = x[1];
-        }
+    fn with_output() -> Closure {
+        let f: fn(f64, &[f64], &mut [f64]) = |_, x, r| {
+            r[0] = -x[0];
+            r[1] = x[1].powi(3) + x[1] - x[0];
+            r[2] = x[2] - x[1];
+        };
+        let jac: JacFn =
+            |_, x| vec![(0, 0, -1.0), (1, 1, 3.0 * x[1] * x[1] + 1.0), (1, 0, -1.0), (2, 2, 1.0), (2, 1, -1.0)];
+        Closure { n: 3, mass: vec![(0, 0)], f, jac }
     }
 
     /// The output-only `z` stays at its start value through the run (Newton never touches it),
@@ -1320,7 +1285,8 @@ mod tests {
     /// and completes `w = z` from it; a second call does no work. `x(1) = e⁻¹` to the tolerance.
     #[test]
     fn output_only_variables_are_solved_when_asked_for() {
-        let sys = WithOutput::new();
+        let base = with_output();
+        let sys = Explicit { sys: &base, pairs: vec![(2, 2)], outputs: vec![(1, 1)], complete: |x| x[2] = x[1] };
         let settings = BdfSettings { rtol: 1e-8, atol: 1e-10, ..BdfSettings::default() };
         // z = 0.6823278038280193 solves z³ + z = 1 (the start is consistent).
         let z0 = 0.682_327_803_828_019_3;
@@ -1515,7 +1481,8 @@ mod tests {
     #[test]
     fn robertson_with_y3_eliminated_matches_sundials_reference() {
         let sys = robertson();
-        let explicit = Explicit { sys: &sys, pairs: vec![(2, 2)], complete: |y| y[2] = 1.0 - y[0] - y[1] };
+        let explicit =
+            Explicit { sys: &sys, pairs: vec![(2, 2)], outputs: vec![], complete: |y| y[2] = 1.0 - y[0] - y[1] };
         let bdf = robertson_run(&explicit);
         assert_eq!(bdf.red.n(), 2);
         let s = bdf.stats();
@@ -1529,7 +1496,8 @@ mod tests {
     #[test]
     fn an_unwatched_explicit_variable_changes_nothing_but_its_dense_output() {
         let sys = robertson();
-        let explicit = Explicit { sys: &sys, pairs: vec![(2, 2)], complete: |y| y[2] = 1.0 - y[0] - y[1] };
+        let explicit =
+            Explicit { sys: &sys, pairs: vec![(2, 2)], outputs: vec![], complete: |y| y[2] = 1.0 - y[0] - y[1] };
         let settings = BdfSettings { rtol: 1e-8, atol: 1e-12, ..BdfSettings::default() };
         let (mut all, mut some) = (Bdf::new(settings.clone()), Bdf::new(settings));
         some.watch(&[]);
