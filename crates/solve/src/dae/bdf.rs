@@ -30,6 +30,11 @@
 //! interpolates those, and holds the others at their value at the step's end. Column A's
 //! iteration matrix goes from 436 variables (2 598 entries in its factors) to 137 (655).
 //!
+//! **Output-only variables** ([`DaeSystem::outputs`]: algebraic variables nothing else reads, in
+//! column A its constant-α tray temperatures) leave the iteration with their equations too; they
+//! keep their last values until [`Bdf::complete_outputs`] solves them, the caller asking before
+//! it hands the state out. Column A's iteration matrix is then 96 variables (532 entries).
+//!
 //! **Start.** At a (re)start the algebraic variables are made consistent by simplified Newton on
 //! the iteration matrix at `c = 0` with the Jacobian the integrator takes anyway, falling back to
 //! [`consistent_algebraic`] (Newton with line search and bounds) when that does not converge.
