@@ -233,6 +233,43 @@ pub struct Bdf {
     w: Work,
 }
 
+/// The weights of the dense output at `t` of a step ending at `t_n` of size `h` and order `q`:
+/// `p_k = Π_{m=0}^{k−1} (t − t_n + m h)/((m + 1) h)` for `k = 1 … q` (`p_0` unused).
+fn interpolation_weights(t: f64, t_n: f64, h: f64, order: usize) -> [f64; MAX_ORDER + 1] {
+    let mut p = [0.0; MAX_ORDER + 1];
+    let mut acc = 1.0;
+    for (k, pk) in p.iter_mut().enumerate().take(order + 1).skip(1) {
+        let m = (k - 1) as f64;
+        acc *= (t - (t_n - h * m)) / (h * k as f64);
+        *pk = acc;
+    }
+    p
+}
+
+/// The last step's dense output for a set of variables ([`Bdf::dense_output`]).
+#[derive(Debug, Clone)]
+pub struct DenseOutput {
+    t: f64,
+    h: f64,
+    order: usize,
+    /// The variables with a history, and their differences `D[0..=q]` (`q + 1` per variable).
+    idx: Vec<usize>,
+    coef: Vec<f64>,
+    /// The others, held at their value at the step's end.
+    held: Vec<(usize, f64)>,
+}
+
+impl DenseOutput {
+    /// The variables' values at `t` (within the step) into their entries of `out`.
+    pub fn at(&self, t: f64, out: &mut [f64]) {
+        let p = interpolation_weights(t, self.t, self.h, self.order);
+        for (&i, d) in self.idx.iter().zip(self.coef.chunks_exact(self.order + 1)) {
+            out[i] = d[0] + (1..=self.order).map(|k| p[k] * d[k]).sum::<f64>();
+        }
+        self.held.iter().for_each(|&(i, v)| out[i] = v);
+    }
+}
+
 /// `R(ρ)` of the module documentation, `(order+1)²` row-major.
 fn compute_r(order: usize, factor: f64) -> [f64; (MAX_ORDER + 1) * (MAX_ORDER + 1)] {
     let n = order + 1;
@@ -936,18 +973,29 @@ impl Bdf {
         }
     }
 
-    /// The weights of the dense output at `t`: `p_k = Π_{m=0}^{k−1} (t − t_n + m h)/((m + 1) h)`
-    /// for `k = 1 … q` (`p_0` unused).
+    /// The weights of the dense output at `t` ([`interpolation_weights`]).
     fn interpolation_weights(&self, t: f64) -> [f64; MAX_ORDER + 1] {
-        let h = self.st.h_abs;
-        let mut p = [0.0; MAX_ORDER + 1];
-        let mut acc = 1.0;
-        for (k, pk) in p.iter_mut().enumerate().take(self.st.order + 1).skip(1) {
-            let m = (k - 1) as f64;
-            acc *= (t - (self.st.t - h * m)) / (h * k as f64);
-            *pk = acc;
+        interpolation_weights(t, self.st.t, self.st.h_abs, self.st.order)
+    }
+
+    /// The dense output of the last step for the variables `indices`, their differences gathered
+    /// once for the many times a caller reads within the step (the recorded rows): the values of
+    /// [`DaeIntegrator::interpolate_at`], bit for bit, at a fraction of the cost per time.
+    pub fn dense_output(&self, indices: &[usize]) -> DenseOutput {
+        let order = self.st.order;
+        let mut coef = Vec::with_capacity(indices.len() * (order + 1));
+        let mut idx = Vec::with_capacity(indices.len());
+        let mut held = Vec::new();
+        for &i in indices {
+            match self.hist_pos.get(i).copied() {
+                Some(r) if r != usize::MAX => {
+                    idx.push(i);
+                    coef.extend(self.st.d[..=order].iter().map(|d| d[r]));
+                }
+                _ => held.push((i, self.x_full[i])),
+            }
         }
-        p
+        DenseOutput { t: self.st.t, h: self.st.h_abs, order, idx, coef, held }
     }
 
     /// Consistent algebraic variables by simplified Newton on the iteration matrix at `c = 0`
@@ -1497,7 +1545,8 @@ mod tests {
 
     /// Without the history of the explicit `y3` ([`Bdf::watch`] of none) the trajectory of the
     /// kept variables is the same to the last bit — the history of an explicit variable only
-    /// serves its dense output — and `y3` is still current at every step's end.
+    /// serves its dense output — and `y3` is still current at every step's end; the step's
+    /// [`Bdf::dense_output`] equals `interpolate_at`.
     #[test]
     fn an_unwatched_explicit_variable_changes_nothing_but_its_dense_output() {
         let sys = robertson();
@@ -1522,6 +1571,12 @@ mod tests {
             all.interpolate_at(t, &[0, 1], &mut a);
             some.interpolate_at(t, &[0, 1], &mut b);
             assert_eq!(a, b);
+            // The dense output gathered once per step gives the same bits, the unwatched `y3`
+            // held at its end-of-step value.
+            let mut c = vec![0.0; 3];
+            some.dense_output(&[0, 1, 2]).at(t, &mut c);
+            assert_eq!(&c[..2], &b[..2]);
+            assert_eq!(c[2], some.x()[2]);
         }
         assert!(!some.hist_all && all.hist_all);
     }

@@ -14,7 +14,7 @@ pub mod bdf;
 mod init;
 pub(crate) mod reduce;
 
-pub use bdf::{Bdf, BdfSettings, BdfState, BdfStats};
+pub use bdf::{Bdf, BdfSettings, BdfState, BdfStats, DenseOutput};
 pub use init::consistent_algebraic;
 pub use reduce::ReduceError;
 

@@ -497,6 +497,7 @@ impl Driver {
     /// Record every row due by `now` (and by the end), interpolated within the last step.
     fn record_through(&mut self, now: f64, xi: &mut [f64]) {
         let interval = self.sc.interval;
+        let mut dense = None;
         while (self.st.next_record as f64 * interval) <= now
             && self.st.next_record as f64 * interval <= self.sc.duration
         {
@@ -504,7 +505,7 @@ impl Driver {
             if tr == now {
                 xi.copy_from_slice(self.bdf.x());
             } else {
-                self.bdf.interpolate_at(tr, &self.recorded, xi);
+                dense.get_or_insert_with(|| self.bdf.dense_output(&self.recorded)).at(tr, xi);
             }
             let (row, refs) = row_at(&self.plant, &self.sc, &self.refs, &self.st.waveforms, tr, xi);
             self.times.push(tr);
