@@ -233,9 +233,7 @@ impl Reduction {
         }
         Ok(())
     }
-}
 
-impl Reduction {
     /// The block `dF_o/dx_o` of the output-only equations and variables of the full Jacobian
     /// `jac`, through the explicit variables computed from outputs (the chain rule of the module
     /// documentation restricted to the output columns: an explicit variable that reads no output,
