@@ -84,7 +84,7 @@ pub fn trends<'py>(py: Python<'py>, r: &SimulationResult) -> PyResult<Bound<'py,
     let d = PyDict::new(py);
     d.set_item("time", &r.times)?;
     d.set_item("columns", r.columns.iter().map(|c| (c.path.clone(), c.si_unit.clone())).collect::<Vec<_>>())?;
-    d.set_item("rows", &r.rows)?;
+    d.set_item("rows", r.rows.iter().collect::<Vec<&[f64]>>())?;
     d.set_item("events", &r.events)?;
     Ok(d)
 }

@@ -44,6 +44,7 @@ mod live;
 mod mpc;
 mod session;
 mod snapshot;
+mod table;
 mod waveform;
 
 pub use conservation::{CONSERVATION_TOL, Conservation, ConservationError};
@@ -51,6 +52,7 @@ pub use live::{Clock, LIVE_MAX_STEP, Live, LiveError, MAX_SNAPSHOTS, PlantComman
 pub use mpc::{MpcError, MpcLog, StepModelFile, mv_limits};
 pub use session::{Session, SessionError};
 pub use snapshot::{DriverState, SNAPSHOT_VERSION, Snapshot};
+pub use table::{Rows, Table};
 pub use waveform::Waveform;
 
 use driver::Driver;
@@ -161,7 +163,7 @@ pub struct SimulationResult {
     /// Recording times [s].
     pub times: Vec<f64>,
     /// Rows of SI values, one per time.
-    pub rows: Vec<Vec<f64>>,
+    pub rows: Table,
     /// Reference of each column over time (the controller's setpoint for a controlled variable),
     /// `None` to measure deviations from the first recorded value.
     pub references: Vec<Option<Vec<f64>>>,

@@ -13,6 +13,7 @@ use plantwide_flowsheet::{Plant, Read};
 use super::adapter::{DaeShape, PlantDae, Quadratures};
 use super::mpc::{self, MpcError, MpcLog, MpcRun};
 use super::snapshot::{self, DriverState, SNAPSHOT_VERSION, Snapshot};
+use super::table::Table;
 use super::waveform::{Waveform, values_at};
 use super::{Column, Conservation, Progress, SimError, SimulationResult, Start, conservation};
 use crate::dae::{Bdf, BdfSettings, BdfState, DaeError, DaeIntegrator};
@@ -33,11 +34,11 @@ pub(super) struct Driver {
     /// Per analyzer: (held input, measured variable).
     analyzers: Vec<(usize, usize)>,
     times: Vec<f64>,
-    rows: Vec<Vec<f64>>,
+    rows: Table,
     /// Per recorded path: the setpoint input of the controller that measures it.
     refs: Vec<Option<usize>>,
     /// Per recorded row: the references of the paths that have one (`refs`), in order.
-    ref_rows: Vec<Vec<f64>>,
+    ref_rows: Table,
     events: Vec<(f64, String)>,
     /// Start from a snapshot of the same plant: the history to restore instead of restarting.
     restore: Option<BdfState>,
@@ -145,7 +146,7 @@ impl Driver {
         let outputs: Vec<usize> = plant.inputs().iter().filter_map(|i| i.driven_by).collect();
         let mut plant = plant.clone();
         // Which controller measures each recorded path: read before the analyzers rewire it.
-        let refs = sc.record.iter().map(|r| reference_of(&plant, r.source)).collect();
+        let refs: Vec<Option<usize>> = sc.record.iter().map(|r| reference_of(&plant, r.source)).collect();
         let analyzers = hold_analyzers(&mut plant, sc, &x0)?;
         let mut sampled = hold_sampled(&mut plant, sc, &x0);
         let mut st = DriverState::start(&plant, sc);
@@ -156,6 +157,7 @@ impl Driver {
             (st, restore, t0) = (resumed.driver, resumed.integrator, s.t);
         }
         let recorded = recorded_state(&plant, sc);
+        let n_totals = sc.totals.len() * plant.components().len();
         // What the driver reads between steps; a model predictive controller reads its model's
         // states, which may be anything.
         let mut reads = outputs;
@@ -179,9 +181,9 @@ impl Driver {
             analyzers,
             // One row per interval (a few more at events): no regrowth in a run.
             times: Vec::with_capacity(rows_expected(sc)),
-            rows: Vec::with_capacity(rows_expected(sc)),
+            rows: Table::with_capacity(sc.record.len() + n_totals, rows_expected(sc)),
+            ref_rows: Table::with_capacity(refs.iter().flatten().count(), rows_expected(sc)),
             refs,
-            ref_rows: Vec::with_capacity(rows_expected(sc)),
             events: Vec::new(),
             restore,
             x0,
@@ -278,10 +280,22 @@ impl Driver {
     }
 
     fn push_row(&mut self, t: f64, x: &[f64]) {
-        let (row, refs) = row_at(&self.plant, &self.sc, &self.refs, &self.st.waveforms, t, x);
         self.times.push(t);
-        self.rows.push(row);
-        self.ref_rows.push(refs);
+        self.record_row(t, x);
+    }
+
+    /// The row at `t` from the state `x`, and the references of the recorded paths that have
+    /// one (in order). An input driven by a controller is recorded as the controller's output,
+    /// the value the plant receives.
+    fn record_row(&mut self, t: f64, x: &[f64]) {
+        let (plant, waves) = (&self.plant, &self.st.waveforms);
+        let (np, n_tot) = (plant.n_vars(), self.sc.totals.len() * plant.components().len());
+        let recorded = self.sc.record.iter().map(|r| match r.source {
+            Read::Var(v) => x[v],
+            Read::Input(i) => plant.inputs()[i].driven_by.map_or_else(|| waves[i].at(t), |v| x[v]),
+        });
+        self.rows.push(recorded.chain(x[np..np + n_tot].iter().copied()));
+        self.ref_rows.push(self.refs.iter().flatten().map(|&i| waves[i].at(t)));
     }
 
     /// Apply everything due at `t` (the integrator's time, or the start before it is started);
@@ -507,10 +521,7 @@ impl Driver {
             } else {
                 dense.get_or_insert_with(|| self.bdf.dense_output(&self.recorded)).at(tr, xi);
             }
-            let (row, refs) = row_at(&self.plant, &self.sc, &self.refs, &self.st.waveforms, tr, xi);
-            self.times.push(tr);
-            self.rows.push(row);
-            self.ref_rows.push(refs);
+            self.push_row(tr, xi);
             self.st.next_record += 1;
         }
     }
@@ -577,7 +588,7 @@ impl Driver {
             .iter()
             .scan(0, |m, r| {
                 // `ref_rows` hold the referenced columns only, in order: `m` counts them.
-                let col = r.map(|_| self.ref_rows.iter().map(|row| row[*m]).collect());
+                let col = r.map(|_| self.ref_rows.column(*m).collect());
                 *m += usize::from(r.is_some());
                 Some(col)
             })
@@ -619,27 +630,6 @@ fn recorded_state(plant: &Plant, sc: &Scenario) -> Vec<usize> {
         .collect();
     v.extend(np..np + sc.totals.len() * plant.components().len());
     v
-}
-
-/// One recorded row at `t` from the state `x`, and the references of the recorded paths that
-/// have one (in order; no allocation when none has). An input driven by a controller is recorded
-/// as the controller's output, the value the plant receives.
-fn row_at(
-    plant: &Plant,
-    sc: &Scenario,
-    refs: &[Option<usize>],
-    waves: &[Waveform],
-    t: f64,
-    x: &[f64],
-) -> (Vec<f64>, Vec<f64>) {
-    let (np, n_tot) = (plant.n_vars(), sc.totals.len() * plant.components().len());
-    let mut row = Vec::with_capacity(sc.record.len() + n_tot);
-    row.extend(sc.record.iter().map(|r| match r.source {
-        Read::Var(v) => x[v],
-        Read::Input(i) => plant.inputs()[i].driven_by.map_or_else(|| waves[i].at(t), |v| x[v]),
-    }));
-    row.extend_from_slice(&x[np..np + n_tot]);
-    (row, refs.iter().flatten().map(|&i| waves[i].at(t)).collect())
 }
 
 /// The setpoint input of the controller that measures `source`, if any: `<ctrl>.sp` of a loop,
