@@ -151,7 +151,7 @@ mod tests {
         assert_eq!(t.get(3), None);
         let rows: Vec<&[f64]> = t.iter().collect();
         assert_eq!(rows, [&[1.0, 2.0][..], &[3.0, 4.0], &[5.0, 6.0]]);
-        assert_eq!(t.iter().rev().next(), Some(&[5.0, 6.0][..]));
+        assert_eq!(t.iter().next_back(), Some(&[5.0, 6.0][..]));
         assert_eq!(t.column(1).collect::<Vec<_>>(), [2.0, 4.0, 6.0]);
         assert_eq!(t.iter().len(), 3);
         t.clear();
