@@ -233,24 +233,43 @@ pub struct Bdf {
     w: Work,
 }
 
-/// The weights of the dense output at `t` of a step ending at `t_n` of size `h` and order `q`:
-/// `p_k = Π_{m=0}^{k−1} (t − t_n + m h)/((m + 1) h)` for `k = 1 … q` (`p_0` unused).
-fn interpolation_weights(t: f64, t_n: f64, h: f64, order: usize) -> [f64; MAX_ORDER + 1] {
-    let mut p = [0.0; MAX_ORDER + 1];
-    let mut acc = 1.0;
-    for (k, pk) in p.iter_mut().enumerate().take(order + 1).skip(1) {
-        let m = (k - 1) as f64;
-        acc *= (t - (t_n - h * m)) / (h * k as f64);
-        *pk = acc;
+/// The dense output's weights within a step ending at `t_n` of size `h` and order `q`:
+/// `p_k(t) = Π_{m=0}^{k−1} (t − t_n + m h)/((m + 1) h)` for `k = 1 … q` (`p_0` unused). The
+/// nodes `t_n − m h` and the reciprocals `1/(k h)` are the step's: computed once for the many
+/// times a caller reads within it (a recorded row each), which then costs no division.
+#[derive(Debug, Clone, Copy)]
+struct Interpolation {
+    order: usize,
+    node: [f64; MAX_ORDER + 1],
+    inv: [f64; MAX_ORDER + 1],
+}
+
+impl Interpolation {
+    fn new(t_n: f64, h: f64, order: usize) -> Interpolation {
+        let (mut node, mut inv) = ([0.0; MAX_ORDER + 1], [0.0; MAX_ORDER + 1]);
+        for k in 1..=order {
+            node[k] = t_n - h * (k - 1) as f64;
+            inv[k] = 1.0 / (h * k as f64);
+        }
+        Interpolation { order, node, inv }
     }
-    p
+
+    /// `p_k(t)`, `k = 1 … q`.
+    fn weights(&self, t: f64) -> [f64; MAX_ORDER + 1] {
+        let mut p = [0.0; MAX_ORDER + 1];
+        let mut acc = 1.0;
+        for k in 1..=self.order {
+            acc *= (t - self.node[k]) * self.inv[k];
+            p[k] = acc;
+        }
+        p
+    }
 }
 
 /// The last step's dense output for a set of variables ([`Bdf::dense_output`]).
 #[derive(Debug, Clone)]
 pub struct DenseOutput {
-    t: f64,
-    h: f64,
+    weights: Interpolation,
     order: usize,
     /// The variables with a history, and their differences `D[0..=q]` (`q + 1` per variable).
     idx: Vec<usize>,
@@ -262,7 +281,7 @@ pub struct DenseOutput {
 impl DenseOutput {
     /// The variables' values at `t` (within the step) into their entries of `out`.
     pub fn at(&self, t: f64, out: &mut [f64]) {
-        let p = interpolation_weights(t, self.t, self.h, self.order);
+        let p = self.weights.weights(t);
         for (&i, d) in self.idx.iter().zip(self.coef.chunks_exact(self.order + 1)) {
             out[i] = d[0] + (1..=self.order).map(|k| p[k] * d[k]).sum::<f64>();
         }
@@ -973,9 +992,9 @@ impl Bdf {
         }
     }
 
-    /// The weights of the dense output at `t` ([`interpolation_weights`]).
-    fn interpolation_weights(&self, t: f64) -> [f64; MAX_ORDER + 1] {
-        interpolation_weights(t, self.st.t, self.st.h_abs, self.st.order)
+    /// The dense output's weights of the last step ([`Interpolation`]).
+    fn interpolation(&self) -> Interpolation {
+        Interpolation::new(self.st.t, self.st.h_abs, self.st.order)
     }
 
     /// The dense output of the last step for the variables `indices`, their differences gathered
@@ -995,7 +1014,7 @@ impl Bdf {
                 _ => held.push((i, self.x_full[i])),
             }
         }
-        DenseOutput { t: self.st.t, h: self.st.h_abs, order, idx, coef, held }
+        DenseOutput { weights: self.interpolation(), order, idx, coef, held }
     }
 
     /// Consistent algebraic variables by simplified Newton on the iteration matrix at `c = 0`
@@ -1068,8 +1087,8 @@ impl Bdf {
     /// estimate promises the longest step, and grow or shrink the step accordingly (at most
     /// [`MAX_FACTOR`], safety scaled by the `n_iter` Newton iterations of the last step).
     fn adapt_order_and_step(&mut self, order: usize, n_iter: usize) {
-        let x = if self.hist_all { &self.st.d[0] } else { &self.x_full };
-        Self::weights_into(&self.red, &self.abs_tol, self.settings.rtol, x, &mut self.w.weight);
+        // `w.weight` holds the error test's weights of the accepted state, the state `D[0]` now
+        // holds (to rounding): they are not computed again.
         let norm_of = |k: usize, row: usize| {
             let e = self.error_const[k];
             let d = &self.st.d[row];
@@ -1214,7 +1233,7 @@ impl DaeIntegrator for Bdf {
             let all: Vec<usize> = (0..out.len()).collect();
             return self.interpolate_at(t, &all, out);
         }
-        let p = self.interpolation_weights(t);
+        let p = self.interpolation().weights(t);
         out.copy_from_slice(&self.st.d[0]);
         for (k, pk) in p.iter().enumerate().take(self.st.order + 1).skip(1) {
             out.iter_mut().zip(&self.st.d[k]).for_each(|(a, b)| *a += pk * b);
