@@ -488,9 +488,15 @@ impl Driver {
         }
         let t = self.t();
         let mut x = std::mem::take(&mut self.state_buf);
-        x.clear();
-        x.extend_from_slice(self.bdf.x());
-        self.restart_after_due(t, &mut x)?;
+        // The state is copied out only when something is due now (`next_stop` is the earliest
+        // thing due, or the end): between, `x` is the buffer the recorded rows interpolate into.
+        if self.next_stop(t) <= t {
+            x.clear();
+            x.extend_from_slice(self.bdf.x());
+            self.restart_after_due(t, &mut x)?;
+        } else {
+            x.resize(self.bdf.x().len(), 0.0);
+        }
         if let Some(e) = self.failure.take() {
             return Err(RunError::Mpc(e));
         }
