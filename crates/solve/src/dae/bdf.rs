@@ -247,9 +247,9 @@ struct Interpolation {
 impl Interpolation {
     fn new(t_n: f64, h: f64, order: usize) -> Interpolation {
         let (mut node, mut inv) = ([0.0; MAX_ORDER + 1], [0.0; MAX_ORDER + 1]);
-        for k in 1..=order {
-            node[k] = t_n - h * (k - 1) as f64;
-            inv[k] = 1.0 / (h * k as f64);
+        for (k, (nk, ik)) in node.iter_mut().zip(inv.iter_mut()).enumerate().take(order + 1).skip(1) {
+            *nk = t_n - h * (k - 1) as f64;
+            *ik = 1.0 / (h * k as f64);
         }
         Interpolation { order, node, inv }
     }
@@ -258,9 +258,10 @@ impl Interpolation {
     fn weights(&self, t: f64) -> [f64; MAX_ORDER + 1] {
         let mut p = [0.0; MAX_ORDER + 1];
         let mut acc = 1.0;
-        for k in 1..=self.order {
-            acc *= (t - self.node[k]) * self.inv[k];
-            p[k] = acc;
+        let terms = self.node.iter().zip(&self.inv).take(self.order + 1).skip(1);
+        for (pk, (node, inv)) in p.iter_mut().skip(1).zip(terms) {
+            acc *= (t - node) * inv;
+            *pk = acc;
         }
         p
     }
