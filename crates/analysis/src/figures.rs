@@ -74,15 +74,17 @@ fn path_summary(res: &SimulationResult, k: usize, t_first: f64) -> PathSummary {
 mod tests {
     use super::*;
     use plantwide_solve::dae::BdfStats;
-    use plantwide_solve::dynamic::{Column, Conservation};
+    use plantwide_solve::dynamic::{Column, Conservation, Table};
 
     /// A unit step recorded at t = 0, 1, 2 s: `y = [0, 1, 1]`, once against its initial value and
     /// once against a setpoint of 1.
     fn step(reference: Option<Vec<f64>>) -> SimulationResult {
+        let mut rows = Table::with_capacity(1, 3);
+        [0.0, 1.0, 1.0].into_iter().for_each(|y| rows.push([y]));
         SimulationResult {
             columns: vec![Column { path: "y".into(), unit: "m".into(), si_unit: "m".into() }],
             times: vec![0.0, 1.0, 2.0],
-            rows: vec![vec![0.0], vec![1.0], vec![1.0]],
+            rows,
             references: vec![reference],
             events: Vec::new(),
             x: Vec::new(),
