@@ -429,7 +429,7 @@ impl Driver {
         let events = self.st.next_event;
         if self.apply_due_at(t, x) {
             let sys = PlantDae::new(&self.plant, &self.st.waveforms, &self.shape);
-            self.bdf.restart(&sys, t, x)?;
+            self.bdf.restart_after_discontinuity(&sys, t, x)?;
             if self.st.next_event > events {
                 x.copy_from_slice(self.bdf.x());
                 self.push_row(t, x);

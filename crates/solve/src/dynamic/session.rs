@@ -102,7 +102,7 @@ impl Session {
         let fail = |source, t| SessionError { file: self.plant.file().to_string(), t, source };
         if self.restart {
             let (now, x) = (self.bdf.t(), self.bdf.x().to_vec());
-            self.bdf.restart(&sys, now, &x).map_err(|e| fail(e, now))?;
+            self.bdf.restart_after_discontinuity(&sys, now, &x).map_err(|e| fail(e, now))?;
             self.restart = false;
         }
         while self.bdf.t() < t {
