@@ -270,8 +270,8 @@ impl Interpolation {
 /// The last step's dense output for a set of variables ([`Bdf::dense_output`]).
 #[derive(Debug, Clone)]
 pub struct DenseOutput {
+    /// The step's weights, and its order `q`.
     weights: Interpolation,
-    order: usize,
     /// The variables with a history, and their differences `D[0..=q]` (`q + 1` per variable).
     idx: Vec<usize>,
     coef: Vec<f64>,
@@ -282,9 +282,9 @@ pub struct DenseOutput {
 impl DenseOutput {
     /// The variables' values at `t` (within the step) into their entries of `out`.
     pub fn at(&self, t: f64, out: &mut [f64]) {
-        let p = self.weights.weights(t);
-        for (&i, d) in self.idx.iter().zip(self.coef.chunks_exact(self.order + 1)) {
-            out[i] = d[0] + (1..=self.order).map(|k| p[k] * d[k]).sum::<f64>();
+        let (p, order) = (self.weights.weights(t), self.weights.order);
+        for (&i, d) in self.idx.iter().zip(self.coef.chunks_exact(order + 1)) {
+            out[i] = d[0] + (1..=order).map(|k| p[k] * d[k]).sum::<f64>();
         }
         self.held.iter().for_each(|&(i, v)| out[i] = v);
     }
@@ -1015,7 +1015,7 @@ impl Bdf {
                 _ => held.push((i, self.x_full[i])),
             }
         }
-        DenseOutput { weights: self.interpolation(), order, idx, coef, held }
+        DenseOutput { weights: self.interpolation(), idx, coef, held }
     }
 
     /// [`DaeIntegrator::restart`]; with `keep_jacobian`, after a discontinuity in the inputs of

@@ -279,15 +279,11 @@ impl Driver {
         next.max(t)
     }
 
+    /// Record the row at `t` from the state `x`, and the references of the recorded paths that
+    /// have one (in order). An input driven by a controller is recorded as the controller's
+    /// output, the value the plant receives.
     fn push_row(&mut self, t: f64, x: &[f64]) {
         self.times.push(t);
-        self.record_row(t, x);
-    }
-
-    /// The row at `t` from the state `x`, and the references of the recorded paths that have
-    /// one (in order). An input driven by a controller is recorded as the controller's output,
-    /// the value the plant receives.
-    fn record_row(&mut self, t: f64, x: &[f64]) {
         let (plant, waves) = (&self.plant, &self.st.waveforms);
         let (np, n_tot) = (plant.n_vars(), self.sc.totals.len() * plant.components().len());
         let recorded = self.sc.record.iter().map(|r| match r.source {
@@ -622,7 +618,7 @@ fn rows_expected(sc: &Scenario) -> usize {
     if n.is_finite() && n >= 0.0 { (n as usize).saturating_add(2).min(1 << 16) } else { 0 }
 }
 
-/// The state entries a recorded row reads ([`row_at`]): the recorded variables, the controller
+/// The state entries a recorded row reads ([`Driver::push_row`]): the recorded variables, the controller
 /// outputs that drive recorded inputs, and the recorded totals.
 fn recorded_state(plant: &Plant, sc: &Scenario) -> Vec<usize> {
     let np = plant.n_vars();
