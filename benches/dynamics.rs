@@ -1,8 +1,12 @@
 //! Dynamic-simulation benchmark: column A, feed step 1 → 1.01 kmol/min, 2000 min
 //! (`flowsheets/scenarios/column_a_feed_step.json`), integrated by plantwide's BDF from the
 //! converged steady state. Prints the median wall time of repeated runs and the integrator's
-//! counters, then one JSON line for `tools/bench_bdf_scipy.py`, which runs the same model and
-//! scenario with SciPy's BDF and reports the ratio. Run with `cargo bench --bench dynamics`.
+//! counters, then one JSON line for `tools/bench_dynamics_peers.py`, which runs the same model and
+//! scenario with SciPy, CVODE and CasADi and reports the ratios. Run with
+//! `cargo bench --bench dynamics`.
+//!
+//! The scenario records a row every 2 min (1001 rows); the same run recording only its end
+//! (`final_only` in the JSON line) is the work of a peer asked for the final state alone.
 //!
 //! Beside it, the same scenario on the 82-state ODE the peers integrate (`column_a_ode.rs`:
 //! everything but the holdups eliminated by hand), on the same BDF and settings from the plant's
@@ -26,16 +30,26 @@ fn main() {
     let spec = parse_scenario(&text, &scenario).expect("valid scenario");
     let plant = load_file(std::path::Path::new(&flowsheet)).expect("valid flowsheet");
     let x0 = steady_state(&plant, &plant.input_values(), None, &NewtonSettings::default()).expect("steady state").x;
-    let once = || -> (Duration, SimulationResult) {
-        let sc = resolve(&spec, &plant, &scenario).expect("scenario fits the plant");
+    let once_with = |final_only: bool| -> (Duration, SimulationResult) {
+        let mut sc = resolve(&spec, &plant, &scenario).expect("scenario fits the plant");
+        if final_only {
+            sc.interval = sc.duration;
+        }
         let t = Instant::now();
         let res = simulate(&plant, &sc, Start::Steady(&x0), "bench", &mut |_| {}).expect("integration");
         (t.elapsed(), res)
     };
-    let (_, res) = once();
-    let mut times: Vec<Duration> = (0..15).map(|_| once().0).collect();
-    times.sort();
-    let wall = times[times.len() / 2];
+    let median = |final_only: bool| -> (Duration, SimulationResult) {
+        let (_, res) = once_with(final_only);
+        let mut times: Vec<Duration> = (0..15).map(|_| once_with(final_only).0).collect();
+        times.sort();
+        (times[times.len() / 2], res)
+    };
+    let (wall, res) = median(false);
+    let (final_wall, final_res) = median(true);
+    // Rows just before and after the feed step at t = 0, and at the end.
+    assert_eq!(final_res.rows.len(), 3, "recording the end only");
+    assert_eq!(final_res.x, res.x, "recording does not change the trajectory");
     let col = |p: &str| {
         res.columns
             .iter()
@@ -50,13 +64,14 @@ fn main() {
         "median wall {wall:.3?}: {} steps, {} residual evaluations, {} Jacobian evaluations, {} LU factorizations, {} error-test failures",
         s.n_steps, s.n_residual_evals, s.n_jacobian_evals, s.n_lu, s.n_error_test_failures
     );
+    println!("the same recording the end only: median wall {final_wall:.3?}");
     let o = &ode.stats;
     println!(
         "the same on the peers' 82-state ODE: median wall {:.3?}: {} steps, {} residual evaluations, {} Jacobian evaluations, {} LU factorizations; xB = {:.10}",
         ode.wall, o.n_steps, o.n_residual_evals, o.n_jacobian_evals, o.n_lu, ode.xb
     );
     println!(
-        "{{\"wall_s\": {}, \"steps\": {}, \"residual_evals\": {}, \"jacobian_evals\": {}, \"lu\": {}, \"xB\": {}, \"yD\": {}, \"ode\": {{\"wall_s\": {}, \"steps\": {}, \"residual_evals\": {}, \"jacobian_evals\": {}, \"lu\": {}, \"xB\": {}, \"yD\": {}}}}}",
+        "{{\"wall_s\": {}, \"steps\": {}, \"residual_evals\": {}, \"jacobian_evals\": {}, \"lu\": {}, \"xB\": {}, \"yD\": {}, \"final_only\": {{\"wall_s\": {}}}, \"ode\": {{\"wall_s\": {}, \"steps\": {}, \"residual_evals\": {}, \"jacobian_evals\": {}, \"lu\": {}, \"xB\": {}, \"yD\": {}}}}}",
         wall.as_secs_f64(),
         s.n_steps,
         s.n_residual_evals,
@@ -64,6 +79,7 @@ fn main() {
         s.n_lu,
         col("bottoms.x[light]"),
         col("distillate.x[light]"),
+        final_wall.as_secs_f64(),
         ode.wall.as_secs_f64(),
         o.n_steps,
         o.n_residual_evals,
