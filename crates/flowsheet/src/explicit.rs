@@ -66,6 +66,58 @@ enum Status {
     Demoted,
 }
 
+/// The explicit variables a block declares (algebraic, with an equation of their own) and the
+/// local columns each one's equation reads, from the declared pattern (all of them for a dense
+/// unit), in compressed rows: one allocation per block, not one per variable.
+struct Declared {
+    /// Own (local) indices, in the unit's completion order.
+    own: Vec<usize>,
+    /// `cols[ptr[s]..ptr[s + 1]]` are the columns read by `own[s]`'s equation (empty `ptr`: dense).
+    ptr: Vec<usize>,
+    cols: Vec<usize>,
+}
+
+impl Declared {
+    /// What `b` declares; `vars` are the plant's variables.
+    fn of(b: &Block, vars: &[VarInfo]) -> Declared {
+        let n_own = b.layout.n_own().min(b.n_eq);
+        let own: Vec<usize> = b
+            .unit
+            .explicit(&b.layout)
+            .into_iter()
+            .filter(|&k| k < n_own && vars[b.own_offset + k].spec.kind != VarKind::Differential)
+            .collect();
+        let (mut ptr, mut cols) = (Vec::new(), Vec::new());
+        if let (Some(p), false) = (&b.pattern, own.is_empty()) {
+            let mut slot = vec![usize::MAX; b.n_eq];
+            own.iter().enumerate().for_each(|(s, &k)| slot[k] = s);
+            // Counting sort of the pattern's entries by the slot of their row.
+            let slot_of = |k: usize| slot.get(k).copied().filter(|&s| s != usize::MAX);
+            ptr = vec![0usize; own.len() + 1];
+            p.iter().filter_map(|&(k, _)| slot_of(k)).for_each(|s| ptr[s + 1] += 1);
+            (0..own.len()).for_each(|s| ptr[s + 1] += ptr[s]);
+            let mut next = ptr.clone();
+            cols = vec![0usize; ptr[own.len()]];
+            for &(k, c) in p {
+                if let Some(s) = slot_of(k) {
+                    cols[next[s]] = c;
+                    next[s] += 1;
+                }
+            }
+        }
+        Declared { own, ptr, cols }
+    }
+
+    /// The local columns the equation of `own[s]` reads (`b`: its block).
+    fn reads<'a>(&'a self, s: usize, b: &Block) -> impl Iterator<Item = usize> + 'a {
+        let (cols, dense) = match self.ptr.get(s..s + 2) {
+            Some(&[lo, hi]) => (&self.cols[lo..hi], 0..0),
+            _ => (&[][..], 0..b.layout.len()),
+        };
+        cols.iter().copied().chain(dense)
+    }
+}
+
 thread_local! {
     /// The local vector and the own block of [`Plant::complete`], one per thread.
     static SCRATCH: std::cell::RefCell<(Vec<f64>, Vec<f64>)> = const { std::cell::RefCell::new((Vec::new(), Vec::new())) };
@@ -76,19 +128,18 @@ impl Plant {
     pub fn explicit_plan(&self) -> ExplicitPlan {
         let vars = self.vars();
         let mut status = vec![Status::Kept; vars.len()];
-        // Per block: the declared own indices and, for each, the local columns its equation reads.
-        let declared: Vec<Vec<(usize, Vec<usize>)>> = self.blocks().iter().map(|b| Self::declared(b, vars)).collect();
-        for (b, list) in self.blocks().iter().zip(&declared) {
-            list.iter().for_each(|&(k, _)| status[b.own_offset + k] = Status::Explicit);
+        let declared: Vec<Declared> = self.blocks().iter().map(|b| Declared::of(b, vars)).collect();
+        for (b, d) in self.blocks().iter().zip(&declared) {
+            d.own.iter().for_each(|&k| status[b.own_offset + k] = Status::Explicit);
         }
         while self.demote(&declared, &mut status) {}
         let mut plan = ExplicitPlan::default();
-        for (i, (b, list)) in self.blocks().iter().zip(&declared).enumerate() {
+        for (i, (b, d)) in self.blocks().iter().zip(&declared).enumerate() {
             let keep: Vec<usize> =
-                list.iter().map(|&(k, _)| k).filter(|&k| status[b.own_offset + k] == Status::Explicit).collect();
+                d.own.iter().copied().filter(|&k| status[b.own_offset + k] == Status::Explicit).collect();
             if !keep.is_empty() {
                 plan.pairs.extend(keep.iter().map(|&k| (b.eq_offset + k, b.own_offset + k)));
-                plan.blocks.push(PlanBlock { block: i, whole: keep.len() == list.len(), keep, skip: Vec::new() });
+                plan.blocks.push(PlanBlock { block: i, whole: keep.len() == d.own.len(), keep, skip: Vec::new() });
             }
         }
         plan
@@ -120,47 +171,17 @@ impl Plant {
         plan
     }
 
-    /// The explicit variables `b` declares (algebraic, with an equation of their own) and, for
-    /// each, the local columns its equation reads (from the declared pattern; all of them for a
-    /// dense unit).
-    fn declared(b: &Block, vars: &[VarInfo]) -> Vec<(usize, Vec<usize>)> {
-        let n_own = b.layout.n_own().min(b.n_eq);
-        let own: Vec<usize> = b
-            .unit
-            .explicit(&b.layout)
-            .into_iter()
-            .filter(|&k| k < n_own && vars[b.own_offset + k].spec.kind != VarKind::Differential)
-            .collect();
-        if own.is_empty() {
-            return Vec::new();
-        }
-        let mut slot = vec![usize::MAX; b.n_eq];
-        own.iter().enumerate().for_each(|(s, &k)| slot[k] = s);
-        let mut reads: Vec<(usize, Vec<usize>)> = own.iter().map(|&k| (k, Vec::new())).collect();
-        match &b.pattern {
-            Some(p) => {
-                for &(k, c) in p {
-                    if let Some(&s) = slot.get(k).filter(|&&s| s != usize::MAX) {
-                        reads[s].1.push(c);
-                    }
-                }
-            }
-            None => reads.iter_mut().for_each(|r| r.1.extend(0..b.layout.len())),
-        }
-        reads
-    }
-
     /// One sweep of the demotion rules over the `declared` explicit variables (local index and
     /// the local columns its equation reads, per block); returns whether anything was demoted.
-    fn demote(&self, declared: &[Vec<(usize, Vec<usize>)>], status: &mut [Status]) -> bool {
+    fn demote(&self, declared: &[Declared], status: &mut [Status]) -> bool {
         let mut changed = false;
-        for (bi, (b, list)) in self.blocks().iter().zip(declared).enumerate() {
+        for (bi, (b, d)) in self.blocks().iter().zip(declared).enumerate() {
             let n_own = b.layout.n_own();
-            for (k, reads) in list {
+            for (s, &k) in d.own.iter().enumerate() {
                 if status[b.own_offset + k] != Status::Explicit {
                     continue;
                 }
-                for &c in reads {
+                for c in d.reads(s, b) {
                     if c < n_own {
                         if status[b.own_offset + c] == Status::Demoted {
                             status[b.own_offset + k] = Status::Demoted;
