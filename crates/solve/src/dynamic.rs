@@ -198,7 +198,7 @@ pub fn simulate(
     observer: &mut dyn FnMut(Progress<'_>),
 ) -> Result<SimulationResult, SimError> {
     let file = plant.file().to_string();
-    let mut d = Driver::new(plant, scenario, start, fingerprint)?;
+    let mut d = Driver::new(std::borrow::Cow::Borrowed(plant), scenario, start, fingerprint)?;
     match d.run(observer) {
         Ok(()) => {}
         Err(driver::RunError::Dae(source)) => {

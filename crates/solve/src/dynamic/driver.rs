@@ -2,10 +2,14 @@
 //! scans, analyzer samples and releases, the end), applies what is due at each, restarts the
 //! integrator when an input changed, records rows and hands out snapshots.
 //!
-//! The driver owns a copy of the plant, rewired through the flowsheet's wiring methods: a sampled
-//! controller's driven inputs are held ([`Plant::manual`]) and set to its output at every scan, an
-//! analyzer's controller reads a held copy of its measurement ([`Plant::hold_measurement`]), and a
-//! stuck valve's input is held at its last value ([`Plant::hold_input`]).
+//! The driver rewires the plant through the flowsheet's wiring methods: a sampled controller's
+//! driven inputs are held ([`Plant::manual`]) and set to its output at every scan, an analyzer's
+//! controller reads a held copy of its measurement ([`Plant::hold_measurement`]), and a stuck
+//! valve's input is held at its last value ([`Plant::hold_input`]). It copies the caller's plant
+//! when it first rewires it: a run that rewires nothing reads the caller's plant (a copy was a
+//! tenth of a short run's setup).
+
+use std::borrow::Cow;
 
 use plantwide_flowsheet::scenario::{Action, Event, Scenario};
 use plantwide_flowsheet::{Plant, Read};
@@ -19,9 +23,9 @@ use super::{Column, Conservation, Progress, SimError, SimulationResult, Start, c
 use crate::dae::{Bdf, BdfSettings, BdfState, DaeError, DaeIntegrator};
 
 /// One run in progress.
-pub(super) struct Driver {
-    /// The caller's plant, rewired for this run.
-    plant: Plant,
+pub(super) struct Driver<'p> {
+    /// The caller's plant, or its copy rewired for this run.
+    plant: Cow<'p, Plant>,
     /// The scenario (its own copy: a live run adds events to it as commands arrive).
     sc: Scenario,
     st: DriverState,
@@ -111,13 +115,18 @@ fn bdf_settings(sc: &Scenario) -> BdfSettings {
     }
 }
 
-impl Driver {
-    /// A run of `sc` on a copy of `plant` from `start`; `fingerprint` identifies the plant
-    /// description in snapshots.
-    pub(super) fn new(plant: &Plant, sc: &Scenario, start: Start<'_>, fingerprint: &str) -> Result<Driver, SimError> {
-        let quad = Quadratures::new(plant, &sc.totals);
-        let x0 = initial_state(plant, &quad, start);
-        let mpcs = mpc::build_all(plant, &x0[..plant.n_vars()]).map_err(|e| SimError::Mpc {
+impl<'p> Driver<'p> {
+    /// A run of `sc` on `plant` (copied when rewired) from `start`; `fingerprint` identifies the
+    /// plant description in snapshots.
+    pub(super) fn new(
+        plant: Cow<'p, Plant>,
+        sc: &Scenario,
+        start: Start<'_>,
+        fingerprint: &str,
+    ) -> Result<Driver<'p>, SimError> {
+        let quad = Quadratures::new(&plant, &sc.totals);
+        let x0 = initial_state(&plant, &quad, start);
+        let mpcs = mpc::build_all(&plant, &x0[..plant.n_vars()]).map_err(|e| SimError::Mpc {
             file: plant.file().to_string(),
             source: e,
             partial: None,
@@ -144,16 +153,16 @@ impl Driver {
         }
         // Every controller output (a scan, a stuck valve or a switch to manual reads one).
         let outputs: Vec<usize> = plant.inputs().iter().filter_map(|i| i.driven_by).collect();
-        let mut plant = plant.clone();
+        let mut plant = plant;
         // Which controller measures each recorded path: read before the analyzers rewire it.
         let refs: Vec<Option<usize>> = sc.record.iter().map(|r| reference_of(&plant, r.source)).collect();
-        let analyzers = hold_analyzers(&mut plant, sc, &x0)?;
-        let mut sampled = hold_sampled(&mut plant, sc, &x0);
+        let analyzers = if sc.analyzers.is_empty() { Vec::new() } else { hold_analyzers(plant.to_mut(), sc, &x0)? };
+        let mut sampled = if sc.sampling.is_empty() { Vec::new() } else { hold_sampled(plant.to_mut(), sc, &x0) };
         let mut st = DriverState::start(&plant, sc);
         let (mut restore, mut t0) = (None, 0.0);
         if let Start::Snapshot(s) = start {
             let paths = quad.state_paths(&plant);
-            let resumed = snapshot::resume(&mut plant, sc, s, fingerprint, &paths, st, &mut sampled)?;
+            let resumed = snapshot::resume(plant.to_mut(), sc, s, fingerprint, &paths, st, &mut sampled)?;
             (st, restore, t0) = (resumed.driver, resumed.integrator, s.t);
         }
         let recorded = recorded_state(&plant, sc);
@@ -411,7 +420,7 @@ impl Driver {
             }
             Action::Stuck { input } => {
                 let value = w[input].at(t);
-                let frozen = self.plant.hold_input(input).map_or(value, |op| x[op]);
+                let frozen = self.plant.to_mut().hold_input(input).map_or(value, |op| x[op]);
                 self.sampled.iter_mut().for_each(|s| s.retain(|&(i, _)| i != input));
                 self.st.waveforms[input] = Waveform::Constant(frozen);
                 self.st.stuck.push(self.plant.inputs()[input].path.clone());

@@ -16,6 +16,7 @@
 //! run to the clock's time with [`Live::advance_to`] and reads values interpolated within the last
 //! step ([`Live::values_at`]).
 
+use std::borrow::Cow;
 use std::collections::BTreeMap;
 use std::time::Instant;
 
@@ -97,7 +98,7 @@ pub struct Live {
     spec: ScenarioSpec,
     base: Scenario,
     fingerprint: String,
-    driver: Driver,
+    driver: Driver<'static>,
     /// Commands applied, their events at their times.
     journal: Vec<Queued>,
     pending: Vec<Queued>,
@@ -130,7 +131,7 @@ impl Live {
             base.max_step = LIVE_MAX_STEP;
             spec.integrator.max_step = Some(QuantityValue::Number(LIVE_MAX_STEP));
         }
-        let mut driver = Driver::new(plant, &base, Start::Steady(x0), fingerprint)?;
+        let mut driver = Driver::new(Cow::Owned(plant.clone()), &base, Start::Steady(x0), fingerprint)?;
         driver.endless();
         driver.start().map_err(|e| LiveError::Failed(failure(plant, RunError::Dae(e))))?;
         Ok(Live {
@@ -357,7 +358,8 @@ impl Live {
         let mut sc = self.base.clone();
         sc.events.extend(saved.journal.iter().flat_map(|q| q.events.iter().cloned()));
         sc.events.sort_by(|a, b| a.t.total_cmp(&b.t));
-        let mut driver = Driver::new(&self.plant, &sc, Start::Snapshot(&saved.snapshot), &self.fingerprint)?;
+        let owned = Cow::Owned(self.plant.clone());
+        let mut driver = Driver::new(owned, &sc, Start::Snapshot(&saved.snapshot), &self.fingerprint)?;
         driver.endless();
         driver.start().map_err(|e| LiveError::Failed(failure(&self.plant, RunError::Dae(e))))?;
         self.driver = driver;
