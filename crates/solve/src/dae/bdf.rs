@@ -235,7 +235,7 @@ pub struct Bdf {
 /// `p_k(t) = Π_{m=0}^{k−1} (t − t_n + m h)/((m + 1) h)` for `k = 1 … q` (`p_0` unused). The
 /// nodes `t_n − m h` and the reciprocals `1/(k h)` are the step's: computed once for the many
 /// times a caller reads within it (a recorded row each), which then costs no division.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, Default)]
 struct Interpolation {
     order: usize,
     node: [f64; MAX_ORDER + 1],
@@ -265,24 +265,36 @@ impl Interpolation {
     }
 }
 
-/// The last step's dense output for a set of variables ([`Bdf::dense_output`]).
-#[derive(Debug, Clone)]
+/// The last step's dense output for a set of variables ([`Bdf::dense_output_into`]).
+#[derive(Debug, Clone, Default)]
 pub struct DenseOutput {
     /// The step's weights, and its order `q`.
     weights: Interpolation,
-    /// The variables with a history, and their differences `D[0..=q]` (`q + 1` per variable).
+    /// The variables with a history, and their differences `D[0..=q]`, `D[k]` of every
+    /// variable after those of `D[k − 1]` (the sum over `k` then runs across the variables).
     idx: Vec<usize>,
     coef: Vec<f64>,
     /// The others, held at their value at the step's end.
     held: Vec<(usize, f64)>,
+    /// Scratch: the rows of `idx` in the history ([`Bdf::dense_output_into`]), the values
+    /// ([`DenseOutput::at`]).
+    rows: Vec<usize>,
+    values: Vec<f64>,
 }
 
 impl DenseOutput {
-    /// The variables' values at `t` (within the step) into their entries of `out`.
-    pub fn at(&self, t: f64, out: &mut [f64]) {
-        let (p, order) = (self.weights.weights(t), self.weights.order);
-        for (&i, d) in self.idx.iter().zip(self.coef.chunks_exact(order + 1)) {
-            out[i] = d[0] + (1..=order).map(|k| p[k] * d[k]).sum::<f64>();
+    /// The variables' values at `t` (within the step) into their entries of `out`: `D[0]` plus
+    /// `p_k(t)·D[k]` for `k = 1 … q` in turn (the sum [`DaeIntegrator::interpolate`] makes).
+    pub fn at(&mut self, t: f64, out: &mut [f64]) {
+        let (p, order, m) = (self.weights.weights(t), self.weights.order, self.idx.len());
+        if m > 0 {
+            let (d0, rest) = self.coef.split_at(m);
+            self.values.clear();
+            self.values.extend_from_slice(d0);
+            for (pk, dk) in p[1..=order].iter().zip(rest.chunks_exact(m)) {
+                self.values.iter_mut().zip(dk).for_each(|(v, d)| *v += pk * d);
+            }
+            self.idx.iter().zip(&self.values).for_each(|(&i, v)| out[i] = *v);
         }
         self.held.iter().for_each(|&(i, v)| out[i] = v);
     }
@@ -1054,24 +1066,29 @@ impl Bdf {
         Interpolation::new(self.st.t, self.st.h_abs, self.st.order)
     }
 
-    /// The dense output of the last step for the variables `indices`, their differences gathered
-    /// once for the many times a caller reads within the step (the recorded rows): the values of
-    /// [`DaeIntegrator::interpolate_at`], bit for bit, at a fraction of the cost per time.
-    pub fn dense_output(&self, indices: &[usize]) -> DenseOutput {
+    /// The dense output of the last step for the variables `indices` into `out` (its buffers
+    /// reused), their differences gathered once for the many times a caller reads within the step
+    /// (the recorded rows): the values of [`DaeIntegrator::interpolate_at`], bit for bit, at a
+    /// fraction of the cost per time.
+    pub fn dense_output_into(&self, indices: &[usize], out: &mut DenseOutput) {
         let order = self.st.order;
-        let mut coef = Vec::with_capacity(indices.len() * (order + 1));
-        let mut idx = Vec::with_capacity(indices.len());
-        let mut held = Vec::new();
+        out.idx.clear();
+        out.held.clear();
+        out.rows.clear();
         for &i in indices {
             match self.hist_pos.get(i).copied() {
                 Some(r) if r != usize::MAX => {
-                    idx.push(i);
-                    coef.extend(self.st.d[..=order].iter().map(|d| d[r]));
+                    out.idx.push(i);
+                    out.rows.push(r);
                 }
-                _ => held.push((i, self.x_full[i])),
+                _ => out.held.push((i, self.x_full[i])),
             }
         }
-        DenseOutput { weights: self.interpolation(), idx, coef, held }
+        out.coef.clear();
+        for d in &self.st.d[..=order] {
+            out.coef.extend(out.rows.iter().map(|&r| d[r]));
+        }
+        out.weights = self.interpolation();
     }
 
     /// [`DaeIntegrator::restart`]; with `keep_jacobian`, after a discontinuity in the inputs of
@@ -1321,7 +1338,9 @@ impl DaeIntegrator for Bdf {
 
     /// Variables without a history ([`Bdf::watch`]) hold their value at the step's end.
     fn interpolate_at(&self, t: f64, indices: &[usize], out: &mut [f64]) {
-        self.dense_output(indices).at(t, out);
+        let mut dense = DenseOutput::default();
+        self.dense_output_into(indices, &mut dense);
+        dense.at(t, out);
     }
 
     fn stats(&self) -> BdfStats {

@@ -20,7 +20,7 @@ use super::snapshot::{self, DriverState, SNAPSHOT_VERSION, Snapshot};
 use super::table::Table;
 use super::waveform::{Waveform, values_at};
 use super::{Column, Conservation, Progress, SimError, SimulationResult, Start, conservation};
-use crate::dae::{Bdf, BdfSettings, BdfState, DaeError, DaeIntegrator};
+use crate::dae::{Bdf, BdfSettings, BdfState, DaeError, DaeIntegrator, DenseOutput};
 
 /// One run in progress.
 pub(super) struct Driver<'p> {
@@ -56,6 +56,8 @@ pub(super) struct Driver<'p> {
     failure: Option<MpcError>,
     /// The state buffer of [`Driver::step_once`] (events, interpolated rows), kept between steps.
     state_buf: Vec<f64>,
+    /// The last step's dense output of the recorded entries (its buffers kept between steps).
+    dense: DenseOutput,
 }
 
 /// Why a run stopped early.
@@ -201,6 +203,7 @@ impl<'p> Driver<'p> {
             mpcs,
             failure: None,
             state_buf: Vec::new(),
+            dense: DenseOutput::default(),
         })
     }
 
@@ -522,7 +525,7 @@ impl<'p> Driver<'p> {
     /// Record every row due by `now` (and by the end), interpolated within the last step.
     fn record_through(&mut self, now: f64, xi: &mut [f64]) {
         let interval = self.sc.interval;
-        let mut dense = None;
+        let mut gathered = false;
         while (self.st.next_record as f64 * interval) <= now
             && self.st.next_record as f64 * interval <= self.sc.duration
         {
@@ -530,7 +533,11 @@ impl<'p> Driver<'p> {
             if tr == now {
                 xi.copy_from_slice(self.bdf.x());
             } else {
-                dense.get_or_insert_with(|| self.bdf.dense_output(&self.recorded)).at(tr, xi);
+                if !gathered {
+                    self.bdf.dense_output_into(&self.recorded, &mut self.dense);
+                    gathered = true;
+                }
+                self.dense.at(tr, xi);
             }
             self.push_row(tr, xi);
             self.st.next_record += 1;
