@@ -600,9 +600,10 @@ impl Bdf {
     ///
     /// Chord iteration on the output block `∂F_o/∂x_o` of the reduced Jacobian last evaluated
     /// (the outputs' equations form the lower block of a block-triangular system, so the other
-    /// variables' values are final), until the weighted correction is [`OUTPUT_TOL`] of the
-    /// integrator's tolerance (or the rounding level); if [`OUTPUT_MAXITER`] chord steps do
-    /// not get there, once more with the Jacobian at the last iterate. The integrator's own
+    /// variables' values are final; a diagonal block is updated by secants, see
+    /// `Bdf::output_chord`), until the weighted correction is [`OUTPUT_TOL`] of the
+    /// integrator's tolerance (or the rounding level); if [`OUTPUT_MAXITER`] steps do not get
+    /// there, once more with the Jacobian at the last iterate. The integrator's own
     /// Jacobian and factors are not touched: the run continues as it would have without the call.
     ///
     /// # Errors
