@@ -16,6 +16,7 @@
 
 use plantwide_model::{UnitIo, VarKind};
 
+use crate::outputs::Rows;
 use crate::plant::{Block, Plant, Read, VarInfo};
 
 /// The explicit variables of a plant and the order that computes them.
@@ -67,14 +68,12 @@ enum Status {
 }
 
 /// The explicit variables a block declares (algebraic, with an equation of their own) and the
-/// local columns each one's equation reads, from the declared pattern (all of them for a dense
-/// unit), in compressed rows: one allocation per block, not one per variable.
+/// block's pattern by rows ([`Rows`]), for the local columns each one's equation reads.
 struct Declared {
     /// Own (local) indices, in the unit's completion order.
     own: Vec<usize>,
-    /// `cols[ptr[s]..ptr[s + 1]]` are the columns read by `own[s]`'s equation (empty `ptr`: dense).
-    ptr: Vec<usize>,
-    cols: Vec<usize>,
+    /// The pattern by rows, when `own` is not empty.
+    rows: Option<Rows>,
 }
 
 impl Declared {
@@ -87,34 +86,14 @@ impl Declared {
             .into_iter()
             .filter(|&k| k < n_own && vars[b.own_offset + k].spec.kind != VarKind::Differential)
             .collect();
-        let (mut ptr, mut cols) = (Vec::new(), Vec::new());
-        if let (Some(p), false) = (&b.pattern, own.is_empty()) {
-            let mut slot = vec![usize::MAX; b.n_eq];
-            own.iter().enumerate().for_each(|(s, &k)| slot[k] = s);
-            // Counting sort of the pattern's entries by the slot of their row.
-            let slot_of = |k: usize| slot.get(k).copied().filter(|&s| s != usize::MAX);
-            ptr = vec![0usize; own.len() + 1];
-            p.iter().filter_map(|&(k, _)| slot_of(k)).for_each(|s| ptr[s + 1] += 1);
-            (0..own.len()).for_each(|s| ptr[s + 1] += ptr[s]);
-            let mut next = ptr.clone();
-            cols = vec![0usize; ptr[own.len()]];
-            for &(k, c) in p {
-                if let Some(s) = slot_of(k) {
-                    cols[next[s]] = c;
-                    next[s] += 1;
-                }
-            }
-        }
-        Declared { own, ptr, cols }
+        let rows = (!own.is_empty()).then(|| Rows::new(b));
+        Declared { own, rows }
     }
 
     /// The local columns the equation of `own[s]` reads (`b`: its block).
-    fn reads<'a>(&'a self, s: usize, b: &Block) -> impl Iterator<Item = usize> + 'a {
-        let (cols, dense) = match self.ptr.get(s..s + 2) {
-            Some(&[lo, hi]) => (&self.cols[lo..hi], 0..0),
-            _ => (&[][..], 0..b.layout.len()),
-        };
-        cols.iter().copied().chain(dense)
+    fn reads<'a>(&'a self, s: usize, b: &'a Block) -> impl Iterator<Item = usize> + 'a {
+        let k = self.own[s];
+        self.rows.iter().flat_map(move |r| r.local(b, k))
     }
 }
 

@@ -57,10 +57,10 @@ impl Plant {
 
 /// A block's pattern grouped by row: the local columns of row `k` are `col[ptr[k]..ptr[k + 1]]`;
 /// `None` for a dense block.
-struct Rows(Option<(Vec<usize>, Vec<usize>)>);
+pub(crate) struct Rows(Option<(Vec<usize>, Vec<usize>)>);
 
 impl Rows {
-    fn new(b: &Block) -> Rows {
+    pub(crate) fn new(b: &Block) -> Rows {
         Rows(b.pattern.as_ref().map(|p| {
             let mut ptr = vec![0usize; b.n_eq + 1];
             p.iter().filter(|e| e.0 < b.n_eq).for_each(|&(k, _)| ptr[k + 1] += 1);
@@ -75,17 +75,21 @@ impl Rows {
         }))
     }
 
-    /// The plant variables equation `k` of block `b` reads (own variables and the variables it
-    /// reads through its inlets and signals; inputs are not variables).
-    fn reads<'a>(&'a self, b: &'a Block, k: usize) -> impl Iterator<Item = usize> + 'a {
-        // A declared row, or (dense) every local column.
+    /// The local columns equation `k` of block `b` reads: its declared row, or (dense) every
+    /// local column.
+    pub(crate) fn local<'a>(&'a self, b: &Block, k: usize) -> impl Iterator<Item = usize> + 'a {
         let (declared, dense) = match &self.0 {
             Some((ptr, col)) => (&col[ptr[k]..ptr[k + 1]], 0..0),
             None => (&[][..], 0..b.layout.len()),
         };
-        let local = declared.iter().copied().chain(dense);
+        declared.iter().copied().chain(dense)
+    }
+
+    /// The plant variables equation `k` of block `b` reads (own variables and the variables it
+    /// reads through its inlets and signals; inputs are not variables).
+    fn reads<'a>(&'a self, b: &'a Block, k: usize) -> impl Iterator<Item = usize> + 'a {
         let n_own = b.layout.n_own();
-        local.filter_map(move |c| {
+        self.local(b, k).filter_map(move |c| {
             if c < n_own {
                 Some(b.own_offset + c)
             } else {
