@@ -40,10 +40,12 @@
 //! [`consistent_algebraic`] (Newton with line search and bounds) when that does not converge.
 //!
 //! **Error.** `err = d/(q + 1)` measured in the weighted RMS norm over the error-controlled
-//! (differential) variables with weights `atol·nominal_i + rtol·|x_i|`; a step is accepted when the
-//! norm is ≤ 1. After `q + 1` steps at the same size the order moves by one where
-//! `‖err_{q±1}‖^{−1/(q±1+1)}` promises the longest step, and the step grows by at most 10 (safety
-//! 0.9, scaled by the Newton effort); a rejected step shrinks by at least 5.
+//! (differential) variables with weights `atol·nominal_i + rtol·|x_i|` at the state the step
+//! starts from (CVODE's `ewt`: set once per step, shared by the Newton norms and the order
+//! selection); a step is accepted when the norm is ≤ 1. After `q + 1` steps at the same size the
+//! order moves by one where `‖err_{q±1}‖^{−1/(q±1+1)}` promises the longest step, and the step
+//! grows by at most 10 (safety 0.9, scaled by the Newton effort); a rejected step shrinks by at
+//! least 5.
 //!
 //! **Dense output.** Between `t_n − h` and `t_n`, `x(t) = D[0] + Σ_{k=1}^{q} D[k] Π_{m=0}^{k−1}
 //! (t − t_n + m h)/((m + 1) h)`.
@@ -526,6 +528,7 @@ impl Bdf {
             let entry = Self::entry(&self.red_diff_var, c);
             self.lu.factor_mapped_on(entry, (&pivots.0, &pivots.1)).map_err(err)?;
         }
+        self.state_weights();
         Ok(())
     }
 
@@ -757,6 +760,17 @@ impl Bdf {
         }
     }
 
+    /// The error weights of the current state ([`DaeIntegrator::x`]) into `w.weight` and those of
+    /// the kept variables into `w.weight_kept`: CVODE's `ewt`, set once per step from `x_n` and
+    /// used by the next step's Newton norms, error test and order selection. Computed from the
+    /// state itself, a restored run has the same weights as the run it continues.
+    fn state_weights(&mut self) {
+        let x = if self.hist_all { &self.st.d[0] } else { &self.x_full };
+        let w = &mut self.w;
+        Self::weights_into(&self.red, &self.abs_tol, self.settings.rtol, x, &mut w.weight);
+        w.weight_kept.iter_mut().zip(&self.red.kept_vars).for_each(|(k, &j)| *k = w.weight[j]);
+    }
+
     /// Factorize the iteration matrix `M/c − J` (at `c = 0`: `M − 0·J`, see [`Bdf::entry`]). The
     /// Jacobian is loaded into the LU once per evaluation (the mass entries pinned in its pattern);
     /// a new `c` only shifts the mass diagonal and refactorizes its columns.
@@ -925,7 +939,6 @@ impl Bdf {
     ) -> Result<(f64, usize), DaeError> {
         let t = self.st.t;
         let order = self.st.order;
-        let rtol = self.settings.rtol;
         let mut lu_ok = self.st.lu_c.is_some() && self.lu.is_factored();
         loop {
             if *h_abs < min_step {
@@ -941,9 +954,6 @@ impl Bdf {
             }
             let h = t_new - t;
             self.predict(order);
-            Self::weights_into(&self.red, &self.abs_tol, rtol, &self.w.x_pred, &mut self.w.weight);
-            let w = &mut self.w;
-            w.weight_kept.iter_mut().zip(&self.red.kept_vars).for_each(|(k, &j)| *k = w.weight[j]);
             let c = h / self.gamma[order];
             let Some(iters) = self.correct(sys, t_new, c, NEWTON_TOL, &mut lu_ok)? else {
                 self.st.stats.n_newton_failures += 1;
@@ -952,8 +962,7 @@ impl Bdf {
                 continue;
             };
             let safety = 0.9 * (2 * NEWTON_MAXITER + 1) as f64 / (2 * NEWTON_MAXITER + iters) as f64;
-            let w = &mut self.w;
-            Self::weights_into(&self.red, &self.abs_tol, rtol, &w.x, &mut w.weight);
+            let w = &self.w;
             let e = self.error_const[order];
             let error_norm = e * rms(&w.d, &w.weight, &self.controlled);
             if error_norm > 1.0 {
@@ -1138,15 +1147,15 @@ impl Bdf {
         for &(i, j) in sys.mass() {
             xdot[j] = f[i];
         }
-        let mut weight = vec![0.0; n];
-        Self::weights_into(&self.red, &self.abs_tol, self.settings.rtol, &x, &mut weight);
+        Self::weights_into(&self.red, &self.abs_tol, self.settings.rtol, &x, &mut self.w.weight);
+        let weight = &self.w.weight;
         // First step: 1 % of the time the differential variables take to change by their own
         // size (SciPy's first estimate), and after an event no longer than the last step taken.
         let h = match self.settings.first_step {
             Some(h) => h,
             None => {
-                let d0 = rms(&x, &weight, &self.controlled).max(1e-5);
-                let d1 = rms(&xdot, &weight, &self.controlled);
+                let d0 = rms(&x, weight, &self.controlled).max(1e-5);
+                let d1 = rms(&xdot, weight, &self.controlled);
                 let h = if d1 <= 1e-10 { 1.0 } else { 0.01 * d0 / d1 };
                 if self.st.h_abs > 0.0 { h.min(self.st.h_abs) } else { h }
             }
@@ -1174,6 +1183,7 @@ impl Bdf {
         self.st.stats.n_restarts += 1;
         self.lu.invalidate();
         self.seed_outputs();
+        self.state_weights();
         Ok(())
     }
 
@@ -1253,8 +1263,7 @@ impl Bdf {
     /// estimate promises the longest step, and grow or shrink the step accordingly (at most
     /// [`MAX_FACTOR`], safety scaled by the `n_iter` Newton iterations of the last step).
     fn adapt_order_and_step(&mut self, order: usize, n_iter: usize) {
-        // `w.weight` holds the error test's weights of the accepted state, the state `D[0]` now
-        // holds (to rounding): they are not computed again.
+        // `w.weight` holds the weights of the state just accepted ([`Bdf::state_weights`]).
         let norm_of = |k: usize, row: usize| {
             let e = self.error_const[k];
             let d = &self.st.d[row];
@@ -1306,6 +1315,7 @@ impl DaeIntegrator for Bdf {
         self.st.current_jac = false;
         self.outputs_done = false;
         self.update_differences(order);
+        self.state_weights();
         if self.st.n_equal_steps < order + 1 {
             return Ok(());
         }
