@@ -273,30 +273,28 @@ pub struct DenseOutput {
     /// The step's weights, and its order `q`.
     weights: Interpolation,
     /// The variables with a history, and their differences `D[0..=q]`, `D[k]` of every
-    /// variable after those of `D[k − 1]` (the sum over `k` then runs across the variables).
+    /// variable after those of `D[k − 1]`.
     idx: Vec<usize>,
     coef: Vec<f64>,
     /// The others, held at their value at the step's end.
     held: Vec<(usize, f64)>,
-    /// Scratch: the rows of `idx` in the history ([`Bdf::dense_output_into`]), the values
-    /// ([`DenseOutput::at`]).
+    /// Scratch: the rows of `idx` in the history ([`Bdf::dense_output_into`]).
     rows: Vec<usize>,
-    values: Vec<f64>,
 }
 
 impl DenseOutput {
     /// The variables' values at `t` (within the step) into their entries of `out`: `D[0]` plus
-    /// `p_k(t)·D[k]` for `k = 1 … q` in turn (the sum [`DaeIntegrator::interpolate`] makes).
-    pub fn at(&mut self, t: f64, out: &mut [f64]) {
+    /// `p_k(t)·D[k]` for `k = 1 … q` in turn (the sum [`DaeIntegrator::interpolate`] makes),
+    /// each variable's sum straight into its entry.
+    pub fn at(&self, t: f64, out: &mut [f64]) {
         let (p, order, m) = (self.weights.weights(t), self.weights.order, self.idx.len());
-        if m > 0 {
-            let (d0, rest) = self.coef.split_at(m);
-            self.values.clear();
-            self.values.extend_from_slice(d0);
-            for (pk, dk) in p[1..=order].iter().zip(rest.chunks_exact(m)) {
-                self.values.iter_mut().zip(dk).for_each(|(v, d)| *v += pk * d);
+        let coef = &self.coef[..m * (order + 1)];
+        for (r, &i) in self.idx.iter().enumerate() {
+            let mut v = coef[r];
+            for (k, pk) in p.iter().enumerate().take(order + 1).skip(1) {
+                v += pk * coef[k * m + r];
             }
-            self.idx.iter().zip(&self.values).for_each(|(&i, v)| out[i] = *v);
+            out[i] = v;
         }
         self.held.iter().for_each(|&(i, v)| out[i] = v);
     }
