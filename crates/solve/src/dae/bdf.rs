@@ -718,7 +718,9 @@ impl Bdf {
                 return Ok(false);
             }
             if matches!(block, OutputBlock::Diagonal(_)) {
-                last = Some((outputs.iter().map(|&(i, _)| f[i]).collect(), dx.clone()));
+                let (f_last, dx_last) = last.get_or_insert_with(|| (vec![0.0; dx.len()], vec![0.0; dx.len()]));
+                f_last.iter_mut().zip(outputs).for_each(|(v, &(i, _))| *v = f[i]);
+                dx_last.copy_from_slice(&dx);
             }
             let mut sum = 0.0;
             for (d, &(_, j)) in dx.iter().zip(outputs) {
@@ -1145,43 +1147,44 @@ impl Bdf {
         for &(i, j) in sys.mass() {
             xdot[j] = f[i];
         }
-        Self::weights_into(&self.red, &self.abs_tol, self.settings.rtol, &x, &mut self.w.weight);
-        let weight = &self.w.weight;
+        // The state first: its weights ([`Bdf::state_weights`]) size the first step.
+        self.st.d = vec![vec![0.0; self.hist.len()]; MAX_ORDER + 3];
+        if self.hist_all {
+            self.st.d[0] = x;
+        } else {
+            self.st.d[0] = self.hist.iter().map(|&j| x[j]).collect();
+            self.x_full = x;
+        }
+        self.state_weights();
         // First step: 1 % of the time the differential variables take to change by their own
         // size (SciPy's first estimate), and after an event no longer than the last step taken.
         let h = match self.settings.first_step {
             Some(h) => h,
             None => {
-                let d0 = rms(&x, weight, &self.controlled).max(1e-5);
-                let d1 = rms(&xdot, weight, &self.controlled);
+                let state = if self.hist_all { &self.st.d[0] } else { &self.x_full };
+                let d0 = rms(state, &self.w.weight, &self.controlled).max(1e-5);
+                let d1 = rms(&xdot, &self.w.weight, &self.controlled);
                 let h = if d1 <= 1e-10 { 1.0 } else { 0.01 * d0 / d1 };
                 if self.st.h_abs > 0.0 { h.min(self.st.h_abs) } else { h }
             }
         };
         let h = h.min(self.settings.max_step);
-        let n_hist = self.hist.len();
-        let mut d = vec![vec![0.0; n_hist]; MAX_ORDER + 3];
-        if self.hist_all {
-            d[1] = xdot.iter().map(|v| v * h).collect();
-            d[0] = x;
+        self.st.d[1] = if self.hist_all {
+            xdot.iter().map(|v| v * h).collect()
         } else {
-            d[0] = self.hist.iter().map(|&j| x[j]).collect();
-            d[1] = self.hist.iter().map(|&j| xdot[j] * h).collect();
-            self.x_full = x;
-        }
+            self.hist.iter().map(|&j| xdot[j] * h).collect()
+        };
         self.st.t = t;
         self.st.t_prev = t;
         self.st.h_abs = h;
         self.st.order = 1;
         self.st.n_equal_steps = 0;
-        self.st.d = d;
         self.st.current_jac = jac_at_x;
         self.st.lu_c = None;
         self.st.newton_ss = None;
         self.st.stats.n_restarts += 1;
         self.lu.invalidate();
         self.seed_outputs();
-        self.state_weights();
         Ok(())
     }
 
