@@ -197,6 +197,9 @@ pub struct Bdf {
     all: Vec<usize>,
     /// For each equation, the variable whose derivative it is (`usize::MAX`: algebraic).
     diff_var: Vec<usize>,
+    /// For each kept equation (in reduced order), the equation and its [`Bdf::diff_var`]: the
+    /// Newton right-hand side reads both with one load per row.
+    kept_rows: Vec<(usize, usize)>,
     /// The explicit variables eliminated from Newton ([`DaeSystem::explicit`]): the iteration
     /// matrix, its factors and the corrections live in the kept (reduced) indices.
     red: Reduction,
@@ -409,6 +412,26 @@ impl OutputBlock {
     }
 }
 
+/// The Newton right-hand side of the kept equations into `rhs`: for each `(i, j)` of `rows`,
+/// `f_i` for an algebraic equation (`j = usize::MAX`) and `(c f_i − ψ_j − d_j)/c` for the
+/// derivative of `x_j` (`d` zero before the first correction: `None`). `c f − ψ − d` first: on
+/// an exactly predicted step (a ramp) it cancels to 0. Two loops, so that neither tests `d`.
+fn newton_rhs(rows: &[(usize, usize)], f: &[f64], psi: &[f64], d: Option<&[f64]>, c: f64, rhs: &mut [f64]) {
+    let inv_c = 1.0 / c;
+    match d {
+        None => {
+            for (r, &(i, j)) in rhs.iter_mut().zip(rows) {
+                *r = if j == usize::MAX { f[i] } else { (c * f[i] - psi[j]) * inv_c };
+            }
+        }
+        Some(d) => {
+            for (r, &(i, j)) in rhs.iter_mut().zip(rows) {
+                *r = if j == usize::MAX { f[i] } else { (c * f[i] - psi[j] - d[j]) * inv_c };
+            }
+        }
+    }
+}
+
 impl Bdf {
     /// A BDF integrator with these settings; call [`DaeIntegrator::restart`] before stepping.
     pub fn new(settings: BdfSettings) -> Bdf {
@@ -445,6 +468,7 @@ impl Bdf {
             controlled: Vec::new(),
             all: Vec::new(),
             diff_var: Vec::new(),
+            kept_rows: Vec::new(),
             red: Reduction::default(),
             red_jac: Vec::new(),
             red_mass: Vec::new(),
@@ -546,6 +570,7 @@ impl Bdf {
         self.red_mass = sys.mass().iter().map(|&(i, j)| (red.row[i], red.col[j])).collect();
         self.red_diff_var =
             red.kept_eqs.iter().map(|&i| red.col.get(self.diff_var[i]).copied().unwrap_or(usize::MAX)).collect();
+        self.kept_rows = red.kept_eqs.iter().map(|&i| (i, self.diff_var[i])).collect();
         self.newton_over = (0..red.n()).filter(|&r| !sys.quadrature(red.kept_vars[r])).collect();
         self.all = self.newton_over.iter().map(|&r| red.kept_vars[r]).collect();
         let mut tracked = vec![true; n];
@@ -831,7 +856,7 @@ impl Bdf {
     /// 54 on equal steps while its level ramp, exact for BDF, drifted towards 1e-9 at rtol 1e-9.
     fn newton(&mut self, sys: &dyn DaeSystem, t_new: f64, c: f64, tol: f64) -> (bool, usize) {
         let c_lu = self.st.lu_c.unwrap_or(c);
-        let (ratio, damping, inv_c) = (c_lu / c, 2.0 / (1.0 + c_lu / c), 1.0 / c);
+        let (ratio, damping) = (c_lu / c, 2.0 / (1.0 + c_lu / c));
         // The error test's bound on the correction `d` at this order (`‖d‖/(q + 1) ≤ 1`).
         let max_first = 1.0 / self.error_const[self.st.order];
         let (red, w) = (&self.red, &mut self.w);
@@ -853,14 +878,8 @@ impl Bdf {
             self.st.stats.n_newton_iters += 1;
             // A non-finite residual gives a non-finite correction: the solve refuses it below.
             // `d` is zero before the first correction (and not yet written: it is set below).
-            let d_of = |j: usize| if k == 0 { 0.0 } else { w.d[j] };
-            for (r, &i) in w.rhs.iter_mut().zip(&red.kept_eqs) {
-                *r = match self.diff_var[i] {
-                    usize::MAX => w.f[i],
-                    // `c f − ψ − d` first: on an exactly predicted step (a ramp) it cancels to 0.
-                    j => (c * w.f[i] - w.psi[j] - d_of(j)) * inv_c,
-                };
-            }
+            let d = (k > 0).then_some(&w.d[..]);
+            newton_rhs(&self.kept_rows, &w.f, &w.psi, d, c, &mut w.rhs);
             if self.lu.solve_in_place(&mut w.rhs).is_err() {
                 return (false, iters);
             }
@@ -868,9 +887,10 @@ impl Bdf {
                 w.rhs.iter_mut().for_each(|v| *v *= damping);
             }
             let dy_norm = rms(&w.rhs, &w.weight_kept, &self.newton_over);
+            let (x, d) = (&mut w.x[..], &mut w.d[..]);
             for (&j, r) in red.kept_vars.iter().zip(&w.rhs) {
-                w.x[j] += r;
-                w.d[j] = if k == 0 { *r } else { w.d[j] + r };
+                x[j] += r;
+                d[j] = if k == 0 { *r } else { d[j] + r };
             }
             if !red.is_identity() {
                 sys.complete(t_new, &mut w.x);
