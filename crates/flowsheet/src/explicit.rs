@@ -220,23 +220,28 @@ impl Plant {
     }
 
     /// [`Plant::residual`] at a point `x` that [`Plant::complete`] has just completed for `plan`:
-    /// the explicit equations hold there, so their rows are set to zero and a unit whose declared
-    /// explicit variables all are evaluates only its other equations
-    /// ([`plantwide_model::Unit::residual_kept`]).
+    /// the explicit equations hold there, so a unit whose declared explicit variables all are
+    /// evaluates only its other equations ([`plantwide_model::Unit::residual_kept`]) and leaves
+    /// the explicit rows of `r`, and those of the plan's output-only variables, as they were.
     pub fn residual_completed(&self, plan: &ExplicitPlan, x: &[f64], u: &[f64], t: f64, r: &mut [f64]) {
         SCRATCH.with_borrow_mut(|(local, _)| {
             let mut next = plan.blocks.iter().peekable();
             for (i, b) in self.blocks().iter().enumerate() {
-                self.gather(b, x, u, local);
-                let io = UnitIo { local, layout: &b.layout, thermo: self.thermo(), time: t };
                 let rows = &mut r[b.eq_offset..b.eq_offset + b.n_eq];
                 match next.next_if(|p| p.block == i) {
                     Some(p) if p.whole => {
-                        // `residual_kept` leaves the explicit rows as they are: zero.
-                        rows.fill(0.0);
-                        b.unit.residual_kept(&io, rows, &p.skip);
+                        // The own variables are read in place, not copied into `local`; the
+                        // explicit rows are left as they are.
+                        self.gather_reads(b, x, u, local);
+                        let io = UnitIo { local, layout: &b.layout, thermo: self.thermo(), time: t };
+                        let own = &x[b.own_offset..b.own_offset + b.layout.n_own()];
+                        b.unit.residual_kept(&io, own, rows, &p.skip);
                     }
-                    _ => b.unit.residual(&io, rows),
+                    _ => {
+                        self.gather(b, x, u, local);
+                        let io = UnitIo { local, layout: &b.layout, thermo: self.thermo(), time: t };
+                        b.unit.residual(&io, rows);
+                    }
                 }
             }
         });

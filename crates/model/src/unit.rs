@@ -185,13 +185,17 @@ pub trait UnitModel: Send + Sync + std::fmt::Debug {
     /// own variables (read from `own`: the own block of `io.local` is not filled here), the
     /// inlets and the inputs, and leaving every other entry of `own` as it is (default: nothing).
     fn complete(&self, _io: &UnitIo<'_, f64>, _own: &mut [f64]) {}
-    /// The residuals of the equations that are not [`UnitModel::explicit`], at a local vector
-    /// whose explicit variables [`UnitModel::complete`] has just set; the explicit equations'
-    /// rows of `r` may be left as they are, and so may the rows `k` with `skip[k]` (equations of
-    /// output-only variables the dynamic integrator solves only when they are asked for; `skip`
-    /// empty: none) (default: [`UnitModel::eval`]).
-    fn eval_kept(&self, io: &UnitIo<'_, f64>, r: &mut [f64], _skip: &[bool]) {
-        self.eval(io, r);
+    /// The residuals of the equations that are not [`UnitModel::explicit`], at own variables
+    /// `own` whose explicit ones [`UnitModel::complete`] has just set (read from `own`, as
+    /// `complete` does: the own block of `io.local` is not filled here, which saves the
+    /// integrator a copy of the block per residual); the explicit equations' rows of `r` may be
+    /// left as they are, and so may the rows `k` with `skip[k]` (equations of output-only
+    /// variables the dynamic integrator solves only when they are asked for; `skip` empty: none)
+    /// (default: [`UnitModel::eval`] on a copy of the local vector with `own` in place).
+    fn eval_kept(&self, io: &UnitIo<'_, f64>, own: &[f64], r: &mut [f64], _skip: &[bool]) {
+        let mut local = io.local.to_vec();
+        local[..own.len()].copy_from_slice(own);
+        self.eval(&UnitIo { local: &local, ..*io }, r);
     }
     /// Initial guess of the own variables from the inlets and inputs in `local` (its own block holds
     /// whatever was there before: defaults or a previous solution).
@@ -278,7 +282,7 @@ pub trait Unit: Send + Sync + std::fmt::Debug {
     /// See [`UnitModel::complete`].
     fn complete(&self, io: &UnitIo<'_, f64>, own: &mut [f64]);
     /// See [`UnitModel::eval_kept`].
-    fn residual_kept(&self, io: &UnitIo<'_, f64>, r: &mut [f64], skip: &[bool]);
+    fn residual_kept(&self, io: &UnitIo<'_, f64>, own: &[f64], r: &mut [f64], skip: &[bool]);
     /// See [`UnitModel::without_limits`].
     fn without_limits(&self) -> Option<Box<dyn Unit>>;
     /// See [`UnitModel::output_limits`].
@@ -399,8 +403,8 @@ impl<U: UnitModel + 'static> Unit for U {
     fn complete(&self, io: &UnitIo<'_, f64>, own: &mut [f64]) {
         UnitModel::complete(self, io, own);
     }
-    fn residual_kept(&self, io: &UnitIo<'_, f64>, r: &mut [f64], skip: &[bool]) {
-        UnitModel::eval_kept(self, io, r, skip);
+    fn residual_kept(&self, io: &UnitIo<'_, f64>, own: &[f64], r: &mut [f64], skip: &[bool]) {
+        UnitModel::eval_kept(self, io, own, r, skip);
     }
     fn without_limits(&self) -> Option<Box<dyn Unit>> {
         UnitModel::without_limits(self).map(|u| Box::new(u) as Box<dyn Unit>)

@@ -61,8 +61,9 @@ pub trait DaeSystem: Sync {
     /// at time `t` (default: nothing).
     fn complete(&self, _t: f64, _x: &mut [f64]) {}
     /// [`DaeSystem::residual`] at an `x` that [`DaeSystem::complete`] has just completed: the
-    /// explicit equations hold there and their rows may be left zero without evaluating them,
-    /// and the rows of [`DaeSystem::outputs`] may be left anything (default: the residual).
+    /// explicit equations hold there, and their rows and those of [`DaeSystem::outputs`] may be
+    /// left anything, unevaluated (the integrator reads the other rows alone; default: the
+    /// residual).
     fn residual_completed(&self, t: f64, x: &[f64], r: &mut [f64]) {
         self.residual(t, x, r);
     }

@@ -326,8 +326,8 @@ impl UnitModel for Column {
     fn complete(&self, io: &UnitIo<'_, f64>, own: &mut [f64]) {
         delegate!(self, complete(io, own))
     }
-    fn eval_kept(&self, io: &UnitIo<'_, f64>, r: &mut [f64], skip: &[bool]) {
-        delegate!(self, eval_kept(io, r, skip))
+    fn eval_kept(&self, io: &UnitIo<'_, f64>, own: &[f64], r: &mut [f64], skip: &[bool]) {
+        delegate!(self, eval_kept(io, own, r, skip))
     }
     fn holdup(&self, io: &UnitIo<'_, f64>) -> Option<Vec<f64>> {
         delegate!(self, holdup(io))
