@@ -231,6 +231,8 @@ pub struct Bdf {
     jac_loaded: bool,
     /// `atol · nominal_i`: the absolute part of each variable's error scale.
     abs_tol: Vec<f64>,
+    /// [`Bdf::abs_tol`] of the kept variables (reduced order).
+    abs_tol_kept: Vec<f64>,
     /// Whether the output-only variables hold their solution at the current time.
     outputs_done: bool,
     w: Work,
@@ -483,6 +485,7 @@ impl Bdf {
             x_full: Vec::new(),
             jac_loaded: false,
             abs_tol: Vec::new(),
+            abs_tol_kept: Vec::new(),
             outputs_done: false,
             w: Work::default(),
         }
@@ -588,6 +591,7 @@ impl Bdf {
         self.controlled_h = self.controlled.iter().map(|&j| (self.hist_pos[j], j)).collect();
         self.jac_loaded = false;
         self.abs_tol = (0..n).map(|i| self.settings.atol * sys.nominal(i).abs().max(1e-300)).collect();
+        self.abs_tol_kept = self.red.kept_vars.iter().map(|&j| self.abs_tol[j]).collect();
         let n_hist = self.hist.len();
         if self.w.x.len() != n || self.w.rhs.len() != self.red.n() || self.w.d_h.len() != n_hist {
             self.w = Work::new(n, self.red.n(), n_hist);
@@ -770,30 +774,19 @@ impl Bdf {
         self.red.jacobian(&self.st.jac, &mut self.red_jac).map_err(|source| DaeError::Explicit { time, source })
     }
 
-    /// The error weights `1/(atol·nominal_i + rtol·|x_i|)` of the kept variables into `out`
-    /// (CVODE's `ewt`: the norms multiply by them, a division per variable once per step instead
-    /// of one per norm). Explicit variables are in no norm: their entries are left as they are.
-    fn weights_into(red: &Reduction, abs_tol: &[f64], rtol: f64, x: &[f64], out: &mut [f64]) {
-        if red.is_identity() {
-            for ((o, a), v) in out.iter_mut().zip(abs_tol).zip(x) {
-                *o = 1.0 / (a + rtol * v.abs());
-            }
-        } else {
-            for &j in &red.kept_vars {
-                out[j] = 1.0 / (abs_tol[j] + rtol * x[j].abs());
-            }
-        }
-    }
-
-    /// The error weights of the current state ([`DaeIntegrator::x`]) into `w.weight` and those of
-    /// the kept variables into `w.weight_kept`: CVODE's `ewt`, set once per step from `x_n` and
-    /// used by the next step's Newton norms, error test and order selection. Computed from the
-    /// state itself, a restored run has the same weights as the run it continues.
+    /// The error weights `1/(atol·nominal_i + rtol·|x_i|)` of the current state
+    /// ([`DaeIntegrator::x`]) into `w.weight_kept` (the kept variables) and `w.weight` (their
+    /// entries; explicit variables are in no norm, theirs are left as they are): CVODE's `ewt`, a
+    /// division per variable once per step instead of one per norm, set from `x_n` and used by
+    /// the next step's Newton norms, error test and order selection. Computed from the state
+    /// itself, a restored run has the same weights as the run it continues. The kept values are
+    /// gathered first, so that the divisions run over contiguous arrays (vectorized).
     fn state_weights(&mut self) {
         let x = if self.hist_all { &self.st.d[0] } else { &self.x_full };
-        let w = &mut self.w;
-        Self::weights_into(&self.red, &self.abs_tol, self.settings.rtol, x, &mut w.weight);
-        w.weight_kept.iter_mut().zip(&self.red.kept_vars).for_each(|(k, &j)| *k = w.weight[j]);
+        let (w, rtol, kept) = (&mut self.w, self.settings.rtol, &self.red.kept_vars);
+        w.weight_kept.iter_mut().zip(kept).for_each(|(k, &j)| *k = x[j]);
+        w.weight_kept.iter_mut().zip(&self.abs_tol_kept).for_each(|(k, a)| *k = 1.0 / (a + rtol * k.abs()));
+        w.weight_kept.iter().zip(kept).for_each(|(k, &j)| w.weight[j] = *k);
     }
 
     /// Factorize the iteration matrix `M/c − J` (at `c = 0`: `M − 0·J`, see [`Bdf::entry`]). The
