@@ -127,8 +127,14 @@ impl Plant {
     /// [`Plant::explicit_plan`] with the output-only variables ([`Plant::needed_variables`])
     /// when the caller reads `roots` during the run: those not explicit are listed in
     /// [`ExplicitPlan::outputs`] and their equations skipped by [`Plant::residual_completed`]
-    /// where the unit allows.
+    /// where the unit allows. A plan computed before for the same structure and roots is taken
+    /// from the process's cache (`plan_cache.rs`).
     pub fn explicit_plan_for(&self, roots: &[usize]) -> ExplicitPlan {
+        crate::plan_cache::plan_for(self, roots, || self.plan_for(roots))
+    }
+
+    /// [`Plant::explicit_plan_for`], computed.
+    pub(crate) fn plan_for(&self, roots: &[usize]) -> ExplicitPlan {
         let mut plan = self.explicit_plan();
         let needed = self.needed_variables(roots);
         let mut explicit = vec![false; needed.len()];

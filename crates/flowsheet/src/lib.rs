@@ -17,6 +17,7 @@ pub mod outputs;
 pub mod overrides;
 pub mod parse;
 pub mod path;
+mod plan_cache;
 pub mod plant;
 pub mod query;
 pub mod scenario;
