@@ -16,7 +16,8 @@
 //!
 //! The entry holds its `Arc`s, so no other plant's variables or units can take their addresses
 //! while it is kept. At most [`MAX_ENTRIES`] plans are kept, the least recently used evicted
-//! first.
+//! first, and only of plants of at most [`MAX_VARS`] variables: an entry keeps its plant's
+//! variables alive, and a larger plant's plan is a small part of its run anyway.
 
 use std::sync::{Arc, Mutex, PoisonError};
 
@@ -27,6 +28,8 @@ use crate::plant::{Block, Plant, Read, VarInfo};
 
 /// Most plans kept.
 const MAX_ENTRIES: usize = 8;
+/// Largest plant (variables) whose plan is kept: eight entries then hold at most a few MB.
+const MAX_VARS: usize = 20_000;
 
 /// What a plan is a function of, for one block.
 struct BlockKey {
@@ -81,6 +84,9 @@ static PLANS: Mutex<Vec<Entry>> = Mutex::new(Vec::new());
 
 /// The plan of `plant` for `roots` from the cache, or from `compute` (then kept).
 pub(crate) fn plan_for(plant: &Plant, roots: &[usize], compute: impl FnOnce() -> ExplicitPlan) -> ExplicitPlan {
+    if plant.vars.len() > MAX_VARS {
+        return compute();
+    }
     // A panic while the lock was held leaves whole entries: the data is still consistent.
     let mut plans = PLANS.lock().unwrap_or_else(PoisonError::into_inner);
     if let Some(k) = plans.iter().position(|e| e.is(plant, roots)) {
