@@ -259,12 +259,13 @@ impl Interpolation {
         Interpolation { order, node, inv }
     }
 
-    /// `p_k(t)`, `k = 1 … q`.
+    /// `p_k(t)`, `k = 1 … q`. All `MAX_ORDER` factors are multiplied, a fixed count the loop is
+    /// unrolled for (a recorded row calls this once); above `q` the reciprocals are zero and the
+    /// entries are not weights: callers read up to `q`.
     fn weights(&self, t: f64) -> [f64; MAX_ORDER + 1] {
         let mut p = [0.0; MAX_ORDER + 1];
         let mut acc = 1.0;
-        let terms = self.node.iter().zip(&self.inv).take(self.order + 1).skip(1);
-        for (pk, (node, inv)) in p.iter_mut().skip(1).zip(terms) {
+        for ((pk, node), inv) in p.iter_mut().zip(&self.node).zip(&self.inv).skip(1) {
             acc *= (t - node) * inv;
             *pk = acc;
         }

@@ -298,12 +298,20 @@ impl<'p> Driver<'p> {
         self.times.push(t);
         let (plant, waves) = (&self.plant, &self.st.waveforms);
         let (np, n_tot) = (plant.n_vars(), self.sc.totals.len() * plant.components().len());
-        let recorded = self.sc.record.iter().map(|r| match r.source {
-            Read::Var(v) => x[v],
-            Read::Input(i) => plant.inputs()[i].driven_by.map_or_else(|| waves[i].at(t), |v| x[v]),
+        let record = &self.sc.record;
+        self.rows.push_with(|row| {
+            let (paths, totals) = row.split_at_mut(record.len());
+            for (v, r) in paths.iter_mut().zip(record) {
+                *v = match r.source {
+                    Read::Var(v) => x[v],
+                    Read::Input(i) => plant.inputs()[i].driven_by.map_or_else(|| waves[i].at(t), |v| x[v]),
+                };
+            }
+            totals.copy_from_slice(&x[np..np + n_tot]);
         });
-        self.rows.push(recorded.chain(x[np..np + n_tot].iter().copied()));
-        self.ref_rows.push(self.refs.iter().flatten().map(|&i| waves[i].at(t)));
+        let refs = &self.refs;
+        self.ref_rows
+            .push_with(|row| row.iter_mut().zip(refs.iter().flatten()).for_each(|(v, &i)| *v = waves[i].at(t)));
     }
 
     /// Apply everything due at `t` (the integrator's time, or the start before it is started);

@@ -48,6 +48,15 @@ impl Table {
         self.rows += 1;
     }
 
+    /// Append a row that `fill` writes into its [`Table::width`] values (zero before): a recorded
+    /// row is written in place, not collected from an iterator of unknown length.
+    pub fn push_with(&mut self, fill: impl FnOnce(&mut [f64])) {
+        let start = self.data.len();
+        self.data.resize(start + self.width, 0.0);
+        fill(&mut self.data[start..]);
+        self.rows += 1;
+    }
+
     /// Remove every row (the width and the storage are kept).
     pub fn clear(&mut self) {
         self.data.clear();
@@ -156,6 +165,22 @@ mod tests {
         assert_eq!(t.iter().len(), 3);
         t.clear();
         assert!(t.is_empty() && t.last().is_none() && t.iter().next().is_none());
+    }
+
+    /// A row written in place is the row pushed from its values; the closure sees exactly the
+    /// table's width (zeros), also for a table of no columns.
+    #[test]
+    fn a_row_written_in_place_is_the_row_pushed() {
+        let (mut a, mut b) = (Table::with_capacity(3, 2), Table::with_capacity(3, 0));
+        a.push([1.0, 2.0, 3.0]);
+        b.push_with(|row| {
+            assert_eq!(row, [0.0; 3]);
+            row.copy_from_slice(&[1.0, 2.0, 3.0]);
+        });
+        assert_eq!((a.len(), a.last()), (b.len(), b.last()));
+        let mut empty = Table::with_capacity(0, 1);
+        empty.push_with(|row| assert!(row.is_empty()));
+        assert_eq!(empty.len(), 1);
     }
 
     /// A run that records no column still has one (empty) row per recorded time.
