@@ -22,6 +22,13 @@ use plantwide::solve::dae::{Bdf, BdfSettings, DaeIntegrator};
 use plantwide::solve::dynamic::{SimulationResult, Start, simulate};
 use plantwide::solve::{NewtonSettings, steady_state};
 
+/// The number of timed runs: `--repeats N` on the command line (cargo adds `--bench`), else 15.
+fn repeats() -> usize {
+    let args: Vec<String> = std::env::args().collect();
+    let n = args.windows(2).find(|w| w[0] == "--repeats").map(|w| w[1].parse().expect("--repeats takes a count"));
+    n.unwrap_or(15).max(1)
+}
+
 fn main() {
     let root = env!("CARGO_MANIFEST_DIR");
     let flowsheet = format!("{root}/flowsheets/column_a.json");
@@ -41,7 +48,7 @@ fn main() {
     };
     let median = |final_only: bool| -> (Duration, SimulationResult) {
         let (_, res) = once_with(final_only);
-        let mut times: Vec<Duration> = (0..15).map(|_| once_with(final_only).0).collect();
+        let mut times: Vec<Duration> = (0..repeats()).map(|_| once_with(final_only).0).collect();
         times.sort();
         (times[times.len() / 2], res)
     };
@@ -99,7 +106,7 @@ struct OdeRun {
 }
 
 /// The scenario (its feed step to 1.01 kmol/min, duration and tolerances) on the peers' ODE from
-/// the plant's steady holdups `x0`, median of 15 runs after one untimed.
+/// the plant's steady holdups `x0`, median of [`repeats`] runs after one untimed.
 fn ode_run(
     plant: &plantwide::flowsheet::Plant,
     x0: &[f64],
@@ -129,7 +136,7 @@ fn ode_run(
         (t.elapsed(), bdf)
     };
     let (_, bdf) = once();
-    let mut times: Vec<Duration> = (0..15).map(|_| once().0).collect();
+    let mut times: Vec<Duration> = (0..repeats()).map(|_| once().0).collect();
     times.sort();
     let x = bdf.x();
     let frac = |i: usize| x[2 * i] / (x[2 * i] + x[2 * i + 1]);

@@ -27,8 +27,8 @@ Peers:
                       linear solver (csparse, sparse direct) and Newton scheme ("direct"); same rtol and
                       scalar abstol. "idas" is the same ODE handed to IDAS in implicit form. The integrator
                       is built once outside the timing loop; only the call I(x0=..., p=...) is timed.
-  plantwide           `cargo bench --bench dynamics` run once from the repository root (median of 15 runs
-                      inside the bench; exact Jacobians by dual numbers); --no-plantwide skips it,
+  plantwide           `cargo bench --bench dynamics -- --repeats N` from the repository root (median of N
+                      runs inside the bench; exact Jacobians by dual numbers); --no-plantwide skips it,
                       --plantwide-json '<json line>' passes its last line in instead. Its line also
                       carries ("ode") plantwide's BDF on this script's 82-state ODE written in Rust
                       (benches/column_a_ode.rs), the integrator without the plant's DAE formulation.
@@ -39,14 +39,20 @@ each interpolates its BDF polynomial there, as plantwide does): "wall_s" and the
 final state alone (no output grid; plantwide's scenario recording only its end) is reported beside it as
 "final_only_wall_s" and "ratios_final_only".
 
-The figures are medians on this machine (2 cores, shared with whatever else is running): compare ratios
-from one run, not absolute times across runs.
+Rounds: the peers are timed in turn, plantwide then SciPy, CVODE and CasADi, and that round is repeated
+(--rounds, default 5). A shared machine's speed drifts by a factor of 2-3 over seconds (seen on this
+2-core VM: the same binary's run took 2.2 ms, then 5.8 ms, then 2.3 ms), so a ratio is taken inside a
+round, between peers timed seconds apart, and the figure reported ("ratios", "ratios_final_only") is
+the median of the rounds' ratios, each round's listed beside it ("ratios_by_round"). A peer's times in
+the JSON are the medians over the rounds of its per-round medians ("wall_s_by_round" beside them);
+its counters are the last round's. Compare ratios, not absolute times across runs.
 
 Usage (virtual environment outside the repository):
   python3 -m venv /work/venv-bench && /work/venv-bench/bin/pip install numpy scipy casadi scikit-sundae
   /work/venv-bench/bin/python tools/bench_dynamics_peers.py [--no-plantwide | --plantwide-json '<json>']
-                                                           [--repeats N]
---repeats N (default 21) is the number of timed runs of SciPy and CVODE; CasADi gets 3 N (it is fast).
+                                                           [--repeats N] [--plantwide-repeats M] [--rounds R]
+--repeats N (default 21) is the number of timed runs of SciPy and CVODE in a round; CasADi gets 3 N (it
+is fast); --plantwide-repeats M (default 15) plantwide's in its bench.
 numpy and scipy are required; a peer whose package (scikit-sundae, casadi) is missing is skipped with a
 note in the JSON. Prints one line per peer, then one JSON line.
 """
@@ -220,8 +226,9 @@ def run_casadi(ca, dae, n0, repeats, plugin):
             "config": f"CasADi {ca.__version__} {plugin}, SX RHS, AD Jacobian, csparse"}
 
 
-def run_plantwide(root):
-    out = subprocess.run(["cargo", "bench", "--bench", "dynamics"], cwd=root, capture_output=True, text=True)
+def run_plantwide(root, repeats):
+    cmd = ["cargo", "bench", "--bench", "dynamics", "--", "--repeats", str(repeats)]
+    out = subprocess.run(cmd, cwd=root, capture_output=True, text=True)
     lines = [line for line in out.stdout.splitlines() if line.startswith('{"wall_s":')]
     if out.returncode != 0 or not lines:
         tail = "\n".join(out.stderr.splitlines()[-10:])
@@ -229,110 +236,45 @@ def run_plantwide(root):
     return json.loads(lines[-1])
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--no-plantwide", action="store_true", help="skip `cargo bench --bench dynamics`")
-    ap.add_argument("--plantwide-json", metavar="JSON", help="the bench's last line, instead of running it")
-    ap.add_argument("--repeats", type=int, default=21, help="timed runs for SciPy and CVODE (CasADi: 3x)")
-    args = ap.parse_args()
-    root = Path(__file__).resolve().parent.parent
-    result = {"model": "column_a_feed_step_2000min", "rtol": RTOL, "atol": 1e-8}
-
-    # plantwide first, so that its build (if any) is over before the Python peers are timed
+def measure_round(args, root, n0, casadi):
+    """One round: plantwide's bench, then every Python peer; {peer: its figures}."""
+    out = {}
     if args.plantwide_json:
-        pw = json.loads(args.plantwide_json)
+        out["plantwide"] = json.loads(args.plantwide_json)
     elif args.no_plantwide:
-        pw = {"skipped": "--no-plantwide"}
+        out["plantwide"] = {"skipped": "--no-plantwide"}
     else:
         try:
-            pw = run_plantwide(root)
+            out["plantwide"] = run_plantwide(root, args.plantwide_repeats)
         except RuntimeError as e:
-            pw = {"error": str(e).splitlines()[0]}
+            out["plantwide"] = {"error": str(e).splitlines()[0]}
             print(e, file=sys.stderr)
-    result["plantwide"] = pw
-    if "wall_s" in pw:
-        final_ms = pw.get("final_only", {}).get("wall_s", float("nan")) * 1e3
-        print(f"plantwide BDF (median of 15, in the bench): {pw['wall_s'] * 1e3:.2f} ms recording every 2 min, "
-              f"{final_ms:.2f} ms recording the end only, {pw['steps']} steps, "
-              f"{pw['residual_evals']} residual evaluations, {pw['jacobian_evals']} exact Jacobians, {pw['lu']} LU; "
-              f"xB = {pw['xB']:.10f}, yD = {pw['yD']:.10f}")
-    else:
-        print(f"plantwide: {pw}")
-    ode = pw.get("ode", {})
-    if "wall_s" in ode:
-        print(f"plantwide BDF on this script's 82-state ODE (benches/column_a_ode.rs, hand-derived Jacobian; the "
-              f"integrator without the plant DAE): {ode['wall_s'] * 1e3:.2f} ms, {ode['steps']} steps, "
-              f"{ode['residual_evals']} RHS evaluations, {ode['lu']} LU; xB = {ode['xB']:.10f}")
-
-    n0 = model.steady_state()
-    xb0, yd0 = ends(n0)
-    res0 = float(np.max(np.abs(model.rhs(0.0, n0, model.F_NOM))))
-    print(f"Python peers: numpy {np.__version__}, SciPy {scipy.__version__}; initial steady state at F = 1 "
-          f"kmol/min (fsolve): xB = {xb0:.10f}, yD = {yd0:.10f}, max |dn/dt| = {res0:.1e} mol/s")
-    result["initial"] = {"xB": xb0, "yD": yd0, "max_abs_rhs_mol_s": res0, "xB_minus_0.01": xb0 - 0.01,
-                         "yD_minus_0.99": yd0 - 0.99,
-                         "note": "one array for all Python peers; plantwide converges its own (yD 0.99, xB 0.01)"}
-
-    s = run_scipy(n0, args.repeats)
-    result["scipy_bdf"] = s
-    print(f"SciPy BDF (median of {args.repeats}): {s['wall_s'] * 1e3:.2f} ms on the grid, "
-          f"{s['final_only_wall_s'] * 1e3:.2f} ms final only, {s['steps']} steps, {s['rhs_evals']} RHS "
-          f"evaluations (incl. FD Jacobians), {s['jacobian_evals']} Jacobians, {s['lu']} LU; "
-          f"xB = {s['xB']:.10f}, yD = {s['yD']:.10f}")
-
+    out["scipy_bdf"] = run_scipy(n0, args.repeats)
     try:
-        import sksundae
+        import sksundae  # noqa: F401
         for key, ls in (("cvode_python", "band"), ("cvode_python_dense", "dense")):
-            c = run_cvode(n0, args.repeats, ls)
-            result[key] = c
-            print(f"CVODE (scikit-sundae {sksundae.__version__}, {ls}, median of {args.repeats}): "
-                  f"{c['wall_s'] * 1e3:.2f} ms on the grid, {c['final_only_wall_s'] * 1e3:.2f} ms final only, "
-                  f"{c['steps']} steps, {c['rhs_calls']} Python RHS calls "
-                  f"({c['rhs_evals_nfe']} + DQ Jacobians), {c['jacobian_evals']} Jacobians; Python RHS "
-                  f"{c['rhs_calls']} x {c['rhs_call_s'] * 1e6:.1f} us = {c['rhs_s'] * 1e3:.2f} ms "
-                  f"({100 * c['rhs_fraction']:.0f} %); xB = {c['xB']:.10f}, yD = {c['yD']:.10f}")
+            out[key] = run_cvode(n0, args.repeats, ls)
     except ImportError:
-        result["cvode_python"] = {"skipped": "scikit-sundae not installed"}
-        print("CVODE: skipped (scikit-sundae not installed)")
-
-    try:
-        ca, dae, _, sx_diff = casadi_model(n0)
-        result["casadi_rhs_vs_numpy_max_rel_diff"] = sx_diff
-        print(f"CasADi {ca.__version__}: SX RHS against numpy RHS, max relative difference {sx_diff:.1e}")
+        out["cvode_python"] = {"skipped": "scikit-sundae not installed"}
+    if casadi is None:
+        out["casadi_cvodes"] = out["casadi_idas"] = {"skipped": "casadi not installed"}
+    else:
+        ca, dae = casadi
         for key, plugin in (("casadi_cvodes", "cvodes"), ("casadi_idas", "idas")):
-            c = run_casadi(ca, dae, n0, 3 * args.repeats, plugin)
-            result[key] = c
-            print(f"CasADi {plugin} (median of {3 * args.repeats}): {c['wall_s'] * 1e3:.2f} ms on the grid, "
-                  f"{c['final_only_wall_s'] * 1e3:.2f} ms final only, {c['steps']} steps, "
-                  f"{c['rhs_evals']} RHS evaluations, {c['jacobian_evals']} AD Jacobians, {c['lu']} LU setups, "
-                  f"{c['error_test_failures']} error-test failures; xB = {c['xB']:.10f}, yD = {c['yD']:.10f}")
-    except ImportError:
-        result["casadi_cvodes"] = result["casadi_idas"] = {"skipped": "casadi not installed"}
-        print("CasADi: skipped (casadi not installed)")
+            out[key] = run_casadi(ca, dae, n0, 3 * args.repeats, plugin)
+    return out
 
-    peers = [k for k in PEERS if "xB" in result.get(k, {})]
-    ref_name = "plantwide" if "plantwide" in peers else "reference (plantwide's earlier bench)"
-    ref = result["plantwide"] if "plantwide" in peers else {"xB": XB_REF, "yD": YD_REF}
-    agreement = {"against": ref_name}
-    for k in peers:
-        if k != "plantwide":
-            agreement[k] = {"xB_rel": abs(result[k]["xB"] / ref["xB"] - 1.0),
-                            "yD_rel": abs(result[k]["yD"] / ref["yD"] - 1.0)}
-    agreement["max_rel"] = max([max(v["xB_rel"], v["yD_rel"]) for k, v in agreement.items() if isinstance(v, dict)],
-                               default=0.0)
-    result["agreement"] = agreement
-    print(f"final values against {ref_name}: largest relative difference {agreement['max_rel']:.1e} "
-          f"({'within' if agreement['max_rel'] < 1e-6 else 'OUTSIDE'} 1e-6); "
-          + ", ".join(f"{k} xB {v['xB_rel']:.1e} yD {v['yD_rel']:.1e}" for k, v in agreement.items()
-                      if isinstance(v, dict)))
 
-    # Equal work: every peer's trajectory at the 1001 recorded times against plantwide's recorded run
-    # ("wall_s"); then the final state alone on both sides ("final_only_wall_s"; plantwide's ODE run
-    # records nothing, so it is compared there).
+def round_ratios(r):
+    """Wall-time ratios of one round: every peer's trajectory at the 1001 recorded times against
+    plantwide's recorded run, then the final state alone on both sides (plantwide's ODE run records
+    nothing, so it is compared there). Peers slower than plantwide as peer/plantwide, CasADi as
+    plantwide/CasADi."""
+    pw = r.get("plantwide", {})
+    pw_final, ode = pw.get("final_only", {}), pw.get("ode", {})
     ratios, final_ratios = {}, {}
-    pw_final = pw.get("final_only", {})
     for k in ("scipy_bdf", "cvode_python", "cvode_python_dense", "casadi_cvodes", "casadi_idas"):
-        peer = result.get(k, {})
+        peer = r.get(k, {})
         if "wall_s" not in peer:
             continue
         casadi = k.startswith("casadi")
@@ -345,13 +287,137 @@ def main():
                 else peer["final_only_wall_s"] / pw_final["wall_s"])
         if casadi and "wall_s" in ode:
             final_ratios[f"plantwide_ode/{k}"] = ode["wall_s"] / peer["final_only_wall_s"]
-    result["ratios"] = ratios
-    result["ratios_final_only"] = final_ratios
-    if ratios:
-        print("wall-time ratios, equal work (1001-point trajectories): "
-              + ", ".join(f"{k} {v:.2f}" for k, v in ratios.items()))
-    if final_ratios:
-        print("wall-time ratios, final state only: " + ", ".join(f"{k} {v:.2f}" for k, v in final_ratios.items()))
+    return ratios, final_ratios
+
+
+def median_of(dicts):
+    """{key: median over the dicts that have it}."""
+    keys = [k for k in dicts[0]] if dicts else []
+    return {k: statistics.median(d[k] for d in dicts if k in d) for k in keys}
+
+
+def merge_rounds(rounds):
+    """Each peer's figures from the last round, its times replaced by their medians over the rounds
+    (the per-round medians listed beside them)."""
+    merged = {}
+    for k, last in rounds[-1].items():
+        entry = dict(last)
+        for key in ("wall_s", "final_only_wall_s"):
+            walls = [r[k][key] for r in rounds if key in r.get(k, {})]
+            if walls:
+                entry[key], entry[f"{key}_by_round"] = statistics.median(walls), walls
+        if k == "plantwide" and "final_only" in last:
+            walls = [r[k]["final_only"]["wall_s"] for r in rounds if "final_only" in r.get(k, {})]
+            entry["final_only"] = {"wall_s": statistics.median(walls), "wall_s_by_round": walls}
+        merged[k] = entry
+    return merged
+
+
+def describe(result, rounds):
+    """The human-readable lines: each peer's figures (times: medians over the rounds)."""
+    pw, ode = result["plantwide"], result["plantwide"].get("ode", {})
+    if "wall_s" in pw:
+        final_ms = pw.get("final_only", {}).get("wall_s", float("nan")) * 1e3
+        print(f"plantwide BDF: {pw['wall_s'] * 1e3:.2f} ms recording every 2 min, "
+              f"{final_ms:.2f} ms recording the end only, {pw['steps']} steps, "
+              f"{pw['residual_evals']} residual evaluations, {pw['jacobian_evals']} exact Jacobians, {pw['lu']} LU; "
+              f"xB = {pw['xB']:.10f}, yD = {pw['yD']:.10f}")
+    else:
+        print(f"plantwide: {pw}")
+    if "wall_s" in ode:
+        print(f"plantwide BDF on this script's 82-state ODE (benches/column_a_ode.rs, hand-derived Jacobian; the "
+              f"integrator without the plant DAE): {ode['wall_s'] * 1e3:.2f} ms, {ode['steps']} steps, "
+              f"{ode['residual_evals']} RHS evaluations, {ode['lu']} LU; xB = {ode['xB']:.10f}")
+    s = result["scipy_bdf"]
+    print(f"SciPy BDF: {s['wall_s'] * 1e3:.2f} ms on the grid, "
+          f"{s['final_only_wall_s'] * 1e3:.2f} ms final only, {s['steps']} steps, {s['rhs_evals']} RHS "
+          f"evaluations (incl. FD Jacobians), {s['jacobian_evals']} Jacobians, {s['lu']} LU; "
+          f"xB = {s['xB']:.10f}, yD = {s['yD']:.10f}")
+    for key in ("cvode_python", "cvode_python_dense"):
+        c = result.get(key, {})
+        if "wall_s" in c:
+            print(f"CVODE ({c['config']}): {c['wall_s'] * 1e3:.2f} ms on the grid, "
+                  f"{c['final_only_wall_s'] * 1e3:.2f} ms final only, "
+                  f"{c['steps']} steps, {c['rhs_calls']} Python RHS calls "
+                  f"({c['rhs_evals_nfe']} + DQ Jacobians), {c['jacobian_evals']} Jacobians; Python RHS "
+                  f"{c['rhs_calls']} x {c['rhs_call_s'] * 1e6:.1f} us = {c['rhs_s'] * 1e3:.2f} ms "
+                  f"({100 * c['rhs_fraction']:.0f} %); xB = {c['xB']:.10f}, yD = {c['yD']:.10f}")
+    for key in ("casadi_cvodes", "casadi_idas"):
+        c = result.get(key, {})
+        if "wall_s" in c:
+            print(f"{c['config']}: {c['wall_s'] * 1e3:.2f} ms on the grid, "
+                  f"{c['final_only_wall_s'] * 1e3:.2f} ms final only, {c['steps']} steps, "
+                  f"{c['rhs_evals']} RHS evaluations, {c['jacobian_evals']} AD Jacobians, {c['lu']} LU setups, "
+                  f"{c['error_test_failures']} error-test failures; xB = {c['xB']:.10f}, yD = {c['yD']:.10f}")
+    print(f"times above: medians over {len(rounds)} round(s) of each round's median")
+
+
+def agreement_of(result):
+    """The final xB, yD of every peer against plantwide's (or the reference values)."""
+    peers = [k for k in PEERS if "xB" in result.get(k, {})]
+    ref_name = "plantwide" if "plantwide" in peers else "reference (plantwide's earlier bench)"
+    ref = result["plantwide"] if "plantwide" in peers else {"xB": XB_REF, "yD": YD_REF}
+    agreement = {"against": ref_name}
+    for k in peers:
+        if k != "plantwide":
+            agreement[k] = {"xB_rel": abs(result[k]["xB"] / ref["xB"] - 1.0),
+                            "yD_rel": abs(result[k]["yD"] / ref["yD"] - 1.0)}
+    agreement["max_rel"] = max([max(v["xB_rel"], v["yD_rel"]) for k, v in agreement.items() if isinstance(v, dict)],
+                               default=0.0)
+    print(f"final values against {ref_name}: largest relative difference {agreement['max_rel']:.1e} "
+          f"({'within' if agreement['max_rel'] < 1e-6 else 'OUTSIDE'} 1e-6); "
+          + ", ".join(f"{k} xB {v['xB_rel']:.1e} yD {v['yD_rel']:.1e}" for k, v in agreement.items()
+                      if isinstance(v, dict)))
+    return agreement
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--no-plantwide", action="store_true", help="skip `cargo bench --bench dynamics`")
+    ap.add_argument("--plantwide-json", metavar="JSON", help="the bench's last line, instead of running it")
+    ap.add_argument("--repeats", type=int, default=21, help="timed runs for SciPy and CVODE (CasADi: 3x)")
+    ap.add_argument("--plantwide-repeats", type=int, default=15, help="timed runs of plantwide in its bench")
+    ap.add_argument("--rounds", type=int, default=5, help="rounds of every peer in turn (ratios: their median)")
+    args = ap.parse_args()
+    root = Path(__file__).resolve().parent.parent
+    result = {"model": "column_a_feed_step_2000min", "rtol": RTOL, "atol": 1e-8}
+
+    n0 = model.steady_state()
+    xb0, yd0 = ends(n0)
+    res0 = float(np.max(np.abs(model.rhs(0.0, n0, model.F_NOM))))
+    print(f"Python peers: numpy {np.__version__}, SciPy {scipy.__version__}; initial steady state at F = 1 "
+          f"kmol/min (fsolve): xB = {xb0:.10f}, yD = {yd0:.10f}, max |dn/dt| = {res0:.1e} mol/s")
+    result["initial"] = {"xB": xb0, "yD": yd0, "max_abs_rhs_mol_s": res0, "xB_minus_0.01": xb0 - 0.01,
+                         "yD_minus_0.99": yd0 - 0.99,
+                         "note": "one array for all Python peers; plantwide converges its own (yD 0.99, xB 0.01)"}
+    try:
+        ca, dae, _, sx_diff = casadi_model(n0)
+        casadi = (ca, dae)
+        result["casadi_rhs_vs_numpy_max_rel_diff"] = sx_diff
+        print(f"CasADi {ca.__version__}: SX RHS against numpy RHS, max relative difference {sx_diff:.1e}")
+    except ImportError:
+        casadi = None
+
+    rounds, by_round = [], []
+    for k in range(max(1, args.rounds)):
+        rounds.append(measure_round(args, root, n0, casadi))
+        by_round.append(round_ratios(rounds[-1]))
+        print(f"round {k + 1}: " + ", ".join(f"{name} {v:.2f}" for name, v in by_round[-1][0].items())
+              + "; final only: " + ", ".join(f"{name} {v:.2f}" for name, v in by_round[-1][1].items()))
+    result.update(merge_rounds(rounds))
+    describe(result, rounds)
+    result["agreement"] = agreement_of(result)
+    result["rounds"] = len(rounds)
+    result["ratios"] = median_of([r for r, _ in by_round])
+    result["ratios_final_only"] = median_of([f for _, f in by_round])
+    result["ratios_by_round"] = [r for r, _ in by_round]
+    result["ratios_final_only_by_round"] = [f for _, f in by_round]
+    if result["ratios"]:
+        print("wall-time ratios, equal work (1001-point trajectories), median of the rounds' ratios: "
+              + ", ".join(f"{k} {v:.2f}" for k, v in result["ratios"].items()))
+    if result["ratios_final_only"]:
+        print("wall-time ratios, final state only, median of the rounds' ratios: "
+              + ", ".join(f"{k} {v:.2f}" for k, v in result["ratios_final_only"].items()))
     print(json.dumps(result))
 
 
