@@ -33,6 +33,8 @@
 
 use plantwide_units::Dimension;
 
+mod kernels;
+
 use super::{ColumnConfig, Draw, StageIdx, side_draws};
 
 use crate::stream::{F, H, P, T, Z0};
@@ -341,41 +343,6 @@ impl SimpleColumn {
     }
 }
 
-/// A stage's `M = Σ n`, `x = n/M` and `y = K x` in its variables `v` (returned: `M`), with
-/// constant `alpha` as `y_j = α_j n_j / Σ α n` (`= α_j x_j / Σ α x`: `M` cancels) or from
-/// `k_values(T, x, k)` (scratch `k`). On slices of the stage's blocks: this is the inner loop of
-/// every completion. With constant α the two divisions (`1/M`, `1/Σ α n`) are independent, where
-/// `1/Σ α x` waited on `x` and so on the first: on column A the chain of two divisions per stage
-/// was a quarter of the completion's time.
-fn stage_composition(
-    v: &mut [f64],
-    nc: usize,
-    alpha: Option<&[f64]>,
-    k_values: impl Fn(f64, &[f64], &mut [f64]),
-    k: &mut [f64],
-) -> f64 {
-    let ix = StageIdx { nc };
-    let (n, rest) = v.split_at_mut(nc);
-    let (x, rest) = rest.split_at_mut(nc);
-    let (y, tail) = rest.split_at_mut(nc);
-    let m = n.iter().fold(0.0, |a, b| a + b);
-    // One division: `x = n·(1/M)` is within an ulp of `n/M`.
-    let inv_m = 1.0 / m;
-    x.iter_mut().zip(n.iter()).for_each(|(xj, nj)| *xj = nj * inv_m);
-    match alpha {
-        Some(a) => {
-            let inv = n.iter().zip(a).fold(0.0, |d, (nj, aj)| d + nj * aj).recip();
-            y.iter_mut().zip(n.iter().zip(a)).for_each(|(yj, (nj, aj))| *yj = inv * aj * nj);
-        }
-        None => {
-            k_values(tail[0], x, k);
-            y.iter_mut().zip(x.iter().zip(k.iter())).for_each(|(yj, (xj, kj))| *yj = kj * xj);
-        }
-    }
-    v[ix.m()] = m;
-    m
-}
-
 impl UnitModel for SimpleColumn {
     fn type_name(&self) -> &'static str {
         "column"
@@ -550,94 +517,21 @@ impl UnitModel for SimpleColumn {
     /// values bit for bit), on slices of the stage and its neighbours and without allocation: this
     /// runs at every Newton iteration of the dynamic integrator.
     fn eval_kept(&self, io: &UnitIo<'_, f64>, own: &[f64], r: &mut [f64], skip: &[bool]) {
-        let (nc, n, ix, ps) = (self.nc(), self.n_stages, StageIdx { nc: self.nc() }, self.per_stage());
-        let internal0 = self.n_outlets() * io.layout.stream.len();
-        let stages = &own[internal0..internal0 + n * ps];
-        let d_in = io.input(IN_DISTILLATE);
-        for (s, v) in stages.chunks_exact(ps).enumerate() {
-            let o = internal0 + s * ps;
-            let up = (s + 1 < n).then(|| &stages[(s + 1) * ps..(s + 2) * ps]);
-            let dn = (s > 0).then(|| &stages[(s - 1) * ps..s * ps]);
-            for j in 0..nc {
-                let feed = self.feeds.iter().enumerate().filter(|(_, f)| f.stage == s).fold(0.0, |acc, (k, _)| {
-                    let inlet = io.inlet(k);
-                    acc + inlet.f() * inlet.z()[j]
-                });
-                let xj = v[ix.x(j)];
-                let mut acc = feed - v[ix.l()] * xj - v[ix.v()] * v[ix.y(j)];
-                if let Some(up) = up {
-                    acc += up[ix.l()] * up[ix.x(j)];
-                }
-                if let Some(dn) = dn {
-                    acc += dn[ix.v()] * dn[ix.y(j)];
-                }
-                if s + 1 == n {
-                    acc -= d_in * xj;
-                }
-                for (k, d) in self.draws.iter().enumerate() {
-                    if d.stage == s {
-                        acc -= io.input(4 + k) * xj;
-                    }
-                }
-                r[o + ix.n(j)] = acc;
-            }
-            if !skip.get(o + ix.t()).copied().unwrap_or(false) {
-                r[o + ix.t()] = io.thermo.bubble_residual(v[ix.t()], self.pressure, &v[ix.x(0)..ix.x(0) + nc]);
-            }
+        match self.nc() {
+            2 => self.eval_kept_nc::<2>(io, own, r, skip),
+            3 => self.eval_kept_nc::<3>(io, own, r, skip),
+            4 => self.eval_kept_nc::<4>(io, own, r, skip),
+            _ => self.eval_kept_nc::<0>(io, own, r, skip),
         }
     }
     /// `M = Σ n`, `x = n/M`, `y = K(T, P, x) x`, the CMO vapour flows, the liquid flows and the
     /// outlets, each from its own equation of [`UnitModel::eval`] (module documentation).
     fn complete(&self, io: &UnitIo<'_, f64>, own: &mut [f64]) {
-        let (nc, n, ix, ps) = (self.nc(), self.n_stages, StageIdx { nc: self.nc() }, self.per_stage());
-        let (outs, stages) = own.split_at_mut(self.n_outlets() * io.layout.stream.len());
-        let mut k_stack = [0.0; 8];
-        let mut k_heap = Vec::new();
-        let k: &mut [f64] = if nc <= k_stack.len() {
-            &mut k_stack[..nc]
-        } else {
-            k_heap.resize(nc, 0.0);
-            &mut k_heap
-        };
-        let alpha = io.thermo.constant_alpha();
-        // One pass up the column: each stage's M, x, y, then its V (from the V below) and L.
-        let mut v_below = 0.0;
-        for (s, v) in stages[..n * ps].chunks_exact_mut(ps).enumerate() {
-            let m = stage_composition(v, nc, alpha, |t, x, k| io.thermo.k_values(t, self.pressure, x, k), k);
-            // The feed quality may read this stage's x and y, just computed.
-            let fed: f64 =
-                (0..self.feeds.len()).filter(|&f| self.feeds[f].stage == s).map(|f| self.feed_vapour(io, f, v)).sum();
-            v[ix.v()] = match s {
-                0 => io.input(IN_BOILUP) + fed,
-                _ if s + 1 == n => 0.0,
-                _ => v_below + fed,
-            };
-            v[ix.l()] = match s {
-                _ if s + 1 == n => io.input(IN_REFLUX),
-                0 => io.input(IN_BOTTOMS),
-                _ => {
-                    let l = self.l0[s] + (m - self.m0[s]) / self.tau_l;
-                    if self.lambda != 0.0 { l + (v_below - self.v0) * self.lambda } else { l }
-                }
-            };
-            v_below = v[ix.v()];
-        }
-        let slen = io.layout.stream.len();
-        let mut outlet = |k: usize, s: usize, flow: f64| {
-            let v = &stages[self.stage(s)..self.stage(s) + ps];
-            let x = &v[ix.x(0)..ix.x(0) + nc];
-            let out = &mut outs[k * slen..(k + 1) * slen];
-            out[F] = flow;
-            out[T] = v[ix.t()];
-            out[P] = self.pressure;
-            out[H] = io.thermo.h_liq(v[ix.t()], x);
-            out[Z0..Z0 + nc].copy_from_slice(x);
-        };
-        let bottoms = stages[self.stage(0) + ix.l()];
-        outlet(0, n - 1, io.input(IN_DISTILLATE));
-        outlet(1, 0, bottoms);
-        for (k, d) in self.draws.iter().enumerate() {
-            outlet(2 + k, d.stage, io.input(4 + k));
+        match self.nc() {
+            2 => self.complete_nc::<2>(io, own),
+            3 => self.complete_nc::<3>(io, own),
+            4 => self.complete_nc::<4>(io, own),
+            _ => self.complete_nc::<0>(io, own),
         }
     }
     fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]) {
@@ -844,6 +738,35 @@ mod tests {
                         full[k]
                     );
                 }
+            }
+        }
+    }
+
+    /// The kernels with the component count a compile-time constant ([`super::kernels`]) give
+    /// the general loop's values bit for bit: completion and kept residuals, for every
+    /// configuration, constant α and temperature-dependent K-values, at perturbed points.
+    #[test]
+    fn the_unrolled_kernels_equal_the_general_loop_bit_for_bit() {
+        let (ideal, feed) = subcooled_feed();
+        let alpha = ThermoPackage { vle: VleModel::ConstantAlpha { alpha: vec![2.0, 1.0] }, ..ideal.clone() };
+        let mut rng = Lcg(13);
+        for ((f, extra), thermo) in CONFIGS.into_iter().flat_map(|c| [(c, &ideal), (c, &alpha)]) {
+            let u = column_in(thermo, f, extra);
+            let Column::Simple(c) = &u else { panic!("a simple column") };
+            let (lay, guess) = at_guess(&u, thermo, &feed);
+            let m = lay.n_own();
+            for _ in 0..3 {
+                let local: Vec<f64> = guess.iter().map(|&v| v * rng.range(0.8, 1.2) + rng.range(0.0, 1e-3)).collect();
+                let io = UnitIo { local: &local, layout: &lay, thermo, time: 0.0 };
+                let (mut fixed, mut general) = (local[..m].to_vec(), local[..m].to_vec());
+                c.complete_nc::<2>(&io, &mut fixed);
+                c.complete_nc::<0>(&io, &mut general);
+                let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                assert_eq!(bits(&fixed), bits(&general), "{f}{extra}: completion");
+                let (mut r_fixed, mut r_general) = (vec![0.0; m], vec![0.0; m]);
+                c.eval_kept_nc::<2>(&io, &fixed, &mut r_fixed, &[]);
+                c.eval_kept_nc::<0>(&io, &fixed, &mut r_general, &[]);
+                assert_eq!(bits(&r_fixed), bits(&r_general), "{f}{extra}: kept residuals");
             }
         }
     }
