@@ -63,11 +63,16 @@ pub(super) struct Factors {
     /// columns), if they hold them: a refactorization resumes at the first column whose entries
     /// changed (see [`Factors::refactor`]).
     factored: Option<Vec<f64>>,
-    /// For each value index, the permuted column it lies in.
+    /// For each value index, the permuted column and row it lies in.
     col_of: Vec<usize>,
+    row_of: Vec<usize>,
     /// The row maxima of `|values|` over the permuted columns before `.0`, kept between
     /// refactorizations that leave those columns unchanged (the partial ones).
     head_max: Option<(usize, Vec<f64>)>,
+    /// The row maxima of `|values|` over the entries outside the `changed` list of
+    /// [`Factors::refactor`], kept between refactorizations that change only those entries (the
+    /// shifts of the BDF's iteration matrix): only the listed entries are then folded in.
+    fixed_max: Option<Vec<f64>>,
     /// Columns eliminated by refactorizations so far (tests).
     #[cfg(test)]
     eliminated: usize,
@@ -105,9 +110,11 @@ impl Factors {
             }
             f.a_ptr.push(f.a_row.len());
         }
-        f.col_of = vec![0; f.a_idx.len()];
+        (f.col_of, f.row_of) = (vec![0; f.a_idx.len()], vec![0; f.a_idx.len()]);
         for j in 0..n {
-            (f.a_ptr[j]..f.a_ptr[j + 1]).for_each(|p| f.col_of[f.a_idx[p]] = j);
+            for p in f.a_ptr[j]..f.a_ptr[j + 1] {
+                (f.col_of[f.a_idx[p]], f.row_of[f.a_idx[p]]) = (j, f.a_row[p]);
+            }
         }
         let (mut mark, mut stack, mut reach) = (vec![usize::MAX; n], Vec::new(), Vec::new());
         f.l_ptr.push(0);
@@ -194,7 +201,11 @@ impl Factors {
         };
         debug_assert!(start <= self.first_changed(values), "an entry changed outside `changed`");
         let factored = self.factored.take();
-        self.eliminate(values, check, start)?;
+        // The maxima outside `changed` hold only while nothing else can have changed.
+        if factored.is_none() || changed.is_none() {
+            self.fixed_max = None;
+        }
+        self.eliminate(values, check, start, changed)?;
         let mut held = factored.unwrap_or_default();
         held.clear();
         held.extend_from_slice(values);
@@ -216,10 +227,40 @@ impl Factors {
         ks.iter().filter(|&&k| values[k].to_bits() != old[k].to_bits()).map(|&k| self.col_of[k]).min().unwrap_or(self.n)
     }
 
-    /// Reciprocal row maxima of `|values|` into `row_scale`, the maxima over the columns before
-    /// `start` (unchanged since the last refactorization from the same `start`) taken from
-    /// `head_max`, else computed and kept there.
-    fn scale_rows(&mut self, values: &[f64], start: usize) {
+    /// Reciprocal row maxima of `|values|` into `row_scale`. With `changed` (the only entries
+    /// that can differ from the values factored last), the maxima over the other entries come from
+    /// `fixed_max` (computed once and kept there) and only the `changed` entries are folded in;
+    /// otherwise the maxima over the columns before `start` (unchanged since the last
+    /// refactorization from the same `start`) come from `head_max`, else are computed and kept
+    /// there. A maximum is the same whatever the order its entries are taken in: the scales, and
+    /// so the pivot test, are those of one pass over every entry.
+    fn scale_rows(&mut self, values: &[f64], start: usize, changed: Option<&[usize]>) {
+        if let Some(ks) = changed {
+            let fixed = match self.fixed_max.take() {
+                Some(fixed) => fixed,
+                None => {
+                    let mut listed = vec![false; values.len()];
+                    ks.iter().for_each(|&k| listed[k] = true);
+                    let mut fixed = vec![0.0f64; self.n];
+                    for (&i, &k) in self.a_row.iter().zip(&self.a_idx).filter(|&(_, &k)| !listed[k]) {
+                        fixed[i] = fixed[i].max(values[k].abs());
+                    }
+                    fixed
+                }
+            };
+            let scale = &mut self.row_scale;
+            scale.clear();
+            scale.extend_from_slice(&fixed);
+            for &k in ks {
+                let i = self.row_of[k];
+                scale[i] = scale[i].max(values[k].abs());
+            }
+            scale.iter_mut().for_each(|s| *s = if *s > 0.0 { 1.0 / *s } else { 1.0 });
+            self.fixed_max = Some(fixed);
+            // The listed entries may lie in any column: the head maxima no longer hold.
+            self.head_max = None;
+            return;
+        }
         let row_max = |range: std::ops::Range<usize>, into: &mut [f64]| {
             for (&i, &k) in self.a_row[range.clone()].iter().zip(&self.a_idx[range]) {
                 into[i] = into[i].max(values[k].abs());
@@ -243,12 +284,18 @@ impl Factors {
 
     /// The elimination of [`Factors::refactor`] from column `start` on (the columns before it kept,
     /// their pivot test repeated under `check`).
-    fn eliminate(&mut self, values: &[f64], check: bool, start: usize) -> Result<(), NeedsPivoting> {
+    fn eliminate(
+        &mut self,
+        values: &[f64],
+        check: bool,
+        start: usize,
+        changed: Option<&[usize]>,
+    ) -> Result<(), NeedsPivoting> {
         let threshold = if check { PIVOT_THRESHOLD } else { 0.0 };
         // The test is on the row-equilibrated matrix (KLU's default scaling by row maxima): the
         // plant's equations have their own units, a pivot is small or large against its row.
         if check {
-            self.scale_rows(values, start);
+            self.scale_rows(values, start, changed);
         } else {
             self.head_max = None;
             self.row_scale.clear();

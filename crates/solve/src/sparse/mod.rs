@@ -768,6 +768,47 @@ mod tests {
         assert!(residual(&a, &x, &b) < 1e-14, "{x:?}");
     }
 
+    /// Shifts of `M/c − J` over twelve orders of magnitude on a 40 × 40 matrix with small
+    /// diagonal entries (pivots near the threshold test's bound) and every other diagonal pinned,
+    /// one after another: the refactorizations of the shifted pinned entries alone, whose pivot
+    /// test folds only those entries into the row maxima of the others (kept between shifts),
+    /// keep and replace the same pivots, and give the same solutions bit for bit, as the same
+    /// sequence of factorizations of the whole matrix (the maxima taken over every entry), also
+    /// across new Jacobians. A pinned entry a million times the rest of its row changes that
+    /// row's scale in the test.
+    #[test]
+    fn a_sequence_of_shifts_pivots_as_factorizations_of_the_whole_matrix_do() {
+        let (jac, b) = ring_matrix(4242, |u| 1e-3 * u);
+        let n = b.len();
+        let mass: Vec<(usize, usize)> = (0..n).step_by(2).map(|i| (i, i)).collect();
+        let (mut shifted, mut whole) = (SparseLu::default(), SparseLu::default());
+        shifted.load_pinned(n, &jac, &mass).unwrap();
+        whole.load_pinned(n, &jac, &mass).unwrap();
+        // Shifts log-uniform over [1e-6, 1e6], from a linear congruential generator.
+        let mut state = 99u64;
+        let shifts = (0..60).map(|_| {
+            state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+            10f64.powf(12.0 * (state >> 11) as f64 / (1u64 << 53) as f64 - 6.0)
+        });
+        for (step, s) in shifts.enumerate() {
+            // Every seventh shift, a new Jacobian: the maxima kept for the old one are stale.
+            if step % 7 == 6 {
+                let scaled: Vec<_> = jac.iter().map(|&(i, j, v)| (i, j, v * (1.0 + s.ln().abs()))).collect();
+                shifted.load_pinned(n, &scaled, &mass).unwrap();
+                whole.load_pinned(n, &scaled, &mass).unwrap();
+            }
+            shifted.factor_shifted(-1.0, s).unwrap();
+            whole.factor_mapped(|i, j, v| if i == j && i % 2 == 0 { -v + s } else { -v }).unwrap();
+            assert_eq!(shifted.pivots(), whole.pivots(), "pivots at shift {s}");
+            let (mut x, mut y) = (b.clone(), b.clone());
+            shifted.solve_in_place(&mut x).unwrap();
+            whole.solve_in_place(&mut y).unwrap();
+            assert!(x.iter().zip(&y).all(|(a, b)| a.to_bits() == b.to_bits()), "solution at shift {s}");
+        }
+        let (_, pivoting, refactors) = shifted.counts();
+        assert!(pivoting > 1 && refactors > 1, "both paths taken: {pivoting} pivoting, {refactors} refactorizations");
+    }
+
     #[test]
     fn singular_and_out_of_bounds_are_errors() {
         let mut lu = SparseLu::default();
