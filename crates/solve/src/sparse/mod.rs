@@ -456,7 +456,9 @@ impl SparseLu {
     fn solve_with(&mut self, b: &mut [f64], transpose: bool) -> Result<(), SparseError> {
         let (Some(f), true) = (&mut self.factors, self.factored) else { return Err(SparseError::NotFactored) };
         f.solve(b, transpose);
-        if b.iter().all(|v| v.is_finite()) { Ok(()) } else { Err(SparseError::NonFinite { n: self.n }) }
+        // Every entry is looked at (no early exit): the or-reduction runs as wide vector operations.
+        let non_finite = b.iter().fold(false, |acc, v| acc | !v.is_finite());
+        if non_finite { Err(SparseError::NonFinite { n: self.n }) } else { Ok(()) }
     }
 
     /// Factorize and solve `A x = b` in place.
@@ -807,6 +809,23 @@ mod tests {
         }
         let (_, pivoting, refactors) = shifted.counts();
         assert!(pivoting > 1 && refactors > 1, "both paths taken: {pivoting} pivoting, {refactors} refactorizations");
+    }
+
+    /// A non-finite entry anywhere in the solution, NaN or infinite, first or last, is an error;
+    /// finite solutions, however large, are not.
+    #[test]
+    fn a_non_finite_solution_is_an_error_wherever_it_is() {
+        let (t, b) = ring_matrix(31, |u| 4.0 + u);
+        let n = b.len();
+        let mut lu = SparseLu::default();
+        lu.factor(n, &t).unwrap();
+        for (k, bad) in [(0, f64::NAN), (n - 1, f64::INFINITY), (n / 2, f64::NEG_INFINITY)] {
+            let mut x = b.clone();
+            x[k] = bad;
+            assert!(matches!(lu.solve_in_place(&mut x), Err(SparseError::NonFinite { .. })), "{bad} at {k}");
+        }
+        let mut x: Vec<f64> = b.iter().map(|v| v * 1e300).collect();
+        assert!(lu.solve_in_place(&mut x).is_ok(), "large but finite");
     }
 
     #[test]
