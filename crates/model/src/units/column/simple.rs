@@ -650,6 +650,14 @@ mod tests {
         (thermo, feed)
     }
 
+    /// [`subcooled_feed`]'s package (temperature-dependent K-values) and its constant-α twin,
+    /// and the feed.
+    fn both_packages() -> ([ThermoPackage; 2], [f64; 6]) {
+        let (ideal, feed) = subcooled_feed();
+        let alpha = ThermoPackage { vle: VleModel::ConstantAlpha { alpha: vec![2.0, 1.0] }, ..ideal.clone() };
+        ([ideal, alpha], feed)
+    }
+
     /// The configurations that change which rows read what: feed quality given or from
     /// enthalpies, vapour dynamics (λ ≠ 0) with a side draw.
     const CONFIGS: [(&str, &str); 3] = [
@@ -665,8 +673,7 @@ mod tests {
     /// Jacobian; the coloured one also agrees with central differences.
     #[test]
     fn the_declared_pattern_holds_every_nonzero_and_colours_the_jacobian_exactly() {
-        let (ideal, feed) = subcooled_feed();
-        let alpha = ThermoPackage { vle: VleModel::ConstantAlpha { alpha: vec![2.0, 1.0] }, ..ideal.clone() };
+        let ([ideal, alpha], feed) = both_packages();
         let mut rng = Lcg(7);
         for ((f, extra), thermo) in CONFIGS.into_iter().flat_map(|c| [(c, &ideal), (c, &alpha)]) {
             let u = column_in(thermo, f, extra);
@@ -747,8 +754,7 @@ mod tests {
     /// configuration, constant α and temperature-dependent K-values, at perturbed points.
     #[test]
     fn the_unrolled_kernels_equal_the_general_loop_bit_for_bit() {
-        let (ideal, feed) = subcooled_feed();
-        let alpha = ThermoPackage { vle: VleModel::ConstantAlpha { alpha: vec![2.0, 1.0] }, ..ideal.clone() };
+        let ([ideal, alpha], feed) = both_packages();
         let mut rng = Lcg(13);
         for ((f, extra), thermo) in CONFIGS.into_iter().flat_map(|c| [(c, &ideal), (c, &alpha)]) {
             let u = column_in(thermo, f, extra);
