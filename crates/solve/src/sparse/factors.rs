@@ -227,38 +227,14 @@ impl Factors {
         ks.iter().filter(|&&k| values[k].to_bits() != old[k].to_bits()).map(|&k| self.col_of[k]).min().unwrap_or(self.n)
     }
 
-    /// Reciprocal row maxima of `|values|` into `row_scale`. With `changed` (the only entries
-    /// that can differ from the values factored last), the maxima over the other entries come from
-    /// `fixed_max` (computed once and kept there) and only the `changed` entries are folded in;
+    /// Reciprocal row maxima of `|values|` into `row_scale`: with `changed` (the only entries
+    /// that can differ from the values factored last) by [`Factors::scale_rows_changed`];
     /// otherwise the maxima over the columns before `start` (unchanged since the last
     /// refactorization from the same `start`) come from `head_max`, else are computed and kept
-    /// there. A maximum is the same whatever the order its entries are taken in: the scales, and
-    /// so the pivot test, are those of one pass over every entry.
+    /// there.
     fn scale_rows(&mut self, values: &[f64], start: usize, changed: Option<&[usize]>) {
         if let Some(ks) = changed {
-            let fixed = match self.fixed_max.take() {
-                Some(fixed) => fixed,
-                None => {
-                    let mut listed = vec![false; values.len()];
-                    ks.iter().for_each(|&k| listed[k] = true);
-                    let mut fixed = vec![0.0f64; self.n];
-                    for (&i, &k) in self.a_row.iter().zip(&self.a_idx).filter(|&(_, &k)| !listed[k]) {
-                        fixed[i] = fixed[i].max(values[k].abs());
-                    }
-                    fixed
-                }
-            };
-            let scale = &mut self.row_scale;
-            scale.clear();
-            scale.extend_from_slice(&fixed);
-            for &k in ks {
-                let i = self.row_of[k];
-                scale[i] = scale[i].max(values[k].abs());
-            }
-            scale.iter_mut().for_each(|s| *s = if *s > 0.0 { 1.0 / *s } else { 1.0 });
-            self.fixed_max = Some(fixed);
-            // The listed entries may lie in any column: the head maxima no longer hold.
-            self.head_max = None;
+            self.scale_rows_changed(values, ks);
             return;
         }
         let row_max = |range: std::ops::Range<usize>, into: &mut [f64]| {
@@ -280,6 +256,36 @@ impl Factors {
         row_max(self.a_ptr[start]..self.a_ptr[self.n], scale);
         scale.iter_mut().for_each(|s| *s = if *s > 0.0 { 1.0 / *s } else { 1.0 });
         self.head_max = Some((start, head));
+    }
+
+    /// [`Factors::scale_rows`] when only the entries `ks` can have changed: the maxima over the
+    /// other entries come from `fixed_max` (computed once and kept there) and only the `ks` are
+    /// folded in. A maximum is the same whatever the order its entries are taken in: the scales,
+    /// and so the pivot test, are those of one pass over every entry.
+    fn scale_rows_changed(&mut self, values: &[f64], ks: &[usize]) {
+        let fixed = match self.fixed_max.take() {
+            Some(fixed) => fixed,
+            None => {
+                let mut listed = vec![false; values.len()];
+                ks.iter().for_each(|&k| listed[k] = true);
+                let mut fixed = vec![0.0f64; self.n];
+                for (&i, &k) in self.a_row.iter().zip(&self.a_idx).filter(|&(_, &k)| !listed[k]) {
+                    fixed[i] = fixed[i].max(values[k].abs());
+                }
+                fixed
+            }
+        };
+        let scale = &mut self.row_scale;
+        scale.clear();
+        scale.extend_from_slice(&fixed);
+        for &k in ks {
+            let i = self.row_of[k];
+            scale[i] = scale[i].max(values[k].abs());
+        }
+        scale.iter_mut().for_each(|s| *s = if *s > 0.0 { 1.0 / *s } else { 1.0 });
+        self.fixed_max = Some(fixed);
+        // The listed entries may lie in any column: the head maxima no longer hold.
+        self.head_max = None;
     }
 
     /// The elimination of [`Factors::refactor`] from column `start` on (the columns before it kept,
