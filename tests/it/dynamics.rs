@@ -137,6 +137,24 @@ const COLUMN_A_STEP: &str = r#"{"format_version": 1, "duration": "2000 min",
                "totals": ["feed", "distillate", "bottoms"]}}"#;
 
 /// Column A (S&P 2005 §12.4), LV with P level loops, feed 1 → 1.01 kmol/min at t = 0.
+/// A run on a thread that has run before (its integrator recycled, `Bdf::recycle`) is the run
+/// a new integrator makes, bit for bit: after another plant (the sparse LU's pattern rebuilt)
+/// and after the same plant (its live matrix and analysis kept). The reference runs on a thread
+/// of its own, which has no integrator to recycle.
+#[test]
+fn a_run_after_runs_on_the_same_thread_is_bit_for_bit_a_fresh_run() {
+    let bits = |res: &SimulationResult| {
+        let rows: Vec<u64> = res.rows.iter().flat_map(|r| r.iter().map(|v| v.to_bits())).collect();
+        (res.x.iter().map(|v| v.to_bits()).collect::<Vec<u64>>(), rows, format!("{:?}", res.stats))
+    };
+    let fresh = std::thread::spawn(move || bits(&run("column_a.json", &[], COLUMN_A_STEP).2)).join().unwrap();
+    run("surge_tank_pi.json", &[], TANK_STEP);
+    let after_other = bits(&run("column_a.json", &[], COLUMN_A_STEP).2);
+    assert!(after_other == fresh, "after another plant");
+    let after_same = bits(&run("column_a.json", &[], COLUMN_A_STEP).2);
+    assert!(after_same == fresh, "after the same plant");
+}
+
 #[test]
 fn column_a_feed_step_settles_on_the_new_steady_state_with_a_200_min_time_constant() {
     let (plant, x0, res) = run("column_a.json", &[], COLUMN_A_STEP);

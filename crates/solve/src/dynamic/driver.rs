@@ -22,6 +22,25 @@ use super::waveform::{Waveform, values_at};
 use super::{Column, Conservation, Progress, SimError, SimulationResult, Start, conservation};
 use crate::dae::{Bdf, BdfSettings, BdfState, DaeError, DaeIntegrator, DenseOutput};
 
+thread_local! {
+    /// The integrator of the last run finished on this thread, which the next run recycles
+    /// ([`Bdf::recycle`]: the same results as a new one, bit for bit, without redoing the sparse
+    /// LU's pattern work when the plant is the same). Studies run one plant many times, on the
+    /// calling thread or a rayon worker each; one integrator per thread is held between runs.
+    static SPARE: std::cell::RefCell<Option<Bdf>> = const { std::cell::RefCell::new(None) };
+}
+
+/// An integrator with `settings`: this thread's spare one recycled, else a new one.
+fn integrator(settings: BdfSettings) -> Bdf {
+    match SPARE.take() {
+        Some(mut bdf) => {
+            bdf.recycle(settings);
+            bdf
+        }
+        None => Bdf::new(settings),
+    }
+}
+
 /// One run in progress.
 pub(super) struct Driver<'p> {
     /// The caller's plant, or its copy rewired for this run.
@@ -178,7 +197,7 @@ impl<'p> Driver<'p> {
         let shape = DaeShape::new(&plant, &quad.streams, mpcs.is_empty().then_some(reads.as_slice()));
         // Between steps only the recorded variables are interpolated: the integrator need not
         // keep the history of the other explicit ones.
-        let mut bdf = Bdf::new(bdf_settings(sc));
+        let mut bdf = integrator(bdf_settings(sc));
         bdf.watch(&recorded);
         Ok(Driver {
             shape,
@@ -210,7 +229,7 @@ impl<'p> Driver<'p> {
     /// No budget of steps (a live run's duration is endless); before [`Driver::start`].
     /// A live run reads any variable at any time: none is output-only.
     pub(super) fn endless(&mut self) {
-        self.bdf = Bdf::new(BdfSettings { max_steps: usize::MAX, ..bdf_settings(&self.sc) });
+        self.bdf.recycle(BdfSettings { max_steps: usize::MAX, ..bdf_settings(&self.sc) });
         self.shape = DaeShape::new(&self.plant, &self.quad.streams, None);
     }
 
@@ -620,7 +639,7 @@ impl<'p> Driver<'p> {
             })
             .chain(std::iter::repeat_n(None, n_tot))
             .collect();
-        SimulationResult {
+        let result = SimulationResult {
             columns,
             times: self.times,
             rows: self.rows,
@@ -631,7 +650,9 @@ impl<'p> Driver<'p> {
             stats: self.bdf.stats(),
             conservation,
             mpc: self.mpcs.into_iter().map(|m| m.log).collect::<Vec<MpcLog>>(),
-        }
+        };
+        SPARE.set(Some(self.bdf));
+        result
     }
 }
 

@@ -8,7 +8,9 @@
 //! entries that have ever held a nonzero value. An entry that turns nonzero later (a controller
 //! leaving its limit, a tray that fills) joins it and the symbolic analysis is redone; an entry
 //! that returns to zero stays, as an explicit zero. The live pattern is therefore exact wherever the
-//! Jacobian has been evaluated, and never loses a value.
+//! Jacobian has been evaluated, and never loses a value — until [`SparseLu::forget_values`], which
+//! an integrator run again calls to factorize as a new LU would, keeping what the pattern alone
+//! determines.
 //!
 //! **Work per factorization.** The triplet → compressed-column map and the diagonal order
 //! (matching + AMD, `order.rs`) are computed once per live pattern, and the order with the
@@ -146,21 +148,22 @@ impl Structure {
         t.len() == triplets.len() && p == pinned && t.iter().zip(triplets).all(|(p, t)| p.0 == t.0 && p.1 == t.1)
     }
 
-    /// Sum the triplet values per slot; true if a slot outside the live pattern became nonzero
-    /// (it is added to the pattern).
-    fn accumulate(&mut self, triplets: &[(usize, usize, f64)]) -> bool {
+    /// Sum the triplet values per slot; a slot outside the live pattern that became nonzero is
+    /// added to it.
+    fn accumulate(&mut self, triplets: &[(usize, usize, f64)]) {
         self.sum.iter_mut().for_each(|s| *s = 0.0);
         for (t, &s) in triplets.iter().zip(&self.slot) {
             self.sum[s] += t.2;
         }
-        let mut grew = false;
         for (live, &v) in self.live.iter_mut().zip(&self.sum) {
-            if !*live && v != 0.0 {
-                *live = true;
-                grew = true;
-            }
+            *live |= v != 0.0;
         }
-        grew
+    }
+
+    /// The live pattern back to the pinned slots alone, as [`Structure::new`] leaves it.
+    fn reset_live(&mut self) {
+        self.live.iter_mut().for_each(|l| *l = false);
+        self.slot[self.n_triplets..].iter().for_each(|&k| self.live[k] = true);
     }
 }
 
@@ -198,6 +201,11 @@ impl Live {
         let mut f = Factors::symbolic(&source)?;
         f.refactor(&self.values, check, None).ok()?;
         Some(f)
+    }
+
+    /// Whether this is the live matrix of the slots `s.live` marks (its entries are those slots).
+    fn is_pattern_of(&self, s: &Structure) -> bool {
+        self.from.len() == s.live.iter().filter(|&&l| l).count() && self.from.iter().all(|&k| s.live[k])
     }
 
     fn new(n: usize, s: &Structure) -> Live {
@@ -288,14 +296,14 @@ impl SparseLu {
             self.live = None;
             self.n = n;
         }
-        let mut grew = self.structure.accumulate(triplets);
+        self.structure.accumulate(triplets);
         if live.len() == self.structure.live.len() {
-            for (l, &m) in self.structure.live.iter_mut().zip(live) {
-                grew |= m && !*l;
-                *l |= m;
-            }
+            self.structure.live.iter_mut().zip(live).for_each(|(l, &m)| *l |= m);
         }
-        if grew || self.live.is_none() {
+        // The held live matrix serves while its entries are the live slots: they only grow,
+        // except after [`SparseLu::forget_values`], where the same slots come back on the same
+        // pattern (a plant run again) and the live matrix, its analysis and the map are kept.
+        if self.live.as_ref().is_none_or(|l| !l.is_pattern_of(&self.structure)) {
             self.factors = None;
             self.live = Some(Live::new(n, &self.structure));
             self.counts.0 += 1;
@@ -475,6 +483,21 @@ impl SparseLu {
     /// Drop the numeric factors (the pattern and its symbolic analysis are kept).
     pub fn invalidate(&mut self) {
         self.factored = false;
+    }
+
+    /// Forget every value this LU has seen: the numeric factors and their pivot sequence, and
+    /// the entries that joined the live pattern by turning nonzero. The next load and
+    /// factorization are then those of a new `SparseLu`, bit for bit (the same live pattern,
+    /// the same pivots), while what the triplet pattern alone determines is kept: the
+    /// triplet → slot map and, when the same slots turn live again, the live matrix with its
+    /// analysis. For an integrator run again on the same plant.
+    pub fn forget_values(&mut self) {
+        self.factored = false;
+        self.factors = None;
+        self.structure.reset_live();
+        if let Some(live) = &mut self.live {
+            live.shifted = None;
+        }
     }
 
     /// Entries of the live pattern (the matrix factorized).
@@ -671,6 +694,45 @@ mod tests {
         restored.solve_in_place(&mut z).unwrap();
         assert_eq!(x.map(f64::to_bits), z.map(f64::to_bits));
         assert_eq!(restored.pivots().unwrap(), (rows.as_slice(), columns.as_slice()));
+    }
+
+    /// After [`SparseLu::forget_values`] an LU factorizes as a new one does, bit for bit: it
+    /// drops the pivots a refactorization kept (which a new LU would not take), and the entries
+    /// that joined the live pattern; it keeps the live matrix and its analysis when the same
+    /// slots turn live again.
+    #[test]
+    fn a_forgetful_lu_factorizes_as_a_new_one_and_keeps_its_analysis() {
+        let a = |a00: f64, a10: f64| vec![(0, 0, a00), (0, 1, 1.0), (1, 0, a10), (1, 1, 3.0), (1, 2, 1.0), (2, 2, 2.0)];
+        let b = [1.0, 2.0, 3.0];
+        let mut reused = SparseLu::default();
+        let mut x = b;
+        // Pivoting (a negligible a00), then a matrix refactorized on those pivots.
+        reused.solve(3, &a(1e-9, 0.6), &mut x).unwrap();
+        let t = a(0.3, 0.6);
+        reused.solve(3, &t, &mut x).unwrap();
+        let held = reused.pivots().map(|(r, c)| (r.to_vec(), c.to_vec())).unwrap();
+        let mut fresh = SparseLu::default();
+        let mut y = b;
+        fresh.solve(3, &t, &mut y).unwrap();
+        assert_ne!(fresh.pivots().unwrap(), (held.0.as_slice(), held.1.as_slice()));
+        reused.forget_values();
+        let mut x = b;
+        reused.solve(3, &t, &mut x).unwrap();
+        assert_eq!(reused.pivots(), fresh.pivots(), "the pivots of a new LU");
+        assert_eq!(x.map(f64::to_bits), y.map(f64::to_bits));
+        assert_eq!(reused.counts().0, 1, "the live matrix and its analysis kept");
+        // A structural zero that turned nonzero leaves the live pattern with the values.
+        let mut lu = SparseLu::default();
+        let mut x = [1.0, 2.0, 3.0];
+        lu.solve(3, &triplets(0.5), &mut x).unwrap();
+        assert_eq!(lu.live_nnz(), 8);
+        lu.forget_values();
+        let mut x = [1.0, 2.0, 3.0];
+        lu.solve(3, &triplets(0.0), &mut x).unwrap();
+        let mut y = [1.0, 2.0, 3.0];
+        SparseLu::default().solve(3, &triplets(0.0), &mut y).unwrap();
+        assert_eq!((lu.live_nnz(), lu.counts().0), (7, 2), "the pattern of the values loaded, analysed anew");
+        assert_eq!(x.map(f64::to_bits), y.map(f64::to_bits));
     }
 
     /// A tridiagonal matrix with its rows and columns permuted alike: the matching keeps the
