@@ -29,6 +29,11 @@
 //! [`DaeSystem::outputs`]: super::DaeSystem::outputs
 //! [`DaeSystem::complete`]: super::DaeSystem::complete
 
+use std::borrow::Cow;
+
+/// A matrix entry `(row, column, value)`.
+type Triplet = (usize, usize, f64);
+
 /// Why a reduced Jacobian could not be formed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ReduceError {
@@ -188,8 +193,8 @@ impl Reduction {
             out.extend_from_slice(jac);
             return Ok(());
         }
-        let (ptr, entries) = by_row(n, jac);
-        let row_of = |i: usize| &entries[ptr[i]..ptr[i + 1]];
+        let (ptr, rows) = by_row(n, jac);
+        let row_of = |i: usize| &rows[ptr[i]..ptr[i + 1]];
         let mut acc = Accumulator::new(self.n());
         // The gradients `dx_e/dx_k`, one sparse row per explicit variable, in compressed rows.
         let (mut g_ptr, mut g) = (vec![0usize], Vec::<(usize, f64)>::new());
@@ -199,7 +204,7 @@ impl Reduction {
             // An output read by an explicit equation makes its variable an output too (`reads`
             // marks it): no kept equation may read it (checked below), so the gradient left
             // without the output's column never reaches the iteration.
-            for &(c, v) in row_of(i).iter().filter(|e| e.1 != 0.0) {
+            for &(_, c, v) in row_of(i).iter().filter(|e| e.2 != 0.0) {
                 match self.position[c] {
                     _ if self.output[c] => reads_output[k] = true,
                     usize::MAX => acc.add(self.col[c], v),
@@ -219,7 +224,7 @@ impl Reduction {
             g_ptr.push(g.len());
         }
         for (r, &i) in self.kept_eqs.iter().enumerate() {
-            for &(c, v) in row_of(i).iter().filter(|e| e.1 != 0.0) {
+            for &(_, c, v) in row_of(i).iter().filter(|e| e.2 != 0.0) {
                 match self.position[c] {
                     p if self.output[c] || (p != usize::MAX && reads_output[p]) => {
                         acc.drain(|_, _| {});
@@ -246,8 +251,8 @@ impl Reduction {
     /// appear in its own equation.
     pub(crate) fn output_block(&self, jac: &[(usize, usize, f64)]) -> Result<Vec<(usize, usize, f64)>, ReduceError> {
         let n = self.position.len();
-        let (ptr, entries) = by_row(n, jac);
-        let row_of = |i: usize| entries[ptr[i]..ptr[i + 1]].iter().filter(|e| e.1 != 0.0);
+        let (ptr, rows) = by_row(n, jac);
+        let row_of = |i: usize| rows[ptr[i]..ptr[i + 1]].iter().filter(|e| e.2 != 0.0);
         let mut out_pos = vec![usize::MAX; n];
         self.outputs.iter().enumerate().for_each(|(k, &(_, j))| out_pos[j] = k);
         let mut acc = Accumulator::new(self.outputs.len());
@@ -255,7 +260,7 @@ impl Reduction {
         let (mut g_ptr, mut g) = (vec![0usize], Vec::<(usize, f64)>::new());
         for (k, &(i, j)) in self.explicit.iter().enumerate() {
             let mut pivot = 0.0;
-            for &(c, v) in row_of(i) {
+            for &(_, c, v) in row_of(i) {
                 match self.position[c] {
                     _ if out_pos[c] != usize::MAX => acc.add(out_pos[c], v),
                     p if p == k => pivot += v,
@@ -272,7 +277,7 @@ impl Reduction {
         }
         let mut out = Vec::new();
         for (r, &(i, _)) in self.outputs.iter().enumerate() {
-            for &(c, v) in row_of(i) {
+            for &(_, c, v) in row_of(i) {
                 match self.position[c] {
                     _ if out_pos[c] != usize::MAX => acc.add(out_pos[c], v),
                     usize::MAX => {}
@@ -285,27 +290,56 @@ impl Reduction {
     }
 }
 
-/// The triplets `jac` of an `n`-row matrix grouped by row: row `i`'s `(column, value)` entries
-/// are `entries[ptr[i]..ptr[i + 1]]` (duplicates kept: the reduction sums them).
-fn by_row(n: usize, jac: &[(usize, usize, f64)]) -> (Vec<usize>, Vec<(usize, f64)>) {
+/// The triplets `jac` of an `n`-row matrix grouped by row: row `i`'s triplets are
+/// `rows[ptr[i]..ptr[i + 1]]`, in the order they come (duplicates kept: the reduction sums
+/// them). A plant's Jacobian comes row by row (each block's declared pattern is sorted, the
+/// blocks follow their equations) and is then its own grouping, borrowed; any other order is
+/// grouped by a counting sort.
+fn by_row(n: usize, jac: &[Triplet]) -> (Vec<usize>, Cow<'_, [Triplet]>) {
     let mut ptr = vec![0usize; n + 1];
-    jac.iter().filter(|t| t.0 < n).for_each(|&(i, _, _)| ptr[i + 1] += 1);
+    let (mut sorted, mut last) = (true, 0);
+    for &(i, j, _) in jac {
+        let inside = i < n && j < n;
+        if inside {
+            ptr[i + 1] += 1;
+        }
+        sorted &= inside && i >= last;
+        last = i;
+    }
     for i in 0..n {
         ptr[i + 1] += ptr[i];
     }
-    let mut next = ptr.clone();
-    let mut entries = vec![(0usize, 0.0); ptr[n]];
-    for &(i, j, v) in jac.iter().filter(|t| t.0 < n && t.1 < n) {
-        entries[next[i]] = (j, v);
-        next[i] += 1;
+    if sorted {
+        return (ptr, Cow::Borrowed(jac));
     }
-    entries.truncate(ptr[n]);
-    (ptr, entries)
+    let mut next = ptr.clone();
+    let mut rows = vec![(0, 0, 0.0); ptr[n]];
+    for &t in jac.iter().filter(|t| t.0 < n && t.1 < n) {
+        rows[next[t.0]] = t;
+        next[t.0] += 1;
+    }
+    (ptr, Cow::Owned(rows))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Triplets that come row by row are their own grouping (borrowed); in another order, or with
+    /// an entry outside the matrix, they are grouped by the counting sort into the same rows, each
+    /// in the order its entries came.
+    #[test]
+    fn triplets_in_row_order_are_grouped_as_they_come() {
+        let sorted = vec![(0, 1, 1.0), (0, 0, 2.0), (0, 1, 3.0), (2, 2, 4.0), (2, 0, 5.0), (3, 3, 6.0)];
+        let (ptr, rows) = by_row(4, &sorted);
+        assert!(matches!(rows, Cow::Borrowed(_)));
+        assert_eq!(ptr, [0, 3, 3, 5, 6]);
+        let mut shuffled = vec![(2, 2, 4.0), (0, 1, 1.0), (3, 3, 6.0), (0, 0, 2.0), (2, 0, 5.0), (0, 1, 3.0)];
+        shuffled.push((1, 4, 7.0));
+        let (ptr_s, rows_s) = by_row(4, &shuffled);
+        assert!(matches!(rows_s, Cow::Owned(_)));
+        assert_eq!((ptr_s, rows_s.to_vec()), (ptr, rows.to_vec()));
+    }
 
     /// Dense matrix of reduced triplets (`m × m`).
     fn dense(m: usize, t: &[(usize, usize, f64)]) -> Vec<f64> {
