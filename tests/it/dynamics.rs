@@ -138,21 +138,36 @@ const COLUMN_A_STEP: &str = r#"{"format_version": 1, "duration": "2000 min",
 
 /// Column A (S&P 2005 §12.4), LV with P level loops, feed 1 → 1.01 kmol/min at t = 0.
 /// A run on a thread that has run before (its integrator recycled, `Bdf::recycle`) is the run
-/// a new integrator makes, bit for bit: after another plant (the sparse LU's pattern rebuilt)
-/// and after the same plant (its live matrix and analysis kept). The reference runs on a thread
-/// of its own, which has no integrator to recycle.
+/// a new integrator makes, bit for bit: after another plant (the sparse LU's pattern rebuilt),
+/// after the same plant (its live matrix, analysis and binding kept), and for the same plant
+/// recording other paths (another history kept) or at another tolerance (both bound anew). The
+/// references run on threads of their own, which have no integrator to recycle.
 #[test]
 fn a_run_after_runs_on_the_same_thread_is_bit_for_bit_a_fresh_run() {
-    let bits = |res: &SimulationResult| {
+    fn bits(scenario: &str) -> (Vec<u64>, Vec<u64>, String) {
+        let res = run("column_a.json", &[], scenario).2;
         let rows: Vec<u64> = res.rows.iter().flat_map(|r| r.iter().map(|v| v.to_bits())).collect();
-        (res.x.iter().map(|v| v.to_bits()).collect::<Vec<u64>>(), rows, format!("{:?}", res.stats))
-    };
-    let fresh = std::thread::spawn(move || bits(&run("column_a.json", &[], COLUMN_A_STEP).2)).join().unwrap();
+        (res.x.iter().map(|v| v.to_bits()).collect(), rows, format!("{:?}", res.stats))
+    }
+    let recording = COLUMN_A_STEP.replace(r#""column.M[1]", "column.M[41]""#, r#""column.M[20]""#);
+    let tolerance = COLUMN_A_STEP.replace(r#""duration""#, r#""integrator": {"atol": 1e-6}, "duration""#);
+    let scenarios = [COLUMN_A_STEP.to_string(), recording, tolerance];
+    let fresh: Vec<_> = scenarios
+        .iter()
+        .map(|sc| {
+            let sc = sc.clone();
+            std::thread::spawn(move || bits(&sc)).join().unwrap()
+        })
+        .collect();
+    assert!(fresh[1] != fresh[0] && fresh[2] != fresh[0], "the variants are other runs");
     run("surge_tank_pi.json", &[], TANK_STEP);
-    let after_other = bits(&run("column_a.json", &[], COLUMN_A_STEP).2);
-    assert!(after_other == fresh, "after another plant");
-    let after_same = bits(&run("column_a.json", &[], COLUMN_A_STEP).2);
-    assert!(after_same == fresh, "after the same plant");
+    for (k, what) in
+        [(0, "after another plant"), (0, "after the same plant"), (1, "another recording"), (0, "after it")]
+            .into_iter()
+            .chain([(2, "another tolerance"), (0, "after it")])
+    {
+        assert!(bits(&scenarios[k]) == fresh[k], "{what}");
+    }
 }
 
 #[test]

@@ -236,6 +236,37 @@ pub struct Bdf {
     /// Whether the output-only variables hold their solution at the current time.
     outputs_done: bool,
     w: Work,
+    /// What the fields [`Bdf::bind`] sets were computed from (`None`: nothing bound yet).
+    bound: Option<BindKey>,
+}
+
+/// Everything [`Bdf::bind`] reads of a system and the settings: equal keys, equal bindings.
+#[derive(Debug, Default, PartialEq)]
+struct BindKey {
+    mass: Vec<(usize, usize)>,
+    explicit: Vec<(usize, usize)>,
+    outputs: Vec<(usize, usize)>,
+    /// Per variable: error-controlled (bit 0), quadrature (bit 1).
+    flags: Vec<u8>,
+    /// Per variable: the nominal value's bits.
+    nominal: Vec<u64>,
+    atol: u64,
+    watch: Option<Vec<usize>>,
+}
+
+impl BindKey {
+    fn of(sys: &dyn DaeSystem, atol: f64, watch: &Option<Vec<usize>>) -> BindKey {
+        let n = sys.n();
+        BindKey {
+            mass: sys.mass().to_vec(),
+            explicit: sys.explicit().to_vec(),
+            outputs: sys.outputs().to_vec(),
+            flags: (0..n).map(|i| u8::from(sys.error_controlled(i)) | (u8::from(sys.quadrature(i)) << 1)).collect(),
+            nominal: (0..n).map(|i| sys.nominal(i).to_bits()).collect(),
+            atol: atol.to_bits(),
+            watch: watch.clone(),
+        }
+    }
 }
 
 /// The dense output's weights within a step ending at `t_n` of size `h` and order `q`:
@@ -497,6 +528,7 @@ impl Bdf {
             abs_tol_kept: Vec::new(),
             outputs_done: false,
             w: Work::default(),
+            bound: None,
         }
     }
 
@@ -515,6 +547,15 @@ impl Bdf {
         self.st.jac = old.st.jac;
         old.red_jac.clear();
         self.red_jac = old.red_jac;
+        // What `bind` computed, with its key: kept if the next system has the same key.
+        (self.controlled, self.all, self.diff_var, self.kept_rows) =
+            (old.controlled, old.all, old.diff_var, old.kept_rows);
+        (self.red, self.red_mass, self.red_diff_var, self.newton_over) =
+            (old.red, old.red_mass, old.red_diff_var, old.newton_over);
+        (self.hist, self.hist_pos, self.hist_all, self.tracked_explicit) =
+            (old.hist, old.hist_pos, old.hist_all, old.tracked_explicit);
+        (self.controlled_h, self.abs_tol, self.abs_tol_kept) = (old.controlled_h, old.abs_tol, old.abs_tol_kept);
+        self.bound = old.bound;
     }
 
     /// The settings.
@@ -583,7 +624,23 @@ impl Bdf {
         Ok(())
     }
 
+    /// Bind the integrator to `sys`: its partition into kept, explicit and output-only
+    /// variables, the error-test and history sets and the absolute tolerances. A recycled
+    /// integrator whose last system had the same [`BindKey`] keeps them.
     fn bind(&mut self, sys: &dyn DaeSystem) {
+        let key = BindKey::of(sys, self.settings.atol, &self.watch);
+        self.jac_loaded = false;
+        if self.bound.as_ref() != Some(&key) {
+            self.bind_anew(sys);
+            self.bound = Some(key);
+        }
+        let (n, n_hist) = (sys.n(), self.hist.len());
+        if self.w.x.len() != n || self.w.rhs.len() != self.red.n() || self.w.d_h.len() != n_hist {
+            self.w = Work::new(n, self.red.n(), n_hist);
+        }
+    }
+
+    fn bind_anew(&mut self, sys: &dyn DaeSystem) {
         let n = sys.n();
         self.controlled = (0..n).filter(|&i| sys.error_controlled(i)).collect();
         self.diff_var = vec![usize::MAX; n];
@@ -615,13 +672,8 @@ impl Bdf {
         self.hist_pos = vec![usize::MAX; n];
         self.hist.iter().enumerate().for_each(|(r, &j)| self.hist_pos[j] = r);
         self.controlled_h = self.controlled.iter().map(|&j| (self.hist_pos[j], j)).collect();
-        self.jac_loaded = false;
         self.abs_tol = (0..n).map(|i| self.settings.atol * sys.nominal(i).abs().max(1e-300)).collect();
         self.abs_tol_kept = self.red.kept_vars.iter().map(|&j| self.abs_tol[j]).collect();
-        let n_hist = self.hist.len();
-        if self.w.x.len() != n || self.w.rhs.len() != self.red.n() || self.w.d_h.len() != n_hist {
-            self.w = Work::new(n, self.red.n(), n_hist);
-        }
     }
 
     /// A row over the variables with a history as a row over all, zero elsewhere.
