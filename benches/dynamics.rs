@@ -11,9 +11,17 @@
 //! Beside it, the same scenario on the 82-state ODE the peers integrate (`column_a_ode.rs`:
 //! everything but the holdups eliminated by hand), on the same BDF and settings from the plant's
 //! steady holdups: the integrator's own cost, and so what the plant's DAE formulation adds.
+//!
+//! `--serve`: set up once, then answer requests on standard input, one per line, `recorded` or
+//! `final`, each with one run of the scenario (recording every 2 min, or the end only) and one
+//! JSON line `{"wall_s": …, "xB": …}` on standard output. The peers script alternates these runs
+//! with a peer's, so that both sides of a ratio are timed milliseconds apart, in the same phase of
+//! a shared machine's speed (on this VM it switches between two speeds a factor of ~2 apart every
+//! few seconds).
 
 mod column_a_ode;
 
+use std::io::{BufRead, Write};
 use std::time::{Duration, Instant};
 
 use plantwide::flowsheet::load_file;
@@ -46,6 +54,10 @@ fn main() {
         let res = simulate(&plant, &sc, Start::Steady(&x0), "bench", &mut |_| {}).expect("integration");
         (t.elapsed(), res)
     };
+    if std::env::args().any(|a| a == "--serve") {
+        serve(&once_with);
+        return;
+    }
     let median = |final_only: bool| -> (Duration, SimulationResult) {
         let (_, res) = once_with(final_only);
         let mut times: Vec<Duration> = (0..repeats()).map(|_| once_with(final_only).0).collect();
@@ -95,6 +107,26 @@ fn main() {
         ode.xb,
         ode.yd
     );
+}
+
+/// Answers `recorded` / `final` lines on standard input with one timed run each (see the module
+/// documentation) until the input ends; an unknown request ends the process with a message.
+fn serve(once_with: &dyn Fn(bool) -> (Duration, SimulationResult)) {
+    let stdout = std::io::stdout();
+    for line in std::io::stdin().lock().lines() {
+        let line = line.expect("standard input");
+        let final_only = match line.trim() {
+            "recorded" => false,
+            "final" => true,
+            other => panic!("--serve: unknown request '{other}' (expected 'recorded' or 'final')"),
+        };
+        let (wall, res) = once_with(final_only);
+        let k = res.columns.iter().position(|c| c.path == "bottoms.x[light]").expect("bottoms.x[light] recorded");
+        let xb = res.rows.last().map_or(f64::NAN, |r| r[k]);
+        let mut out = stdout.lock();
+        writeln!(out, "{{\"wall_s\": {}, \"xB\": {}}}", wall.as_secs_f64(), xb).expect("standard output");
+        out.flush().expect("standard output");
+    }
 }
 
 /// The ODE run's median wall time, counters and final compositions.

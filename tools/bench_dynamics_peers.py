@@ -47,10 +47,19 @@ the median of the rounds' ratios, each round's listed beside it ("ratios_by_roun
 the JSON are the medians over the rounds of its per-round medians ("wall_s_by_round" beside them);
 its counters are the last round's. Compare ratios, not absolute times across runs.
 
+Pairs (--pairs, default 41; 0 skips them): plantwide's bench is started once, kept running
+(`cargo bench --bench dynamics -- --serve`), and each peer's run is paired with one plantwide run,
+milliseconds apart, the order alternating from pair to pair; both processes are pinned to one CPU,
+because each vCPU of this VM has speed phases of its own (seen: plantwide's run 0.96 -> 1.70 ms while
+CVODE's on the other vCPU stayed at 10.5 ms). A ratio ("paired": "ratios", "ratios_final_only") is the
+median over the pairs of the pair's ratio, with its quartiles, min and max: on one CPU the quartiles of
+CVODE's ratio span ~10 % where the rounds' ratios spread from 5 to 14.
+
 Usage (virtual environment outside the repository):
   python3 -m venv /work/venv-bench && /work/venv-bench/bin/pip install numpy scipy casadi scikit-sundae
   /work/venv-bench/bin/python tools/bench_dynamics_peers.py [--no-plantwide | --plantwide-json '<json>']
                                                            [--repeats N] [--plantwide-repeats M] [--rounds R]
+                                                           [--pairs K]
 --repeats N (default 21) is the number of timed runs of SciPy and CVODE in a round; CasADi gets 3 N (it
 is fast); --plantwide-repeats M (default 15) plantwide's in its bench.
 numpy and scipy are required; a peer whose package (scikit-sundae, casadi) is missing is skipped with a
@@ -59,6 +68,7 @@ note in the JSON. Prints one line per peer, then one JSON line.
 
 import argparse
 import json
+import os
 import statistics
 import subprocess
 import sys
@@ -105,7 +115,8 @@ def timed(run, repeats):
     return statistics.median(walls), min(walls), out
 
 
-def run_scipy(n0, repeats):
+def scipy_runner(n0):
+    """run(t_eval): one SciPy BDF integration of the scenario (t_eval None: the final state only)."""
     pattern = model.sparsity()
 
     def run(t_eval):
@@ -115,6 +126,11 @@ def run_scipy(n0, repeats):
         assert t_eval is None or len(sol.t) == len(GRID)
         return sol
 
+    return run
+
+
+def run_scipy(n0, repeats):
+    run = scipy_runner(n0)
     final_only, _, final = timed(lambda: run(None), repeats)
     wall, fastest, sol = timed(lambda: run(GRID), repeats)
     xb, yd = ends(sol.y[:, -1])
@@ -123,7 +139,8 @@ def run_scipy(n0, repeats):
             "config": "solve_ivp BDF, Python RHS, FD Jacobian on jac_sparsity, SuperLU"}
 
 
-def run_cvode(n0, repeats, linsolver):
+def cvode_runner(n0, linsolver):
+    """(run(tspan), f): one CVODE integration returning (solution, RHS calls), and the counted RHS."""
     from sksundae.cvode import CVODE
 
     calls = [0]
@@ -141,6 +158,11 @@ def run_cvode(n0, repeats, linsolver):
         assert sol.success, sol.message
         return sol, calls[0]
 
+    return run, f
+
+
+def run_cvode(n0, repeats, linsolver):
+    run, f = cvode_runner(n0, linsolver)
     # a two-point tspan returns every internal step: its length counts them
     final_only, _, (final, _) = timed(lambda: run(np.array([0.0, T_END])), repeats)
     wall, fastest, (sol, ncalls) = timed(lambda: run(GRID), repeats)
@@ -205,16 +227,18 @@ def casadi_model(n0):
     return ca, {"x": n, "p": feed, "ode": ode}, f, diff
 
 
-def run_casadi(ca, dae, n0, repeats, plugin):
+def casadi_runners(ca, dae, n0, plugin):
+    """(final(), grid(), the grid integrator): CasADi integrations of the final state alone and of
+    the trajectory on the output grid after t0 (x0 is the row at t = 0: plantwide's 1000 later times)."""
     opts = {"abstol": ATOL, "reltol": RTOL, "max_num_steps": 100000}
     final = ca.integrator("F", plugin, dae, 0.0, T_END, opts)
-    final_only, _, _ = timed(lambda: final(x0=n0, p=FEED_STEP), repeats)
-    # the output grid after t0 (x0 is the row at t = 0): the trajectory at plantwide's 1000 later times
     integ = ca.integrator("F", plugin, dae, 0.0, GRID[1:], opts)
+    return (lambda: final(x0=n0, p=FEED_STEP)), (lambda: integ(x0=n0, p=FEED_STEP)), integ
 
-    def run():
-        return integ(x0=n0, p=FEED_STEP)
 
+def run_casadi(ca, dae, n0, repeats, plugin):
+    final, run, integ = casadi_runners(ca, dae, n0, plugin)
+    final_only, _, _ = timed(final, repeats)
     wall, fastest, res = timed(run, repeats)
     st = integ.stats()
     xf = np.array(res["xf"])
@@ -234,6 +258,96 @@ def run_plantwide(root, repeats):
         tail = "\n".join(out.stderr.splitlines()[-10:])
         raise RuntimeError(f"cargo bench --bench dynamics failed (exit {out.returncode}):\n{tail}")
     return json.loads(lines[-1])
+
+
+class PlantwideServer:
+    """`cargo bench --bench dynamics -- --serve`, kept running: run(kind) is one run of the scenario
+    ("recorded" or "final"), its wall time as timed inside the bench (seconds), its final xB checked."""
+
+    def __init__(self, root):
+        cmd = ["cargo", "bench", "--bench", "dynamics", "--", "--serve"]
+        self.proc = subprocess.Popen(cmd, cwd=root, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                     stderr=subprocess.DEVNULL, text=True, bufsize=1)
+
+    def run(self, kind):
+        self.proc.stdin.write(kind + "\n")
+        self.proc.stdin.flush()
+        line = self.proc.stdout.readline()
+        if not line:
+            raise RuntimeError(f"cargo bench --bench dynamics -- --serve ended (exit {self.proc.wait()})")
+        out = json.loads(line)
+        assert abs(out["xB"] / XB_REF - 1.0) < 1e-6, out
+        return out["wall_s"]
+
+    def close(self):
+        self.proc.stdin.close()
+        self.proc.wait()
+
+
+def wall_of(run):
+    start = time.perf_counter()
+    run()
+    return time.perf_counter() - start
+
+
+def peer_runs(n0, casadi):
+    """{peer: (one run on the 1001-point grid, one run to the final state only)}, each a callable."""
+    scipy_run = scipy_runner(n0)
+    peers = {"scipy_bdf": (lambda: scipy_run(GRID), lambda: scipy_run(None))}
+    try:
+        for key, ls in (("cvode_python", "band"), ("cvode_python_dense", "dense")):
+            cvode_run = cvode_runner(n0, ls)[0]
+            peers[key] = ((lambda r=cvode_run: r(GRID)), (lambda r=cvode_run: r(np.array([0.0, T_END]))))
+    except ImportError:
+        pass
+    if casadi is not None:
+        ca, dae = casadi
+        for key, plugin in (("casadi_cvodes", "cvodes"), ("casadi_idas", "idas")):
+            final, grid, _ = casadi_runners(ca, dae, n0, plugin)
+            peers[key] = (grid, final)
+    return peers
+
+
+def quartiles(values):
+    q = statistics.quantiles(values, n=4)
+    return {"median": statistics.median(values), "q1": q[0], "q3": q[2], "min": min(values), "max": max(values)}
+
+
+def measure_paired(root, n0, casadi, pairs):
+    """Ratios from pairs of runs: one plantwide run (in its kept-running bench) next to one run of
+    the peer, milliseconds apart, the order alternating from pair to pair; each ratio is the median
+    over the pairs of the pair's ratio (quartiles beside it). Both sides of a pair see the same phase
+    of the machine's speed, which the rounds' ratios (peers timed seconds apart) do not."""
+    server = PlantwideServer(root)
+    out, spread = {}, {}
+    # Both processes on one CPU: a vCPU of this VM has speed phases of its own (seen: plantwide's
+    # run 0.96 -> 1.70 ms while CVODE's on the other vCPU stayed at 10.5 ms, and the reverse), so
+    # a pair is in one phase only if both of its runs are on the same CPU.
+    cpu = min(os.sched_getaffinity(0))
+    saved = os.sched_getaffinity(0)
+    os.sched_setaffinity(0, {cpu})
+    os.sched_setaffinity(server.proc.pid, {cpu})
+    try:
+        for key, runs in peer_runs(n0, casadi).items():
+            casadi_peer = key.startswith("casadi")
+            name = f"plantwide/{key}" if casadi_peer else f"{key}/plantwide"
+            for kind, run, target in (("recorded", runs[0], out), ("final", runs[1], spread)):
+                server.run(kind)
+                run()  # one untimed run of each side
+                ratios = []
+                for i in range(pairs):
+                    if i % 2 == 0:
+                        pw = server.run(kind)
+                        peer = wall_of(run)
+                    else:
+                        peer = wall_of(run)
+                        pw = server.run(kind)
+                    ratios.append(pw / peer if casadi_peer else peer / pw)
+                target[name] = quartiles(ratios)
+    finally:
+        server.close()
+        os.sched_setaffinity(0, saved)
+    return {"cpu": cpu, "pairs": pairs, "ratios": out, "ratios_final_only": spread}
 
 
 def measure_round(args, root, n0, casadi):
@@ -378,6 +492,8 @@ def main():
     ap.add_argument("--repeats", type=int, default=21, help="timed runs for SciPy and CVODE (CasADi: 3x)")
     ap.add_argument("--plantwide-repeats", type=int, default=15, help="timed runs of plantwide in its bench")
     ap.add_argument("--rounds", type=int, default=5, help="rounds of every peer in turn (ratios: their median)")
+    ap.add_argument("--pairs", type=int, default=41,
+                    help="pairs of one plantwide run and one peer run, per peer and recording (0: none)")
     args = ap.parse_args()
     root = Path(__file__).resolve().parent.parent
     result = {"model": "column_a_feed_step_2000min", "rtol": RTOL, "atol": 1e-8}
@@ -418,6 +534,12 @@ def main():
     if result["ratios_final_only"]:
         print("wall-time ratios, final state only, median of the rounds' ratios: "
               + ", ".join(f"{k} {v:.2f}" for k, v in result["ratios_final_only"].items()))
+    if args.pairs > 0 and not (args.no_plantwide or args.plantwide_json):
+        result["paired"] = measure_paired(root, n0, casadi, max(2, args.pairs))
+        for key, label in (("ratios", "1001-point trajectories"), ("ratios_final_only", "final state only")):
+            print(f"wall-time ratios in {result['paired']['pairs']} alternating pairs, {label}, median [quartiles]: "
+                  + ", ".join(f"{k} {v['median']:.2f} [{v['q1']:.2f}, {v['q3']:.2f}]"
+                              for k, v in result["paired"][key].items()))
     print(json.dumps(result))
 
 
