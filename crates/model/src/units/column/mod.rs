@@ -73,6 +73,7 @@ pub(crate) fn side_draws(
 
 /// Offsets of the variables within one stage's block, shared by both fidelities:
 /// `[n_1 … n_c, x_1 … x_c, y_1 … y_c, T, M, L, V]`.
+#[derive(Debug, Clone, Copy)]
 pub(crate) struct StageIdx {
     pub(crate) nc: usize,
 }

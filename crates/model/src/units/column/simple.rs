@@ -67,6 +67,8 @@ pub struct SimpleColumn {
     distillate: f64,
     bottoms: f64,
     comp_names: Vec<String>,
+    /// Per stage: a tray with no feed and no draw (the fast path of the hot loops, `kernels.rs`).
+    plain: Vec<bool>,
 }
 
 // Inputs, in declaration order.
@@ -150,7 +152,11 @@ impl SimpleColumn {
             }
             l0[i] = l;
         }
+        let plain = (0..n)
+            .map(|s| s > 0 && s + 1 < n && feeds.iter().all(|f| f.stage != s) && draws.iter().all(|d| d.stage != s))
+            .collect();
         let column = SimpleColumn {
+            plain,
             n_stages: n,
             feeds,
             feed_ports,

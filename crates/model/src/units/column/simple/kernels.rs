@@ -63,6 +63,21 @@ impl SimpleColumn {
         let d_in = io.input(IN_DISTILLATE);
         for (s, v) in stages.chunks_exact(ps).enumerate() {
             let o = internal0 + s * ps;
+            let rows = &mut r[o..o + ps];
+            if self.plain[s] {
+                // A tray with no feed and no draw: the general loop's operations in its order (the
+                // empty feed sum is its 0.0), without the scans for feeds and draws and the tests
+                // for the neighbours, which a tray always has.
+                let (dn, up) = (&stages[(s - 1) * ps..s * ps], &stages[(s + 1) * ps..(s + 2) * ps]);
+                for j in 0..nc {
+                    let acc = 0.0 - v[ix.l()] * v[ix.x(j)] - v[ix.v()] * v[ix.y(j)];
+                    rows[ix.n(j)] = acc + up[ix.l()] * up[ix.x(j)] + dn[ix.v()] * dn[ix.y(j)];
+                }
+                if !skip.get(o + ix.t()).copied().unwrap_or(false) {
+                    rows[ix.t()] = io.thermo.bubble_residual(v[ix.t()], self.pressure, &v[ix.x(0)..ix.x(0) + nc]);
+                }
+                continue;
+            }
             let up = (s + 1 < n).then(|| &stages[(s + 1) * ps..(s + 2) * ps]);
             let dn = (s > 0).then(|| &stages[(s - 1) * ps..s * ps]);
             for j in 0..nc {
@@ -86,10 +101,10 @@ impl SimpleColumn {
                         acc -= io.input(4 + k) * xj;
                     }
                 }
-                r[o + ix.n(j)] = acc;
+                rows[ix.n(j)] = acc;
             }
             if !skip.get(o + ix.t()).copied().unwrap_or(false) {
-                r[o + ix.t()] = io.thermo.bubble_residual(v[ix.t()], self.pressure, &v[ix.x(0)..ix.x(0) + nc]);
+                rows[ix.t()] = io.thermo.bubble_residual(v[ix.t()], self.pressure, &v[ix.x(0)..ix.x(0) + nc]);
             }
         }
     }
@@ -111,6 +126,14 @@ impl SimpleColumn {
         let mut v_below = 0.0;
         for (s, v) in stages[..n * ps].chunks_exact_mut(ps).enumerate() {
             let m = stage_composition(v, nc, alpha, |t, x, k| io.thermo.k_values(t, self.pressure, x, k), k);
+            if self.plain[s] {
+                // A tray with no feed: its vapour is the one from below (`+ Σ` over no feeds adds
+                // −0.0, which leaves every value as it is) and its liquid the tray's hydraulics.
+                let l = self.l0[s] + (m - self.m0[s]) / self.tau_l;
+                v[ix.l()] = if self.lambda != 0.0 { l + (v_below - self.v0) * self.lambda } else { l };
+                v[ix.v()] = v_below;
+                continue;
+            }
             // The feed quality may read this stage's x and y, just computed.
             let fed: f64 =
                 (0..self.feeds.len()).filter(|&f| self.feeds[f].stage == s).map(|f| self.feed_vapour(io, f, v)).sum();
@@ -130,7 +153,12 @@ impl SimpleColumn {
             v_below = v[ix.v()];
         }
         let slen = io.layout.stream.len();
-        let mut outlet = |k: usize, s: usize, flow: f64| {
+        let stages: &[f64] = stages;
+        // `move`: the closure holds copies of `nc`, `ix` and `ps`. Captured by reference, their
+        // stack slots escaped into it, and the stage loop above reloaded `nc` from memory at
+        // every stage (a call may write an escaped slot): its loops over the components ran
+        // with a run-time count, not unrolled for the fixed `NC`.
+        let mut outlet = move |k: usize, s: usize, flow: f64| {
             let v = &stages[self.stage(s)..self.stage(s) + ps];
             let x = &v[ix.x(0)..ix.x(0) + nc];
             let out = &mut outs[k * slen..(k + 1) * slen];
