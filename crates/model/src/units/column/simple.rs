@@ -783,6 +783,37 @@ mod tests {
         }
     }
 
+    /// The plain trays' fast path of the kernels (no feed, no draw) gives the general loop's
+    /// values bit for bit: the same column with every tray taken through the general loop is the
+    /// reference, for completion and kept residuals, every configuration (λ ≠ 0 with a side draw
+    /// among them), constant α and temperature-dependent K-values, at perturbed points.
+    #[test]
+    fn the_plain_trays_fast_path_equals_the_general_loop_bit_for_bit() {
+        let ([ideal, alpha], feed) = both_packages();
+        let mut rng = Lcg(17);
+        for ((f, extra), thermo) in CONFIGS.into_iter().flat_map(|c| [(c, &ideal), (c, &alpha)]) {
+            let u = column_in(thermo, f, extra);
+            let Column::Simple(c) = &u else { panic!("a simple column") };
+            assert!(c.plain.iter().filter(|&&p| p).count() >= 3, "{f}{extra}: plain trays to test");
+            let general = super::SimpleColumn { plain: vec![false; c.plain.len()], ..c.clone() };
+            let (lay, guess) = at_guess(&u, thermo, &feed);
+            let m = lay.n_own();
+            for _ in 0..3 {
+                let local: Vec<f64> = guess.iter().map(|&v| v * rng.range(0.8, 1.2) + rng.range(0.0, 1e-3)).collect();
+                let io = UnitIo { local: &local, layout: &lay, thermo, time: 0.0 };
+                let (mut fast, mut slow) = (local[..m].to_vec(), local[..m].to_vec());
+                c.complete_nc::<2>(&io, &mut fast);
+                general.complete_nc::<2>(&io, &mut slow);
+                let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                assert_eq!(bits(&fast), bits(&slow), "{f}{extra}: completion");
+                let (mut r_fast, mut r_slow) = (vec![0.0; m], vec![0.0; m]);
+                c.eval_kept_nc::<2>(&io, &fast, &mut r_fast, &[]);
+                general.eval_kept_nc::<2>(&io, &fast, &mut r_slow, &[]);
+                assert_eq!(bits(&r_fast), bits(&r_slow), "{f}{extra}: kept residuals");
+            }
+        }
+    }
+
     /// `complete` solves every explicit equation exactly and leaves the other variables alone,
     /// and no explicit equation reads an explicit variable computed after it (the dense Jacobian's
     /// entries there are zero) — the contract the integrator's elimination relies on — for the
