@@ -309,8 +309,8 @@ impl Interpolation {
 pub struct DenseOutput {
     /// The step's weights, and its order `q`.
     weights: Interpolation,
-    /// The variables with a history, and their differences `D[0..=q]`, `D[k]` of every
-    /// variable after those of `D[k − 1]`.
+    /// The variables with a history, and their differences `D[0..=q]`, each variable's `q + 1`
+    /// in a row (a recorded row reads them contiguously).
     idx: Vec<usize>,
     coef: Vec<f64>,
     /// The others, held at their value at the step's end.
@@ -324,14 +324,10 @@ impl DenseOutput {
     /// `p_k(t)·D[k]` for `k = 1 … q` in turn (the sum [`DaeIntegrator::interpolate`] makes),
     /// each variable's sum straight into its entry.
     pub fn at(&self, t: f64, out: &mut [f64]) {
-        let (p, order, m) = (self.weights.weights(t), self.weights.order, self.idx.len());
-        let coef = &self.coef[..m * (order + 1)];
-        for (r, &i) in self.idx.iter().enumerate() {
-            let mut v = coef[r];
-            for (k, pk) in p.iter().enumerate().take(order + 1).skip(1) {
-                v += pk * coef[k * m + r];
-            }
-            out[i] = v;
+        let (p, order) = (self.weights.weights(t), self.weights.order);
+        let p = &p[1..=order];
+        for (&i, d) in self.idx.iter().zip(self.coef.chunks_exact(order + 1)) {
+            out[i] = p.iter().zip(&d[1..]).fold(d[0], |v, (pk, dk)| v + pk * dk);
         }
         self.held.iter().for_each(|&(i, v)| out[i] = v);
     }
@@ -1186,8 +1182,8 @@ impl Bdf {
             }
         }
         out.coef.clear();
-        for d in &self.st.d[..=order] {
-            out.coef.extend(out.rows.iter().map(|&r| d[r]));
+        for &r in &out.rows {
+            out.coef.extend(self.st.d[..=order].iter().map(|d| d[r]));
         }
         out.weights = self.interpolation();
     }
@@ -1900,6 +1896,30 @@ mod tests {
         let settings = BdfSettings { rtol: 1e-10, atol: 1e-8, ..BdfSettings::default() };
         let bdf = run(&sys, settings, &[1.0, 80.0], 1000.0);
         assert!((bdf.x()[1] - 80.0).abs() < 1e-11);
+    }
+
+    /// The dense output of chosen variables (`interpolate_at`, the path of the recorded rows)
+    /// is the whole state's interpolation (`interpolate`, another loop) bit for bit, within
+    /// every step and at every order reached, the variables asked for in any order.
+    #[test]
+    fn dense_output_of_some_variables_is_the_interpolation_bit_for_bit() {
+        let sys = robertson();
+        let mut bdf = Bdf::new(BdfSettings { rtol: 1e-8, atol: 1e-12, ..BdfSettings::default() });
+        bdf.restart(&sys, 0.0, &[1.0, 0.0, 0.0]).unwrap();
+        let mut orders = [false; MAX_ORDER + 1];
+        while bdf.t() < 40.0 {
+            bdf.step(&sys, 40.0).unwrap();
+            orders[bdf.st.order] = true;
+            for s in [0.25, 0.5, 0.9] {
+                let t = bdf.t_prev() + s * (bdf.t() - bdf.t_prev());
+                let (mut whole, mut some) = ([0.0; 3], [f64::NAN; 3]);
+                bdf.interpolate(t, &mut whole);
+                bdf.interpolate_at(t, &[2, 0], &mut some);
+                assert_eq!([some[0].to_bits(), some[2].to_bits()], [whole[0].to_bits(), whole[2].to_bits()]);
+                assert!(some[1].is_nan(), "a variable not asked for is left alone");
+            }
+        }
+        assert!(orders[4] && orders[5], "orders reached: {orders:?}");
     }
 
     #[test]
