@@ -370,9 +370,12 @@ impl<U: UnitModel + 'static> Unit for U {
             }
             Some(c) => {
                 for color in 0..c.n_colors {
-                    for (j, v) in local.iter_mut().enumerate() {
-                        v.eps = if c.colors[j] == color { 1.0 } else { 0.0 };
+                    // Seed this colour's columns, unseeding the last colour's (all others are
+                    // zero already): a pass over the colour's columns, not over every column.
+                    if color > 0 {
+                        c.columns_of_color[color - 1].iter().for_each(|&j| local[j].eps = 0.0);
                     }
+                    c.columns_of_color[color].iter().for_each(|&j| local[j].eps = 1.0);
                     eval(&local, &mut rd);
                     for &j in &c.columns_of_color[color] {
                         for &k in &c.rows_of_col[j] {
