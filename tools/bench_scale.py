@@ -13,7 +13,8 @@ compositions every 1 min), and four whole CLI processes are timed:
 
 Recorded per N: the variable count (`variables: N (...)` of `plantwide check`), the median
 wall-clock seconds over --repeat runs (default 3 for N <= 32, 1 above; Python's monotonic
-clock around the process), and the peak RSS in MB of each command (`/usr/bin/time -f %M`,
+clock around the process; the runs go in rounds over the sizes, so that every size samples the
+machine's speed over the whole benchmark), and the peak RSS in MB of each command (`/usr/bin/time -f %M`,
 per process, max over the repeats). A process over --timeout seconds is killed and recorded
 as a timeout; a non-zero exit is recorded with its code and the first 300 characters of its
 stderr; the benchmark carries on (a command that timed out is skipped at larger N).
@@ -120,6 +121,39 @@ def fmt(v, spec="%.3f"):
     return "-" if v is None else spec % v
 
 
+def run_once(row, commands, files, sc, workdir, args, timed_out_at):
+    """One run of each command on `row`'s train, its wall time and peak RSS appended to the row
+    (a failure recorded instead; a timed-out command is skipped from then on at larger N)."""
+    fs, csv = files
+    for cmd in commands:
+        if cmd in timed_out_at and timed_out_at[cmd] <= row["N"]:
+            if not any(f.get("command") == cmd for f in row["failures"]):
+                row["failures"].append({"command": cmd, "skipped": "timed out at N = %d" % timed_out_at[cmd]})
+            continue
+        if any(f.get("command") == cmd for f in row["failures"]):
+            continue
+        r = timed(argv_for(cmd, args.binary, fs, sc, csv), args.timeout, capture_stdout=(cmd == "check"),
+                  workdir=workdir)
+        if r["peak_mb"] is not None:
+            row["peaks"][cmd].append(r["peak_mb"])
+        if cmd == "check" and row["variables"] is None:
+            m = re.search(r"^variables:\s*(\d+)", r["stdout"], re.M)
+            if m:
+                row["variables"] = int(m.group(1))
+        if not r["ok"]:
+            row["failures"].append({
+                "command": cmd,
+                "timeout": r["timeout"],
+                "exit_code": r["rc"],
+                "wall_s": round(r["wall_s"], 3),
+                "stderr": r["stderr"][:300],
+            })
+            if r["timeout"]:
+                timed_out_at[cmd] = row["N"]
+            continue
+        row["walls"][cmd].append(r["wall_s"])
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--sizes", default="1,2,4,8,16,32,64,128,256", help="comma-separated N (default 1,2,4,...,256)")
@@ -150,51 +184,38 @@ def main(argv=None):
     timed_out_at = {}  # command -> N at which it timed out (skip it for larger N)
     t_start = time.monotonic()
     try:
+        rows, files = [], {}
         for n in sizes:
             fs = os.path.join(workdir, "train_%d.json" % n)
             with open(fs, "w") as f:
                 json.dump(column_train.train(n), f, indent=1)
-            csv = os.path.join(workdir, "train_%d.csv" % n)
+            files[n] = (fs, os.path.join(workdir, "train_%d.csv" % n))
             reps = args.repeat if args.repeat is not None else (3 if n <= 32 else 1)
-            row = {"N": n, "variables": None, "repeat": reps, "peak_mb": {}, "failures": []}
+            rows.append({"N": n, "variables": None, "repeat": reps, "peak_mb": {}, "failures": [],
+                         "walls": {c: [] for c in commands}, "peaks": {c: [] for c in commands}})
+        # Rounds over the sizes, one run of each size and command per round: a shared machine's
+        # speed drifts by a factor of ~2 over seconds (this VM switches between two speeds), so
+        # that each size's median samples the same phases instead of the few seconds its own
+        # repeats took, which moved the fitted exponent from 0.93 to 1.21 between two runs.
+        for rnd in range(max(r["repeat"] for r in rows)):
+            for row in rows:
+                if rnd < row["repeat"]:
+                    run_once(row, commands, files[row["N"]], sc, workdir, args, timed_out_at)
+        for row in rows:
             for cmd in commands:
+                walls = row["walls"][cmd]
                 key = cmd + "_s"
-                row[key] = None
-                if cmd in timed_out_at:
-                    row["failures"].append({"command": cmd, "skipped": "timed out at N = %d" % timed_out_at[cmd]})
-                    continue
-                walls, peaks = [], []
-                for _ in range(reps):
-                    r = timed(argv_for(cmd, args.binary, fs, sc, csv), args.timeout,
-                              capture_stdout=(cmd == "check"), workdir=workdir)
-                    if r["peak_mb"] is not None:
-                        peaks.append(r["peak_mb"])
-                    if cmd == "check" and row["variables"] is None:
-                        m = re.search(r"^variables:\s*(\d+)", r["stdout"], re.M)
-                        if m:
-                            row["variables"] = int(m.group(1))
-                    if not r["ok"]:
-                        row["failures"].append({
-                            "command": cmd,
-                            "timeout": r["timeout"],
-                            "exit_code": r["rc"],
-                            "wall_s": round(r["wall_s"], 3),
-                            "stderr": r["stderr"][:300],
-                        })
-                        if r["timeout"]:
-                            timed_out_at[cmd] = n
-                        break
-                    walls.append(r["wall_s"])
-                if walls and len(walls) == reps:
-                    row[key] = statistics.median(walls)
+                row[key] = statistics.median(walls) if walls and len(walls) == row["repeat"] else None
+                peaks = row["peaks"][cmd]
                 row["peak_mb"][cmd] = round(max(peaks), 1) if peaks else None
                 print("N=%-4d %-6s %s s  %s MB%s" % (
-                    n, cmd, fmt(row[key]), fmt(row["peak_mb"][cmd], "%.1f"),
+                    row["N"], cmd, fmt(row[key]), fmt(row["peak_mb"][cmd], "%.1f"),
                     "" if row[key] is not None else "  FAILED"), file=sys.stderr, flush=True)
             if row.get("steady_s") is not None and row.get("run_s") is not None:
                 row["steady_plus_run_s"] = row["steady_s"] + row["run_s"]
             else:
                 row["steady_plus_run_s"] = None
+            del row["walls"], row["peaks"]
             results.append(row)
     finally:
         if not args.keep:
