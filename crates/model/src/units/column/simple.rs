@@ -755,52 +755,47 @@ mod tests {
         }
     }
 
-    /// Two ways of running the kernels, `a` and `b`, give the same values bit for bit: the
-    /// completion, and the kept residuals at the completed point, for every configuration with
-    /// constant α and temperature-dependent K-values, at three perturbed points each. Each way is
-    /// `(column, completion, kept residuals)` of the configuration's column.
+    /// The completion of `own` by the kernels for `NC` components, and the kept residuals at the
+    /// completed point.
+    fn kernels<const NC: usize>(c: &super::SimpleColumn, io: &UnitIo<'_, f64>, own: &[f64]) -> [Vec<u64>; 2] {
+        let mut own = own.to_vec();
+        c.complete_nc::<NC>(io, &mut own);
+        let mut r = vec![0.0; own.len()];
+        c.eval_kept_nc::<NC>(io, &own, &mut r, &[]);
+        [own, r].map(|v| v.iter().map(|x| x.to_bits()).collect())
+    }
+
+    /// Two ways of running the kernels on a configuration's column, `a` and `b` (each giving
+    /// [`kernels`]' bits), agree bit for bit for every configuration, with constant α and
+    /// temperature-dependent K-values, at three perturbed points each.
     fn kernels_agree(
         seed: u64,
-        a: impl Fn(&super::SimpleColumn) -> (super::SimpleColumn, Complete, EvalKept),
-        b: impl Fn(&super::SimpleColumn) -> (super::SimpleColumn, Complete, EvalKept),
+        a: impl Fn(&super::SimpleColumn, &UnitIo<'_, f64>, &[f64]) -> [Vec<u64>; 2],
+        b: impl Fn(&super::SimpleColumn, &UnitIo<'_, f64>, &[f64]) -> [Vec<u64>; 2],
     ) {
         let ([ideal, alpha], feed) = both_packages();
         let mut rng = Lcg(seed);
         for ((f, extra), thermo) in CONFIGS.into_iter().flat_map(|c| [(c, &ideal), (c, &alpha)]) {
             let u = column_in(thermo, f, extra);
             let Column::Simple(c) = &u else { panic!("a simple column") };
-            let ((ca, complete_a, kept_a), (cb, complete_b, kept_b)) = (a(c), b(c));
             let (lay, guess) = at_guess(&u, thermo, &feed);
-            let m = lay.n_own();
-            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
             for _ in 0..3 {
                 let local: Vec<f64> = guess.iter().map(|&v| v * rng.range(0.8, 1.2) + rng.range(0.0, 1e-3)).collect();
                 let io = UnitIo { local: &local, layout: &lay, thermo, time: 0.0 };
-                let (mut own_a, mut own_b) = (local[..m].to_vec(), local[..m].to_vec());
-                complete_a(&ca, &io, &mut own_a);
-                complete_b(&cb, &io, &mut own_b);
-                assert_eq!(bits(&own_a), bits(&own_b), "{f}{extra}: completion");
-                let (mut r_a, mut r_b) = (vec![0.0; m], vec![0.0; m]);
-                kept_a(&ca, &io, &own_a, &mut r_a, &[]);
-                kept_b(&cb, &io, &own_a, &mut r_b, &[]);
-                assert_eq!(bits(&r_a), bits(&r_b), "{f}{extra}: kept residuals");
+                let own = &local[..lay.n_own()];
+                let ([own_a, r_a], [own_b, r_b]) = (a(c, &io, own), b(c, &io, own));
+                assert_eq!(own_a, own_b, "{f}{extra}: completion");
+                assert_eq!(r_a, r_b, "{f}{extra}: kept residuals");
             }
         }
     }
-
-    type Complete = fn(&super::SimpleColumn, &UnitIo<'_, f64>, &mut [f64]);
-    type EvalKept = fn(&super::SimpleColumn, &UnitIo<'_, f64>, &[f64], &mut [f64], &[bool]);
 
     /// The kernels with the component count a compile-time constant ([`super::kernels`]) give
     /// the general loop's values bit for bit: completion and kept residuals, for every
     /// configuration, constant α and temperature-dependent K-values, at perturbed points.
     #[test]
     fn the_unrolled_kernels_equal_the_general_loop_bit_for_bit() {
-        kernels_agree(
-            13,
-            |c| (c.clone(), super::SimpleColumn::complete_nc::<2>, super::SimpleColumn::eval_kept_nc::<2>),
-            |c| (c.clone(), super::SimpleColumn::complete_nc::<0>, super::SimpleColumn::eval_kept_nc::<0>),
-        );
+        kernels_agree(13, kernels::<2>, kernels::<0>);
     }
 
     /// The plain trays' fast path of the kernels (no feed, no draw) gives the general loop's
@@ -808,18 +803,11 @@ mod tests {
     /// reference, for every configuration (λ ≠ 0 with a side draw among them).
     #[test]
     fn the_plain_trays_fast_path_equals_the_general_loop_bit_for_bit() {
-        let with = |plain: fn(&super::SimpleColumn) -> Vec<bool>| {
-            move |c: &super::SimpleColumn| {
-                assert!(c.plain.iter().filter(|&&p| p).count() >= 3, "plain trays to test");
-                let column = super::SimpleColumn { plain: plain(c), ..c.clone() };
-                (
-                    column,
-                    super::SimpleColumn::complete_nc::<2> as Complete,
-                    super::SimpleColumn::eval_kept_nc::<2> as EvalKept,
-                )
-            }
+        let general = |c: &super::SimpleColumn, io: &UnitIo<'_, f64>, own: &[f64]| {
+            assert!(c.plain.iter().filter(|&&p| p).count() >= 3, "plain trays to test");
+            kernels::<2>(&super::SimpleColumn { plain: vec![false; c.plain.len()], ..c.clone() }, io, own)
         };
-        kernels_agree(17, with(|c| c.plain.clone()), with(|c| vec![false; c.plain.len()]));
+        kernels_agree(17, kernels::<2>, general);
     }
 
     /// `complete` solves every explicit equation exactly and leaves the other variables alone,

@@ -47,6 +47,14 @@ fn stage_composition(
 }
 
 impl SimpleColumn {
+    /// The liquid leaving tray `s` of holdup `m` with `v_below` rising into it (Francis-weir
+    /// linearization with the vapour effect λ, module documentation of `simple.rs`).
+    #[inline(always)]
+    fn tray_liquid(&self, s: usize, m: f64, v_below: f64) -> f64 {
+        let l = self.l0[s] + (m - self.m0[s]) / self.tau_l;
+        if self.lambda != 0.0 { l + (v_below - self.v0) * self.lambda } else { l }
+    }
+
     /// [`UnitModel::eval_kept`](crate::UnitModel::eval_kept) with `NC` components (`0`: as many
     /// as the column has).
     pub(super) fn eval_kept_nc<const NC: usize>(
@@ -73,41 +81,56 @@ impl SimpleColumn {
                     let acc = 0.0 - v[ix.l()] * v[ix.x(j)] - v[ix.v()] * v[ix.y(j)];
                     rows[ix.n(j)] = acc + up[ix.l()] * up[ix.x(j)] + dn[ix.v()] * dn[ix.y(j)];
                 }
-                if !skip.get(o + ix.t()).copied().unwrap_or(false) {
-                    rows[ix.t()] = io.thermo.bubble_residual(v[ix.t()], self.pressure, &v[ix.x(0)..ix.x(0) + nc]);
-                }
-                continue;
-            }
-            let up = (s + 1 < n).then(|| &stages[(s + 1) * ps..(s + 2) * ps]);
-            let dn = (s > 0).then(|| &stages[(s - 1) * ps..s * ps]);
-            for j in 0..nc {
-                let feed = self.feeds.iter().enumerate().filter(|(_, f)| f.stage == s).fold(0.0, |acc, (k, _)| {
-                    let inlet = io.inlet(k);
-                    acc + inlet.f() * inlet.z()[j]
-                });
-                let xj = v[ix.x(j)];
-                let mut acc = feed - v[ix.l()] * xj - v[ix.v()] * v[ix.y(j)];
-                if let Some(up) = up {
-                    acc += up[ix.l()] * up[ix.x(j)];
-                }
-                if let Some(dn) = dn {
-                    acc += dn[ix.v()] * dn[ix.y(j)];
-                }
-                if s + 1 == n {
-                    acc -= d_in * xj;
-                }
-                for (k, d) in self.draws.iter().enumerate() {
-                    if d.stage == s {
-                        acc -= io.input(4 + k) * xj;
-                    }
-                }
-                rows[ix.n(j)] = acc;
+            } else {
+                self.balances_general::<NC>(io, stages, s, d_in, rows);
             }
             if !skip.get(o + ix.t()).copied().unwrap_or(false) {
                 rows[ix.t()] = io.thermo.bubble_residual(v[ix.t()], self.pressure, &v[ix.x(0)..ix.x(0) + nc]);
             }
         }
     }
+
+    /// The component balances of stage `s` into its `rows`, any stage: feeds, draws, the
+    /// distillate at the top, the neighbours it has (see [`SimpleColumn::eval_kept_nc`]).
+    #[inline(always)]
+    fn balances_general<const NC: usize>(
+        &self,
+        io: &UnitIo<'_, f64>,
+        stages: &[f64],
+        s: usize,
+        d_in: f64,
+        rows: &mut [f64],
+    ) {
+        let nc = if NC == 0 { self.nc() } else { NC };
+        let (n, ix, ps) = (self.n_stages, StageIdx { nc }, 3 * nc + 4);
+        let v = &stages[s * ps..(s + 1) * ps];
+        let up = (s + 1 < n).then(|| &stages[(s + 1) * ps..(s + 2) * ps]);
+        let dn = (s > 0).then(|| &stages[(s - 1) * ps..s * ps]);
+        for j in 0..nc {
+            let feed = self.feeds.iter().enumerate().filter(|(_, f)| f.stage == s).fold(0.0, |acc, (k, _)| {
+                let inlet = io.inlet(k);
+                acc + inlet.f() * inlet.z()[j]
+            });
+            let xj = v[ix.x(j)];
+            let mut acc = feed - v[ix.l()] * xj - v[ix.v()] * v[ix.y(j)];
+            if let Some(up) = up {
+                acc += up[ix.l()] * up[ix.x(j)];
+            }
+            if let Some(dn) = dn {
+                acc += dn[ix.v()] * dn[ix.y(j)];
+            }
+            if s + 1 == n {
+                acc -= d_in * xj;
+            }
+            for (k, d) in self.draws.iter().enumerate() {
+                if d.stage == s {
+                    acc -= io.input(4 + k) * xj;
+                }
+            }
+            rows[ix.n(j)] = acc;
+        }
+    }
+
     /// [`UnitModel::complete`](crate::UnitModel::complete) with `NC` components (`0`: as many as the column has).
     pub(super) fn complete_nc<const NC: usize>(&self, io: &UnitIo<'_, f64>, own: &mut [f64]) {
         let nc = if NC == 0 { self.nc() } else { NC };
@@ -129,8 +152,7 @@ impl SimpleColumn {
             if self.plain[s] {
                 // A tray with no feed: its vapour is the one from below (`+ Σ` over no feeds adds
                 // −0.0, which leaves every value as it is) and its liquid the tray's hydraulics.
-                let l = self.l0[s] + (m - self.m0[s]) / self.tau_l;
-                v[ix.l()] = if self.lambda != 0.0 { l + (v_below - self.v0) * self.lambda } else { l };
+                v[ix.l()] = self.tray_liquid(s, m, v_below);
                 v[ix.v()] = v_below;
                 continue;
             }
@@ -145,10 +167,7 @@ impl SimpleColumn {
             v[ix.l()] = match s {
                 _ if s + 1 == n => io.input(IN_REFLUX),
                 0 => io.input(IN_BOTTOMS),
-                _ => {
-                    let l = self.l0[s] + (m - self.m0[s]) / self.tau_l;
-                    if self.lambda != 0.0 { l + (v_below - self.v0) * self.lambda } else { l }
-                }
+                _ => self.tray_liquid(s, m, v_below),
             };
             v_below = v[ix.v()];
         }
