@@ -264,10 +264,12 @@ class PlantwideServer:
     """`cargo bench --bench dynamics -- --serve`, kept running: run(kind) is one run of the scenario
     ("recorded" or "final"), its wall time as timed inside the bench (seconds), its final xB checked."""
 
-    def __init__(self, root):
+    def __init__(self, root, cpu):
+        """Started on CPU `cpu` alone: cargo and the bench it spawns inherit the affinity."""
         cmd = ["cargo", "bench", "--bench", "dynamics", "--", "--serve"]
         self.proc = subprocess.Popen(cmd, cwd=root, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-                                     stderr=subprocess.DEVNULL, text=True, bufsize=1)
+                                     stderr=subprocess.DEVNULL, text=True, bufsize=1,
+                                     preexec_fn=lambda: os.sched_setaffinity(0, {cpu}))
 
     def run(self, kind):
         self.proc.stdin.write(kind + "\n")
@@ -318,15 +320,14 @@ def measure_paired(root, n0, casadi, pairs):
     the peer, milliseconds apart, the order alternating from pair to pair; each ratio is the median
     over the pairs of the pair's ratio (quartiles beside it). Both sides of a pair see the same phase
     of the machine's speed, which the rounds' ratios (peers timed seconds apart) do not."""
-    server = PlantwideServer(root)
     out, spread = {}, {}
     # Both processes on one CPU: a vCPU of this VM has speed phases of its own (seen: plantwide's
     # run 0.96 -> 1.70 ms while CVODE's on the other vCPU stayed at 10.5 ms, and the reverse), so
     # a pair is in one phase only if both of its runs are on the same CPU.
-    cpu = min(os.sched_getaffinity(0))
     saved = os.sched_getaffinity(0)
+    cpu = min(saved)
+    server = PlantwideServer(root, cpu)
     os.sched_setaffinity(0, {cpu})
-    os.sched_setaffinity(server.proc.pid, {cpu})
     try:
         for key, runs in peer_runs(n0, casadi).items():
             casadi_peer = key.startswith("casadi")
