@@ -26,9 +26,15 @@ const TOP_LEVEL: &[&str] = &[
     "specs",
 ];
 
-/// Read a flowsheet or scenario file as text: at most [`Limits::max_file_bytes`] bytes, valid UTF-8
-/// (an invalid byte is reported with its offset, line and column).
+/// Read a file the engine is given (flowsheet, scenario, model, matrices) as text: at most
+/// [`Limits::max_file_bytes`] bytes, valid UTF-8 (an invalid byte is reported with its offset,
+/// line and column).
+///
+/// The limit holds for what is read, not for what the file system says: `/dev/zero`, a pipe or a
+/// file still growing report a length of 0 and would otherwise be read without end. One byte past
+/// the limit is read at most.
 pub fn read_text(path: &Path) -> Result<String, LoadError> {
+    use std::io::Read;
     let file = path.display().to_string();
     let io = |e: std::io::Error| LoadError::Io { file: file.clone(), reason: e.to_string() };
     let limit = Limits::get().file_bytes();
@@ -36,7 +42,17 @@ pub fn read_text(path: &Path) -> Result<String, LoadError> {
     if let Some(msg) = limit.check(usize::try_from(len).unwrap_or(usize::MAX), "the file size in bytes") {
         return Err(LoadError::Io { file, reason: msg });
     }
-    let bytes = std::fs::read(path).map_err(io)?;
+    let mut bytes = Vec::new();
+    let cap = u64::try_from(limit.max).unwrap_or(u64::MAX).saturating_add(1);
+    std::fs::File::open(path).map_err(io)?.take(cap).read_to_end(&mut bytes).map_err(io)?;
+    if bytes.len() > limit.max {
+        let reason = format!(
+            "more than {} bytes and still going (the size it reports: {len}); the limit is set by the environment \
+             variable {}",
+            limit.max, limit.var
+        );
+        return Err(LoadError::Io { file, reason });
+    }
     String::from_utf8(bytes).map_err(|e| {
         let offset = e.utf8_error().valid_up_to();
         let good = &e.as_bytes()[..offset];
