@@ -40,6 +40,7 @@ use crate::dae::{BdfStats, DaeError};
 mod adapter;
 pub mod conservation;
 mod driver;
+mod instants;
 mod live;
 mod mpc;
 mod session;
@@ -221,10 +222,15 @@ fn failure_detail(plant: &Plant, source: &DaeError) -> String {
     match *source {
         DaeError::Initialization { equation, .. } if equation < plant.n_eqs() => {
             let var = plant.equation_variable(equation).map_or("-".to_string(), |v| plant.vars()[v].path.clone());
-            format!(
-                " ({}, variable {var}; a vessel running dry or overflowing, or a flow reversing, ends a run this way)",
-                plant.equation_name(equation)
-            )
+            let block = plant.blocks().iter().find(|b| (b.eq_offset..b.eq_offset + b.n_eq).contains(&equation));
+            let hint = match block.map(|b| b.kind) {
+                Some(plantwide_flowsheet::BlockKind::Controller) => {
+                    "a controller whose output the plant cannot take there — moved past the range of the input it \
+                     drives, or by a model of the wrong sign or size — ends a run this way"
+                }
+                _ => "a vessel running dry or overflowing, or a flow reversing, ends a run this way",
+            };
+            format!(" ({}, variable {var}; {hint})", plant.equation_name(equation))
         }
         _ => String::new(),
     }

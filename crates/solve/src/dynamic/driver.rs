@@ -15,6 +15,7 @@ use plantwide_flowsheet::scenario::{Action, Event, Scenario};
 use plantwide_flowsheet::{Plant, Read};
 
 use super::adapter::{DaeShape, PlantDae, Quadratures};
+use super::instants;
 use super::mpc::{self, MpcError, MpcLog, MpcRun};
 use super::snapshot::{self, DriverState, SNAPSHOT_VERSION, Snapshot};
 use super::table::Table;
@@ -391,7 +392,7 @@ impl<'p> Driver<'p> {
                     changed |= self.st.waveforms[i] != Waveform::Constant(x[op]);
                     self.st.waveforms[i] = Waveform::Constant(x[op]);
                 }
-                self.st.next_scan[k] = (t / scan).floor() as u64 + 1;
+                self.st.next_scan[k] = instants::after(t, scan);
             }
         }
         changed
@@ -405,7 +406,7 @@ impl<'p> Driver<'p> {
             let (input, v) = self.analyzers[k];
             if self.st.next_sample[k] as f64 * ts <= t {
                 self.st.pending[k].push((self.st.next_sample[k] as f64 * ts + td, x[v]));
-                self.st.next_sample[k] = (t / ts).floor() as u64 + 1;
+                self.st.next_sample[k] = instants::after(t, ts);
             }
             let due: Vec<(f64, f64)> = self.st.pending[k].iter().copied().filter(|&(r, _)| r <= t).collect();
             if let Some(&(_, value)) = due.last() {
@@ -486,7 +487,7 @@ impl<'p> Driver<'p> {
         let (t0, interval) = (self.t0, self.sc.interval);
         if self.st.next_record as f64 * interval <= t0 {
             self.push_row(t0, &x);
-            self.st.next_record = (t0 / interval).floor() as u64 + 1;
+            self.st.next_record = instants::after(t0, interval);
         }
         let events = self.st.next_event;
         self.apply_due_at(t0, &mut x);
