@@ -145,9 +145,16 @@ impl<'s> Assembler<'s> {
             }
         }
         self.stop_if_invalid()?;
-        for name in spec.units.keys().chain(spec.controllers.keys()) {
-            if name.is_empty() || name.contains(['.', '[', ']', '@', ',', '=', ' ']) {
-                self.diags.push(Diagnostic::new(name.clone(), "names may not be empty or contain '.', '[', ']', '@', ',', '=' or spaces (they appear in variable paths)"));
+        let named = spec.units.keys().map(|n| ("units", n)).chain(spec.controllers.keys().map(|n| ("controllers", n)));
+        for (section, name) in named {
+            if name.is_empty() {
+                let msg = "a name may not be empty (it begins every variable path of the unit): name it";
+                self.diags.push(Diagnostic::new(format!("{section}.\"\""), msg));
+            } else if name.contains(['.', '[', ']', '@', ',', '=', ' ']) {
+                self.diags.push(Diagnostic::new(
+                    format!("{section}.{name}"),
+                    "names may not contain '.', '[', ']', '@', ',', '=' or spaces (they appear in variable paths)",
+                ));
             }
         }
         for name in spec.controllers.keys().filter(|n| spec.units.contains_key(*n)) {
@@ -438,6 +445,20 @@ impl<'s> Assembler<'s> {
             .map(|p| p.find(&self.var_index).map_or(Dimension::DIMENSIONLESS, |i| self.vars[i].spec.dim))
             .collect();
         let driven = c.driven.iter().map(|&i| (self.inputs[i].dim, self.inputs[i].value)).collect();
+        let measured_ranges = c
+            .measured
+            .iter()
+            .map(|p| {
+                p.find(&self.var_index)
+                    .map(|i| physical_range(&self.vars[i].spec))
+                    .or_else(|| {
+                        let master = pending.iter().find(|m| m.name == p.owner())?;
+                        master.driven.first().map(|&i| input_range_of(&self.blocks, &self.inputs, i))
+                    })
+                    .unwrap_or((f64::NEG_INFINITY, f64::INFINITY))
+            })
+            .collect();
+        let driven_ranges = c.driven.iter().map(|&i| input_range_of(&self.blocks, &self.inputs, i)).collect();
         ControllerLinks {
             pv_dim,
             op_dim,
@@ -445,6 +466,8 @@ impl<'s> Assembler<'s> {
             pv_nominal: 1.0,
             measured_dims,
             driven,
+            measured_ranges,
+            driven_ranges,
         }
     }
 
@@ -480,11 +503,12 @@ impl<'s> Assembler<'s> {
     /// ([`plantwide_model::limits::check_input`], the check `--set` and scenario events go through
     /// too), and the number of variables within its limit.
     fn check_plant(&mut self) {
-        for info in &self.inputs {
+        for (i, info) in self.inputs.iter().enumerate() {
             let b = &self.blocks[info.block];
             let path = VarPath::parse(&info.path);
             let name = path.field().unwrap_or(&info.path);
-            if let Err(why) = plantwide_model::limits::check_input(name, info.dim, info.value) {
+            let range = input_range_of(&self.blocks, &self.inputs, i);
+            if let Err(why) = plantwide_model::limits::check_input_within(name, info.dim, info.value, range) {
                 self.diags.push(Diagnostic::new(format!("{}.{name}", section_path(b)), why.to_string()));
             }
         }
@@ -572,6 +596,30 @@ impl<'s> Assembler<'s> {
 }
 
 /// `units.<name>` or `controllers.<name>`: where block `b` is described in the file.
+/// The physical range of input `i` (SI): the one its block declares
+/// ([`plantwide_model::UnitModel::input_range`]: a setpoint takes its measurement's), else the one
+/// its name and dimension give ([`plantwide_model::limits::input_range`]).
+pub(crate) fn input_range_of(blocks: &[Block], inputs: &[InputInfo], i: usize) -> (f64, f64) {
+    let info = &inputs[i];
+    let path = VarPath::parse(&info.path);
+    let name = path.field().unwrap_or(&info.path);
+    let declared = blocks
+        .get(info.block)
+        .and_then(|b| Some((b, b.input_ids.iter().position(|&j| j == i)?)))
+        .and_then(|(b, k)| b.unit.input_range(k));
+    declared.unwrap_or_else(|| plantwide_model::limits::input_range(name, info.dim))
+}
+
+/// The physical range of a variable's values (SI), for the setpoints that measure it: its bounds,
+/// with a holdup's numerical floor (a tiny positive amount that keeps Newton off zero) read as 0
+/// and no bound beyond the largest magnitude of its dimension
+/// ([`plantwide_model::limits::max_magnitude`]).
+pub(crate) fn physical_range(spec: &plantwide_model::VarSpec) -> (f64, f64) {
+    let max = plantwide_model::limits::max_magnitude(spec.dim);
+    let lo = if spec.inventory { spec.lower.min(0.0) } else { spec.lower };
+    (lo.max(-max), spec.upper.min(max))
+}
+
 fn section_path(b: &Block) -> String {
     match b.kind {
         BlockKind::Unit => format!("units.{}", b.name),

@@ -88,7 +88,7 @@ pub fn check_input_value(plant: &Plant, i: usize, v: f64) -> Result<(), plantwid
     let info = &plant.inputs[i];
     let block = &plant.blocks[info.block].name;
     let name = info.path.strip_prefix(&format!("{block}.")).unwrap_or(&info.path);
-    plantwide_model::limits::check_input(name, info.dim, v)
+    plantwide_model::limits::check_input_within(name, info.dim, v, plant.input_range(i))
 }
 
 /// Read the flowsheet at `path` and apply `overrides`: inputs (validated like the file's values)

@@ -15,7 +15,7 @@ use plantwide_units::Dimension;
 use crate::spec::FlowsheetSpec;
 
 /// Where one entry of a unit's local vector (beyond its own variables) comes from.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Read {
     /// Global variable index.
     Var(usize),
@@ -216,6 +216,18 @@ impl Plant {
         let own: Vec<String> =
             self.vars[b.own_offset..b.own_offset + b.layout.n_own()].iter().map(|v| v.path.clone()).collect();
         format!("{}: {}", b.name, b.unit.equation_name(eq - b.eq_offset, &own))
+    }
+
+    /// The physical range `[lo, hi]` of input `i` (SI) that every value it is given is checked
+    /// against ([`crate::overrides::check_input_value`]): its block's declared range (a
+    /// controller's setpoint: its measurement's), else its name's and dimension's.
+    pub fn input_range(&self, i: usize) -> (f64, f64) {
+        crate::assemble::input_range_of(&self.blocks, &self.inputs, i)
+    }
+
+    /// The physical range `[lo, hi]` of variable `v`'s values (SI): what a setpoint on it may ask.
+    pub fn var_range(&self, v: usize) -> (f64, f64) {
+        crate::assemble::physical_range(&self.vars[v].spec)
     }
 
     /// The own variable that equation `eq` belongs to (for diagnostics).

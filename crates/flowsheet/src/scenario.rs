@@ -18,6 +18,8 @@
 //!  "record": {"interval": "1 min", "paths": ["bottoms.x[light]", {"path": "distillate.F", "unit": "kmol/min"}]}}
 //! ```
 
+use std::collections::HashMap;
+
 use indexmap::IndexMap;
 use plantwide_model::controllers::Mode;
 use plantwide_units::{Dimension, QuantityValue, convert_from_si, unit_dimension};
@@ -609,6 +611,12 @@ pub fn resolve_with(spec: &ScenarioSpec, plant: &Plant, file: &str, limits: &Lim
     }
     let mut snapshots = Vec::new();
     for (k, s) in spec.snapshots.iter().enumerate() {
+        if s.file.trim().is_empty() {
+            cx.diags.push(Diagnostic::new(
+                format!("snapshots[{k}].file"),
+                "is empty: give the file to write the snapshot to (e.g. \"column_a_600s.snapshot.json\")",
+            ));
+        }
         snapshots.push((cx.time(&format!("snapshots[{k}].at"), &s.at, false), s.file.clone()));
     }
     let n_columns = record.len() + totals.len() * plant.components.len();
@@ -649,6 +657,7 @@ fn recorded(cx: &mut Cx<'_>, rec: &RecordSpec, events: &[Event]) -> Vec<Recorded
             })
             .collect()
     };
+    let mut seen: HashMap<(Read, String), usize> = HashMap::new();
     for (k, (path, unit)) in paths.iter().enumerate() {
         let field = format!("record.paths[{k}]");
         let (source, dim) = match (cx.plant.var(path), resolve_input(cx.plant, path)) {
@@ -679,6 +688,14 @@ fn recorded(cx: &mut Cx<'_>, rec: &RecordSpec, events: &[Event]) -> Vec<Recorded
             }
             None => dim.to_string(),
         };
+        if let Some(first) = seen.get(&(source, unit.clone())) {
+            cx.diags.push(Diagnostic::new(
+                field,
+                format!("`{path}` is recorded already (record.paths[{first}]) in the same unit: record it once"),
+            ));
+            continue;
+        }
+        seen.insert((source, unit.clone()), k);
         record.push(Recorded { path: path.clone(), source, unit, dim });
     }
     record
@@ -796,7 +813,7 @@ fn check_values(cx: &mut Cx<'_>, events: &[(Event, String)]) {
                 let path = &cx.plant.inputs[input].path;
                 cx.diags.push(Diagnostic::new(
                     label.split(' ').next().unwrap_or_default(),
-                    format!("takes `{path}` to {why}"),
+                    format!("takes `{path}` out of its range: {why}"),
                 ));
                 return;
             }

@@ -288,8 +288,8 @@ pub enum RangeError {
     },
     /// The value is finite but outside [`input_range`].
     #[error(
-        "{}{}{} is outside the range {} … {}{} in which the models hold",
-        negative_hint(*.value, *.lo), number(*.value), unit_suffix(*.dim), number(*.lo), number(*.hi), unit_suffix(*.dim)
+        "{}{} is outside the range {} … {}{} in which the models hold{}",
+        number(*.value), unit_suffix(*.dim), number(*.lo), number(*.hi), unit_suffix(*.dim), negative_hint(*.value, *.lo)
     )]
     Outside {
         /// The input's name within its unit.
@@ -305,9 +305,9 @@ pub enum RangeError {
     },
 }
 
-/// `"must not be negative: "` for a negative value of a quantity whose range starts at zero.
+/// `" (it must not be negative)"` for a negative value of a quantity whose range starts at zero.
 fn negative_hint(value: f64, lo: f64) -> &'static str {
-    if lo == 0.0 && value < 0.0 { "must not be negative: " } else { "" }
+    if lo == 0.0 && value < 0.0 { " (it must not be negative)" } else { "" }
 }
 
 /// ` <SI unit>` after a number, nothing for a dimensionless one.
@@ -320,7 +320,15 @@ fn unit_suffix(dim: Dimension) -> String {
 /// # Errors
 /// [`RangeError`] naming the input, its value and the range.
 pub fn check_input(name: &str, dim: Dimension, value: f64) -> Result<(), RangeError> {
-    let (lo, hi) = input_range(name, dim);
+    check_input_within(name, dim, value, input_range(name, dim))
+}
+
+/// Check an input value against the range `(lo, hi)` (SI) its unit declares
+/// ([`crate::UnitModel::input_range`]), or [`input_range`]'s.
+///
+/// # Errors
+/// [`RangeError`] naming the input, its value and the range.
+pub fn check_input_within(name: &str, dim: Dimension, value: f64, (lo, hi): (f64, f64)) -> Result<(), RangeError> {
     if !value.is_finite() {
         return Err(RangeError::NotFinite { name: name.to_string(), value });
     }
@@ -328,6 +336,13 @@ pub fn check_input(name: &str, dim: Dimension, value: f64) -> Result<(), RangeEr
         return Err(RangeError::Outside { name: name.to_string(), dim, value, lo, hi });
     }
     Ok(())
+}
+
+/// `None` if `value` lies in `range`, else the sentence [`RangeError::Outside`] says of it
+/// ("-5 mol/s is outside the range 0 … 1e6 mol/s in which the models hold (it must not be
+/// negative)"), for a field whose range another quantity gives (a setpoint, a controller limit).
+pub fn outside(value: f64, range: (f64, f64), dim: Dimension) -> Option<String> {
+    check_input_within("", dim, value, range).err().map(|e| e.to_string())
 }
 
 /// A number for a message: plain between 1e-3 and 1e6 (at most 6 significant digits), else in
@@ -362,7 +377,7 @@ mod tests {
         let e = check_input("F", Dimension::MOLAR_FLOW, -1.0).unwrap_err();
         assert_eq!(
             e.to_string(),
-            "must not be negative: -1 mol/s is outside the range 0 … 1e6 mol/s in which the models hold"
+            "-1 mol/s is outside the range 0 … 1e6 mol/s in which the models hold (it must not be negative)"
         );
         let e = check_input("z[light]", Dimension::DIMENSIONLESS, 1.5).unwrap_err();
         assert_eq!(e.to_string(), "1.5 is outside the range 0 … 1 in which the models hold");

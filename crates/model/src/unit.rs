@@ -241,6 +241,13 @@ pub trait UnitModel: Send + Sync + std::fmt::Debug {
     fn output_limits(&self) -> Option<(f64, f64)> {
         None
     }
+    /// The physical range `[lo, hi]` (SI) of input `k` when the unit knows a narrower one than
+    /// its name and dimension give ([`crate::limits::input_range`]): a controller's setpoint takes
+    /// its measurement's range (a mole fraction's 0 … 1), its manual output that of the input it
+    /// drives (default: none, the input's own range).
+    fn input_range(&self, _k: usize) -> Option<(f64, f64)> {
+        None
+    }
 }
 
 /// Object-safe view of a [`UnitModel`], used by assembly and solvers.
@@ -295,6 +302,8 @@ pub trait Unit: Send + Sync + std::fmt::Debug {
     fn saturation(&self, io: &UnitIo<'_, f64>) -> Option<Saturation>;
     /// See [`UnitModel::check_inputs`].
     fn check_inputs(&self, thermo: &ThermoPackage, inputs: &[f64]) -> Result<(), InputError>;
+    /// See [`UnitModel::input_range`].
+    fn input_range(&self, k: usize) -> Option<(f64, f64)>;
 }
 
 /// A controller output held at a limit with the measurement off its setpoint.
@@ -320,6 +329,9 @@ impl<U: UnitModel + 'static> Unit for U {
     }
     fn check_inputs(&self, thermo: &ThermoPackage, inputs: &[f64]) -> Result<(), InputError> {
         UnitModel::check_inputs(self, thermo, inputs)
+    }
+    fn input_range(&self, k: usize) -> Option<(f64, f64)> {
+        UnitModel::input_range(self, k)
     }
     fn inlet_ports(&self) -> Vec<String> {
         UnitModel::inlet_ports(self)

@@ -337,6 +337,8 @@ mod tests {
             op_dim: Dimension::MOLAR_FLOW,
             op_value: 5.0,
             pv_nominal: 1.0,
+            measured_ranges: Vec::new(),
+            driven_ranges: Vec::new(),
         }
     }
 

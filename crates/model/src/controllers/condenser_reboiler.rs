@@ -176,6 +176,8 @@ mod tests {
             op_dim,
             op_value: 1.0e6,
             pv_nominal: 1.0,
+            measured_ranges: Vec::new(),
+            driven_ranges: Vec::new(),
         }
     }
 

@@ -154,6 +154,8 @@ mod tests {
             op_dim: Dimension::MOLAR_FLOW,
             op_value: 0.0,
             pv_nominal: 5.0,
+            measured_ranges: Vec::new(),
+            driven_ranges: Vec::new(),
         };
         Delay::build(&c, BuildCx::new(&comps, &thermo, "controllers.d"), &links).unwrap()
     }

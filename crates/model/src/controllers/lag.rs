@@ -126,6 +126,8 @@ mod tests {
             op_dim: Dimension::DIMENSIONLESS,
             op_value: 0.5,
             pv_nominal: 0.5,
+            measured_ranges: Vec::new(),
+            driven_ranges: Vec::new(),
         };
         Lag::build(&c, BuildCx::new(&comps, &thermo, "controllers.actuator"), &links)
     }

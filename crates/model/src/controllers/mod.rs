@@ -40,6 +40,24 @@ pub struct ControllerLinks {
     /// Dimension and file value (SI) of every driven input, in the order of
     /// [`ControllerPaths::driven`].
     pub driven: Vec<(Dimension, f64)>,
+    /// Physical range `[lo, hi]` (SI) of every measured path, in the order of
+    /// [`ControllerPaths::measured`]: its variable's bounds, or the range of the input a master
+    /// controller drives; a setpoint outside it can never be met.
+    pub measured_ranges: Vec<(f64, f64)>,
+    /// Physical range `[lo, hi]` (SI) of every driven input, in the order of
+    /// [`ControllerPaths::driven`]: the values it can take.
+    pub driven_ranges: Vec<(f64, f64)>,
+}
+
+impl ControllerLinks {
+    /// The first measurement's physical range (unbounded if unknown).
+    pub fn pv_range(&self) -> (f64, f64) {
+        self.measured_ranges.first().copied().unwrap_or((f64::NEG_INFINITY, f64::INFINITY))
+    }
+    /// The first driven input's physical range (unbounded if unknown).
+    pub fn op_range(&self) -> (f64, f64) {
+        self.driven_ranges.first().copied().unwrap_or((f64::NEG_INFINITY, f64::INFINITY))
+    }
 }
 
 /// A setpoint: a value (an input `sp` that analyses and scenarios may move) or another controller's

@@ -217,9 +217,41 @@ fn horizons(c: &MpcConfig, cx: &mut BuildCx<'_>) -> (usize, usize, usize) {
     (p.clamp(1, MAX_HORIZON), m.clamp(1, p.clamp(1, MAX_HORIZON)), n.clamp(1, MAX_HORIZON))
 }
 
-/// The controller's plan in SI from its description, the CVs' dimensions and the MVs'
-/// dimensions and file values; problems are reported on `cx`.
-pub fn plan(c: &MpcConfig, cx: &mut BuildCx<'_>, cv_dims: &[Dimension], mvs: &[(Dimension, f64)]) -> MpcPlan {
+/// What a controller's CVs and MVs are in the plant: dimensions, the MVs' file values and the
+/// physical ranges (SI) of both, in the order of `cvs` and `mvs`.
+#[derive(Debug, Clone, Copy)]
+pub struct Channels<'a> {
+    /// Dimension of each CV.
+    pub cv_dims: &'a [Dimension],
+    /// Physical range of each CV (its variable's bounds).
+    pub cv_ranges: &'a [(f64, f64)],
+    /// Dimension and file value of each MV's driven input.
+    pub mvs: &'a [(Dimension, f64)],
+    /// Physical range of each MV's driven input.
+    pub mv_ranges: &'a [(f64, f64)],
+}
+
+impl Channels<'_> {
+    fn cv_range(&self, k: usize) -> (f64, f64) {
+        self.cv_ranges.get(k).copied().unwrap_or((f64::NEG_INFINITY, f64::INFINITY))
+    }
+    fn mv_range(&self, k: usize) -> (f64, f64) {
+        self.mv_ranges.get(k).copied().unwrap_or((f64::NEG_INFINITY, f64::INFINITY))
+    }
+}
+
+/// Report `field` = `v` (SI) outside `range`, `what` naming whose range it is.
+fn within(cx: &mut BuildCx<'_>, field: String, v: f64, range: (f64, f64), dim: Dimension, what: &str) {
+    if let Some(why) = crate::limits::outside(v, range, dim) {
+        cx.error(&field, format!("{why}; the range is {what}"));
+    }
+}
+
+/// The controller's plan in SI from its description and its channels; problems are reported on
+/// `cx`. A setpoint must lie in its CV's physical range and a hard MV limit in its input's; an MV
+/// without a limit is held to its input's range (a flow is never moved below zero).
+pub fn plan(c: &MpcConfig, cx: &mut BuildCx<'_>, ch: Channels<'_>) -> MpcPlan {
+    let (cv_dims, mvs) = (ch.cv_dims, ch.mvs);
     if c.cvs.is_empty() || c.mvs.is_empty() {
         cx.error(
             if c.cvs.is_empty() { "cvs" } else { "mvs" },
@@ -234,7 +266,9 @@ pub fn plan(c: &MpcConfig, cx: &mut BuildCx<'_>, cv_dims: &[Dimension], mvs: &[(
         let s = scale(cx, format!("cvs[{k}].scale"), &cv.scale, dim);
         cv_scales.push(s);
         q.push(weight(cx, format!("cvs[{k}].weight"), cv.weight));
-        setpoints.push(cx.quantity(&format!("cvs[{k}].sp"), &cv.sp, dim));
+        let sp = cx.quantity(&format!("cvs[{k}].sp"), &cv.sp, dim);
+        within(cx, format!("cvs[{k}].sp"), sp, ch.cv_range(k), dim, "the controlled variable's");
+        setpoints.push(sp);
         y_min.push(opt(cx, format!("cvs[{k}].min"), &cv.min, dim, f64::NEG_INFINITY) / s);
         y_max.push(opt(cx, format!("cvs[{k}].max"), &cv.max, dim, f64::INFINITY) / s);
     }
@@ -244,8 +278,13 @@ pub fn plan(c: &MpcConfig, cx: &mut BuildCx<'_>, cv_dims: &[Dimension], mvs: &[(
         let s = scale(cx, format!("mvs[{k}].scale"), &mv.scale, dim);
         mv_scales.push(s);
         r.push(weight(cx, format!("mvs[{k}].move_weight"), mv.move_weight));
-        u_min.push(opt(cx, format!("mvs[{k}].min"), &mv.min, dim, f64::NEG_INFINITY) / s);
-        u_max.push(opt(cx, format!("mvs[{k}].max"), &mv.max, dim, f64::INFINITY) / s);
+        let (lo, hi) = ch.mv_range(k);
+        let (min, max) =
+            (opt(cx, format!("mvs[{k}].min"), &mv.min, dim, lo), opt(cx, format!("mvs[{k}].max"), &mv.max, dim, hi));
+        within(cx, format!("mvs[{k}].min"), min, (lo, hi), dim, "that of the input it drives");
+        within(cx, format!("mvs[{k}].max"), max, (lo, hi), dim, "that of the input it drives");
+        u_min.push(min / s);
+        u_max.push(max / s);
         du_max.push(mv.rate.as_ref().map_or(f64::INFINITY, |q| cx.positive(&format!("mvs[{k}].rate"), q, dim)) / s);
         let default_step = 1e-4 * if value != 0.0 { value.abs() } else { s };
         steps.push(mv.step.as_ref().map_or(default_step, |q| cx.positive(&format!("mvs[{k}].step"), q, dim)));
@@ -279,12 +318,20 @@ pub struct Mpc {
     mvs: Vec<(Dimension, f64)>,
     cv_dims: Vec<Dimension>,
     setpoints: Vec<f64>,
+    /// Physical range of each input, in [`UnitModel::inputs`] order (the MVs', then the CVs').
+    ranges: Vec<(f64, f64)>,
 }
 
 impl Mpc {
     /// Build from the flowsheet description and the resolved links.
     pub fn build(c: &MpcConfig, mut cx: BuildCx<'_>, links: &ControllerLinks) -> Result<Mpc, Vec<FieldError>> {
-        let plan = plan(c, &mut cx, &links.measured_dims, &links.driven);
+        let channels = Channels {
+            cv_dims: &links.measured_dims,
+            cv_ranges: &links.measured_ranges,
+            mvs: &links.driven,
+            mv_ranges: &links.driven_ranges,
+        };
+        let plan = plan(c, &mut cx, channels);
         for (k, (mv, &(_, value))) in c.mvs.iter().zip(&links.driven).enumerate() {
             let s = plan.mv_scales.get(k).copied().unwrap_or(1.0);
             let (lo, hi) = (plan.settings.u_min[k] * s, plan.settings.u_max[k] * s);
@@ -297,7 +344,10 @@ impl Mpc {
         }
         let cvs = c.cvs.iter().map(|cv| cv.pv.clone()).collect();
         let (mvs, cv_dims) = (links.driven.clone(), links.measured_dims.clone());
-        cx.finish(Mpc { cvs, mvs, cv_dims, setpoints: plan.setpoints })
+        let ranges =
+            (0..mvs.len()).map(|k| channels.mv_range(k)).chain((0..cv_dims.len()).map(|k| channels.cv_range(k)));
+        let ranges = ranges.collect();
+        cx.finish(Mpc { cvs, mvs, cv_dims, setpoints: plan.setpoints, ranges })
     }
 }
 
@@ -309,6 +359,10 @@ fn output_name(k: usize) -> String {
 impl UnitModel for Mpc {
     fn type_name(&self) -> &'static str {
         "mpc"
+    }
+    /// An MV input takes its driven input's range, a setpoint its CV's.
+    fn input_range(&self, k: usize) -> Option<(f64, f64)> {
+        self.ranges.get(k).copied()
     }
     fn internal_vars(&self) -> Vec<VarSpec> {
         self.mvs

@@ -102,6 +102,13 @@ pub struct Pid {
     links: ControllerLinks,
 }
 
+/// Report `field` = `v` (SI) outside `range`, `what` naming whose range it is.
+fn within(cx: &mut BuildCx<'_>, field: &str, v: f64, range: (f64, f64), dim: Dimension, what: &str) {
+    if let Some(why) = crate::limits::outside(v, range, dim) {
+        cx.error(field, format!("{why}; the range is {what}"));
+    }
+}
+
 impl Pid {
     /// Build from the flowsheet description and the resolved links.
     pub fn build(c: &PidConfig, mut cx: BuildCx<'_>, links: &ControllerLinks) -> Result<Pid, Vec<FieldError>> {
@@ -123,6 +130,14 @@ impl Pid {
             cx.error("op_max", format!("must exceed op_min ({op_min} ≥ {op_max} in SI units)"));
         }
         let op_manual = c.op_manual.as_ref().map_or(bias, |v| cx.quantity("op_manual", v, links.op_dim));
+        if remote_sp.is_none() {
+            within(&mut cx, "sp", sp, links.pv_range(), links.pv_dim, "the measurement's");
+        }
+        for (field, v) in [("op_min", op_min), ("op_max", op_max), ("op_manual", op_manual)] {
+            if v.is_finite() {
+                within(&mut cx, field, v, links.op_range(), links.op_dim, "that of the input it drives");
+            }
+        }
         let pid = Pid {
             pv_path: c.pv.clone(),
             remote_sp,
@@ -186,6 +201,15 @@ impl UnitModel for Pid {
         let auto = f64::from(u8::from(self.mode == Mode::Auto));
         v.push(InputSpec { name: "auto".into(), dim: Dimension::DIMENSIONLESS, value: auto });
         v
+    }
+    /// The setpoint takes the measurement's range, the manual output the driven input's.
+    fn input_range(&self, k: usize) -> Option<(f64, f64)> {
+        let k = k + usize::from(self.remote_sp.is_some());
+        match k {
+            0 => Some(self.links.pv_range()),
+            1 => Some(self.links.op_range()),
+            _ => None,
+        }
     }
     fn signals(&self) -> Vec<SignalSpec> {
         let mut v = vec![SignalSpec { role: "pv".into(), path: self.pv_path.clone() }];
@@ -294,6 +318,8 @@ mod tests {
             op_dim: Dimension::MOLAR_FLOW,
             op_value: 5.0,
             pv_nominal: 1.2,
+            measured_ranges: Vec::new(),
+            driven_ranges: Vec::new(),
         }
     }
 

@@ -189,6 +189,8 @@ mod tests {
             op_dim,
             op_value: 3.0,
             pv_nominal: 1.0,
+            measured_ranges: Vec::new(),
+            driven_ranges: Vec::new(),
         }
     }
 

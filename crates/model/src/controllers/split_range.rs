@@ -224,6 +224,8 @@ mod tests {
             op_dim,
             op_value: 0.5,
             pv_nominal: 1.0,
+            measured_ranges: Vec::new(),
+            driven_ranges: Vec::new(),
         }
     }
 

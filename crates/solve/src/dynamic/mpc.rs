@@ -8,7 +8,7 @@ use std::collections::BTreeMap;
 
 use plantwide_flowsheet::Plant;
 use plantwide_model::BuildCx;
-use plantwide_model::controllers::mpc::{MpcConfig, MpcModelSource, MpcPlan, plan};
+use plantwide_model::controllers::mpc::{Channels, MpcConfig, MpcModelSource, MpcPlan, plan};
 use plantwide_model::registry::ControllerSpec;
 use plantwide_mpc::{Dmc, StepModel};
 use serde::{Deserialize, Serialize};
@@ -41,17 +41,44 @@ pub struct MpcLog {
 }
 
 /// A step-response model file: the model with the names of its inputs and outputs.
+///
+/// Read with every key checked (an unknown key is refused: a misspelt `"input"` must not leave the
+/// channels unnamed) and its channels named, so that a controller can refuse a model of other
+/// variables, or of its own in another order.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "RawStepModelFile")]
 pub struct StepModelFile {
     /// Input paths, in column order.
-    #[serde(default)]
     pub inputs: Vec<String>,
     /// Output paths, in row order.
-    #[serde(default)]
     pub outputs: Vec<String>,
     /// The model (SI, deviation variables).
     #[serde(flatten)]
     pub model: StepModel,
+}
+
+/// [`StepModelFile`] as written, every key known (serde cannot deny unknown keys through
+/// `flatten`).
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields, expecting = "a step-response model: an object with inputs, outputs, ts, ny, nu and steps")]
+struct RawStepModelFile {
+    #[serde(default)]
+    inputs: Vec<String>,
+    #[serde(default)]
+    outputs: Vec<String>,
+    ts: f64,
+    ny: usize,
+    nu: usize,
+    steps: Vec<Vec<f64>>,
+}
+
+impl TryFrom<RawStepModelFile> for StepModelFile {
+    type Error = String;
+    fn try_from(r: RawStepModelFile) -> Result<Self, String> {
+        let model = StepModel { ts: r.ts, ny: r.ny, nu: r.nu, steps: r.steps };
+        model.validate().map_err(|e| e.to_string())?;
+        Ok(StepModelFile { inputs: r.inputs, outputs: r.outputs, model })
+    }
 }
 
 /// One controller in a run.
@@ -114,9 +141,16 @@ fn resolve(plant: &Plant, name: &str, cfg: &MpcConfig) -> Result<Resolved, MpcEr
     let sp_inputs: Vec<usize> =
         (1..=cfg.cvs.len()).map(|k| input(format!("{name}.sp{k}"))).collect::<Result<_, _>>()?;
     let cv_dims: Vec<_> = cvs.iter().map(|&v| plant.vars()[v].spec.dim).collect();
+    let cv_ranges: Vec<_> = cvs.iter().map(|&v| plant.var_range(v)).collect();
     let mvs: Vec<_> = mv_inputs.iter().map(|&i| (plant.inputs()[i].dim, plant.inputs()[i].value)).collect();
+    let mv_ranges: Vec<_> = cfg
+        .mvs
+        .iter()
+        .map(|m| plant.input(&m.output).map_or((f64::NEG_INFINITY, f64::INFINITY), |i| plant.input_range(i)))
+        .collect();
     let mut cx = BuildCx::new(plant.components(), plant.thermo(), format!("controllers.{name}"));
-    let p = plan(cfg, &mut cx, &cv_dims, &mvs);
+    let channels = Channels { cv_dims: &cv_dims, cv_ranges: &cv_ranges, mvs: &mvs, mv_ranges: &mv_ranges };
+    let p = plan(cfg, &mut cx, channels);
     let p = cx.finish(p).map_err(|e| {
         fail(name, e.iter().map(|e| format!("{}: {}", e.path, e.message)).collect::<Vec<_>>().join("; "))
     })?;
@@ -141,7 +175,7 @@ fn build(plant: &Plant, x: &[f64], name: &str, cfg: &MpcConfig) -> Result<MpcRun
     let (p, cvs, mv_inputs, sp_inputs) = resolve(plant, name, cfg)?;
     let (model, source) = match &p.model {
         MpcModelSource::Builtin(_) => (step_test(plant, x, name, &p, &cvs, &mv_inputs)?, "step_test".to_string()),
-        MpcModelSource::File { file } => (model_file(plant, name, file, &p, cvs.len(), mv_inputs.len())?, file.clone()),
+        MpcModelSource::File { file } => (model_file(plant, name, cfg, file, &p)?, file.clone()),
     };
     let u0: Vec<f64> = mv_inputs.iter().zip(&p.mv_scales).map(|(&i, s)| plant.inputs()[i].value / s).collect();
     let y0: Vec<f64> = cvs.iter().zip(&p.cv_scales).map(|(&v, s)| x[v] / s).collect();
@@ -222,38 +256,86 @@ fn step_test(
     StepModel::new(p.sample_time, ny, nu, steps).map_err(|e| fail(name, e.to_string()))
 }
 
-/// A step-response model file, relative to the flowsheet's folder, checked against the controller.
-fn model_file(plant: &Plant, name: &str, file: &str, p: &MpcPlan, ny: usize, nu: usize) -> Result<StepModel, MpcError> {
+/// A step-response model file, relative to the flowsheet's folder, checked against the controller:
+/// read under the file-size limit, every key known, its channels the controller's CVs and MVs in
+/// order, its sample time the controller's, its gain of full rank in the controller's scales.
+fn model_file(plant: &Plant, name: &str, cfg: &MpcConfig, file: &str, p: &MpcPlan) -> Result<StepModel, MpcError> {
     let base = std::path::Path::new(plant.file()).parent().unwrap_or(std::path::Path::new("."));
     let path = base.join(file);
-    let text = std::fs::read_to_string(&path).map_err(|e| fail(name, format!("model file {}: {e}", path.display())))?;
-    let m: StepModelFile =
-        serde_json::from_str(&text).map_err(|e| fail(name, format!("model file {}: {e}", path.display())))?;
-    m.model.validate().map_err(|e| fail(name, format!("model file {}: {e}", path.display())))?;
+    let bad = |reason: String| fail(name, format!("model file {}: {reason}", path.display()));
+    let text = plantwide_flowsheet::read_text(&path).map_err(|e| bad(e.to_string()))?;
+    let de = &mut serde_json::Deserializer::from_str(&text);
+    let m: StepModelFile = serde_path_to_error::deserialize(de).map_err(|e| {
+        let at = e.path().to_string();
+        let at = if at == "." { String::new() } else { format!("{at}: ") };
+        bad(format!("{at}{}", e.into_inner()))
+    })?;
+    let (ny, nu) = (cfg.cvs.len(), cfg.mvs.len());
     if m.model.ny != ny || m.model.nu != nu {
-        return Err(fail(
-            name,
-            format!(
-                "model file {} is {}×{} but the controller has {ny} CVs and {nu} MVs",
-                path.display(),
-                m.model.ny,
-                m.model.nu
-            ),
-        ));
+        return Err(bad(format!("is {}×{} but the controller has {ny} CVs and {nu} MVs", m.model.ny, m.model.nu)));
     }
+    check_channels(plant, cfg, &m).map_err(bad)?;
     if (m.model.ts - p.sample_time).abs() > 1e-9 * p.sample_time {
-        return Err(fail(
-            name,
-            format!(
-                "model file {} is sampled every {} s but the controller executes every {} s: give sample_time = {} s",
-                path.display(),
-                m.model.ts,
-                p.sample_time,
-                m.model.ts
-            ),
+        return Err(bad(format!(
+            "is sampled every {} s but the controller executes every {} s: give sample_time = {} s",
+            m.model.ts, p.sample_time, m.model.ts
+        )));
+    }
+    check_gain(&scaled(&m.model, p)).map_err(bad)?;
+    Ok(m.model)
+}
+
+/// The file's `outputs` must be the controller's CVs (`cvs[k].pv`) and its `inputs` the inputs
+/// its MVs drive (`mvs[k].output`), in the same order, compared as resolved variables and inputs
+/// (so `stream.z[c]` and `stream.x[c]` are one).
+fn check_channels(plant: &Plant, cfg: &MpcConfig, m: &StepModelFile) -> Result<(), String> {
+    if m.inputs.is_empty() || m.outputs.is_empty() {
+        return Err("names no channels: give \"inputs\" (the MVs' driven inputs) and \"outputs\" (the CVs), in the \
+                    order of the controller's mvs and cvs, as `plantwide identify --report` writes them"
+            .to_string());
+    }
+    let want_out: Vec<&str> = cfg.cvs.iter().map(|c| c.pv.as_str()).collect();
+    let want_in: Vec<&str> = cfg.mvs.iter().map(|v| v.output.as_str()).collect();
+    let same_var = |a: &str, b: &str| plant.var(a).is_some() && plant.var(a) == plant.var(b);
+    let same_input = |a: &str, b: &str| plant.input(a).is_some() && plant.input(a) == plant.input(b);
+    let mismatch = |what: &str, field: &str, got: &[String], want: &[&str]| {
+        let order = if got.len() == want.len() && want.iter().all(|w| got.iter().any(|g| g == w)) {
+            " (the same channels in another order: the model's rows and columns would drive the wrong ones)"
+        } else {
+            ""
+        };
+        format!("\"{what}\" are [{}] but the controller's {field} are [{}]{order}", got.join(", "), want.join(", "))
+    };
+    if m.outputs.len() != want_out.len() || !m.outputs.iter().zip(&want_out).all(|(a, b)| same_var(a, b)) {
+        return Err(mismatch("outputs", "CVs (cvs[k].pv)", &m.outputs, &want_out));
+    }
+    if m.inputs.len() != want_in.len() || !m.inputs.iter().zip(&want_in).all(|(a, b)| same_input(a, b)) {
+        return Err(mismatch("inputs", "MVs (mvs[k].output)", &m.inputs, &want_in));
+    }
+    Ok(())
+}
+
+/// A model the controller can use: finite in its scaled variables, and a steady-state gain of
+/// full rank (σ_min > 1e-12 σ_max): with a singular gain no move sets the CVs independently, and
+/// the QP drives the MVs along the null direction without bound.
+fn check_gain(scaled: &StepModel) -> Result<(), String> {
+    if scaled.steps.iter().flatten().any(|v| !v.is_finite()) {
+        return Err("its coefficients overflow in the controller's scaled variables (coefficient × MV scale / CV \
+                    scale): check the coefficients' units (SI) and the scales"
+            .to_string());
+    }
+    let g = scaled.gain();
+    let (ny, nu) = (scaled.ny, scaled.nu);
+    let svd = faer::Mat::<f64>::from_fn(ny, nu, |i, j| g[i][j]).thin_svd().map_err(|_| "its gain has no SVD")?;
+    let s = svd.S().column_vector();
+    let (hi, lo) = (s[0], s[ny.min(nu) - 1]);
+    if lo.is_nan() || lo <= 1e-12 * hi {
+        return Err(format!(
+            "its steady-state gain (last step coefficients, in the controller's scales) is singular: singular values \
+             {hi:.4e} … {lo:.4e}; no MV move sets the CVs independently — check the model, or control fewer CVs"
         ));
     }
-    Ok(m.model)
+    Ok(())
 }
 
 impl MpcRun {
@@ -276,7 +358,7 @@ impl MpcRun {
         let y: Vec<f64> = self.cvs.iter().zip(&self.cv_scales).map(|(&v, s)| x[v] / s).collect();
         let sp: Vec<f64> = self.sp_inputs.iter().zip(&self.cv_scales).map(|(&i, s)| setpoint(i) / s).collect();
         let m = self.dmc.step(&y, &sp).map_err(|e| fail(&self.name, format!("at t = {t:.6e} s: {e}")))?;
-        self.next = (t / self.sample_time).floor() as u64 + 1;
+        self.next = super::instants::after(t, self.sample_time);
         let log = &mut self.log;
         log.samples += 1;
         *log.statuses.entry(m.status.clone()).or_insert(0) += 1;
