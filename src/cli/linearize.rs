@@ -96,7 +96,8 @@ fn run_tf(a: &LinearizeArgs, file: &std::path::Path, tu: &TimeUnit) -> Result<()
         time_unit: tu.name.clone(),
         points: w.iter().map(|&w| frequency::point(w * tu.seconds, &model.response(w), &[])).collect(),
     });
-    let doc = plantwide::io::tf::export(&model, (&tu.name, tu.seconds), frequency.as_ref());
+    let doc = plantwide::io::tf::export(&model, (&tu.name, tu.seconds), frequency.as_ref())
+        .map_err(|e| CliError::numerical(e.to_string()))?;
     outln!(
         "transfer-function model `{}`: {} inputs, {} outputs (s in rad/{}, times in {})",
         model.name,

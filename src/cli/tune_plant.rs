@@ -7,7 +7,7 @@ use std::path::Path;
 use plantwide::flowsheet::Plant;
 use plantwide::studies::tune::averaging::AveragingForm;
 use plantwide::studies::tune::flowsheet::{FlowsheetLoop, FlowsheetTuning, averaging_loop, blt_loops, edits, kc_text};
-use plantwide::studies::tune::loops::{Measurement, PlantLoop, inner_first, plant_loop};
+use plantwide::studies::tune::loops::{Measurement, PlantLoop, inner_first, plant_loop, plant_loops};
 use plantwide::units::{Dimension, parse_quantity_as};
 
 use super::CliError;
@@ -20,8 +20,7 @@ pub fn run(a: &TuneArgs, tu: &TimeUnit) -> Result<(), CliError> {
     let Some(file) = &a.file else { return Err(CliError::user("give a flowsheet FILE or --tf MODEL")) };
     let (plant, u) = load_with_overrides(file, &a.set)?;
     let names = loop_names(a)?;
-    let loops: Vec<PlantLoop> =
-        names.iter().map(|n| plant_loop(&plant, n)).collect::<Result<_, _>>().map_err(tune_error)?;
+    let loops: Vec<PlantLoop> = plant_loops(&plant, &names).map_err(tune_error)?;
     let tuning = match a.method {
         MethodArg::Blt => blt_loops(&plant, &converge(&plant, &u)?.x, &loops, measurement(a)?).map_err(tune_error)?,
         _ => in_sequence(a, file, &plant, &loops, tu)?,
@@ -88,10 +87,24 @@ fn in_sequence(
 }
 
 /// An optional quantity option in SI.
+/// A flag's quantity in SI, checked against the largest magnitude a quantity of its dimension may
+/// have anywhere in a flowsheet ([`plantwide::model::limits::max_magnitude`]: 10⁶ mol/s for a
+/// flow), the rule every value of a file and of `--set` passes.
 pub(super) fn quantity(text: &Option<String>, flag: &str, dim: Dimension) -> Result<Option<f64>, CliError> {
-    text.as_ref()
-        .map(|t| parse_quantity_as(t, dim).map_err(|e| CliError::user(format!("--{flag} {t}: {e}"))))
-        .transpose()
+    let check = |t: &String| {
+        let v = parse_quantity_as(t, dim).map_err(|e| CliError::user(format!("--{flag} {t}: {e}")))?;
+        let max = plantwide::model::limits::max_magnitude(dim);
+        if v.is_nan() || v.abs() > max {
+            let n = plantwide::model::limits::number;
+            return Err(CliError::user(format!(
+                "--{flag} {t}: {} {dim} is beyond ±{} {dim}, the range in which the models hold",
+                n(v),
+                n(max)
+            )));
+        }
+        Ok(v)
+    };
+    text.as_ref().map(check).transpose()
 }
 
 pub(super) fn measurement(a: &TuneArgs) -> Result<Measurement, CliError> {

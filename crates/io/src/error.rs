@@ -14,6 +14,25 @@ pub enum IoError {
         /// What is wrong and what would fix it.
         message: String,
     },
+    /// A transfer-function element whose polynomial coefficients overflow in the time unit asked
+    /// for (`Π(τ s + 1)` of many slow lags: τⁿ beyond 1e308).
+    #[error(
+        "model `{model}`: element {element}: its polynomial coefficients overflow with times in {time_unit} (a \
+         product of {order} lags and leads of up to {slowest:e} {time_unit}): give a larger --time-unit (min, h) \
+         so that the coefficients stay finite"
+    )]
+    Overflow {
+        /// Model name.
+        model: String,
+        /// The element (`y ← u`).
+        element: String,
+        /// The time unit of the coefficients.
+        time_unit: String,
+        /// Number of lags and leads.
+        order: usize,
+        /// Its slowest time constant in that unit.
+        slowest: f64,
+    },
     /// A plot file whose name ends in neither `.png` nor `.svg`.
     #[error("{file}: the plot file must end in .png or .svg")]
     PlotKind {

@@ -202,29 +202,42 @@ fn element(e: &ElementSpec, file: &str, at: &dyn Fn(&str) -> String) -> Result<E
 /// m = json.load(open("wood_berry.model.json")); e = m["elements"][0][0]
 /// g11 = control.tf(e["num"], e["den"])          # times e^(-e["dead_time"] s), e.g. control.pade
 /// ```
+///
+/// # Errors
+/// [`IoError::Overflow`] when an element's coefficients are not finite in `time_unit`.
 pub fn export(
     model: &TfModel,
     time_unit: (&str, f64),
     frequency: Option<&plantwide_analysis::frequency::FrequencyResults>,
-) -> serde_json::Value {
+) -> Result<serde_json::Value, IoError> {
     let (unit, per) = time_unit;
     let signal = |s: &TfSignal| serde_json::json!({"name": s.name, "unit": s.unit});
+    let element = |i: usize, j: usize, e: &Element| {
+        let (num, den) = (e.numerator(per), e.denominator(per));
+        if num.iter().chain(&den).all(|c| c.is_finite()) {
+            return Ok(serde_json::json!({
+                "gain": e.gain,
+                "num": num,
+                "den": den,
+                "dead_time": e.dead_time / per,
+                "poles": e.poles().iter().map(|p| p * per).collect::<Vec<_>>(),
+            }));
+        }
+        Err(IoError::Overflow {
+            model: model.name.clone(),
+            element: format!("{} ← {}", model.outputs[i].name, model.inputs[j].name),
+            time_unit: unit.to_string(),
+            order: e.lags.len() + e.leads.len(),
+            slowest: e.lags.iter().chain(&e.leads).map(|t| t.abs()).fold(0.0, f64::max) / per,
+        })
+    };
     let elements: Vec<Vec<serde_json::Value>> = (0..model.outputs.len())
         .map(|i| {
             (0..model.inputs.len())
-                .map(|j| match model.element(i, j) {
-                    Some(e) => serde_json::json!({
-                        "gain": e.gain,
-                        "num": e.numerator(per),
-                        "den": e.denominator(per),
-                        "dead_time": e.dead_time / per,
-                        "poles": e.poles().iter().map(|p| p * per).collect::<Vec<_>>(),
-                    }),
-                    None => serde_json::Value::Null,
-                })
-                .collect()
+                .map(|j| model.element(i, j).map_or(Ok(serde_json::Value::Null), |e| element(i, j, e)))
+                .collect::<Result<_, _>>()
         })
-        .collect();
+        .collect::<Result<_, _>>()?;
     let mut poles: Vec<f64> = (0..model.outputs.len())
         .flat_map(|i| (0..model.inputs.len()).filter_map(move |j| model.element(i, j)))
         .flat_map(|e| e.poles())
@@ -244,7 +257,7 @@ pub fn export(
     if let Some(f) = frequency {
         doc["frequency"] = serde_json::to_value(f).unwrap_or(serde_json::Value::Null);
     }
-    doc
+    Ok(doc)
 }
 
 #[cfg(test)]

@@ -32,6 +32,9 @@ impl Error {
 /// Why a tuning request was refused.
 #[derive(Debug, Clone, Error)]
 pub enum TuneError {
+    /// A list of the request names one item twice.
+    #[error(transparent)]
+    Duplicate(#[from] crate::request::Duplicate),
     /// BLT needs as many inputs as outputs (one loop per output).
     #[error(
         "model `{model}` is not square ({n_outputs} outputs × {n_inputs} inputs): BLT pairs output i with input i; \
@@ -68,6 +71,22 @@ pub enum TuneError {
         input: String,
         /// What the element is (e.g. ", a first-order lag without dead time").
         detail: String,
+    },
+    /// An element whose ultimate gain is not a representable number (its gain is too small or
+    /// too large for `K_u = 1/|g(jω_u)|` to be finite and nonzero in double precision).
+    #[error(
+        "element {output} ← {input}: its ultimate gain {ku:e} is not a usable number (the element's gain is {gain:e}): \
+         give the gain in other units, so that it lies within about 1e-300 … 1e300"
+    )]
+    UltimateOutOfRange {
+        /// Output of the element.
+        output: String,
+        /// Input of the element.
+        input: String,
+        /// The element's gain.
+        gain: f64,
+        /// The ultimate gain computed.
+        ku: f64,
     },
     /// A relay test did not settle into a cycle.
     #[error("relay test: no limit cycle: {why}")]
@@ -167,7 +186,8 @@ pub enum TuneError {
     },
     /// A test amplitude of zero (the output's steady value is zero).
     #[error(
-        "`{controller}`: the test amplitude is {amplitude} (5 % of an output at zero); give --relay-amplitude or --step"
+        "`{controller}`: the test amplitude is {} (5 % of an output at zero); give --relay-amplitude or --step",
+        plantwide_model::limits::number(*.amplitude)
     )]
     RelayAmplitude {
         /// Controller.
@@ -175,8 +195,22 @@ pub enum TuneError {
         /// The amplitude.
         amplitude: f64,
     },
+    /// A plant test's scan that is not a positive time, or so short against the loop's own time
+    /// that the test would take without bound.
+    #[error("`{controller}`: a scan of {scan:e} s {why}")]
+    Scan {
+        /// Controller.
+        controller: String,
+        /// The scan asked for \[s\].
+        scan: f64,
+        /// What is wrong and what would fix it.
+        why: String,
+    },
     /// A test would drive its input out of range (a valve past fully open).
-    #[error("`{controller}`: the test moves {input} to {value}: {why}; give a smaller --relay-amplitude or --step")]
+    #[error(
+        "`{controller}`: the test moves {input} to {}: {why}; give a smaller --relay-amplitude or --step",
+        plantwide_model::limits::number(*.value)
+    )]
     Saturates {
         /// Controller.
         controller: String,

@@ -12,6 +12,7 @@ pub mod compare;
 pub mod error;
 pub mod identify;
 mod numeric;
+pub mod request;
 pub mod screen;
 pub mod size;
 pub mod tune;

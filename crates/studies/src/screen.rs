@@ -16,6 +16,9 @@ pub use pairings::{PairingRequest, PairingScreen, screen_pairings};
 /// Why a screening could not be done.
 #[derive(Debug, Clone, thiserror::Error)]
 pub enum ScreenError {
+    /// A list of the request names one item twice.
+    #[error(transparent)]
+    Duplicate(#[from] crate::request::Duplicate),
     /// The unit named is no column (it lacks the reflux, reboiler, distillate and bottoms inputs).
     #[error("no column `{name}` in the flowsheet{hint} (its columns: {columns})")]
     NotAColumn {

@@ -292,6 +292,17 @@ pub struct Current {
 /// Why a sizing was refused or failed.
 #[derive(Debug, Clone, thiserror::Error)]
 pub enum SizeError {
+    /// More candidates than a ranking takes.
+    #[error("--candidates: {n} vessels, above the {max} a ranking sizes (each by three verified designs): rank fewer")]
+    Candidates {
+        /// As given.
+        n: usize,
+        /// The limit.
+        max: usize,
+    },
+    /// A list of the request names one item twice.
+    #[error(transparent)]
+    Duplicate(#[from] crate::request::Duplicate),
     /// No vessel of that name.
     #[error("`{name}` is no vessel of the flowsheet: {why}; vessels with a level: {known}")]
     Vessel {
@@ -311,7 +322,7 @@ pub enum SizeError {
         why: String,
     },
     /// The band does not fit the vessel or is not positive.
-    #[error("--level-band {band} m for `{vessel}`: {why}")]
+    #[error("--level-band {} m for `{vessel}`: {why}", plantwide_model::limits::number(*.band))]
     Band {
         /// The vessel.
         vessel: String,
@@ -321,7 +332,10 @@ pub enum SizeError {
         why: String,
     },
     /// The rate limit is not positive.
-    #[error("--max-outflow-rate {value}: must be a positive rate of change of the outflow (e.g. \"5 kmol/h/min\")")]
+    #[error(
+        "--max-outflow-rate {} (SI): must be a positive rate of change of the outflow (e.g. \"5 kmol/h/min\")",
+        plantwide_model::limits::number(*.value)
+    )]
     Rate {
         /// As given (SI).
         value: f64,

@@ -134,7 +134,7 @@ pub fn diagonal_ultimates(model: &TfModel) -> Result<Vec<Ultimate>, TuneError> {
             let Some(e) = model.element(i, i) else {
                 return Err(no_crossover(", the element is missing (zero)".into()));
             };
-            element_ultimate(e).ok_or_else(|| {
+            let u = element_ultimate(e).ok_or_else(|| {
                 let detail = match (e.lags.len(), e.leads.len(), e.dead_time > 0.0) {
                     (_, _, _) if e.gain == 0.0 => ", the element's gain is zero".to_string(),
                     (0, 0, false) => ", a pure gain".to_string(),
@@ -142,7 +142,16 @@ pub fn diagonal_ultimates(model: &TfModel) -> Result<Vec<Ultimate>, TuneError> {
                     _ => String::new(),
                 };
                 no_crossover(detail)
-            })
+            })?;
+            if !u.ku.is_finite() || u.ku == 0.0 {
+                return Err(TuneError::UltimateOutOfRange {
+                    output: model.outputs[i].name.clone(),
+                    input: model.inputs[i].name.clone(),
+                    gain: e.gain,
+                    ku: u.ku,
+                });
+            }
+            Ok(u)
         })
         .collect()
 }

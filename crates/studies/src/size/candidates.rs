@@ -28,6 +28,9 @@ pub struct RankedCandidate {
     pub failure: Option<String>,
 }
 
+/// Most candidates of one ranking (each is sized by three verified designs).
+pub const MAX_CANDIDATES: usize = 64;
+
 /// The ranking; serializes to `{"candidates": [...]}`, best first.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct CandidateRanking {
@@ -47,6 +50,10 @@ pub fn rank_candidates(
     names: &[String],
     r: &SizeRequest,
 ) -> Result<CandidateRanking, SizeError> {
+    crate::request::unique("--candidates", names, |a, b| a == b)?;
+    if names.len() > MAX_CANDIDATES {
+        return Err(SizeError::Candidates { n: names.len(), max: MAX_CANDIDATES });
+    }
     let sized: Vec<Result<VesselSizing, SizeError>> = names.par_iter().map(|n| size_vessel(plant, x, n, r)).collect();
     let mut out = Vec::new();
     for (name, s) in names.iter().zip(sized) {

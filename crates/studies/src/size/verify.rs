@@ -26,6 +26,10 @@ use crate::tune::averaging::{AveragingForm, averaging};
 /// run record without bound).
 const MAX_SAMPLES: f64 = 2e5;
 
+/// Most periods of a sinusoidal disturbance a verification run follows (each costs tens of
+/// integrator steps).
+const MAX_PERIODS: f64 = 2000.0;
+
 /// Most corrections of a closed-form design that the plant's run showed short.
 pub const MAX_REFINEMENTS: usize = 8;
 
@@ -317,8 +321,23 @@ impl Run<'_> {
             .ok_or_else(|| SizeError::Disturbance { path: r.disturbance.path.clone(), why: "no such input".into() })?;
         let d = &r.disturbance;
         s.set_waveform(i, d.shape.wave(self.plant.inputs()[i].value, d.change));
-        // A sinusoid does not settle: it runs its fixed length (at least 10 periods).
+        // A sinusoid does not settle: it runs its fixed length (at least 10 periods), and the
+        // integrator follows every period of it, so the work is bounded by refusing more than
+        // MAX_PERIODS of them.
         let (duration, exact) = match d.shape {
+            Shape::Sine { period } if duration / period > MAX_PERIODS => {
+                return Err(SizeError::Disturbance {
+                    path: d.path.clone(),
+                    why: format!(
+                        "a sinusoid of period {period:e} s would need {:.3e} periods to show the periodic steady \
+                         state of {} ({duration:.4e} s, its settling time); at most {MAX_PERIODS} are simulated: a \
+                         disturbance this fast is filtered by the vessel itself — give a period of at least {:.4e} s",
+                        duration / period,
+                        self.what,
+                        duration / MAX_PERIODS
+                    ),
+                });
+            }
             Shape::Sine { period } => (duration.max(10.0 * period), true),
             _ => (duration, exact),
         };

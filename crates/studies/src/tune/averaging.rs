@@ -48,7 +48,7 @@ pub struct AveragingSettings {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum AveragingError {
     /// A quantity is zero, negative or not finite.
-    #[error("averaging level: {what} = {value} must be {fix}")]
+    #[error("averaging level: {what} = {} must be {fix}", plantwide_model::limits::number(*.value))]
     Bad {
         /// The quantity.
         what: &'static str,

@@ -57,6 +57,15 @@ pub fn plant_loop(plant: &Plant, name: &str) -> Result<PlantLoop, TuneError> {
     Ok(PlantLoop { name: name.to_string(), pv_path: cfg.pv.clone(), pv, op, op_manual, auto, action: cfg.action })
 }
 
+/// The PID loops `names` of `plant`, each named once.
+///
+/// # Errors
+/// [`TuneError::Duplicate`] for a loop named twice, [`TuneError::NotALoop`] as [`plant_loop`].
+pub fn plant_loops<T: AsRef<str>>(plant: &Plant, names: &[T]) -> Result<Vec<PlantLoop>, TuneError> {
+    crate::request::unique("--loops", names, |a, b| a == b)?;
+    names.iter().map(|n| plant_loop(plant, n.as_ref())).collect()
+}
+
 /// `loops` in the order a cascade is tuned: a slave (a loop whose setpoint is another listed loop's
 /// output, `"sp": {"from": "<master>.op"}`) before its master, at any depth; otherwise as listed.
 /// Each master is then tested with its slaves in auto at their new settings.

@@ -112,6 +112,7 @@ pub fn relay_loop(plant: &Plant, x: &[f64], l: &PlantLoop, o: RelayOptions) -> R
     if !(settings.amplitude.is_finite() && settings.amplitude > 0.0) {
         return Err(TuneError::RelayAmplitude { controller: l.name.clone(), amplitude: settings.amplitude });
     }
+    check_scan(l, settings.scan, linear.pu, "the loop's linear ultimate period")?;
     within_range(plant, l, u0 + settings.amplitude)?;
     within_range(plant, l, u0 - settings.amplitude)?;
     let mut b = bench(plant, x, l, o.measurement, settings.scan)?;
@@ -152,6 +153,7 @@ pub fn step_loop(plant: &Plant, x: &[f64], l: &PlantLoop, o: StepOptions) -> Res
         (Some(scan), None) => (scan, 500.0 * scan),
         (None, None) => return Err(TuneError::ResidenceTime { controller: l.name.clone() }),
     };
+    check_scan(l, scan, max_duration / 100.0, "a hundredth of the test's length")?;
     let settings = StepTest { step: o.step.unwrap_or(0.05 * u0.abs()), scan, max_duration, settle: 2e-3 };
     if !(settings.step != 0.0 && settings.step.is_finite()) {
         return Err(TuneError::RelayAmplitude { controller: l.name.clone(), amplitude: settings.step });
@@ -164,6 +166,27 @@ pub fn step_loop(plant: &Plant, x: &[f64], l: &PlantLoop, o: StepOptions) -> Res
         return Err(TuneError::PoorFit { controller: l.name.clone(), model: order.name(), r2: fit.r2, min_r2: MIN_R2 });
     }
     Ok((fit, settled || integrating))
+}
+
+/// Most scans a plant test's characteristic time may span (a relay's cycle, a step response's
+/// length): the work of a test is bounded by it.
+const MAX_SCANS_PER_TIME: f64 = 1e4;
+
+/// A scan must be a positive time, and at least `time / MAX_SCANS_PER_TIME` of the loop's
+/// characteristic `time` (named by `what`), so that a test takes a bounded number of scans.
+fn check_scan(l: &PlantLoop, scan: f64, time: f64, what: &str) -> Result<(), TuneError> {
+    let bad = |why: String| Err(TuneError::Scan { controller: l.name.clone(), scan, why });
+    if !(scan.is_finite() && scan > 0.0) {
+        return bad("is not a positive time: give --scan a positive time, or leave it out for the default".into());
+    }
+    if time.is_finite() && scan < time / MAX_SCANS_PER_TIME {
+        return bad(format!(
+            "is below 1/{MAX_SCANS_PER_TIME:e} of {what} ({time:.4e} s): the test would take over {MAX_SCANS_PER_TIME:e} \
+             scans; give a scan of at least {:.4e} s",
+            time / MAX_SCANS_PER_TIME
+        ));
+    }
+    Ok(())
 }
 
 /// A test output `u` must be a value the driven input can take (a valve opening within [0, 1], a

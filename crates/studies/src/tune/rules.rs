@@ -59,7 +59,7 @@ pub enum RuleError {
     )]
     NoDeadTime,
     /// A gain or time of the model or `τ_c` is zero, negative or not finite.
-    #[error("{what} = {value} cannot be tuned for; {fix}")]
+    #[error("{what} = {} cannot be tuned for; {fix}", plantwide_model::limits::number(*.value))]
     Degenerate {
         /// The quantity.
         what: &'static str,

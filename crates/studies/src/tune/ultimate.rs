@@ -76,12 +76,36 @@ pub fn element_frequency_range(e: &Element) -> Option<(f64, f64)> {
 
 /// The ultimate gain and frequency of one transfer-function element, or `None` when its phase
 /// never reaches −180° (e.g. a first- or second-order lag without dead time).
+///
+/// The element's phase and magnitude are known in closed form ([`Element::phase`],
+/// [`Element::log_magnitude`]), so no unwrapping is needed and nothing overflows: the first
+/// crossover is bracketed on a log grid fine enough that the phase turns by at most π/16 between
+/// points, and `K_u = sign(K) / (|K| e^{ln|g/K|})` is formed in logarithms (a gain of 1e308 gives
+/// 1e-308, one of 5e-324 an infinite `K_u`, which the caller refuses).
 pub fn element_ultimate(e: &Element) -> Option<Ultimate> {
     let (lo, hi) = element_frequency_range(e)?;
-    if e.gain == 0.0 {
+    if e.gain == 0.0 || !e.gain.is_finite() {
         return None;
     }
-    ultimate(|w| e.response(w), lo, hi)
+    let pi = std::f64::consts::PI;
+    let (mut w, mut phase) = (lo, e.phase(lo));
+    let mut ratio: f64 = 1.1;
+    while w < hi {
+        let w_next = (w * ratio).min(hi);
+        let phase_next = e.phase(w_next);
+        if (phase_next - phase).abs() > MAX_PHASE_STEP && ratio > 1.0 + 1e-9 {
+            ratio = 1.0 + 0.5 * (ratio - 1.0);
+            continue;
+        }
+        if phase > -pi && phase_next <= -pi {
+            let wu = root_bracketed(|x| e.phase(x) + pi, w, w_next, 1e-12);
+            let ku = e.gain.signum() * (-(e.gain.abs().ln() + e.log_magnitude(wu))).exp();
+            return Some(Ultimate { ku, omega_u: wu, pu: 2.0 * pi / wu });
+        }
+        (w, phase) = (w_next, phase_next);
+        ratio = (1.0 + 2.0 * (ratio - 1.0)).min(1.1);
+    }
+    None
 }
 
 #[cfg(test)]
@@ -118,5 +142,41 @@ mod tests {
         let exact =
             crate::numeric::root_bracketed(|w| -50.0 * w - (0.01 * w).atan() + std::f64::consts::PI, 1e-6, 1.0, 1e-15);
         assert!((u.omega_u - exact).abs() < 1e-12 * exact, "{u:?} vs {exact}");
+    }
+
+    /// Ninety equal lags: ω_u τ = tan(π/90), K_u = sec(π/90)⁹⁰ (the phase of each lag is π/90
+    /// there); the products `Π(1 + jτω)` overflow near ω_u for τ = 1 h, the closed form does not.
+    #[test]
+    fn ninety_lags_of_an_hour_cross_where_each_turns_two_degrees() {
+        let e = Element { gain: 1.0, lags: vec![3600.0; 90], leads: vec![], dead_time: 0.0 };
+        let u = element_ultimate(&e).unwrap();
+        let x = (std::f64::consts::PI / 90.0).tan();
+        assert!((u.omega_u - x / 3600.0).abs() < 1e-12 * u.omega_u, "{u:?}");
+        let ku = (1.0 + x * x).sqrt().powi(90);
+        assert!((u.ku - ku).abs() < 1e-10 * ku, "{u:?} vs {ku}");
+    }
+
+    /// Ninety lead–lag pairs (2 h over 1 h) behind a minute of dead time: the leads lift the phase
+    /// by up to 30 rad, but at high frequency each pair's phase vanishes and the dead time crosses
+    /// −π; the crossover solves `90 (atan 2τω − atan τω) − θω = −π`.
+    #[test]
+    fn lead_lags_of_high_order_with_dead_time_cross_at_the_dead_times_frequency() {
+        let e = Element { gain: 1.0, lags: vec![3600.0; 90], leads: vec![7200.0; 90], dead_time: 60.0 };
+        let u = element_ultimate(&e).unwrap();
+        let phase = |w: f64| 90.0 * ((7200.0 * w).atan() - (3600.0 * w).atan()) - 60.0 * w;
+        assert!((phase(u.omega_u) + std::f64::consts::PI).abs() < 1e-9, "{u:?}");
+        assert!(u.ku.is_finite() && u.ku > 0.0, "{u:?}");
+    }
+
+    /// The gain only scales K_u: 1e308 gives K_u(1)/1e308, not an overflow called "no crossover".
+    #[test]
+    fn an_extreme_gain_scales_the_ultimate_gain() {
+        let one = Element { gain: 1.0, lags: vec![1002.0], leads: vec![], dead_time: 60.0 };
+        let big = Element { gain: 1e308, ..one.clone() };
+        let (u1, ub) = (element_ultimate(&one).unwrap(), element_ultimate(&big).unwrap());
+        assert_eq!(u1.omega_u, ub.omega_u);
+        assert!((ub.ku * 1e308 - u1.ku).abs() < 1e-12 * u1.ku, "{ub:?} {u1:?}");
+        let tiny = Element { gain: 5e-324, ..one };
+        assert!(element_ultimate(&tiny).unwrap().ku.is_infinite());
     }
 }
