@@ -23,6 +23,7 @@ mod flowsheets;
 mod fuzz;
 mod heat_integration;
 mod hostile;
+mod hostile_commands;
 mod identify;
 mod mpc;
 mod plots;
