@@ -259,6 +259,22 @@ fn serve_refuses_a_foreign_host_so_a_rebound_name_reads_nothing() {
 }
 
 #[test]
+fn serve_refuses_a_key_given_twice_in_a_command_naming_it() {
+    // serde_json keeps the last of two equal keys: `{"pause": true, "pause": true}` would pass as
+    // one pause, and a set naming one input twice would apply one value unseen.
+    let s = Server::start(&flowsheet("column_a.json"), &["--paused"]);
+    refused(&s, r#"{"resume": true, "resume": true}"#, "`resume`: this key appears twice");
+    refused(
+        &s,
+        r#"{"set": {"feed_source.F": "1.01 kmol/min", "feed_source.F": "0.99 kmol/min"}}"#,
+        "`set.feed_source.F`: this key appears twice",
+    );
+    refused(&s, r#"{"event": {"type": "step", "type": "ramp", "path": "feed_source.F"}}"#, "`event.type`");
+    assert_eq!(s.get("/api/state")["running"], json!(false));
+    assert_eq!(s.get("/api/journal")["events"], json!([]));
+}
+
+#[test]
 fn serve_takes_its_own_pages_requests_and_the_page_carries_the_token() {
     let s = Server::start(&flowsheet("column_a.json"), &["--paused"]);
     let (page_status, page) = s.raw("GET", "/", &[("Host", &s.addr)], "");
