@@ -450,3 +450,17 @@ fn the_live_journal_holds_no_more_events_than_a_scenario_may() {
     refused(&s, r#"{"set": {"column.boilup": "3.2 kmol/min"}}"#, "journal holds 2 events, the most a scenario may");
     assert_eq!(s.get("/api/state")["running"], json!(false), "the run goes on, paused as it was");
 }
+
+#[test]
+fn serve_keeps_at_most_64_snapshots_and_says_how_to_replace_one() {
+    // Each snapshot holds the integrator's state: a session saving under ever new names would grow.
+    let s = Server::start(&flowsheet("column_a.json"), &["--paused"]);
+    for k in 0..plantwide::solve::dynamic::MAX_SNAPSHOTS {
+        s.ok(json!({ "snapshot": format!("s{k}") }));
+    }
+    refused(&s, r#"{"snapshot": "one_more"}"#, "64 snapshots are kept already");
+    refused(&s, r#"{"snapshot": "one_more"}"#, "save under one of their names to replace it");
+    s.ok(json!({"step": true}));
+    s.ok(json!({"snapshot": "s0"}));
+    assert_eq!(s.get("/api/snapshots").as_array().expect("names").len(), 64);
+}
