@@ -1,5 +1,5 @@
-//! `plantwide serve FILE [--scenario S] [--port 8080] [--bind 127.0.0.1] [--set PATH=VALUE ...]
-//! [--speed K] [--paused]`: the browser simulator. Loads and converges the plant as `run` does,
+//! `plantwide serve FILE [--scenario S] [--port 8080] [--bind 127.0.0.1] [--allow-host NAME ...]
+//! [--set PATH=VALUE ...] [--speed K] [--paused]`: the browser simulator. Loads and converges the plant as `run` does,
 //! starts a live run of the scenario (or of none: the plant left to itself) from that steady
 //! state, and hands it to the server (`src/serve/`).
 
@@ -27,9 +27,14 @@ pub struct ServeArgs {
     /// Port (0: any free one, printed at start).
     #[arg(long, default_value_t = 8080)]
     pub port: u16,
-    /// Address to listen on; any other than 127.0.0.1 or ::1 asks for the token printed at start.
+    /// Address to listen on; any other than 127.0.0.1 or ::1 asks every API request for the token
+    /// printed at start (on those two, commands only: the page carries it).
     #[arg(long, default_value = "127.0.0.1")]
     pub bind: IpAddr,
+    /// A host name the server answers to besides its address (e.g. the machine's name when bound
+    /// beyond loopback); requests naming any other host are refused (DNS rebinding).
+    #[arg(long = "allow-host", value_name = "NAME")]
+    pub allow_hosts: Vec<String>,
     /// Override an input or a unit parameter, e.g. `--set feed_source.F=1.01kmol/min`.
     #[arg(long = "set", value_name = "PATH=VALUE")]
     pub set: Vec<String>,
@@ -91,6 +96,7 @@ pub fn run(args: &ServeArgs) -> Result<(), CliError> {
         speed: args.speed,
         paused: args.paused,
         rate: args.rate,
+        allow_hosts: args.allow_hosts.clone(),
         exit_after: args.exit_after,
     };
     serve(live, &opts).map_err(|e| user(&e))

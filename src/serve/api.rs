@@ -195,9 +195,16 @@ pub async fn stream(
     Ok(Sse::new(futures_util::StreamExt::chain(first, samples)).keep_alive(KeepAlive::default()))
 }
 
-/// The page.
-pub async fn page() -> impl IntoResponse {
-    ([(header::CONTENT_TYPE, "text/html; charset=utf-8")], include_str!("assets/index.html"))
+/// The page with the session `token` in its `plantwide-token` meta tag (empty: the page takes
+/// the token from its address, `?token=`).
+pub fn page_html(token: &str) -> String {
+    include_str!("assets/index.html").replace("{{token}}", token)
+}
+
+/// The page (never cached: it carries the session's token).
+pub async fn page(html: Arc<String>) -> impl IntoResponse {
+    let headers = [(header::CONTENT_TYPE, "text/html; charset=utf-8"), (header::CACHE_CONTROL, "no-store")];
+    (headers, (*html).clone())
 }
 
 /// The page's script.

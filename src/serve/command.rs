@@ -6,6 +6,7 @@
 //! disturbance or failure from the scenario vocabulary). Shape errors are reported here; what
 //! the plant makes of a path, unit or value is the library's to say.
 
+use plantwide::flowsheet::parse::walk_diagnostics;
 use plantwide::flowsheet::scenario::EventSpec;
 use plantwide::model::controllers::Mode;
 use serde_json::Value;
@@ -18,10 +19,16 @@ const KEYS: &str = "set, speed, pause, resume, step, mode, event, snapshot, load
 /// Parse a command body.
 ///
 /// # Errors
-/// The message for HTTP 400: malformed JSON, not one key, an unknown key, a value of the wrong
-/// type.
+/// The message for HTTP 400: malformed JSON, a key given twice in one object (JSON readers keep
+/// one of them silently), not one key, an unknown key, a value of the wrong type.
 pub fn parse_command(body: &[u8]) -> Result<Command, String> {
     let v: Value = serde_json::from_slice(body).map_err(|e| format!("malformed JSON: {e}"))?;
+    let text = std::str::from_utf8(body).map_err(|e| format!("malformed JSON: {e}"))?;
+    let found = walk_diagnostics(text);
+    if !found.is_empty() {
+        let each = found.iter().map(|d| format!("`{}`: {}", d.path, d.message));
+        return Err(each.collect::<Vec<_>>().join("; "));
+    }
     let Value::Object(map) = v else { return Err(format!("give one JSON object with one of the keys {KEYS}")) };
     let mut it = map.into_iter();
     let (Some((key, value)), None) = (it.next(), it.next()) else {

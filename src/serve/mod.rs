@@ -1,5 +1,6 @@
 //! `plantwide serve`: the browser simulator. HTTP only: the page (embedded in the binary), the
-//! JSON API it uses, trend streams, the access token, request size and rate limits. The
+//! JSON API it uses, trend streams, the checks in front of them ([`guard`]: host, origin, content
+//! type, session token), request size and rate limits. The
 //! simulation itself is [`plantwide::solve::dynamic::Live`], run on a thread of its own
 //! ([`sim`]); the page's view of the plant comes from the plant's accessors ([`plant_view`]).
 
@@ -22,7 +23,7 @@ use plantwide::solve::dynamic::{Live, LiveError};
 use tokio::sync::broadcast;
 
 use api::App;
-use guard::Guard;
+use guard::{Guard, Hosts};
 use sim::{Published, Sim};
 
 /// Largest request body accepted \[bytes\].
@@ -52,22 +53,25 @@ pub struct Options {
     pub paused: bool,
     /// Requests per second the API admits (twice as many in a burst).
     pub rate: f64,
+    /// Host names answered besides the bound address (and its loopback aliases).
+    pub allow_hosts: Vec<String>,
     /// Stop after this many seconds (tests).
     pub exit_after: Option<f64>,
 }
 
-/// Only these addresses are served without a token.
-fn needs_token(bind: IpAddr) -> bool {
+/// Whether every `/api/` request needs the token: on any address but 127.0.0.1 and ::1 (on those,
+/// commands only, and the page carries it).
+fn token_everywhere(bind: IpAddr) -> bool {
     bind != IpAddr::V4(Ipv4Addr::LOCALHOST) && bind != IpAddr::V6(Ipv6Addr::LOCALHOST)
 }
 
-/// Serve `live` until the process ends (or `exit_after`). Prints the address (and the token when
-/// one is needed) on stdout once listening.
+/// Serve `live` until the process ends (or `exit_after`). Prints the address and the session
+/// token on stdout once listening.
 ///
 /// # Errors
 /// [`ServeError`] when the address cannot be bound.
 pub fn serve(live: Live, opts: &Options) -> Result<(), ServeError> {
-    let token = if needs_token(opts.bind) { Some(guard::new_token()?) } else { None };
+    let token = guard::new_token()?;
     let paths = live.paths();
     let index: HashMap<String, usize> = paths.iter().enumerate().map(|(k, p)| (p.clone(), k)).collect();
     let plant = plant_view::describe(live.plant(), &paths);
@@ -101,20 +105,27 @@ pub fn serve(live: Live, opts: &Options) -> Result<(), ServeError> {
         streams: Arc::new(AtomicUsize::new(0)),
     };
     let rt = tokio::runtime::Builder::new_current_thread().enable_all().build()?;
-    rt.block_on(listen(app, Guard::new(token, opts.rate), opts))?;
+    rt.block_on(listen(app, token, opts))?;
     // The router (and with it every sender) is gone: the simulation thread ends.
     worker.join().map_err(|_| std::io::Error::other("the simulation thread panicked"))?;
     Ok(())
 }
 
 /// Bind, print where, and serve the router.
-async fn listen(app: App, guard: Guard, opts: &Options) -> Result<(), ServeError> {
+async fn listen(app: App, token: String, opts: &Options) -> Result<(), ServeError> {
     let listener = tokio::net::TcpListener::bind(SocketAddr::new(opts.bind, opts.port)).await?;
-    let addr = listener.local_addr()?;
-    let host = if addr.is_ipv6() { format!("[{}]", addr.ip()) } else { addr.ip().to_string() };
-    match &guard.token {
-        Some(t) => println!("plantwide serve: listening on http://{host}:{}/?token={t}\ntoken: {t}", addr.port()),
-        None => println!("plantwide serve: listening on http://{host}:{}/", addr.port()),
+    let hosts = Hosts::new(listener.local_addr()?, &opts.allow_hosts);
+    let everywhere = token_everywhere(opts.bind);
+    let page = Arc::new(api::page_html(if everywhere { "" } else { &token }));
+    let guard = Guard::new(token, everywhere, hosts.clone(), opts.rate);
+    let t = &guard.token;
+    if everywhere {
+        println!("plantwide serve: listening on {}?token={t}\ntoken: {t}", hosts.address());
+    } else {
+        println!(
+            "plantwide serve: listening on {}\ntoken: {t} (commands carry it as X-Plantwide-Token; the page does)",
+            hosts.address()
+        );
     }
     use std::io::Write;
     let _ = std::io::stdout().flush();
@@ -126,13 +137,14 @@ async fn listen(app: App, guard: Guard, opts: &Options) -> Result<(), ServeError
         .route("/snapshots", get(api::snapshots))
         .route("/stream", get(api::stream))
         .with_state(app)
-        .layer(axum::middleware::from_fn_with_state(guard, guard::check))
+        .layer(axum::middleware::from_fn_with_state(guard.clone(), guard::check))
         .layer(DefaultBodyLimit::max(MAX_BODY));
     let router = Router::new()
-        .route("/", get(api::page))
+        .route("/", get(move || api::page(page.clone())))
         .route("/app.js", get(api::script))
         .route("/app.css", get(api::style))
-        .nest("/api", api);
+        .nest("/api", api)
+        .layer(axum::middleware::from_fn_with_state(guard, guard::site));
     if let Some(s) = opts.exit_after {
         // Open trend streams never end, so no graceful shutdown would: the process ends.
         std::thread::spawn(move || {

@@ -1,17 +1,20 @@
 """The browser simulator in a real browser: headless Chromium (Debian's `chromium` and
 `chromium-driver`) loads the page of `plantwide serve` on column A, a screenshot is saved, a
-setpoint change made through the page's own faceplate controls moves the trend, and a feed step
-made through the page settles on the steady state and equals the scenario-file run.
+setpoint change made through the page's own faceplate controls moves the trend (the page's commands
+carry the session token it was served), a feed step made through the page settles on the steady
+state and equals the scenario-file run, and a page of another origin cannot command the server.
 
 Run by `.ci/run` (pytest); the binary is $PLANTWIDE_BIN (default target/release/plantwide, then
 target/debug/plantwide); the screenshot goes to $PLANTWIDE_SCREENSHOT (default
 target/serve_column_a.png).
 """
 
+import http.server
 import json
 import os
 import re
 import subprocess
+import threading
 import time
 import urllib.request
 from pathlib import Path
@@ -155,3 +158,57 @@ def test_page_feed_step_reaches_the_steady_state_and_equals_the_scenario_run(ser
         diff = abs(ran["final_values"][p] - live["values"][p])
         print(f"{p}: live vs scenario file |Δ| = {diff:.3e}")
         assert diff <= 1e-10
+
+
+@pytest.fixture
+def foreign_site():
+    """Another origin on loopback: an empty page served on a free port of 127.0.0.1."""
+    class Page(http.server.BaseHTTPRequestHandler):
+        def do_GET(self):
+            body = b"<!doctype html><title>another site</title><form id=f method=post></form>"
+            self.send_response(200)
+            self.send_header("Content-Type", "text/html")
+            self.send_header("Content-Length", str(len(body)))
+            self.end_headers()
+            self.wfile.write(body)
+
+        def log_message(self, *args):
+            pass
+
+    httpd = http.server.ThreadingHTTPServer(("127.0.0.1", 0), Page)
+    threading.Thread(target=httpd.serve_forever, daemon=True).start()
+    try:
+        yield f"http://127.0.0.1:{httpd.server_address[1]}/"
+    finally:
+        httpd.shutdown()
+
+
+def test_a_page_of_another_origin_cannot_command_the_server(server, browser, foreign_site):
+    """What any web page can send without a CORS preflight: a text/plain fetch and a form post,
+    from its own origin to the server on 127.0.0.1. Both are refused; the clock keeps running."""
+    assert api(server, "api/state")["running"]
+    browser.get(foreign_site)
+    statuses = browser.execute_async_script("""
+        const [url, done] = [arguments[0], arguments[arguments.length - 1]];
+        const body = JSON.stringify({pause: true});
+        // no-cors: the request is sent, its answer hidden from the page.
+        fetch(url + 'api/command', {method: 'POST', mode: 'no-cors', headers: {'Content-Type': 'text/plain'}, body})
+          .then(r => r.type, e => 'error: ' + e).then(done);
+    """, server)
+    assert statuses == "opaque", statuses
+    assert api(server, "api/state")["running"], "a foreign page's fetch paused the clock"
+    # A form post, the other request a page sends unasked; as text/plain its body reads as JSON
+    # ({"pause": true, "x": "="}).
+    browser.execute_script("""
+        const f = document.getElementById('f');
+        f.action = arguments[0] + 'api/command';
+        f.enctype = 'text/plain';
+        const i = document.createElement('input');
+        i.name = '{"pause": true, "x": "'; i.value = '"}';
+        f.appendChild(i);
+        f.submit();
+    """, server)
+    WebDriverWait(browser, 30).until(lambda d: d.current_url.startswith(server))
+    answer = browser.find_element(By.TAG_NAME, "body").text
+    assert "are refused" in answer, answer
+    assert api(server, "api/state")["running"], "a foreign page's form paused the clock"

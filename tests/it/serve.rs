@@ -1,7 +1,9 @@
 //! `plantwide serve`: the server started on a loopback address and an ephemeral port, driven
 //! over HTTP (a raw `TcpStream` client): every command and every bad input, the token beyond
-//! 127.0.0.1, the rate limit, the trend stream; and on column A a live feed step that equals the
-//! scenario-file run of the same event and settles on the steady state `steady --set` gives.
+//! 127.0.0.1, the rate limit, the trend stream; every cross-site attack refused (a command not in
+//! JSON, from a foreign origin or without the session token, a foreign host reading the state);
+//! and on column A a live feed step that equals the scenario-file run of the same event and
+//! settles on the steady state `steady --set` gives.
 
 use std::io::{BufRead, BufReader, Read, Write};
 use std::net::TcpStream;
@@ -20,7 +22,8 @@ use crate::harness::{command, flowsheet, plantwide};
 struct Server {
     child: Child,
     addr: String,
-    token: Option<String>,
+    /// The session token it printed.
+    token: String,
 }
 
 impl Server {
@@ -41,38 +44,43 @@ impl Server {
         let mut out = BufReader::new(child.stdout.take().expect("stdout"));
         let (mut addr, mut token) = (None, None);
         let mut line = String::new();
-        while addr.is_none() || (extra.contains(&"--bind") && token.is_none()) {
+        // The address, then the session token (every server prints one).
+        while addr.is_none() || token.is_none() {
             line.clear();
             assert!(out.read_line(&mut line).expect("reads stdout") > 0, "the server ended before listening");
             if let Some(rest) = line.split("http://").nth(1) {
                 addr = Some(rest.split('/').next().expect("host:port").to_string());
             }
             if let Some(t) = line.trim().strip_prefix("token: ") {
-                token = Some(t.to_string());
+                token = t.split_whitespace().next().map(str::to_string);
             }
         }
-        Server { child, addr: addr.expect("address"), token }
+        Server { child, addr: addr.expect("address"), token: token.expect("a token") }
     }
 
-    /// One request; the status and the body.
-    fn request(&self, method: &str, path: &str, body: &str, auth: bool) -> (u16, String) {
+    /// One request with exactly these header lines (and `Content-Length`, `Connection: close`);
+    /// the status and the body.
+    fn raw(&self, method: &str, path: &str, headers: &[(&str, &str)], body: &str) -> (u16, String) {
         let mut s = TcpStream::connect(&self.addr).expect("connects");
         s.set_read_timeout(Some(Duration::from_secs(60))).expect("timeout");
-        let bearer = match (&self.token, auth) {
-            (Some(t), true) => format!("Authorization: Bearer {t}\r\n"),
-            _ => String::new(),
-        };
-        let head = format!(
-            "{method} {path} HTTP/1.1\r\nHost: {}\r\nConnection: close\r\n{bearer}Content-Type: application/json\r\nContent-Length: {}\r\n\r\n",
-            self.addr,
-            body.len()
-        );
+        let mut head = format!("{method} {path} HTTP/1.1\r\nConnection: close\r\nContent-Length: {}\r\n", body.len());
+        headers.iter().for_each(|(k, v)| head.push_str(&format!("{k}: {v}\r\n")));
+        head.push_str("\r\n");
         s.write_all(head.as_bytes()).and_then(|()| s.write_all(body.as_bytes())).expect("writes");
         let mut text = String::new();
         s.read_to_string(&mut text).expect("reads the response");
         let status = text.split(' ').nth(1).and_then(|c| c.parse().ok()).expect("a status line");
         let body = text.split_once("\r\n\r\n").map(|(_, b)| b.to_string()).unwrap_or_default();
         (status, body)
+    }
+
+    /// One request as the page makes it: this server's host, JSON, and (if `auth`) the token.
+    fn request(&self, method: &str, path: &str, body: &str, auth: bool) -> (u16, String) {
+        let mut headers = vec![("Host", self.addr.as_str()), ("Content-Type", "application/json")];
+        if auth {
+            headers.push(("X-Plantwide-Token", &self.token));
+        }
+        self.raw(method, path, &headers, body)
     }
 
     fn get(&self, path: &str) -> Value {
@@ -190,11 +198,117 @@ fn serve_applies_every_command_and_refuses_every_bad_input_with_400() {
     assert_eq!(s.request("GET", "/app.js", "", false).0, 200);
 }
 
+/// A request refused with `status` whose `{"error"}` message holds `needle`.
+fn refused_with(answer: (u16, String), status: u16, needle: &str) {
+    let (got, body) = answer;
+    assert_eq!(got, status, "{body}");
+    let v: Value = serde_json::from_str(&body).unwrap_or_else(|e| panic!("{e}: {body}"));
+    let msg = v["error"].as_str().unwrap_or_else(|| panic!("an error message: {body}"));
+    assert!(msg.contains(needle), "`{msg}` does not mention `{needle}`");
+}
+
+#[test]
+fn serve_on_loopback_refuses_a_command_not_in_json_from_a_foreign_origin_or_without_the_token() {
+    // What a web page open in the user's browser can send to 127.0.0.1 without a CORS preflight
+    // (text/plain, a form), or with its own origin; none may resume the paused clock.
+    let s = Server::start(&flowsheet("column_a.json"), &["--paused"]);
+    let (host, token) = (s.addr.as_str(), s.token.as_str());
+    let resume = r#"{"resume": true}"#;
+    let post = |headers: &[(&str, &str)]| s.raw("POST", "/api/command", headers, resume);
+    let needs_json = "Content-Type: application/json";
+    let text_plain = post(&[("Host", host), ("X-Plantwide-Token", token), ("Content-Type", "text/plain")]);
+    refused_with(text_plain, 415, needs_json);
+    let form = [("Host", host), ("X-Plantwide-Token", token), ("Content-Type", "application/x-www-form-urlencoded")];
+    refused_with(post(&form), 415, needs_json);
+    let multipart = ("Content-Type", "multipart/form-data; boundary=x");
+    refused_with(post(&[("Host", host), ("X-Plantwide-Token", token), multipart]), 415, needs_json);
+    refused_with(post(&[("Host", host), ("X-Plantwide-Token", token)]), 415, needs_json);
+    let json = ("Content-Type", "application/json");
+    let foreign = post(&[("Host", host), ("X-Plantwide-Token", token), json, ("Origin", "http://evil.example")]);
+    refused_with(foreign, 403, "origin `http://evil.example`");
+    refused_with(post(&[("Host", host), ("X-Plantwide-Token", token), json, ("Origin", "null")]), 403, "origin `null`");
+    refused_with(post(&[("Host", host), json]), 403, "X-Plantwide-Token");
+    let wrong = "0123456789abcdef0123456789abcdef";
+    refused_with(post(&[("Host", host), ("X-Plantwide-Token", wrong), json]), 403, "X-Plantwide-Token");
+    let cross_site = ("Sec-Fetch-Site", "cross-site");
+    refused_with(post(&[("Host", host), ("X-Plantwide-Token", token), json, cross_site]), 403, "another site");
+    assert_eq!(s.get("/api/state")["running"], json!(false), "no refused command was obeyed");
+}
+
+#[test]
+fn serve_refuses_a_foreign_host_so_a_rebound_name_reads_nothing() {
+    // DNS rebinding: a page of rebind.example whose name now points at 127.0.0.1 reads with its
+    // own host name (and from its own origin); neither the state, the journal nor the page (which
+    // carries the token) is served.
+    let s = Server::start(&flowsheet("column_a.json"), &["--paused"]);
+    let port = s.addr.rsplit(':').next().expect("a port");
+    let rebound = format!("rebind.example:{port}");
+    for path in ["/api/state", "/api/journal", "/api/snapshots", "/api/plant", "/api/stream", "/"] {
+        refused_with(s.raw("GET", path, &[("Host", &rebound)], ""), 403, &format!("host `{rebound}`"));
+    }
+    let other_port = format!("127.0.0.1:{}", port.parse::<u32>().expect("a port") + 1);
+    refused_with(s.raw("GET", "/api/state", &[("Host", &other_port)], ""), 403, "host `127.0.0.1:");
+    refused_with(s.raw("GET", "/api/state", &[], ""), 403, "host `(none)`");
+    let origin = format!("http://{rebound}");
+    let from_rebound = s.raw("GET", "/api/journal", &[("Host", &s.addr), ("Origin", &origin)], "");
+    refused_with(from_rebound, 403, &format!("origin `{origin}`"));
+    let json = ("Content-Type", "application/json");
+    let command = [("Host", rebound.as_str()), ("X-Plantwide-Token", s.token.as_str()), json];
+    refused_with(s.raw("POST", "/api/command", &command, r#"{"resume": true}"#), 403, "host `rebind.example");
+    assert_eq!(s.get("/api/state")["running"], json!(false));
+}
+
+#[test]
+fn serve_refuses_a_key_given_twice_in_a_command_naming_it() {
+    // serde_json keeps the last of two equal keys: `{"pause": true, "pause": true}` would pass as
+    // one pause, and a set naming one input twice would apply one value unseen.
+    let s = Server::start(&flowsheet("column_a.json"), &["--paused"]);
+    refused(&s, r#"{"resume": true, "resume": true}"#, "`resume`: this key appears twice");
+    refused(
+        &s,
+        r#"{"set": {"feed_source.F": "1.01 kmol/min", "feed_source.F": "0.99 kmol/min"}}"#,
+        "`set.feed_source.F`: this key appears twice",
+    );
+    refused(&s, r#"{"event": {"type": "step", "type": "ramp", "path": "feed_source.F"}}"#, "`event.type`");
+    assert_eq!(s.get("/api/state")["running"], json!(false));
+    assert_eq!(s.get("/api/journal")["events"], json!([]));
+}
+
+#[test]
+fn serve_takes_its_own_pages_requests_and_the_page_carries_the_token() {
+    let s = Server::start(&flowsheet("column_a.json"), &["--paused"]);
+    let (page_status, page) = s.raw("GET", "/", &[("Host", &s.addr)], "");
+    assert_eq!(page_status, 200);
+    assert!(page.contains(&format!(r#"<meta name="plantwide-token" content="{}">"#, s.token)), "{page}");
+    // As a browser sends them from the page, under any loopback name of this server.
+    let port = s.addr.rsplit(':').next().expect("a port");
+    for name in ["127.0.0.1", "localhost", "[::1]"] {
+        let host = format!("{name}:{port}");
+        let origin = format!("http://{host}");
+        let headers = [
+            ("Host", host.as_str()),
+            ("Origin", origin.as_str()),
+            ("Sec-Fetch-Site", "same-origin"),
+            ("Content-Type", "application/json; charset=utf-8"),
+            ("X-Plantwide-Token", s.token.as_str()),
+        ];
+        let (status, body) = s.raw("POST", "/api/command", &headers, r#"{"step": true}"#);
+        assert_eq!(status, 200, "{host}: {body}");
+        assert_eq!(s.raw("GET", "/api/state", &headers[..3], "").0, 200, "{host}");
+    }
+    // A client without Origin (curl, scripts): reads need nothing more than the right host.
+    assert_eq!(s.raw("GET", "/api/journal", &[("Host", &s.addr)], "").0, 200);
+    let bearer = format!("Bearer {}", s.token);
+    let curl = [("Host", s.addr.as_str()), ("Content-Type", "application/json"), ("Authorization", bearer.as_str())];
+    assert_eq!(s.raw("POST", "/api/command", &curl, r#"{"step": true}"#).0, 200);
+    assert!(s.get("/api/state")["time"].as_f64().expect("time") > 0.0, "the steps were taken");
+}
+
 /// Read the trend stream until `n` samples arrived; the paths event and the samples.
 fn stream_samples(s: &Server, paths: &str, n: usize) -> (Value, Vec<Value>) {
     let mut sock = TcpStream::connect(&s.addr).expect("connects");
     sock.set_read_timeout(Some(Duration::from_secs(30))).expect("timeout");
-    write!(sock, "GET /api/stream?paths={paths} HTTP/1.1\r\nHost: x\r\n\r\n").expect("writes");
+    write!(sock, "GET /api/stream?paths={paths} HTTP/1.1\r\nHost: {}\r\n\r\n", s.addr).expect("writes");
     let mut r = BufReader::new(sock);
     let (mut head, mut samples, mut event) = (Value::Null, Vec::new(), String::new());
     let mut line = String::new();
@@ -244,13 +358,18 @@ fn serve_streams_trend_samples_to_several_clients() {
 #[test]
 fn serve_beyond_127_0_0_1_asks_for_the_token_and_limits_the_rate() {
     let s = Server::start(&flowsheet("column_a.json"), &["--bind", "127.0.0.2", "--paused", "--rate", "5"]);
-    let token = s.token.clone().expect("a token printed at start");
+    let token = s.token.clone();
     assert_eq!(token.len(), 32);
     let (status, body) = s.request("GET", "/api/state", "", false);
     assert_eq!(status, 401, "{body}");
     assert!(body.contains("token"), "{body}");
     assert_eq!(s.request("POST", "/api/command", r#"{"resume": true}"#, false).0, 401);
     assert_eq!(s.request("GET", &format!("/api/state?token={token}"), "", false).0, 200);
+    let bearer = format!("Bearer {token}");
+    assert_eq!(s.raw("GET", "/api/state", &[("Host", &s.addr), ("Authorization", &bearer)], "").0, 200);
+    // Beyond loopback the page does not carry the token: whoever reaches it must have been given it.
+    let (status, page) = s.request("GET", "/", "", false);
+    assert!(status == 200 && !page.contains(&token), "{status}");
     assert_eq!(s.request("GET", "/api/state?token=0123456789abcdef0123456789abcdef", "", false).0, 401);
     // 5 per second, 10 in a burst: 30 at once meet 429s.
     let statuses: Vec<u16> = (0..30).map(|_| s.request("GET", "/api/state", "", true).0).collect();
@@ -330,4 +449,18 @@ fn the_live_journal_holds_no_more_events_than_a_scenario_may() {
     s.ok(json!({"set": {"column.reflux": "2.7 kmol/min"}}));
     refused(&s, r#"{"set": {"column.boilup": "3.2 kmol/min"}}"#, "journal holds 2 events, the most a scenario may");
     assert_eq!(s.get("/api/state")["running"], json!(false), "the run goes on, paused as it was");
+}
+
+#[test]
+fn serve_keeps_at_most_64_snapshots_and_says_how_to_replace_one() {
+    // Each snapshot holds the integrator's state: a session saving under ever new names would grow.
+    let s = Server::start(&flowsheet("column_a.json"), &["--paused"]);
+    for k in 0..plantwide::solve::dynamic::MAX_SNAPSHOTS {
+        s.ok(json!({ "snapshot": format!("s{k}") }));
+    }
+    refused(&s, r#"{"snapshot": "one_more"}"#, "64 snapshots are kept already");
+    refused(&s, r#"{"snapshot": "one_more"}"#, "save under one of their names to replace it");
+    s.ok(json!({"step": true}));
+    s.ok(json!({"snapshot": "s0"}));
+    assert_eq!(s.get("/api/snapshots").as_array().expect("names").len(), 64);
 }

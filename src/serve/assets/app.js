@@ -3,8 +3,11 @@
 // POST /api/command (the API is the page's only way in).
 'use strict';
 
-const token = new URLSearchParams(location.search).get('token');
-const authHeaders = token ? { Authorization: 'Bearer ' + token } : {};
+// The session token: in the page on 127.0.0.1 and ::1, in the address (?token=) beyond; every
+// request sends it (commands are refused without it), the trend stream in its query.
+const urlToken = new URLSearchParams(location.search).get('token');
+const token = urlToken || document.querySelector('meta[name="plantwide-token"]').content;
+const authHeaders = token ? { 'X-Plantwide-Token': token } : {};
 const COLORS = ['#4fc3f7', '#ffb74d', '#81c784', '#e57373', '#ba68c8', '#fff176', '#4db6ac', '#f06292'];
 const MAX_POINTS = 4000;
 const MAX_PENS = 8;
@@ -16,7 +19,7 @@ window.plantwide = live;
 const $ = (id) => document.getElementById(id);
 
 async function getJson(path) {
-  const r = await fetch(path + (token ? (path.includes('?') ? '&' : '?') + 'token=' + token : ''), { headers: authHeaders });
+  const r = await fetch(path, { headers: authHeaders });
   if (!r.ok) throw new Error((await r.json()).error || r.statusText);
   return r.json();
 }
@@ -216,7 +219,7 @@ function updateFaceplates(values) {
 let stream = null;
 function openStream() {
   if (stream) stream.close();
-  const q = 'api/stream?paths=' + encodeURIComponent(live.pens.join(',')) + (token ? '&token=' + token : '');
+  const q = 'api/stream?paths=' + encodeURIComponent(live.pens.join(',')) + (urlToken ? '&token=' + encodeURIComponent(urlToken) : '');
   stream = new EventSource(q);
   stream.onmessage = (e) => {
     const s = JSON.parse(e.data);

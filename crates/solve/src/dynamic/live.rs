@@ -18,6 +18,7 @@
 
 use std::borrow::Cow;
 use std::collections::BTreeMap;
+use std::sync::Arc;
 use std::time::Instant;
 
 use plantwide_flowsheet::Plant;
@@ -80,14 +81,15 @@ pub enum PlantCommand {
 #[derive(Debug, Clone)]
 struct Queued {
     spec: EventSpec,
-    events: Vec<Event>,
+    events: Box<[Event]>,
 }
 
-/// A named snapshot: the run's state and the commands applied up to it.
+/// A named snapshot: the run's state and the commands applied up to it (shared with the journal
+/// and the other snapshots: a snapshot costs a pointer per command, not a copy of each).
 #[derive(Debug, Clone)]
 struct Saved {
     snapshot: Snapshot,
-    journal: Vec<Queued>,
+    journal: Vec<Arc<Queued>>,
 }
 
 /// A plant run live.
@@ -100,7 +102,7 @@ pub struct Live {
     fingerprint: String,
     driver: Driver<'static>,
     /// Commands applied, their events at their times.
-    journal: Vec<Queued>,
+    journal: Vec<Arc<Queued>>,
     pending: Vec<Queued>,
     saved: BTreeMap<String, Saved>,
     /// Time of the last (re)start: values are not interpolated before it.
@@ -192,7 +194,8 @@ impl Live {
         };
         // The journal is a scenario file: it may hold no more events than a scenario may.
         let limits = plantwide_model::limits::Limits::get();
-        let held: usize = self.journal.iter().chain(&self.pending).map(|q| q.events.len()).sum();
+        let held: usize =
+            self.journal.iter().map(|q| q.events.len()).chain(self.pending.iter().map(|q| q.events.len())).sum();
         if held >= limits.max_events {
             return Err(LiveError::Refused(format!(
                 "the live run's journal holds {held} events, the most a scenario may ({} = {}); save a snapshot's \
@@ -201,7 +204,7 @@ impl Live {
                 limits.max_events
             )));
         }
-        let events = self.resolve_one(&spec)?;
+        let events = self.resolve_one(&spec)?.into_boxed_slice();
         let target = events.first().map(|e| e.action.target());
         self.pending.retain(|q| q.events.first().map(|e| e.action.target()) != target);
         self.pending.push(Queued { spec, events });
@@ -259,7 +262,7 @@ impl Live {
             q.spec = at_time(q.spec, t);
             q.events.iter_mut().for_each(|e| e.t += t);
             self.driver.insert_events(&q.events);
-            self.journal.push(q);
+            self.journal.push(Arc::new(q));
         }
         self.floor = t;
     }
@@ -338,7 +341,10 @@ impl Live {
             )));
         }
         if self.saved.len() >= MAX_SNAPSHOTS && !self.saved.contains_key(name) {
-            return Err(LiveError::Refused(format!("{MAX_SNAPSHOTS} snapshots are kept already")));
+            return Err(LiveError::Refused(format!(
+                "snapshot `{name}`: {MAX_SNAPSHOTS} snapshots are kept already, the most a live run keeps; save under \
+                 one of their names to replace it"
+            )));
         }
         let saved = Saved { snapshot: self.driver.snapshot(), journal: self.journal.clone() };
         self.saved.insert(name.to_string(), saved);
@@ -496,7 +502,35 @@ impl Clock {
 mod tests {
     use std::time::Duration;
 
+    use plantwide_flowsheet::scenario::parse_scenario;
+
     use super::*;
+
+    /// A week-long session saves snapshots again and again: each must hold the journal's entries,
+    /// not copies of them (64 snapshots of a 10 000-event journal were 64 × 10 000 copies).
+    #[test]
+    fn snapshots_share_the_journals_commands_rather_than_copy_them() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../flowsheets/surge_tank_pi.json");
+        let plant = plantwide_flowsheet::load_file(std::path::Path::new(path)).expect("loads");
+        let u = plant.input_values();
+        let x0 = crate::steady_state(&plant, &u, None, &crate::NewtonSettings::default()).expect("converges").x;
+        let spec =
+            parse_scenario(r#"{"format_version": 1, "name": "live", "duration": "1 h"}"#, "live").expect("parses");
+        let sc = resolve(&spec, &plant, "live").expect("resolves");
+        let mut live = Live::new(&plant, &x0, &spec, &sc, "test").expect("starts");
+        for value in ["51 mol/s", "49 mol/s"] {
+            live.command(PlantCommand::Set { path: "F_in".into(), value: value.into() }).expect("a valid command");
+            live.step().expect("steps");
+        }
+        live.save("a").expect("saves");
+        live.save("b").expect("saves");
+        assert_eq!(live.journal.len(), 2);
+        for saved in live.saved.values() {
+            assert!(saved.journal.iter().zip(&live.journal).all(|(s, j)| Arc::ptr_eq(s, j)), "a copy");
+        }
+        live.load("a").expect("loads");
+        assert_eq!(live.journal().events.len(), 2);
+    }
 
     #[test]
     fn the_clock_runs_at_its_speed_stops_when_paused_and_never_jumps_back() {
