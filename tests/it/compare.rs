@@ -2,7 +2,7 @@
 //! where the physics gives one — the reactor with and without its feed–effluent exchanger, and
 //! Luyben's snowball plant in structure 1 (fresh feed fixed) and 2 (effluent fixed).
 
-use crate::harness::{flowsheet, plantwide};
+use crate::harness::{fixture, flowsheet, plantwide};
 
 fn compare(files: &[&str], extra: &[&str]) -> serde_json::Value {
     let mut args: Vec<String> = vec!["compare".into()];
@@ -131,4 +131,51 @@ fn compare_mistakes_exit_1_naming_the_scheme() {
     assert!(err.contains("column_a.json") && err.contains("no output `effluent.T`"), "{err}");
     let out = plantwide(&["compare", &flowsheet("column_a.json"), "--disturbances", "F", "--outputs", "feed.F"]);
     assert_eq!(out.status.code(), Some(1), "one scheme is no comparison");
+}
+
+/// Issue 53, D1: `compare` of a newcomer's benzene–toluene column (its bottoms loop on the reboiler
+/// duty) with BLT tuning runs every closed loop, and each run is the one `plantwide run` gives for
+/// the file with the same settings written in: the same step, length and records, IAE alike.
+#[test]
+fn a_reboiler_duty_loop_is_tuned_and_its_runs_match_plantwide_run() {
+    let files = ["data/newcomer3/bt_column_lv.json", "data/newcomer3/bt_column_lv_blt.json"].map(fixture);
+    let args = ["compare", &files[0], &files[1], "--disturbances", "feed_source.F=+10%"];
+    let out = plantwide(&[&args[..], &["--outputs", "distillate.x[benzene],bottoms.x[benzene]", "--json"]].concat());
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let c: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let duration = f(&c["duration"]);
+    let d = &c["schemes"][0]["structure"]["dynamic"];
+    assert!(d["failure"].is_null(), "{d}");
+    // BLT on the file's own loops (tune) gives the settings the comparison used.
+    for (cv, kc, ti) in crate::screen::bt_file_blt() {
+        let l = d["loops"].as_array().unwrap().iter().find(|l| l["cv"] == cv.as_str()).unwrap();
+        assert!((f(&l["kc"]) - kc.abs()).abs() < 1e-6 * kc.abs() && (f(&l["tau_i"]) - ti).abs() < 1e-6 * ti, "{l}");
+    }
+    // The file run with those settings through a scenario written here: the same IAE (neither run
+    // reaches an output limit, the file's or the study's [0, 2 u₀]).
+    let dir = std::env::temp_dir().join(format!("plantwide-compare-bt-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let scenario = serde_json::json!({
+        "format_version": 1, "name": "feed +10 %", "duration": format!("{duration} s"), "integrator": {"rtol": 1e-6},
+        "events": [{"type": "step", "at": format!("{} s", 0.02 * duration), "path": "feed_source.F", "by": 15.0 / 3.6}],
+        "record": {"interval": format!("{} s", duration / 500.0), "paths": ["distillate.x[benzene]", "bottoms.x[benzene]"]}
+    });
+    std::fs::write(dir.join("s.json"), scenario.to_string()).unwrap();
+    let (scenario, csv) = (dir.join("s.json").display().to_string(), dir.join("o.csv").display().to_string());
+    let mut args: Vec<String> =
+        ["run", &files[0], "--scenario", &scenario, "--csv", &csv, "--json"].map(String::from).to_vec();
+    for l in d["loops"].as_array().unwrap() {
+        let (name, unit) = if l["mv"] == "column.reflux" { ("top_x", "mol/s") } else { ("bottom_x", "W") };
+        args.extend(["--set".into(), format!("{name}.kc={:e} {unit}", f(&l["kc"]))]);
+        args.extend(["--set".into(), format!("{name}.tau_i={:e} s", f(&l["tau_i"]))]);
+    }
+    let out = plantwide(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let run: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    std::fs::remove_dir_all(&dir).ok();
+    for cv in d["runs"][0]["cvs"].as_array().unwrap() {
+        let p = run["paths"].as_array().unwrap().iter().find(|p| p["path"] == cv["cv"]).unwrap();
+        assert!((f(&cv["iae"]) - f(&p["iae"])).abs() < 1e-6 * f(&p["iae"]), "{cv} vs {p}");
+        assert!((f(&cv["max_deviation"]) - f(&p["max_deviation"])).abs() < 1e-6 * f(&p["max_deviation"]).abs());
+    }
 }

@@ -40,6 +40,19 @@ pub enum CandidateFailure {
     /// The disturbance run stopped.
     #[error(transparent)]
     Simulation(#[from] Box<plantwide_solve::dynamic::SimError>),
+    /// A pair whose MV does not move its CV with the other loops open: no gain to close it with.
+    #[error(
+        "pair {cv} ← {mv}: its steady-state gain with the other loops open is {gain:e}, so no PI loop on it can \
+         hold {cv}; pair {cv} with another MV"
+    )]
+    NoPairedGain {
+        /// The CV.
+        cv: String,
+        /// The MV.
+        mv: String,
+        /// Its gain (SI).
+        gain: f64,
+    },
 }
 
 /// Settings of the dynamic test.
@@ -326,16 +339,44 @@ pub(super) fn closed_plant(
     Ok((v, st.x))
 }
 
-/// The actions that make each of the candidate's loops a negative feedback.
-pub(super) fn actions(open: &OpenPlant, r: &PairingRequest, s: &PairingStructure) -> Vec<&'static str> {
+/// The steady-state gain of each of the candidate's pairs in the open plant (SI: CV unit per MV
+/// unit).
+fn paired_gains(open: &OpenPlant, r: &PairingRequest, s: &PairingStructure) -> Vec<f64> {
     s.pairs
         .iter()
         .enumerate()
-        .map(|(i, p)| {
-            let j = r.mvs.iter().position(|m| *m == p.mv).unwrap_or(0);
-            if open.gain[(i, j)] < 0.0 { "direct" } else { "reverse" }
-        })
+        .map(|(i, p)| r.mvs.iter().position(|m| *m == p.mv).map_or(f64::NAN, |j| open.gain[(i, j)]))
         .collect()
+}
+
+/// The actions that make each of the candidate's loops a negative feedback.
+pub(super) fn actions(open: &OpenPlant, r: &PairingRequest, s: &PairingStructure) -> Vec<&'static str> {
+    paired_gains(open, r, s).into_iter().map(|g| if g < 0.0 { "direct" } else { "reverse" }).collect()
+}
+
+/// Reset time of the trial loops \[s\]: at steady state no reset time matters (the integral only
+/// holds the CV on its setpoint), and with the loops in manual, as BLT linearizes them, neither
+/// does the gain.
+const TRIAL_TAU_I: f64 = 1e3;
+
+/// The open plant with the candidate's loops closed at a trial tuning, and its steady state: each
+/// loop's gain the inverse of its own steady-state process gain `|g_ii|`, so every loop has gain 1
+/// at steady state whatever the units of its CV and MV. A fixed gain (1 in SI units) is no trial
+/// tuning: a reboiler duty (W) holding a bottoms mole fraction needs some 10⁷ W per unit, and at
+/// 1 W per unit the loop barely acts, so its integral is all but free: on a 32-stage column the
+/// scaled Jacobian's σ_min/σ_max fell to 9·10⁻¹⁵, under the steady state's null-space probe's
+/// 10⁻¹², which rightly reported `pair1.I` as undetermined (with `1/|g_ii|`: 4·10⁻⁴).
+pub(super) fn trial_plant(
+    open: &OpenPlant,
+    r: &PairingRequest,
+    s: &PairingStructure,
+) -> Result<(Plant, Vec<f64>), CandidateFailure> {
+    let gains = paired_gains(open, r, s);
+    if let Some((p, g)) = s.pairs.iter().zip(&gains).find(|(_, g)| !(g.is_finite() && **g != 0.0)) {
+        return Err(CandidateFailure::NoPairedGain { cv: p.cv.clone(), mv: p.mv.clone(), gain: *g });
+    }
+    let kc: Vec<f64> = gains.iter().map(|g| 1.0 / g.abs()).collect();
+    closed_plant(open, s, &kc, &vec![TRIAL_TAU_I; s.pairs.len()], &actions(open, r, s))
 }
 
 /// The open plant with the candidate's loops at the settings given.
@@ -363,15 +404,14 @@ fn tuned(s: &PairingStructure, kc: &[f64], ti: &[f64], actions: &[&str], detunin
 }
 
 fn tuned_plant(open: &OpenPlant, r: &PairingRequest, s: &PairingStructure) -> TunedCandidate {
-    let n = s.pairs.len();
-    let build = |kc: &[f64], ti: &[f64], actions: &[&str]| closed_plant(open, s, kc, ti, actions);
-    let (trial, x) = build(&vec![1.0; n], &vec![1e3; n], &actions(open, r, s))?;
-    let loops: Vec<_> = (0..n).map(|i| plant_loop(&trial, &format!("pair{}", i + 1))).collect::<Result<_, _>>()?;
+    let (trial, x) = trial_plant(open, r, s)?;
+    let loops: Vec<_> =
+        (0..s.pairs.len()).map(|i| plant_loop(&trial, &format!("pair{}", i + 1))).collect::<Result<_, _>>()?;
     let t = blt_loops(&trial, &x, &loops, r.dynamic.measurement)?;
     let kc: Vec<f64> = t.loops.iter().map(|l| l.kc.abs()).collect();
     let ti: Vec<f64> = t.loops.iter().map(|l| l.tau_i.unwrap_or(f64::INFINITY)).collect();
     let actions: Vec<&str> = t.loops.iter().map(|l| l.action).collect();
-    let (plant, x) = build(&kc, &ti, &actions)?;
+    let (plant, x) = closed_plant(open, s, &kc, &ti, &actions)?;
     Ok((plant, x, tuned(s, &kc, &ti, &actions, t.detuning_factor)))
 }
 

@@ -8,7 +8,7 @@
 use plantwide_analysis::sensitivity::{Disturbance, SweepSettings, sweep};
 use serde::Serialize;
 
-use super::dynamic::{actions, closed_plant};
+use super::dynamic::trial_plant;
 use super::{OpenPlant, PairingRequest, PairingStructure};
 use crate::screen::ScreenError;
 
@@ -75,9 +75,7 @@ pub(super) fn test(
 /// The sweeps of one throughput choice, on the plant with `s`'s loops closed.
 fn choice(open: &OpenPlant, r: &PairingRequest, s: &PairingStructure) -> Result<Vec<WatchResult>, ScreenError> {
     let fail = |why: String| ScreenError::Sensitivity { throughput: s.throughput.clone().unwrap_or_default(), why };
-    let n = s.pairs.len();
-    let (plant, x) =
-        closed_plant(open, s, &vec![1.0; n], &vec![1e3; n], &actions(open, r, s)).map_err(|e| fail(e.to_string()))?;
+    let (plant, x) = trial_plant(open, r, s).map_err(|e| fail(e.to_string()))?;
     let u = plant.input_values();
     let outputs: Vec<usize> = r.watch.iter().filter_map(|w| plant.var(&w.path)).collect();
     let mut out = Vec::new();
