@@ -99,8 +99,9 @@ fn the_snowball_plant_in_its_two_structures() {
     assert!(gain(0) > 10.0 * gain(1), "loop gains {} and {}", gain(0), gain(1));
 }
 
-/// A sweep end outside the input's physical range (pure A feed + 5 %) is said to be so, not
-/// reported as a steady state that could not be found; the other end is swept.
+/// A sweep end outside the input's physical range (pure A feed + 5 %, the mirror of the −5 %
+/// step asked for) is said to be so, not reported as a steady state that could not be found nor
+/// as a failure (exit 0); the other end is swept.
 #[test]
 fn a_sweep_end_outside_the_inputs_range_is_named() {
     let c = compare(
@@ -110,9 +111,11 @@ fn a_sweep_end_outside_the_inputs_range_is_named() {
     for s in c["schemes"].as_array().unwrap() {
         let r = &s["sensitivity"][0];
         assert!(r["high"].is_null() && r["low"].is_f64(), "{r}");
-        let why = r["failures"][0].as_str().unwrap();
+        let why = r["no_steady_state"][0].as_str().unwrap();
         assert!(why.contains("fresh.z[A] at 1.05") && why.contains("z[A]"), "{why}");
+        assert_eq!(r["failures"], serde_json::json!([]), "{r}");
     }
+    assert_eq!(c["failed"], serde_json::json!([]));
 }
 
 #[test]
@@ -178,4 +181,151 @@ fn a_reboiler_duty_loop_is_tuned_and_its_runs_match_plantwide_run() {
         assert!((f(&cv["iae"]) - f(&p["iae"])).abs() < 1e-6 * f(&p["iae"]), "{cv} vs {p}");
         assert!((f(&cv["max_deviation"]) - f(&p["max_deviation"])).abs() < 1e-6 * f(&p["max_deviation"]).abs());
     }
+}
+
+/// `compare --json` of `files` (fixtures) with `extra`: its exit code, JSON and standard error.
+fn compare_fixtures(files: &[&str], extra: &[&str]) -> (Option<i32>, serde_json::Value, String) {
+    let files: Vec<String> = files.iter().map(|f| fixture(f)).collect();
+    let args = ["compare"].into_iter().chain(files.iter().map(String::as_str)).chain(extra.iter().copied());
+    let out = plantwide(&args.chain(["--json"]).collect::<Vec<_>>());
+    let err = String::from_utf8_lossy(&out.stderr).to_string();
+    let json = serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{e}: {err}"));
+    (out.status.code(), json, err)
+}
+
+const BT_LV_PAIR: [&str; 2] = ["data/newcomer3/bt_column_lv.json", "data/newcomer3/bt_column_lv_blt.json"];
+const HX_PAIR: [&str; 2] = ["data/newcomer3/with_hx.json", "data/newcomer3/without_hx.json"];
+
+/// The closed-loop run of `label` in scheme `s`.
+fn run_of<'a>(s: &'a serde_json::Value, label: &str) -> &'a serde_json::Value {
+    let runs = s["structure"]["dynamic"]["runs"].as_array().unwrap();
+    runs.iter().find(|r| r["disturbance"] == label).unwrap_or_else(|| panic!("no run {label} in {runs:?}"))
+}
+
+/// Issue 53, #12: every written form of a disturbance steps its input. `±10%` is one run up and
+/// one down (opposite first excursions), and an amount with its unit steps by that amount: 15
+/// kmol/h is the +10 % of the file's 150 kmol/h feed, so it is the same run to rounding. The
+/// sweeps go to both sides once per input and size.
+#[test]
+fn disturbances_in_every_written_form_step_their_input() {
+    let (code, c, err) = compare_fixtures(
+        &BT_LV_PAIR,
+        &["--disturbances", "feed_source.F=±10%,feed_source.F=+15 kmol/h", "--outputs", "bottoms.x[benzene]"],
+    );
+    assert_eq!(code, Some(0), "{err}");
+    assert_eq!(c["disturbances"], serde_json::json!(["feed_source.F ±10 %", "feed_source.F +15 kmol/h"]));
+    let s = &c["schemes"][0];
+    let labels: Vec<&str> = s["structure"]["dynamic"]["runs"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| r["disturbance"].as_str().unwrap())
+        .collect();
+    assert_eq!(labels, ["feed_source.F +10 %", "feed_source.F -10 %", "feed_source.F +15 kmol/h"]);
+    let (up, down, amount) =
+        (run_of(s, "feed_source.F +10 %"), run_of(s, "feed_source.F -10 %"), run_of(s, "feed_source.F +15 kmol/h"));
+    for k in 0..2 {
+        let (u, d, a) = (&up["cvs"][k], &down["cvs"][k], &amount["cvs"][k]);
+        assert!((f(&a["iae"]) - f(&u["iae"])).abs() < 1e-9 * f(&u["iae"]), "{a} vs {u}");
+        assert!(f(&u["max_deviation"]) * f(&d["max_deviation"]) < 0.0, "{u} vs {d}");
+    }
+    let sweeps: Vec<&str> =
+        s["sensitivity"].as_array().unwrap().iter().map(|r| r["disturbance"].as_str().unwrap()).collect();
+    assert_eq!(sweeps, ["feed_source.F ±10 %", "feed_source.F ±15 kmol/h"]);
+}
+
+/// Issue 53, #12: a temperature step written in degC is a difference (5 degC is 5 K, not 278 K):
+/// the same run as +5 K, and one sweep for both.
+#[test]
+fn a_temperature_step_in_degc_is_a_difference() {
+    let (code, c, err) = compare_fixtures(
+        &HX_PAIR,
+        &[
+            "--disturbances",
+            "feed_source.T=+5 K,feed_source.T=+5 degC",
+            "--outputs",
+            "bottoms.x[benzene]",
+            "--duration",
+            "2 h",
+        ],
+    );
+    assert_eq!(code, Some(0), "{err}");
+    for s in c["schemes"].as_array().unwrap() {
+        let (k, c) = (run_of(s, "feed_source.T +5 K"), run_of(s, "feed_source.T +5 degC"));
+        assert_eq!(k["cvs"], c["cvs"], "{s}");
+        assert_eq!(s["sensitivity"].as_array().unwrap().len(), 1, "one sweep");
+        assert_eq!(s["sensitivity"][0]["disturbance"], "feed_source.T ±5 K");
+    }
+}
+
+/// Issue 53, #13: a step that takes its input outside its physical range (benzene's feed fraction
+/// 0.45 + 130 % = 1.035) is refused before anything runs, by the range rule of the file and
+/// `--set`, naming the input, the value and the range; so is a step on an input a controller
+/// drives, one in the wrong unit, and (in `size`, which verifies one step) a step both ways.
+#[test]
+fn a_step_outside_the_inputs_range_is_refused_naming_it() {
+    let files = BT_LV_PAIR.map(fixture);
+    let cases = [
+        (
+            "feed_source.z[benzene]=+130%",
+            "feed_source.z[benzene] +130 %: the step takes `feed_source.z[benzene]` from 0.45 to 1.035",
+        ),
+        ("feed_source.F=-101%", "-0.416667 mol/s is outside the range 0 … 1e6 mol/s"),
+        ("column.reflux=+5%", "`column.reflux` is driven by `top_x.op`"),
+        ("feed_source.F=+5 K", "`feed_source.F` is a molar flow (mol/s) and the step a temperature"),
+        ("feed_source.F=+ten%", "expected PATH (+10 %), PATH=±x% or PATH=±AMOUNT with a unit"),
+    ];
+    for (d, msg) in cases {
+        let out = plantwide(&["compare", &files[0], &files[1], "--disturbances", d, "--outputs", "bottoms.x[benzene]"]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{d}: {err}");
+        assert!(err.contains(msg) && err.starts_with("error: --disturbances "), "{d}: {err}");
+        if d.contains("130") {
+            assert!(err.contains("1.035 is outside the range 0 … 1"), "{err}");
+        }
+        let args = ["screen", &files[0], "--cvs", "distillate.x[benzene],bottoms.x[benzene]"];
+        let out =
+            plantwide(&[&args[..], &["--mvs", "column.reflux,column.reboiler_duty", "--disturbances", d]].concat());
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "screen {d}: {err}");
+        assert!(err.contains(msg), "screen {d}: {err}");
+    }
+    let size = |d: &str| {
+        let args = ["size", &files[0], "--vessel", "column.sump", "--disturbance", d, "--level-band", "0.5 m"];
+        plantwide(&[&args[..], &["--max-outflow-rate", "0.5 kmol/h/min"]].concat())
+    };
+    for (d, msg) in [
+        ("feed_source.z[benzene]=+130%", "1.035 is outside the range 0 … 1"),
+        ("feed_source.F=±10%", "sizing verifies one step"),
+    ] {
+        let out = size(d);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "size {d}: {err}");
+        assert!(err.contains(msg) && err.contains("--disturbance feed_source"), "size {d}: {err}");
+    }
+}
+
+/// Issue 53, #13 and exit status: a run that fails (a fivefold feed floods the column: the
+/// integrator gives up) is marked as failed with its reason and `null` figures, the scheme's
+/// other runs are kept, and `compare` exits 2 after printing the comparison, naming the part.
+#[test]
+fn a_failed_run_is_marked_the_others_kept_and_compare_exits_2() {
+    let (code, c, err) = compare_fixtures(
+        &BT_LV_PAIR,
+        &["--disturbances", "feed_source.F=+10%,feed_source.F=+400%", "--outputs", "bottoms.x[benzene]"],
+    );
+    assert_eq!(code, Some(2), "{err}");
+    for s in c["schemes"].as_array().unwrap() {
+        let (ok, failed) = (run_of(s, "feed_source.F +10 %"), run_of(s, "feed_source.F +400 %"));
+        assert!(ok["failure"].is_null() && f(&ok["cvs"][0]["iae"]) > 0.0, "{ok}");
+        assert!(failed["failure"].as_str().unwrap().contains("integration failed"), "{failed}");
+        assert!(failed["cvs"].as_array().unwrap().iter().all(|v| v["iae"].is_null() && v["max_deviation"].is_null()));
+        assert!(s["structure"]["dynamic"]["failure"].is_null());
+    }
+    let failed = c["failed"].as_array().unwrap();
+    assert_eq!(failed.len(), 2, "{failed:?}");
+    assert!(failed[0].as_str().unwrap().starts_with("bt_column_lv, run feed_source.F +400 %: "), "{failed:?}");
+    assert!(
+        err.contains("error: compare: 2 parts failed (marked in the report): bt_column_lv, run feed_source.F +400 %")
+    );
 }

@@ -276,7 +276,7 @@ fn bad_pairing_requests_exit_1_naming_what_is_wrong() {
         ),
         (
             &["--cvs", "column1.T[21]", "--mvs", "column1.reflux", "--disturbances", "fresh_A.F=ten"],
-            "expected PATH or PATH=±x%",
+            "expected PATH (+10 %), PATH=±x%",
         ),
     ];
     for (extra, msg) in cases {
@@ -411,4 +411,31 @@ fn a_reboiler_duty_loop_is_tuned_and_run_in_the_dynamic_test() {
             assert!(cv["iae"].as_f64().unwrap() > 0.0 && cv["settling_time"].is_f64(), "{cv}");
         }
     }
+}
+
+/// Issue 53, #13 and exit status: a disturbance run that fails is marked with its reason (figures
+/// `null`), the candidate's other runs are kept, it is not ranked (its score would compare runs
+/// that did not happen), and `screen` prints the table then exits 2 naming the part.
+#[test]
+fn a_failed_run_is_marked_and_screen_exits_2() {
+    let file = crate::harness::fixture(BT_LV);
+    let args = ["screen", &file, "--cvs", BT_QUALITIES, "--mvs", "column.reflux,column.reboiler_duty"];
+    let out = plantwide(&[&args[..], &["--disturbances", "feed_source.F=+10%,feed_source.F=+400%", "--json"]].concat());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let s = &v["structures"][0];
+    let runs = s["dynamic"]["runs"].as_array().unwrap();
+    assert!(runs[0]["failure"].is_null() && runs[0]["cvs"][0]["iae"].as_f64().unwrap() > 0.0, "{s}");
+    assert!(runs[1]["failure"].as_str().unwrap().contains("integration failed"), "{s}");
+    assert!(runs[1]["cvs"][0]["iae"].is_null() && s["dynamic"]["score"].is_null() && s["rank"].is_null(), "{s}");
+    assert_eq!(v["failed"].as_array().unwrap().len(), 1);
+    assert!(
+        err.contains("screen: 1 part failed (marked in the report): candidate distillate.x[benzene] ← column.reflux")
+    );
+    // The text report marks it too.
+    let out = plantwide(&[&args[..], &["--disturbances", "feed_source.F=+10%,feed_source.F=+400%"]].concat());
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(text.contains("| failed | failed, run feed_source.F +400 %: "), "{text}");
 }

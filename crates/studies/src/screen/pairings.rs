@@ -39,34 +39,7 @@ pub use sensitivity::{Watch, WatchResult};
 use super::ScreenError;
 use super::column::is_singular;
 
-/// A disturbance of the dynamic test: input `path` stepped by `fraction` of its steady value.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Disturbance {
-    /// Input path.
-    pub path: String,
-    /// Step as a fraction of the steady value (0.1 for +10 %).
-    pub fraction: f64,
-}
-
-impl std::str::FromStr for Disturbance {
-    type Err = String;
-
-    /// `PATH` (a +10 % step) or `PATH=±x%`; the error is the message for `--disturbances`.
-    fn from_str(text: &str) -> Result<Self, Self::Err> {
-        let Some((path, step)) = text.split_once('=') else {
-            return Ok(Disturbance { path: text.trim().to_string(), fraction: 0.1 });
-        };
-        let pct = step
-            .trim()
-            .strip_suffix('%')
-            .and_then(|v| v.trim().parse::<f64>().ok())
-            .filter(|v| v.is_finite() && *v != 0.0);
-        match pct {
-            Some(pct) => Ok(Disturbance { path: path.trim().to_string(), fraction: pct / 100.0 }),
-            None => Err(format!("--disturbances {text}: expected PATH or PATH=±x% (e.g. fresh_A.F=+10%)")),
-        }
-    }
-}
+pub use crate::disturbance::Disturbance;
 
 /// What to screen.
 #[derive(Debug, Clone, PartialEq)]
@@ -77,7 +50,8 @@ pub struct PairingRequest {
     pub mvs: Vec<String>,
     /// Throughput-manipulator candidates, each one of `mvs` (empty: as many MVs as CVs).
     pub throughput: Vec<String>,
-    /// Disturbances of the sensitivity and dynamic tests (empty: neither).
+    /// Disturbances of the sensitivity and dynamic tests (empty: neither); a `±` one is two steps
+    /// of the dynamic test ([`PairingRequest::steps`]).
     pub disturbances: Vec<Disturbance>,
     /// Uncontrolled variables that must stay in a band over ± each disturbance (sensitivity test).
     pub watch: Vec<Watch>,
@@ -92,6 +66,19 @@ pub struct PairingRequest {
     /// all, a shard's (then nothing is scored or ranked, and no MPC is run), or none, their
     /// results given by the shards' parts.
     pub share: Share<DynamicResult>,
+}
+
+impl PairingRequest {
+    /// The steps of the dynamic test, one run each: every disturbance, a `±` one up then down.
+    pub fn steps(&self) -> Vec<Disturbance> {
+        self.disturbances.iter().flat_map(Disturbance::steps).collect()
+    }
+
+    /// The disturbances of the steady-state sweeps (to both sides of the base case), each input
+    /// and size once.
+    pub fn sweeps(&self) -> Vec<&Disturbance> {
+        crate::disturbance::sweeps(&self.disturbances)
+    }
 }
 
 /// One CV–MV pair and its relative gain.
@@ -156,6 +143,10 @@ pub struct PairingScreen {
     /// The structures tested dynamically, in task order (indices into `structures`).
     #[serde(skip)]
     pub tested: Vec<usize>,
+    /// The parts asked for that failed, each with its reason (a candidate's tuning, a run, the
+    /// model predictive controller's runs), also marked where they stand; empty when all went
+    /// through.
+    pub failed: Vec<String>,
 }
 
 /// The open plant: the loops on the CVs and MVs removed, its steady state and gains.
@@ -219,9 +210,10 @@ pub fn screen_pairings(plant: &Plant, request: &PairingRequest) -> Result<Pairin
     if let Some(d) = mpc.as_mut().and_then(|m| m.dynamic.as_mut()) {
         let mut all: Vec<&mut DynamicResult> = structures.iter_mut().filter_map(|s| s.dynamic.as_mut()).collect();
         all.push(d);
-        dynamic::score(&mut all, request.disturbances.len(), request.cvs.len());
+        dynamic::score(&mut all, request.steps().len(), request.cvs.len());
     }
     rank(&mut structures);
+    let failed = failed_tests(&structures, mpc.as_ref());
     Ok(PairingScreen {
         cvs: request.cvs.clone(),
         mvs: request.mvs.clone(),
@@ -233,7 +225,23 @@ pub fn screen_pairings(plant: &Plant, request: &PairingRequest) -> Result<Pairin
         structures,
         mpc,
         tested,
+        failed,
     })
+}
+
+/// A candidate in words: its pairs, and its throughput manipulator.
+fn describe(s: &PairingStructure) -> String {
+    let pairs: Vec<String> = s.pairs.iter().map(|p| format!("{} ← {}", p.cv, p.mv)).collect();
+    let tpm = s.throughput.as_ref().map_or(String::new(), |t| format!(" ({t} held)"));
+    format!("{}{tpm}", pairs.join(", "))
+}
+
+/// The dynamic tests of `structures` and `mpc` that failed or had a run fail, each with its
+/// reason.
+fn failed_tests(structures: &[PairingStructure], mpc: Option<&mpc::MpcAlternative>) -> Vec<String> {
+    let pi = structures.iter().filter_map(|c| Some((format!("candidate {}", describe(c)), c.dynamic.as_ref()?)));
+    let mpc = mpc.into_iter().filter_map(|m| Some((format!("MPC `{}`", m.controller), m.dynamic.as_ref()?)));
+    pi.chain(mpc).flat_map(|(label, d)| d.failures(&label)).collect()
 }
 
 /// One given pairing (CV `i` with MV `pairing[i]`) of `request` on `plant`: the open plant, the
@@ -277,6 +285,9 @@ fn check_request(plant: &Plant, r: &PairingRequest) -> Result<(), ScreenError> {
     if let Some(w) = r.watch.iter().find(|w| plant.var(&w.path).is_none()) {
         let hint = hint(&w.path, plant.vars().iter().map(|v| v.path.as_str()).collect());
         return Err(ScreenError::NoWatch { path: w.path.clone(), hint });
+    }
+    for d in &r.disturbances {
+        d.check(plant)?;
     }
     if !r.watch.is_empty() && r.disturbances.is_empty() {
         return Err(ScreenError::WatchWithoutDisturbances);
@@ -439,7 +450,7 @@ fn rank(structures: &mut [PairingStructure]) {
         let score = s.dynamic.as_ref().map_or(f64::INFINITY, |d| d.score);
         (score, s.rga_number)
     };
-    let failed = |s: &PairingStructure| s.dynamic.as_ref().is_some_and(|d| d.failure.is_some());
+    let failed = |s: &PairingStructure| s.dynamic.as_ref().is_some_and(|d| !d.completed());
     let mut order: Vec<usize> =
         (0..structures.len()).filter(|&k| structures[k].passed && !failed(&structures[k])).collect();
     order.sort_by(|&a, &b| key(&structures[a]).partial_cmp(&key(&structures[b])).unwrap_or(std::cmp::Ordering::Equal));

@@ -79,10 +79,9 @@ fn choice(open: &OpenPlant, r: &PairingRequest, s: &PairingStructure) -> Result<
     let u = plant.input_values();
     let outputs: Vec<usize> = r.watch.iter().filter_map(|w| plant.var(&w.path)).collect();
     let mut out = Vec::new();
-    for d in &r.disturbances {
-        let pct = 100.0 * d.fraction.abs();
-        let text = format!("{}=-{pct}%:+{pct}%", d.path);
-        let dist = Disturbance::parse(&plant, &u, &text).map_err(|e| fail(e.to_string()))?;
+    for d in r.sweeps() {
+        let u0 = plantwide_flowsheet::overrides::resolve_input(&plant, &d.path).map_or(f64::NAN, |i| u[i]);
+        let dist = Disturbance::parse(&plant, &u, &d.sweep_range(u0)).map_err(|e| fail(e.to_string()))?;
         let settings = SweepSettings { points: 9, ..SweepSettings::default() };
         let curves = sweep(&plant, &x, &u, &[dist], &outputs, &settings).map_err(|e| fail(e.to_string()))?;
         for (j, w) in r.watch.iter().enumerate() {
@@ -93,7 +92,7 @@ fn choice(open: &OpenPlant, r: &PairingRequest, s: &PairingStructure) -> Result<
             let converged = values.iter().all(Option::is_some);
             out.push(WatchResult {
                 path: w.path.clone(),
-                disturbance: format!("{} ±{pct} %", d.path),
+                disturbance: d.sweep_label(),
                 min,
                 max,
                 band: [w.low, w.high],
