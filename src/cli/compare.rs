@@ -31,7 +31,8 @@ pub struct CompareArgs {
     /// `PATH=-10 kmol/h`); the sensitivity sweeps go to both sides by the step's size.
     #[arg(long, value_name = "PATH[=±x%|±AMOUNT],…", value_delimiter = ',', required = true)]
     disturbances: Vec<String>,
-    /// Outputs watched in every scheme, comma-separated variable paths.
+    /// Outputs watched in every scheme, comma-separated: variable paths, or inputs a controller
+    /// drives (its output), each with an optional display unit (`column.reboiler_duty@MW`).
     #[arg(long, value_name = "P1,P2,…", value_delimiter = ',', required = true)]
     outputs: Vec<String>,
     /// Quality loops by controller name (default: every PI loop whose measurement is not a level,

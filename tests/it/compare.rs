@@ -329,3 +329,32 @@ fn a_failed_run_is_marked_the_others_kept_and_compare_exits_2() {
         err.contains("error: compare: 2 parts failed (marked in the report): bt_column_lv, run feed_source.F +400 %")
     );
 }
+
+/// Issue 53, D12: an input a controller drives is an output, as in `gains`: the reboiler duty
+/// (driven by `bottom_x`) is read at its controller's output. With the qualities and the feed's
+/// temperature held every flow of the column scales with the feed, so at the feed ±10 % the duty
+/// is ±10 % of its steady value, which `steady --json` gives as `bottom_x.op`.
+#[test]
+fn a_controller_driven_input_is_an_output() {
+    let (code, c, err) = compare_fixtures(
+        &HX_PAIR,
+        &["--disturbances", "feed_source.F=±10%", "--outputs", "column.reboiler_duty@kW", "--duration", "4 h"],
+    );
+    assert_eq!(code, Some(0), "{err}");
+    let out = plantwide(&["steady", &fixture(HX_PAIR[0]), "--json"]);
+    let steady: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let q0 = f(&steady["values"]["bottom_x.op"]);
+    for s in c["schemes"].as_array().unwrap() {
+        let r = &s["sensitivity"][0];
+        assert_eq!(r["output"], "column.reboiler_duty");
+        let (low, base, high) = (f(&r["low"]), f(&r["base"]), f(&r["high"]));
+        assert!((base - q0).abs() < 1e-6 * q0, "{base} vs {q0}");
+        assert!((low - 0.9 * base).abs() < 1e-6 * base && (high - 1.1 * base).abs() < 1e-6 * base, "{r}");
+        let (up, down) = (run_of(s, "feed_source.F +10 %"), run_of(s, "feed_source.F -10 %"));
+        let duty = |run: &serde_json::Value| {
+            let v = run["cvs"].as_array().unwrap().iter().find(|v| v["cv"] == "column.reboiler_duty").unwrap();
+            f(&v["max_deviation"])
+        };
+        assert!(duty(up) > 0.0 && duty(down) < 0.0, "{up} {down}");
+    }
+}

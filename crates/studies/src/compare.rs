@@ -50,7 +50,8 @@ pub struct CompareRequest {
     /// Disturbances, each an input stepped by a fraction of its steady value or by an amount, up,
     /// down or both ways (the sensitivity sweeps go to both sides by that size).
     pub disturbances: Vec<Disturbance>,
-    /// Outputs watched in every scheme (variable paths every scheme has).
+    /// Outputs watched in every scheme: variable paths every scheme has, or inputs a controller
+    /// drives (read as its output, as `gains` reads them).
     pub outputs: Vec<String>,
     /// Quality loops by controller name (empty: every PI loop on a non-inventory measurement).
     pub loops: Vec<String>,
@@ -326,19 +327,7 @@ fn failed_parts(schemes: &[Scheme]) -> Vec<String> {
 /// One scheme judged on `r`.
 fn scheme(plant: &Plant, r: &CompareRequest) -> Result<Scheme, CompareError> {
     let file = plant.file().to_string();
-    let outputs: Vec<usize> = r
-        .outputs
-        .iter()
-        .map(|o| {
-            plant.var(o).ok_or_else(|| CompareError::Request {
-                file: file.clone(),
-                what: format!(
-                    "no output `{o}`{}: every scheme must have every output",
-                    plantwide_flowsheet::error::did_you_mean(o, plant.vars().iter().map(|v| v.path.as_str()))
-                ),
-            })
-        })
-        .collect::<Result<_, _>>()?;
+    let outputs: Vec<usize> = r.outputs.iter().map(|o| output(plant, o)).collect::<Result<_, _>>()?;
     for d in &r.disturbances {
         d.check(plant)?;
     }
@@ -376,6 +365,23 @@ fn scheme(plant: &Plant, r: &CompareRequest) -> Result<Scheme, CompareError> {
         stability,
         recycles,
         sensitivity,
+    })
+}
+
+/// The variable output `o` reads in `plant`: a variable, or an input a controller drives (its
+/// output), as `gains` reads outputs.
+fn output(plant: &Plant, o: &str) -> Result<usize, CompareError> {
+    let driven = || plantwide_flowsheet::overrides::resolve_input(plant, o).and_then(|i| plant.inputs()[i].driven_by);
+    plant.var(o).or_else(driven).ok_or_else(|| {
+        let names = plant.vars().iter().map(|v| v.path.as_str());
+        let inputs = plant.inputs().iter().filter(|i| i.driven_by.is_some()).map(|i| i.path.as_str());
+        CompareError::Request {
+            file: plant.file().to_string(),
+            what: format!(
+                "no output `{o}`{}: every scheme must have every output (a variable, or an input a controller drives)",
+                plantwide_flowsheet::error::did_you_mean(o, names.chain(inputs))
+            ),
+        }
     })
 }
 
