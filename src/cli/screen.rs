@@ -435,5 +435,6 @@ fn pairing_table(s: &PairingScreen, shown: &Shown) -> String {
     if let Some(m) = &s.mpc {
         t.push_str(&mpc_row(m));
     }
+    t.push_str(&format!("\nverdict: {}\n", s.verdict));
     t
 }

@@ -433,6 +433,7 @@ fn a_failed_run_is_marked_and_screen_exits_2() {
     assert!(
         err.contains("screen: 1 part failed (marked in the report): candidate distillate.x[benzene] ← column.reflux")
     );
+    assert!(v["verdict"].as_str().unwrap().starts_with("no pairing recommended"), "{}", v["verdict"]);
     // The text report marks it too.
     let out = plantwide(&[&args[..], &["--disturbances", "feed_source.F=+10%,feed_source.F=+400%"]].concat());
     let text = String::from_utf8_lossy(&out.stdout);

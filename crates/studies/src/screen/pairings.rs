@@ -147,6 +147,10 @@ pub struct PairingScreen {
     /// model predictive controller's runs), also marked where they stand; empty when all went
     /// through.
     pub failed: Vec<String>,
+    /// The recommendation (the candidate ranked first) and what it rests on; when the steady-state
+    /// measure (RGA number) orders the dynamically tested candidates otherwise than their dynamic
+    /// scores do, it says so.
+    pub verdict: String,
 }
 
 /// The open plant: the loops on the CVs and MVs removed, its steady state and gains.
@@ -214,6 +218,7 @@ pub fn screen_pairings(plant: &Plant, request: &PairingRequest) -> Result<Pairin
     }
     rank(&mut structures);
     let failed = failed_tests(&structures, mpc.as_ref());
+    let verdict = verdict(&structures);
     Ok(PairingScreen {
         cvs: request.cvs.clone(),
         mvs: request.mvs.clone(),
@@ -226,6 +231,7 @@ pub fn screen_pairings(plant: &Plant, request: &PairingRequest) -> Result<Pairin
         mpc,
         tested,
         failed,
+        verdict,
     })
 }
 
@@ -234,6 +240,49 @@ fn describe(s: &PairingStructure) -> String {
     let pairs: Vec<String> = s.pairs.iter().map(|p| format!("{} ← {}", p.cv, p.mv)).collect();
     let tpm = s.throughput.as_ref().map_or(String::new(), |t| format!(" ({t} held)"));
     format!("{}{tpm}", pairs.join(", "))
+}
+
+/// The recommendation and its evidence: the candidate ranked first and why; when the RGA number
+/// (the steady-state filters' order) and the dynamic scores order the tested candidates
+/// differently, both orders and which one the ranking follows.
+fn verdict(structures: &[PairingStructure]) -> String {
+    let Some(best) = structures.iter().find(|s| s.rank == Some(1)) else {
+        return "no pairing recommended: no candidate passed the steady-state filters, or every tested candidate's \
+                dynamic test failed"
+            .into();
+    };
+    let scored: Vec<&PairingStructure> =
+        structures.iter().filter(|s| s.rank.is_some() && s.dynamic.as_ref().is_some_and(|d| d.completed())).collect();
+    let mut by_rga = scored.clone();
+    by_rga.sort_by(|a, b| a.rga_number.total_cmp(&b.rga_number));
+    let mut by_score = scored.clone();
+    by_score.sort_by_key(|s| s.rank);
+    let why = match best.dynamic.as_ref().filter(|d| d.completed()) {
+        Some(d) => format!("best dynamic score ({:.3}) of {} tested on the nonlinear plant", d.score, scored.len()),
+        None => format!("smallest RGA number ({:.3}); no dynamic test", best.rga_number),
+    };
+    let mut text = format!("recommended: {} — {why}", describe(best));
+    let same = by_rga.iter().zip(&by_score).all(|(a, b)| std::ptr::eq(*a, *b));
+    if !same {
+        let ranks: Vec<String> = by_rga.iter().map(|s| s.rank.map_or("–".into(), |r| r.to_string())).collect();
+        let first = if std::ptr::eq(by_rga[0], by_score[0]) {
+            "they agree on the best only".to_string()
+        } else {
+            format!(
+                "the steady-state measure alone would recommend rank {}, {} (RGA number {:.3} against {:.3})",
+                by_rga[0].rank.unwrap_or(0),
+                describe(by_rga[0]),
+                by_rga[0].rga_number,
+                best.rga_number
+            )
+        };
+        text.push_str(&format!(
+            "; the evidence disagrees: by RGA number the tested candidates go in the order of ranks {}, not by \
+             their dynamic scores ({first}); the ranking follows the dynamic test",
+            ranks.join(", ")
+        ));
+    }
+    text
 }
 
 /// The dynamic tests of `structures` and `mpc` that failed or had a run fail, each with its
@@ -497,6 +546,57 @@ mod tests {
         leaves.sort();
         assert_eq!(leaves, brute);
         assert!(pruned > 0 && leaves.len() < 120, "{} leaves, {pruned} cut", leaves.len());
+    }
+
+    /// A candidate pairing `cv` with `mv`, with its RGA number and, when tested, its score.
+    fn candidate(mv: &str, rga_number: f64, score: Option<f64>) -> PairingStructure {
+        let dynamic = score.map(|score| DynamicResult {
+            detuning_factor: None,
+            loops: Vec::new(),
+            runs: Vec::new(),
+            score,
+            failure: None,
+        });
+        PairingStructure {
+            throughput: None,
+            pairs: vec![Pair { cv: "x".into(), mv: mv.into(), relative_gain: 1.0 }],
+            niederlinski: 1.0,
+            rga_number,
+            dic: true,
+            passed: true,
+            rejected: None,
+            sensitivity: Vec::new(),
+            dynamic,
+            rank: None,
+        }
+    }
+
+    #[test]
+    fn a_recommendation_its_own_steady_state_evidence_contradicts_says_so() {
+        // The RGA number prefers `a`, the dynamic test `b`: the ranking follows the dynamic test and
+        // the verdict names the candidate the steady-state measure alone would recommend.
+        let mut s = vec![candidate("a", 0.5, Some(2.0)), candidate("b", 1.0, Some(1.0)), candidate("c", 3.0, None)];
+        rank(&mut s);
+        assert_eq!(s.iter().map(|c| c.rank).collect::<Vec<_>>(), [Some(2), Some(1), Some(3)]);
+        let v = verdict(&s);
+        assert!(v.starts_with("recommended: x ← b — best dynamic score (1.000) of 2 tested"), "{v}");
+        assert!(
+            v.contains("the evidence disagrees: by RGA number the tested candidates go in the order of ranks 2, 1")
+        );
+        assert!(v.contains("would recommend rank 2, x ← a (RGA number 0.500 against 1.000)"), "{v}");
+        // Both measures agree: no contradiction to flag.
+        let mut s = vec![candidate("a", 0.5, Some(1.0)), candidate("b", 1.0, Some(2.0))];
+        rank(&mut s);
+        let v = verdict(&s);
+        assert!(v.starts_with("recommended: x ← a — best dynamic score") && !v.contains("disagrees"), "{v}");
+        // They agree on the best only.
+        let mut s =
+            vec![candidate("a", 0.5, Some(1.0)), candidate("b", 1.0, Some(3.0)), candidate("c", 2.0, Some(2.0))];
+        rank(&mut s);
+        let v = verdict(&s);
+        assert!(v.contains("order of ranks 1, 3, 2") && v.contains("they agree on the best only"), "{v}");
+        // Nothing ranked.
+        assert!(verdict(&[]).starts_with("no pairing recommended"));
     }
 
     #[test]
