@@ -100,18 +100,13 @@ pub enum DisturbanceError {
         file: String,
     },
     /// The amount's unit is not the input's.
-    #[error("{text}: `{path}` is {input} ({input_si}) and the step {step}; give the step in a unit of {input_si}")]
+    #[error("{text}: {why}")]
     Unit {
         /// The disturbance (`path +10 %`).
         text: String,
-        /// Its path.
-        path: String,
-        /// The input's dimension, described.
-        input: String,
-        /// The input's SI unit.
-        input_si: String,
-        /// The step's dimension, described.
-        step: String,
+        /// What the input and the step are, and the unit to give (`` `feed.F` is a molar flow
+        /// (mol/s) and the step a temperature; give the step in a unit of mol/s ``).
+        why: String,
     },
     /// A fraction of an input whose value is zero.
     #[error("{text}: `{path}` is 0 in {file}, so a fraction of it is no step; give the step as an amount with a unit")]
@@ -124,15 +119,14 @@ pub enum DisturbanceError {
         file: String,
     },
     /// A step that takes its input outside its physical range.
-    #[error("{text}: the step takes `{path}` {values} in {file}: {why}; give a smaller step")]
+    #[error("{text}: the step takes {values} in {file}: {why}; give a smaller step")]
     Range {
         /// The disturbance (`path +10 %`).
         text: String,
-        /// Its path.
-        path: String,
         /// The flowsheet file.
         file: String,
-        /// Its values before and after the step (`from 0.45 to 1.035`, SI with the unit).
+        /// The input and its values before and after the step (`` `z[a]` from 0.45 to 1.035 ``,
+        /// SI with the unit).
         values: String,
         /// The range rule's verdict (the value and the range).
         why: String,
@@ -281,13 +275,15 @@ impl Disturbance {
         }
         match self.size {
             StepSize::Amount { dim: Some(d), .. } if d != info.dim => {
-                return Err(DisturbanceError::Unit {
-                    text,
-                    path: self.path.clone(),
-                    input: info.dim.describe().into_owned(),
-                    input_si: info.dim.to_string(),
-                    step: d.describe().into_owned(),
-                });
+                let why = format!(
+                    "`{}` is {} ({}) and the step {}; give the step in a unit of {}",
+                    self.path,
+                    info.dim.describe(),
+                    info.dim,
+                    d.describe(),
+                    info.dim
+                );
+                return Err(DisturbanceError::Unit { text, why });
             }
             StepSize::Fraction(_) if info.value == 0.0 => {
                 return Err(DisturbanceError::ZeroBase { text, path: self.path.clone(), file });
@@ -302,9 +298,8 @@ impl Disturbance {
             let to = info.value + step.change(info.value);
             let range = |why: String| DisturbanceError::Range {
                 text: text.clone(),
-                path: self.path.clone(),
                 file: file.clone(),
-                values: format!("from {} to {}", shown(info.value), shown(to)),
+                values: format!("`{}` from {} to {}", self.path, shown(info.value), shown(to)),
                 why,
             };
             plantwide_flowsheet::overrides::check_input_value(plant, i, to).map_err(|e| range(e.to_string()))?;
