@@ -11,7 +11,7 @@ use plantwide::io::plot::{LabelledMatrix, Overlay, write_bars, write_matrices, w
 use plantwide::studies::compare::{CompareRequest, Comparison, Scheme, compare};
 use plantwide::studies::screen::pairings::STEP_AT;
 use plantwide::studies::screen::pairings::mpc::MpcAlternative;
-use plantwide::studies::screen::pairings::{DynamicResult, DynamicSettings};
+use plantwide::studies::screen::pairings::{DisturbanceRun, DynamicResult, DynamicSettings};
 use plantwide::studies::tune::loops::Measurement;
 use plantwide::units::UnitSystem;
 
@@ -26,11 +26,13 @@ pub struct CompareArgs {
     /// Flowsheet files (JSON) of the schemes, two or more.
     #[arg(value_name = "FILE", num_args = 2.., required = true)]
     files: Vec<PathBuf>,
-    /// Disturbances, each an input stepped by a fraction of its steady value: `PATH` (+10 %) or
-    /// `PATH=±x%`, comma-separated; the sensitivity sweeps go to ± that fraction.
-    #[arg(long, value_name = "PATH[=±x%],…", value_delimiter = ',', required = true)]
+    /// Disturbances, comma-separated: `PATH` (+10 % of its steady value), `PATH=+x%`, `-x%`,
+    /// `±x%` (one closed-loop run each way) or an amount with its unit (`PATH=+5 K`,
+    /// `PATH=-10 kmol/h`); the sensitivity sweeps go to both sides by the step's size.
+    #[arg(long, value_name = "PATH[=±x%|±AMOUNT],…", value_delimiter = ',', required = true)]
     disturbances: Vec<String>,
-    /// Outputs watched in every scheme, comma-separated variable paths.
+    /// Outputs watched in every scheme, comma-separated: variable paths, or inputs a controller
+    /// drives (its output), each with an optional display unit (`column.reboiler_duty@MW`).
     #[arg(long, value_name = "P1,P2,…", value_delimiter = ',', required = true)]
     outputs: Vec<String>,
     /// Quality loops by controller name (default: every PI loop whose measurement is not a level,
@@ -108,7 +110,7 @@ pub fn run(a: &CompareArgs, system: UnitSystem) -> Result<(), CliError> {
     } else {
         outln!("{}", markdown(&c, &shown));
     }
-    Ok(())
+    super::screen::failed_parts("compare", &c.failed)
 }
 
 fn write_report(dir: &Path, c: &Comparison, json: &str, shown: &Shown) -> Result<(), CliError> {
@@ -154,8 +156,8 @@ fn write_rga(file: &Path, c: &Comparison) -> Result<bool, plantwide::io::IoError
     Ok(true)
 }
 
-/// A scheme's closed-loop runs, if they ran: its PI loops', else its first model predictive
-/// controller's.
+/// A scheme's closed-loop runs, if its loops were tuned: its PI loops', else its first model
+/// predictive controller's.
 fn runs(s: &Scheme) -> Option<&DynamicResult> {
     tests(s).into_iter().map(|(_, d)| d).find(|d| d.failure.is_none())
 }
@@ -168,13 +170,21 @@ fn tests(s: &Scheme) -> Vec<(String, &DynamicResult)> {
     pi.into_iter().chain(mpc).collect()
 }
 
+/// Run `d` of a scheme's closed-loop runs, if it went through.
+fn ran(s: &Scheme, d: usize) -> Option<&DisturbanceRun> {
+    runs(s).and_then(|t| t.runs.get(d)).filter(|r| r.failure.is_none())
+}
+
 /// One figure per disturbance: a panel per CV and output, a curve per scheme (schemes whose runs
 /// share the time grid; all do when the run length is common).
 fn write_responses(dir: &Path, c: &Comparison, shown: &Shown) -> Result<Vec<String>, plantwide::io::IoError> {
     let Some(first) = c.schemes.iter().find_map(runs) else { return Ok(Vec::new()) };
     let mut names = Vec::new();
-    for (d, run) in first.runs.iter().enumerate() {
-        let paths: Vec<&String> = first.runs[d].cvs.iter().map(|f| &f.cv).collect();
+    for d in 0..first.runs.len() {
+        // The time grid of the first scheme whose run went through (a failed run has none).
+        let ran = |s| ran(s, d);
+        let Some(run) = c.schemes.iter().find_map(ran) else { continue };
+        let paths: Vec<&String> = run.cvs.iter().map(|f| &f.cv).collect();
         let panels: Vec<Overlay> = paths
             .iter()
             .map(|&p| Overlay {
@@ -183,7 +193,7 @@ fn write_responses(dir: &Path, c: &Comparison, shown: &Shown) -> Result<Vec<Stri
                     .schemes
                     .iter()
                     .filter_map(|s| {
-                        let r = &runs(s)?.runs[d];
+                        let r = ran(s)?;
                         let k = r.cvs.iter().position(|f| &f.cv == p)?;
                         let series = r.series[k].iter().map(|v| shown.value(p, *v)).collect();
                         (r.times.len() == run.times.len()).then(|| (s.name.clone(), series))
@@ -328,7 +338,8 @@ fn sensitivity_table(c: &Comparison, shown: &Shown) -> String {
     let mut notes: Vec<String> = Vec::new();
     for s in &c.schemes {
         for r in &s.sensitivity {
-            for f in &r.failures {
+            let failed = r.failures.iter().map(|f| format!("failed: {f}"));
+            for f in r.no_steady_state.iter().cloned().chain(failed) {
                 let note = format!("- {}: {f}", s.name);
                 if !notes.contains(&note) {
                     notes.push(note);
@@ -362,6 +373,10 @@ fn response_table(c: &Comparison, shown: &Shown) -> String {
             continue;
         }
         for run in &d.runs {
+            if let Some(why) = &run.failure {
+                t.push_str(&format!("| {label} | {} | – | failed: {why} | | | |\n", run.disturbance));
+                continue;
+            }
             for f in &run.cvs {
                 t.push_str(&format!(
                     "| {} | {} | {} | {} | {} | {} | {} |\n",

@@ -44,8 +44,10 @@ pub struct ScreenArgs {
     /// Throughput-manipulator candidates (each one of the MVs, held while the others are paired).
     #[arg(long, value_name = "MV,…", value_delimiter = ',')]
     throughput: Vec<String>,
-    /// Disturbances of the dynamic test: input paths, each stepped by +10 % or by PATH=±x%.
-    #[arg(long, value_name = "PATH[=±x%],…", value_delimiter = ',')]
+    /// Disturbances of the dynamic and sensitivity tests: input paths, each stepped by +10 %, or
+    /// PATH=+x%, -x%, ±x% (one run each way) or an amount with its unit (PATH=+5 K,
+    /// PATH=-10 kmol/h); the sweeps go to both sides by the step's size.
+    #[arg(long, value_name = "PATH[=±x%|±AMOUNT],…", value_delimiter = ',')]
     disturbances: Vec<String>,
     /// Uncontrolled variables that must stay in a band over ± each disturbance with the CVs held
     /// (sensitivity test), e.g. "column1.x[1][B]=0:0.02" or "reactor.T=340 K:360 K".
@@ -106,7 +108,21 @@ pub fn run(a: &ScreenArgs, system: UnitSystem) -> Result<(), CliError> {
     } else {
         outln!("{}", table(&screen, &a.file));
     }
-    Ok(())
+    failed_parts("screen", &screen.failed)
+}
+
+/// Exit 2 when parts of a study failed (the report, already printed, marks them): the message
+/// counts them and gives each one's reason.
+pub(super) fn failed_parts(study: &str, failed: &[String]) -> Result<(), CliError> {
+    match failed {
+        [] => Ok(()),
+        [one] => Err(CliError::numerical(format!("{study}: 1 part failed (marked in the report): {one}"))),
+        many => Err(CliError::numerical(format!(
+            "{study}: {} parts failed (marked in the report): {}",
+            many.len(),
+            many.join("; ")
+        ))),
+    }
 }
 
 /// The configurations as a markdown table, best first within the regular ones.
@@ -132,7 +148,7 @@ fn table(s: &ColumnScreen, file: &Path) -> String {
             num(c.niederlinski),
             num(c.condition_number),
             num(c.minimized_condition_number),
-            c.verdict
+            c.failure.as_ref().map_or(c.verdict.clone(), |why| format!("failed: {why}"))
         ));
     }
     t
@@ -202,7 +218,7 @@ fn write_responses(dir: &Path, s: &PairingScreen, shown: &Shown) -> Result<Vec<S
     let mut best: Vec<_> = s
         .structures
         .iter()
-        .filter(|c| c.rank.is_some() && c.dynamic.as_ref().is_some_and(|d| d.failure.is_none()))
+        .filter(|c| c.rank.is_some() && c.dynamic.as_ref().is_some_and(DynamicResult::completed))
         .collect();
     best.sort_by_key(|c| c.rank);
     best.truncate(3);
@@ -243,9 +259,10 @@ pub(super) fn time(text: &str, flag: &str) -> Result<f64, CliError> {
         .map_err(|e| CliError::user(format!("--{flag} {text}: {e}")))
 }
 
-/// `PATH` (+10 %) or `PATH=±x%`.
+/// A disturbance of `--disturbances`: `PATH` (+10 %), `PATH=±x%` or `PATH=±AMOUNT UNIT` (the
+/// studies' one parser, [`plantwide::studies::disturbance`]).
 pub(super) fn disturbance(text: &str) -> Result<Disturbance, CliError> {
-    text.parse().map_err(CliError::user)
+    text.parse().map_err(|e| CliError::user(format!("--disturbances {e}")))
 }
 
 /// `PATH=LOW:HIGH`, the ends in the variable's unit (SI when bare).
@@ -324,7 +341,7 @@ fn pairings(a: &ScreenArgs, plant: &plantwide::flowsheet::Plant, system: UnitSys
     } else {
         outln!("{}", pairing_table(&screen, &shown));
     }
-    Ok(())
+    failed_parts("screen", &screen.failed)
 }
 
 /// The `--mpc` file's controller description.
@@ -336,11 +353,12 @@ fn mpc_description(file: &Path) -> Result<serde_json::Value, CliError> {
 /// The model predictive controller's row of the pairing table.
 fn mpc_row(m: &MpcAlternative) -> String {
     let dynamic = m.dynamic.as_ref();
-    let score = dynamic
-        .map_or("–".to_string(), |d| if d.failure.is_some() { "failed".into() } else { format!("{:.3}", d.score) });
+    let score =
+        dynamic.map_or("–".to_string(), |d| if d.completed() { format!("{:.3}", d.score) } else { "failed".into() });
     let samples: usize = m.qp.iter().map(|l| l.samples).sum();
     let mean = m.qp.iter().map(|l| l.mean_solve_time * l.samples as f64).sum::<f64>() / samples.max(1) as f64;
-    let note = dynamic.and_then(|d| d.failure.clone()).unwrap_or_else(|| {
+    let failures = dynamic.map(|d| d.failures("failed").join("; ")).filter(|f| !f.is_empty());
+    let note = failures.unwrap_or_else(|| {
         format!(
             "every {} s, P = {}, M = {}; {samples} QPs, mean solve {:.3} ms; condition number {}",
             m.sample_time,
@@ -401,8 +419,9 @@ fn pairing_table(s: &PairingScreen, shown: &Shown) -> String {
             c.pairs.iter().map(|p| format!("{} ← {} ({:.3})", p.cv, p.mv, p.relative_gain)).collect();
         let dynamic = c.dynamic.as_ref();
         let score = dynamic
-            .map_or("–".to_string(), |d| if d.failure.is_some() { "failed".into() } else { format!("{:.3}", d.score) });
-        let note = c.rejected.clone().or_else(|| dynamic.and_then(|d| d.failure.clone())).unwrap_or_default();
+            .map_or("–".to_string(), |d| if d.completed() { format!("{:.3}", d.score) } else { "failed".into() });
+        let failures = dynamic.map(|d| d.failures("failed").join("; ")).filter(|f| !f.is_empty());
+        let note = c.rejected.clone().or(failures).unwrap_or_default();
         t.push_str(&format!(
             "| {} | {} | {} | {:.4} | {} | {:.3} | {score} | {note} |\n",
             c.rank.map_or("–".to_string(), |r| r.to_string()),
@@ -416,5 +435,6 @@ fn pairing_table(s: &PairingScreen, shown: &Shown) -> String {
     if let Some(m) = &s.mpc {
         t.push_str(&mpc_row(m));
     }
+    t.push_str(&format!("\nverdict: {}\n", s.verdict));
     t
 }

@@ -30,7 +30,8 @@ pub struct SizeArgs {
     /// Rank these vessels (same forms as --vessel) by the surge volume they need.
     #[arg(long, value_name = "V1,V2,…", value_delimiter = ',')]
     candidates: Vec<String>,
-    /// The disturbance, a step of an input: PATH=±x% (of its value) or PATH=±VALUE with units.
+    /// The disturbance, a step of an input: PATH=+x% or -x% (of its value), or an amount with its
+    /// unit (PATH=+5 kmol/h, PATH=-2 K).
     #[arg(long, value_name = "PATH=±Δ", required_unless_present = "scenario")]
     disturbance: Option<String>,
     /// The disturbance as the one step, ramp or sinusoid of a scenario file (started at once from
@@ -149,23 +150,27 @@ fn from_scenario(file: &Path, plant: &Plant) -> Result<Disturbance, CliError> {
     Disturbance::from_scenario(&scenario, plant).map_err(|e| CliError::user(format!("{name}: {e}")))
 }
 
-/// `PATH=±x%` or `PATH=±VALUE` with the input's units.
+/// `PATH=+x%`, `PATH=-x%` or an amount with its unit (`PATH=+5 kmol/h`), read by the studies' one
+/// parser and judged by its range rule ([`plantwide::studies::disturbance`]); sizing verifies one
+/// step, so `±` is refused.
 fn disturbance(text: &str, plant: &Plant, shape: Shape) -> Result<Disturbance, CliError> {
-    let bad = |why: String| CliError::user(format!("--disturbance {text}: {why}"));
-    let (path, value) = text
-        .split_once('=')
-        .map(|(p, v)| (p.trim(), v.trim()))
-        .ok_or_else(|| bad("expected PATH=±Δ, e.g. fresh_A.F=+10% or feed.F=+5kmol/h".into()))?;
-    let i = plantwide::flowsheet::overrides::resolve_input(plant, path)
-        .ok_or_else(|| bad(format!("`{path}` is no input of the flowsheet")))?;
-    let info = &plant.inputs()[i];
-    let change = match value.strip_suffix('%') {
-        Some(p) => {
-            p.trim().parse::<f64>().map_err(|e| bad(format!("`{p}` is not a number: {e}")))? / 100.0 * info.value
-        }
-        None => parse_quantity_as(value, info.dim).map_err(|e| bad(e.to_string()))?,
-    };
-    Ok(Disturbance { path: path.to_string(), change, shape })
+    use plantwide::studies::disturbance::{Direction, Disturbance as Step};
+    let bad = |why: String| CliError::user(format!("--disturbance {why}"));
+    let d: Step = text.parse().map_err(|e| bad(format!("{e}")))?;
+    if d.direction == Direction::Both {
+        return Err(bad(format!(
+            "{}: sizing verifies one step (the closed forms hold for either sign); give its direction, {} +{} or {} -{}",
+            d.label(),
+            d.path,
+            d.shown,
+            d.path,
+            d.shown
+        )));
+    }
+    d.check(plant).map_err(|e| bad(e.to_string()))?;
+    let i = plantwide::flowsheet::overrides::resolve_input(plant, &d.path)
+        .ok_or_else(|| bad(format!("`{}` is no input of the flowsheet", d.path)))?;
+    Ok(Disturbance { path: d.path.clone(), change: d.change(plant.inputs()[i].value), shape })
 }
 
 fn opt(v: Option<f64>, scale: f64) -> String {

@@ -2,7 +2,7 @@
 //! where the physics gives one — the reactor with and without its feed–effluent exchanger, and
 //! Luyben's snowball plant in structure 1 (fresh feed fixed) and 2 (effluent fixed).
 
-use crate::harness::{flowsheet, plantwide};
+use crate::harness::{fixture, flowsheet, plantwide};
 
 fn compare(files: &[&str], extra: &[&str]) -> serde_json::Value {
     let mut args: Vec<String> = vec!["compare".into()];
@@ -99,8 +99,9 @@ fn the_snowball_plant_in_its_two_structures() {
     assert!(gain(0) > 10.0 * gain(1), "loop gains {} and {}", gain(0), gain(1));
 }
 
-/// A sweep end outside the input's physical range (pure A feed + 5 %) is said to be so, not
-/// reported as a steady state that could not be found; the other end is swept.
+/// A sweep end outside the input's physical range (pure A feed + 5 %, the mirror of the −5 %
+/// step asked for) is said to be so, not reported as a steady state that could not be found nor
+/// as a failure (exit 0); the other end is swept.
 #[test]
 fn a_sweep_end_outside_the_inputs_range_is_named() {
     let c = compare(
@@ -110,9 +111,11 @@ fn a_sweep_end_outside_the_inputs_range_is_named() {
     for s in c["schemes"].as_array().unwrap() {
         let r = &s["sensitivity"][0];
         assert!(r["high"].is_null() && r["low"].is_f64(), "{r}");
-        let why = r["failures"][0].as_str().unwrap();
+        let why = r["no_steady_state"][0].as_str().unwrap();
         assert!(why.contains("fresh.z[A] at 1.05") && why.contains("z[A]"), "{why}");
+        assert_eq!(r["failures"], serde_json::json!([]), "{r}");
     }
+    assert_eq!(c["failed"], serde_json::json!([]));
 }
 
 #[test]
@@ -131,4 +134,227 @@ fn compare_mistakes_exit_1_naming_the_scheme() {
     assert!(err.contains("column_a.json") && err.contains("no output `effluent.T`"), "{err}");
     let out = plantwide(&["compare", &flowsheet("column_a.json"), "--disturbances", "F", "--outputs", "feed.F"]);
     assert_eq!(out.status.code(), Some(1), "one scheme is no comparison");
+}
+
+/// Issue 53, D1: `compare` of a newcomer's benzene–toluene column (its bottoms loop on the reboiler
+/// duty) with BLT tuning runs every closed loop, and each run is the one `plantwide run` gives for
+/// the file with the same settings written in: the same step, length and records, IAE alike.
+#[test]
+fn a_reboiler_duty_loop_is_tuned_and_its_runs_match_plantwide_run() {
+    let files = ["data/newcomer3/bt_column_lv.json", "data/newcomer3/bt_column_lv_blt.json"].map(fixture);
+    let args = ["compare", &files[0], &files[1], "--disturbances", "feed_source.F=+10%"];
+    let out = plantwide(&[&args[..], &["--outputs", "distillate.x[benzene],bottoms.x[benzene]", "--json"]].concat());
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let c: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let duration = f(&c["duration"]);
+    let d = &c["schemes"][0]["structure"]["dynamic"];
+    assert!(d["failure"].is_null(), "{d}");
+    // BLT on the file's own loops (tune) gives the settings the comparison used.
+    for (cv, kc, ti) in crate::screen::bt_file_blt() {
+        let l = d["loops"].as_array().unwrap().iter().find(|l| l["cv"] == cv.as_str()).unwrap();
+        assert!((f(&l["kc"]) - kc.abs()).abs() < 1e-6 * kc.abs() && (f(&l["tau_i"]) - ti).abs() < 1e-6 * ti, "{l}");
+    }
+    // The file run with those settings through a scenario written here: the same IAE (neither run
+    // reaches an output limit, the file's or the study's [0, 2 u₀]).
+    let dir = std::env::temp_dir().join(format!("plantwide-compare-bt-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let scenario = serde_json::json!({
+        "format_version": 1, "name": "feed +10 %", "duration": format!("{duration} s"), "integrator": {"rtol": 1e-6},
+        "events": [{"type": "step", "at": format!("{} s", 0.02 * duration), "path": "feed_source.F", "by": 15.0 / 3.6}],
+        "record": {"interval": format!("{} s", duration / 500.0), "paths": ["distillate.x[benzene]", "bottoms.x[benzene]"]}
+    });
+    std::fs::write(dir.join("s.json"), scenario.to_string()).unwrap();
+    let (scenario, csv) = (dir.join("s.json").display().to_string(), dir.join("o.csv").display().to_string());
+    let mut args: Vec<String> =
+        ["run", &files[0], "--scenario", &scenario, "--csv", &csv, "--json"].map(String::from).to_vec();
+    for l in d["loops"].as_array().unwrap() {
+        let (name, unit) = if l["mv"] == "column.reflux" { ("top_x", "mol/s") } else { ("bottom_x", "W") };
+        args.extend(["--set".into(), format!("{name}.kc={:e} {unit}", f(&l["kc"]))]);
+        args.extend(["--set".into(), format!("{name}.tau_i={:e} s", f(&l["tau_i"]))]);
+    }
+    let out = plantwide(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let run: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    std::fs::remove_dir_all(&dir).ok();
+    for cv in d["runs"][0]["cvs"].as_array().unwrap() {
+        let p = run["paths"].as_array().unwrap().iter().find(|p| p["path"] == cv["cv"]).unwrap();
+        assert!((f(&cv["iae"]) - f(&p["iae"])).abs() < 1e-6 * f(&p["iae"]), "{cv} vs {p}");
+        assert!((f(&cv["max_deviation"]) - f(&p["max_deviation"])).abs() < 1e-6 * f(&p["max_deviation"]).abs());
+    }
+}
+
+/// `compare --json` of `files` (fixtures) with `extra`: its exit code, JSON and standard error.
+fn compare_fixtures(files: &[&str], extra: &[&str]) -> (Option<i32>, serde_json::Value, String) {
+    let files: Vec<String> = files.iter().map(|f| fixture(f)).collect();
+    let args = ["compare"].into_iter().chain(files.iter().map(String::as_str)).chain(extra.iter().copied());
+    let out = plantwide(&args.chain(["--json"]).collect::<Vec<_>>());
+    let err = String::from_utf8_lossy(&out.stderr).to_string();
+    let json = serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{e}: {err}"));
+    (out.status.code(), json, err)
+}
+
+const BT_LV_PAIR: [&str; 2] = ["data/newcomer3/bt_column_lv.json", "data/newcomer3/bt_column_lv_blt.json"];
+const HX_PAIR: [&str; 2] = ["data/newcomer3/with_hx.json", "data/newcomer3/without_hx.json"];
+
+/// The closed-loop run of `label` in scheme `s`.
+fn run_of<'a>(s: &'a serde_json::Value, label: &str) -> &'a serde_json::Value {
+    let runs = s["structure"]["dynamic"]["runs"].as_array().unwrap();
+    runs.iter().find(|r| r["disturbance"] == label).unwrap_or_else(|| panic!("no run {label} in {runs:?}"))
+}
+
+/// Issue 53, #12: every written form of a disturbance steps its input. `±10%` is one run up and
+/// one down (opposite first excursions), and an amount with its unit steps by that amount: 15
+/// kmol/h is the +10 % of the file's 150 kmol/h feed, so it is the same run to rounding. The
+/// sweeps go to both sides once per input and size.
+#[test]
+fn disturbances_in_every_written_form_step_their_input() {
+    let (code, c, err) = compare_fixtures(
+        &BT_LV_PAIR,
+        &["--disturbances", "feed_source.F=±10%,feed_source.F=+15 kmol/h", "--outputs", "bottoms.x[benzene]"],
+    );
+    assert_eq!(code, Some(0), "{err}");
+    assert_eq!(c["disturbances"], serde_json::json!(["feed_source.F ±10 %", "feed_source.F +15 kmol/h"]));
+    let s = &c["schemes"][0];
+    let labels: Vec<&str> = s["structure"]["dynamic"]["runs"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| r["disturbance"].as_str().unwrap())
+        .collect();
+    assert_eq!(labels, ["feed_source.F +10 %", "feed_source.F -10 %", "feed_source.F +15 kmol/h"]);
+    let (up, down, amount) =
+        (run_of(s, "feed_source.F +10 %"), run_of(s, "feed_source.F -10 %"), run_of(s, "feed_source.F +15 kmol/h"));
+    for k in 0..2 {
+        let (u, d, a) = (&up["cvs"][k], &down["cvs"][k], &amount["cvs"][k]);
+        assert!((f(&a["iae"]) - f(&u["iae"])).abs() < 1e-9 * f(&u["iae"]), "{a} vs {u}");
+        assert!(f(&u["max_deviation"]) * f(&d["max_deviation"]) < 0.0, "{u} vs {d}");
+    }
+    let sweeps: Vec<&str> =
+        s["sensitivity"].as_array().unwrap().iter().map(|r| r["disturbance"].as_str().unwrap()).collect();
+    assert_eq!(sweeps, ["feed_source.F ±10 %", "feed_source.F ±15 kmol/h"]);
+}
+
+/// Issue 53, #12: a temperature step written in degC is a difference (5 degC is 5 K, not 278 K):
+/// the same run as +5 K, and one sweep for both.
+#[test]
+fn a_temperature_step_in_degc_is_a_difference() {
+    let (code, c, err) = compare_fixtures(
+        &HX_PAIR,
+        &[
+            "--disturbances",
+            "feed_source.T=+5 K,feed_source.T=+5 degC",
+            "--outputs",
+            "bottoms.x[benzene]",
+            "--duration",
+            "2 h",
+        ],
+    );
+    assert_eq!(code, Some(0), "{err}");
+    for s in c["schemes"].as_array().unwrap() {
+        let (k, c) = (run_of(s, "feed_source.T +5 K"), run_of(s, "feed_source.T +5 degC"));
+        assert_eq!(k["cvs"], c["cvs"], "{s}");
+        assert_eq!(s["sensitivity"].as_array().unwrap().len(), 1, "one sweep");
+        assert_eq!(s["sensitivity"][0]["disturbance"], "feed_source.T ±5 K");
+    }
+}
+
+/// Issue 53, #13: a step that takes its input outside its physical range (benzene's feed fraction
+/// 0.45 + 130 % = 1.035) is refused before anything runs, by the range rule of the file and
+/// `--set`, naming the input, the value and the range; so is a step on an input a controller
+/// drives, one in the wrong unit, and (in `size`, which verifies one step) a step both ways.
+#[test]
+fn a_step_outside_the_inputs_range_is_refused_naming_it() {
+    let files = BT_LV_PAIR.map(fixture);
+    let cases = [
+        (
+            "feed_source.z[benzene]=+130%",
+            "feed_source.z[benzene] +130 %: the step takes `feed_source.z[benzene]` from 0.45 to 1.035",
+        ),
+        ("feed_source.F=-101%", "-0.416667 mol/s is outside the range 0 … 1e6 mol/s"),
+        ("column.reflux=+5%", "`column.reflux` is driven by `top_x.op`"),
+        ("feed_source.F=+5 K", "`feed_source.F` is a molar flow (mol/s) and the step a temperature"),
+        ("feed_source.F=+ten%", "expected PATH (+10 %), PATH=±x% or PATH=±AMOUNT with a unit"),
+    ];
+    for (d, msg) in cases {
+        let out = plantwide(&["compare", &files[0], &files[1], "--disturbances", d, "--outputs", "bottoms.x[benzene]"]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{d}: {err}");
+        assert!(err.contains(msg) && err.starts_with("error: --disturbances "), "{d}: {err}");
+        if d.contains("130") {
+            assert!(err.contains("1.035 is outside the range 0 … 1"), "{err}");
+        }
+        let args = ["screen", &files[0], "--cvs", "distillate.x[benzene],bottoms.x[benzene]"];
+        let out =
+            plantwide(&[&args[..], &["--mvs", "column.reflux,column.reboiler_duty", "--disturbances", d]].concat());
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "screen {d}: {err}");
+        assert!(err.contains(msg), "screen {d}: {err}");
+    }
+    let size = |d: &str| {
+        let args = ["size", &files[0], "--vessel", "column.sump", "--disturbance", d, "--level-band", "0.5 m"];
+        plantwide(&[&args[..], &["--max-outflow-rate", "0.5 kmol/h/min"]].concat())
+    };
+    for (d, msg) in [
+        ("feed_source.z[benzene]=+130%", "1.035 is outside the range 0 … 1"),
+        ("feed_source.F=±10%", "sizing verifies one step"),
+    ] {
+        let out = size(d);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "size {d}: {err}");
+        assert!(err.contains(msg) && err.contains("--disturbance feed_source"), "size {d}: {err}");
+    }
+}
+
+/// Issue 53, #13 and exit status: a run that fails (a fivefold feed floods the column: the
+/// integrator gives up) is marked as failed with its reason and `null` figures, the scheme's
+/// other runs are kept, and `compare` exits 2 after printing the comparison, naming the part.
+#[test]
+fn a_failed_run_is_marked_the_others_kept_and_compare_exits_2() {
+    let (code, c, err) = compare_fixtures(
+        &BT_LV_PAIR,
+        &["--disturbances", "feed_source.F=+10%,feed_source.F=+400%", "--outputs", "bottoms.x[benzene]"],
+    );
+    assert_eq!(code, Some(2), "{err}");
+    for s in c["schemes"].as_array().unwrap() {
+        let (ok, failed) = (run_of(s, "feed_source.F +10 %"), run_of(s, "feed_source.F +400 %"));
+        assert!(ok["failure"].is_null() && f(&ok["cvs"][0]["iae"]) > 0.0, "{ok}");
+        assert!(failed["failure"].as_str().unwrap().contains("integration failed"), "{failed}");
+        assert!(failed["cvs"].as_array().unwrap().iter().all(|v| v["iae"].is_null() && v["max_deviation"].is_null()));
+        assert!(s["structure"]["dynamic"]["failure"].is_null());
+    }
+    let failed = c["failed"].as_array().unwrap();
+    assert_eq!(failed.len(), 2, "{failed:?}");
+    assert!(failed[0].as_str().unwrap().starts_with("bt_column_lv, run feed_source.F +400 %: "), "{failed:?}");
+    assert!(
+        err.contains("error: compare: 2 parts failed (marked in the report): bt_column_lv, run feed_source.F +400 %")
+    );
+}
+
+/// Issue 53, D12: an input a controller drives is an output, as in `gains`: the reboiler duty
+/// (driven by `bottom_x`) is read at its controller's output. With the qualities and the feed's
+/// temperature held every flow of the column scales with the feed, so at the feed ±10 % the duty
+/// is ±10 % of its steady value, which `steady --json` gives as `bottom_x.op`.
+#[test]
+fn a_controller_driven_input_is_an_output() {
+    let (code, c, err) = compare_fixtures(
+        &HX_PAIR,
+        &["--disturbances", "feed_source.F=±10%", "--outputs", "column.reboiler_duty@kW", "--duration", "4 h"],
+    );
+    assert_eq!(code, Some(0), "{err}");
+    let out = plantwide(&["steady", &fixture(HX_PAIR[0]), "--json"]);
+    let steady: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let q0 = f(&steady["values"]["bottom_x.op"]);
+    for s in c["schemes"].as_array().unwrap() {
+        let r = &s["sensitivity"][0];
+        assert_eq!(r["output"], "column.reboiler_duty");
+        let (low, base, high) = (f(&r["low"]), f(&r["base"]), f(&r["high"]));
+        assert!((base - q0).abs() < 1e-6 * q0, "{base} vs {q0}");
+        assert!((low - 0.9 * base).abs() < 1e-6 * base && (high - 1.1 * base).abs() < 1e-6 * base, "{r}");
+        let (up, down) = (run_of(s, "feed_source.F +10 %"), run_of(s, "feed_source.F -10 %"));
+        let duty = |run: &serde_json::Value| {
+            let v = run["cvs"].as_array().unwrap().iter().find(|v| v["cv"] == "column.reboiler_duty").unwrap();
+            f(&v["max_deviation"])
+        };
+        assert!(duty(up) > 0.0 && duty(down) < 0.0, "{up} {down}");
+    }
 }

@@ -276,7 +276,7 @@ fn bad_pairing_requests_exit_1_naming_what_is_wrong() {
         ),
         (
             &["--cvs", "column1.T[21]", "--mvs", "column1.reflux", "--disturbances", "fresh_A.F=ten"],
-            "expected PATH or PATH=±x%",
+            "expected PATH (+10 %), PATH=±x%",
         ),
     ];
     for (extra, msg) in cases {
@@ -366,4 +366,77 @@ fn two_column_screening_with_throughput_choices_reaches_the_studys_conclusions()
     assert_eq!(best["throughput"], "fresh_A.F", "{best}");
     let mvs: Vec<&str> = best["pairs"].as_array().unwrap().iter().map(|p| p["mv"].as_str().unwrap()).collect();
     assert_eq!(mvs, ["column1.reflux", "column1.bottoms", "column2.bottoms", "column2.reflux"]);
+}
+
+/// The LV pairing of a newcomer's rigorous benzene–toluene column (tests/data/newcomer3).
+const BT_LV: &str = "data/newcomer3/bt_column_lv.json";
+const BT_QUALITIES: &str = "distillate.x[benzene],bottoms.x[benzene]";
+
+/// `plantwide tune FILE --loops top_x,bottom_x --method blt --measurement-dead-time 1min --json`
+/// of the benzene–toluene column: BLT on the file's own quality loops, `(kc, τI)` by measurement.
+pub(crate) fn bt_file_blt() -> Vec<(String, f64, f64)> {
+    let file = crate::harness::fixture(BT_LV);
+    let args = ["tune", &file, "--loops", "top_x,bottom_x", "--method", "blt", "--measurement-dead-time", "1min"];
+    let out = plantwide(&[&args[..], &["--json"]].concat());
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let loops = v["loops"].as_array().unwrap().iter();
+    loops
+        .map(|l| (l["output"].as_str().unwrap().to_string(), l["kc"].as_f64().unwrap(), l["tau_i"].as_f64().unwrap()))
+        .collect()
+}
+
+/// Issue 53, D1: the dynamic test of a pairing whose bottoms loop moves a reboiler duty (W) failed
+/// on every run with `pair1.I` undetermined: the loops were first closed at a trial gain of 1 in
+/// SI units, seven orders of magnitude below what a duty needs, which left their integrals free.
+/// Now the candidate is tuned, and its BLT settings are those `tune --method blt` finds for the
+/// file's own loops on the same CVs and MVs (an independent wiring of the same loops).
+#[test]
+fn a_reboiler_duty_loop_is_tuned_and_run_in_the_dynamic_test() {
+    let file = crate::harness::fixture(BT_LV);
+    let args = ["screen", &file, "--cvs", BT_QUALITIES, "--mvs", "column.reflux,column.reboiler_duty"];
+    let out = plantwide(&[&args[..], &["--disturbances", "feed_source.F=+10%", "--json"]].concat());
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let d = &v["structures"][0]["dynamic"];
+    assert!(d["failure"].is_null(), "{d}");
+    let file_blt = bt_file_blt();
+    for l in d["loops"].as_array().unwrap() {
+        let (_, kc, ti) = file_blt.iter().find(|(cv, ..)| l["cv"] == cv.as_str()).unwrap();
+        let (got_kc, got_ti) = (l["kc"].as_f64().unwrap(), l["tau_i"].as_f64().unwrap());
+        assert!((got_kc - kc.abs()).abs() < 1e-6 * kc.abs() && (got_ti - ti).abs() < 1e-6 * ti, "{l} vs {kc} {ti}");
+    }
+    for run in d["runs"].as_array().unwrap() {
+        for cv in run["cvs"].as_array().unwrap() {
+            assert!(cv["iae"].as_f64().unwrap() > 0.0 && cv["settling_time"].is_f64(), "{cv}");
+        }
+    }
+}
+
+/// Issue 53, #13 and exit status: a disturbance run that fails is marked with its reason (figures
+/// `null`), the candidate's other runs are kept, it is not ranked (its score would compare runs
+/// that did not happen), and `screen` prints the table then exits 2 naming the part.
+#[test]
+fn a_failed_run_is_marked_and_screen_exits_2() {
+    let file = crate::harness::fixture(BT_LV);
+    let args = ["screen", &file, "--cvs", BT_QUALITIES, "--mvs", "column.reflux,column.reboiler_duty"];
+    let out = plantwide(&[&args[..], &["--disturbances", "feed_source.F=+10%,feed_source.F=+400%", "--json"]].concat());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let s = &v["structures"][0];
+    let runs = s["dynamic"]["runs"].as_array().unwrap();
+    assert!(runs[0]["failure"].is_null() && runs[0]["cvs"][0]["iae"].as_f64().unwrap() > 0.0, "{s}");
+    assert!(runs[1]["failure"].as_str().unwrap().contains("integration failed"), "{s}");
+    assert!(runs[1]["cvs"][0]["iae"].is_null() && s["dynamic"]["score"].is_null() && s["rank"].is_null(), "{s}");
+    assert_eq!(v["failed"].as_array().unwrap().len(), 1);
+    assert!(
+        err.contains("screen: 1 part failed (marked in the report): candidate distillate.x[benzene] ← column.reflux")
+    );
+    assert!(v["verdict"].as_str().unwrap().starts_with("no pairing recommended"), "{}", v["verdict"]);
+    // The text report marks it too.
+    let out = plantwide(&[&args[..], &["--disturbances", "feed_source.F=+10%,feed_source.F=+400%"]].concat());
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(text.contains("| failed | failed, run feed_source.F +400 %: "), "{text}");
 }

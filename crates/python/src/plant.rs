@@ -217,7 +217,7 @@ pub fn pairings(src: &Source, sets: &[String], args: &str, share: PairingShare) 
             .iter()
             .map(|d| d.parse::<pairings::Disturbance>())
             .collect::<Result<_, _>>()
-            .map_err(FaceError::Input)?,
+            .map_err(|e| FaceError::Input(format!("--disturbances {e}")))?,
         dynamic: DynamicSettings {
             candidates: a.candidates,
             duration: a.duration.as_deref().map(|d| time(d, "duration")).transpose()?,

@@ -47,10 +47,11 @@ pub use energy::{Energy, energy};
 /// What to compare.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CompareRequest {
-    /// Disturbances, each an input stepped by a fraction of its steady value (the sensitivity
-    /// sweeps go to ± that fraction).
+    /// Disturbances, each an input stepped by a fraction of its steady value or by an amount, up,
+    /// down or both ways (the sensitivity sweeps go to both sides by that size).
     pub disturbances: Vec<Disturbance>,
-    /// Outputs watched in every scheme (variable paths every scheme has).
+    /// Outputs watched in every scheme: variable paths every scheme has, or inputs a controller
+    /// drives (read as its output, as `gains` reads them).
     pub outputs: Vec<String>,
     /// Quality loops by controller name (empty: every PI loop on a non-inventory measurement).
     pub loops: Vec<String>,
@@ -89,6 +90,10 @@ pub enum CompareError {
         /// Why.
         source: Box<plantwide_solve::SolveError>,
     },
+    /// A disturbance a scheme refuses: no such input, a wrong unit, or a step outside the input's
+    /// physical range.
+    #[error("--disturbances {0}")]
+    Disturbance(Box<crate::disturbance::DisturbanceError>),
     /// An output or a loop the request names is not in a scheme.
     #[error("{file}: {what}")]
     Request {
@@ -115,12 +120,18 @@ pub enum CompareError {
     },
 }
 
+impl From<crate::disturbance::DisturbanceError> for CompareError {
+    fn from(e: crate::disturbance::DisturbanceError) -> Self {
+        CompareError::Disturbance(Box::new(e))
+    }
+}
+
 impl CompareError {
     /// True for a request or a file at fault (exit 1), false for a numerical failure (exit 2).
     pub fn is_user_error(&self) -> bool {
         match self {
             CompareError::Steady { source, .. } => source.is_user_error(),
-            CompareError::Request { .. } => true,
+            CompareError::Request { .. } | CompareError::Disturbance(_) => true,
             CompareError::Screen { source, .. } => source.is_user_error(),
             CompareError::Analysis { source, .. } => source.is_user_error(),
         }
@@ -185,8 +196,13 @@ pub struct Sensitivity {
     pub low: Option<f64>,
     /// At its high end.
     pub high: Option<f64>,
-    /// Why an end has no value: outside the input's physical range, or where the continuation
-    /// stopped and Newton's verdict there.
+    /// Ends with no steady state for a physical reason, which is a finding and no failure: outside
+    /// the input's physical range (the sweep mirrors the step asked for, and the mirror may not
+    /// exist; not swept), or where a model predictive controller's output would lie beyond its
+    /// limits.
+    pub no_steady_state: Vec<String>,
+    /// Ends the sweep failed to reach: where the continuation stopped, and Newton's verdict there
+    /// (naming the equation and variable).
     pub failures: Vec<String>,
 }
 
@@ -223,7 +239,7 @@ pub struct Scheme {
 /// The schemes side by side.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Comparison {
-    /// Disturbances (`path ±x %`).
+    /// Disturbances (`path +x %`, `path -5 K`, `path ±x %`).
     pub disturbances: Vec<String>,
     /// Outputs.
     pub outputs: Vec<String>,
@@ -231,6 +247,10 @@ pub struct Comparison {
     pub duration: Option<f64>,
     /// The schemes, in the order given.
     pub schemes: Vec<Scheme>,
+    /// The parts asked for that failed, each with its reason (a closed-loop test or run, a sweep
+    /// end the continuation could not reach), also marked where they stand; empty when all went
+    /// through.
+    pub failed: Vec<String>,
 }
 
 /// Compare `plants` on `request`; schemes are judged in parallel.
@@ -272,30 +292,45 @@ pub fn compare(plants: &[Plant], request: &CompareRequest) -> Result<Comparison,
                 .into(),
         });
     }
+    let failed = failed_parts(&schemes);
     Ok(Comparison {
-        disturbances: request.disturbances.iter().map(|d| format!("{} {:+} %", d.path, 100.0 * d.fraction)).collect(),
+        disturbances: request.disturbances.iter().map(Disturbance::label).collect(),
         outputs: request.outputs.clone(),
         duration,
         schemes,
+        failed,
     })
+}
+
+/// The parts of the comparison that failed, each with its reason: closed-loop tests and runs of
+/// the file's pairing and of each model predictive controller, and sweep ends the continuation
+/// could not reach.
+fn failed_parts(schemes: &[Scheme]) -> Vec<String> {
+    let mut out = Vec::new();
+    for s in schemes {
+        let pi = s.structure.as_ref().and_then(|t| t.dynamic.as_ref()).map(|d| (s.name.clone(), d));
+        let mpc =
+            s.mpc.iter().filter_map(|m| Some((format!("{} (MPC `{}`)", s.name, m.controller), m.dynamic.as_ref()?)));
+        out.extend(pi.into_iter().chain(mpc).flat_map(|(label, d)| d.failures(&label)));
+        for r in &s.sensitivity {
+            for f in &r.failures {
+                let part = format!("{}, sweep {}: {f}", s.name, r.disturbance);
+                if !out.contains(&part) {
+                    out.push(part);
+                }
+            }
+        }
+    }
+    out
 }
 
 /// One scheme judged on `r`.
 fn scheme(plant: &Plant, r: &CompareRequest) -> Result<Scheme, CompareError> {
     let file = plant.file().to_string();
-    let outputs: Vec<usize> = r
-        .outputs
-        .iter()
-        .map(|o| {
-            plant.var(o).ok_or_else(|| CompareError::Request {
-                file: file.clone(),
-                what: format!(
-                    "no output `{o}`{}: every scheme must have every output",
-                    plantwide_flowsheet::error::did_you_mean(o, plant.vars().iter().map(|v| v.path.as_str()))
-                ),
-            })
-        })
-        .collect::<Result<_, _>>()?;
+    let outputs: Vec<usize> = r.outputs.iter().map(|o| output(plant, o)).collect::<Result<_, _>>()?;
+    for d in &r.disturbances {
+        d.check(plant)?;
+    }
     let sol = converge(plant, &StrategySettings::default())
         .map_err(|e| CompareError::Steady { file: file.clone(), source: Box::new(e) })?;
     let loops = quality_loops(plant, &r.loops)?;
@@ -330,6 +365,23 @@ fn scheme(plant: &Plant, r: &CompareRequest) -> Result<Scheme, CompareError> {
         stability,
         recycles,
         sensitivity,
+    })
+}
+
+/// The variable output `o` reads in `plant`: a variable, or an input a controller drives (its
+/// output), as `gains` reads outputs.
+fn output(plant: &Plant, o: &str) -> Result<usize, CompareError> {
+    let driven = || plantwide_flowsheet::overrides::resolve_input(plant, o).and_then(|i| plant.inputs()[i].driven_by);
+    plant.var(o).or_else(driven).ok_or_else(|| {
+        let names = plant.vars().iter().map(|v| v.path.as_str());
+        let inputs = plant.inputs().iter().filter(|i| i.driven_by.is_some()).map(|i| i.path.as_str());
+        CompareError::Request {
+            file: plant.file().to_string(),
+            what: format!(
+                "no output `{o}`{}: every scheme must have every output (a variable, or an input a controller drives)",
+                plantwide_flowsheet::error::did_you_mean(o, names.chain(inputs))
+            ),
+        }
     })
 }
 
@@ -491,64 +543,77 @@ fn sensitivity(
     let op_vars: Vec<usize> = ops.iter().filter_map(|o| plant.var(&o.op)).collect();
     let watched: Vec<usize> = outputs.iter().chain(&op_vars).copied().collect();
     let mut rows = Vec::new();
-    for d in &r.disturbances {
-        let f = 100.0 * d.fraction.abs();
-        let mut range = Sweep::parse(plant, u, &format!("{}=-{f}%:+{f}%", d.path))?;
-        // An end outside the input's physical range (a mole fraction above 1) is no steady state
-        // to look for: it is reported as such, and the sweep goes to the other end only.
-        let mut failures = Vec::new();
-        let i = range.signal.index;
-        for end in [range.low, range.high] {
-            if let Err(why) = plantwide_flowsheet::overrides::check_input_value(plant, i, end) {
-                failures.push(format!("{} at {}: {why}", d.path, plantwide_model::limits::number(end)));
-            }
-        }
-        let inside = |v: f64| plantwide_flowsheet::overrides::check_input_value(plant, i, v).is_ok();
-        let (low_ok, high_ok) = (inside(range.low), inside(range.high));
-        range.low = if low_ok { range.low } else { range.base - 1e-9 * range.base.abs().max(1.0) };
-        range.high = if high_ok { range.high } else { range.base + 1e-9 * range.base.abs().max(1.0) };
-        let curve = sweep(
-            plant,
-            x,
-            u,
-            std::slice::from_ref(&range),
-            &watched,
-            &SweepSettings { points: 2, ..Default::default() },
-        )?
-        .remove(0);
-        failures.extend(curve.failures.iter().map(|fl| fl.to_string()));
-        let mut at = |value: f64, ok: bool| {
-            let failed = curve.failures.iter().any(|fl| (fl.value < range.base) == (value < range.base));
-            if failed || !ok {
-                return None;
-            }
-            let k = if value < range.base { 0 } else { curve.outputs.len() - 1 };
-            let v = curve.outputs.get(k).cloned().flatten()?;
-            let beyond: Vec<String> = ops_beyond(ops, &v[outputs.len()..]);
-            if beyond.is_empty() {
-                return Some(v);
-            }
-            let end = plantwide_model::limits::number(value);
-            failures.push(format!(
-                "{} at {end}: {}; the controller cannot hold its CVs there",
-                d.path,
-                beyond.join(", ")
-            ));
-            None
-        };
-        let (low, high) = (at(range.low, low_ok), at(range.high, high_ok));
+    for d in crate::disturbance::sweeps(&r.disturbances) {
+        let (low, high, no_steady_state, failures) = ends(plant, (x, u), d, (&watched, outputs.len()), ops)?;
         for (k, o) in r.outputs.iter().enumerate() {
             rows.push(Sensitivity {
-                disturbance: format!("{} ±{f} %", d.path),
+                disturbance: d.sweep_label(),
                 output: o.clone(),
                 base: x[outputs[k]],
                 low: low.as_ref().map(|v| v[k]),
                 high: high.as_ref().map(|v| v[k]),
+                no_steady_state: no_steady_state.clone(),
                 failures: failures.clone(),
             });
         }
     }
     Ok(rows)
+}
+
+/// The watched values at the two ends of `d`'s sweep from the steady state `(x, u)` (`None` where
+/// there is none), the ends with no steady state for a physical reason, and the ends the sweep
+/// failed to reach. `watched` holds the outputs first (`n_outputs` of them), then the model
+/// predictive controllers' outputs `ops`.
+type Ends = (Option<Vec<f64>>, Option<Vec<f64>>, Vec<String>, Vec<String>);
+
+fn ends(
+    plant: &Plant,
+    (x, u): (&[f64], &[f64]),
+    d: &Disturbance,
+    (watched, n_outputs): (&[usize], usize),
+    ops: &[Limited],
+) -> Result<Ends, plantwide_analysis::AnalysisError> {
+    let u0 = plantwide_flowsheet::overrides::resolve_input(plant, &d.path).map_or(f64::NAN, |i| u[i]);
+    let mut range = Sweep::parse(plant, u, &d.sweep_range(u0))?;
+    // An end outside the input's physical range (a mole fraction above 1) is no steady state to
+    // look for: it is reported as such, and the sweep goes to the other end only (that side's
+    // walk has no point: a point just inside the base, where the range may end, is no sweep).
+    let (mut no_steady_state, mut failures) = (Vec::new(), Vec::new());
+    let i = range.signal.index;
+    let number = plantwide_model::limits::number;
+    for end in [range.low, range.high] {
+        if let Err(why) = plantwide_flowsheet::overrides::check_input_value(plant, i, end) {
+            no_steady_state.push(format!("{} at {}: {why} (not swept)", d.path, number(end)));
+        }
+    }
+    let inside = |v: f64| plantwide_flowsheet::overrides::check_input_value(plant, i, v).is_ok();
+    let (low_ok, high_ok) = (inside(range.low), inside(range.high));
+    range.low = if low_ok { range.low } else { range.base };
+    range.high = if high_ok { range.high } else { range.base };
+    let settings = SweepSettings { points: 2, ..Default::default() };
+    let curve = sweep(plant, x, u, std::slice::from_ref(&range), watched, &settings)?.remove(0);
+    failures.extend(curve.failures.iter().map(|fl| fl.to_string()));
+    let mut at = |value: f64, ok: bool| {
+        let failed = curve.failures.iter().any(|fl| (fl.value < range.base) == (value < range.base));
+        if failed || !ok {
+            return None;
+        }
+        let k = if value < range.base { 0 } else { curve.outputs.len() - 1 };
+        let v = curve.outputs.get(k).cloned().flatten()?;
+        let beyond: Vec<String> = ops_beyond(ops, &v[n_outputs..]);
+        if beyond.is_empty() {
+            return Some(v);
+        }
+        let end = number(value);
+        no_steady_state.push(format!(
+            "{} at {end}: {}; the controller cannot hold its CVs there",
+            d.path,
+            beyond.join(", ")
+        ));
+        None
+    };
+    let (low, high) = (at(range.low, low_ok), at(range.high, high_ok));
+    Ok((low, high, no_steady_state, failures))
 }
 
 /// The controller outputs of `ops` whose steady values `v` lie outside their limits, described.

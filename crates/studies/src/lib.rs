@@ -9,6 +9,7 @@
 #![warn(missing_docs)]
 
 pub mod compare;
+pub mod disturbance;
 pub mod error;
 pub mod identify;
 mod numeric;

@@ -113,6 +113,10 @@ pub enum ScreenError {
         /// The path.
         path: String,
     },
+    /// A disturbance that cannot be read, or whose step the plant refuses (no such input, a wrong
+    /// unit, a value outside the input's physical range).
+    #[error("--disturbances {0}")]
+    BadDisturbance(Box<crate::disturbance::DisturbanceError>),
     /// The sensitivity test could not be run for a throughput choice.
     #[error("sensitivity test (throughput {throughput}): {why}")]
     Sensitivity {
@@ -191,6 +195,12 @@ pub(crate) fn without_mpc(plant: &plantwide_flowsheet::Plant, study: &'static st
     match mpc {
         Some((name, _)) => Err(ScreenError::ModelPredictive { controller: name.clone(), study }),
         None => Ok(()),
+    }
+}
+
+impl From<crate::disturbance::DisturbanceError> for ScreenError {
+    fn from(e: crate::disturbance::DisturbanceError) -> Self {
+        ScreenError::BadDisturbance(Box::new(e))
     }
 }
 

@@ -87,10 +87,13 @@ pub struct ColumnStructure {
     pub minimized_condition_number: Option<f64>,
     /// Singular at steady state.
     pub singular: bool,
-    /// Place in the ranking (1 best), `None` when singular.
+    /// Place in the ranking (1 best), `None` when singular or failed.
     pub rank: Option<usize>,
     /// What the numbers say, in words.
     pub verdict: String,
+    /// Why its steady state or gains could not be computed (the solver's verdict, naming the unit,
+    /// equation and variable), its measures then `null`; `null` when it was judged.
+    pub failure: Option<String>,
 }
 
 /// The configurations of one column.
@@ -104,6 +107,9 @@ pub struct ColumnScreen {
     pub flows: Flows,
     /// The configurations, in the table's order.
     pub structures: Vec<ColumnStructure>,
+    /// The configurations that failed, each with its reason (also in its `failure`); empty when
+    /// all were judged.
+    pub failed: Vec<String>,
 }
 
 /// The column's four flows at the steady state (SI: mol/s; W or kg/s for a duty or steam boilup).
@@ -149,15 +155,24 @@ pub fn screen_column(plant: &Plant, column: &str, outputs: &[String]) -> Result<
     let flows = h.paths.each_ref().map(|p| input_value(plant, &base.x, p));
     let mut structures = Vec::new();
     for (name, top, bottom) in CONFIGURATIONS {
-        structures.push(configuration(plant, &h, &base.x, &flows, &out, (name, top, bottom))?);
+        // A configuration that fails numerically is marked and the others are judged; a request
+        // at fault stops the screening.
+        structures.push(match configuration(plant, &h, &base.x, &flows, &out, (name, top, bottom)) {
+            Ok(s) => s,
+            Err(e) if e.is_user_error() => return Err(e),
+            Err(e) => failed(name, edits(plant, &h, &flows, top, bottom).1, e.to_string()),
+        });
     }
     rank(&mut structures);
+    let failed =
+        structures.iter().filter_map(|c| Some(format!("configuration {}: {}", c.name, c.failure.as_ref()?))).collect();
     let [reflux, boilup, distillate, bottoms] = flows;
     Ok(ColumnScreen {
         column: column.to_string(),
         outputs: outputs.to_vec(),
         flows: Flows { reflux, boilup, distillate, bottoms },
         structures,
+        failed,
     })
 }
 
@@ -400,6 +415,23 @@ pub(super) fn is_singular(g: &Mat<f64>) -> bool {
         || svd(e.as_ref()).is_ok_and(|s| condition_number(&s.singular_values) > 1.0 / SINGULAR_RATIO.sqrt())
 }
 
+/// A configuration whose steady state or gains failed for `why`: no measures, not ranked.
+fn failed(name: &str, inputs: Vec<String>, why: String) -> ColumnStructure {
+    ColumnStructure {
+        name: name.into(),
+        inputs,
+        gain: None,
+        rga: None,
+        niederlinski: None,
+        condition_number: None,
+        minimized_condition_number: None,
+        singular: false,
+        rank: None,
+        verdict: "not judged: the configuration failed; not ranked".into(),
+        failure: Some(why),
+    }
+}
+
 /// The measures of gains `g` (`None`: singular).
 fn measures(name: &str, inputs: Vec<String>, g: Option<Mat<f64>>) -> Result<ColumnStructure, ScreenError> {
     let analysis = |e| ScreenError::Analysis { structure: name.into(), source: Box::new(e) };
@@ -417,6 +449,7 @@ fn measures(name: &str, inputs: Vec<String>, g: Option<Mat<f64>>) -> Result<Colu
             verdict: "singular at steady state: the two inputs cannot set both qualities (for DB, D + B = F ties \
                       the products); not ranked"
                 .into(),
+            failure: None,
         });
     };
     let l = rga(g.as_ref()).map_err(analysis)?;
@@ -434,6 +467,7 @@ fn measures(name: &str, inputs: Vec<String>, g: Option<Mat<f64>>) -> Result<Colu
         minimized_condition_number: Some(min_cond),
         singular: false,
         rank: None,
+        failure: None,
     })
 }
 
@@ -457,15 +491,17 @@ fn verdict(l11: f64, inputs: &[String]) -> String {
     }
 }
 
-/// Rank the regular configurations: integral-controllable pairings (λ11 > 0) first, closest to
-/// λ11 = 1 (by |ln λ11|), then by minimized condition number; the others after them.
+/// Rank the regular configurations (neither singular nor failed): integral-controllable pairings
+/// (λ11 > 0) first, closest to λ11 = 1 (by |ln λ11|), then by minimized condition number; the
+/// others after them.
 fn rank(structures: &mut [ColumnStructure]) {
     let score = |s: &ColumnStructure| {
         let l11 = s.rga.as_ref().map_or(f64::NAN, |r| r[0][0]);
         let l = if l11 > 0.0 { l11.ln().abs() } else { f64::INFINITY };
         (l, s.minimized_condition_number.unwrap_or(f64::INFINITY))
     };
-    let mut order: Vec<usize> = (0..structures.len()).filter(|&k| !structures[k].singular).collect();
+    let mut order: Vec<usize> =
+        (0..structures.len()).filter(|&k| !structures[k].singular && structures[k].failure.is_none()).collect();
     order.sort_by(|&a, &b| {
         score(&structures[a]).partial_cmp(&score(&structures[b])).unwrap_or(std::cmp::Ordering::Equal)
     });

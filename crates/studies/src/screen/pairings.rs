@@ -39,34 +39,7 @@ pub use sensitivity::{Watch, WatchResult};
 use super::ScreenError;
 use super::column::is_singular;
 
-/// A disturbance of the dynamic test: input `path` stepped by `fraction` of its steady value.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Disturbance {
-    /// Input path.
-    pub path: String,
-    /// Step as a fraction of the steady value (0.1 for +10 %).
-    pub fraction: f64,
-}
-
-impl std::str::FromStr for Disturbance {
-    type Err = String;
-
-    /// `PATH` (a +10 % step) or `PATH=±x%`; the error is the message for `--disturbances`.
-    fn from_str(text: &str) -> Result<Self, Self::Err> {
-        let Some((path, step)) = text.split_once('=') else {
-            return Ok(Disturbance { path: text.trim().to_string(), fraction: 0.1 });
-        };
-        let pct = step
-            .trim()
-            .strip_suffix('%')
-            .and_then(|v| v.trim().parse::<f64>().ok())
-            .filter(|v| v.is_finite() && *v != 0.0);
-        match pct {
-            Some(pct) => Ok(Disturbance { path: path.trim().to_string(), fraction: pct / 100.0 }),
-            None => Err(format!("--disturbances {text}: expected PATH or PATH=±x% (e.g. fresh_A.F=+10%)")),
-        }
-    }
-}
+pub use crate::disturbance::Disturbance;
 
 /// What to screen.
 #[derive(Debug, Clone, PartialEq)]
@@ -77,7 +50,8 @@ pub struct PairingRequest {
     pub mvs: Vec<String>,
     /// Throughput-manipulator candidates, each one of `mvs` (empty: as many MVs as CVs).
     pub throughput: Vec<String>,
-    /// Disturbances of the sensitivity and dynamic tests (empty: neither).
+    /// Disturbances of the sensitivity and dynamic tests (empty: neither); a `±` one is two steps
+    /// of the dynamic test ([`PairingRequest::steps`]).
     pub disturbances: Vec<Disturbance>,
     /// Uncontrolled variables that must stay in a band over ± each disturbance (sensitivity test).
     pub watch: Vec<Watch>,
@@ -92,6 +66,19 @@ pub struct PairingRequest {
     /// all, a shard's (then nothing is scored or ranked, and no MPC is run), or none, their
     /// results given by the shards' parts.
     pub share: Share<DynamicResult>,
+}
+
+impl PairingRequest {
+    /// The steps of the dynamic test, one run each: every disturbance, a `±` one up then down.
+    pub fn steps(&self) -> Vec<Disturbance> {
+        self.disturbances.iter().flat_map(Disturbance::steps).collect()
+    }
+
+    /// The disturbances of the steady-state sweeps (to both sides of the base case), each input
+    /// and size once.
+    pub fn sweeps(&self) -> Vec<&Disturbance> {
+        crate::disturbance::sweeps(&self.disturbances)
+    }
 }
 
 /// One CV–MV pair and its relative gain.
@@ -156,6 +143,14 @@ pub struct PairingScreen {
     /// The structures tested dynamically, in task order (indices into `structures`).
     #[serde(skip)]
     pub tested: Vec<usize>,
+    /// The parts asked for that failed, each with its reason (a candidate's tuning, a run, the
+    /// model predictive controller's runs), also marked where they stand; empty when all went
+    /// through.
+    pub failed: Vec<String>,
+    /// The recommendation (the candidate ranked first) and what it rests on; when the steady-state
+    /// measure (RGA number) orders the dynamically tested candidates otherwise than their dynamic
+    /// scores do, it says so.
+    pub verdict: String,
 }
 
 /// The open plant: the loops on the CVs and MVs removed, its steady state and gains.
@@ -219,9 +214,11 @@ pub fn screen_pairings(plant: &Plant, request: &PairingRequest) -> Result<Pairin
     if let Some(d) = mpc.as_mut().and_then(|m| m.dynamic.as_mut()) {
         let mut all: Vec<&mut DynamicResult> = structures.iter_mut().filter_map(|s| s.dynamic.as_mut()).collect();
         all.push(d);
-        dynamic::score(&mut all, request.disturbances.len(), request.cvs.len());
+        dynamic::score(&mut all, request.steps().len(), request.cvs.len());
     }
     rank(&mut structures);
+    let failed = failed_tests(&structures, mpc.as_ref());
+    let verdict = verdict(&structures);
     Ok(PairingScreen {
         cvs: request.cvs.clone(),
         mvs: request.mvs.clone(),
@@ -233,7 +230,67 @@ pub fn screen_pairings(plant: &Plant, request: &PairingRequest) -> Result<Pairin
         structures,
         mpc,
         tested,
+        failed,
+        verdict,
     })
+}
+
+/// A candidate in words: its pairs, and its throughput manipulator.
+fn describe(s: &PairingStructure) -> String {
+    let pairs: Vec<String> = s.pairs.iter().map(|p| format!("{} ← {}", p.cv, p.mv)).collect();
+    let tpm = s.throughput.as_ref().map_or(String::new(), |t| format!(" ({t} held)"));
+    format!("{}{tpm}", pairs.join(", "))
+}
+
+/// The recommendation and its evidence: the candidate ranked first and why; when the RGA number
+/// (the steady-state filters' order) and the dynamic scores order the tested candidates
+/// differently, both orders and which one the ranking follows.
+fn verdict(structures: &[PairingStructure]) -> String {
+    let Some(best) = structures.iter().find(|s| s.rank == Some(1)) else {
+        return "no pairing recommended: no candidate passed the steady-state filters, or every tested candidate's \
+                dynamic test failed"
+            .into();
+    };
+    let scored: Vec<&PairingStructure> =
+        structures.iter().filter(|s| s.rank.is_some() && s.dynamic.as_ref().is_some_and(|d| d.completed())).collect();
+    let mut by_rga = scored.clone();
+    by_rga.sort_by(|a, b| a.rga_number.total_cmp(&b.rga_number));
+    let mut by_score = scored.clone();
+    by_score.sort_by_key(|s| s.rank);
+    let why = match best.dynamic.as_ref().filter(|d| d.completed()) {
+        Some(d) => format!("best dynamic score ({:.3}) of {} tested on the nonlinear plant", d.score, scored.len()),
+        None => format!("smallest RGA number ({:.3}); no dynamic test", best.rga_number),
+    };
+    let mut text = format!("recommended: {} — {why}", describe(best));
+    let same = by_rga.iter().zip(&by_score).all(|(a, b)| std::ptr::eq(*a, *b));
+    if !same {
+        let ranks: Vec<String> = by_rga.iter().map(|s| s.rank.map_or("–".into(), |r| r.to_string())).collect();
+        let first = if std::ptr::eq(by_rga[0], by_score[0]) {
+            "they agree on the best only".to_string()
+        } else {
+            format!(
+                "the steady-state measure alone would recommend rank {}, {} (RGA number {:.3} against {:.3})",
+                by_rga[0].rank.unwrap_or(0),
+                describe(by_rga[0]),
+                by_rga[0].rga_number,
+                best.rga_number
+            )
+        };
+        text.push_str(&format!(
+            "; the evidence disagrees: by RGA number the tested candidates go in the order of ranks {}, not by \
+             their dynamic scores ({first}); the ranking follows the dynamic test",
+            ranks.join(", ")
+        ));
+    }
+    text
+}
+
+/// The dynamic tests of `structures` and `mpc` that failed or had a run fail, each with its
+/// reason.
+fn failed_tests(structures: &[PairingStructure], mpc: Option<&mpc::MpcAlternative>) -> Vec<String> {
+    let pi = structures.iter().filter_map(|c| Some((format!("candidate {}", describe(c)), c.dynamic.as_ref()?)));
+    let mpc = mpc.into_iter().filter_map(|m| Some((format!("MPC `{}`", m.controller), m.dynamic.as_ref()?)));
+    pi.chain(mpc).flat_map(|(label, d)| d.failures(&label)).collect()
 }
 
 /// One given pairing (CV `i` with MV `pairing[i]`) of `request` on `plant`: the open plant, the
@@ -277,6 +334,9 @@ fn check_request(plant: &Plant, r: &PairingRequest) -> Result<(), ScreenError> {
     if let Some(w) = r.watch.iter().find(|w| plant.var(&w.path).is_none()) {
         let hint = hint(&w.path, plant.vars().iter().map(|v| v.path.as_str()).collect());
         return Err(ScreenError::NoWatch { path: w.path.clone(), hint });
+    }
+    for d in &r.disturbances {
+        d.check(plant)?;
     }
     if !r.watch.is_empty() && r.disturbances.is_empty() {
         return Err(ScreenError::WatchWithoutDisturbances);
@@ -441,7 +501,7 @@ fn rank(structures: &mut [PairingStructure]) {
         let score = s.dynamic.as_ref().map_or(f64::INFINITY, |d| d.score);
         (score, s.rga_number)
     };
-    let failed = |s: &PairingStructure| s.dynamic.as_ref().is_some_and(|d| d.failure.is_some());
+    let failed = |s: &PairingStructure| s.dynamic.as_ref().is_some_and(|d| !d.completed());
     let mut order: Vec<usize> =
         (0..structures.len()).filter(|&k| structures[k].passed && !failed(&structures[k])).collect();
     order.sort_by(|&a, &b| key(&structures[a]).partial_cmp(&key(&structures[b])).unwrap_or(std::cmp::Ordering::Equal));
@@ -488,6 +548,57 @@ mod tests {
         leaves.sort();
         assert_eq!(leaves, brute);
         assert!(pruned > 0 && leaves.len() < 120, "{} leaves, {pruned} cut", leaves.len());
+    }
+
+    /// A candidate pairing `cv` with `mv`, with its RGA number and, when tested, its score.
+    fn candidate(mv: &str, rga_number: f64, score: Option<f64>) -> PairingStructure {
+        let dynamic = score.map(|score| DynamicResult {
+            detuning_factor: None,
+            loops: Vec::new(),
+            runs: Vec::new(),
+            score,
+            failure: None,
+        });
+        PairingStructure {
+            throughput: None,
+            pairs: vec![Pair { cv: "x".into(), mv: mv.into(), relative_gain: 1.0 }],
+            niederlinski: 1.0,
+            rga_number,
+            dic: true,
+            passed: true,
+            rejected: None,
+            sensitivity: Vec::new(),
+            dynamic,
+            rank: None,
+        }
+    }
+
+    #[test]
+    fn a_recommendation_its_own_steady_state_evidence_contradicts_says_so() {
+        // The RGA number prefers `a`, the dynamic test `b`: the ranking follows the dynamic test and
+        // the verdict names the candidate the steady-state measure alone would recommend.
+        let mut s = vec![candidate("a", 0.5, Some(2.0)), candidate("b", 1.0, Some(1.0)), candidate("c", 3.0, None)];
+        rank(&mut s);
+        assert_eq!(s.iter().map(|c| c.rank).collect::<Vec<_>>(), [Some(2), Some(1), Some(3)]);
+        let v = verdict(&s);
+        assert!(v.starts_with("recommended: x ← b — best dynamic score (1.000) of 2 tested"), "{v}");
+        assert!(
+            v.contains("the evidence disagrees: by RGA number the tested candidates go in the order of ranks 2, 1")
+        );
+        assert!(v.contains("would recommend rank 2, x ← a (RGA number 0.500 against 1.000)"), "{v}");
+        // Both measures agree: no contradiction to flag.
+        let mut s = vec![candidate("a", 0.5, Some(1.0)), candidate("b", 1.0, Some(2.0))];
+        rank(&mut s);
+        let v = verdict(&s);
+        assert!(v.starts_with("recommended: x ← a — best dynamic score") && !v.contains("disagrees"), "{v}");
+        // They agree on the best only.
+        let mut s =
+            vec![candidate("a", 0.5, Some(1.0)), candidate("b", 1.0, Some(3.0)), candidate("c", 2.0, Some(2.0))];
+        rank(&mut s);
+        let v = verdict(&s);
+        assert!(v.contains("order of ranks 1, 3, 2") && v.contains("they agree on the best only"), "{v}");
+        // Nothing ranked.
+        assert!(verdict(&[]).starts_with("no pairing recommended"));
     }
 
     #[test]

@@ -40,6 +40,19 @@ pub enum CandidateFailure {
     /// The disturbance run stopped.
     #[error(transparent)]
     Simulation(#[from] Box<plantwide_solve::dynamic::SimError>),
+    /// A pair whose MV does not move its CV with the other loops open: no gain to close it with.
+    #[error(
+        "pair {cv} ← {mv}: its steady-state gain with the other loops open is {gain:e}, so no PI loop on it can \
+         hold {cv}; pair {cv} with another MV"
+    )]
+    NoPairedGain {
+        /// The CV.
+        cv: String,
+        /// The MV.
+        mv: String,
+        /// Its gain (SI).
+        gain: f64,
+    },
 }
 
 /// Settings of the dynamic test.
@@ -99,6 +112,10 @@ pub struct DisturbanceRun {
     pub cvs: Vec<CvFigures>,
     /// MVs whose loop output reached a limit.
     pub saturated: Vec<String>,
+    /// Why the run failed, as the simulation reports it (its figures are then `null`); `null` for
+    /// a run that went through.
+    #[serde(default)]
+    pub failure: Option<String>,
     /// Recorded times \[s\] (for plots; not serialized).
     #[serde(skip)]
     pub times: Vec<f64>,
@@ -120,8 +137,26 @@ pub struct DynamicResult {
     /// failed or before the candidates are scored together).
     #[serde(deserialize_with = "infinite_if_null")]
     pub score: f64,
-    /// Why the test failed (tuning or a run), if it did.
+    /// Why the test as a whole failed (its loops could not be added or tuned), if it did; a
+    /// failed run is marked in its own `failure`.
     pub failure: Option<String>,
+}
+
+impl DynamicResult {
+    /// The loops were tuned and every run went through.
+    pub fn completed(&self) -> bool {
+        self.failure.is_none() && self.runs.iter().all(|r| r.failure.is_none())
+    }
+
+    /// What failed, each with its reason, for the test labelled `label`: the test as a whole, or
+    /// each run that failed.
+    pub fn failures(&self, label: &str) -> Vec<String> {
+        if let Some(why) = &self.failure {
+            return vec![format!("{label}: {why}")];
+        }
+        let failed = self.runs.iter().filter_map(|r| Some((&r.disturbance, r.failure.as_ref()?)));
+        failed.map(|(d, why)| format!("{label}, run {d}: {why}")).collect()
+    }
 }
 
 /// A candidate's dynamic test as the task of a sharded screening: the result and the records of
@@ -194,7 +229,7 @@ pub(super) fn test_picked(
     tuning: &Tuning,
 ) -> Result<f64, ScreenError> {
     for d in &r.disturbances {
-        match open.plant.input(&d.path) {
+        match plantwide_flowsheet::overrides::resolve_input(&open.plant, &d.path) {
             Some(i) if open.plant.inputs()[i].driven_by.is_none() => {}
             _ => return Err(ScreenError::Disturbance { path: d.path.clone() }),
         }
@@ -228,7 +263,7 @@ pub(super) fn test_picked(
         })
         .collect();
     if !r.share.is_shard() {
-        score(&mut results.iter_mut().flatten().collect::<Vec<_>>(), r.disturbances.len(), r.cvs.len());
+        score(&mut results.iter_mut().flatten().collect::<Vec<_>>(), r.steps().len(), r.cvs.len());
     }
     for (k, t) in picked.into_iter().zip(results) {
         structures[k].dynamic = t;
@@ -236,18 +271,22 @@ pub(super) fn test_picked(
     Ok(duration)
 }
 
-/// Score each result that ran: the mean over disturbances and CVs of its IAE over the best IAE of
-/// all `results` there (1 when best everywhere); a failed result keeps an infinite score.
-pub(crate) fn score(results: &mut [&mut DynamicResult], disturbances: usize, cvs: usize) {
-    let best: Vec<Vec<f64>> = (0..disturbances)
+/// Score each result that ran: the mean over its runs (`steps`) and CVs of its IAE over the best
+/// IAE of all `results` there (1 when best everywhere); a result whose test or one of whose runs
+/// failed has an infinite score (it cannot be compared run by run).
+pub(crate) fn score(results: &mut [&mut DynamicResult], steps: usize, cvs: usize) {
+    let best: Vec<Vec<f64>> = (0..steps)
         .map(|d| {
-            let ok = || results.iter().filter(|t| t.failure.is_none());
+            let ok = || results.iter().filter(|t| t.completed());
             (0..cvs).map(|c| ok().map(|t| t.runs[d].cvs[c].iae).fold(f64::INFINITY, f64::min)).collect()
         })
         .collect();
-    for t in results.iter_mut().filter(|t| t.failure.is_none()) {
-        let n = (disturbances * cvs).max(1) as f64;
-        let sum: f64 = (0..disturbances)
+    for t in results.iter_mut().filter(|t| !t.completed()) {
+        t.score = f64::INFINITY;
+    }
+    for t in results.iter_mut().filter(|t| t.completed()) {
+        let n = (steps * cvs).max(1) as f64;
+        let sum: f64 = (0..steps)
             .flat_map(|d| (0..cvs).map(move |c| (d, c)))
             .map(|(d, c)| t.runs[d].cvs[c].iae / best[d][c].max(f64::MIN_POSITIVE))
             .sum();
@@ -255,33 +294,49 @@ pub(crate) fn score(results: &mut [&mut DynamicResult], disturbances: usize, cvs
     }
 }
 
-/// Run one tuned candidate; a failure is recorded, not returned (the other candidates go on).
+/// Run one tuned candidate; a failure is recorded, not returned (the other candidates go on), and a
+/// run that fails is marked in its place (the other runs go on).
 fn candidate(tuned: TunedCandidate, r: &PairingRequest, ops: &[Limited], duration: f64) -> DynamicResult {
-    let failed = |why: String| DynamicResult {
-        detuning_factor: None,
-        loops: Vec::new(),
-        runs: Vec::new(),
-        score: f64::INFINITY,
-        failure: Some(why),
-    };
     let (plant, x, tuned) = match tuned {
         Ok(t) => t,
-        Err(why) => return failed(why.to_string()),
-    };
-    let mut runs = Vec::new();
-    for d in &r.disturbances {
-        match run(&plant, &x, r, d, duration, ops) {
-            Ok((run, _)) => runs.push(run),
-            Err(why) => {
-                return DynamicResult {
-                    detuning_factor: tuned.detuning,
-                    loops: tuned.loops,
-                    ..failed(why.to_string())
-                };
-            }
+        Err(why) => {
+            return DynamicResult {
+                detuning_factor: None,
+                loops: Vec::new(),
+                runs: Vec::new(),
+                score: f64::INFINITY,
+                failure: Some(why.to_string()),
+            };
         }
+    };
+    let runs: Vec<DisturbanceRun> = r
+        .steps()
+        .iter()
+        .map(|d| run(&plant, &x, r, d, duration, ops).map_or_else(|why| failed_run(r, d, why.to_string()), |o| o.0))
+        .collect();
+    let score = if runs.iter().all(|r| r.failure.is_none()) { f64::NAN } else { f64::INFINITY };
+    DynamicResult { detuning_factor: tuned.detuning, loops: tuned.loops, runs, score, failure: None }
+}
+
+/// The paths a run of `r` records figures of: its CVs, then its other recorded variables.
+fn watched(r: &PairingRequest) -> Vec<&String> {
+    r.cvs.iter().chain(r.record.iter().filter(|p| !r.cvs.contains(p))).collect()
+}
+
+/// A run of step `d` that failed for `why`: every figure `null`, nothing recorded.
+pub(crate) fn failed_run(r: &PairingRequest, d: &super::Disturbance, why: String) -> DisturbanceRun {
+    let cvs = watched(r)
+        .into_iter()
+        .map(|cv| CvFigures { cv: cv.clone(), iae: f64::NAN, max_deviation: f64::NAN, settling_time: None })
+        .collect();
+    DisturbanceRun {
+        disturbance: d.label(),
+        cvs,
+        saturated: Vec::new(),
+        failure: Some(why),
+        times: Vec::new(),
+        series: Vec::new(),
     }
-    DynamicResult { detuning_factor: tuned.detuning, loops: tuned.loops, runs, score: f64::NAN, failure: None }
 }
 
 /// A candidate's plant with its tuned loops, its steady state and tuning, or why it has none.
@@ -326,16 +381,44 @@ pub(super) fn closed_plant(
     Ok((v, st.x))
 }
 
-/// The actions that make each of the candidate's loops a negative feedback.
-pub(super) fn actions(open: &OpenPlant, r: &PairingRequest, s: &PairingStructure) -> Vec<&'static str> {
+/// The steady-state gain of each of the candidate's pairs in the open plant (SI: CV unit per MV
+/// unit).
+fn paired_gains(open: &OpenPlant, r: &PairingRequest, s: &PairingStructure) -> Vec<f64> {
     s.pairs
         .iter()
         .enumerate()
-        .map(|(i, p)| {
-            let j = r.mvs.iter().position(|m| *m == p.mv).unwrap_or(0);
-            if open.gain[(i, j)] < 0.0 { "direct" } else { "reverse" }
-        })
+        .map(|(i, p)| r.mvs.iter().position(|m| *m == p.mv).map_or(f64::NAN, |j| open.gain[(i, j)]))
         .collect()
+}
+
+/// The actions that make each of the candidate's loops a negative feedback.
+pub(super) fn actions(open: &OpenPlant, r: &PairingRequest, s: &PairingStructure) -> Vec<&'static str> {
+    paired_gains(open, r, s).into_iter().map(|g| if g < 0.0 { "direct" } else { "reverse" }).collect()
+}
+
+/// Reset time of the trial loops \[s\]: at steady state no reset time matters (the integral only
+/// holds the CV on its setpoint), and with the loops in manual, as BLT linearizes them, neither
+/// does the gain.
+const TRIAL_TAU_I: f64 = 1e3;
+
+/// The open plant with the candidate's loops closed at a trial tuning, and its steady state: each
+/// loop's gain the inverse of its own steady-state process gain `|g_ii|`, so every loop has gain 1
+/// at steady state whatever the units of its CV and MV. A fixed gain (1 in SI units) is no trial
+/// tuning: a reboiler duty (W) holding a bottoms mole fraction needs some 10⁷ W per unit, and at
+/// 1 W per unit the loop barely acts, so its integral is all but free: on a 32-stage column the
+/// scaled Jacobian's σ_min/σ_max fell to 9·10⁻¹⁵, under the steady state's null-space probe's
+/// 10⁻¹², which rightly reported `pair1.I` as undetermined (with `1/|g_ii|`: 4·10⁻⁴).
+pub(super) fn trial_plant(
+    open: &OpenPlant,
+    r: &PairingRequest,
+    s: &PairingStructure,
+) -> Result<(Plant, Vec<f64>), CandidateFailure> {
+    let gains = paired_gains(open, r, s);
+    if let Some((p, g)) = s.pairs.iter().zip(&gains).find(|(_, g)| !(g.is_finite() && **g != 0.0)) {
+        return Err(CandidateFailure::NoPairedGain { cv: p.cv.clone(), mv: p.mv.clone(), gain: *g });
+    }
+    let kc: Vec<f64> = gains.iter().map(|g| 1.0 / g.abs()).collect();
+    closed_plant(open, s, &kc, &vec![TRIAL_TAU_I; s.pairs.len()], &actions(open, r, s))
 }
 
 /// The open plant with the candidate's loops at the settings given.
@@ -363,15 +446,14 @@ fn tuned(s: &PairingStructure, kc: &[f64], ti: &[f64], actions: &[&str], detunin
 }
 
 fn tuned_plant(open: &OpenPlant, r: &PairingRequest, s: &PairingStructure) -> TunedCandidate {
-    let n = s.pairs.len();
-    let build = |kc: &[f64], ti: &[f64], actions: &[&str]| closed_plant(open, s, kc, ti, actions);
-    let (trial, x) = build(&vec![1.0; n], &vec![1e3; n], &actions(open, r, s))?;
-    let loops: Vec<_> = (0..n).map(|i| plant_loop(&trial, &format!("pair{}", i + 1))).collect::<Result<_, _>>()?;
+    let (trial, x) = trial_plant(open, r, s)?;
+    let loops: Vec<_> =
+        (0..s.pairs.len()).map(|i| plant_loop(&trial, &format!("pair{}", i + 1))).collect::<Result<_, _>>()?;
     let t = blt_loops(&trial, &x, &loops, r.dynamic.measurement)?;
     let kc: Vec<f64> = t.loops.iter().map(|l| l.kc.abs()).collect();
     let ti: Vec<f64> = t.loops.iter().map(|l| l.tau_i.unwrap_or(f64::INFINITY)).collect();
     let actions: Vec<&str> = t.loops.iter().map(|l| l.action).collect();
-    let (plant, x) = build(&kc, &ti, &actions)?;
+    let (plant, x) = closed_plant(open, s, &kc, &ti, &actions)?;
     Ok((plant, x, tuned(s, &kc, &ti, &actions, t.detuning_factor)))
 }
 
@@ -416,13 +498,14 @@ pub(crate) fn run(
     duration: f64,
     ops: &[Limited],
 ) -> Result<(DisturbanceRun, Vec<plantwide_solve::dynamic::MpcLog>), CandidateFailure> {
-    let u0 = plant.input(&d.path).map_or(f64::NAN, |i| plant.inputs()[i].value);
-    let watched: Vec<&String> = r.cvs.iter().chain(r.record.iter().filter(|p| !r.cvs.contains(p))).collect();
+    let u0 =
+        plantwide_flowsheet::overrides::resolve_input(plant, &d.path).map_or(f64::NAN, |i| plant.inputs()[i].value);
+    let watched = watched(r);
     let record: Vec<&String> = watched.iter().copied().chain(ops.iter().map(|o| &o.op)).collect();
     let text = serde_json::json!({
         "format_version": 1, "name": format!("{} step", d.path), "duration": format!("{duration} s"),
         "integrator": {"rtol": 1e-6},
-        "events": [{"type": "step", "at": format!("{} s", STEP_AT * duration), "path": d.path, "by": d.fraction * u0}],
+        "events": [{"type": "step", "at": format!("{} s", STEP_AT * duration), "path": d.path, "by": d.change(u0)}],
         "record": {"interval": format!("{} s", duration / 500.0), "paths": record}
     })
     .to_string();
@@ -453,12 +536,7 @@ pub(crate) fn run(
         .map(|(_, o)| o.mv.clone())
         .collect();
     let series = (0..watched.len()).map(|k| res.rows.iter().map(|row| row[k]).collect()).collect();
-    let run = DisturbanceRun {
-        disturbance: format!("{} {:+} %", d.path, 100.0 * d.fraction),
-        cvs,
-        saturated,
-        times: res.times.clone(),
-        series,
-    };
+    let run =
+        DisturbanceRun { disturbance: d.label(), cvs, saturated, failure: None, times: res.times.clone(), series };
     Ok((run, res.mpc))
 }

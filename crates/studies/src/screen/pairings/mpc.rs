@@ -24,7 +24,7 @@ use serde::Serialize;
 
 use plantwide_solve::{NewtonSettings, SolveError, steady_state};
 
-use super::dynamic::{DynamicResult, Limited, run};
+use super::dynamic::{DynamicResult, Limited, failed_run, run};
 use super::{OpenPlant, PairingRequest};
 use crate::screen::ScreenError;
 
@@ -49,7 +49,7 @@ pub struct MpcAlternative {
     pub condition_number: Option<f64>,
     /// The disturbance runs (no loops, no detuning: `score` relative to the best alternative).
     pub dynamic: Option<DynamicResult>,
-    /// What the controller did in each run, in disturbance order.
+    /// What the controller did in each run that went through, in run order.
     pub qp: Vec<MpcLog>,
 }
 
@@ -177,7 +177,7 @@ pub(crate) fn output_name(name: &str, k: usize) -> String {
     if k == 0 { format!("{name}.op") } else { format!("{name}.op{}", k + 1) }
 }
 
-/// Every disturbance run; the first that stops ends the test as its failure.
+/// Every disturbance run; a run that stops is marked as failed and the others go on.
 fn runs(
     plant: &Plant,
     x: &[f64],
@@ -188,16 +188,15 @@ fn runs(
     let mut result =
         DynamicResult { detuning_factor: None, loops: Vec::new(), runs: Vec::new(), score: f64::NAN, failure: None };
     let mut qp = Vec::new();
-    for d in &r.disturbances {
-        match run(plant, x, r, d, duration, ops) {
+    for d in r.steps() {
+        match run(plant, x, r, &d, duration, ops) {
             Ok((one, logs)) => {
                 result.runs.push(one);
                 qp.extend(logs);
             }
             Err(why) => {
-                result.failure = Some(why.to_string());
+                result.runs.push(failed_run(r, &d, why.to_string()));
                 result.score = f64::INFINITY;
-                break;
             }
         }
     }

@@ -8,7 +8,7 @@
 use plantwide_analysis::sensitivity::{Disturbance, SweepSettings, sweep};
 use serde::Serialize;
 
-use super::dynamic::{actions, closed_plant};
+use super::dynamic::trial_plant;
 use super::{OpenPlant, PairingRequest, PairingStructure};
 use crate::screen::ScreenError;
 
@@ -75,16 +75,13 @@ pub(super) fn test(
 /// The sweeps of one throughput choice, on the plant with `s`'s loops closed.
 fn choice(open: &OpenPlant, r: &PairingRequest, s: &PairingStructure) -> Result<Vec<WatchResult>, ScreenError> {
     let fail = |why: String| ScreenError::Sensitivity { throughput: s.throughput.clone().unwrap_or_default(), why };
-    let n = s.pairs.len();
-    let (plant, x) =
-        closed_plant(open, s, &vec![1.0; n], &vec![1e3; n], &actions(open, r, s)).map_err(|e| fail(e.to_string()))?;
+    let (plant, x) = trial_plant(open, r, s).map_err(|e| fail(e.to_string()))?;
     let u = plant.input_values();
     let outputs: Vec<usize> = r.watch.iter().filter_map(|w| plant.var(&w.path)).collect();
     let mut out = Vec::new();
-    for d in &r.disturbances {
-        let pct = 100.0 * d.fraction.abs();
-        let text = format!("{}=-{pct}%:+{pct}%", d.path);
-        let dist = Disturbance::parse(&plant, &u, &text).map_err(|e| fail(e.to_string()))?;
+    for d in r.sweeps() {
+        let u0 = plantwide_flowsheet::overrides::resolve_input(&plant, &d.path).map_or(f64::NAN, |i| u[i]);
+        let dist = Disturbance::parse(&plant, &u, &d.sweep_range(u0)).map_err(|e| fail(e.to_string()))?;
         let settings = SweepSettings { points: 9, ..SweepSettings::default() };
         let curves = sweep(&plant, &x, &u, &[dist], &outputs, &settings).map_err(|e| fail(e.to_string()))?;
         for (j, w) in r.watch.iter().enumerate() {
@@ -95,7 +92,7 @@ fn choice(open: &OpenPlant, r: &PairingRequest, s: &PairingStructure) -> Result<
             let converged = values.iter().all(Option::is_some);
             out.push(WatchResult {
                 path: w.path.clone(),
-                disturbance: format!("{} ±{pct} %", d.path),
+                disturbance: d.sweep_label(),
                 min,
                 max,
                 band: [w.low, w.high],
