@@ -734,3 +734,40 @@ fn flash_feed_step_restarts_consistently_and_matches_a_short_ramp() {
         assert!((a - b).abs() < 1e-5 * b.abs(), "{path}: {a} vs {b}");
     }
 }
+
+/// A failure of the consistent start names the unit, equation and variable wherever it reaches
+/// the user: through a `Session` (plant tests, surge sizing) as through `simulate`, with the
+/// variable it left on a bound. The flash's feed cooled below the drum's bubble point asks for a
+/// negative vapour flow, so no consistent state exists after the change.
+#[test]
+fn a_failed_consistent_start_names_its_unit_and_variable_in_a_session() {
+    use plantwide::solve::dynamic::Session;
+    let (plant, x0) = min_flash();
+    let mut s = Session::new(&plant, &x0).unwrap();
+    s.advance_to(60.0).unwrap();
+    s.set_input(plant.input("preheater.T_out").unwrap(), 368.15);
+    // `in equation 24 (preheater: equation for hot.T, variable hot.T)`: which equation is worst
+    // where the line search stops is Newton's business; that it is named is this test's.
+    let named = |msg: &str| {
+        let Some((_, rest)) = msg.split_once("in equation ") else { return false };
+        let unit = rest.split_once(" (").and_then(|(_, r)| r.split_once(": equation for ")).map(|(u, _)| u);
+        unit.is_some_and(|u| plant.blocks().iter().any(|b| b.name == u)) && rest.contains(", variable ")
+    };
+    let msg = s.advance_to(120.0).unwrap_err().to_string();
+    eprintln!("{msg}");
+    assert!(
+        msg.contains("consistent initialization failed at t = 60 s")
+            && named(&msg)
+            && msg.contains("beyond the bounds of `flash_vapour.F` at its lower bound 0")
+            && msg.contains("a flow reversing"),
+        "{msg}"
+    );
+    // `simulate` says the same.
+    let scenario =
+        min_flash_scenario(r#"{"type": "step", "at": "1 min", "path": "preheater.T_out", "to": "95 degC"}"#, "5 min");
+    let spec = parse_scenario(&scenario, "scenario.json").unwrap();
+    let sc = resolve(&spec, &plant, "scenario.json").unwrap();
+    let msg = simulate(&plant, &sc, Start::Steady(&x0), "test", &mut |_| {}).unwrap_err().to_string();
+    eprintln!("{msg}");
+    assert!(named(&msg), "{msg}");
+}

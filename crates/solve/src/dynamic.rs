@@ -95,7 +95,7 @@ pub enum SimError {
         file: String,
         /// Cause.
         source: DaeError,
-        /// The equation and variable concerned, when known.
+        /// What the failure may mean for the plant ([`failure_hint`]).
         detail: String,
         /// What was recorded up to the failure (the trends that lead to it).
         partial: Box<SimulationResult>,
@@ -202,7 +202,7 @@ pub fn simulate(
     match d.run(observer) {
         Ok(()) => {}
         Err(driver::RunError::Dae(source)) => {
-            let detail = failure_detail(plant, &source);
+            let detail = failure_hint(&source).to_string();
             return Err(SimError::Integration { file, source, detail, partial: Box::new(d.finish()) });
         }
         Err(driver::RunError::Mpc(source)) => {
@@ -216,16 +216,14 @@ pub fn simulate(
     }
 }
 
-/// The equation and variable an integration failure concerns, when known (for the message).
-fn failure_detail(plant: &Plant, source: &DaeError) -> String {
-    match *source {
-        DaeError::Initialization { equation, .. } if equation < plant.n_eqs() => {
-            let var = plant.equation_variable(equation).map_or("-".to_string(), |v| plant.vars()[v].path.clone());
-            format!(
-                " ({}, variable {var}; a vessel running dry or overflowing, or a flow reversing, ends a run this way)",
-                plant.equation_name(equation)
-            )
+/// What an integration failure may mean for the plant, after the integrator's own message (which
+/// names the unit, equation and variable): a consistent start that fails is most often a state the
+/// plant cannot reach (a vessel running dry or overflowing, a flow reversing).
+pub(crate) fn failure_hint(source: &DaeError) -> &'static str {
+    match source {
+        DaeError::Initialization(_) => {
+            "; a vessel running dry or overflowing, or a flow reversing, ends a run this way"
         }
-        _ => String::new(),
+        _ => "",
     }
 }

@@ -205,6 +205,16 @@ impl DaeSystem for PlantDae<'_> {
     fn outputs(&self) -> &[(usize, usize)] {
         self.shape.explicit.outputs()
     }
+    fn equation_name(&self, i: usize) -> Option<String> {
+        if i >= self.shape.n_plant {
+            return None;
+        }
+        let var = self.plant.equation_variable(i).map_or("-", |v| self.plant.vars()[v].path.as_str());
+        Some(format!("{}, variable {var}", self.plant.equation_name(i)))
+    }
+    fn variable_name(&self, i: usize) -> Option<String> {
+        self.plant.vars().get(i).map(|v| v.path.clone())
+    }
     fn complete(&self, t: f64, x: &mut [f64]) {
         let np = self.shape.n_plant;
         INPUTS.with_borrow_mut(|u| {
