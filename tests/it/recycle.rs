@@ -359,7 +359,10 @@ fn flash_loop_with_two_recycles_is_torn_once_and_all_methods_agree() {
     assert_eq!(tears(&p), vec![vec!["mixed"]]);
     let eo = steady_state(&p, &u, None, &NewtonSettings::default()).unwrap_or_else(|e| panic!("{e}")).x;
     assert!(component_balance_error(&p, &eo, &[]) < 1e-9);
-    for (m, passes) in [(Accelerator::Direct, 22), (Accelerator::Wegstein, 12), (Accelerator::Broyden, 10)] {
+    // Wegstein's per-variable secant slopes amplify rounding on variables that barely move: the
+    // drum's energy balance written without the enthalpy datum (same solution, other rounding in
+    // the local solves) took it from 12 passes to 13.
+    for (m, passes) in [(Accelerator::Direct, 22), (Accelerator::Wegstein, 13), (Accelerator::Broyden, 10)] {
         let sol = solve_sequential(&p, &u, None, &sm(m, 1e-8)).unwrap_or_else(|e| panic!("{m:?}: {e}"));
         assert_eq!(sol.report.sccs[0].passes, passes, "{m:?}");
         let gain = sol.report.sccs[0].loop_gain.unwrap();

@@ -6,6 +6,7 @@ use plantwide::flowsheet::{Plant, load_file};
 use plantwide::solve::{NewtonSettings, steady_state};
 
 use crate::harness::{component_balance_error, fixture, flowsheet, plantwide, value};
+use plantwide::model::limits::number;
 
 const KMOL_PER_MIN: f64 = 1000.0 / 60.0;
 
@@ -154,6 +155,49 @@ fn an_infeasible_spec_exits_2_naming_it() {
         2,
     );
     assert!(err.contains("`distillate.x[light] = 0.9999` by `column.reflux`"), "{err}");
+}
+
+/// A spec no steady state can meet is reported by the offset the plant really gives and the way
+/// its input would have to move. A spec's equation is linear, so every Newton step meets it: the
+/// last iterate read "off by 0" and "needs more than the input can give" at a lower bound. The
+/// newcomer's file asks xB = 0.5 of a 0.45 feed; its command asks xD = 0.2. Checked against the
+/// plant converged without the specs at the file's inputs (the offset there) and moved a little
+/// (the direction).
+#[test]
+fn an_infeasible_spec_says_which_way_its_input_must_move_and_by_how_much_it_is_off() {
+    let file = fixture("data/newcomer3/spec_infeasible_in_file.json");
+    let mut plant = load_file(std::path::Path::new(&file)).unwrap();
+    plant.fix_specs(&plant.input_values());
+    let at = |plant: &Plant, path: &str, factor: f64, read: &str| {
+        let mut u = plant.input_values();
+        u[plant.input(path).unwrap()] *= factor;
+        let ss = steady_state(plant, &u, None, &NewtonSettings::default()).unwrap_or_else(|e| panic!("{e}"));
+        value(plant, &ss.x, read)
+    };
+    let xb = at(&plant, "column.reboiler_duty", 1.0, "bottoms.x[benzene]");
+    assert!(at(&plant, "column.reboiler_duty", 0.95, "bottoms.x[benzene]") > xb, "less duty, more benzene below");
+    let err = fails(&["steady", &file], 2);
+    eprintln!("{err}");
+    let duty = err.split("`bottoms.x[benzene] = 0.5` by `column.reboiler_duty` (specs[1]):").nth(1).unwrap();
+    assert!(
+        duty.contains(&format!("`bottoms.x[benzene]` = {} (off by {:+.3e})", number(xb), xb - 0.5))
+            && duty.contains("`column.reboiler_duty` would have to go lower")
+            && duty.contains("the spec asks for less than the input can give"),
+        "{err}"
+    );
+    assert!(!err.contains("off by 0.000e0") && !err.contains("more than the input can give"), "{err}");
+    // Less reflux, less benzene on top: xD = 0.2 asks for less reflux than zero.
+    let plain = load_file(std::path::Path::new(&fixture("data/newcomer3/bt_column.json"))).unwrap();
+    let xd = at(&plain, "column.reflux", 1.0, "distillate.x[benzene]");
+    assert!(at(&plain, "column.reflux", 0.9, "distillate.x[benzene]") < xd, "less reflux, less benzene on top");
+    let file = fixture("data/newcomer3/bt_column.json");
+    let err = fails(&["steady", &file, "--spec", "distillate.x[benzene]=0.2", "--vary", "column.reflux"], 2);
+    assert!(
+        err.contains(&format!("(off by {:+.3e})", xd - 0.2))
+            && err.contains("`column.reflux` would have to go lower")
+            && err.contains("the spec asks for less than the input can give"),
+        "{err}"
+    );
 }
 
 #[test]

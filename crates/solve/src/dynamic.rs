@@ -96,7 +96,7 @@ pub enum SimError {
         file: String,
         /// Cause.
         source: DaeError,
-        /// The equation and variable concerned, when known.
+        /// What the failure may mean for the plant ([`failure_hint`]).
         detail: String,
         /// What was recorded up to the failure (the trends that lead to it).
         partial: Box<SimulationResult>,
@@ -203,7 +203,7 @@ pub fn simulate(
     match d.run(observer) {
         Ok(()) => {}
         Err(driver::RunError::Dae(source)) => {
-            let detail = failure_detail(plant, &source);
+            let detail = failure_hint(&source).to_string();
             return Err(SimError::Integration { file, source, detail, partial: Box::new(d.finish()) });
         }
         Err(driver::RunError::Mpc(source)) => {
@@ -217,21 +217,16 @@ pub fn simulate(
     }
 }
 
-/// The equation and variable an integration failure concerns, when known (for the message).
-fn failure_detail(plant: &Plant, source: &DaeError) -> String {
-    match *source {
-        DaeError::Initialization { equation, .. } if equation < plant.n_eqs() => {
-            let var = plant.equation_variable(equation).map_or("-".to_string(), |v| plant.vars()[v].path.clone());
-            let block = plant.blocks().iter().find(|b| (b.eq_offset..b.eq_offset + b.n_eq).contains(&equation));
-            let hint = match block.map(|b| b.kind) {
-                Some(plantwide_flowsheet::BlockKind::Controller) => {
-                    "a controller whose output the plant cannot take there — moved past the range of the input it \
-                     drives, or by a model of the wrong sign or size — ends a run this way"
-                }
-                _ => "a vessel running dry or overflowing, or a flow reversing, ends a run this way",
-            };
-            format!(" ({}, variable {var}; {hint})", plant.equation_name(equation))
-        }
-        _ => String::new(),
+/// What an integration failure may mean for the plant, after the integrator's own message (which
+/// names the unit, equation and variable): a consistent start that fails is most often a state the
+/// plant cannot reach — a vessel running dry or overflowing, a flow reversing, or, on a
+/// controller's equation, an output the plant cannot take ([`DaeSystem::equation_hint`]).
+pub(crate) fn failure_hint(source: &DaeError) -> &'static str {
+    match source {
+        DaeError::Initialization(inc) => inc
+            .equation
+            .hint
+            .unwrap_or("; a vessel running dry or overflowing, or a flow reversing, ends a run this way"),
+        _ => "",
     }
 }

@@ -12,6 +12,8 @@ use plantwide_model::VarKind;
 
 use crate::System;
 
+pub(crate) mod standing;
+
 /// The plant at inputs `u` with its design specifications, as one square nonlinear system.
 pub struct SteadySystem<'a> {
     plant: &'a Plant,
@@ -147,41 +149,5 @@ pub fn equation_name(plant: &Plant, eq: usize) -> String {
     match plant.specs().get(eq.wrapping_sub(n)) {
         Some(s) if eq >= n => format!("design spec {} ({})", s.label(), s.origin),
         _ => plant.equation_name(eq),
-    }
-}
-
-/// The specs at unknowns `z` that fail, for a failed solve's message: each spec's residual and
-/// where its varied input stands (`; design specs solved with the plant: …`), empty without specs.
-pub(crate) fn note(sys: &SteadySystem<'_>, z: &[f64]) -> String {
-    let plant = sys.plant;
-    let n = plant.n_vars();
-    let items: Vec<String> = plant
-        .specs()
-        .iter()
-        .enumerate()
-        .map(|(k, s)| {
-            let (lo, hi) = input_bounds(plant, s.input);
-            let v = z[n + k];
-            let at =
-                if v <= lo || v >= hi { " (at its bound: the spec needs more than the input can give)" } else { "" };
-            format!(
-                "{} ({}): `{}` = {}{at} at the last iterate, `{}` = {} (off by {:.3e})",
-                s.label(),
-                s.origin,
-                s.vary,
-                plantwide_model::limits::number(v),
-                s.path,
-                plantwide_model::limits::number(z[s.var]),
-                sys.spec_residual(z, k)
-            )
-        })
-        .collect();
-    if items.is_empty() {
-        String::new()
-    } else {
-        format!(
-            "; design specs solved with the plant (a spec no steady state can meet shows here): {}",
-            items.join("; ")
-        )
     }
 }

@@ -306,8 +306,9 @@ pub struct ConvergenceFailure {
     pub worst: f64,
     /// Total holdups resting on their lower bound at the last iterate.
     pub at_floor: Vec<String>,
-    /// The design specs at the last iterate (empty without specs): each one's residual and its
-    /// varied input's value.
+    /// The design specs at the last iterate (empty without specs): each varied input's value, the
+    /// offset the plant gives with it held there (or at its start, where the plant has no steady
+    /// state there) and which way it would have to move ([`crate::specs::standing`]).
     pub specs: String,
     /// The full report with the iteration history.
     pub report: NewtonReport,
@@ -381,7 +382,7 @@ pub fn steady_state_observed(
         variable,
         worst,
         at_floor: crate::certify::floors_anywhere(plant, &x),
-        specs: crate::specs::note(&sys, &z),
+        specs: crate::specs::standing::note(plant, u, &z),
         report,
         x,
     })))

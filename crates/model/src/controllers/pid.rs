@@ -295,8 +295,10 @@ impl UnitModel for Pid {
             own[k] = e;
         }
         let n_diff = self.n_diff();
+        // The manual output is an input (`--set ctrl.op_manual=…` moves it, the description does not).
+        let op_manual = io.input(usize::from(self.remote_sp.is_none()));
         own[n_diff] =
-            if self.is_auto(io) { clamp(self.bias + self.kc * e, self.op_min, self.op_max) } else { self.op_manual };
+            if self.is_auto(io) { clamp(self.bias + self.kc * e, self.op_min, self.op_max) } else { op_manual };
     }
 }
 

@@ -208,7 +208,7 @@ impl UnitModel for Summer {
     }
     fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]) {
         let op = self.output(io);
-        own[0] = if op.is_finite() { op } else { self.bias };
+        own[0] = if op.is_finite() { op } else { io.input(0) };
     }
 }
 

@@ -174,16 +174,20 @@ impl UnitModel for Feed {
         let phase = if self.condition == FeedCondition::Vapour { Phase::Vapour } else { Phase::Liquid };
         r[H] = out.h() - phase.enthalpy(io.thermo, out.t(), out.p(), z);
     }
+    /// The feed's outlet at its input values (the guess is made at the inputs it is given, which
+    /// `--set` or an analysis may have moved from the file's), the last fraction making up the
+    /// balance as in [`UnitModel::eval`].
     fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]) {
-        own[F] = self.flow;
-        own[P] = self.pressure;
-        own[Z0..].copy_from_slice(&self.z);
-        own[T] = if self.has_t_input() {
-            self.temperature
-        } else {
-            io.thermo.bubble_t(self.pressure, &self.z).map(|s| s.t).unwrap_or(350.0)
-        };
+        let n = io.n_comp();
+        let z0 = if self.has_t_input() { 3 } else { 2 };
+        let mut z: Vec<f64> = (0..n - 1).map(|i| io.input(z0 + i)).collect();
+        z.push((1.0 - z.iter().sum::<f64>()).max(0.0));
+        own[F] = io.input(0);
+        own[P] = io.input(1);
+        own[Z0..].copy_from_slice(&z);
+        own[T] =
+            if self.has_t_input() { io.input(2) } else { io.thermo.bubble_t(own[P], &z).map(|s| s.t).unwrap_or(350.0) };
         let phase = if self.condition == FeedCondition::Vapour { Phase::Vapour } else { Phase::Liquid };
-        own[H] = phase.enthalpy(io.thermo, own[T], own[P], &self.z);
+        own[H] = phase.enthalpy(io.thermo, own[T], own[P], &z);
     }
 }

@@ -16,16 +16,23 @@
 //!   `Σ_i K_i(T, P, x) x_i = 1`, which fixes `T` [K] (for constant relative volatility, whose
 //!   K-values do not depend on `T`, the Raoult bubble point `Σ_i x_i P_sat,i(T) = P` instead, as in
 //!   `ThermoPackage::bubble_t`); `T_vapour = T`;
-//! - quasi-steady energy balance `0 = F h_F + Q − V h_V − L h_L` [W] (gives `V`), `Q` the input
-//!   `duty`, `h_V = h_vap(T, y)`, `h_L = h_liq(T, x)` [J/mol];
+//! - quasi-steady energy balance `0 = F (h_F − h_L) + Q − V (h_V − h_L)` [W] (gives `V`), `Q` the
+//!   input `duty`, `h_V = h_vap(T, y)`, `h_L = h_liq(T, x)` [J/mol];
 //! - `P_vapour = P` [Pa]; the outflow law for `L` [mol/s] and the liquid's outlet pressure [Pa]
 //!   (see [`super::outflow`]).
 //!
 //! Why the energy balance is algebraic: at fixed `P` the liquid sits at its bubble point, so its
 //! temperature and enthalpy follow from its composition; `U = M h_L` is not an independent state.
-//! The sensible-heat accumulation `d(M h_L)/dt` is neglected (Luyben's usual simplification), which
-//! makes the drum's vapour respond instantly to feed enthalpy and duty. At steady state the drum is
-//! exactly an isobaric PH flash of the feed at `h_F + Q/F`.
+//! Of `d(M h_L)/dt = F h_F + Q − V h_V − L h_L` the specific-enthalpy accumulation `M dh_L/dt` is
+//! neglected (Luyben's usual simplification, the rigorous column's model 2a), which makes the
+//! drum's vapour respond instantly to feed enthalpy and duty; the other part, `h_L dM/dt =
+//! h_L (F − V − L)`, is kept: subtracting it leaves the balance above, in which the liquid outflow
+//! drops out. Dropping the whole accumulation instead (`0 = F h_F + Q − V h_V − L h_L`) would say
+//! that liquid gathering in the drum carries no enthalpy — zero on the package's arbitrary datum —
+//! so the vapour would depend on that datum whenever the holdup moves: a step in the feed, with `L`
+//! still at its old value, asked for `V = (F h_F − L h_L)/h_V < 0` on a datum where liquid
+//! enthalpies are negative, and no consistent state existed. At steady state `F = V + L` and both
+//! forms are the exact energy balance: the drum is an isobaric PH flash of the feed at `h_F + Q/F`.
 //!
 //! The drum must operate two-phase. For a subcooled feed (`h_F + Q/F` below the bubble-point
 //! enthalpy) the energy balance asks for `V < 0`; the bound `F ≥ 0` on the vapour stream then stops
@@ -139,7 +146,7 @@ impl UnitModel for Flash {
             res[Z0 + i] = y[i] - k[i] * x[i];
         }
         self.holdup.residuals(n, x, mlv, vl, &mut res, (len + Z0, 2 * len + nc));
-        res[F] = inlet.f() * inlet.h() + q - vap.f() * vap.h() - liq.f() * liq.h();
+        res[F] = inlet.f() * (inlet.h() - liq.h()) + q - vap.f() * (vap.h() - liq.h());
         res[T] = vap.t() - t;
         res[P] = vap.p() - p;
         res[H] = vap.h() - io.thermo.h_vap(t, y);
@@ -250,6 +257,37 @@ mod tests {
             );
             assert!(s.beta > 0.05 && s.beta < 0.95);
             assert!(d_c < 1e-12 && d_e < 1e-9 && d_k < 1e-12 && d_beta < 1e-8 && d_xy < 1e-8 && d_t < 1e-6);
+        }
+    }
+
+    /// The drum's energy balance does not depend on the enthalpy datum, also off steady state
+    /// (`F ≠ V + L`, the holdup moving): adding one constant to the feed's, the vapour's and the
+    /// liquid's molar enthalpies leaves its residual as it was. The balance without `h_L dM/dt`
+    /// changed by `(F − V − L)·c`, and a feed step could ask for a negative vapour flow.
+    #[test]
+    fn energy_balance_is_independent_of_the_enthalpy_datum_off_steady_state() {
+        let thermo = binary_package();
+        for json in [VALVE, FLOW, FREE] {
+            let u = build_unit(json, &thermo, Flash::build);
+            let (lay, mut local) = at_guess(&u, &thermo, &feed(&thermo));
+            let (len, inlet) = (lay.stream.len(), lay.inlets_offset());
+            local[inlet + F] *= 1.3;
+            local[F] += 0.1;
+            let n_eq = (lay.n_own() as isize + UnitModel::extra_equations(&u)) as usize;
+            let energy = |local: &[f64]| -> f64 {
+                let mut r = vec![0.0; n_eq];
+                UnitModel::eval(&u, &UnitIo { local, layout: &lay, thermo: &thermo, time: 0.0 }, &mut r);
+                r[F]
+            };
+            let flows = local[inlet + F] - local[F] - local[len + F];
+            let mut shifted = local.clone();
+            for k in [H, len + H, inlet + H] {
+                shifted[k] += 1e4;
+            }
+            let (e0, e1) = (energy(&local), energy(&shifted));
+            let scale = local[inlet + F] * local[inlet + H].abs();
+            eprintln!("F − V − L = {flows:.3} mol/s: energy residual {e0:.6e} W, datum + 10 kJ/mol {e1:.6e} W");
+            assert!(flows.abs() > 1.0 && (e1 - e0).abs() < 1e-12 * scale, "{json}: {e0} vs {e1}");
         }
     }
 

@@ -63,7 +63,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::reduce::Reduction;
-use super::{DaeError, DaeIntegrator, DaeSystem, consistent_algebraic, rms};
+use super::{DaeError, DaeIntegrator, DaeSystem, Equation, consistent_algebraic, rms};
 use crate::NewtonSettings;
 use crate::newton::row_weights;
 use crate::sparse::{SparseError, SparseLu};
@@ -761,7 +761,7 @@ impl Bdf {
             .iter()
             .map(|&(i, _)| (i, f[i].abs()))
             .fold((0, -1.0), |w, e| if e.1 > w.1 || e.1.is_nan() { e } else { w });
-        Err(DaeError::Outputs { time: t, equation, residual })
+        Err(DaeError::Outputs { time: t, equation: Box::new(Equation::of(sys, equation)), residual })
     }
 
     /// The output block `∂F_o/∂x_o` of the full Jacobian `jac`, through the explicit variables

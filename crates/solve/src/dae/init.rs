@@ -2,7 +2,7 @@
 //! algebraic equations `0 = f_a(t, x_d, x_a)` for the algebraic variables `x_a` by the
 //! steady-state Newton solver (line search, bounds) on that subsystem.
 
-use super::{DaeError, DaeSystem};
+use super::{DaeError, DaeSystem, Equation, Inconsistent};
 use crate::{NewtonSettings, NewtonStatus, System, solve_steady};
 
 /// The algebraic subsystem of a DAE at fixed time and differential variables.
@@ -94,10 +94,33 @@ pub fn consistent_algebraic(sys: &dyn DaeSystem, t: f64, x: &mut [f64]) -> Resul
     let stalled_at_roundoff = report.worst.is_some_and(|(_, r)| r <= STALL_TOLERANCE);
     if report.status != NewtonStatus::Converged && !stalled_at_roundoff {
         let (k, residual) = report.worst.unwrap_or((0, f64::NAN));
-        return Err(DaeError::Initialization { time: t, residual, equation: alg.rows.get(k).copied().unwrap_or(0) });
+        let equation = Equation::of(sys, alg.rows.get(k).copied().unwrap_or(0));
+        let pinned = pinned_on_bounds(&alg, x, &xa);
+        return Err(DaeError::Initialization(Box::new(Inconsistent { time: t, residual, equation, pinned })));
     }
     for (k, &j) in alg.cols.iter().enumerate() {
         x[j] = xa[k];
     }
     Ok((report.n_residual_evals, report.n_jacobian_evals))
+}
+
+/// The algebraic variables a failed solve left on a bound they did not start on (a flow that
+/// would reverse, a holdup that would go negative): where the solution the equations ask for lies
+/// outside the bounds, as `` `path` at its lower bound 0 ``.
+fn pinned_on_bounds(alg: &Algebraic<'_>, x0: &[f64], xa: &[f64]) -> Vec<String> {
+    let mut pinned = Vec::new();
+    for (k, &j) in alg.cols.iter().enumerate() {
+        let (lo, hi) = alg.sys.bounds(j);
+        let near = |v: f64, b: f64| (v - b).abs() <= 1e-9 * alg.sys.nominal(j).abs().max(b.abs());
+        let side = if near(xa[k], lo) && !near(x0[j], lo) {
+            ("lower", lo)
+        } else if near(xa[k], hi) && !near(x0[j], hi) {
+            ("upper", hi)
+        } else {
+            continue;
+        };
+        let name = alg.sys.variable_name(j).unwrap_or_else(|| format!("variable {j}"));
+        pinned.push(format!("`{name}` at its {} bound {}", side.0, side.1));
+    }
+    pinned
 }

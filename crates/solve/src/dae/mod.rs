@@ -67,6 +67,49 @@ pub trait DaeSystem: Sync {
     fn residual_completed(&self, t: f64, x: &[f64], r: &mut [f64]) {
         self.residual(t, x, r);
     }
+    /// What equation `i` is, for messages (a plant: its unit, equation and variable; default:
+    /// nothing beyond its index).
+    fn equation_name(&self, _i: usize) -> Option<String> {
+        None
+    }
+    /// What variable `i` is, for messages (a plant: its path; default: nothing beyond its index).
+    fn variable_name(&self, _i: usize) -> Option<String> {
+        None
+    }
+    /// What a failure on equation `i` most often means, as a clause beginning with `"; "` (a
+    /// plant: a vessel running dry for a unit's equation, an output the plant cannot take for a
+    /// controller's; default: nothing).
+    fn equation_hint(&self, _i: usize) -> Option<&'static str> {
+        None
+    }
+}
+
+/// An equation of a [`DaeSystem`] as a failure names it: its index and, when the system knows
+/// it, its name ([`DaeSystem::equation_name`]); shown as `equation 6 (flash: …)`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Equation {
+    /// Global index.
+    pub index: usize,
+    /// The system's name for it.
+    pub name: Option<String>,
+    /// What a failure on it most often means ([`DaeSystem::equation_hint`]).
+    pub hint: Option<&'static str>,
+}
+
+impl Equation {
+    /// Equation `index` of `sys`, with its name and hint.
+    pub fn of(sys: &dyn DaeSystem, index: usize) -> Equation {
+        Equation { index, name: sys.equation_name(index), hint: sys.equation_hint(index) }
+    }
+}
+
+impl std::fmt::Display for Equation {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match &self.name {
+            Some(name) => write!(f, "equation {} ({name})", self.index),
+            None => write!(f, "equation {}", self.index),
+        }
+    }
 }
 
 /// Why an integration stopped.
@@ -89,15 +132,8 @@ pub enum DaeError {
         max_steps: usize,
     },
     /// The algebraic variables could not be made consistent.
-    #[error("consistent initialization failed at t = {time} s: scaled residual {residual:.3e} in equation {equation}")]
-    Initialization {
-        /// Time [s].
-        time: f64,
-        /// Final scaled residual.
-        residual: f64,
-        /// Global index of the worst equation.
-        equation: usize,
-    },
+    #[error(transparent)]
+    Initialization(Box<Inconsistent>),
     /// The iteration matrix could not be factorized.
     #[error("iteration matrix singular at t = {time} s: {source}")]
     Singular {
@@ -107,14 +143,12 @@ pub enum DaeError {
         source: crate::sparse::SparseError,
     },
     /// The output-only variables did not converge when asked for.
-    #[error(
-        "output-only variables at t = {time} s did not converge: equation {equation} keeps a residual of {residual:.3e}"
-    )]
+    #[error("output-only variables at t = {time} s did not converge: {equation} keeps a residual of {residual:.3e}")]
     Outputs {
         /// Time [s].
         time: f64,
-        /// Global index of the equation with the largest residual.
-        equation: usize,
+        /// The equation with the largest residual.
+        equation: Box<Equation>,
         /// Its residual.
         residual: f64,
     },
@@ -129,6 +163,32 @@ pub enum DaeError {
     /// A restored state does not fit the system.
     #[error("integrator state does not fit the system: {0}")]
     BadState(String),
+}
+
+/// A consistent initialization that failed: where, and what the algebraic equations asked for.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error(
+    "consistent initialization failed at t = {time} s: scaled residual {residual:.3e} in {equation}{}",
+    pinned_note(.pinned)
+)]
+pub struct Inconsistent {
+    /// Time [s].
+    pub time: f64,
+    /// Final scaled residual.
+    pub residual: f64,
+    /// The worst equation.
+    pub equation: Equation,
+    /// The variables the solve left on a bound they did not start on (`` `path` at its lower
+    /// bound 0 ``): the equations ask for values beyond them.
+    pub pinned: Vec<String>,
+}
+
+/// `; the equations ask for values beyond the bounds of …` (empty when nothing was pinned).
+fn pinned_note(pinned: &[String]) -> String {
+    if pinned.is_empty() {
+        return String::new();
+    }
+    format!("; the equations ask for values beyond the bounds of {}", pinned.join(", "))
 }
 
 /// A DAE integrator that can be stopped exactly at given times and restarted after events.

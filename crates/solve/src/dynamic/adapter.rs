@@ -205,6 +205,28 @@ impl DaeSystem for PlantDae<'_> {
     fn outputs(&self) -> &[(usize, usize)] {
         self.shape.explicit.outputs()
     }
+    fn equation_name(&self, i: usize) -> Option<String> {
+        if i >= self.shape.n_plant {
+            return None;
+        }
+        let var = self.plant.equation_variable(i).map_or("-", |v| self.plant.vars()[v].path.as_str());
+        Some(format!("{}, variable {var}", self.plant.equation_name(i)))
+    }
+    fn variable_name(&self, i: usize) -> Option<String> {
+        self.plant.vars().get(i).map(|v| v.path.clone())
+    }
+    fn equation_hint(&self, i: usize) -> Option<&'static str> {
+        let block = self.plant.blocks().iter().find(|b| (b.eq_offset..b.eq_offset + b.n_eq).contains(&i))?;
+        Some(match block.kind {
+            plantwide_flowsheet::BlockKind::Controller => {
+                "; a controller whose output the plant cannot take there (moved past the range of the input it \
+                 drives, or by a model of the wrong sign or size) ends a run this way"
+            }
+            plantwide_flowsheet::BlockKind::Unit => {
+                "; a vessel running dry or overflowing, or a flow reversing, ends a run this way"
+            }
+        })
+    }
     fn complete(&self, t: f64, x: &mut [f64]) {
         let np = self.shape.n_plant;
         INPUTS.with_borrow_mut(|u| {

@@ -422,7 +422,7 @@ fn failure(plant: &Plant, e: RunError) -> String {
     let file = plant.file();
     match e {
         RunError::Dae(source) => {
-            format!("{file}: integration failed: {source}{}", super::failure_detail(plant, &source))
+            format!("{file}: integration failed: {source}{}", super::failure_hint(&source))
         }
         RunError::Mpc(source) => format!("{file}: {source}"),
     }

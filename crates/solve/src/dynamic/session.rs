@@ -14,7 +14,7 @@ use crate::dae::{Bdf, BdfSettings, DaeError, DaeIntegrator};
 
 /// Why a session could not advance.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("{file}: integration failed at t = {t:.6e} s: {source}")]
+#[error("{file}: integration failed at t = {t:.6e} s: {source}{}", super::failure_hint(.source))]
 pub struct SessionError {
     /// Flowsheet file.
     pub file: String,
