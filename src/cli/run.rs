@@ -117,7 +117,9 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
         }
         Err(e) => {
             // The trends up to the failure show what led to it (a vessel draining, a loop saturating).
-            let SimError::Integration { partial, .. } = &e else { return Err(CliError::numerical(e.to_string())) };
+            let (SimError::Integration { partial, .. } | SimError::Stopped { partial, .. }) = &e else {
+                return Err(CliError::numerical(e.to_string()));
+            };
             let mut partial = partial.clone();
             display_units(&mut partial, args.units, &spec);
             let written = write_trends_files(args, &partial, &plot_cx, &sc.time_unit, time_factor);

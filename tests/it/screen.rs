@@ -420,14 +420,15 @@ fn a_reboiler_duty_loop_is_tuned_and_run_in_the_dynamic_test() {
 fn a_failed_run_is_marked_and_screen_exits_2() {
     let file = crate::harness::fixture(BT_LV);
     let args = ["screen", &file, "--cvs", BT_QUALITIES, "--mvs", "column.reflux,column.reboiler_duty"];
-    let out = plantwide(&[&args[..], &["--disturbances", "feed_source.F=+10%,feed_source.F=+400%", "--json"]].concat());
+    let out = plantwide(&[&args[..], &["--disturbances", "feed_source.F=+10%,feed_source.F=-100%", "--json"]].concat());
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
     let v: Value = serde_json::from_slice(&out.stdout).unwrap();
     let s = &v["structures"][0];
     let runs = s["dynamic"]["runs"].as_array().unwrap();
     assert!(runs[0]["failure"].is_null() && runs[0]["cvs"][0]["iae"].as_f64().unwrap() > 0.0, "{s}");
-    assert!(runs[1]["failure"].as_str().unwrap().contains("integration failed"), "{s}");
+    // The feed lost: the sump's level loop asks for a reversed bottoms flow (compare's test).
+    assert!(runs[1]["failure"].as_str().unwrap().contains("drives `column.bottoms` out of its range"), "{s}");
     assert!(runs[1]["cvs"][0]["iae"].is_null() && s["dynamic"]["score"].is_null() && s["rank"].is_null(), "{s}");
     assert_eq!(v["failed"].as_array().unwrap().len(), 1);
     assert!(
@@ -435,8 +436,8 @@ fn a_failed_run_is_marked_and_screen_exits_2() {
     );
     assert!(v["verdict"].as_str().unwrap().starts_with("no pairing recommended"), "{}", v["verdict"]);
     // The text report marks it too.
-    let out = plantwide(&[&args[..], &["--disturbances", "feed_source.F=+10%,feed_source.F=+400%"]].concat());
+    let out = plantwide(&[&args[..], &["--disturbances", "feed_source.F=+10%,feed_source.F=-100%"]].concat());
     let text = String::from_utf8_lossy(&out.stdout);
     assert_eq!(out.status.code(), Some(2));
-    assert!(text.contains("| failed | failed, run feed_source.F +400 %: "), "{text}");
+    assert!(text.contains("| failed | failed, run feed_source.F -100 %: "), "{text}");
 }

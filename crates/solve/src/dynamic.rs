@@ -101,6 +101,16 @@ pub enum SimError {
         /// What was recorded up to the failure (the trends that lead to it).
         partial: Box<SimulationResult>,
     },
+    /// The plant stopped: a vessel ran dry (with the run up to there).
+    #[error("{file}: stopped: {reason}")]
+    Stopped {
+        /// Flowsheet file.
+        file: String,
+        /// Which holdup, when, and what keeps it from happening.
+        reason: String,
+        /// What was recorded up to the stop.
+        partial: Box<SimulationResult>,
+    },
     /// The run finished but does not conserve material (a unit's balance or holdup is wrong, or
     /// the integration is not to be trusted).
     #[error("{file}: {source}")]
@@ -208,6 +218,9 @@ pub fn simulate(
         }
         Err(driver::RunError::Mpc(source)) => {
             return Err(SimError::Mpc { file, source, partial: Some(Box::new(d.finish())) });
+        }
+        Err(driver::RunError::Stopped(reason)) => {
+            return Err(SimError::Stopped { file, reason, partial: Box::new(d.finish()) });
         }
     }
     let res = d.finish();

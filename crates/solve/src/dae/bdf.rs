@@ -1051,6 +1051,13 @@ impl Bdf {
             let Some(iters) = self.correct(sys, t_new, c, NEWTON_TOL, &mut lu_ok)? else {
                 self.st.stats.n_newton_failures += 1;
                 culprit = self.worst_correction().map(|j| (j, "the corrector diverged on it"));
+                // The retry evaluates a Jacobian at its own predicted point if the held one fails
+                // it (CVODE's `CV_FAIL_OTHER`): one taken at a longer step's prediction may lie
+                // across a kink of the model (a controller output leaving its limit) from every
+                // shorter step's solution, and the corrector then cycles across the kink at every
+                // step size. A two-column plant whose lost feed came back stopped this way, its
+                // step halved from 0.6 s to 2e-11 s on one stale Jacobian.
+                self.st.current_jac = false;
                 self.scale_step(h_abs, order, 0.5);
                 lu_ok = false;
                 continue;

@@ -74,6 +74,10 @@ pub(super) struct Driver<'p> {
     mpcs: Vec<MpcRun>,
     /// The first controller failure, which ends the run.
     failure: Option<MpcError>,
+    /// The total holdups of the plant's vessels and stages (variables marked `inventory`).
+    holdups: Vec<usize>,
+    /// The inputs controllers drive: (input, the controller output variable driving it).
+    driven: Vec<(usize, usize)>,
     /// The state buffer of [`Driver::step_once`] (events, interpolated rows), kept between steps.
     state_buf: Vec<f64>,
     /// The last step's dense output of the recorded entries (its buffers kept between steps).
@@ -87,6 +91,8 @@ pub(super) enum RunError {
     Dae(DaeError),
     /// A model predictive controller's QP failed.
     Mpc(MpcError),
+    /// A vessel ran dry: the plant cannot go on as modelled (the message names the holdup).
+    Stopped(String),
 }
 
 impl From<DaeError> for RunError {
@@ -192,6 +198,11 @@ impl<'p> Driver<'p> {
         // What the driver reads between steps; a model predictive controller reads its model's
         // states, which may be anything.
         let mut reads = outputs;
+        let holdups: Vec<usize> = (0..plant.n_vars()).filter(|&v| plant.vars()[v].spec.inventory).collect();
+        reads.extend(holdups.iter().copied());
+        let driven: Vec<(usize, usize)> =
+            plant.inputs().iter().enumerate().filter_map(|(i, info)| info.driven_by.map(|v| (i, v))).collect();
+        reads.extend(driven.iter().map(|&(_, v)| v));
         reads.extend(recorded.iter().copied().filter(|&v| v < plant.n_vars()));
         reads.extend(analyzers.iter().map(|&(_, v)| v));
         reads.extend(sampled.iter().flatten().map(|&(_, op)| op));
@@ -222,6 +233,8 @@ impl<'p> Driver<'p> {
             quad,
             mpcs,
             failure: None,
+            holdups,
+            driven,
             state_buf: Vec::new(),
             dense: DenseOutput::default(),
         })
@@ -606,9 +619,67 @@ impl<'p> Driver<'p> {
         let now = self.bdf.t();
         self.record_through(now, &mut x);
         self.state_buf = x;
+        if let Some(why) = self.ran_dry().or_else(|| self.driven_out_of_range()) {
+            return Err(RunError::Stopped(why));
+        }
         self.offer_snapshots(now, observer)?;
         observer(Progress::Step { t: now, duration: self.sc.duration });
         Ok(true)
+    }
+
+    /// A vessel or stage whose total holdup went below zero in the last step (by more than a
+    /// millionth of its nominal holdup, beyond the integrator's error): what is drawn from it (an
+    /// outflow an input or a controller sets, which goes on at an empty vessel) outran what flows
+    /// in, and the model has no meaning past that point.
+    fn ran_dry(&self) -> Option<String> {
+        let x = self.bdf.x();
+        let plant = &self.plant;
+        let v = *self.holdups.iter().find(|&&v| x[v] < -1e-6 * plant.vars()[v].spec.nominal)?;
+        let var = &plant.vars()[v];
+        Some(format!(
+            "`{}` ran dry at t = {} s (holdup {} mol): what is drawn from it (an outflow set by an input or a controller \
+             that goes on at an empty vessel) outran what flows in; a level controller on it, or a lower limit on the \
+             controllers that draw from it, keeps it from running dry",
+            var.path,
+            plantwide_model::limits::number(self.bdf.t()),
+            plantwide_model::limits::number(x[v]),
+        ))
+    }
+
+    /// An input a controller drives taken out of its physical range in the last step (a flow
+    /// below zero: a controller with no lower limit asking a valve to pass a reversed flow), by
+    /// more than a millionth of the output's nominal value, on a side the controller does not
+    /// limit: the models do not hold past it.
+    fn driven_out_of_range(&self) -> Option<String> {
+        let (x, plant) = (self.bdf.x(), &*self.plant);
+        self.driven.iter().find_map(|&(i, v)| {
+            let (lo, hi) = plant.input_range(i);
+            let tol = 1e-6 * plant.vars()[v].spec.nominal.abs();
+            let value = x[v];
+            // A side the controller limits holds by its own clamp (what is beyond is the
+            // corrector's tolerance on the output, not the controller's intent).
+            let (op_min, op_max) = plant.blocks()[plant.vars()[v].block]
+                .unit
+                .output_limits()
+                .unwrap_or((f64::NEG_INFINITY, f64::INFINITY));
+            let below = value < lo - tol && op_min == f64::NEG_INFINITY;
+            let above = value > hi + tol && op_max == f64::INFINITY;
+            if !(below || above || !value.is_finite()) {
+                return None;
+            }
+            let info = &plant.inputs()[i];
+            let dim = info.dim;
+            let why = plantwide_model::limits::check_input_within(&info.path, dim, value, (lo, hi))
+                .err()
+                .map_or_else(String::new, |e| e.to_string());
+            Some(format!(
+                "`{}` drives `{}` out of its range at t = {} s: {why}; a limit on the controller's output (op_min, \
+                 op_max) makes it saturate there instead",
+                plant.vars()[v].path,
+                info.path,
+                plantwide_model::limits::number(self.bdf.t()),
+            ))
+        })
     }
 
     /// Record every row due by `now` (and by the end), interpolated within the last step.
@@ -641,6 +712,12 @@ impl<'p> Driver<'p> {
                 self.complete_outputs()?;
                 let snap = self.snapshot();
                 observer(Progress::Snapshot { file: &self.sc.snapshots[k].1, snapshot: &snap });
+                // The run goes on from the snapshot as a resume from it does (the integrator
+                // restored from the state it saved): the held LU factors and the untracked
+                // variables are rebuilt from the snapshot in both, so that a resumed run is the
+                // continuous one bit for bit, not just within rounding.
+                let sys = PlantDae::new(&self.plant, &self.st.waveforms, &self.shape);
+                self.bdf.restore(&sys, snap.integrator)?;
             }
         }
         Ok(())

@@ -429,6 +429,7 @@ fn failure(plant: &Plant, e: RunError) -> String {
             format!("{file}: integration failed: {source}{}", super::failure_hint(&source))
         }
         RunError::Mpc(source) => format!("{file}: {source}"),
+        RunError::Stopped(reason) => format!("{file}: stopped: {reason}"),
     }
 }
 
