@@ -18,9 +18,12 @@
 //! - equilibrium `y_ij = K_ij(T_i, P, x_i) x_ij` (constant α: `y = α x / Σ α x`);
 //! - bubble point: `Σ_j K_ij x_ij = 1` (constant α: `Σ_j x_ij P_sat,j(T_i) = P`, the temperature
 //!   scale of the hypothetical components);
-//! - liquid flow: trays `L_i = L0_i + (M_i − M0_i)/τ_L + λ (V_{i−1} − V0)` (linearized Francis weir),
-//!   condenser `L_N = reflux`, reboiler `L_1 = B`;
-//! - vapour flow: `V_1 = boilup`, `V_i = V_{i−1} + Σ_feeds (1 − q) F` (CMO), condenser `V_N = 0`.
+//! - liquid flow: trays `L_i = max(0, L0_i + (M_i − M0_i)/τ_L + λ (V_{i−1} − V0))` (linearized
+//!   Francis weir; no flow once a tray has drained below its weir, as when the boilup is lost and
+//!   the trays run down), condenser `L_N = reflux`, reboiler `L_1 = B`;
+//! - vapour flow: `V_1 = max(0, boilup + Σ_feeds (1 − q) F)`, `V_i = max(0, V_{i−1} + Σ_feeds (1 − q) F)`
+//!   (CMO; a subcooled feed condenses at most the vapour there is, as when the boilup is lost),
+//!   condenser `V_N = 0`.
 //!
 //! `L0_i` is the nominal liquid flow leaving stage i: the nominal reflux above the feeds, plus
 //! `q·F_nominal` below each feed (`F_nominal` defaults to the nominal `D + B` for one feed).
@@ -486,15 +489,21 @@ impl UnitModel for SimpleColumn {
                 if self.lambda != 0.0 {
                     l += (st(s - 1)[ix.v()] - self.v0) * self.lambda;
                 }
+                // No flow over the weir once the tray has drained below it.
+                if l.re() < 0.0 {
+                    l = S::from(0.0);
+                }
                 v[ix.l()] - l
             };
             // Vapour flows (CMO).
+            // A subcooled feed condenses at most the vapour there is: no negative vapour flow.
+            let floor = |v: S| if v.re() < 0.0 { S::from(0.0) } else { v };
             r[o + ix.v()] = if s == 0 {
-                v[ix.v()] - v_in - feed_vap[0]
+                v[ix.v()] - floor(v_in + feed_vap[0])
             } else if s + 1 == n {
                 v[ix.v()]
             } else {
-                v[ix.v()] - st(s - 1)[ix.v()] - feed_vap[s]
+                v[ix.v()] - floor(st(s - 1)[ix.v()] + feed_vap[s])
             };
         }
         self.outlet_residuals(io, d_in, &draw_flow, r);

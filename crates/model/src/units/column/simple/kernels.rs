@@ -48,11 +48,14 @@ fn stage_composition(
 
 impl SimpleColumn {
     /// The liquid leaving tray `s` of holdup `m` with `v_below` rising into it (Francis-weir
-    /// linearization with the vapour effect λ, module documentation of `simple.rs`).
+    /// linearization with the vapour effect λ, none below the weir; module documentation of
+    /// `simple.rs`).
     #[inline(always)]
     fn tray_liquid(&self, s: usize, m: f64, v_below: f64) -> f64 {
         let l = self.l0[s] + (m - self.m0[s]) / self.tau_l;
-        if self.lambda != 0.0 { l + (v_below - self.v0) * self.lambda } else { l }
+        let l = if self.lambda != 0.0 { l + (v_below - self.v0) * self.lambda } else { l };
+        // `<`, not `max`: a NaN stays one.
+        if l < 0.0 { 0.0 } else { l }
     }
 
     /// [`UnitModel::eval_kept`](crate::UnitModel::eval_kept) with `NC` components (`0`: as many
@@ -159,10 +162,13 @@ impl SimpleColumn {
             // The feed quality may read this stage's x and y, just computed.
             let fed: f64 =
                 (0..self.feeds.len()).filter(|&f| self.feeds[f].stage == s).map(|f| self.feed_vapour(io, f, v)).sum();
+            // A subcooled feed condenses at most the vapour there is (CMO's `V + (1 − q) F`
+            // would turn negative once the boilup is lost).
+            let floor = |v: f64| if v < 0.0 { 0.0 } else { v };
             v[ix.v()] = match s {
-                0 => io.input(IN_BOILUP) + fed,
+                0 => floor(io.input(IN_BOILUP) + fed),
                 _ if s + 1 == n => 0.0,
-                _ => v_below + fed,
+                _ => floor(v_below + fed),
             };
             v[ix.l()] = match s {
                 _ if s + 1 == n => io.input(IN_REFLUX),
