@@ -889,7 +889,8 @@ fn events_of(cx: &mut Cx<'_>, specs: &[EventSpec], duration: f64, limits: &Limit
 fn check_values(cx: &mut Cx<'_>, events: &[(Event, String)]) {
     let mut u = cx.plant.input_values();
     let mut saved: Vec<Option<f64>> = vec![None; u.len()];
-    for (e, label) in events {
+    let mut before_fault: Vec<Option<f64>> = vec![None; u.len()];
+    for (k, (e, label)) in events.iter().enumerate() {
         let (input, values): (usize, Vec<f64>) = match e.action {
             Action::Step { input, change } | Action::Ramp { input, change, .. } => {
                 (input, vec![change.apply(u[input])])
@@ -903,7 +904,18 @@ fn check_values(cx: &mut Cx<'_>, events: &[(Event, String)]) {
                 saved[input] = Some(u[input]);
                 (input, vec![u[input] - amplitude.abs(), u[input] + amplitude.abs()])
             }
-            Action::Stuck { input, value: Some(v) } => (input, vec![v]),
+            Action::Stuck { input, value: Some(v) } => {
+                before_fault[input] = Some(u[input]);
+                (input, vec![v])
+            }
+            // The repaired input is back at its value before the fault (a free input), or with
+            // its controller, whose output the check does not follow: either way not the failed value.
+            Action::Repair { input } => {
+                if let Some(v) = before_fault[input].take() {
+                    u[input] = v;
+                }
+                continue;
+            }
             _ => continue,
         };
         for &v in &values {
@@ -918,6 +930,14 @@ fn check_values(cx: &mut Cx<'_>, events: &[(Event, String)]) {
         }
         if !matches!(e.action, Action::Sinusoid { .. }) {
             u[input] = values[0];
+            // A feed's fractions but its last (the balance) must not pass 1 together: another
+            // event may have raised one of them earlier. Checked once all the events at one time
+            // have acted (they may move fractions of one feed together).
+            let last_at_time = events.get(k + 1).is_none_or(|(next, _)| next.t != e.t);
+            if let (true, Err(why)) = (last_at_time, crate::overrides::check_compositions(cx.plant, &u)) {
+                cx.diags.push(Diagnostic::new(label.split(' ').next().unwrap_or_default(), why.to_string()));
+                return;
+            }
         }
     }
 }
