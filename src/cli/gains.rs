@@ -91,7 +91,7 @@ pub struct GainsArgs {
     #[arg(long = "set", value_name = "PATH=VALUE")]
     set: Vec<String>,
     /// Draw the relative gain array as a heat map here (`.png` or `.svg`).
-    #[arg(long, value_name = "RGA.png")]
+    #[arg(long, value_name = "RGA.png", value_parser = super::output_file)]
     plot: Option<PathBuf>,
 }
 

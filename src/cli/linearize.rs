@@ -35,7 +35,7 @@ pub struct LinearizeArgs {
     #[arg(long, value_delimiter = ',', required_unless_present = "tf")]
     outputs: Vec<String>,
     /// Write the model here: JSON, or a NumPy archive when the name ends in `.npz`.
-    #[arg(long, value_name = "MODEL.json|MODEL.npz")]
+    #[arg(long, value_name = "MODEL.json|MODEL.npz", value_parser = super::output_file)]
     out: Option<PathBuf>,
     /// Time unit of the exported A and B, eigenvalues and time constants (default s).
     #[arg(long, default_value = "s")]

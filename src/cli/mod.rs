@@ -123,10 +123,10 @@ enum Command {
         #[arg(long)]
         scenario: PathBuf,
         /// Write the recorded trends here (CSV, units in the header).
-        #[arg(long)]
+        #[arg(long, value_parser = output_file)]
         csv: PathBuf,
         /// Write trend plots here (.png or .svg).
-        #[arg(long)]
+        #[arg(long, value_parser = output_file)]
         plot: Option<PathBuf>,
         /// Print the summary as JSON.
         #[arg(long)]
@@ -238,4 +238,24 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             Ok(())
         }
     }
+}
+
+/// The value of a flag naming a file to write: its folder must exist and it must not be a folder,
+/// checked when the command line is read (a run is not started only to fail at its end).
+pub(crate) fn output_file(value: &str) -> Result<PathBuf, String> {
+    let path = PathBuf::from(value);
+    if value.is_empty() {
+        return Err("an empty path: give a file name".into());
+    }
+    if path.is_dir() {
+        return Err(format!("`{value}` is a folder: give a file name in it"));
+    }
+    let folder = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
+    if !folder.is_dir() {
+        return Err(format!(
+            "the folder `{}` does not exist: create it, or write the file elsewhere",
+            folder.display()
+        ));
+    }
+    Ok(path)
 }

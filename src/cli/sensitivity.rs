@@ -33,10 +33,10 @@ pub struct SensitivityArgs {
     #[arg(long, default_value_t = 21)]
     points: usize,
     /// Write the table as CSV here.
-    #[arg(long, value_name = "OUT.csv")]
+    #[arg(long, value_name = "OUT.csv", value_parser = super::output_file)]
     csv: Option<PathBuf>,
     /// Draw the curves into a PNG or SVG file.
-    #[arg(long, value_name = "OUT.png|OUT.svg")]
+    #[arg(long, value_name = "OUT.png|OUT.svg", value_parser = super::output_file)]
     plot: Option<PathBuf>,
     /// Override an input or a unit parameter first.
     #[arg(long = "set", value_name = "PATH=VALUE")]

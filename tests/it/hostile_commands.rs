@@ -347,3 +347,34 @@ fn a_transfer_function_file_with_a_key_twice_or_an_endless_name_is_refused_brief
     let err = expect(&["linearize", "--tf", long.to_str().unwrap()], 1, &["long.tf.json"]);
     assert!(err.len() < 2000, "a {} character message", err.len());
 }
+
+/// newcomer3 D11: a plot into a missing folder failed after the whole run with a raw backend
+/// error. Output files are checked when the command line is read, naming the flag and the folder.
+#[test]
+fn an_output_file_in_a_missing_folder_is_refused_before_the_run() {
+    let missing = scratch("d11").join("missing_dir").join("o.png");
+    let scenario = harness::flowsheet("scenarios/surge_tank_inflow_step.json");
+    let tank = harness::flowsheet("surge_tank_pi.json");
+    let args = ["run", &tank, "--scenario", &scenario, "--csv", "/dev/null", "--plot", missing.to_str().unwrap()];
+    expect(&args, 1, &["--plot", "missing_dir", "does not exist"]);
+    let sensitivity = ["sensitivity", &tank, "--csv", missing.to_str().unwrap()];
+    expect(&sensitivity, 1, &["--csv", "missing_dir", "does not exist"]);
+}
+
+/// Found by the 100 000-mutant fuzz: an element of 10 000 lags kept `tune` busy for minutes.
+/// An element's order is bounded, refused by field.
+#[test]
+fn a_transfer_function_of_ten_thousand_lags_is_refused_by_field() {
+    let dir = scratch("tf_order");
+    let file = dir.join("lags.tf.json");
+    let lags = vec!["\"14.4 min\""; 10_000].join(",");
+    std::fs::write(
+        &file,
+        format!(
+            r#"{{"format_version": 1, "name": "t", "inputs": [{{"name": "u"}}], "outputs": [{{"name": "y"}}],
+                "elements": [{{"output": "y", "input": "u", "gain": 1.0, "lags": [{lags}]}}]}}"#
+        ),
+    )
+    .unwrap();
+    expect(&["tune", "--tf", file.to_str().unwrap(), "--method", "zn"], 1, &["elements[0].lags", "more than the 200"]);
+}
