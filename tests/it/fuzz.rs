@@ -21,6 +21,7 @@ mod corpus;
 mod doc;
 mod exec;
 mod guard;
+mod kinds;
 mod mutate;
 mod rng;
 mod targeted;
@@ -29,7 +30,7 @@ use std::io::Write;
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
-use corpus::{Corpus, Mode, Mutant};
+use corpus::{Corpus, Mode, Mutant, Other};
 use exec::{Dishonest, Outcome, execute};
 
 #[global_allocator]
@@ -61,7 +62,7 @@ fn env_u64(name: &str) -> Option<u64> {
 /// Counts and extremes of a campaign.
 #[derive(Default)]
 struct Report {
-    by_mode: [(usize, Duration); 3],
+    by_mode: [(usize, Duration); Mode::ALL.len()],
     ok: usize,
     user: usize,
     numerical: usize,
@@ -110,19 +111,18 @@ impl Report {
 
     fn summary(&self, wall: Duration) -> String {
         let rate = |(n, t): (usize, Duration)| n as f64 / t.as_secs_f64().max(1e-9);
-        let [l, s, r] = self.by_mode;
+        let kinds: Vec<String> = Mode::ALL
+            .iter()
+            .zip(&self.by_mode)
+            .map(|(m, &slot)| format!("{} {} at {:.1}/s", format!("{m:?}").to_lowercase(), slot.0, rate(slot)))
+            .collect();
         format!(
-            "fuzz: {} shipped runs, then {} mutants in {:.1} s (load {} at {:.0}/s, steady {} at {:.1}/s, run {} at {:.1}/s; {} skipped): \
+            "fuzz: {} shipped runs, then {} mutants in {:.1} s ({}; {} skipped): \
              ok {}, user error {}, numerical failure {}, FAILURES {}; slowest {:.2} s ({}); peak allocation {:.1} MiB above a {:.0} MiB baseline; longest message {} chars (seed {:#x})",
             self.warmup,
-            l.0 + s.0 + r.0,
+            self.by_mode.iter().map(|s| s.0).sum::<usize>(),
             wall.as_secs_f64(),
-            l.0,
-            rate(l),
-            s.0,
-            rate(s),
-            r.0,
-            rate(r),
+            kinds.join(", "),
             self.skipped,
             self.ok,
             self.user,
@@ -145,6 +145,19 @@ fn dump(m: &Mutant) {
     let fs = dir.join("flowsheet.json");
     let _ = std::fs::write(&fs, &m.text);
     let sets: String = m.sets.iter().map(|s| format!(" --set '{s}'")).collect();
+    if let Some(other) = &m.other {
+        let what = match other {
+            Other::Tf(_, text) => write_as(&dir, "model.tf.json", text, "tune --tf {} --method zn"),
+            Other::StepModel(text) => write_as(&dir, "sm.json", text, "(column A's MPC reading {})"),
+            Other::Snapshot(text) => {
+                write_as(&dir, "snapshot.json", text, "run flowsheets/surge_tank_pi.json --resume {}")
+            }
+            Other::Study(args) => args.join(" "),
+            Other::Serve(raw) => write_as(&dir, "request.txt", raw, "(an HTTP request to serve: {})"),
+        };
+        say(&format!("fuzz replay files: plantwide {what}"));
+        return;
+    }
     let command = match &m.scenario {
         Some((_, text)) => {
             let sc = dir.join("scenario.json");
@@ -155,6 +168,13 @@ fn dump(m: &Mutant) {
         None => format!("steady {}{sets}", fs.display()),
     };
     say(&format!("fuzz replay files: plantwide {command}"));
+}
+
+/// Write `text` to `dir/name` and fill the file's path into `command`.
+fn write_as(dir: &std::path::Path, name: &str, text: &str, command: &str) -> String {
+    let file = dir.join(name);
+    let _ = std::fs::write(&file, text);
+    command.replace("{}", &file.display().to_string())
 }
 
 /// Make and run `n` mutants from `seed` (mutant 0 has the seed itself).
@@ -169,7 +189,7 @@ fn campaign(seed: u64, n: usize, skip: &[String]) -> Report {
     }
     for m in &shipped {
         guard::begin(&m.describe());
-        let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| execute(m)));
+        let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| execute(m, &corpus)));
         guard::end();
         if !matches!(result, Ok(Ok(Outcome::Ok))) {
             report.failures.push(("shipped file".into(), m.describe(), format!("{result:?}")));
@@ -196,12 +216,15 @@ fn campaign(seed: u64, n: usize, skip: &[String]) -> Report {
         }
         guard::begin(&description);
         let started = Instant::now();
-        let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| execute(&m)));
+        let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| execute(&m, &corpus)));
         guard::end();
         if n == 1 {
             say(&format!("fuzz replay: {description}\n    -> {result:?}"));
         }
         report.record(&m, started.elapsed(), result);
+    }
+    if let Err(why) = kinds::stop_server() {
+        report.failures.push(("serve".into(), "the live server after the campaign".into(), why));
     }
     report
 }
