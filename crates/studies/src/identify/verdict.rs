@@ -415,7 +415,7 @@ mod tests {
     /// An element error of −1/λ11 makes G singular (Yu & Luyben 1987): g11 3 % low (1/35.1 = 2.85 %)
     /// passes the element tolerance, but det Ĝ changes sign, so λ̂11 < 0 and Ĝ⁻¹G has a negative
     /// eigenvalue (their product is det G / det Ĝ < 0). Independent 2 % errors that keep the sign
-    /// move λ11 by far more than 20 %: λ̂11 = 1/(1 − g12 g21/(1.02² g11 g22)).
+    /// move the relative gains by far more than 20 %: λ̂11 = 1/(1 − g12 g21/(1.02² g11 g22)).
     #[test]
     fn rga_and_integral_controllability_catch_errors_the_elements_hide() {
         let l11 = |g: [[f64; 2]; 2]| 1.0 / (1.0 - g[0][1] * g[1][0] / (g[0][0] * g[1][1]));
@@ -433,8 +433,10 @@ mod tests {
         g[1][1] *= 1.02;
         let v = verdict_of(COLUMN_A, g);
         let rga = criterion(&v, "rga_error");
-        let expected = (l11(g) - l11(COLUMN_A)).abs() / l11(COLUMN_A);
-        assert!(rga.at.starts_with("λ11") && (rga.value - expected).abs() < 1e-9 && expected > 0.5, "{rga:?}");
+        // In a 2×2 RGA λ12 = 1 − λ11 moves as much as λ11 and is smaller (λ11 > 1), so its relative
+        // error is the largest: |Δλ11| / (λ11 − 1).
+        let expected = (l11(g) - l11(COLUMN_A)).abs() / (l11(COLUMN_A) - 1.0);
+        assert!(rga.at.starts_with("λ12") && (rga.value - expected).abs() < 1e-9 && expected > 0.5, "{rga:?}");
         assert!(!v.reliable && criterion(&v, "gain_error").value < 0.021 && criterion(&v, "rga_sign").pass);
     }
 
