@@ -207,7 +207,12 @@ fn print_details(l: &FlowsheetLoop, u: &str) {
 /// larger ones before it whose responses left the linear range.
 fn linearity_line(c: &Linearity) -> String {
     let line = |t: &StepTry| {
-        format!("step {}: gain {}, {:.1} % off", significant(t.step), significant(t.gain), 100.0 * t.gain_error)
+        format!(
+            "step {}: gain {}, {} % off",
+            significant(t.step),
+            significant(t.gain),
+            significant(100.0 * t.gain_error)
+        )
     };
     let mut s = format!("  linearized gain G(0) = {}", significant(c.linear_gain));
     if let Some((last, before)) = c.tests.split_last() {

@@ -452,3 +452,20 @@ fn json_of(args: &[&str]) -> serde_json::Value {
     assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
     serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{args:?}: {e}"))
 }
+
+/// When no step gives the linearized gain, the step test fails (exit 2) listing every step with
+/// its fitted gain, rather than tuning on one of them: column A's bottom composition loop (the top
+/// loop in auto) fits FOPTD gains 24 %, 11 % and 16 % off its G(0) at steps of 2.67, 0.275 and
+/// 0.064 mol/s (5 % of the boilup, then smaller); the last smaller step brought it no closer, so the
+/// difference is not the plant's curvature (with the top loop fighting it, the response rises and
+/// then creeps: FOPTD explains R² 0.03-0.46 of longer tests).
+#[test]
+fn a_step_test_whose_gain_never_agrees_with_g0_exits_2_listing_the_steps() {
+    let fs = flowsheet("column_a_lv.json");
+    let out = plantwide(&["tune", &fs, "--loop", "bottom_composition", "--method", "simc", "--tau-c", "5 min"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("`bottom_composition`") && err.contains("disagrees with the linearized gain"), "{err}");
+    assert!(err.matches("step ").count() >= 2 && err.contains("a smaller step did not bring it closer"), "{err}");
+    assert!(out.stdout.is_empty(), "no settings printed");
+}

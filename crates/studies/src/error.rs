@@ -308,7 +308,7 @@ impl TuneError {
 fn step_tries(tests: &[crate::tune::plant_tests::StepTry]) -> String {
     use crate::identify::number;
     let one = |t: &crate::tune::plant_tests::StepTry| {
-        format!("step {}: gain {}, {:.1} % off", number(t.step), number(t.gain), 100.0 * t.gain_error)
+        format!("step {}: gain {}, {} % off", number(t.step), number(t.gain), number(100.0 * t.gain_error))
     };
     tests.iter().map(one).collect::<Vec<_>>().join("; ")
 }
