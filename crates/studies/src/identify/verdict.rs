@@ -451,6 +451,22 @@ mod tests {
         assert!((e.value - (1e-4 + 1e-6) / 1e-2).abs() < 1e-12 && e.pass, "{e:?}");
     }
 
+    /// Issue 53 #11: a model row (one output, one structure) is marked reliable only when each of
+    /// its gains has the exact one's sign and is within 20 % of it: a wrong sign or a gain 100× off
+    /// fails however well the model fits (95 % here).
+    #[test]
+    fn a_model_row_with_a_wrong_sign_or_a_gain_100_times_off_is_not_reliable() {
+        let exact = Mat::from_fn(2, 2, |i, j| COLUMN_A[i][j]);
+        let (inputs, outputs) = ([signal("L"), signal("V")], [signal("yD"), signal("xB")]);
+        let r = Reference { exact: &exact, amplitude: &[1.0, 1.0], inputs: &inputs, outputs: &outputs };
+        let row = |g: [f64; 2]| fitted("oe", g, 95.0);
+        assert!(r.output_passes(1, &row(COLUMN_A[1])));
+        assert!(!r.output_passes(1, &row([-COLUMN_A[1][0], COLUMN_A[1][1]])), "wrong sign");
+        assert!(!r.output_passes(1, &row([COLUMN_A[1][0], 100.0 * COLUMN_A[1][1]])), "100× off");
+        assert!(!r.output_passes(1, &row([COLUMN_A[1][0], 0.01 * COLUMN_A[1][1]])), "100× below");
+        assert!(r.output_passes(1, &row([COLUMN_A[1][0], 1.19 * COLUMN_A[1][1]])), "19 % off passes");
+    }
+
     #[test]
     fn the_best_reliable_structure_is_chosen_over_a_better_fit() {
         let exact = Mat::from_fn(2, 2, |i, j| COLUMN_A[i][j]);
