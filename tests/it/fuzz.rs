@@ -1,10 +1,13 @@
 //! Seeded, structure-aware mutation fuzz of the shipped flowsheets and scenarios, in process.
 //!
-//! Each mutant is made from its own seed: a shipped file, a mode (84 % load, 12 % steady, 4 %
-//! run) and one to three mutations chosen by the kind and key of the JSON nodes (`tests/fuzz/`).
-//! It fails on a panic, a mutant over 10 s or 2 GiB (the process aborts after printing the
-//! mutant; a crash leaves it in `target/fuzz-current.txt`), a steady state reported converged
-//! that fails the independent certificate, or a run that returns non-finite values.
+//! Each mutant is made from its own seed: a file of one kind the engine reads (flowsheet loaded,
+//! converged or run; transfer-function model; MPC step model; snapshot), a study command line, or
+//! a request to a live server, with one to three mutations chosen by the kind and key of the JSON
+//! nodes (`tests/fuzz/`). It fails on a panic, a mutant over 10 s of both wall and CPU time (or a
+//! minute of wall time) or 2 GiB (the process aborts after printing the mutant; a crash leaves it
+//! in `target/fuzz-current.txt`), a steady state reported converged that fails the independent
+//! certificate, a run that returns non-finite values, a study that exits 0 with a failed part, or
+//! a server answer outside its documented statuses.
 //!
 //! * `cargo test --test it fuzz::`: the fast sample (2 000 mutants, seed fixed).
 //! * `PLANTWIDE_FUZZ_MUTANTS=100000`: a large sample; `PLANTWIDE_FUZZ_SEED=<n|0x..>`: another seed.
@@ -75,15 +78,20 @@ struct Report {
 }
 
 impl Report {
-    fn record(&mut self, m: &Mutant, took: Duration, result: std::thread::Result<Result<Outcome, Dishonest>>) {
+    fn record(
+        &mut self,
+        m: &Mutant,
+        (took, cpu): (Duration, Duration),
+        result: std::thread::Result<Result<Outcome, Dishonest>>,
+    ) {
         let slot = &mut self.by_mode[m.mode as usize];
         slot.0 += 1;
         slot.1 += took;
         if took > self.slowest.0 {
             self.slowest = (took, m.describe());
         }
-        if took > guard::TIME_LIMIT {
-            self.failures.push(("over the time limit".into(), m.describe(), format!("{took:?}")));
+        if guard::over_limit(took, cpu) {
+            self.failures.push(("over the time limit".into(), m.describe(), format!("{took:?} wall, {cpu:?} CPU")));
         }
         if let Ok(Ok(Outcome::User(msg) | Outcome::Numerical(msg))) = &result
             && msg.len() > MAX_MESSAGE
@@ -215,13 +223,13 @@ fn campaign(seed: u64, n: usize, skip: &[String]) -> Report {
             dump(&m);
         }
         guard::begin(&description);
-        let started = Instant::now();
+        let (started, cpu) = (Instant::now(), guard::cpu_time(None));
         let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| execute(&m, &corpus)));
         guard::end();
         if n == 1 {
             say(&format!("fuzz replay: {description}\n    -> {result:?}"));
         }
-        report.record(&m, started.elapsed(), result);
+        report.record(&m, (started.elapsed(), guard::cpu_time(None).saturating_sub(cpu)), result);
     }
     if let Err(why) = kinds::stop_server() {
         report.failures.push(("serve".into(), "the live server after the campaign".into(), why));

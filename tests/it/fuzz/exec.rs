@@ -34,7 +34,7 @@ pub fn execute(m: &Mutant, corpus: &Corpus) -> Result<Outcome, Dishonest> {
             Other::Tf(file, text) => kinds::tf(file, text),
             Other::StepModel(text) => kinds::step_model(&corpus.seeds.mpc_flowsheet, text),
             Other::Snapshot(text) => kinds::snapshot(text, &corpus.seeds.snapshot.1),
-            Other::Study(args) => kinds::study(args, super::guard::TIME_LIMIT - std::time::Duration::from_secs(1)),
+            Other::Study(args) => kinds::study(args),
             Other::Serve(raw) => kinds::serve(raw),
         };
     }

@@ -328,7 +328,7 @@ pub fn study_args(rng: &mut Rng) -> (Vec<String>, Vec<String>) {
 
 /// Run a study command line in a child process: exit 0, 1 or 2 within the time limit, no panic,
 /// and exit 0 only when no part of the answer is marked failed.
-pub fn study(args: &[String], limit: Duration) -> Result<Outcome, Dishonest> {
+pub fn study(args: &[String]) -> Result<Outcome, Dishonest> {
     let mut child = Command::new(env!("CARGO_BIN_EXE_plantwide"))
         .args(args)
         .current_dir(root())
@@ -342,10 +342,10 @@ pub fn study(args: &[String], limit: Duration) -> Result<Outcome, Dishonest> {
         if let Some(s) = child.try_wait().expect("waits") {
             break s;
         }
-        if started.elapsed() > limit {
+        if super::guard::over_limit(started.elapsed(), super::guard::cpu_time(Some(child.id()))) {
             let _ = child.kill();
             let _ = child.wait();
-            return Err(Dishonest(format!("over {limit:?}: plantwide {}", args.join(" "))));
+            return Err(Dishonest(format!("over the time limit: plantwide {}", args.join(" "))));
         }
         std::thread::sleep(Duration::from_millis(10));
     };
