@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use plantwide::analysis::select::{Signal, in_system, select_inputs, select_outputs};
 use plantwide::io::html::markdown_to_html;
 use plantwide::io::plot::{Overlay, write_overlays};
-use plantwide::studies::identify::{Design, Identification, IdentifySettings, identify};
+use plantwide::studies::identify::{Design, Identification, IdentifySettings, identify, number};
 use plantwide::units::{Dimension, UnitSystem, parse_quantity_as};
 
 use super::CliError;
@@ -77,9 +77,13 @@ pub struct IdentifyArgs {
     #[arg(long)]
     json: bool,
     /// Write identify.md, identify.html, identify.json, the validation plot and step_model.json (the
-    /// chosen models' step responses, a model for an `mpc` controller's `"model": {"file": …}`) here.
+    /// chosen models' step responses, a model for an `mpc` controller's `"model": {"file": …}`) here;
+    /// step_model.json only when the verdict finds the model usable (or with --force).
     #[arg(long, value_name = "DIR")]
     report: Option<PathBuf>,
+    /// Write step_model.json even when the verdict finds the model not usable (the exit code stays 2).
+    #[arg(long, requires = "report")]
+    force: bool,
     /// Override an input or a unit parameter first, e.g. `--set feed_source.F=1.01kmol/min`.
     #[arg(long = "set", value_name = "PATH=VALUE")]
     set: Vec<String>,
@@ -142,26 +146,131 @@ pub fn run(a: &IdentifyArgs, units: UnitSystem) -> Result<(), CliError> {
         if e.is_user_error() { CliError::user(e.to_string()) } else { CliError::numerical(e.to_string()) }
     })?;
     let json = serde_json::to_string_pretty(&id).map_err(|e| CliError::user(e.to_string()))?;
+    let step_model = match (&a.report, id.verdict.reliable, a.force) {
+        (None, ..) => StepModel::NoReport,
+        (Some(_), true, _) => StepModel::Written,
+        (Some(_), false, true) => StepModel::Forced,
+        (Some(_), false, false) => StepModel::Withheld,
+    };
     if let Some(dir) = &a.report {
-        write_report(dir, &a.file, &id, &outputs, &json)?;
+        write_report(dir, &a.file, &id, &outputs, &json, step_model)?;
     }
     if a.json {
         outln!("{json}");
     } else {
-        outln!("{}", markdown(&a.file, &id));
+        outln!("{}", markdown(&a.file, &id, step_model));
     }
-    Ok(())
+    verdict_exit(&id, step_model, a.report.as_deref())
+}
+
+/// What became of step_model.json.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum StepModel {
+    /// No --report.
+    NoReport,
+    /// Written: the model is usable.
+    Written,
+    /// Written although the model is not usable (--force).
+    Forced,
+    /// Not written: the model is not usable.
+    Withheld,
+}
+
+impl StepModel {
+    fn sentence(self) -> &'static str {
+        match self {
+            StepModel::NoReport => "",
+            StepModel::Written => "step_model.json written (the model for an `mpc` controller).",
+            StepModel::Forced => {
+                "step_model.json written although the model is not usable, because --force was given: an MPC on it \
+                 may move the plant the wrong way or too far."
+            }
+            StepModel::Withheld => {
+                "step_model.json not written: the model is not usable for an `mpc` controller (--force writes it \
+                 anyway)."
+            }
+        }
+    }
+}
+
+/// Exit 2 when the verdict finds the model not usable (the report, already printed, says why).
+fn verdict_exit(id: &Identification, step_model: StepModel, report: Option<&Path>) -> Result<(), CliError> {
+    if id.verdict.reliable {
+        return Ok(());
+    }
+    let failed: Vec<String> = id.verdict.failed().map(|c| c.line()).collect();
+    let mut file = match step_model {
+        StepModel::NoReport => String::new(),
+        s => format!("; {}", s.sentence().trim_end_matches('.')),
+    };
+    if let (StepModel::Withheld, Some(dir)) = (step_model, report)
+        && dir.join("step_model.json").exists()
+    {
+        file.push_str(&format!(
+            "; the step_model.json already in {} is an earlier run's, not this one's",
+            dir.display()
+        ));
+    }
+    Err(CliError::numerical(format!(
+        "identify: the identified {} model is not usable ({} of its criteria failed, marked in the report): {}{file}",
+        id.verdict.model,
+        failed.len(),
+        failed.join("; ")
+    )))
 }
 
 fn matrix(rows: &[Vec<f64>]) -> String {
     rows.iter()
-        .map(|r| format!("[{}]", r.iter().map(|v| format!("{v:.6}")).collect::<Vec<_>>().join(", ")))
+        .map(|r| format!("[{}]", r.iter().map(|v| sig(*v)).collect::<Vec<_>>().join(", ")))
         .collect::<Vec<_>>()
         .join("; ")
 }
 
+/// A number with five significant digits, fixed or in exponent form by its size.
+fn sig(v: f64) -> String {
+    if v == 0.0 || (1e-3..1e5).contains(&v.abs()) { format!("{v:.5}") } else { format!("{v:.4e}") }
+}
+
+/// The verdict as markdown: the overall answer, one row per criterion, and where each threshold
+/// comes from.
+fn verdict_markdown(id: &Identification, step_model: StepModel) -> String {
+    let v = &id.verdict;
+    let answer = if v.reliable { "usable" } else { "**not usable**" };
+    let mut md = format!("## Verdict: the {} model is {answer}\n\n", v.model);
+    let line = step_model.sentence();
+    if !line.is_empty() {
+        md.push_str(&format!("{line}\n\n"));
+    }
+    md.push_str("| criterion | at | value | must be | threshold | result |\n|---|---|---|---|---|---|\n");
+    for c in &v.criteria {
+        let result = match (c.pass, c.decides) {
+            (true, _) => "pass",
+            (false, true) => "**fail**",
+            (false, false) => "warning",
+        };
+        let detail = c.detail.as_ref().map_or(String::new(), |d| format!(" ({d})"));
+        md.push_str(&format!(
+            "| {} | {}{detail} | {} | {} | {} | {result} |\n",
+            c.criterion,
+            c.at,
+            number(c.value),
+            c.must_be,
+            number(c.threshold)
+        ));
+    }
+    md.push_str("\nThresholds (a warning does not decide):\n\n");
+    let mut seen = Vec::new();
+    for c in &v.criteria {
+        if !seen.contains(&c.criterion) {
+            seen.push(c.criterion);
+            md.push_str(&format!("- {}: {}\n", c.criterion, c.source));
+        }
+    }
+    md
+}
+
 /// The identification as markdown.
-fn markdown(file: &Path, id: &Identification) -> String {
+fn markdown(file: &Path, id: &Identification, step_model: StepModel) -> String {
     let d = &id.design;
     let label = |s: &plantwide::analysis::select::SignalLabel| format!("`{}` [{}]", s.path, s.unit);
     let mut md = format!("# Identification of `{}`\n\n", file.display());
@@ -180,6 +289,8 @@ fn markdown(file: &Path, id: &Identification) -> String {
             dir.singular_values, dir.condition_number, dir.scales
         ));
     }
+    md.push('\n');
+    md.push_str(&verdict_markdown(id, step_model));
     md.push_str(&format!("\n## Gains ({} model)\n\n", id.validation.model));
     md.push_str(&format!("- identified G(0) = {}\n- exact G(0) = {}\n", matrix(&id.gain), matrix(&id.exact.gain)));
     md.push_str(&format!("- relative errors {}\n", matrix(&id.exact.gain_relative_error)));
@@ -193,28 +304,44 @@ fn markdown(file: &Path, id: &Identification) -> String {
     if let Some(e) = id.exact.rga11_relative_error {
         md.push_str(&format!("- λ11 relative error {:.2} %\n", 100.0 * e));
     }
-    md.push_str("\n## Models (validation data)\n\n| output | model | orders | gains | fit % | white | independent |\n|---|---|---|---|---|---|---|\n");
+    md.push_str(
+        "\n## Models (validation data)\n\nfit %: against the measured output; noise-free fit %: against the plant's own \
+         response (what the verdict judges); reliable: the criteria of one output (denominator, gain signs, gain error, \
+         fit).\n\n| output | model | orders | gains | fit % | noise-free fit % | white | independent | reliable |\n\
+         |---|---|---|---|---|---|---|---|---|\n",
+    );
     for m in &id.models {
         md.push_str(&format!(
-            "| `{}` | {} | {} | {} | {:.2} | {} | {} |\n",
+            "| `{}` | {} | {} | {} | {:.2} | {:.2} | {} | {} | {} |\n",
             m.output,
             m.model,
             m.orders,
-            m.gain.iter().map(|v| format!("{v:.5}")).collect::<Vec<_>>().join(", "),
+            m.gain.iter().map(|v| sig(*v)).collect::<Vec<_>>().join(", "),
             m.fit_percent,
+            m.fit_noise_free,
             m.white,
-            m.independent
+            m.independent,
+            m.reliable
         ));
     }
     md
 }
 
-fn write_report(dir: &Path, file: &Path, id: &Identification, outputs: &[Signal], json: &str) -> Result<(), CliError> {
+fn write_report(
+    dir: &Path,
+    file: &Path,
+    id: &Identification,
+    outputs: &[Signal],
+    json: &str,
+    step_model: StepModel,
+) -> Result<(), CliError> {
     let fail = |e: std::io::Error| CliError::user(format!("--report {}: {e}", dir.display()));
     std::fs::create_dir_all(dir).map_err(fail)?;
     std::fs::write(dir.join("identify.json"), json).map_err(fail)?;
-    let model = serde_json::to_string_pretty(&id.step_model).map_err(|e| CliError::user(e.to_string()))?;
-    std::fs::write(dir.join("step_model.json"), model).map_err(fail)?;
+    if step_model != StepModel::Withheld {
+        let model = serde_json::to_string_pretty(&id.step_model).map_err(|e| CliError::user(e.to_string()))?;
+        std::fs::write(dir.join("step_model.json"), model).map_err(fail)?;
+    }
     let ts = id.design.sample_time;
     let n = id.measured.first().map_or(0, Vec::len);
     let times: Vec<f64> = (0..n).map(|k| k as f64 * ts / 60.0).collect();
@@ -244,7 +371,7 @@ fn write_report(dir: &Path, file: &Path, id: &Identification, outputs: &[Signal]
         &[],
     )
     .map_err(|e| CliError::user(format!("--report {}: {e}", dir.display())))?;
-    let md = format!("{}\n![validation](validation.png)\n", markdown(file, id));
+    let md = format!("{}\n![validation](validation.png)\n", markdown(file, id, step_model));
     std::fs::write(dir.join("identify.html"), markdown_to_html("Identification", &md)).map_err(fail)?;
     std::fs::write(dir.join("identify.md"), md).map_err(fail)
 }

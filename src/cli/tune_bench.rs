@@ -47,10 +47,10 @@ pub fn run(
                 ModelArg::Integrating => ModelOrder::Integrating,
             });
             let o = StepOptions { step: quantity(&a.step, "step", out_dim)?, scan, order };
-            let (fit, settled) = step_loop(plant, x, l, o).map_err(tune_error)?;
+            let test = step_loop(plant, x, l, o).map_err(tune_error)?;
             let tau_c = quantity(&a.tau_c, "tau-c", Dimension::TIME)?;
             let rule = if method == MethodArg::Imc { ModelRule::Imc } else { ModelRule::Simc };
-            from_step(l, fit, settled, rule, tau_c, a.pid).map_err(tune_error)
+            from_step(l, test, rule, tau_c, a.pid).map_err(tune_error)
         }
     }
 }

@@ -5,9 +5,12 @@
 use std::path::Path;
 
 use plantwide::flowsheet::Plant;
+use plantwide::model::limits::number;
+use plantwide::studies::identify::number as significant;
 use plantwide::studies::tune::averaging::AveragingForm;
 use plantwide::studies::tune::flowsheet::{FlowsheetLoop, FlowsheetTuning, averaging_loop, blt_loops, edits, kc_text};
 use plantwide::studies::tune::loops::{Measurement, PlantLoop, inner_first, plant_loop, plant_loops};
+use plantwide::studies::tune::plant_tests::{Linearity, StepTry};
 use plantwide::units::{Dimension, parse_quantity_as};
 
 use super::CliError;
@@ -95,7 +98,7 @@ pub(super) fn quantity(text: &Option<String>, flag: &str, dim: Dimension) -> Res
         let v = parse_quantity_as(t, dim).map_err(|e| CliError::user(format!("--{flag} {t}: {e}")))?;
         let max = plantwide::model::limits::max_magnitude(dim);
         if v.is_nan() || v.abs() > max {
-            let n = plantwide::model::limits::number;
+            let n = number;
             return Err(CliError::user(format!(
                 "--{flag} {t}: {} {dim} is beyond ±{} {dim}, the range in which the models hold",
                 n(v),
@@ -192,7 +195,32 @@ fn print_details(l: &FlowsheetLoop, u: &str) {
             if l.settled == Some(false) { "; the response had not settled: the fit extrapolates" } else { "" };
         outln!("  fit ({u}): {model}, R² = {:.4}, RMSE/max = {:.2e}{settled}", f.r2, f.nrmse);
     }
+    if let Some(c) = &l.linearity {
+        outln!("{}", linearity_line(c));
+    }
     if let Some(av) = &l.averaging {
         outln!("  averaging {:?}: largest level deviation {} at {:.4} {u}", av.form, av.band, av.time);
     }
+}
+
+/// The step tests behind a fit against the linearized gain: the step the fit comes from, and the
+/// larger ones before it whose responses left the linear range.
+fn linearity_line(c: &Linearity) -> String {
+    let line = |t: &StepTry| {
+        format!(
+            "step {}: gain {}, {} % off",
+            significant(t.step),
+            significant(t.gain),
+            significant(100.0 * t.gain_error)
+        )
+    };
+    let mut s = format!("  linearized gain G(0) = {}", significant(c.linear_gain));
+    if let Some((last, before)) = c.tests.split_last() {
+        s.push_str(&format!("; fitted on the {}", line(last)));
+        if !before.is_empty() {
+            let tried: Vec<String> = before.iter().map(line).collect();
+            s.push_str(&format!("; larger steps left the linear range ({})", tried.join("; ")));
+        }
+    }
+    s
 }

@@ -247,6 +247,40 @@ pub enum TuneError {
         /// The least accepted.
         min_r2: f64,
     },
+    /// No step tried gives a fitted gain within [`crate::tune::plant_tests::MAX_GAIN_ERROR`] of the
+    /// element's linearized gain: the settings would rest on the secant of a curved response, or on
+    /// a model that does not describe it.
+    #[error(
+        "`{controller}`: the {model} model's gain disagrees with the linearized gain {} at every step tried ({}); {}",
+        crate::identify::number(*.linear_gain),
+        step_tries(tests),
+        if *stalled {
+            if *settled {
+                "a smaller step did not bring it closer, so the difference is not the plant's curvature: the model \
+                 does not describe the response; choose another --model, or a relay test (--method relay)"
+            } else {
+                "a smaller step did not bring it closer, and the response had not settled within the test: the fit \
+                 extrapolates; give a longer --scan, or a relay test (--method relay)"
+            }
+        } else {
+            "the response stays outside the linear range down to the last step; tune by a relay test (--method \
+             relay) or on the linear model (--method blt)"
+        }
+    )]
+    OutsideLinearRange {
+        /// Controller.
+        controller: String,
+        /// The model fitted.
+        model: &'static str,
+        /// The element's gain from the exact linearization (SI).
+        linear_gain: f64,
+        /// The tests run.
+        tests: Vec<crate::tune::plant_tests::StepTry>,
+        /// Whether the last test's response settled.
+        settled: bool,
+        /// Whether the last smaller step failed to bring the gain closer.
+        stalled: bool,
+    },
     /// The step record determines no model.
     #[error(transparent)]
     Fit(#[from] crate::tune::fit::FitError),
@@ -265,6 +299,16 @@ impl TuneError {
                 | TuneError::Linear(_)
                 | TuneError::Simulation(_)
                 | TuneError::ResidenceTime { .. }
+                | TuneError::OutsideLinearRange { .. }
         )
     }
+}
+
+/// The steps of `tests` with their fitted gains and errors, for a message.
+fn step_tries(tests: &[crate::tune::plant_tests::StepTry]) -> String {
+    use crate::identify::number;
+    let one = |t: &crate::tune::plant_tests::StepTry| {
+        format!("step {}: gain {}, {} % off", number(t.step), number(t.gain), number(100.0 * t.gain_error))
+    };
+    tests.iter().map(one).collect::<Vec<_>>().join("; ")
 }

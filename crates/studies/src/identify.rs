@@ -27,6 +27,7 @@ mod closed_loop;
 mod design;
 mod estimate;
 mod plant_test;
+mod verdict;
 
 use faer::Mat;
 use plantwide_analysis::linear::Linearization;
@@ -38,6 +39,7 @@ use serde::Serialize;
 pub use closed_loop::select_driven;
 pub use design::{Design, Directions, TestDesign};
 pub use estimate::{ModelSummary, OutputValidation};
+pub use verdict::{Criterion, MAX_GAIN_ERROR, MAX_RGA_ERROR, MIN_FIT, NEGLIGIBLE, Verdict, number};
 
 /// Settings of an identification; `None` takes the default described on each field.
 #[derive(Debug, Clone, PartialEq)]
@@ -188,6 +190,8 @@ pub struct Identification {
     pub design: TestDesign,
     /// The exact linearization, for comparison.
     pub exact: ExactComparison,
+    /// Whether the model can be used, criterion by criterion.
+    pub verdict: Verdict,
     /// The measured validation outputs (deviations from the steady state, SI, with the noise),
     /// sampled every `design.sample_time`, for plots.
     #[serde(skip)]
@@ -269,19 +273,30 @@ pub fn identify(
     };
     let estimation = plant_test::run(plant, x, &probe, &est_moves, &noise, (ts, settings.seed))?;
     let validation = plant_test::run(plant, x, &probe, &val_moves, &noise, (ts, settings.seed ^ 0x5eed))?;
-    let fits = estimate::fit_all(&estimation, &validation, &test.design, inputs, outputs)?;
-    let gain = Mat::from_fn(outputs.len(), inputs.len(), |i, j| fits.gain[i][j]);
+    let mut fits = estimate::fit_all(&estimation, &validation, &test.design, inputs, outputs)?;
+    let amplitude: Vec<f64> = test.design.amplitude.iter().zip(inputs).map(|(a, s)| a * s.factor).collect();
+    let reference = verdict::Reference { exact: &exact, amplitude: &amplitude, inputs, outputs };
+    let best = verdict::choose(&reference, &fits);
+    let verdict = verdict::judge(&reference, &fits.iter().map(|f| &f[best]).collect::<Vec<_>>());
+    let models = estimate::summaries(&fits, inputs, outputs, &|i, s| reference.output_passes(i, &fits[i][s]));
+    let chosen: Vec<estimate::Fitted> = fits.iter_mut().map(|f| f.swap_remove(best)).collect();
+    let gain = Mat::from_fn(outputs.len(), inputs.len(), |i, j| chosen[i].gain[j]);
+    let step: Vec<Vec<Vec<f64>>> = chosen.iter().map(|f| f.step.clone()).collect();
     Ok(Identification {
         inputs: inputs.iter().map(Signal::label).collect(),
         outputs: outputs.iter().map(Signal::label).collect(),
         gain: display_gain(&gain, inputs, outputs),
         rga: rga(gain.as_ref()).ok().map(|r| rows(r.as_ref())),
-        models: fits.models,
-        validation: ValidationReport { model: fits.chosen, outputs: fits.validation },
+        models,
+        validation: ValidationReport {
+            model: verdict.model.clone(),
+            outputs: chosen.into_iter().map(|f| f.validation).collect(),
+        },
         design: test.design,
         exact: comparison(&exact, &gain, inputs, outputs),
+        verdict,
         measured: validation.y,
-        step_model: step_model(&fits.step, ts, inputs, outputs)?,
+        step_model: step_model(&step, ts, inputs, outputs)?,
     })
 }
 

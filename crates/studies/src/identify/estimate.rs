@@ -2,7 +2,7 @@
 //! from the ARX fit), each simulated on the fresh validation inputs and judged there.
 
 use plantwide_analysis::select::Signal;
-use plantwide_ident::{StepResponse, arx_select, fir, oe, simulate_arx, simulate_oe, validate};
+use plantwide_ident::{StepResponse, arx_select, fir, fit_percent, oe, simulate_arx, simulate_oe, validate};
 use serde::Serialize;
 
 use super::IdentifyError;
@@ -29,11 +29,16 @@ pub struct ModelSummary {
     /// Standard error of each gain from the parameter covariance (delta method; OE only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub gain_std: Option<Vec<f64>>,
-    /// False when a denominator is (nearly) zero at z = 1, `|F(1)|` or `|A(1)| < 1e-3`: a pole at
-    /// the unit circle makes the gain meaningless. Such a model is never the chosen one.
+    /// Whether this model of this output passes the verdict's criteria of one output
+    /// ([`super::verdict`]): a denominator away from zero at z = 1 (`|F(1)|`, `|A(1)| ≥ 1e-3`: a
+    /// pole at the unit circle makes the gain meaningless), every gain of the sign of the exact
+    /// linearization's and within its tolerance, and the fit to the plant's response at least the
+    /// least accepted.
     pub reliable: bool,
-    /// Fit on the validation data \[%\].
+    /// Fit on the validation data \[%\] (the measured output, with its noise).
     pub fit_percent: f64,
+    /// Fit to the plant's own response on the validation test \[%\] (the noise left out).
+    pub fit_noise_free: f64,
     /// Residuals white at 95 % (validation data).
     pub white: bool,
     /// Residuals uncorrelated with every input at 95 % (validation data).
@@ -45,8 +50,11 @@ pub struct ModelSummary {
 pub struct OutputValidation {
     /// Output path.
     pub output: String,
-    /// Fit on the validation data \[%\]: `100 (1 − ‖y − ŷ‖/‖y − ȳ‖)`.
+    /// Fit on the validation data \[%\]: `100 (1 − ‖y − ŷ‖/‖y − ȳ‖)`, `y` measured (with the noise).
     pub fit_percent: f64,
+    /// The same fit with `y` the plant's own response on the validation test (the noise left out):
+    /// how well the model simulates the plant, which the verdict judges.
+    pub fit_noise_free: f64,
     /// Residual autocorrelation at lags 0 … 20 (Eq. 7-59).
     pub autocorrelation: Vec<f64>,
     /// Residual–input cross-correlation per input at lags 0 … 20 (Eq. 7-60).
@@ -63,34 +71,23 @@ pub struct OutputValidation {
     pub predicted: Vec<f64>,
 }
 
-/// Every fit: the chosen structure's gains (SI), every model, and the chosen one's validation.
-pub(super) struct Fits {
-    pub gain: Vec<Vec<f64>>,
-    /// The chosen structure's step responses, per output per input (SI).
-    pub step: Vec<Vec<Vec<f64>>>,
-    pub models: Vec<ModelSummary>,
-    pub chosen: String,
-    pub validation: Vec<OutputValidation>,
-}
-
 fn fit_error(e: impl std::fmt::Display) -> IdentifyError {
     IdentifyError::Estimation(format!("identification: {e}"))
 }
 
 /// One structure fitted to one output: its gains (SI) and validation.
-struct Fitted {
-    model: &'static str,
-    orders: String,
-    gain: Vec<f64>,
-    gain_std: Option<Vec<f64>>,
-    reliable: bool,
-    validation: OutputValidation,
+pub(super) struct Fitted {
+    pub model: &'static str,
+    pub orders: String,
+    pub gain: Vec<f64>,
+    pub gain_std: Option<Vec<f64>>,
+    /// Its denominator at z = 1, `|A(1)|` (ARX) or the least `|F_j(1)|` (OE), 1 for a FIR: near
+    /// zero, a pole at the unit circle makes the gain meaningless.
+    pub denominator: f64,
+    pub validation: OutputValidation,
     /// Step response per input over the settling samples (SI).
-    step: Vec<Vec<f64>>,
+    pub step: Vec<Vec<f64>>,
 }
-
-/// Least `|F(1)|` (or `|A(1)|`) of a model whose gain is reported as reliable.
-const MIN_DENOMINATOR: f64 = 1e-3;
 
 /// The standard error of each OE gain `g_j = B_j(1)/F_j(1)` by the delta method,
 /// `∂g/∂b = 1/F(1)`, `∂g/∂f = −B(1)/F(1)²`, over the input's block of the covariance.
@@ -154,6 +151,7 @@ fn fit_output(
         Ok(OutputValidation {
             output: output.to_string(),
             fit_percent: v.fit_percent,
+            fit_noise_free: fit_percent(&val.clean[i], &yhat).map_err(fit_error)?,
             autocorrelation: v.autocorrelation,
             cross_correlation: v.cross_correlation,
             bound: v.bound,
@@ -174,7 +172,7 @@ fn fit_output(
             orders: format!("n={n_fir}, nk=1, ridge={ridge:.0e}"),
             gain: fir_model.gain.clone(),
             gain_std: None,
-            reliable: true,
+            denominator: 1.0,
             step: fir_model.step_response(n_fir).map_err(fit_error)?,
             validation: fir_validation,
         },
@@ -183,7 +181,7 @@ fn fit_output(
             orders: format!("na={}, nb={}, nk=1", arx.na, arx.nb),
             gain: arx.gain.clone(),
             gain_std: None,
-            reliable: (1.0 + arx.a.iter().sum::<f64>()).abs() > MIN_DENOMINATOR,
+            denominator: (1.0 + arx.a.iter().sum::<f64>()).abs(),
             step: arx.step_response(n_fir).map_err(fit_error)?,
             validation: judge(simulate_arx(&arx, &val.u))?,
         },
@@ -192,22 +190,22 @@ fn fit_output(
             orders: format!("nb={n}, nf={n}, nk=1"),
             gain: oe_model.gain.clone(),
             gain_std: oe_gain_std(&oe_model),
-            reliable: oe_model.f.iter().all(|f| (1.0 + f.iter().sum::<f64>()).abs() > MIN_DENOMINATOR),
+            denominator: oe_model.f.iter().map(|f| (1.0 + f.iter().sum::<f64>()).abs()).fold(f64::INFINITY, f64::min),
             step: oe_model.step_response(n_fir).map_err(fit_error)?,
             validation: judge(simulate_oe(&oe_model, &val.u))?,
         },
     ])
 }
 
-/// Fit every output of the estimation data and validate on the validation data; the structure
-/// with the best mean validation fit is chosen.
+/// Fit FIR, ARX and OE to every output of the estimation data and validate them on the validation
+/// data: per output, per structure (the same structures in the same order for every output).
 pub(super) fn fit_all(
     est: &TestData,
     val: &TestData,
     design: &TestDesign,
     inputs: &[Signal],
     outputs: &[Signal],
-) -> Result<Fits, IdentifyError> {
+) -> Result<Vec<Vec<Fitted>>, IdentifyError> {
     let t99 = 4.6 * design.tau_dom;
     let n_samples = est.y.first().map_or(0, Vec::len);
     // The settling time in samples, at most a quarter of the data per input and the FIR fit's cap.
@@ -223,42 +221,39 @@ pub(super) fn fit_all(
         )),
         e => e,
     };
-    let per_output: Vec<Vec<Fitted>> = outputs
+    outputs
         .iter()
         .enumerate()
         .map(|(i, o)| fit_output(est, val, i, n_fir, &o.path).map_err(|e| explain(o, e)))
-        .collect::<Result<_, _>>()?;
-    let n_structures = per_output[0].len();
-    // A structure unreliable on any output scores below every reliable one.
-    let mean_fit = |s: usize| {
-        let fit = per_output.iter().map(|f| f[s].validation.fit_percent).sum::<f64>() / per_output.len() as f64;
-        if per_output.iter().all(|f| f[s].reliable) { fit } else { fit - 1e6 }
-    };
-    let best = (0..n_structures).max_by(|&a, &b| mean_fit(a).total_cmp(&mean_fit(b))).unwrap_or(0);
+        .collect()
+}
+
+/// The table of every model: per output and structure, its gains (display units), fit and
+/// whether it passes the criteria of one output (`reliable(i, s)` for output `i`, structure `s`).
+pub(super) fn summaries(
+    per_output: &[Vec<Fitted>],
+    inputs: &[Signal],
+    outputs: &[Signal],
+    reliable: &dyn Fn(usize, usize) -> bool,
+) -> Vec<ModelSummary> {
     let display =
         |o: &Signal, g: &[f64]| -> Vec<f64> { g.iter().zip(inputs).map(|(g, s)| g * s.factor / o.factor).collect() };
-    let models = per_output
-        .iter()
-        .zip(outputs)
-        .flat_map(|(fits, o)| {
-            fits.iter().map(move |f| ModelSummary {
+    let mut models = Vec::new();
+    for (i, (fits, o)) in per_output.iter().zip(outputs).enumerate() {
+        for (s, f) in fits.iter().enumerate() {
+            models.push(ModelSummary {
                 output: o.path.clone(),
                 model: f.model.to_string(),
                 orders: f.orders.clone(),
                 gain: display(o, &f.gain),
                 gain_std: f.gain_std.as_ref().map(|g| display(o, g)),
-                reliable: f.reliable,
+                reliable: reliable(i, s),
                 fit_percent: f.validation.fit_percent,
+                fit_noise_free: f.validation.fit_noise_free,
                 white: f.validation.white,
                 independent: f.validation.independent,
-            })
-        })
-        .collect();
-    Ok(Fits {
-        gain: per_output.iter().map(|f| f[best].gain.clone()).collect(),
-        step: per_output.iter().map(|f| f[best].step.clone()).collect(),
-        models,
-        chosen: per_output[0][best].model.to_string(),
-        validation: per_output.into_iter().map(|mut f| f.swap_remove(best).validation).collect(),
-    })
+            });
+        }
+    }
+    models
 }

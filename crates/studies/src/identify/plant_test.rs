@@ -9,11 +9,14 @@ use plantwide_solve::dynamic::Session;
 use super::IdentifyError;
 
 /// Test data as deviations from the pre-test steady state (SI): `u[j][k]` is input `j` over
-/// `[t_k, t_k+1)`, `y[i][k]` output `i` measured at `t_k`.
+/// `[t_k, t_k+1)`, `y[i][k]` output `i` measured at `t_k` (with the noise), `clean[i][k]` the
+/// plant's own output there (without it: what a model is judged against, since a model study
+/// knows it).
 #[derive(Debug, Clone, PartialEq)]
 pub(super) struct TestData {
     pub u: Vec<Vec<f64>>,
     pub y: Vec<Vec<f64>>,
+    pub clean: Vec<Vec<f64>>,
 }
 
 /// What a test moves and reads: the inputs it sets (the plant's inputs in open loop, the loops'
@@ -56,6 +59,7 @@ pub(super) fn run(
         }
         session.advance_to(t_next).map_err(|e| IdentifyError::Simulation(Box::new(e)))?;
     }
+    let clean = y.clone();
     for (i, yi) in y.iter_mut().enumerate() {
         if noise[i] > 0.0 {
             let e = white_noise(n, noise[i], seed.wrapping_add(1000 + i as u64))
@@ -64,5 +68,5 @@ pub(super) fn run(
         }
     }
     let u = if probe.measured_inputs.is_some() { u } else { moves.to_vec() };
-    Ok(TestData { u, y })
+    Ok(TestData { u, y, clean })
 }

@@ -18,8 +18,9 @@ use super::PiRule;
 use super::averaging::{AveragingForm, AveragingSettings, averaging};
 use super::bench::RelayCycle;
 use super::blt::BltSettings;
-use super::fit::ModelFit;
+use super::fit::{ModelFit, ProcessModel};
 use super::loops::{Measurement, PlantLoop, low_frequency_probe, plant_blt};
+use super::plant_tests::{Linearity, StepResult};
 use super::rules::{ModelRule, model_rule};
 use super::ultimate::Ultimate;
 use crate::TuneError;
@@ -64,6 +65,9 @@ pub struct FlowsheetLoop {
     /// Whether the step response settled within the test (an unsettled fit is extrapolated).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub settled: Option<bool>,
+    /// The step tests run and the linearized gain their fitted gains were checked against.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub linearity: Option<Linearity>,
     /// SIMC's τc or IMC's λ used \[s or the time unit asked for\].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub tau_c: Option<f64>,
@@ -94,6 +98,8 @@ impl FlowsheetTuning {
                 r.pu /= seconds;
             }
             if let Some(f) = &mut l.fit {
+                let integrating = matches!(f.model, ProcessModel::Integrating { .. });
+                l.linearity = l.linearity.take().map(|c| c.in_time_unit(seconds, integrating));
                 f.model = f.model.in_time_unit(seconds);
             }
             if let Some(a) = &mut l.averaging {
@@ -130,6 +136,7 @@ fn entry(l: &PlantLoop, kc: f64, tau_i: Option<f64>, tau_d: Option<f64>) -> Flow
         relay: None,
         fit: None,
         settled: None,
+        linearity: None,
         tau_c: None,
     }
 }
@@ -213,16 +220,16 @@ pub fn from_relay(l: &PlantLoop, cycle: &RelayCycle, rule: PiRule, method: &'sta
 /// [`TuneError::Rule`] for a degenerate model.
 pub fn from_step(
     l: &PlantLoop,
-    fit: ModelFit,
-    settled: bool,
+    test: StepResult,
     rule: ModelRule,
     tau_c: Option<f64>,
     derivative: bool,
 ) -> Result<FlowsheetTuning, TuneError> {
-    let p = model_rule(rule, &fit.model, tau_c, derivative)?;
+    let p = model_rule(rule, &test.fit.model, tau_c, derivative)?;
     let e = FlowsheetLoop {
-        fit: Some(fit),
-        settled: Some(settled),
+        fit: Some(test.fit),
+        settled: Some(test.settled),
+        linearity: test.linearity,
         tau_c: Some(p.tau_c),
         ..entry(l, p.kc, Some(p.tau_i), p.tau_d)
     };

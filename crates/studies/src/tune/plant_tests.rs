@@ -11,6 +11,7 @@
 use faer::c64;
 use plantwide_flowsheet::Plant;
 use plantwide_solve::dynamic::{Session, SessionError};
+use serde::Serialize;
 
 use super::bench::{Bench, RelayCycle, SampledRelay, StepTest, relay, step};
 use super::fit::{ModelFit, ModelOrder, fit_step};
@@ -126,7 +127,7 @@ pub const MIN_R2: f64 = 0.9;
 /// Options of a step test; `None` takes the default.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct StepOptions {
-    /// Output step (output units; default 5 % of its steady value).
+    /// Output step (output units; default 5 % of its steady value), the first one tried.
     pub step: Option<f64>,
     /// Sampling interval \[s\].
     pub scan: Option<f64>,
@@ -134,38 +135,130 @@ pub struct StepOptions {
     pub order: Option<ModelOrder>,
 }
 
-/// A step test of loop `l` at the steady state `x` and the model fitted to it, with whether the
-/// response settled.
+/// Largest relative difference between the gain fitted to a step test and the element's gain
+/// from the exact linearization for settings to be drawn from the fit: a step that moves the plant
+/// out of its linear range fits the secant of a curved response, whose gain can be several times
+/// off (plantwide's tolerance; SIMC's `kc` is inversely proportional to the gain).
+pub const MAX_GAIN_ERROR: f64 = 0.1;
+
+/// Most step tests of one loop: the step asked for and up to four smaller ones.
+const MAX_STEP_TESTS: usize = 5;
+
+/// One step test: the step, the gain fitted to it, and its relative difference from the
+/// linearized gain.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct StepTry {
+    /// Output step (output units).
+    pub step: f64,
+    /// Fitted gain (for an integrating element per s, or per the time unit asked for).
+    pub gain: f64,
+    /// `|gain − linear_gain| / |linear_gain|`.
+    pub gain_error: f64,
+}
+
+/// The check of a step test's fitted gain against the exact linearization.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Linearity {
+    /// The element's gain from the exact linearization at the steady state: `G(0)`, or for an
+    /// integrating element the slope `lim s→0 s G(s)` (per s, or per the time unit asked for).
+    pub linear_gain: f64,
+    /// The tests run, in order; the last is the one the fit comes from.
+    pub tests: Vec<StepTry>,
+}
+
+impl Linearity {
+    /// Times in a unit of `seconds` s: an integrating element's gains are per that unit.
+    pub fn in_time_unit(mut self, seconds: f64, integrating: bool) -> Linearity {
+        if integrating {
+            self.linear_gain *= seconds;
+            for t in &mut self.tests {
+                t.gain *= seconds;
+            }
+        }
+        self
+    }
+}
+
+/// A step test of a loop whose fitted gain agrees with the linearization.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StepResult {
+    /// The model fitted to the last test.
+    pub fit: ModelFit,
+    /// Whether its response settled within the test (an integrating one always counts as settled).
+    pub settled: bool,
+    /// The tests run and the gain they were checked against; `None` when the model asked for is not
+    /// of the element's kind (an integrating model of a lag-dominant element, SIMC's approximation,
+    /// has a slope, not `G(0)`), so that one test is run with the step asked for, unchecked.
+    pub linearity: Option<Linearity>,
+}
+
+/// A step test of loop `l` at the steady state `x` and the model fitted to it. The fitted gain is
+/// compared with the element's exact linearized gain; while they differ by more than
+/// [`MAX_GAIN_ERROR`] the step is shrunk (by `MAX_GAIN_ERROR/(4 e)` for an error `e`, between 1/32
+/// and 1/2, since a secant's error shrinks about in proportion to the step) and the test repeated.
 ///
 /// # Errors
 /// [`TuneError::Simulation`] when the plant cannot be integrated, [`TuneError::Fit`] when the
-/// record determines no model.
-pub fn step_loop(plant: &Plant, x: &[f64], l: &PlantLoop, o: StepOptions) -> Result<(ModelFit, bool), TuneError> {
-    let (t_mean, integrating) = residence_time(plant, x, l)?;
-    let order = o.order.unwrap_or(if integrating { ModelOrder::Integrating } else { ModelOrder::Foptd });
+/// record determines no model, [`TuneError::OutsideLinearRange`] when no step tried gives the
+/// linearized gain, [`TuneError::PoorFit`] when the model does not describe the response.
+pub fn step_loop(plant: &Plant, x: &[f64], l: &PlantLoop, o: StepOptions) -> Result<StepResult, TuneError> {
+    let element = element(plant, x, l)?;
+    let order = o.order.unwrap_or(if element.integrating { ModelOrder::Integrating } else { ModelOrder::Foptd });
+    let comparable = (order == ModelOrder::Integrating) == element.integrating;
     let u0 = x[l.op];
     // A pure integrator has no time of its own: the test then runs 500 scans of the scan given.
-    let (scan, max_duration) = match (o.scan, t_mean) {
+    let (scan, max_duration) = match (o.scan, element.residence_time) {
         (scan, Some(t)) => {
             let scan = scan.unwrap_or(t / 100.0);
-            (scan, if integrating { (5.0 * t).max(500.0 * scan) } else { (30.0 * t).max(100.0 * scan) })
+            (scan, if element.integrating { (5.0 * t).max(500.0 * scan) } else { (30.0 * t).max(100.0 * scan) })
         }
         (Some(scan), None) => (scan, 500.0 * scan),
         (None, None) => return Err(TuneError::ResidenceTime { controller: l.name.clone() }),
     };
     check_scan(l, scan, max_duration / 100.0, "a hundredth of the test's length")?;
-    let settings = StepTest { step: o.step.unwrap_or(0.05 * u0.abs()), scan, max_duration, settle: 2e-3 };
-    if !(settings.step != 0.0 && settings.step.is_finite()) {
-        return Err(TuneError::RelayAmplitude { controller: l.name.clone(), amplitude: settings.step });
+    let first = o.step.unwrap_or(0.05 * u0.abs());
+    if !(first != 0.0 && first.is_finite()) {
+        return Err(TuneError::RelayAmplitude { controller: l.name.clone(), amplitude: first });
     }
-    within_range(plant, l, u0 + settings.step)?;
-    let mut b = bench(plant, x, l, Measurement::default(), settings.scan)?;
-    let (record, settled) = step(&mut b, u0, &settings).map_err(|e| TuneError::Simulation(Box::new(e)))?;
-    let fit = fit_step(&record, order).map_err(TuneError::from)?;
-    if fit.r2.is_nan() || fit.r2 < MIN_R2 {
-        return Err(TuneError::PoorFit { controller: l.name.clone(), model: order.name(), r2: fit.r2, min_r2: MIN_R2 });
+    within_range(plant, l, u0 + first)?;
+    let mut settings = StepTest { step: first, scan, max_duration, settle: 2e-3 };
+    let mut tests: Vec<StepTry> = Vec::new();
+    loop {
+        let mut b = bench(plant, x, l, Measurement::default(), settings.scan)?;
+        let (record, settled) = step(&mut b, u0, &settings).map_err(|e| TuneError::Simulation(Box::new(e)))?;
+        let fit = fit_step(&record, order).map_err(TuneError::from)?;
+        let gain = fit.model.gain();
+        let gain_error = ((gain - element.gain) / element.gain).abs();
+        tests.push(StepTry {
+            step: settings.step,
+            gain,
+            gain_error: if gain_error.is_nan() { f64::INFINITY } else { gain_error },
+        });
+        if !comparable || gain_error <= MAX_GAIN_ERROR {
+            if fit.r2.is_nan() || fit.r2 < MIN_R2 {
+                return Err(TuneError::PoorFit {
+                    controller: l.name.clone(),
+                    model: order.name(),
+                    r2: fit.r2,
+                    min_r2: MIN_R2,
+                });
+            }
+            let linearity = comparable.then_some(Linearity { linear_gain: element.gain, tests });
+            return Ok(StepResult { fit, settled: settled || element.integrating, linearity });
+        }
+        let stalled = tests.len() >= 2 && gain_error > 0.8 * tests[tests.len() - 2].gain_error;
+        if stalled || tests.len() == MAX_STEP_TESTS {
+            return Err(TuneError::OutsideLinearRange {
+                controller: l.name.clone(),
+                model: order.name(),
+                linear_gain: element.gain,
+                tests,
+                settled,
+                stalled,
+            });
+        }
+        settings.step *= (MAX_GAIN_ERROR / (4.0 * gain_error)).clamp(1.0 / 32.0, 0.5);
     }
-    Ok((fit, settled || integrating))
 }
 
 /// Most scans a plant test's characteristic time may span (a relay's cycle, a step response's
@@ -206,11 +299,22 @@ fn within_range(plant: &Plant, l: &PlantLoop, u: f64) -> Result<(), TuneError> {
     Ok(())
 }
 
-/// The element's mean residence time `T = −g'(0)/g(0)` \[s\] and whether it integrates: from
-/// `g(jω) ≈ g(0)(1 − jωT)` at ω a thousand times below the slowest nonzero eigenvalue (for an
-/// integrating element, `s g(s)` in place of `g`); `None` when it has none (a pure integrator).
-/// For a stable element whose `T` comes out negative or nil, the slowest time constant.
-fn residence_time(plant: &Plant, x: &[f64], l: &PlantLoop) -> Result<(Option<f64>, bool), TuneError> {
+/// What the exact linear model says of a loop's element at the steady state.
+struct Element {
+    /// Mean residence time `T = −g'(0)/g(0)` \[s\]; `None` for a pure integrator.
+    residence_time: Option<f64>,
+    /// Whether it integrates.
+    integrating: bool,
+    /// `g(0)`, or for an integrating element `lim s→0 s g(s)` \[per s\].
+    gain: f64,
+}
+
+/// The element's mean residence time `T = −g'(0)/g(0)` \[s\], whether it integrates and its gain:
+/// from `g(jω) ≈ g(0)(1 − jωT)` at ω a thousand times below the slowest nonzero eigenvalue (for an
+/// integrating element, `s g(s)` in place of `g`), the gain the real part, exact to `O((ωT)²)`;
+/// `T` is `None` when it has none (a pure integrator). For a stable element whose `T` comes out
+/// negative or nil, the slowest time constant.
+fn element(plant: &Plant, x: &[f64], l: &PlantLoop) -> Result<Element, TuneError> {
     let (response, w, slow) = low_frequency_probe(plant, x, l)?;
     let g = response.at(w)[(0, 0)];
     let integrating = g.im.abs() > g.re.abs();
@@ -228,5 +332,8 @@ fn residence_time(plant: &Plant, x: &[f64], l: &PlantLoop) -> Result<(Option<f64
         (false, true) => None,
         (false, false) => Some(1.0 / slow),
     };
-    Ok((t, integrating))
+    if !(h.re.is_finite() && h.re != 0.0) {
+        return Err(TuneError::NoSteadyGain { controller: l.name.clone() });
+    }
+    Ok(Element { residence_time: t, integrating, gain: h.re })
 }
