@@ -86,6 +86,9 @@ pub fn run(a: &SizeArgs, system: UnitSystem) -> Result<(), CliError> {
     plantwide::analysis::faer::set_global_parallelism(plantwide::analysis::faer::Par::Seq);
     let (plant, u) = load_with_overrides(&a.file, &a.set)?;
     let request = request(a, &plant)?;
+    if let Some(out) = &a.plot {
+        check_plot_path(out)?;
+    }
     let x = converge(&plant, &u)?.x;
     let parts = PARTS_PER_VESSEL * a.vessel.as_ref().map_or(a.candidates.len(), |_| 1);
     let bar = progress_bar(parts as u64);
@@ -120,6 +123,23 @@ pub fn run(a: &SizeArgs, system: UnitSystem) -> Result<(), CliError> {
         (Ok(()), Some(e)) => Err(e),
         (Err(e), None) => Err(e),
         (Err(e), Some(p)) => Err(CliError { message: format!("{}; {}", e.message, p.message), code: e.code }),
+    }
+}
+
+/// Refuse a plot that could not be written before the runs, not after them: a name ending in
+/// neither `.png` nor `.svg`, or a folder that does not exist.
+fn check_plot_path(out: &Path) -> Result<(), CliError> {
+    let ext = out.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    if !matches!(ext.as_deref(), Some("png" | "svg")) {
+        return Err(CliError::user(format!("--plot {}: the plot file must end in .png or .svg", out.display())));
+    }
+    match out.parent().filter(|p| !p.as_os_str().is_empty()) {
+        Some(dir) if !dir.is_dir() => Err(CliError::user(format!(
+            "--plot {}: the folder {} does not exist (create it first)",
+            out.display(),
+            dir.display()
+        ))),
+        _ => Ok(()),
     }
 }
 
@@ -447,16 +467,18 @@ fn candidate_words(c: &RankedCandidate) -> (&'static str, &'static str) {
 /// The candidates, best first, then the parts that failed.
 fn ranking_table(r: &CandidateRanking, u: &SizeUnits) -> String {
     let mut t = format!(
-        "| rank | candidate | kind | outflow change [{}] | now: max rate [{}] | needs surge | optimal band volume [{v}] | \
-         optimal design | P band volume [{v}] |\n|---|---|---|---|---|---|---|---|---|\n",
+        "| rank | candidate | kind | outflow change [{}] | now: max level deviation [{}] | now: max rate [{}] | \
+         needs surge | optimal band volume [{v}] | optimal design | P band volume [{v}] |\n\
+         |---|---|---|---|---|---|---|---|---|---|\n",
         u.flow.unit(),
+        u.length.unit(),
         u.rate_unit(),
         v = u.volume.unit()
     );
     for c in &r.candidates {
         let Some(s) = &c.sizing else {
             t.push_str(&format!(
-                "| – | {} | – | – | – | – | – | failed: {} | – |\n",
+                "| – | {} | – | – | – | – | – | – | failed: {} | – |\n",
                 c.candidate.as_deref().unwrap_or("?"),
                 c.failure.as_deref().unwrap_or("")
             ));
@@ -466,15 +488,16 @@ fn ranking_table(r: &CandidateRanking, u: &SizeUnits) -> String {
             s.designs
                 .iter()
                 .find(|d| d.controller.name() == name)
-                .map_or("–".into(), |d| format!("{:.4}", u.volume.difference(d.band_volume)))
+                .map_or("–".into(), |d| fixed(u.volume.difference(d.band_volume)))
         };
         let (need, holds) = candidate_words(c);
         t.push_str(&format!(
-            "| {} | {} | {} | {:.4e} | {} | {need} | {} | {holds} | {} |\n",
+            "| {} | {} | {} | {:.4e} | {} | {} | {need} | {} | {holds} | {} |\n",
             c.rank.map_or("–".into(), |k| k.to_string()),
             s.vessel,
             s.kind,
             u.flow.difference(s.flow_change),
+            now_level(s, u),
             s.current.max_outflow_rate.map_or("–".into(), |r| format!("{:.4e}", u.rate(r))),
             vol("optimal"),
             vol("p")
@@ -484,6 +507,18 @@ fn ranking_table(r: &CandidateRanking, u: &SizeUnits) -> String {
         t.push_str(&format!("\nfailed: {f}\n"));
     }
     t
+}
+
+/// The file's vessel's largest level deviation as the ranking shows it beside its verdict: a
+/// column's holdup in its amount (no level, the band not judged), nothing for a bare stream.
+fn now_level(s: &VesselSizing, u: &SizeUnits) -> String {
+    let c = &s.current;
+    match (c.max_deviation, c.max_holdup_deviation) {
+        (Some(d), _) => format!("{:.4}", u.length.difference(d)),
+        (None, Some(h)) => format!("– (holdup ±{} {}, no level)", sig(u.amount.difference(h)), u.amount.unit()),
+        (None, None) if s.kind == "new_surge_tank" => "– (no vessel)".to_string(),
+        (None, None) => "–".to_string(),
+    }
 }
 
 /// Level deviation and outflow of the designs and the file's vessel, on one time grid (each

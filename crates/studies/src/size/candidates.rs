@@ -27,7 +27,8 @@ pub struct RankedCandidate {
     pub candidate: Option<String>,
     /// The file's vessel and controller (or the bare stream) exceed the band or the rate limit:
     /// the negation of the file's vessel's verdict; none when the rate holds but the band cannot
-    /// be judged (a column's holdup has no level), or the candidate could not be sized.
+    /// be judged (a column's holdup has no level), when the file's vessel's run failed, or when
+    /// the candidate could not be sized.
     pub needs_surge: Option<bool>,
     /// The optimal design's run holds the band and the rate limit (none when it could not be
     /// sized).
@@ -127,7 +128,7 @@ pub fn rank_candidates_observed(
 fn ranked(s: VesselSizing) -> RankedCandidate {
     RankedCandidate {
         rank: None,
-        needs_surge: s.current.meets.map(|meets| !meets),
+        needs_surge: if s.current.failure.is_some() { None } else { s.current.meets.map(|meets| !meets) },
         optimal_meets: optimal(&s).map(|d| d.verified.meets),
         sizing: Some(s),
         candidate: None,

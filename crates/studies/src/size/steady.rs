@@ -61,16 +61,19 @@ pub(super) fn design_steady(
     match (&v.kind, normal) {
         (Kind::Area { area: a0, unit, .. }, _) => {
             let reacts = matches!(v.plant.spec().units.get(unit), Some(UnitSpec::Cstr(_)));
-            let why = if reacts {
-                "; a reactor's cross-section is also its volume at the setpoint, so its conversion: no steady state \
-                 was found with a reactor this small — size surge elsewhere (--candidates) or keep the reactor's area"
-            } else {
-                ""
+            let why = match (reacts, area < *a0) {
+                (false, _) => String::new(),
+                (true, smaller) => format!(
+                    "; a reactor's cross-section is also its volume at the setpoint, so its conversion: no steady \
+                     state was found with a reactor this {} — size surge elsewhere (--candidates) or keep the \
+                     reactor's area",
+                    if smaller { "small" } else { "large" }
+                ),
             };
             let path = Path {
                 at: &|s: f64| build(a0 * (area / a0).powf(s)),
                 size: &|s: f64| format!("area {} m²", sig(a0 * (area / a0).powf(s))),
-                why,
+                why: &why,
             };
             continuation(v, &path, what, first)
         }

@@ -155,11 +155,8 @@ fn verify(
     };
     let (pv, op) = (index(&v.measurement)?, index(&format!("{}.op", v.controller))?);
     let t_min = r.duration.unwrap_or(law.minimum * law.time);
-    let (end, scale, t_max) =
-        match ends(&plant, &xs, (pv, op), r, &format!("the steady state of {what} after the disturbance"))? {
-            Some((end, change)) => (Some(end), (band_y, change.unwrap_or(du.abs())), longest(&plant, &xs, t_min)),
-            None => (None, (band_y, du.abs()), t_min),
-        };
+    let after_what = format!("the steady state of {what} after the disturbance");
+    let Target { end, scale, t_max } = target(&plant, &xs, (pv, op), r, &after_what, (band_y, du, t_min))?;
     let run = Run { plant: &plant, x: &xs, pv, op, end, scale, t_char: law.time, t_min, t_max, what };
     let (trace, ending) = run.step(r)?;
     let to_m = match v.kind {
@@ -189,24 +186,39 @@ fn verify(
     })
 }
 
-/// Where a run that settles ends: the level's and the outflow's values at the steady state of
-/// `plant` after the disturbance, and the outflow's steady change (none when it does not move);
-/// none for a run of fixed length (a sinusoid, a `--duration` asked).
-#[allow(clippy::type_complexity)]
-fn ends(
+/// What a run settles to and how long it may take.
+struct Target {
+    /// The level's and the outflow's values at the steady state after the disturbance; none for a
+    /// run of fixed length (a sinusoid, a `--duration` asked).
+    end: Option<(f64, f64)>,
+    /// The band (in the measurement's units) and the outflow's steady change (the request's
+    /// `|du|` when it does not move) that settling is measured against.
+    scale: (f64, f64),
+    /// The longest run \[s\].
+    t_max: f64,
+}
+
+/// The [`Target`] of a run on `plant` from its steady state `x`, watching the level `pv` and
+/// the outflow `op`, with the band `band_y`, the request's flow change `du` and the window `t_min`.
+fn target(
     plant: &Plant,
     x: &[f64],
     (pv, op): (usize, usize),
     r: &SizeRequest,
     what: &str,
-) -> Result<Option<((f64, f64), Option<f64>)>, SizeError> {
+    (band_y, du, t_min): (f64, f64, f64),
+) -> Result<Target, SizeError> {
     if r.duration.is_some() || matches!(r.disturbance.shape, Shape::Sine { .. }) {
-        return Ok(None);
+        return Ok(Target { end: None, scale: (band_y, du.abs()), t_max: t_min });
     }
     let xe = after(plant, x, r, what)?;
-    let change = xe[op] - x[op];
-    let moves = change.abs() > 1e-9 * x[op].abs().max(1e-12);
-    Ok(Some(((xe[pv], xe[op]), moves.then_some(change.abs()))))
+    let change = (xe[op] - x[op]).abs();
+    let moves = change > 1e-9 * x[op].abs().max(1e-12);
+    Ok(Target {
+        end: Some((xe[pv], xe[op])),
+        scale: (band_y, if moves { change } else { du.abs() }),
+        t_max: longest(plant, x, t_min),
+    })
 }
 
 /// The longest a run with window `t_min` may take to settle on `plant` (at `x`): see
@@ -354,10 +366,9 @@ pub(super) fn current(v: &Vessel, r: &SizeRequest, designs: &[Design], du: f64) 
     let t_char = designs.iter().map(|d| d.design_time).fold(f64::INFINITY, f64::min);
     let ran = designs.iter().filter(|d| d.verified.failure.is_none()).map(|d| d.verified.duration).fold(0.0, f64::max);
     let t_min = r.duration.unwrap_or(if ran > 0.0 { ran } else { 25.0 * t_char });
-    let ended = ends(plant, x, (pv, op), r, &format!("the steady state of {what} after the disturbance"));
-    let (end, scale, t_max) = match ended {
-        Ok(Some((end, change))) => (Some(end), (band_y, change.unwrap_or(du.abs())), longest(plant, x, t_min)),
-        Ok(None) => (None, (band_y, du.abs()), t_min),
+    let after_what = format!("the steady state of {what} after the disturbance");
+    let Target { end, scale, t_max } = match target(plant, x, (pv, op), r, &after_what, (band_y, du, t_min)) {
+        Ok(target) => target,
         Err(e) if !e.is_user_error() => return Ok(Current::failed(area, e.to_string(), 0.0)),
         Err(e) => return Err(e),
     };
