@@ -365,6 +365,31 @@ pub struct Progress<'a> {
 /// The parts of one vessel's sizing that report [`Progress`]: three designs and the file's vessel.
 pub const PARTS_PER_VESSEL: usize = 4;
 
+/// Where the continuation from the file's vessel to a design's stopped.
+#[derive(Debug, Clone, thiserror::Error)]
+#[error(
+    "no steady state beyond {reached} on the way from the file's {from} to the design's {to} (at {next}: \
+     {reason}){limits}{why}"
+)]
+pub struct Stall {
+    /// The file's size (`area 4 m²`, `normal holdup 40000 mol`).
+    pub from: String,
+    /// The design's.
+    pub to: String,
+    /// The last size with a steady state.
+    pub reached: String,
+    /// The size tried next.
+    pub next: String,
+    /// The solver's reason there, in short (status, residual, worst equation).
+    pub reason: String,
+    /// The loops near a limit at the last steady state (`; at area 2.9 m²: `c` within 0.4 % of
+    /// op_max (…)`), or empty.
+    pub limits: String,
+    /// What it means for this vessel (`; a reactor's cross-section also sets its volume …`), or
+    /// empty.
+    pub why: String,
+}
+
 /// Why a sizing was refused or failed.
 #[derive(Debug, Clone, thiserror::Error)]
 pub enum SizeError {
@@ -462,28 +487,12 @@ pub enum SizeError {
         source: Box<SteadyError>,
     },
     /// No steady state on the way from the file's vessel to a design's.
-    #[error(
-        "{what}: no steady state beyond {reached} on the way from the file's {from} to the design's {to} \
-         (at {next}: {reason}){limits}{why}"
-    )]
+    #[error("{what}: {stall}")]
     Continuation {
         /// Which plant.
         what: String,
-        /// The file's size (`area 4 m²`, `normal holdup 40000 mol`).
-        from: String,
-        /// The design's.
-        to: String,
-        /// The last size with a steady state.
-        reached: String,
-        /// The size tried next.
-        next: String,
-        /// The solver's reason there, in short (status, residual, worst equation).
-        reason: String,
-        /// The loops near a limit at the last steady state (`; at area 2.9 m² `c` within 0.4 % of
-        /// op_max (…)`), or empty.
-        limits: String,
-        /// What it means for this vessel (`; a reactor's cross-section also sets its volume …`).
-        why: String,
+        /// Where the way stopped and why.
+        stall: Box<Stall>,
         /// The solver's reason in full.
         source: Box<SteadyError>,
     },

@@ -20,7 +20,7 @@ use plantwide_solve::SteadyError;
 
 use super::run::near_limits;
 use super::vessel::{Kind, Vessel};
-use super::{SizeError, SizeRequest, newton};
+use super::{SizeError, SizeRequest, Stall, newton};
 use crate::screen::column::mapped_guess;
 
 /// The smallest continuation step, as a fraction of the way from the file's size to the design's.
@@ -122,8 +122,7 @@ fn continuation(v: &Vessel, path: &Path<'_>, what: &str, first: SteadyError) -> 
             }
             Err(source) if h <= MIN_STEP => {
                 let near = near_limits(&here, &x, LIMIT_NOTE);
-                return Err(SizeError::Continuation {
-                    what: what.to_string(),
+                let stall = Stall {
                     from: (path.size)(0.0),
                     to: (path.size)(1.0),
                     reached: (path.size)(s),
@@ -131,6 +130,10 @@ fn continuation(v: &Vessel, path: &Path<'_>, what: &str, first: SteadyError) -> 
                     reason: short(&source),
                     limits: if near.is_empty() { String::new() } else { format!("; at {}: {near}", (path.size)(s)) },
                     why: path.why.to_string(),
+                };
+                return Err(SizeError::Continuation {
+                    what: what.to_string(),
+                    stall: Box::new(stall),
                     source: Box::new(source),
                 });
             }
