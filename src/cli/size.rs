@@ -555,18 +555,17 @@ fn plot_designs(out: &Path, s: &VesselSizing, u: &SizeUnits) -> Result<(), CliEr
     let skipped: Vec<&str> =
         s.designs.iter().filter(|d| d.verified.failure.is_some()).map(|d| d.controller.name()).collect();
     let note = if skipped.is_empty() { String::new() } else { format!("; failed, not drawn: {}", skipped.join(", ")) };
-    let panels = [
-        Overlay { label: format!("level deviation [{}]", u.length.unit()), curves: level, ..Overlay::default() },
-        Overlay { label: format!("{} [{}]", s.outflow, u.flow.unit()), curves: flow, ..Overlay::default() },
-    ];
-    let hours: Vec<f64> = grid.iter().map(|t| t / 3600.0).collect();
     let band = u.length.difference(s.level_band);
-    let title = format!(
-        "surge designs of `{}` for {} (band ±{band:.4} {}){note}",
-        s.vessel,
-        s.disturbance_path,
-        u.length.unit()
-    );
+    let level = Overlay {
+        label: format!("level deviation [{}]", u.length.unit()),
+        curves: level,
+        limits: vec![(format!("+{band:.3} {}", u.length.unit()), band), (format!("−{band:.3}"), -band)],
+        ..Overlay::default()
+    };
+    let panels =
+        [level, Overlay { label: format!("{} [{}]", s.outflow, u.flow.unit()), curves: flow, ..Overlay::default() }];
+    let hours: Vec<f64> = grid.iter().map(|t| t / 3600.0).collect();
+    let title = format!("surge designs of `{}` for a change of {}{note}", s.vessel, s.disturbance_path);
     write_overlays(out, &title, "time after the step [h]", &hours, &panels, &[])
         .map_err(|e| CliError::user(e.to_string()))
 }

@@ -286,3 +286,40 @@ fn a_plot_into_a_missing_folder_is_refused_before_the_runs() {
     assert_eq!(code, Some(1), "{err}");
     assert!(err.contains(&format!("the folder {} does not exist", missing.display())), "{err}");
 }
+
+/// D3 where nothing holds: the two-column plant's reactor sized for a +10 % fresh A needs a
+/// larger reactor than the file's 4 m², and every design's larger volume converts more than the
+/// second column's bottoms loop can take (it saturates on the way). The report shows no figures
+/// for any design, only why each failed; no plot stands in for them; the command exits 2.
+#[test]
+fn when_no_design_has_a_run_the_report_has_no_figures_and_no_plot() {
+    let file = flowsheet("two_column_plant.json");
+    let plot = std::env::temp_dir().join(format!("plantwide_size_none_{}.png", std::process::id()));
+    let args = [
+        "size",
+        &file,
+        "--vessel",
+        "reactor",
+        "--disturbance",
+        "fresh_A.F=+10%",
+        "--level-band",
+        "0.3 m",
+        "--max-outflow-rate",
+        "0.2 kmol/h/min",
+        "--plot",
+        plot.to_str().unwrap(),
+    ];
+    let (code, out, err) = run(&args);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(!plot.exists(), "a plot of failed runs was written");
+    assert!(err.contains("size: 3 parts failed") && err.contains("no design of `reactor` has a verified run"), "{err}");
+    for name in ["p", "pi", "optimal"] {
+        let row = out.lines().find(|l| l.starts_with(&format!("| {name} |"))).unwrap();
+        let cells: Vec<&str> = row.split('|').map(str::trim).collect();
+        let area: f64 = cells[2].parse().unwrap();
+        assert!(area > 4.0, "{row}");
+        assert_eq!(&cells[6..8], ["–", "–"], "{row}");
+        assert!(cells[8].starts_with("failed: ") && cells[8].contains("a reactor this large"), "{row}");
+        assert!(cells[8].contains("`column2_bottom_T` at op_max"), "{row}");
+    }
+}
