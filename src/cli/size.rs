@@ -430,7 +430,13 @@ fn current_line(s: &VesselSizing, u: &SizeUnits) -> String {
     if let Some(r) = c.max_outflow_rate {
         figures.push(format!("max outflow rate {:.4e} {}", u.rate(r), u.rate_unit()));
     }
-    format!("\n{who}{area}: {} — {}\n", figures.join(", "), current_words(c.meets, c.max_holdup_deviation.is_some()))
+    let outside =
+        c.outside.as_ref().map_or(String::new(), |o| format!(" ({o}: the vessel cannot take this disturbance)"));
+    format!(
+        "\n{who}{area}: {} — {}{outside}\n",
+        figures.join(", "),
+        current_words(c.meets, c.max_holdup_deviation.is_some())
+    )
 }
 
 /// The wording of the file's vessel's verdict ([`plantwide::studies::size::verdict`]); a column's

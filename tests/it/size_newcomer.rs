@@ -323,3 +323,21 @@ fn when_no_design_has_a_run_the_report_has_no_figures_and_no_plot() {
         assert!(cells[8].contains("`column2_bottom_T` at op_max"), "{row}");
     }
 }
+
+/// The file's tank through a +60 % feed: its P loop would hold the level Δu/Kc = 4.8 m above its
+/// 2 m setpoint, past the 4 m top. The model has no overflow, so the report says the vessel cannot
+/// take the disturbance rather than quote a level no tank of that height can have.
+#[test]
+fn a_file_vessel_whose_level_would_pass_its_top_is_said_to_overflow() {
+    let file = train();
+    let mut args = [&["size", &file][..], &SURGE, &["--json"]].concat();
+    args[5] = "feed_source.F=+60%";
+    let (code, out, err) = run(&args);
+    assert_eq!(code, Some(0), "{err}");
+    let s: Value = serde_json::from_str(&out).unwrap();
+    let top = 2.0 + 0.6 * num(&steady(&file, &[]), "flash_liquid.F") / (20_000.0 / 3600.0);
+    let c = &s["current"];
+    assert!(c["meets"] == false && rel(num(c, "max_deviation") + 2.0, top) < 1e-3, "{c}");
+    let outside = c["outside"].as_str().unwrap();
+    assert!(outside.contains(&format!("reaches {top:.2}")) && outside.ends_with("above its top at 4 m"), "{outside}");
+}

@@ -346,6 +346,11 @@ pub struct Current {
     /// A sinusoid: the outflow's swing over the inflow's in the last two periods.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub attenuation: Option<f64>,
+    /// Where the level left the vessel in the run (`above its top at 4 m`, `below its bottom`):
+    /// the model holds no overflow or dry running, so the vessel as the file has it cannot take
+    /// the disturbance at all.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub outside: Option<String>,
     /// The run's record (for plots; not serialized).
     #[serde(skip)]
     pub trace: Trace,

@@ -389,8 +389,21 @@ pub(super) fn current(v: &Vessel, r: &SizeRequest, designs: &[Design], du: f64) 
         duration,
         failure: None,
         attenuation: if r.attenuation.is_some() { f.attenuation } else { None },
+        outside: (level == Level::Shown).then(|| outside(v, &trace)).flatten(),
         trace,
     })
+}
+
+/// Where the file's vessel's level (setpoint `v.sp`, the record's deviations from it) went past
+/// its top or below its bottom, if it did.
+fn outside(v: &Vessel, trace: &Trace) -> Option<String> {
+    let Kind::Area { height, .. } = &v.kind else { return None };
+    let (lo, hi) = trace.deviation.iter().fold((0.0f64, 0.0f64), |(lo, hi), &d| (lo.min(d), hi.max(d)));
+    match height {
+        Some(h) if v.sp + hi > *h => Some(format!("its level reaches {:.4} m, above its top at {h} m", v.sp + hi)),
+        _ if v.sp + lo < 0.0 => Some(format!("its level falls {:.4} m below its bottom", -(v.sp + lo))),
+        _ => None,
+    }
 }
 
 impl Current {
@@ -405,6 +418,7 @@ impl Current {
             duration,
             failure: Some(why),
             attenuation: None,
+            outside: None,
             trace: Trace::default(),
         }
     }
