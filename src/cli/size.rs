@@ -337,13 +337,14 @@ fn table(s: &VesselSizing, plant: &Plant, u: &SizeUnits) -> String {
         t.push_str(&format!(
             "The column model gives its {} a holdup, not a level: each design is a vertical drum of the area shown \
              holding the band volume over the level band, its controller measuring the holdup (kc per {} held; \
-             levels below are the drum's).\n\n",
+             levels below are the drum's). The area is the least that holds the limits: where the normal holdup \
+             stands too deep in it, a wider drum of the same band holds them too, its outflow slower.\n\n",
             if s.kind == "column_drum" { "drum" } else { "base" },
             u.amount.unit()
         ));
     }
     let kc_unit = if holdup { format!("{f}/{}", u.amount.unit()) } else { format!("{f}/{l}") };
-    let normal = if holdup { format!(" normal holdup [{}] |", u.amount.unit()) } else { String::new() };
+    let normal = if holdup { format!(" normal holdup [{}] (its depth) |", u.amount.unit()) } else { String::new() };
     t.push_str(&format!(
         "| controller | area [{}] | band volume [{}] |{normal} kc [{kc_unit}] | τI [{}] | max level deviation [{l}] | \
          max outflow rate [{}] | meets |\n",
@@ -354,7 +355,7 @@ fn table(s: &VesselSizing, plant: &Plant, u: &SizeUnits) -> String {
     ));
     t.push_str(if holdup { "|---|---|---|---|---|---|---|---|---|\n" } else { "|---|---|---|---|---|---|---|---|\n" });
     for d in &s.designs {
-        t.push_str(&design_row(d, holdup, u));
+        t.push_str(&design_row(d, holdup.then_some(s.liquid_molar_volume), u));
     }
     if let Some(a) = &s.attenuation {
         t.push_str(&format!(
@@ -378,11 +379,19 @@ fn table(s: &VesselSizing, plant: &Plant, u: &SizeUnits) -> String {
 
 /// One design's row: its figures and verdict, or `failed` with the reason (never figures of a run
 /// that has none).
-fn design_row(d: &Design, holdup: bool, u: &SizeUnits) -> String {
-    let normal = match (holdup, d.normal_holdup) {
-        (true, Some(n)) => format!(" {} |", fixed(u.amount.difference(n))),
-        (true, None) => " – |".to_string(),
-        (false, _) => String::new(),
+fn design_row(d: &Design, v_l: Option<f64>, u: &SizeUnits) -> String {
+    let holdup = v_l.is_some();
+    let normal = match (v_l, d.normal_holdup) {
+        (Some(v_l), Some(n)) => {
+            format!(
+                " {} ({} {}) |",
+                fixed(u.amount.difference(n)),
+                sig(u.length.difference(n * v_l / d.area)),
+                u.length.unit()
+            )
+        }
+        (Some(_), None) => " – |".to_string(),
+        (None, _) => String::new(),
     };
     let kc = d.kc.map_or("–".into(), |k| fixed(if holdup { u.kc_holdup(k) } else { u.kc(k) }));
     let tau_i = d.tau_i.map_or("–".into(), |t| fixed(u.time.difference(t)));
