@@ -464,10 +464,10 @@ fn current_words(meets: Option<bool>, no_level: bool) -> &'static str {
 fn candidate_words(c: &RankedCandidate) -> (&'static str, &'static str) {
     let Some(s) = &c.sizing else { return ("–", "not sized") };
     let need = match (s.current.failure.is_some(), c.needs_surge) {
-        (true, _) => "unknown (its run failed)",
+        (true, _) => "unknown (run failed)",
         (false, Some(true)) => "yes",
         (false, Some(false)) => "no",
-        (false, None) => "not judged (no level; rate within)",
+        (false, None) => "not judged",
     };
     let optimal = s.designs.iter().find(|d| d.controller.name() == "optimal");
     let holds = match (optimal.map(|d| d.verified.failure.is_some()), c.optimal_meets) {
@@ -518,6 +518,11 @@ fn ranking_table(r: &CandidateRanking, u: &SizeUnits) -> String {
             vol("p")
         ));
     }
+    t.push_str(
+        "\nneeds surge: the vessel as the file has it (a stream: as it is) exceeds the band or the rate limit; not \
+         judged: a column's holdup has no level, and its rate is within. optimal: the optimal design's run holds \
+         both.\n",
+    );
     for f in &r.failed {
         t.push_str(&format!("\nfailed: {f}\n"));
     }
@@ -611,7 +616,7 @@ fn plot_candidates(out: &Path, r: &CandidateRanking, u: &SizeUnits) -> Result<()
                     .find(|d| d.controller.name() == "optimal")
                     .map_or(f64::NAN, |d| u.volume.difference(d.band_volume));
                 let rank = c.rank.map_or("–".into(), |k| k.to_string());
-                (format!("{rank} {} (needs surge: {need}; optimal design: {holds})", s.vessel), volume)
+                (format!("{rank} {} (needs surge: {need}; optimal: {holds})", s.vessel), volume)
             }
             None => (format!("– {} (not sized)", c.candidate.as_deref().unwrap_or("?")), f64::NAN),
         })

@@ -271,7 +271,7 @@ fn candidates_with_the_same_outflow_are_told_apart_by_their_level() {
     let svg = std::fs::read_to_string(&plot).unwrap();
     std::fs::remove_file(&plot).ok();
     for (c, name) in [(&tank, "surge"), (&stream, "column_feed")] {
-        let label = format!("{} {name} (needs surge: {}; optimal design: {})", c[1], c[7], c[9]);
+        let label = format!("{} {name} (needs surge: {}; optimal: {})", c[1], c[7], c[9]);
         assert!(svg.contains(&label), "{label} not in the plot");
     }
 }
