@@ -9,8 +9,8 @@ use std::path::{Path, PathBuf};
 use plantwide::flowsheet::Plant;
 use plantwide::io::plot::{Overlay, write_bars, write_overlays};
 use plantwide::studies::size::{
-    Attenuation, CandidateRanking, Disturbance, Shape, SizeError, SizeRequest, VesselSizing, rank_candidates,
-    size_vessel,
+    Attenuation, CandidateRanking, Design, Disturbance, PARTS_PER_VESSEL, Progress, RankedCandidate, Shape, SizeError,
+    SizeRequest, VesselSizing, rank_candidates_observed, size_vessel_observed,
 };
 use plantwide::units::{Dimension, Display, UnitSystem, parse_quantity_as};
 
@@ -69,31 +69,90 @@ pub struct SizeArgs {
     /// Write a plot here (.png or .svg): the designs' level and outflow, or the candidates' volumes.
     #[arg(long, value_name = "OUT")]
     plot: Option<PathBuf>,
+    /// Report each design and run as it is done on stderr even when stderr is not a terminal (a
+    /// terminal gets a progress bar without it).
+    #[arg(long)]
+    progress: bool,
 }
 
 fn size_error(e: SizeError) -> CliError {
     if e.is_user_error() { CliError::user(e.to_string()) } else { CliError::numerical(e.to_string()) }
 }
 
-/// Run `plantwide size`.
+/// Run `plantwide size`: the report is printed whole (a failed part marked where it stands), then
+/// the command exits 2 when a part failed or the plot had nothing to show.
 pub fn run(a: &SizeArgs, system: UnitSystem) -> Result<(), CliError> {
     let units = SizeUnits::new(system)?;
     plantwide::analysis::faer::set_global_parallelism(plantwide::analysis::faer::Par::Seq);
     let (plant, u) = load_with_overrides(&a.file, &a.set)?;
     let request = request(a, &plant)?;
-    let x = converge(&plant, &u)?.x;
-    if let Some(v) = &a.vessel {
-        let s = size_vessel(&plant, &x, v, &request).map_err(size_error)?;
-        if let Some(out) = &a.plot {
-            plot_designs(out, &s, &units)?;
-        }
-        return print(a.json, &s, |s| table(s, &units));
-    }
-    let ranking = rank_candidates(&plant, &x, &a.candidates, &request).map_err(size_error)?;
     if let Some(out) = &a.plot {
-        plot_candidates(out, &ranking)?;
+        check_plot_path(out)?;
     }
-    print(a.json, &ranking, |r| ranking_table(r, &units))
+    let x = converge(&plant, &u)?.x;
+    let parts = PARTS_PER_VESSEL * a.vessel.as_ref().map_or(a.candidates.len(), |_| 1);
+    let bar = progress_bar(parts as u64);
+    let lines = a.progress && !std::io::IsTerminal::is_terminal(&std::io::stderr());
+    let tell = |p: Progress<'_>| {
+        bar.inc(1);
+        let how = if p.failed { "failed" } else { "done" };
+        let message = format!("`{}`: {} {how}", p.vessel, p.part);
+        if lines {
+            eprintln!("size: {}/{parts} {message}", bar.position());
+        }
+        bar.set_message(message);
+    };
+    let (failed, plotted) = if let Some(v) = &a.vessel {
+        let s = size_vessel_observed(&plant, &x, v, &request, &tell);
+        bar.finish_and_clear();
+        let s = s.map_err(size_error)?;
+        let plotted = a.plot.as_deref().map(|out| plot_designs(out, &s, &units)).transpose();
+        print(a.json, &s, |s| table(s, &plant, &units))?;
+        (s.failed, plotted)
+    } else {
+        let ranking = rank_candidates_observed(&plant, &x, &a.candidates, &request, &tell);
+        bar.finish_and_clear();
+        let ranking = ranking.map_err(size_error)?;
+        let plotted = a.plot.as_deref().map(|out| plot_candidates(out, &ranking, &units)).transpose();
+        print(a.json, &ranking, |r| ranking_table(r, &units))?;
+        (ranking.failed, plotted)
+    };
+    let plot_error = plotted.err();
+    match (super::screen::failed_parts("size", &failed), plot_error) {
+        (Ok(()), None) => Ok(()),
+        (Ok(()), Some(e)) => Err(e),
+        (Err(e), None) => Err(e),
+        (Err(e), Some(p)) => Err(CliError { message: format!("{}; {}", e.message, p.message), code: e.code }),
+    }
+}
+
+/// Refuse a plot that could not be written before the runs, not after them: a name ending in
+/// neither `.png` nor `.svg`, or a folder that does not exist.
+fn check_plot_path(out: &Path) -> Result<(), CliError> {
+    let ext = out.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    if !matches!(ext.as_deref(), Some("png" | "svg")) {
+        return Err(CliError::user(format!("--plot {}: the plot file must end in .png or .svg", out.display())));
+    }
+    match out.parent().filter(|p| !p.as_os_str().is_empty()) {
+        Some(dir) if !dir.is_dir() => Err(CliError::user(format!(
+            "--plot {}: the folder {} does not exist (create it first)",
+            out.display(),
+            dir.display()
+        ))),
+        _ => Ok(()),
+    }
+}
+
+/// A bar of `parts` on stderr, drawn only when stderr is a terminal (never on stdout; `--progress`
+/// prints a line per part instead where it is not).
+fn progress_bar(parts: u64) -> indicatif::ProgressBar {
+    let bar = indicatif::ProgressBar::new(parts);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("sizing {pos}/{len} parts [{elapsed_precise}] {bar:30} {msg}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    bar.enable_steady_tick(std::time::Duration::from_millis(250));
+    bar
 }
 
 /// `value` as JSON with `--json`, otherwise as the text `table` makes of it.
@@ -177,25 +236,29 @@ fn opt(v: Option<f64>, scale: f64) -> String {
     v.map_or("–".into(), |v| format!("{:.4}", v * scale))
 }
 
-/// The display units of `size`: flows, levels, areas, volumes and amounts in the `--units`
+/// The display units of `size`: flows, levels, areas, volumes, amounts and times in the `--units`
 /// system (a rate of change of a flow per minute).
 struct SizeUnits {
+    system: UnitSystem,
     flow: Display,
     length: Display,
     area: Display,
     volume: Display,
     amount: Display,
+    time: Display,
 }
 
 impl SizeUnits {
     fn new(system: UnitSystem) -> Result<SizeUnits, CliError> {
         let d = |dim: Dimension| Display::new(&system.unit_for(dim)).map_err(|e| CliError::user(e.to_string()));
         Ok(SizeUnits {
+            system,
             flow: d(Dimension::MOLAR_FLOW)?,
             length: d(Dimension::LENGTH)?,
             area: d(Dimension::AREA)?,
             volume: d(Dimension::VOLUME)?,
             amount: d(Dimension::AMOUNT)?,
+            time: Display::new("min").map_err(|e| CliError::user(e.to_string()))?,
         })
     }
     /// A flow's rate of change \[mol/s²\] per minute, and its unit.
@@ -209,11 +272,51 @@ impl SizeUnits {
     fn kc(&self, si: f64) -> f64 {
         self.flow.difference(si) / self.length.difference(1.0)
     }
+    /// A holdup controller's gain \[mol/s per mol\] in flow per amount.
+    fn kc_holdup(&self, si: f64) -> f64 {
+        self.flow.difference(si) / self.amount.difference(1.0)
+    }
+    /// A time \[s\] in minutes.
+    fn minutes(&self, si: f64) -> String {
+        format!("{} {}", sig(self.time.difference(si)), self.time.unit())
+    }
 }
 
-/// The designs as a markdown table.
-fn table(s: &VesselSizing, u: &SizeUnits) -> String {
+/// Four decimals, or four significant digits in exponent form below 10⁻³ (a holdup loop's gain).
+fn fixed(v: f64) -> String {
+    if v != 0.0 && v.abs() < 1e-3 { format!("{v:.3e}") } else { format!("{v:.4}") }
+}
+
+/// Four significant digits, plain or in exponent form.
+fn sig(v: f64) -> String {
+    if v != 0.0 && v.is_finite() && (v.abs() < 1e-3 || v.abs() >= 1e6) {
+        return format!("{v:.3e}");
+    }
+    let digits = if v == 0.0 || !v.is_finite() { 0 } else { (3 - v.abs().log10().floor() as i32).max(0) as usize };
+    format!("{v:.digits$}")
+}
+
+/// `PATH +Δ unit, shape` in display units (the disturbed input's dimension in the `--units`
+/// system, the shape's time in minutes).
+fn disturbance_text(s: &VesselSizing, plant: &Plant, u: &SizeUnits) -> String {
+    let dim = plant.input(&s.disturbance_path).map(|i| plant.inputs()[i].dim);
+    let shown = dim.and_then(|d| Display::new(&u.system.unit_for(d)).ok());
+    let change = match &shown {
+        Some(d) => format!("{:+.6e} {}", d.difference(s.disturbance_change), d.unit()),
+        None => format!("{:+.6e} (SI)", s.disturbance_change),
+    };
+    let shape = match s.shape {
+        Shape::Step => "step".to_string(),
+        Shape::Ramp { duration } => format!("ramp over {}", u.minutes(duration)),
+        Shape::Sine { period } => format!("sinusoid of period {}", u.minutes(period)),
+    };
+    format!("{} {change}, {shape}", s.disturbance_path)
+}
+
+/// The designs as a markdown table, then the file's vessel.
+fn table(s: &VesselSizing, plant: &Plant, u: &SizeUnits) -> String {
     let (f, l) = (u.flow.unit(), u.length.unit());
+    let holdup = s.kind == "column_drum" || s.kind == "column_sump";
     let mut t = format!(
         "surge sizing of `{}` ({}; level controller `{}` on `{}`) for {}: outflow change {:.4e} {f}, \
          level band ±{:.4} {l}, rate limit {:.4e} {}, liquid {:.4e} {}/{}\n\n",
@@ -221,7 +324,7 @@ fn table(s: &VesselSizing, u: &SizeUnits) -> String {
         s.kind,
         s.level_controller,
         s.outflow,
-        s.disturbance,
+        disturbance_text(s, plant, u),
         u.flow.difference(s.flow_change),
         u.length.difference(s.level_band),
         u.rate(s.max_outflow_rate),
@@ -230,31 +333,36 @@ fn table(s: &VesselSizing, u: &SizeUnits) -> String {
         u.volume.unit(),
         u.amount.unit()
     );
+    if holdup {
+        t.push_str(&format!(
+            "The column model gives its {} a holdup, not a level: each design is a vertical drum of the area shown \
+             holding the band volume over the level band, its controller measuring the holdup (kc per {} held; \
+             levels below are the drum's). The area is the least that holds the limits: where the normal holdup \
+             stands too deep in it, a wider drum of the same band holds them too, its outflow slower.\n\n",
+            if s.kind == "column_drum" { "drum" } else { "base" },
+            u.amount.unit()
+        ));
+    }
+    let kc_unit = if holdup { format!("{f}/{}", u.amount.unit()) } else { format!("{f}/{l}") };
+    let normal = if holdup { format!(" normal holdup [{}] (its depth) |", u.amount.unit()) } else { String::new() };
     t.push_str(&format!(
-        "| controller | area [{}] | band volume [{}] | kc [{f}/{l}] | τI [min] | max level deviation [{l}] | max outflow rate [{}] | meets |\n",
+        "| controller | area [{}] | band volume [{}] |{normal} kc [{kc_unit}] | τI [{}] | max level deviation [{l}] | \
+         max outflow rate [{}] | meets |\n",
         u.area.unit(),
         u.volume.unit(),
+        u.time.unit(),
         u.rate_unit()
     ));
-    t.push_str("|---|---|---|---|---|---|---|---|\n");
+    t.push_str(if holdup { "|---|---|---|---|---|---|---|---|---|\n" } else { "|---|---|---|---|---|---|---|---|\n" });
     for d in &s.designs {
-        t.push_str(&format!(
-            "| {} | {:.4} | {:.4} | {} | {} | {:.6} | {:.4e} | {} |\n",
-            d.controller.name(),
-            u.area.difference(d.area),
-            u.volume.difference(d.band_volume),
-            d.kc.map_or("–".into(), |k| format!("{:.4}", u.kc(k))),
-            opt(d.tau_i, 1.0 / 60.0),
-            u.length.difference(d.verified.max_level_deviation),
-            u.rate(d.verified.max_outflow_rate),
-            if d.verified.meets { "yes" } else { "NO" }
-        ));
+        t.push_str(&design_row(d, holdup.then_some(s.liquid_molar_volume), u));
     }
     if let Some(a) = &s.attenuation {
         t.push_str(&format!(
-            "\nperiodic swing at {} s (asked: outflow ≤ {} of the inflow; `meets` is judged on it, the peaks above \
+            "\nperiodic swing at {} (asked: outflow ≤ {} of the inflow; `meets` is judged on it, the peaks above \
              include the start from rest):\n",
-            a.period, a.ratio
+            u.minutes(a.period),
+            a.ratio
         ));
         for d in &s.designs {
             t.push_str(&format!(
@@ -265,66 +373,193 @@ fn table(s: &VesselSizing, u: &SizeUnits) -> String {
             ));
         }
     }
-    for d in s.designs.iter().filter(|d| d.verified.failure.is_some()) {
-        t.push_str(&format!("\n{}: {}\n", d.controller.name(), d.verified.failure.as_deref().unwrap_or("")));
-    }
-    let c = &s.current;
-    t.push_str(&format!(
-        "\nas the file has it{}: max deviation {} {l}, max outflow rate {:.4e} {} — {}\n",
-        c.area.map_or(String::new(), |a| format!(" (area {:.4} {})", u.area.difference(a), u.area.unit())),
-        opt(c.max_deviation.map(|d| u.length.difference(d)), 1.0),
-        u.rate(c.max_outflow_rate),
-        u.rate_unit(),
-        if c.meets { "meets the limits" } else { "exceeds them" }
-    ));
-    if let Some(why) = &c.failure {
-        t.push_str(&format!("its run stopped: {why}\n"));
-    }
+    t.push_str(&current_line(s, u));
     t
 }
 
-/// The candidates, best first.
+/// One design's row: its figures and verdict, or `failed` with the reason (never figures of a run
+/// that has none).
+fn design_row(d: &Design, v_l: Option<f64>, u: &SizeUnits) -> String {
+    let holdup = v_l.is_some();
+    let normal = match (v_l, d.normal_holdup) {
+        (Some(v_l), Some(n)) => {
+            format!(
+                " {} ({} {}) |",
+                fixed(u.amount.difference(n)),
+                sig(u.length.difference(n * v_l / d.area)),
+                u.length.unit()
+            )
+        }
+        (Some(_), None) => " – |".to_string(),
+        (None, _) => String::new(),
+    };
+    let kc = d.kc.map_or("–".into(), |k| fixed(if holdup { u.kc_holdup(k) } else { u.kc(k) }));
+    let tau_i = d.tau_i.map_or("–".into(), |t| fixed(u.time.difference(t)));
+    let v = &d.verified;
+    let figures = match (v.max_level_deviation, v.max_outflow_rate, &v.failure) {
+        (Some(dev), Some(rate), None) => {
+            format!("{:.6} | {:.4e} | {}", u.length.difference(dev), u.rate(rate), if v.meets { "yes" } else { "NO" })
+        }
+        (_, _, why) => format!("– | – | failed: {}", why.as_deref().unwrap_or("no figures")),
+    };
+    format!(
+        "| {} | {} | {} |{normal} {kc} | {tau_i} | {figures} |\n",
+        d.controller.name(),
+        fixed(u.area.difference(d.area)),
+        fixed(u.volume.difference(d.band_volume)),
+    )
+}
+
+/// The file's vessel (a new tank: the bare stream) through the disturbance, judged as the designs
+/// are; a column's holdup, which has no level, shown in its amount and the band not judged.
+fn current_line(s: &VesselSizing, u: &SizeUnits) -> String {
+    let c = &s.current;
+    let l = u.length.unit();
+    let who = match s.kind {
+        "new_surge_tank" => format!("without a tank on `{}`", s.vessel),
+        _ => "as the file has it".to_string(),
+    };
+    let area = c.area.map_or(String::new(), |a| format!(" (area {:.4} {})", u.area.difference(a), u.area.unit()));
+    if let Some(why) = &c.failure {
+        return format!("\n{who}{area}: failed: {why}\n");
+    }
+    let mut figures = Vec::new();
+    if let Some(d) = c.max_deviation {
+        figures.push(format!("max deviation {:.4} {l}", u.length.difference(d)));
+    }
+    if let Some(d) = c.max_holdup_deviation {
+        figures.push(format!(
+            "max holdup deviation {:.4} {} (the column model has no drum geometry: the level band is not judged on the \
+             file's {})",
+            u.amount.difference(d),
+            u.amount.unit(),
+            if s.kind == "column_drum" { "drum" } else { "base" }
+        ));
+    }
+    if let Some(r) = c.max_outflow_rate {
+        figures.push(format!("max outflow rate {:.4e} {}", u.rate(r), u.rate_unit()));
+    }
+    let outside =
+        c.outside.as_ref().map_or(String::new(), |o| format!(" ({o}: the vessel cannot take this disturbance)"));
+    format!(
+        "\n{who}{area}: {} — {}{outside}\n",
+        figures.join(", "),
+        current_words(c.meets, c.max_holdup_deviation.is_some())
+    )
+}
+
+/// The wording of the file's vessel's verdict ([`plantwide::studies::size::verdict`]); a column's
+/// holdup (`no_level`) is judged on the rate alone.
+fn current_words(meets: Option<bool>, no_level: bool) -> &'static str {
+    match (meets, no_level) {
+        (Some(true), _) => "meets the limits",
+        (Some(false), false) => "exceeds them",
+        (Some(false), true) => "exceeds the rate limit (the band not judged)",
+        (None, _) => "within the rate limit; the band not judged",
+    }
+}
+
+/// A candidate's verdicts in words: whether it needs surge, and whether its optimal design holds
+/// (the ranking's table and its plot say the same).
+fn candidate_words(c: &RankedCandidate) -> (&'static str, &'static str) {
+    let Some(s) = &c.sizing else { return ("–", "not sized") };
+    let need = match (s.current.failure.is_some(), c.needs_surge) {
+        (true, _) => "unknown (run failed)",
+        (false, Some(true)) => "yes",
+        (false, Some(false)) => "no",
+        (false, None) => "not judged",
+    };
+    let optimal = s.designs.iter().find(|d| d.controller.name() == "optimal");
+    let holds = match (optimal.map(|d| d.verified.failure.is_some()), c.optimal_meets) {
+        (Some(true), _) => "failed",
+        (_, Some(true)) => "holds",
+        (_, Some(false)) => "does not hold",
+        (_, None) => "–",
+    };
+    (need, holds)
+}
+
+/// The candidates, best first, then the parts that failed.
 fn ranking_table(r: &CandidateRanking, u: &SizeUnits) -> String {
     let mut t = format!(
-        "| rank | candidate | kind | outflow change [{}] | now: max rate [{}] | needs surge | optimal band volume [{v}] | P band volume [{v}] |\n|---|---|---|---|---|---|---|---|\n",
+        "| rank | candidate | kind | outflow change [{}] | now: max level deviation [{}] | now: max rate [{}] | \
+         needs surge | optimal band volume [{v}] | optimal design | P band volume [{v}] |\n\
+         |---|---|---|---|---|---|---|---|---|---|\n",
         u.flow.unit(),
+        u.length.unit(),
         u.rate_unit(),
         v = u.volume.unit()
     );
     for c in &r.candidates {
         let Some(s) = &c.sizing else {
             t.push_str(&format!(
-                "| – | {} | – | – | – | – | – | {} |\n",
+                "| – | {} | – | – | – | – | – | – | failed: {} | – |\n",
                 c.candidate.as_deref().unwrap_or("?"),
                 c.failure.as_deref().unwrap_or("")
             ));
             continue;
         };
-        let vol = |k: usize| s.designs.get(k).map_or(f64::NAN, |d| u.volume.difference(d.band_volume));
+        let vol = |name: &str| {
+            s.designs
+                .iter()
+                .find(|d| d.controller.name() == name)
+                .map_or("–".into(), |d| fixed(u.volume.difference(d.band_volume)))
+        };
+        let (need, holds) = candidate_words(c);
         t.push_str(&format!(
-            "| {} | {} | {} | {:.4e} | {:.4e} | {} | {:.4} | {:.4} |\n",
-            c.rank.unwrap_or(0),
+            "| {} | {} | {} | {:.4e} | {} | {} | {need} | {} | {holds} | {} |\n",
+            c.rank.map_or("–".into(), |k| k.to_string()),
             s.vessel,
             s.kind,
             u.flow.difference(s.flow_change),
-            u.rate(s.current.max_outflow_rate),
-            if c.needs_surge == Some(true) { "yes" } else { "no" },
-            vol(2),
-            vol(0)
+            now_level(s, u),
+            s.current.max_outflow_rate.map_or("–".into(), |r| format!("{:.4e}", u.rate(r))),
+            vol("optimal"),
+            vol("p")
         ));
+    }
+    t.push_str(
+        "\nneeds surge: the vessel as the file has it (a stream: as it is) exceeds the band or the rate limit; not \
+         judged: a column's holdup has no level, and its rate is within. optimal: the optimal design's run holds \
+         both.\n",
+    );
+    for f in &r.failed {
+        t.push_str(&format!("\nfailed: {f}\n"));
     }
     t
 }
 
+/// The file's vessel's largest level deviation as the ranking shows it beside its verdict: a
+/// column's holdup in its amount (no level, the band not judged), nothing for a bare stream.
+fn now_level(s: &VesselSizing, u: &SizeUnits) -> String {
+    let c = &s.current;
+    match (c.max_deviation, c.max_holdup_deviation) {
+        (Some(d), _) => format!("{:.4}", u.length.difference(d)),
+        (None, Some(h)) => format!("– (holdup ±{} {}, no level)", sig(u.amount.difference(h)), u.amount.unit()),
+        (None, None) if s.kind == "new_surge_tank" => "– (no vessel)".to_string(),
+        (None, None) => "–".to_string(),
+    }
+}
+
 /// Level deviation and outflow of the designs and the file's vessel, on one time grid (each
-/// record held at its last value after it ends).
+/// record held at its last value after it ends). A design or run without figures is left out (its
+/// record ends where it failed, and a plot of it would read as an answer); when no design has
+/// any, the plot is not written and the error says why.
 fn plot_designs(out: &Path, s: &VesselSizing, u: &SizeUnits) -> Result<(), CliError> {
-    let end = s.designs.iter().map(|d| d.verified.duration).fold(0.0, f64::max);
+    let shown: Vec<&Design> = s.designs.iter().filter(|d| d.verified.failure.is_none()).collect();
+    if shown.is_empty() {
+        return Err(CliError::numerical(format!(
+            "--plot {}: not written: no design of `{}` has a verified run to plot (each is marked failed in the report)",
+            out.display(),
+            s.vessel
+        )));
+    }
+    let end = shown.iter().map(|d| d.verified.duration).fold(0.0, f64::max);
     let grid: Vec<f64> = (0..=1000).map(|k| end * k as f64 / 1000.0).collect();
     let at = |times: &[f64], ys: &[f64]| -> Vec<f64> { grid.iter().map(|&t| interpolate(times, ys, t)).collect() };
     let mut level = Vec::new();
     let mut flow = Vec::new();
-    for d in &s.designs {
+    for d in &shown {
         let tr = &d.verified.trace;
         let name = format!("{} (A = {:.3} {})", d.controller.name(), u.area.difference(d.area), u.area.unit());
         let deviation: Vec<f64> = tr.deviation.iter().map(|v| u.length.difference(*v)).collect();
@@ -332,16 +567,25 @@ fn plot_designs(out: &Path, s: &VesselSizing, u: &SizeUnits) -> Result<(), CliEr
         level.push((name.clone(), at(&tr.times, &deviation)));
         flow.push((name, at(&tr.times, &outflow)));
     }
-    let tr = &s.current.trace;
-    let outflow: Vec<f64> = tr.outflow.iter().map(|v| u.flow.value(*v)).collect();
-    flow.push(("as in the file".to_string(), at(&tr.times, &outflow)));
-    let panels = [
-        Overlay { label: format!("level deviation [{}]", u.length.unit()), curves: level, ..Overlay::default() },
-        Overlay { label: format!("{} [{}]", s.outflow, u.flow.unit()), curves: flow, ..Overlay::default() },
-    ];
-    let hours: Vec<f64> = grid.iter().map(|t| t / 3600.0).collect();
+    if s.current.failure.is_none() {
+        let tr = &s.current.trace;
+        let outflow: Vec<f64> = tr.outflow.iter().map(|v| u.flow.value(*v)).collect();
+        flow.push(("as in the file".to_string(), at(&tr.times, &outflow)));
+    }
+    let skipped: Vec<&str> =
+        s.designs.iter().filter(|d| d.verified.failure.is_some()).map(|d| d.controller.name()).collect();
+    let note = if skipped.is_empty() { String::new() } else { format!("; failed, not drawn: {}", skipped.join(", ")) };
     let band = u.length.difference(s.level_band);
-    let title = format!("surge designs of `{}` for {} (band ±{band:.4} {})", s.vessel, s.disturbance, u.length.unit());
+    let level = Overlay {
+        label: format!("level deviation [{}]", u.length.unit()),
+        curves: level,
+        limits: vec![(format!("+{band:.3} {}", u.length.unit()), band), (format!("−{band:.3}"), -band)],
+        ..Overlay::default()
+    };
+    let panels =
+        [level, Overlay { label: format!("{} [{}]", s.outflow, u.flow.unit()), curves: flow, ..Overlay::default() }];
+    let hours: Vec<f64> = grid.iter().map(|t| t / 3600.0).collect();
+    let title = format!("surge designs of `{}` for a change of {}{note}", s.vessel, s.disturbance_path);
     write_overlays(out, &title, "time after the step [h]", &hours, &panels, &[])
         .map_err(|e| CliError::user(e.to_string()))
 }
@@ -358,24 +602,25 @@ fn interpolate(times: &[f64], ys: &[f64], t: f64) -> f64 {
     }
 }
 
-/// The candidates' optimal band volumes as bars.
-fn plot_candidates(out: &Path, r: &CandidateRanking) -> Result<(), CliError> {
+/// The candidates' optimal band volumes as bars, labelled with the table's verdicts.
+fn plot_candidates(out: &Path, r: &CandidateRanking, u: &SizeUnits) -> Result<(), CliError> {
     let bars: Vec<(String, f64)> = r
         .candidates
         .iter()
         .map(|c| match &c.sizing {
             Some(s) => {
-                let need = if c.needs_surge == Some(true) { "needs surge" } else { "meets the limit now" };
-                let fails = s.designs.get(2).is_some_and(|d| !d.verified.meets);
-                let need = if fails { format!("{need}; the design fails its run") } else { need.to_string() };
-                (
-                    format!("{} {} ({need})", c.rank.unwrap_or(0), s.vessel),
-                    s.designs.get(2).map_or(f64::NAN, |d| d.band_volume),
-                )
+                let (need, holds) = candidate_words(c);
+                let volume = s
+                    .designs
+                    .iter()
+                    .find(|d| d.controller.name() == "optimal")
+                    .map_or(f64::NAN, |d| u.volume.difference(d.band_volume));
+                let rank = c.rank.map_or("–".into(), |k| k.to_string());
+                (format!("{rank} {} (needs surge: {need}; optimal: {holds})", s.vessel), volume)
             }
-            None => (format!("– {}", c.candidate.as_deref().unwrap_or("?")), f64::NAN),
+            None => (format!("– {} (not sized)", c.candidate.as_deref().unwrap_or("?")), f64::NAN),
         })
         .collect();
-    write_bars(out, "band volume the optimal averaging controller needs", "m³", &bars)
+    write_bars(out, "band volume the optimal averaging controller needs", u.volume.unit(), &bars)
         .map_err(|e| CliError::user(e.to_string()))
 }

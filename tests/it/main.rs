@@ -34,6 +34,7 @@ mod screen;
 mod serve;
 mod shard;
 mod size;
+mod size_newcomer;
 mod snowball;
 mod specs;
 mod tune;

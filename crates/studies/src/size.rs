@@ -25,6 +25,8 @@
 pub mod candidates;
 pub mod closed_form;
 pub mod residence;
+mod run;
+mod steady;
 mod verify;
 mod vessel;
 
@@ -33,7 +35,7 @@ use plantwide_solve::dynamic::SessionError;
 use plantwide_solve::{NewtonSettings, SteadyError, steady_state};
 use serde::Serialize;
 
-pub use candidates::{CandidateRanking, RankedCandidate, rank_candidates};
+pub use candidates::{CandidateRanking, RankedCandidate, rank_candidates, rank_candidates_observed};
 pub use closed_form::LevelDesign;
 use vessel::Vessel;
 
@@ -163,15 +165,17 @@ pub struct Attenuation {
 /// The peaks of one verification run.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Verified {
-    /// Largest `|level − setpoint|` \[m\].
-    pub max_level_deviation: f64,
-    /// Largest `|d outflow/dt|` (SI).
-    pub max_outflow_rate: f64,
-    /// Both within [`VERIFY_TOLERANCE`] of the band and the rate limit.
+    /// Largest `|level − setpoint|` \[m\] (none when the run failed: its peaks up to the failure
+    /// are no answer).
+    pub max_level_deviation: Option<f64>,
+    /// Largest `|d outflow/dt|` (SI; none when the run failed).
+    pub max_outflow_rate: Option<f64>,
+    /// Both within [`VERIFY_TOLERANCE`] of the band and the rate limit, by [`verdict`].
     pub meets: bool,
     /// Length of the run \[s\].
     pub duration: f64,
-    /// Why the run did not settle, or stopped (the peaks are then those up to there).
+    /// Why the design has no answer: its steady state not found, its run stopped, or its run not
+    /// settled (the figures are then none and the design is listed under the sizing's `failed`).
     pub failure: Option<String>,
     /// A sinusoid: the level's and the outflow's half peak-to-peak swing over its last two periods,
     /// the outflow's over the inflow amplitude `|Δu|` (the periodic steady state).
@@ -185,12 +189,50 @@ pub struct Verified {
     pub trace: Trace,
 }
 
+impl Verified {
+    /// A design without an answer: `why` it has none.
+    pub(crate) fn failed(why: String, duration: f64) -> Verified {
+        Verified {
+            max_level_deviation: None,
+            max_outflow_rate: None,
+            meets: false,
+            duration,
+            failure: Some(why),
+            level_amplitude: None,
+            attenuation: None,
+            trace: Trace::default(),
+        }
+    }
+}
+
+/// The one verdict of sizing on a run's figures, each `(value, limit)` and `None` for a figure the
+/// vessel cannot show (a column's drum or base has no geometry, so the file's holdup has no level
+/// in m): `Some(false)` when the run failed or any figure exceeds its limit by more than
+/// [`VERIFY_TOLERANCE`], `Some(true)` when every figure is shown and within, `None` when those
+/// shown are within but one could not be judged. The designs' `meets`, the file's vessel's `meets`
+/// and a candidate's `needs_surge` all come from here.
+pub fn verdict(failed: bool, figures: &[(Option<f64>, f64)]) -> Option<bool> {
+    if failed {
+        return Some(false);
+    }
+    let mut judged = true;
+    for &(value, limit) in figures {
+        match value {
+            Some(v) if v.is_nan() || v > limit * (1.0 + VERIFY_TOLERANCE) => return Some(false),
+            Some(_) => {}
+            None => judged = false,
+        }
+    }
+    judged.then_some(true)
+}
+
 /// A verification run's record.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Trace {
     /// Times from the step \[s\].
     pub times: Vec<f64>,
-    /// Level deviation \[m\] (for a column's holdup: of the equivalent vertical drum).
+    /// Level deviation \[m\] (a design on a column's holdup: of its equivalent vertical drum; the
+    /// file's column holdup, which has no level: mol).
     pub deviation: Vec<f64>,
     /// Outflow (SI).
     pub outflow: Vec<f64>,
@@ -231,6 +273,9 @@ pub struct Design {
     /// Column drum or base: the normal holdup run (mol), at least twice the band's.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub normal_holdup: Option<f64>,
+    /// The design's time \[s\]: P's filter time, PI's `1/ω_n`, the optimal law's ramp time (the
+    /// run's sampling and its minimum length are in units of it).
+    pub design_time: f64,
     /// The nonlinear run.
     pub verified: Verified,
 }
@@ -248,6 +293,13 @@ pub struct VesselSizing {
     pub outflow: String,
     /// `path +Δ` of the disturbance (SI).
     pub disturbance: String,
+    /// The disturbed input's path and its change (SI, signed).
+    pub disturbance_path: String,
+    /// See `disturbance_path`.
+    pub disturbance_change: f64,
+    /// The disturbance's time course (for display).
+    #[serde(skip)]
+    pub shape: Shape,
     /// The steady change of the outflow the disturbance needs (SI).
     pub flow_change: f64,
     /// Molar volume of the vessel's liquid \[m³/mol\].
@@ -265,6 +317,9 @@ pub struct VesselSizing {
     pub current: Current,
     /// The three designs.
     pub designs: Vec<Design>,
+    /// The parts that have no answer, each with its reason (a design's steady state or run, the
+    /// file's vessel's run), also marked where they stand; empty when all went through.
+    pub failed: Vec<String>,
 }
 
 /// The file's own vessel and controller through the disturbance.
@@ -272,21 +327,72 @@ pub struct VesselSizing {
 pub struct Current {
     /// Its cross-section \[m²\] (none for a column's holdup or a stream).
     pub area: Option<f64>,
-    /// Largest deviation of the measurement (its SI unit: m, or mol for a column's holdup; none
-    /// for a stream).
+    /// Largest deviation of the level \[m\]: a vessel with a level only (none for a column's drum
+    /// or base, whose holdup has no level in the model, for a stream, or when the run failed).
     pub max_deviation: Option<f64>,
-    /// Largest rate of the outflow (SI).
-    pub max_outflow_rate: f64,
-    /// Within the band (where the measurement is a level) and the rate limit.
-    pub meets: bool,
-    /// Why the run stopped, if it did.
+    /// A column's drum or base: largest deviation of its holdup \[mol\] (the column model has no
+    /// drum geometry, so no level band can be judged on it).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_holdup_deviation: Option<f64>,
+    /// Largest rate of the outflow (SI; none when the run failed).
+    pub max_outflow_rate: Option<f64>,
+    /// Within the band (where the vessel has a level) and the rate limit, by [`verdict`]: none when
+    /// the rate holds but the band cannot be judged (a column's holdup).
+    pub meets: Option<bool>,
+    /// Length of the run \[s\].
+    pub duration: f64,
+    /// Why the run stopped or did not settle, if it did (the figures are then none).
     pub failure: Option<String>,
     /// A sinusoid: the outflow's swing over the inflow's in the last two periods.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub attenuation: Option<f64>,
+    /// Where the level left the vessel in the run (`above its top at 4 m`, `below its bottom`):
+    /// the model holds no overflow or dry running, so the vessel as the file has it cannot take
+    /// the disturbance at all.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub outside: Option<String>,
     /// The run's record (for plots; not serialized).
     #[serde(skip)]
     pub trace: Trace,
+}
+
+/// What a sizing reports as it goes (for a progress bar): a part of vessel `vessel` done.
+#[derive(Debug, Clone, Copy)]
+pub struct Progress<'a> {
+    /// The vessel as asked.
+    pub vessel: &'a str,
+    /// `p design`, `pi design`, `optimal design` or `file's vessel`.
+    pub part: &'a str,
+    /// The part failed.
+    pub failed: bool,
+}
+
+/// The parts of one vessel's sizing that report [`Progress`]: three designs and the file's vessel.
+pub const PARTS_PER_VESSEL: usize = 4;
+
+/// Where the continuation from the file's vessel to a design's stopped.
+#[derive(Debug, Clone, thiserror::Error)]
+#[error(
+    "no steady state beyond {reached} on the way from the file's {from} to the design's {to} (at {next}: \
+     {reason}){limits}{why}"
+)]
+pub struct Stall {
+    /// The file's size (`area 4 m²`, `normal holdup 40000 mol`).
+    pub from: String,
+    /// The design's.
+    pub to: String,
+    /// The last size with a steady state.
+    pub reached: String,
+    /// The size tried next.
+    pub next: String,
+    /// The solver's reason there, in short (status, residual, worst equation).
+    pub reason: String,
+    /// The loops near a limit at the last steady state (`; at area 2.9 m²: `c` within 0.4 % of
+    /// op_max (…)`), or empty.
+    pub limits: String,
+    /// What it means for this vessel (`; a reactor's cross-section also sets its volume …`), or
+    /// empty.
+    pub why: String,
 }
 
 /// Why a sizing was refused or failed.
@@ -385,6 +491,16 @@ pub enum SizeError {
         /// The solver's reason.
         source: Box<SteadyError>,
     },
+    /// No steady state on the way from the file's vessel to a design's.
+    #[error("{what}: {stall}")]
+    Continuation {
+        /// Which plant.
+        what: String,
+        /// Where the way stopped and why.
+        stall: Box<Stall>,
+        /// The solver's reason in full.
+        source: Box<SteadyError>,
+    },
     /// A verification run stopped.
     #[error("{what}: {source}")]
     Simulation {
@@ -398,7 +514,7 @@ pub enum SizeError {
 impl SizeError {
     /// True for problems of the request (exit code 1), false for numerical failures (exit code 2).
     pub fn is_user_error(&self) -> bool {
-        !matches!(self, SizeError::Steady { .. } | SizeError::Simulation { .. })
+        !matches!(self, SizeError::Steady { .. } | SizeError::Simulation { .. } | SizeError::Continuation { .. })
     }
 }
 
@@ -406,8 +522,24 @@ impl SizeError {
 ///
 /// # Errors
 /// [`SizeError`]: a bad request (vessel, band, rate, disturbance), a disturbance that does not
-/// reach the vessel, or a plant that cannot be solved or run.
+/// reach the vessel, or a plant that cannot be solved before or after the disturbance. A design
+/// or a run that has no answer is not an error: it is marked where it stands and listed under
+/// [`VesselSizing::failed`].
 pub fn size_vessel(plant: &Plant, x: &[f64], name: &str, r: &SizeRequest) -> Result<VesselSizing, SizeError> {
+    size_vessel_observed(plant, x, name, r, &|_| {})
+}
+
+/// [`size_vessel`], telling `progress` as each design and the file's vessel are done.
+///
+/// # Errors
+/// See [`size_vessel`].
+pub fn size_vessel_observed(
+    plant: &Plant,
+    x: &[f64],
+    name: &str,
+    r: &SizeRequest,
+    progress: &(dyn Fn(Progress<'_>) + Sync),
+) -> Result<VesselSizing, SizeError> {
     check_request(plant, r)?;
     let v = Vessel::resolve(plant, x, name, r)?;
     let flow_change = v.flow_change(r)?;
@@ -420,22 +552,39 @@ pub fn size_vessel(plant: &Plant, x: &[f64], name: &str, r: &SizeRequest) -> Res
         }
     });
     let r = effective.as_ref().unwrap_or(r);
-    let designs =
-        LevelDesign::ALL.iter().map(|&d| verify::design(&v, d, flow_change.abs(), r)).collect::<Result<Vec<_>, _>>()?;
-    let duration = designs.iter().map(|d| d.verified.duration).fold(0.0, f64::max);
-    let current = verify::current(&v, r, duration, flow_change)?;
+    let mut designs = Vec::with_capacity(LevelDesign::ALL.len());
+    for d in LevelDesign::ALL {
+        let design = verify::design(&v, d, flow_change, r)?;
+        let part = format!("{} design", d.name());
+        progress(Progress { vessel: name, part: &part, failed: design.verified.failure.is_some() });
+        designs.push(design);
+    }
+    let current = verify::current(&v, r, &designs, flow_change)?;
+    progress(Progress { vessel: name, part: "file's vessel", failed: current.failure.is_some() });
+    let mut failed: Vec<String> = designs
+        .iter()
+        .filter_map(|d| {
+            d.verified.failure.as_ref().map(|why| format!("the {} design of `{name}`: {why}", d.controller.name()))
+        })
+        .collect();
+    if let Some(why) = &current.failure {
+        failed.push(format!("`{name}` as the file has it: {why}"));
+    }
+    let dim = plant.input(&r.disturbance.path).map_or("(SI)".to_string(), |i| plant.inputs()[i].dim.to_string());
     Ok(VesselSizing {
         vessel: name.to_string(),
         kind: v.kind_name(),
         level_controller: v.controller.clone(),
         outflow: v.outflow.clone(),
         disturbance: format!(
-            "{} {:+.6e} {}, {}",
+            "{} {:+.6e} {dim}, {}",
             r.disturbance.path,
             r.disturbance.change,
-            plant.input(&r.disturbance.path).map_or("(SI)".to_string(), |i| plant.inputs()[i].dim.to_string()),
             r.disturbance.shape.describe()
         ),
+        disturbance_path: r.disturbance.path.clone(),
+        disturbance_change: r.disturbance.change,
+        shape: r.disturbance.shape,
         flow_change,
         liquid_molar_volume: v.v_l,
         level_band: r.level_band,
@@ -443,6 +592,7 @@ pub fn size_vessel(plant: &Plant, x: &[f64], name: &str, r: &SizeRequest) -> Res
         attenuation: r.attenuation,
         current,
         designs,
+        failed,
     })
 }
 
@@ -489,12 +639,11 @@ fn check_request(plant: &Plant, r: &SizeRequest) -> Result<(), SizeError> {
 
 /// The steady state of `v` from the guess `x` of `base` (variables matched by path).
 fn steady_from(base: &Plant, x: &[f64], v: &Plant, what: &str) -> Result<Vec<f64>, SizeError> {
-    steady_at(v, &crate::screen::column::mapped_guess(base, x, v), what)
+    newton(v, &crate::screen::column::mapped_guess(base, x, v))
+        .map_err(|e| SizeError::Steady { what: what.to_string(), source: Box::new(e) })
 }
 
-/// The steady state of `v` from `guess`.
-fn steady_at(v: &Plant, guess: &[f64], what: &str) -> Result<Vec<f64>, SizeError> {
-    steady_state(v, &v.input_values(), Some(guess), &NewtonSettings::default())
-        .map(|s| s.x)
-        .map_err(|e| SizeError::Steady { what: what.to_string(), source: Box::new(e) })
+/// The steady state of `v` from `guess`, the solver's reason when none is found.
+fn newton(v: &Plant, guess: &[f64]) -> Result<Vec<f64>, SteadyError> {
+    steady_state(v, &v.input_values(), Some(guess), &NewtonSettings::default()).map(|s| s.x)
 }

@@ -183,18 +183,13 @@ impl Vessel {
 
     /// The steady change of the outflow after the disturbance (signed, SI).
     pub fn flow_change(&self, r: &SizeRequest) -> Result<f64, SizeError> {
-        let d = &r.disturbance;
-        let i = plantwide_flowsheet::overrides::resolve_input(&self.plant, &d.path)
-            .ok_or_else(|| SizeError::Disturbance { path: d.path.clone(), why: "no such input".into() })?;
-        let mut after = self.plant.clone();
-        after.set_input_value(i, self.plant.inputs()[i].value + d.change);
-        let x1 = steady_from(&self.plant, &self.x, &after, "the plant after the disturbance")?;
+        let x1 = super::steady::after(&self.plant, &self.x, r, "the plant after the disturbance")?;
         let du = x1[self.op] - self.x[self.op];
         if du.abs() <= 1e-9 * self.x[self.op].abs().max(1e-12) {
             return Err(SizeError::Unreached {
                 vessel: self.measurement.clone(),
                 outflow: self.outflow.clone(),
-                path: d.path.clone(),
+                path: r.disturbance.path.clone(),
                 change: du,
             });
         }
