@@ -152,6 +152,11 @@ fn overall(structures: &[ColumnStructure], dynamic: bool) -> String {
         pairing(best),
         best.iae_scaled.unwrap_or(f64::NAN)
     );
+    let failed: Vec<&str> =
+        structures.iter().filter(|s| s.dynamic.is_some() && s.iae_scaled.is_none()).map(|s| s.name.as_str()).collect();
+    if !failed.is_empty() {
+        text.push_str(&format!("; not compared: {} (dynamic check failed, see failed)", failed.join(", ")));
+    }
     if let Some(first) = by(|s| s.steady_rank).filter(|f| f.name != best.name) {
         let dynamic = match (first.rank, first.iae_scaled, best.iae_scaled) {
             (Some(r), Some(v), Some(b)) => format!("ranks {r} (scaled IAE {:.2}× the best)", v / b),
