@@ -99,7 +99,7 @@ mod tests {
         for (i, j) in [(0, 0), (0, 1), (1, 0), (1, 1)] {
             assert!((s[(i, j)] - e[i][j]).abs() < 1e-15, "{i}{j}");
         }
-        let (sum, det) = (0.04 + 0.01 + 0.09 + 0.16, 0.2 * -0.4 - (-0.1 * 0.3));
+        let (sum, det): (f64, f64) = (0.04 + 0.01 + 0.09 + 0.16, 0.2 * -0.4 - (-0.1 * 0.3));
         let root = (sum * sum - 4.0 * det * det).sqrt();
         let want = ((sum + root) / (sum - root)).sqrt();
         let got = condition_number(&svd(s.as_ref()).unwrap().singular_values);

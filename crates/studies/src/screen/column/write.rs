@@ -36,7 +36,8 @@ pub(super) fn flowsheet(
             .filter(|&i| {
                 let info = &tuned.inputs()[i];
                 // NaN (no such input written) differs too.
-                !((value(&info.path) - info.value).abs() <= 1e-12 * info.value.abs().max(1e-300))
+                let same = (value(&info.path) - info.value).abs() <= 1e-12 * info.value.abs().max(1e-300);
+                !same
             })
             .collect();
         if differ.is_empty() {
