@@ -64,9 +64,9 @@ pub enum ScreenError {
         /// The value given (SI).
         value: f64,
     },
-    /// The column's feed is not a `feed` unit, so the dynamic check has no default disturbances.
+    /// No feed of free rate is upstream of the column, so the dynamic check has no default disturbances.
     #[error(
-        "column `{column}`: no feed unit feeds it directly ({why}), so the dynamic check has no default \
+        "column `{column}`: no feed of free rate upstream ({why}), so the dynamic check has no default \
          disturbances; give them with --disturbances PATH=±x%,… or screen with --steady-only"
     )]
     NoFeed {

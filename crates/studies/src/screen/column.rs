@@ -275,10 +275,14 @@ pub fn screen_column_with(plant: &Plant, r: &ColumnRequest) -> Result<ColumnScre
         CONFIGURATIONS.par_iter().map(|&c| configuration(plant, &h, &base.x, &flows, &out, c)).collect();
     let (mut structures, mut variants) = (Vec::new(), Vec::new());
     for (b, (name, top, bottom)) in built.into_iter().zip(CONFIGURATIONS) {
-        // A configuration that fails numerically is marked and the others are judged; a request
-        // at fault stops the screening.
+        // A configuration whose steady state is not determined (an inventory it leaves free, as DB
+        // leaves D + B = F) is singular; one that fails numerically is marked and the others are
+        // judged; a request at fault stops the screening.
         let (s, v) = match b {
             Ok(sv) => sv,
+            Err(ScreenError::Steady { source, .. }) if source.is_user_error() => {
+                (undetermined(name, edits(plant, &h, &flows, top, bottom).1, &source.to_string()), None)
+            }
             Err(e) if e.is_user_error() => return Err(e),
             Err(e) => (failed(name, edits(plant, &h, &flows, top, bottom).1, e.to_string()), None),
         };
@@ -568,6 +572,17 @@ pub(super) fn is_singular(g: &Mat<f64>) -> bool {
     }
     !e.is_all_finite()
         || svd(e.as_ref()).is_ok_and(|s| condition_number(&s.singular_values) > 1.0 / SINGULAR_RATIO.sqrt())
+}
+
+/// A configuration whose steady state is not determined (`why`: which variables move together):
+/// singular, not ranked.
+fn undetermined(name: &str, inputs: Vec<String>, why: &str) -> ColumnStructure {
+    ColumnStructure {
+        inputs,
+        singular: true,
+        verdict: format!("singular at steady state: the configuration leaves an inventory free; not ranked ({why})"),
+        ..unjudged(name)
+    }
 }
 
 /// A configuration whose steady state or gains failed for `why`: no measures, not ranked.

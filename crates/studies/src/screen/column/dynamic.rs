@@ -7,8 +7,10 @@
 //!
 //! Every run has the same length so that IAEs compare: given, or 20 times the longest reset time
 //! of all the configurations' tuned loops (each configuration then has time to settle). The
-//! disturbances default to the column's feed rate ±10 % and its feed's mole fraction of the top
-//! quality's component ± a tenth of its distance to 0 or 1 (0.45 ± 0.045), one run each way.
+//! disturbances default to the rate ±10 % of every feed upstream of the column (walked back
+//! through heaters, tanks, reactors and recycles to the units whose rate `F` is a free input) and
+//! its mole fraction of the top quality's component ± a tenth of its distance to 0 or 1
+//! (0.45 ± 0.045), one run each way.
 //! Configurations are tuned, then run, in parallel (rayon); each is a pure function of its plant
 //! and the request, so nothing depends on the thread count.
 
@@ -78,57 +80,80 @@ pub(super) fn disturbances(
     Ok(list)
 }
 
-/// The feed rate ±10 % and the feed's mole fraction of the top quality's component (the first
-/// component the feed lets vary when the quality names none) ± a tenth of its distance to 0 or 1,
-/// of every feed unit feeding the column directly.
+/// The feed rate ±10 % and a feed mole fraction ± a tenth of its distance to 0 or 1 (that of the
+/// top quality's component, or else of the component with the most room), of every feed upstream
+/// of the column whose rate is free.
 fn defaults(plant: &Plant, column: &str, outputs: &[String]) -> Result<Vec<Disturbance>, ScreenError> {
     let free = |p: &str| plant.input(p).filter(|&i| plant.inputs()[i].driven_by.is_none());
     let top = VarPath::parse(&outputs[0]);
     let component = top.field().and_then(|f| Some(f.split_once('[')?.1.trim_end_matches(']')));
-    let port = format!("{column}.");
-    let sources: Vec<&str> = plant
-        .spec()
-        .streams
-        .values()
-        .filter(|s| s.to.starts_with(&port))
-        .map(|s| s.from.split('.').next().unwrap_or(""))
-        .collect();
+    let (feeds, sources) = upstream_feeds(plant, column);
     let mut list = Vec::new();
-    for unit in &sources {
+    for unit in &feeds {
         let flow = format!("{unit}.F");
-        let z = component.map(|c| format!("{unit}.z[{c}]")).filter(|p| free(p).is_some()).or_else(|| {
-            let prefix = format!("{unit}.z[");
-            plant.inputs().iter().map(|i| i.path.clone()).find(|p| p.starts_with(&prefix) && free(p).is_some())
-        });
-        let (Some(_), Some(z)) = (free(&flow), z) else { continue };
-        let z0 = plant.inputs()[free(&z).unwrap_or_default()].value;
-        let step = 0.1 * z0.min(1.0 - z0);
-        if !(step > 0.0) {
-            continue;
-        }
-        let shown = plantwide_model::limits::number(step);
         list.push(Disturbance {
             path: flow,
             size: StepSize::Fraction(0.1),
             direction: Direction::Both,
             shown: "10 %".into(),
         });
-        list.push(Disturbance {
-            path: z,
-            size: StepSize::Amount { si: step, dim: None },
-            direction: Direction::Both,
-            shown,
-        });
+        let room = |p: &String| free(p).map_or(0.0, |i| plant.inputs()[i].value.min(1.0 - plant.inputs()[i].value));
+        let prefix = format!("{unit}.z[");
+        let own = component.map(|c| format!("{unit}.z[{c}]")).filter(|p| room(p) > 0.0);
+        let widest = || {
+            let paths = plant.inputs().iter().map(|i| i.path.clone()).filter(|p| p.starts_with(&prefix));
+            paths.filter(|p| room(p) > 0.0).max_by(|a, b| room(a).total_cmp(&room(b)))
+        };
+        if let Some(z) = own.or_else(widest) {
+            let step = 0.1 * room(&z);
+            let shown = plantwide_model::limits::number(step);
+            list.push(Disturbance {
+                path: z,
+                size: StepSize::Amount { si: step, dim: None },
+                direction: Direction::Both,
+                shown,
+            });
+        }
     }
     if list.is_empty() {
-        let why = if sources.is_empty() {
-            "no stream enters it".to_string()
-        } else {
-            format!("it is fed by {}", sources.join(", "))
+        let why = match sources.is_empty() {
+            true => "no stream enters it".to_string(),
+            false => format!("it is fed by {}", sources.join(", ")),
         };
         return Err(ScreenError::NoFeed { column: column.into(), why });
     }
     Ok(list)
+}
+
+/// The units with a free feed rate (`unit.F`, an input no controller drives) upstream of `column`,
+/// found by walking its inlet streams back through every unit (heaters, tanks, splits, reactors,
+/// other columns; a recycle is walked once), in the flowsheet's stream order; and the units
+/// feeding the column directly.
+fn upstream_feeds<'a>(plant: &'a Plant, column: &'a str) -> (Vec<&'a str>, Vec<&'a str>) {
+    let is_feed = |u: &str| {
+        let flow = plant.input(&format!("{u}.F"));
+        flow.is_some_and(|i| plant.inputs()[i].driven_by.is_none())
+    };
+    let sources_of = |unit: &str| -> Vec<&'a str> {
+        // A stream's ends are `unit.port`, or `unit` alone for a unit of one inlet or outlet.
+        let owner = |end: &'a str| end.split('.').next().unwrap_or(end);
+        let streams = plant.spec().streams.values().filter(|s| owner(&s.to) == unit);
+        streams.map(|s| owner(&s.from)).collect()
+    };
+    let direct = sources_of(column);
+    let (mut seen, mut feeds, mut queue) = (vec![column], Vec::new(), direct.clone());
+    while !queue.is_empty() {
+        let unit = queue.remove(0);
+        if seen.contains(&unit) {
+            continue;
+        }
+        seen.push(unit);
+        match is_feed(unit) {
+            true => feeds.push(unit),
+            false => queue.extend(sources_of(unit)),
+        }
+    }
+    (feeds, direct)
 }
 
 /// A configuration ready for the pairing screen's dynamic test.
