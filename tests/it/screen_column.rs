@@ -259,3 +259,24 @@ fn on_the_low_reflux_column_the_first_choice_is_confirmed_by_its_own_dynamic_che
     let verdict = v["verdict"].as_str().unwrap();
     assert!(verdict.contains("the steady-state measures alone would recommend DV"), "{verdict}");
 }
+
+/// A plant the column screen was not written on: the reactor–column recycle, whose column is fed
+/// by the reactor (the dynamic check refused to start, no feed unit feeding it directly). The
+/// default disturbances come from the fresh feed upstream (pure A, so its rate alone). LB holds the
+/// bottoms, the plant's only outlet, at a fixed flow against a fixed fresh feed, so the holdup of
+/// the reactor–column loop is not determined at steady state (DB likewise: D + B = F): both
+/// singular, named, not ranked; the others ranked by the check, exit 0.
+#[test]
+fn a_recycle_column_is_stepped_by_its_fresh_feed_and_an_undetermined_configuration_is_singular() {
+    let (code, v, err) = screen(&flowsheet("reactor_column_recycle.json"), "recycle.x[A],bottoms.x[A]", &[]);
+    assert_eq!(code, Some(0), "{err}");
+    assert_eq!(v["disturbances"], serde_json::json!(["fresh.F +10 %", "fresh.F -10 %"]));
+    for name in ["LB", "DB"] {
+        let s = by_name(&v, name);
+        assert!(s["singular"].as_bool().unwrap() && s["rank"].is_null(), "{s}");
+        assert!(s["verdict"].as_str().unwrap().contains("the steady state is not determined"), "{s}");
+    }
+    assert!(by_name(&v, "LB")["verdict"].as_str().unwrap().contains("reactor_level"));
+    let ranks: Vec<u64> = regular(&v).iter().filter_map(|s| s["rank"].as_u64()).collect();
+    assert_eq!(ranks.len(), 5, "{ranks:?}");
+}
