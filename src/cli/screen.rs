@@ -64,7 +64,7 @@ pub struct ScreenArgs {
     /// Disturbances of the dynamic and sensitivity tests: input paths, each stepped by +10 %, or
     /// PATH=+x%, -x%, ±x% (one run each way) or an amount with its unit (PATH=+5 K,
     /// PATH=-10 kmol/h); the sweeps go to both sides by the step's size. With --column the
-    /// default is the column's feed rate ±10 % and feed composition ± a tenth of its room.
+    /// default is the rate ±10 % and composition ± a tenth of its room of each feed upstream.
     #[arg(long, value_name = "PATH[=±x%|±AMOUNT],…", value_delimiter = ',')]
     disturbances: Vec<String>,
     /// Uncontrolled variables that must stay in a band over ± each disturbance with the CVs held
