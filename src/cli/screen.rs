@@ -1,5 +1,7 @@
-//! `plantwide screen FILE --column COL --outputs TOP,BOTTOM [--json] [--report DIR]`: the inventory
-//! configurations of a column, built through the library and judged by their steady-state gains;
+//! `plantwide screen FILE --column COL --outputs TOP,BOTTOM [--disturbances …] [--steady-only]
+//! [--write-dir DIR] [--json] [--report DIR]`: the inventory configurations of a column, built
+//! through the library, judged by their scaled steady-state gains and ranked by a dynamic check
+//! (each tuned by BLT and stepped by the disturbances), or by the steady state alone;
 //! `plantwide screen FILE --cvs … --mvs … [--disturbances …] [--throughput …]`: the pairings of CVs
 //! to MVs, filtered at steady state and the best tested dynamically; `--shard I/N` runs a share of
 //! the dynamic tests (task `t`: the `t`-th candidate tested), `plantwide merge` scores them all.
@@ -8,12 +10,15 @@ use std::path::{Path, PathBuf};
 
 use plantwide::io::html::markdown_to_html;
 use plantwide::io::plot::{LabelledMatrix, Overlay, write_bars, write_matrices, write_overlays};
+use plantwide::studies::screen::column::file_stem;
 use plantwide::studies::screen::pairings::STEP_AT;
 use plantwide::studies::screen::pairings::mpc::MpcAlternative;
 use plantwide::studies::screen::pairings::{
     CandidateTask, Disturbance, DynamicResult, DynamicSettings, PairingRequest, PairingScreen, Watch,
 };
-use plantwide::studies::screen::{ColumnScreen, ScreenError, screen_column, screen_pairings};
+use plantwide::studies::screen::{
+    ColumnDynamic, ColumnRequest, ColumnScreen, ColumnStructure, ScreenError, screen_column_with, screen_pairings,
+};
 use plantwide::units::Dimension;
 
 use plantwide::units::UnitSystem;
@@ -35,6 +40,18 @@ pub struct ScreenArgs {
     /// The two qualities, top then bottom (variable paths), e.g. distillate.x[light],bottoms.x[light].
     #[arg(long, value_name = "TOP,BOTTOM", value_delimiter = ',', requires = "column")]
     outputs: Vec<String>,
+    /// Rank a column's configurations by their steady-state measures alone (fast): no dynamic check.
+    #[arg(long, requires = "column", conflicts_with_all = ["write_dir", "disturbances", "duration"])]
+    steady_only: bool,
+    /// Write each configuration's flowsheet, its quality loops as tuned by the dynamic check
+    /// (`<config>.json`: LV, DV, LB, LD-V, L-VB, LD-VB), and each run's scenario
+    /// (`step<N>.scenario.json`) here, for `plantwide run`.
+    #[arg(long, value_name = "DIR", requires = "column")]
+    write_dir: Option<PathBuf>,
+    /// The largest deviation allowed of each quality, top then bottom (in its unit, SI when bare):
+    /// the scale of the gains and IAEs (default: a mole fraction's distance to 0 or 1).
+    #[arg(long, value_name = "TOP,BOTTOM", value_delimiter = ',', requires = "column")]
+    allowed_deviation: Vec<String>,
     /// Controlled variables to pair (variable paths), comma separated.
     #[arg(long, value_name = "CV1,CV2,…", value_delimiter = ',', requires = "mvs")]
     cvs: Vec<String>,
@@ -46,7 +63,8 @@ pub struct ScreenArgs {
     throughput: Vec<String>,
     /// Disturbances of the dynamic and sensitivity tests: input paths, each stepped by +10 %, or
     /// PATH=+x%, -x%, ±x% (one run each way) or an amount with its unit (PATH=+5 K,
-    /// PATH=-10 kmol/h); the sweeps go to both sides by the step's size.
+    /// PATH=-10 kmol/h); the sweeps go to both sides by the step's size. With --column the
+    /// default is the rate ±10 % and composition ± a tenth of its room of each feed upstream.
     #[arg(long, value_name = "PATH[=±x%|±AMOUNT],…", value_delimiter = ',')]
     disturbances: Vec<String>,
     /// Uncontrolled variables that must stay in a band over ± each disturbance with the CVs held
@@ -95,20 +113,82 @@ pub fn run(a: &ScreenArgs, system: UnitSystem) -> Result<(), CliError> {
     if a.shard.is_shard() {
         return Err(CliError::user(
             "--shard splits the pairings' dynamic tests (--cvs … --mvs … --disturbances …); a column's seven \
-             configurations are steady solves that run in one process: drop --shard",
+             configurations run in one process, in parallel: drop --shard",
         ));
     }
-    let screen = screen_column(&plant, column, &a.outputs).map_err(screen_error)?;
+    let request = column_request(a, &plant, column)?;
+    let screen = screen_column_with(&plant, &request).map_err(screen_error)?;
     let json = serde_json::to_string_pretty(&screen).map_err(|e| CliError::user(e.to_string()))?;
     if let Some(dir) = &a.report {
         write_report(dir, &a.file, &screen, &json)?;
     }
+    let written = a.write_dir.as_deref().map(|dir| write_flowsheets(dir, &screen)).transpose()?;
     if a.json {
         outln!("{json}");
     } else {
         outln!("{}", table(&screen, &a.file));
+        if let (Some(dir), Some(n)) = (&a.write_dir, written) {
+            outln!("wrote {n} tuned flowsheets and {} scenarios to {}", screen.scenarios.len(), dir.display());
+        }
     }
     failed_parts("screen", &screen.failed)
+}
+
+/// The column screening `a` asks for.
+fn column_request(
+    a: &ScreenArgs,
+    plant: &plantwide::flowsheet::Plant,
+    column: &str,
+) -> Result<ColumnRequest, CliError> {
+    let allowed = match a.allowed_deviation.as_slice() {
+        [] => None,
+        [top, bottom] => Some([allowed(plant, &a.outputs, 0, top)?, allowed(plant, &a.outputs, 1, bottom)?]),
+        more => {
+            return Err(CliError::user(format!(
+                "--allowed-deviation: give two deviations, top then bottom quality; got {}",
+                more.len()
+            )));
+        }
+    };
+    let dynamic = match a.steady_only {
+        true => None,
+        false => Some(ColumnDynamic {
+            disturbances: a.disturbances.iter().map(|d| disturbance(d)).collect::<Result<_, _>>()?,
+            duration: a.duration.as_deref().map(|d| time(d, "duration")).transpose()?,
+            measurement: plantwide::studies::tune::loops::Measurement {
+                dead_time: time(&a.measurement_dead_time, "measurement-dead-time")?,
+                lag: 0.0,
+            },
+            keep_flowsheets: a.write_dir.is_some(),
+        }),
+    };
+    Ok(ColumnRequest { column: column.to_string(), outputs: a.outputs.clone(), allowed, dynamic })
+}
+
+/// Allowed deviation `text` of quality `k` of `outputs`, in the quality's unit (SI when bare).
+fn allowed(plant: &plantwide::flowsheet::Plant, outputs: &[String], k: usize, text: &str) -> Result<f64, CliError> {
+    let dim = outputs.get(k).and_then(|o| plant.var(o)).map_or(Dimension::DIMENSIONLESS, |v| plant.vars()[v].spec.dim);
+    plantwide::units::parse_quantity_as(text.trim(), dim)
+        .map_err(|e| CliError::user(format!("--allowed-deviation {text}: {e}")))
+}
+
+/// Write each configuration's tuned flowsheet and the runs' scenarios into `dir`; how many
+/// flowsheets.
+fn write_flowsheets(dir: &Path, s: &ColumnScreen) -> Result<usize, CliError> {
+    let fail = |e: std::io::Error| CliError::user(format!("--write-dir {}: {e}", dir.display()));
+    std::fs::create_dir_all(dir).map_err(fail)?;
+    let pretty = |v: &serde_json::Value| serde_json::to_string_pretty(v).map_err(|e| CliError::user(e.to_string()));
+    let mut n = 0;
+    for c in &s.structures {
+        if let Some(f) = &c.flowsheet {
+            std::fs::write(dir.join(format!("{}.json", file_stem(&c.name))), f).map_err(fail)?;
+            n += 1;
+        }
+    }
+    for (name, text) in &s.scenarios {
+        std::fs::write(dir.join(name), pretty(text)? + "\n").map_err(fail)?;
+    }
+    Ok(n)
 }
 
 /// Exit 2 when parts of a study failed (the report, already printed, marks them): the message
@@ -125,33 +205,66 @@ pub(super) fn failed_parts(study: &str, failed: &[String]) -> Result<(), CliErro
     }
 }
 
-/// The configurations as a markdown table, best first within the regular ones.
+/// The configurations as a markdown table, in the library's order, with the scaling and the
+/// verdict.
 fn table(s: &ColumnScreen, file: &Path) -> String {
     let mut t = format!(
-        "inventory configurations of column `{}` in {} (qualities {} and {}; gains in SI at the steady state)\n\n",
+        "inventory configurations of column `{}` in {} (qualities {} and {}), ranked by the {}\n\n",
         s.column,
         file.display(),
         s.outputs[0],
-        s.outputs[1]
+        s.outputs[1],
+        s.ranked_by
     );
-    t.push_str(
-        "| rank | structure | inputs | λ11 | Niederlinski | γ | γ* | verdict |\n|---|---|---|---|---|---|---|---|\n",
-    );
-    let num = |v: Option<f64>| v.map_or("–".to_string(), |v| format!("{v:.4}"));
-    for c in &s.structures {
+    let allowed: Vec<String> = s
+        .outputs
+        .iter()
+        .zip(&s.scaling.allowed_deviation)
+        .zip(&s.scaling.basis)
+        .map(|((o, d), b)| format!("{o} by {d:.4e} ({b})"))
+        .collect();
+    t.push_str(&format!("scaling of γ and of the IAEs: {}; {}\n", allowed.join(", "), s.scaling.inputs));
+    if let Some(d) = s.duration {
         t.push_str(&format!(
-            "| {} | {} | {} | {} | {} | {} | {} | {} |\n",
-            c.rank.map_or("–".to_string(), |r| r.to_string()),
-            c.name,
-            c.inputs.join(", "),
-            num(c.rga.as_ref().map(|r| r[0][0])),
-            num(c.niederlinski),
-            num(c.condition_number),
-            num(c.minimized_condition_number),
-            c.failure.as_ref().map_or(c.verdict.clone(), |why| format!("failed: {why}"))
+            "dynamic check: PI loops tuned by BLT ({} s measurement dead time), {} runs of {:.4e} s: {}\n",
+            s.measurement_dead_time.unwrap_or(0.0),
+            s.disturbances.len(),
+            d,
+            s.disturbances.join(", ")
         ));
     }
+    t.push_str(
+        "\n| rank | structure | pairing (top, bottom) | λ | Niederlinski | γ scaled | γ* | scaled IAE [s] | steady rank | verdict |\n",
+    );
+    t.push_str("|---|---|---|---|---|---|---|---|---|---|\n");
+    for c in &s.structures {
+        t.push_str(&row(c));
+    }
+    t.push_str(&format!("\nverdict: {}\n", s.verdict));
     t
+}
+
+/// A configuration's row of the table.
+fn row(c: &ColumnStructure) -> String {
+    let num = |v: Option<f64>| v.map_or("–".to_string(), |v| format!("{v:.4}"));
+    let place = |r: Option<usize>| r.map_or("–".to_string(), |r| r.to_string());
+    let iae = match (&c.dynamic, c.iae_scaled) {
+        (_, Some(v)) => format!("{v:.4e}"),
+        (Some(_), None) => "failed".into(),
+        (None, None) => "–".into(),
+    };
+    format!(
+        "| {} | {} | {} | {} | {} | {} | {} | {iae} | {} | {} |\n",
+        place(c.rank),
+        c.name,
+        c.pairing.as_ref().map_or_else(|| c.inputs.join(", "), |p| p.join(", ")),
+        num(c.relative_gain),
+        num(c.niederlinski),
+        num(c.condition_number),
+        num(c.minimized_condition_number),
+        place(c.steady_rank),
+        c.failure.as_ref().map_or(c.verdict.clone(), |why| format!("failed: {why}"))
+    )
 }
 
 fn write_report(dir: &Path, file: &Path, s: &ColumnScreen, json: &str) -> Result<(), CliError> {
@@ -174,12 +287,25 @@ fn write_report(dir: &Path, file: &Path, s: &ColumnScreen, json: &str) -> Result
     }
     let mut ranked: Vec<_> = s.structures.iter().collect();
     ranked.sort_by_key(|c| (c.rank.is_none(), c.rank));
+    let dynamic = s.duration.is_some();
     let bars: Vec<(String, f64)> = ranked
         .iter()
-        .map(|c| (c.name.clone(), c.rga.as_ref().filter(|_| c.rank.is_some()).map_or(f64::NAN, |r| r[0][0].ln().abs())))
+        .map(|c| {
+            let value = match dynamic {
+                true => c.iae_scaled.unwrap_or(f64::NAN),
+                false => c.relative_gain.filter(|_| c.rank.is_some()).map_or(f64::NAN, |l| l.ln().abs()),
+            };
+            (c.name.clone(), value)
+        })
         .collect();
-    let title = format!("ranking of column `{}`'s configurations (0 = decoupled; – singular)", s.column);
-    write_bars(&dir.join("ranking.png"), &title, "|ln λ11|", &bars).map_err(|e| CliError::user(e.to_string()))?;
+    let (title, axis) = match dynamic {
+        true => (
+            format!("ranking of column `{}`'s configurations by the dynamic check (– not run)", s.column),
+            "scaled IAE [s]",
+        ),
+        false => (format!("ranking of column `{}`'s configurations (0 = decoupled; – singular)", s.column), "|ln λ|"),
+    };
+    write_bars(&dir.join("ranking.png"), &title, axis, &bars).map_err(|e| CliError::user(e.to_string()))?;
     let md = format!(
         "# Column configurations: `{}`\n\n{}\n![relative gains](rga.png)\n\n![ranking](ranking.png)\n",
         s.column,

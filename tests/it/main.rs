@@ -31,6 +31,7 @@ mod plots;
 mod pressure;
 mod recycle;
 mod screen;
+mod screen_column;
 mod serve;
 mod shard;
 mod size;

@@ -5,7 +5,8 @@ use serde_json::Value;
 
 use crate::harness::{flowsheet, plantwide};
 
-/// `screen --json` of `file` (asserting success).
+/// `screen --steady-only --json` of `file` (asserting success): the fast path, steady-state
+/// measures alone (tests/it/screen_column.rs runs the dynamic check).
 fn screen(file: &str) -> Value {
     let out = plantwide(&[
         "screen",
@@ -14,6 +15,7 @@ fn screen(file: &str) -> Value {
         "column",
         "--outputs",
         "distillate.x[light],bottoms.x[light]",
+        "--steady-only",
         "--json",
     ]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
@@ -127,11 +129,16 @@ fn column_a_configurations_agree_with_the_transforms_of_its_lv_gains() {
     let l11 = lv["rga"][0][0].as_f64().unwrap();
     assert!((l11 - 35.1).abs() < 0.05 * 35.1, "{l11}");
     assert!(lv["verdict"].as_str().unwrap().contains("strong interaction"), "{lv}");
+    // The fast path says what its ranking rests on, and ran nothing dynamic.
+    assert_eq!(v["ranked_by"], "steady state");
+    assert!(v["verdict"].as_str().unwrap().contains("ranked by steady-state λ11 only; the dynamic check was not run"));
+    assert!(v["structures"].as_array().unwrap().iter().all(|s| s["dynamic"].is_null() && s["iae_scaled"].is_null()));
     // The report: the same JSON, a markdown table and the RGA heat map with the values drawn.
     let dir = std::env::temp_dir().join(format!("plantwide-screen-report-{}", std::process::id()));
     let fs = flowsheet("column_a.json");
     let q = "distillate.x[light],bottoms.x[light]";
-    let out = plantwide(&["screen", &fs, "--column", "column", "--outputs", q, "--report", dir.to_str().unwrap()]);
+    let report = ["--steady-only", "--report", dir.to_str().unwrap()];
+    let out = plantwide(&[&["screen", &fs, "--column", "column", "--outputs", q], &report[..]].concat());
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let json: Value = serde_json::from_str(&std::fs::read_to_string(dir.join("screen.json")).unwrap()).unwrap();
     assert_eq!(json, v);

@@ -3,14 +3,16 @@
 //!
 //! Today: [`mod@column`], the standard inventory configurations of one distillation column (LV, DV, LB,
 //! DB, (L/D)V, L(V/B), (L/D)(V/B)), with the exact steady-state gains of its two qualities to the
-//! two inputs each leaves free, RGA, Niederlinski index, condition numbers and a verdict.
+//! two inputs each leaves free, RGA, Niederlinski index, condition numbers of the scaled gains, a
+//! dynamic check of each (BLT-tuned loops stepped by the disturbances) that the ranking follows,
+//! and a verdict; [`mod@pairings`], plantwide pairings of CVs to MVs.
 //!
 //! [`Plant`]: plantwide_flowsheet::Plant
 
 pub mod column;
 pub mod pairings;
 
-pub use column::{ColumnScreen, ColumnStructure, screen_column};
+pub use column::{ColumnDynamic, ColumnRequest, ColumnScreen, ColumnStructure, screen_column, screen_column_with};
 pub use pairings::{PairingRequest, PairingScreen, screen_pairings};
 
 /// Why a screening could not be done.
@@ -53,6 +55,33 @@ pub enum ScreenError {
         path: String,
         /// A suggestion, or empty.
         hint: String,
+    },
+    /// An allowed deviation that is not a positive amount.
+    #[error("--allowed-deviation {path}: {value} is no deviation; give a positive amount in the quality's unit")]
+    Allowed {
+        /// The quality.
+        path: String,
+        /// The value given (SI).
+        value: f64,
+    },
+    /// No feed of free rate is upstream of the column, so the dynamic check has no default disturbances.
+    #[error(
+        "column `{column}`: no feed of free rate upstream ({why}), so the dynamic check has no default \
+         disturbances; give them with --disturbances PATH=±x%,… or screen with --steady-only"
+    )]
+    NoFeed {
+        /// The column.
+        column: String,
+        /// What its feeds are.
+        why: String,
+    },
+    /// A configuration's tuned flowsheet could not be written back to a file's description.
+    #[error("configuration {structure}: its tuned flowsheet cannot be written: {why}")]
+    Write {
+        /// The configuration.
+        structure: String,
+        /// Why.
+        why: String,
     },
     /// Not two outputs.
     #[error("--outputs: a column configuration controls two qualities (top, bottom); got {0}")]
@@ -209,7 +238,10 @@ impl ScreenError {
     pub fn is_user_error(&self) -> bool {
         match self {
             ScreenError::Steady { source, .. } => source.is_user_error(),
-            ScreenError::Moved { .. } | ScreenError::Analysis { .. } | ScreenError::Sensitivity { .. } => false,
+            ScreenError::Moved { .. }
+            | ScreenError::Analysis { .. }
+            | ScreenError::Sensitivity { .. }
+            | ScreenError::Write { .. } => false,
             _ => true,
         }
     }

@@ -98,9 +98,10 @@ def screen(
     sets: Sequence[Mapping[str, Any]] | None = None,
     client=None,
 ) -> list[dict]:
-    """``plantwide screen --column --json`` at each operating point of ``sets`` (default: the
-    file's own): the column's inventory configurations ranked by their steady-state measures, one
-    dict per point (the CLI's JSON). Each point is one task (on ``client`` if given)."""
+    """``plantwide screen --column --steady-only --json`` at each operating point of ``sets``
+    (default: the file's own): the column's inventory configurations ranked by their steady-state
+    measures (the CLI's fast path; its default also runs the dynamic check), one dict per point
+    (the CLI's JSON). Each point is one task (on ``client`` if given)."""
     text, name = _source(path)
     point_sets = [assignments(s) for s in (sets if sets is not None else [{}])]
     args = [(text, name, s, column, list(outputs)) for s in point_sets]

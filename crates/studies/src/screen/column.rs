@@ -24,9 +24,32 @@
 //! linearized: the gains of the two qualities to its two free inputs are exact (`−C J⁻¹ B`, SI units:
 //! mole fraction per mol/s, per mol/mol of a ratio, per W of a duty).
 //!
+//! **Scaled gains** ([`scaling`]): SI gains mix watts, mol/s and mole fractions, so their condition
+//! number γ says nothing. Each input is scaled by its nominal (steady-state) value and each quality
+//! by its allowed deviation (given, or its distance to 0 or 1 for a mole fraction: a quality at
+//! 0.995 may move by 0.005), `G̃ = diag(1/Δy) G diag(u₀)`; γ is `σ_max/σ_min` of `G̃`. The RGA and γ*
+//! (the condition number minimized over scalings) do not depend on the scaling.
+//!
+//! **The recommended pairing**: the diagonal one (top quality with the first input) when
+//! `λ11 ≥ 0.5`, the off-diagonal one (relative gain `1 − λ11`) otherwise; a configuration is ranked
+//! by the pairing its verdict recommends.
+//!
+//! **The dynamic check** ([`mod@dynamic`], the default): each configuration that converged and is not
+//! singular gets PI loops on its recommended pairing, tuned together by one rule (Luyben's BLT on
+//! the exact linearization with a measurement dead time, as the pairing screen's dynamic test),
+//! and every disturbance is stepped on the nonlinear plant; the configurations are ranked by their
+//! scaled IAE, `Σ_runs Σ_qualities IAE/Δy` \[s\], with the steady-state measures beside it. Without
+//! it they are ranked by the steady state alone (the relative gain of the recommended pairing
+//! closest to 1, then γ*), and the verdict says so.
+//!
 //! DB is singular at steady state: with both products fixed, `D + B = F` leaves the total
 //! inventory undetermined (the Jacobian is singular), so its gains do not exist; it is reported as
 //! singular and not ranked (it can still be controlled dynamically — Skogestad et al. 1990).
+
+mod dynamic;
+pub mod scaling;
+mod verdict;
+mod write;
 
 use faer::Mat;
 use plantwide_analysis::linear::Linearization;
@@ -36,9 +59,14 @@ use plantwide_flowsheet::{Override, Plant, StructureEdit};
 use plantwide_model::ControllerSpec;
 use plantwide_solve::{NewtonSettings, StrategySettings, steady_state};
 use plantwide_units::QuantityValue;
+use rayon::prelude::*;
 use serde::Serialize;
 
+pub use dynamic::ColumnDynamic;
+pub use scaling::Scaling;
+
 use super::ScreenError;
+use super::pairings::DynamicResult;
 
 /// The flow left for the top quality: reflux, distillate, or the reflux ratio L/D.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -67,8 +95,36 @@ const CONFIGURATIONS: [(&str, Top, Bottom); 7] = [
     ("(L/D)(V/B)", Top::Ratio, Bottom::Ratio),
 ];
 
-/// One configuration's steady-state interaction measures. `gain[i][j]` is quality i (top, bottom)
-/// to input j of `inputs`; `rga[0][0]` pairs the top quality with the first input.
+/// A configuration's name as a file name: `LV`, `DV`, `LB`, `DB`, `LD-V`, `L-VB`, `LD-VB`.
+pub fn file_stem(name: &str) -> String {
+    name.replace(")(", "-").replace(['(', ')', '/'], "").replace("LDV", "LD-V").replace("LVB", "L-VB")
+}
+
+/// What to screen.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ColumnRequest {
+    /// The column.
+    pub column: String,
+    /// The top and bottom qualities (variable paths).
+    pub outputs: Vec<String>,
+    /// The largest deviation allowed of each quality (SI), top first: the scale of its gains and
+    /// of its IAE; `None`: each quality's distance to 0 or 1 (a mole fraction), else its steady
+    /// value.
+    pub allowed: Option<[f64; 2]>,
+    /// The dynamic check; `None`: the steady-state measures alone (the fast path).
+    pub dynamic: Option<ColumnDynamic>,
+}
+
+impl ColumnRequest {
+    /// The steady-state screening of `column` for `outputs`, without the dynamic check.
+    pub fn steady(column: &str, outputs: &[String]) -> ColumnRequest {
+        ColumnRequest { column: column.into(), outputs: outputs.to_vec(), allowed: None, dynamic: None }
+    }
+}
+
+/// One configuration: its steady-state interaction measures and, when the check ran, its dynamic
+/// test. `gain[i][j]` is quality i (top, bottom) to input j of `inputs`; `rga[0][0]` pairs the top
+/// quality with the first input.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ColumnStructure {
     /// `LV`, `DV`, `LB`, `DB`, `(L/D)V`, `L(V/B)` or `(L/D)(V/B)`.
@@ -77,23 +133,46 @@ pub struct ColumnStructure {
     pub inputs: Vec<String>,
     /// Steady-state gains (SI), `None` when singular.
     pub gain: Option<Vec<Vec<f64>>>,
+    /// The gains scaled ([`Scaling`]): `gain[i][j] · input_scales[j] / allowed_deviation[i]`.
+    pub scaled_gain: Option<Vec<Vec<f64>>>,
+    /// Each input's scale: its nominal (steady-state) value (SI).
+    pub input_scales: Option<Vec<f64>>,
     /// Relative gain array.
     pub rga: Option<Vec<Vec<f64>>>,
     /// Niederlinski index of the diagonal pairing.
     pub niederlinski: Option<f64>,
-    /// `σ_max/σ_min` of the gains in SI units.
+    /// γ: `σ_max/σ_min` of the scaled gains.
     pub condition_number: Option<f64>,
-    /// The condition number minimized over input and output scalings.
+    /// γ*: the condition number minimized over input and output scalings.
     pub minimized_condition_number: Option<f64>,
     /// Singular at steady state.
     pub singular: bool,
-    /// Place in the ranking (1 best), `None` when singular or failed.
+    /// The pairing its verdict recommends: the input paired with the top quality, then the one
+    /// paired with the bottom quality.
+    pub pairing: Option<Vec<String>>,
+    /// The relative gain of that pairing (`λ11`, or `1 − λ11` off the diagonal).
+    pub relative_gain: Option<f64>,
+    /// Place by the steady-state measures alone (the relative gain of the recommended pairing
+    /// closest to 1, then γ*), `None` when singular or failed.
+    pub steady_rank: Option<usize>,
+    /// The dynamic check of the recommended pairing (`null` when not run: `--steady-only`, a
+    /// singular or failed configuration); its `score` is its scaled IAE over the best one's.
+    pub dynamic: Option<DynamicResult>,
+    /// `Σ_runs Σ_qualities IAE/allowed deviation` \[s\] of the dynamic check, `null` when it was
+    /// not run or failed.
+    pub iae_scaled: Option<f64>,
+    /// Place in the ranking (1 best): by `iae_scaled` when the dynamic check ran, else by the
+    /// steady state; `None` when singular or failed.
     pub rank: Option<usize>,
-    /// What the numbers say, in words.
+    /// What the numbers say, in words, and where the evidence disagrees with the recommendation.
     pub verdict: String,
-    /// Why its steady state or gains could not be computed (the solver's verdict, naming the unit,
-    /// equation and variable), its measures then `null`; `null` when it was judged.
+    /// Why its steady state, gains or dynamic check failed (the solver's verdict, naming the
+    /// unit, equation and variable), its measures then `null`; `null` when it was judged.
     pub failure: Option<String>,
+    /// The configuration with its loops as tuned, the text of a flowsheet file (kept when asked
+    /// for).
+    #[serde(skip)]
+    pub flowsheet: Option<String>,
 }
 
 /// The configurations of one column.
@@ -105,11 +184,28 @@ pub struct ColumnScreen {
     pub outputs: Vec<String>,
     /// Values of L, V (or its duty or steam), D and B at the steady state (SI).
     pub flows: Flows,
+    /// How the gains and IAEs are scaled.
+    pub scaling: Scaling,
+    /// `dynamic check` or `steady state`.
+    pub ranked_by: String,
+    /// The dynamic check's steps, one run each (empty when it was not run).
+    pub disturbances: Vec<String>,
+    /// Length of every run \[s\] (`null` when the dynamic check was not run).
+    pub duration: Option<f64>,
+    /// Measurement dead time of the tuning \[s\] (`null` when the dynamic check was not run).
+    pub measurement_dead_time: Option<f64>,
     /// The configurations, in the table's order.
     pub structures: Vec<ColumnStructure>,
     /// The configurations that failed, each with its reason (also in its `failure`); empty when
     /// all were judged.
     pub failed: Vec<String>,
+    /// The recommendation and what it rests on; when the steady-state measures alone would
+    /// recommend another configuration, it says so.
+    pub verdict: String,
+    /// The dynamic check's scenarios, one per step (a file name and its text), kept with the
+    /// flowsheets.
+    #[serde(skip)]
+    pub scenarios: Vec<(String, serde_json::Value)>,
 }
 
 /// The column's four flows at the steady state (SI: mol/s; W or kg/s for a duty or steam boilup).
@@ -138,42 +234,103 @@ struct Handles {
     quality_loops: Vec<String>,
 }
 
+/// A configuration that converged with regular gains: its plant, steady state and SI gains.
+pub(crate) struct Variant {
+    plant: Plant,
+    x: Vec<f64>,
+    gain: Mat<f64>,
+}
+
 /// Screen the inventory configurations of `column` for the qualities `outputs` (top, bottom) at
-/// the steady state of `plant` as written.
+/// the steady state of `plant` as written, by the steady-state measures alone (the fast path;
+/// [`screen_column_with`] runs the dynamic check).
 ///
 /// # Errors
 /// [`ScreenError`] naming the column, output or configuration that failed.
 pub fn screen_column(plant: &Plant, column: &str, outputs: &[String]) -> Result<ColumnScreen, ScreenError> {
+    screen_column_with(plant, &ColumnRequest::steady(column, outputs))
+}
+
+/// Screen the inventory configurations of `r.column` as `r` asks: steady-state measures on scaled
+/// gains, and with `r.dynamic` the dynamic check, which the ranking then follows.
+///
+/// # Errors
+/// [`ScreenError`] naming the column, output, disturbance or configuration that failed; a
+/// configuration whose steady state or dynamic check fails numerically is marked in its place
+/// (and listed in `failed`) instead.
+pub fn screen_column_with(plant: &Plant, r: &ColumnRequest) -> Result<ColumnScreen, ScreenError> {
+    let outputs = &r.outputs;
     if outputs.len() != 2 {
         return Err(ScreenError::OutputCount(outputs.len()));
     }
     super::without_mpc(plant, "screen")?;
-    let h = handles(plant, column)?;
+    let h = handles(plant, &r.column)?;
     let out: Vec<usize> = outputs.iter().map(|p| output_var(plant, p)).collect::<Result<_, _>>()?;
+    let steps = r.dynamic.as_ref().map(|d| dynamic::disturbances(plant, &r.column, outputs, d)).transpose()?;
     let steady = |e| ScreenError::Steady { structure: "file".into(), source: Box::new(e) };
     let base = plantwide_solve::converge(plant, &StrategySettings::default()).map_err(|e| steady(e.into()))?;
+    let scaling = scaling::outputs(plant, &base.x, &out, outputs, r.allowed)?;
     let flows = h.paths.each_ref().map(|p| input_value(plant, &base.x, p));
-    let mut structures = Vec::new();
-    for (name, top, bottom) in CONFIGURATIONS {
-        // A configuration that fails numerically is marked and the others are judged; a request
-        // at fault stops the screening.
-        structures.push(match configuration(plant, &h, &base.x, &flows, &out, (name, top, bottom)) {
-            Ok(s) => s,
+    let built: Vec<_> =
+        CONFIGURATIONS.par_iter().map(|&c| configuration(plant, &h, &base.x, &flows, &out, c)).collect();
+    let (mut structures, mut variants) = (Vec::new(), Vec::new());
+    for (b, (name, top, bottom)) in built.into_iter().zip(CONFIGURATIONS) {
+        // A configuration whose steady state is not determined (an inventory it leaves free, as DB
+        // leaves D + B = F) is singular; one that fails numerically is marked and the others are
+        // judged; a request at fault stops the screening.
+        let (s, v) = match b {
+            Ok(sv) => sv,
+            Err(ScreenError::Steady { source, .. }) if source.is_user_error() => {
+                (undetermined(name, edits(plant, &h, &flows, top, bottom).1, &source.to_string()), None)
+            }
             Err(e) if e.is_user_error() => return Err(e),
-            Err(e) => failed(name, edits(plant, &h, &flows, top, bottom).1, e.to_string()),
-        });
+            Err(e) => (failed(name, edits(plant, &h, &flows, top, bottom).1, e.to_string()), None),
+        };
+        structures.push(s);
+        variants.push(v);
     }
-    rank(&mut structures);
-    let failed =
-        structures.iter().filter_map(|c| Some(format!("configuration {}: {}", c.name, c.failure.as_ref()?))).collect();
+    for (s, v) in structures.iter_mut().zip(&variants) {
+        if let Some(v) = v {
+            scaling::apply(s, v, &scaling)?;
+        }
+    }
+    verdict::rank_steady(&mut structures);
+    let check = match (&r.dynamic, steps) {
+        (Some(d), Some(steps)) => {
+            Some(dynamic::check(plant, outputs, &steps, d, &scaling, &mut structures, &variants)?)
+        }
+        _ => None,
+    };
+    verdict::rank(&mut structures, check.is_some());
+    let verdict = verdict::judge(&mut structures, check.is_some());
+    let failed = structures.iter().flat_map(failures).collect();
     let [reflux, boilup, distillate, bottoms] = flows;
+    let check = check.unwrap_or_default();
     Ok(ColumnScreen {
-        column: column.to_string(),
+        column: r.column.clone(),
         outputs: outputs.to_vec(),
         flows: Flows { reflux, boilup, distillate, bottoms },
+        scaling,
+        ranked_by: if r.dynamic.is_some() { "dynamic check" } else { "steady state" }.into(),
+        disturbances: check.steps,
+        duration: check.duration,
+        measurement_dead_time: r.dynamic.as_ref().map(|d| d.measurement.dead_time),
         structures,
         failed,
+        verdict,
+        scenarios: check.scenarios,
     })
+}
+
+/// What failed of configuration `c`, each with its reason: its steady state, or its dynamic
+/// check's tuning or runs.
+fn failures(c: &ColumnStructure) -> Vec<String> {
+    let label = format!("configuration {}", c.name);
+    match (&c.dynamic, &c.failure) {
+        (Some(d), Some(_)) if !d.completed() => d.failures(&label),
+        (_, Some(why)) => vec![format!("{label}: {why}")],
+        (_, None) => Vec::new(),
+    }
 }
 
 /// The column's flows, level loops and quality loops.
@@ -266,7 +423,7 @@ fn configuration(
     flows: &[f64; 4],
     out: &[usize],
     (name, top, bottom): (&str, Top, Bottom),
-) -> Result<ColumnStructure, ScreenError> {
+) -> Result<(ColumnStructure, Option<Variant>), ScreenError> {
     let (edits, inputs) = edits(plant, h, flows, top, bottom);
     let wiring = |e| ScreenError::Wiring { structure: name.into(), source: Box::new(e) };
     let v = plant.restructure(&edits).map_err(wiring)?;
@@ -277,7 +434,7 @@ fn configuration(
     let steady = match steady_state(&v, &u, Some(&guess), &NewtonSettings::default()) {
         Ok(s) => s,
         // No isolated steady state: singular when the Jacobian at the plant's point is; a failure else.
-        Err(e) => return singular_or_failure((&v, &guess, &u), name, inputs, (&ids, &outs), e),
+        Err(e) => return singular_or_failure((&v, &guess, &u), name, inputs, (&ids, &outs), e).map(|s| (s, None)),
     };
     for (&o, &ob) in outs.iter().zip(out) {
         let (value, base) = (steady.x[o], x[ob]);
@@ -285,8 +442,10 @@ fn configuration(
             return Err(ScreenError::Moved { structure: name.into(), output: v.vars()[o].path.clone(), value, base });
         }
     }
-    let g = Linearization::new(&v, &steady.x, &u).steady_gain(&ids, &outs);
-    measures(name, inputs, g.ok())
+    let g = Linearization::new(&v, &steady.x, &u).steady_gain(&ids, &outs).ok();
+    let structure = measures(name, inputs, g.clone())?;
+    let variant = g.filter(|_| !structure.singular).map(|gain| Variant { plant: v, x: steady.x, gain });
+    Ok((structure, variant))
 }
 
 /// A configuration Newton could not converge: singular if its Jacobian at the plant's own steady
@@ -415,20 +574,24 @@ pub(super) fn is_singular(g: &Mat<f64>) -> bool {
         || svd(e.as_ref()).is_ok_and(|s| condition_number(&s.singular_values) > 1.0 / SINGULAR_RATIO.sqrt())
 }
 
+/// A configuration whose steady state is not determined (`why`: which variables move together):
+/// singular, not ranked.
+fn undetermined(name: &str, inputs: Vec<String>, why: &str) -> ColumnStructure {
+    ColumnStructure {
+        inputs,
+        singular: true,
+        verdict: format!("singular at steady state: the configuration leaves an inventory free; not ranked ({why})"),
+        ..unjudged(name)
+    }
+}
+
 /// A configuration whose steady state or gains failed for `why`: no measures, not ranked.
 fn failed(name: &str, inputs: Vec<String>, why: String) -> ColumnStructure {
     ColumnStructure {
-        name: name.into(),
         inputs,
-        gain: None,
-        rga: None,
-        niederlinski: None,
-        condition_number: None,
-        minimized_condition_number: None,
-        singular: false,
-        rank: None,
         verdict: "not judged: the configuration failed; not ranked".into(),
         failure: Some(why),
+        ..unjudged(name)
     }
 }
 
@@ -437,75 +600,56 @@ fn measures(name: &str, inputs: Vec<String>, g: Option<Mat<f64>>) -> Result<Colu
     let analysis = |e| ScreenError::Analysis { structure: name.into(), source: Box::new(e) };
     let Some(g) = g.filter(|g| !is_singular(g)) else {
         return Ok(ColumnStructure {
-            name: name.into(),
             inputs,
-            gain: None,
-            rga: None,
-            niederlinski: None,
-            condition_number: None,
-            minimized_condition_number: None,
             singular: true,
-            rank: None,
             verdict: "singular at steady state: the two inputs cannot set both qualities (for DB, D + B = F ties \
                       the products); not ranked"
                 .into(),
-            failure: None,
+            ..unjudged(name)
         });
     };
     let l = rga(g.as_ref()).map_err(analysis)?;
     let ni = niederlinski(g.as_ref(), &[0, 1]).map_err(analysis)?;
-    let cond = condition_number(&svd(g.as_ref()).map_err(analysis)?.singular_values);
     let min_cond = minimized_condition_number(g.as_ref()).map_err(analysis)?;
+    // The pairing the verdict recommends: the diagonal one unless its relative gain is below 0.5.
+    let l11 = l[(0, 0)];
+    let (pairing, relative_gain) = match l11 >= 0.5 {
+        true => (vec![inputs[0].clone(), inputs[1].clone()], l11),
+        false => (vec![inputs[1].clone(), inputs[0].clone()], 1.0 - l11),
+    };
     Ok(ColumnStructure {
-        name: name.into(),
-        verdict: verdict(l[(0, 0)], &inputs),
         inputs,
         gain: Some(rows(g.as_ref())),
         rga: Some(rows(l.as_ref())),
         niederlinski: Some(ni),
-        condition_number: Some(cond),
         minimized_condition_number: Some(min_cond),
-        singular: false,
-        rank: None,
-        failure: None,
+        pairing: Some(pairing),
+        relative_gain: Some(relative_gain),
+        ..unjudged(name)
     })
 }
 
-/// The verdict on the diagonal pairing (top quality with the first input) from `λ11`: Skogestad &
-/// Morari (1987), large relative gains mean strong interaction and sensitivity to input
-/// uncertainty; a negative one fails integral controllability (the loop, or the plant with the
-/// other loop open, goes unstable).
-fn verdict(l11: f64, inputs: &[String]) -> String {
-    let other = "the top quality with the second input";
-    match l11 {
-        l if l < 0.0 => format!("λ11 = {l:.3} < 0: the diagonal pairing is not integral controllable; pair {other}"),
-        l if l < 0.5 => {
-            format!("λ11 = {l:.3}: the diagonal pairing is the weak one; pair {other} (λ = {:.3})", 1.0 - l)
-        }
-        l if l <= 2.0 => format!("λ11 = {l:.3}: little interaction; pair the top quality with {}", inputs[0]),
-        l if l <= 10.0 => format!("λ11 = {l:.3}: moderate interaction; detune the loops together (BLT)"),
-        l => format!(
-            "λ11 = {l:.3}: strong interaction; the loops fight and the large relative gains make the column \
-             sensitive to input uncertainty (Skogestad & Morari 1987)"
-        ),
-    }
-}
-
-/// Rank the regular configurations (neither singular nor failed): integral-controllable pairings
-/// (λ11 > 0) first, closest to λ11 = 1 (by |ln λ11|), then by minimized condition number; the
-/// others after them.
-fn rank(structures: &mut [ColumnStructure]) {
-    let score = |s: &ColumnStructure| {
-        let l11 = s.rga.as_ref().map_or(f64::NAN, |r| r[0][0]);
-        let l = if l11 > 0.0 { l11.ln().abs() } else { f64::INFINITY };
-        (l, s.minimized_condition_number.unwrap_or(f64::INFINITY))
-    };
-    let mut order: Vec<usize> =
-        (0..structures.len()).filter(|&k| !structures[k].singular && structures[k].failure.is_none()).collect();
-    order.sort_by(|&a, &b| {
-        score(&structures[a]).partial_cmp(&score(&structures[b])).unwrap_or(std::cmp::Ordering::Equal)
-    });
-    for (place, k) in order.into_iter().enumerate() {
-        structures[k].rank = Some(place + 1);
+/// A configuration with nothing measured yet.
+fn unjudged(name: &str) -> ColumnStructure {
+    ColumnStructure {
+        name: name.into(),
+        inputs: Vec::new(),
+        gain: None,
+        scaled_gain: None,
+        input_scales: None,
+        rga: None,
+        niederlinski: None,
+        condition_number: None,
+        minimized_condition_number: None,
+        singular: false,
+        pairing: None,
+        relative_gain: None,
+        steady_rank: None,
+        dynamic: None,
+        iae_scaled: None,
+        rank: None,
+        verdict: String::new(),
+        failure: None,
+        flowsheet: None,
     }
 }

@@ -258,7 +258,7 @@ pub(super) fn test_picked(
         .zip(tunings)
         .enumerate()
         .map(|(t, (&k, tuned))| match tuned {
-            Some(tuned) => Some(candidate(tuned, r, &pair_outputs(open, &structures[k]), duration)),
+            Some(tuned) => Some(candidate(&tuned, r, &pair_outputs(open, &structures[k]), duration)),
             None => r.share.given(t),
         })
         .collect();
@@ -296,7 +296,7 @@ pub(crate) fn score(results: &mut [&mut DynamicResult], steps: usize, cvs: usize
 
 /// Run one tuned candidate; a failure is recorded, not returned (the other candidates go on), and a
 /// run that fails is marked in its place (the other runs go on).
-fn candidate(tuned: TunedCandidate, r: &PairingRequest, ops: &[Limited], duration: f64) -> DynamicResult {
+pub(crate) fn candidate(tuned: &TunedCandidate, r: &PairingRequest, ops: &[Limited], duration: f64) -> DynamicResult {
     let (plant, x, tuned) = match tuned {
         Ok(t) => t,
         Err(why) => {
@@ -312,10 +312,10 @@ fn candidate(tuned: TunedCandidate, r: &PairingRequest, ops: &[Limited], duratio
     let runs: Vec<DisturbanceRun> = r
         .steps()
         .iter()
-        .map(|d| run(&plant, &x, r, d, duration, ops).map_or_else(|why| failed_run(r, d, why.to_string()), |o| o.0))
+        .map(|d| run(plant, x, r, d, duration, ops).map_or_else(|why| failed_run(r, d, why.to_string()), |o| o.0))
         .collect();
     let score = if runs.iter().all(|r| r.failure.is_none()) { f64::NAN } else { f64::INFINITY };
-    DynamicResult { detuning_factor: tuned.detuning, loops: tuned.loops, runs, score, failure: None }
+    DynamicResult { detuning_factor: tuned.detuning, loops: tuned.loops.clone(), runs, score, failure: None }
 }
 
 /// The paths a run of `r` records figures of: its CVs, then its other recorded variables.
@@ -340,14 +340,14 @@ pub(crate) fn failed_run(r: &PairingRequest, d: &super::Disturbance, why: String
 }
 
 /// A candidate's plant with its tuned loops, its steady state and tuning, or why it has none.
-type TunedCandidate = Result<(Plant, Vec<f64>, Tuned), CandidateFailure>;
+pub(crate) type TunedCandidate = Result<(Plant, Vec<f64>, Tuned), CandidateFailure>;
 
 /// The tuning of a candidate.
-struct Tuned {
+pub(crate) struct Tuned {
     detuning: Option<f64>,
     loops: Vec<TunedLoop>,
     /// Its longest reset time \[s\].
-    tau_i_max: f64,
+    pub(crate) tau_i_max: f64,
 }
 
 /// The controller description of pair `i` with gain `kc` and reset `tau_i` (SI).
@@ -369,16 +369,41 @@ pub(super) fn closed_plant(
     ti: &[f64],
     actions: &[&str],
 ) -> Result<(Plant, Vec<f64>), CandidateFailure> {
-    let edits: Vec<StructureEdit> = (0..s.pairs.len())
-        .map(|i| StructureEdit::AddController {
-            name: format!("pair{}", i + 1),
-            spec: loop_spec(open, s, i, kc[i], ti[i], actions[i]),
-        })
-        .collect();
+    let mut edits: Vec<StructureEdit> = Vec::new();
+    for i in 0..s.pairs.len() {
+        let name = format!("pair{}", i + 1);
+        let mut spec = loop_spec(open, s, i, kc[i], ti[i], actions[i]);
+        if let Some(station) = remote_ratio(open, &s.pairs[i].mv, &name, &mut spec) {
+            edits.extend(station);
+        }
+        edits.insert(0, StructureEdit::AddController { name, spec });
+    }
     let v = open.plant.restructure(&edits)?;
     let guess = crate::screen::column::mapped_guess(&open.plant, &open.x, &v);
     let st = steady_state(&v, &v.input_values(), Some(&guess), &NewtonSettings::default())?;
     Ok((v, st.x))
+}
+
+/// When `mv` is a ratio station's local ratio (`<station>.ratio`, an input no controller can
+/// drive): loop `name` becomes the station's master — `spec` loses its output and starts from the
+/// ratio as its bias — and the edits that give the station the remote ratio `{"from": "<name>.op"}`
+/// (Shinskey's ratio trimmed by a composition controller; the `(L/D)` and `(V/B)` configurations).
+fn remote_ratio(open: &OpenPlant, mv: &str, name: &str, spec: &mut serde_json::Value) -> Option<[StructureEdit; 2]> {
+    let station = mv.strip_suffix(".ratio")?;
+    let Some(plantwide_model::ControllerSpec::Ratio(cfg)) = open.plant.spec().controllers.get(station) else {
+        return None;
+    };
+    let u0 = open.plant.input(mv).map(|i| open.plant.inputs()[i].value)?;
+    let obj = spec.as_object_mut()?;
+    obj.remove("output");
+    obj.insert("bias".into(), u0.into());
+    let mut cfg = cfg.clone();
+    cfg.ratio = plantwide_model::controllers::ratio::RatioValue::Remote { from: format!("{name}.op") };
+    let station_spec = serde_json::to_value(plantwide_model::ControllerSpec::Ratio(cfg)).ok()?;
+    Some([
+        StructureEdit::RemoveController(station.to_string()),
+        StructureEdit::AddController { name: station.to_string(), spec: station_spec },
+    ])
 }
 
 /// The steady-state gain of each of the candidate's pairs in the open plant (SI: CV unit per MV
@@ -445,7 +470,9 @@ fn tuned(s: &PairingStructure, kc: &[f64], ti: &[f64], actions: &[&str], detunin
     Tuned { detuning, loops, tau_i_max }
 }
 
-fn tuned_plant(open: &OpenPlant, r: &PairingRequest, s: &PairingStructure) -> TunedCandidate {
+/// The open plant with the candidate's loops, tuned together by BLT on the exact linearization
+/// (with `r`'s measurement delay), and its steady state.
+pub(crate) fn tuned_plant(open: &OpenPlant, r: &PairingRequest, s: &PairingStructure) -> TunedCandidate {
     let (trial, x) = trial_plant(open, r, s)?;
     let loops: Vec<_> =
         (0..s.pairs.len()).map(|i| plant_loop(&trial, &format!("pair{}", i + 1))).collect::<Result<_, _>>()?;
@@ -476,7 +503,7 @@ pub(crate) struct Limited {
 
 /// The outputs of a candidate's loops with their limits: `[0, 2 u₀]` (or `[2 u₀, 0]`) for an MV
 /// whose steady value in the open plant (which holds every MV) is `u₀`.
-fn pair_outputs(open: &OpenPlant, s: &PairingStructure) -> Vec<Limited> {
+pub(crate) fn pair_outputs(open: &OpenPlant, s: &PairingStructure) -> Vec<Limited> {
     (0..s.pairs.len())
         .map(|i| {
             let mv = &s.pairs[i].mv;
@@ -485,6 +512,17 @@ fn pair_outputs(open: &OpenPlant, s: &PairingStructure) -> Vec<Limited> {
             Limited { op: format!("pair{}.op", i + 1), mv: mv.clone(), lo, hi }
         })
         .collect()
+}
+
+/// The scenario of a dynamic test's run: `d`'s input stepped by `change` (SI) at [`STEP_AT`] of
+/// `duration` \[s\], `record` recorded at 500 intervals.
+pub(crate) fn scenario(d: &super::Disturbance, change: f64, duration: f64, record: &[&String]) -> serde_json::Value {
+    serde_json::json!({
+        "format_version": 1, "name": format!("{} step", d.path), "duration": format!("{duration} s"),
+        "integrator": {"rtol": 1e-6},
+        "events": [{"type": "step", "at": format!("{} s", STEP_AT * duration), "path": d.path, "by": change}],
+        "record": {"interval": format!("{} s", duration / 500.0), "paths": record}
+    })
 }
 
 /// One disturbance step on a controlled plant from its steady state `x`: the figures of `r`'s CVs
@@ -502,13 +540,7 @@ pub(crate) fn run(
         plantwide_flowsheet::overrides::resolve_input(plant, &d.path).map_or(f64::NAN, |i| plant.inputs()[i].value);
     let watched = watched(r);
     let record: Vec<&String> = watched.iter().copied().chain(ops.iter().map(|o| &o.op)).collect();
-    let text = serde_json::json!({
-        "format_version": 1, "name": format!("{} step", d.path), "duration": format!("{duration} s"),
-        "integrator": {"rtol": 1e-6},
-        "events": [{"type": "step", "at": format!("{} s", STEP_AT * duration), "path": d.path, "by": d.change(u0)}],
-        "record": {"interval": format!("{} s", duration / 500.0), "paths": record}
-    })
-    .to_string();
+    let text = scenario(d, d.change(u0), duration, &record).to_string();
     let spec = plantwide_flowsheet::scenario::parse_scenario(&text, "screen")?;
     let scenario = plantwide_flowsheet::scenario::resolve(&spec, plant, "screen")?;
     let res = simulate(plant, &scenario, Start::Steady(x), "screen", &mut |_| {}).map_err(Box::new)?;
