@@ -21,6 +21,7 @@ mod dynamics;
 mod fehe;
 mod flowsheets;
 mod fuzz;
+mod generator;
 mod heat_integration;
 mod hostile;
 mod hostile_commands;
