@@ -163,7 +163,11 @@ pub fn events(res: &SimulationResult, spec: &ScenarioSpec, time_factor: f64) -> 
             Some(EventSpec::Sinusoid { path, .. }) => format!("sinusoid {path}"),
             Some(EventSpec::Mode { controller, mode, .. }) => format!("{controller} {mode:?}").to_lowercase(),
             Some(EventSpec::ValveStuck { path, .. }) => format!("{path} stuck"),
+            Some(EventSpec::ValveRepaired { path, .. }) => format!("{path} repaired"),
             Some(EventSpec::FeedLost { unit, .. }) => format!("{unit} lost"),
+            Some(EventSpec::FeedRestored { unit, .. }) => format!("{unit} restored"),
+            Some(EventSpec::AnalyzerFrozen { controller, .. }) => format!("{controller} analyzer frozen"),
+            Some(EventSpec::AnalyzerRepaired { controller, .. }) => format!("{controller} analyzer repaired"),
             None => origin.to_string(),
         }
     };

@@ -18,6 +18,7 @@ mod compare;
 mod core;
 mod display_units;
 mod dynamics;
+mod faults;
 mod fehe;
 mod flowsheets;
 mod fuzz;

@@ -171,20 +171,55 @@ pub enum EventSpec {
         #[serde(default, skip_serializing_if = "Option::is_none")]
         output: Option<QuantityValue>,
     },
-    /// The input (a valve opening, a flow a controller drives) freezes at its current value; a
-    /// controller that drove it keeps acting on nothing (and winds up if it integrates).
+    /// The input (a valve opening, a flow a controller drives) freezes at its current value, or
+    /// goes `to` one (a valve failed closed: `0`, open: `1`); a controller that drove it keeps
+    /// acting on nothing (and winds up if it integrates) until a `valve_repaired` event.
     ValveStuck {
         /// Time.
         at: QuantityValue,
         /// Input path.
         path: String,
+        /// The value it fails to (default: where it is).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        to: Option<QuantityValue>,
     },
-    /// A feed unit's flow `F` drops to zero.
+    /// A stuck or failed input works again: a controller that drove it takes it back (from
+    /// wherever its output has wound to), a free input returns to its value before the fault.
+    ValveRepaired {
+        /// Time.
+        at: QuantityValue,
+        /// Input path (as its `valve_stuck` event named it).
+        path: String,
+    },
+    /// A feed unit's flow `F` drops to zero, whether or not a controller drives it (a supply
+    /// failure overrides the flow controller, which winds up against it) until `feed_restored`.
     FeedLost {
         /// Time.
         at: QuantityValue,
         /// Feed unit name.
         unit: String,
+    },
+    /// A lost feed comes back: to its controller, or to its flow before the loss.
+    FeedRestored {
+        /// Time.
+        at: QuantityValue,
+        /// Feed unit name.
+        unit: String,
+    },
+    /// A scenario analyzer (`analyzers`) freezes: its controller keeps reading its last result
+    /// (no new samples, results in flight lost) until `analyzer_repaired`.
+    AnalyzerFrozen {
+        /// Time.
+        at: QuantityValue,
+        /// Controller whose measurement is the analyzer's.
+        controller: String,
+    },
+    /// A frozen analyzer samples again from its next sample time.
+    AnalyzerRepaired {
+        /// Time.
+        at: QuantityValue,
+        /// Controller whose measurement is the analyzer's.
+        controller: String,
     },
 }
 
@@ -326,10 +361,24 @@ pub enum Action {
         /// The manual output to hold, if given (else the output at the switch: bumpless).
         output: Option<f64>,
     },
-    /// Freeze an input.
+    /// Freeze an input where it is, or at `value` (a fault: the input leaves its controller).
     Stuck {
         /// The input.
         input: usize,
+        /// The value it fails to (SI), if not where it is.
+        value: Option<f64>,
+    },
+    /// End the fault on an input: back to its controller, or to its value before the fault.
+    Repair {
+        /// The input.
+        input: usize,
+    },
+    /// Freeze or repair the analyzer on a controller's measurement.
+    Analyzer {
+        /// The controller's block.
+        block: usize,
+        /// Frozen after the event.
+        frozen: bool,
     },
 }
 
@@ -441,6 +490,20 @@ fn strip_position(msg: &str) -> String {
 struct Cx<'a> {
     plant: &'a Plant,
     diags: Vec<Diagnostic>,
+    ongoing: Ongoing,
+}
+
+/// What a run has going when a scenario continues it (a live command is resolved as a one-event
+/// scenario): the inputs in a fault, the frozen analyzers and the analyzers it samples, so that a
+/// repair of a fault made earlier is accepted.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Ongoing {
+    /// Inputs stuck or failed (their faults not yet repaired).
+    pub faulted: Vec<usize>,
+    /// Controller blocks whose analyzer is frozen.
+    pub frozen: Vec<usize>,
+    /// Controller blocks the run samples by an analyzer.
+    pub analyzers: Vec<usize>,
 }
 
 impl Cx<'_> {
@@ -550,7 +613,25 @@ pub fn resolve(spec: &ScenarioSpec, plant: &Plant, file: &str) -> Result<Scenari
 /// events after the end of the run or colliding with another on the same target, and requests
 /// beyond `limits`.
 pub fn resolve_with(spec: &ScenarioSpec, plant: &Plant, file: &str, limits: &Limits) -> Result<Scenario, LoadError> {
-    let mut cx = Cx { plant, diags: Vec::new() };
+    resolve_in(Cx { plant, diags: Vec::new(), ongoing: Ongoing::default() }, spec, file, limits)
+}
+
+/// [`resolve`] for events that continue a run with `ongoing` faults and analyzers (a live
+/// command).
+///
+/// # Errors
+/// As [`resolve_with`].
+pub fn resolve_continuing(
+    spec: &ScenarioSpec,
+    plant: &Plant,
+    file: &str,
+    ongoing: Ongoing,
+) -> Result<Scenario, LoadError> {
+    resolve_in(Cx { plant, diags: Vec::new(), ongoing }, spec, file, &Limits::default())
+}
+
+fn resolve_in(mut cx: Cx<'_>, spec: &ScenarioSpec, file: &str, limits: &Limits) -> Result<Scenario, LoadError> {
+    let plant = cx.plant;
     let duration = cx.time("duration", &spec.duration, true);
     let int = &spec.integrator;
     let rtol = int.rtol.unwrap_or(1e-6);
@@ -589,6 +670,7 @@ pub fn resolve_with(spec: &ScenarioSpec, plant: &Plant, file: &str, limits: &Lim
             }
         }
     }
+    check_faults(&mut cx, &events, &analyzers);
     let rec = &spec.record;
     let interval = rec.interval.as_ref().map_or(duration / 1000.0, |q| cx.time("record.interval", q, true));
     let time_unit = rec.time_unit.clone().unwrap_or_else(|| "min".into());
@@ -806,6 +888,7 @@ fn check_values(cx: &mut Cx<'_>, events: &[(Event, String)]) {
                 saved[input] = Some(u[input]);
                 (input, vec![u[input] - amplitude.abs(), u[input] + amplitude.abs()])
             }
+            Action::Stuck { input, value: Some(v) } => (input, vec![v]),
             _ => continue,
         };
         for &v in &values {
@@ -854,8 +937,12 @@ fn target(a: &Action) -> usize {
         | Action::Pulse { input, .. }
         | Action::Sinusoid { input, .. }
         | Action::Restore { input }
-        | Action::Stuck { input } => input,
+        | Action::Stuck { input, .. }
+        | Action::Repair { input } => input,
         Action::Mode { auto_input, .. } => auto_input,
+        // An analyzer's held measurement: one past the plant's inputs per controller block, so it
+        // never equals an input.
+        Action::Analyzer { block, .. } => usize::MAX - block,
     }
 }
 
@@ -864,6 +951,7 @@ fn target_name(plant: &Plant, a: &Action) -> String {
         Action::Mode { auto_input, .. } => {
             format!("the mode of controller `{}`", plant.blocks[plant.inputs[auto_input].block].name)
         }
+        Action::Analyzer { block, .. } => format!("the analyzer of controller `{}`", plant.blocks[block].name),
         _ => {
             let i = target(a);
             let mut aliases: Vec<&str> =
@@ -894,7 +982,7 @@ fn default_paths(plant: &Plant, events: &[Event]) -> Vec<(String, Option<String>
         | Action::Ramp { input, .. }
         | Action::Pulse { input, .. }
         | Action::Sinusoid { input, .. }
-        | Action::Stuck { input } = e.action
+        | Action::Stuck { input, .. } = e.action
         {
             paths.push(plant.inputs[input].path.clone());
         }
@@ -970,20 +1058,68 @@ fn event(cx: &mut Cx<'_>, base: &str, e: &EventSpec) -> Vec<Event> {
             let output = output.as_ref().map(|q| cx.quantity(&format!("{base}.output"), q, dim));
             vec![ev(t, Action::Mode { auto_input, manual_input, op, auto: *mode == Mode::Auto, output })]
         }
-        EventSpec::ValveStuck { at: t, path } => {
+        EventSpec::ValveStuck { at: t, path, to } => {
             let t = at(cx, t);
-            cx.input(path, &path_field, false).map(|input| vec![ev(t, Action::Stuck { input })]).unwrap_or_default()
+            let Some(input) = cx.input(path, &path_field, false) else { return Vec::new() };
+            let dim = cx.plant.inputs[input].dim;
+            let value = to.as_ref().map(|q| cx.quantity(&format!("{base}.to"), q, dim));
+            vec![ev(t, Action::Stuck { input, value })]
+        }
+        EventSpec::ValveRepaired { at: t, path } => {
+            let t = at(cx, t);
+            cx.input(path, &path_field, false).map(|input| vec![ev(t, Action::Repair { input })]).unwrap_or_default()
         }
         EventSpec::FeedLost { at: t, unit } => {
             let t = at(cx, t);
-            let input = cx.plant.input(&format!("{unit}.F"));
-            if input.is_none() || !cx.plant.blocks.iter().any(|b| b.name == *unit && b.unit.type_name() == "feed") {
-                cx.diags
-                    .push(Diagnostic::new(format!("{base}.unit"), format!("no feed unit `{unit}` with an input `F`")));
-                return Vec::new();
-            }
-            let input = cx.input(&format!("{unit}.F"), &format!("{base}.unit"), true);
-            input.map(|input| vec![ev(t, Action::Step { input, change: Change::To(0.0) })]).unwrap_or_default()
+            let input = feed_flow(cx, base, unit);
+            input.map(|input| vec![ev(t, Action::Stuck { input, value: Some(0.0) })]).unwrap_or_default()
         }
+        EventSpec::FeedRestored { at: t, unit } => {
+            let t = at(cx, t);
+            feed_flow(cx, base, unit).map(|input| vec![ev(t, Action::Repair { input })]).unwrap_or_default()
+        }
+        EventSpec::AnalyzerFrozen { at: t, controller } | EventSpec::AnalyzerRepaired { at: t, controller } => {
+            let t = at(cx, t);
+            let frozen = matches!(e, EventSpec::AnalyzerFrozen { .. });
+            let block = cx.controller(controller, &format!("{base}.controller"));
+            block.map(|block| vec![ev(t, Action::Analyzer { block, frozen })]).unwrap_or_default()
+        }
+    }
+}
+
+/// The flow input `F` of feed unit `unit` (refused, naming `base.unit`, if there is none).
+fn feed_flow(cx: &mut Cx<'_>, base: &str, unit: &str) -> Option<usize> {
+    let input = cx.plant.input(&format!("{unit}.F"));
+    if input.is_none() || !cx.plant.blocks.iter().any(|b| b.name == *unit && b.unit.type_name() == "feed") {
+        cx.diags.push(Diagnostic::new(format!("{base}.unit"), format!("no feed unit `{unit}` with an input `F`")));
+    }
+    input
+}
+
+/// Faults in time order: an input fails once before it is repaired, a repair follows a fault, a
+/// frozen analyzer is a scenario analyzer and is repaired after it froze.
+fn check_faults(cx: &mut Cx<'_>, events: &[Event], analyzers: &[(usize, f64, f64)]) {
+    let mut faulted: std::collections::HashSet<usize> = cx.ongoing.faulted.iter().copied().collect();
+    let mut frozen: std::collections::HashSet<usize> = cx.ongoing.frozen.iter().copied().collect();
+    let sampled: Vec<usize> = analyzers.iter().map(|&(b, ..)| b).chain(cx.ongoing.analyzers.iter().copied()).collect();
+    for e in events {
+        let what = target_name(cx.plant, &e.action);
+        let why = match e.action {
+            Action::Stuck { input, .. } if !faulted.insert(input) => {
+                format!("{what} has failed already: repair it (valve_repaired, feed_restored) before it fails again")
+            }
+            Action::Repair { input } if !faulted.remove(&input) => {
+                format!("{what} has no fault to repair at {} s (no valve_stuck or feed_lost before it)", secs(e.t))
+            }
+            Action::Analyzer { block, .. } if !sampled.contains(&block) => {
+                format!("{what} is no scenario analyzer: list the controller under `analyzers` to sample it")
+            }
+            Action::Analyzer { block, frozen: true } if !frozen.insert(block) => format!("{what} is frozen already"),
+            Action::Analyzer { block, frozen: false } if !frozen.remove(&block) => {
+                format!("{what} is not frozen at {} s (no analyzer_frozen before it)", secs(e.t))
+            }
+            _ => continue,
+        };
+        cx.diags.push(Diagnostic::new(e.origin.clone(), why));
     }
 }

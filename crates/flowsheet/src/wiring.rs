@@ -112,6 +112,19 @@ impl Plant {
         Some(op)
     }
 
+    /// Give input `i` back to the controller output variable `op` that drove it before
+    /// [`Plant::hold_input`]: every block reads `op` again (a repaired valve, a restored feed).
+    pub fn release_input(&mut self, i: usize, op: usize) {
+        self.inputs[i].driven_by = Some(op);
+        let slen = self.stream_layout.len();
+        for b in &mut self.blocks {
+            if let Some(k) = b.input_ids.iter().position(|&id| id == i) {
+                let pos = if b.kind == BlockKind::Unit { b.layout.n_inlets * slen + k } else { k };
+                b.reads[pos] = Read::Var(op);
+            }
+        }
+    }
+
     /// Put block `b`'s loop in manual at state `x`: every input its outputs drive is held at the
     /// output's value in `x`. Returns the pairs (held input, output variable).
     pub fn manual(&mut self, b: usize, x: &[f64]) -> Vec<(usize, usize)> {

@@ -309,7 +309,8 @@ function eventOf() {
     case 'ramp': return { type, path: target, to: v, duration: time };
     case 'pulse': return { type, path: target, to: v, width: time };
     case 'sinusoid': return { type, path: target, amplitude: v, period: time };
-    case 'valve_stuck': return { type, path: target };
+    case 'valve_stuck': return v ? { type, path: target, to: v } : { type, path: target };
+    case 'valve_repaired': return { type, path: target };
     default: return { type, unit: target };
   }
 }

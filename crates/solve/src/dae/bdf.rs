@@ -1027,9 +1027,15 @@ impl Bdf {
         let t = self.st.t;
         let order = self.st.order;
         let mut lu_ok = self.st.lu_c.is_some() && self.lu.is_factored();
+        // The variable that failed the last attempt, and how (for the message if the step runs out).
+        let mut culprit: Option<(usize, &'static str)> = None;
         loop {
             if *h_abs < min_step {
-                return Err(DaeError::StepSizeTooSmall { time: t, h: *h_abs });
+                let culprit = culprit.map(|(j, how)| {
+                    let name = sys.variable_name(j).unwrap_or_else(|| format!("variable {j}"));
+                    format!("{name} ({how})")
+                });
+                return Err(DaeError::StepSizeTooSmall { time: t, h: *h_abs, culprit });
             }
             let mut t_new = t + *h_abs;
             if t_new >= t_stop {
@@ -1044,6 +1050,7 @@ impl Bdf {
             let c = h / self.gamma[order];
             let Some(iters) = self.correct(sys, t_new, c, NEWTON_TOL, &mut lu_ok)? else {
                 self.st.stats.n_newton_failures += 1;
+                culprit = self.worst_correction().map(|j| (j, "the corrector diverged on it"));
                 self.scale_step(h_abs, order, 0.5);
                 lu_ok = false;
                 continue;
@@ -1054,6 +1061,7 @@ impl Bdf {
             let error_norm = e * rms(&w.d, &w.weight, &self.controlled);
             if error_norm > 1.0 {
                 self.st.stats.n_error_test_failures += 1;
+                culprit = self.worst_correction().map(|j| (j, "the largest local error"));
                 let factor = MIN_FACTOR.max(safety * error_norm.powf(-1.0 / (order as f64 + 1.0)));
                 // Newton converged: the factors stay valid for the Jacobian, c changes below.
                 self.scale_step(h_abs, order, factor);
@@ -1061,6 +1069,16 @@ impl Bdf {
             }
             return Ok((t_new, iters));
         }
+    }
+
+    /// The error-controlled variable with the largest weighted correction of the last attempt
+    /// (a non-finite one first): what a failing step was stopped by.
+    fn worst_correction(&self) -> Option<usize> {
+        let size = |j: usize| {
+            let v = (self.w.d[j] * self.w.weight[j]).abs();
+            if v.is_finite() { v } else { f64::INFINITY }
+        };
+        self.controlled.iter().copied().max_by(|&a, &b| size(a).total_cmp(&size(b)))
     }
 
     /// The predictor `x⁽⁰⁾ = Σ_{k=0}^{q} D[k]` and `ψ = (1/γ_q) Σ_{k=1}^{q} γ_k D[k]` into `w`.

@@ -116,12 +116,18 @@ impl std::fmt::Display for Equation {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum DaeError {
     /// The step size fell below the resolution of the time axis.
-    #[error("step size too small ({h:.3e} s) at t = {time} s: the model may be discontinuous or ill-posed there")]
+    #[error(
+        "step size too small ({h:.3e} s) at t = {time} s: the model may be discontinuous or ill-posed there{}",
+        culprit.as_ref().map(|c| format!("; the last attempt failed on {c}")).unwrap_or_default()
+    )]
     StepSizeTooSmall {
         /// Time [s].
         time: f64,
         /// Step size [s].
         h: f64,
+        /// The variable that stopped the last attempt and how (`column1.x[3][A] (the largest
+        /// local error)`), when known.
+        culprit: Option<String>,
     },
     /// More steps than [`BdfSettings::max_steps`].
     #[error("more than {max_steps} steps before t = {time} s (raise max_steps or loosen the tolerances)")]

@@ -290,6 +290,16 @@ impl<'p> Driver<'p> {
         }
     }
 
+    /// The faults and analyzers in force, for a command that continues the run.
+    pub(super) fn ongoing(&self) -> plantwide_flowsheet::scenario::Ongoing {
+        let plant = &self.plant;
+        plantwide_flowsheet::scenario::Ongoing {
+            faulted: self.st.faults.iter().filter_map(|f| plant.input(&f.path)).collect(),
+            frozen: self.sc.analyzers.iter().zip(&self.st.frozen).filter(|(_, f)| **f).map(|(&(b, ..), _)| b).collect(),
+            analyzers: self.sc.analyzers.iter().map(|&(b, ..)| b).collect(),
+        }
+    }
+
     /// The earliest discrete time after `t`.
     fn next_stop(&self, t: f64) -> f64 {
         let mut next = self.sc.duration;
@@ -404,6 +414,13 @@ impl<'p> Driver<'p> {
         let mut changed = false;
         for (k, &(_, ts, td)) in self.sc.analyzers.iter().enumerate() {
             let (input, v) = self.analyzers[k];
+            if self.st.frozen[k] {
+                // A frozen analyzer takes no sample and releases nothing; its held value stays.
+                if self.st.next_sample[k] as f64 * ts <= t {
+                    self.st.next_sample[k] = instants::after(t, ts);
+                }
+                continue;
+            }
             if self.st.next_sample[k] as f64 * ts <= t {
                 self.st.pending[k].push((self.st.next_sample[k] as f64 * ts + td, x[v]));
                 self.st.next_sample[k] = instants::after(t, ts);
@@ -449,13 +466,57 @@ impl<'p> Driver<'p> {
                 }
                 w[auto_input] = Waveform::Constant(if auto { 1.0 } else { 0.0 });
             }
-            Action::Stuck { input } => {
-                let value = w[input].at(t);
-                let frozen = self.plant.to_mut().hold_input(input).map_or(value, |op| x[op]);
-                self.sampled.iter_mut().for_each(|s| s.retain(|&(i, _)| i != input));
-                self.st.waveforms[input] = Waveform::Constant(frozen);
-                self.st.stuck.push(self.plant.inputs()[input].path.clone());
+            Action::Stuck { input, value } => self.fail_input(input, value, t, x),
+            Action::Repair { input } => self.repair_input(input, x),
+            Action::Analyzer { block, frozen } => {
+                if let Some(k) = self.sc.analyzers.iter().position(|&(b, ..)| b == block) {
+                    self.st.frozen[k] = frozen;
+                    if frozen {
+                        self.st.pending[k].clear();
+                    }
+                }
             }
+        }
+    }
+
+    /// A fault on `input` at `t`: it leaves the controller that drove it (or the scans that held
+    /// it) and stays where it is, or at `value`; what its repair gives it back to is kept.
+    fn fail_input(&mut self, input: usize, value: Option<f64>, t: f64, x: &[f64]) {
+        let current = self.st.waveforms[input].at(t);
+        let op = self.plant.to_mut().hold_input(input);
+        let before = op.map_or(current, |op| x[op]);
+        let scanned_by = self.sampled.iter().enumerate().find_map(|(k, s)| {
+            s.iter().find(|&&(i, _)| i == input).map(|&(_, op)| (k, self.plant.vars()[op].path.clone()))
+        });
+        self.sampled.iter_mut().for_each(|s| s.retain(|&(i, _)| i != input));
+        self.st.waveforms[input] = Waveform::Constant(value.unwrap_or(before));
+        let path = self.plant.inputs()[input].path.clone();
+        let driven_by = op.map(|op| self.plant.vars()[op].path.clone());
+        self.st.faults.push(snapshot::Fault { path: path.clone(), before, driven_by, scanned_by });
+        self.st.stuck.push(path);
+    }
+
+    /// The end of the fault on `input`: back to its controller (whose output has wound wherever
+    /// the fault left it), to its scans, or to its value before the fault.
+    fn repair_input(&mut self, input: usize, x: &[f64]) {
+        let path = &self.plant.inputs()[input].path;
+        let Some(k) = self.st.faults.iter().position(|f| f.path == *path) else { return };
+        let fault = self.st.faults.remove(k);
+        self.st.stuck.retain(|p| *p != fault.path);
+        let var = |p: &str| self.plant.var(p);
+        match (fault.driven_by.as_deref().and_then(var), fault.scanned_by.as_ref()) {
+            (Some(op), _) => {
+                self.plant.to_mut().release_input(input, op);
+                self.st.waveforms[input] = Waveform::Constant(x[op]);
+            }
+            (None, Some((k, p))) => match var(p) {
+                Some(op) => {
+                    self.sampled[*k].push((input, op));
+                    self.st.waveforms[input] = Waveform::Constant(x[op]);
+                }
+                None => self.st.waveforms[input] = Waveform::Constant(fault.before),
+            },
+            (None, None) => self.st.waveforms[input] = Waveform::Constant(fault.before),
         }
     }
 

@@ -23,7 +23,7 @@ use std::time::Instant;
 
 use plantwide_flowsheet::Plant;
 use plantwide_flowsheet::overrides::set_input;
-use plantwide_flowsheet::scenario::{Event, EventSpec, Scenario, ScenarioSpec, resolve};
+use plantwide_flowsheet::scenario::{Event, EventSpec, Scenario, ScenarioSpec, resolve_continuing};
 use plantwide_flowsheet::{Diagnostic, LoadError};
 use plantwide_model::controllers::Mode;
 use plantwide_units::QuantityValue;
@@ -245,7 +245,7 @@ impl Live {
             record: Default::default(),
             snapshots: Vec::new(),
         };
-        match resolve(&spec, &plant, "command") {
+        match resolve_continuing(&spec, &plant, "command", self.driver.ongoing()) {
             Ok(sc) => Ok(sc.events),
             Err(LoadError::Invalid { diagnostics, .. }) => Err(LiveError::Refused(message(&diagnostics))),
             Err(e) => Err(LiveError::Refused(e.to_string())),
@@ -402,7 +402,11 @@ fn at_time(mut e: EventSpec, t: f64) -> EventSpec {
         | EventSpec::Sinusoid { at: a, .. }
         | EventSpec::Mode { at: a, .. }
         | EventSpec::ValveStuck { at: a, .. }
-        | EventSpec::FeedLost { at: a, .. } => *a = at,
+        | EventSpec::ValveRepaired { at: a, .. }
+        | EventSpec::FeedLost { at: a, .. }
+        | EventSpec::FeedRestored { at: a, .. }
+        | EventSpec::AnalyzerFrozen { at: a, .. }
+        | EventSpec::AnalyzerRepaired { at: a, .. } => *a = at,
     }
     e
 }
@@ -502,7 +506,7 @@ impl Clock {
 mod tests {
     use std::time::Duration;
 
-    use plantwide_flowsheet::scenario::parse_scenario;
+    use plantwide_flowsheet::scenario::{parse_scenario, resolve};
 
     use super::*;
 

@@ -22,8 +22,14 @@ pub struct DriverState {
     pub waveforms: Vec<Waveform>,
     /// Values to return to after a pulse or sinusoid.
     pub saved: Vec<Option<f64>>,
-    /// Paths of inputs frozen by `valve_stuck` events.
+    /// Paths of inputs frozen by `valve_stuck` or `feed_lost` events.
     pub stuck: Vec<String>,
+    /// What undoes each fault still in force (a repair), in the order of `stuck`.
+    #[serde(default)]
+    pub faults: Vec<Fault>,
+    /// Per analyzer: frozen (no new samples) by an `analyzer_frozen` event.
+    #[serde(default)]
+    pub frozen: Vec<bool>,
     /// Index of the next scenario event.
     pub next_event: usize,
     /// Next scan number of each sampled controller (time = k · scan).
@@ -46,6 +52,8 @@ impl DriverState {
             waveforms: plant.inputs().iter().map(|i| Waveform::Constant(i.value)).collect(),
             saved: vec![None; plant.inputs().len()],
             stuck: Vec::new(),
+            faults: Vec::new(),
+            frozen: vec![false; sc.analyzers.len()],
             next_event: 0,
             next_scan: vec![1; sc.sampling.len()],
             next_sample: vec![0; sc.analyzers.len()],
@@ -54,6 +62,22 @@ impl DriverState {
             snapshots_done: vec![false; sc.snapshots.len()],
         }
     }
+}
+
+/// A fault in force on an input and what its repair gives the input back to: the controller
+/// output that drove it (by path, so that a snapshot resumed on a changed plant still finds it),
+/// the sampled controller whose scans held it, or else its value before the fault.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Fault {
+    /// The input's path.
+    pub path: String,
+    /// Its value just before the fault (SI).
+    pub before: f64,
+    /// The controller output variable that drove it, if one did.
+    pub driven_by: Option<String>,
+    /// The sampled controller (index in the scenario's `sampling`) and output variable whose
+    /// scans held it, if any.
+    pub scanned_by: Option<(usize, String)>,
 }
 
 /// Everything needed to continue a run (serialize it with serde).
@@ -142,5 +166,6 @@ pub(super) fn resume(
         return Err(bad("the scenario's sampled controllers or analyzers differ from the snapshot's".into()));
     }
     driver.snapshots_done.resize(sc.snapshots.len(), true);
+    driver.frozen.resize(sc.analyzers.len(), false);
     Ok(Resumed { driver, integrator: same.then(|| s.integrator.clone()) })
 }
