@@ -8,7 +8,7 @@ use plantwide::thermo::ThermoPackage;
 
 use super::doc::{J, obj, q, round_sig};
 use super::rng::Rng;
-use super::shortcut::{Split, gilliland, kirkbride, reachable_split, underwood};
+use super::shortcut::{PUREST, Split, gilliland, kirkbride, reachable_split, underwood};
 use super::thermo;
 
 /// Uniform in `[lo, hi)`.
@@ -32,7 +32,8 @@ pub const DUTY: &[&str] = &["MW", "kW", "Btu/h"];
 /// A level loop's gain written as a flow per amount (`"0.5 kmol/min/kmol"`) for `per_s` [1/s].
 pub fn per_time(rng: &mut Rng, per_s: f64) -> J {
     let (f, a) = (*rng.pick(FLOW), *rng.pick(AMOUNT));
-    let factor = plantwide::units::convert_from_si(1.0, f).unwrap() / plantwide::units::convert_from_si(1.0, a).unwrap();
+    let factor =
+        plantwide::units::convert_from_si(1.0, f).unwrap() / plantwide::units::convert_from_si(1.0, a).unwrap();
     J::S(format!("{} {f}/{a}", round_sig(per_s * factor, 4)))
 }
 
@@ -119,26 +120,22 @@ impl Column {
     }
 }
 
-/// Design the column of `r`, its level loops named `names`.
+/// Design the column of `r`, its level loops named `names`. A column whose stages would reach
+/// beyond [`PUREST`] at its reflux gets the stages that purity needs (at least 10): an engineer
+/// does not build 50 trays for what 20 do, and a column run at its design flows with twice the
+/// stages it needs makes parts per billion.
 pub fn design(rng: &mut Rng, r: &Request<'_>, names: [&str; 2]) -> Column {
     let m = log_uniform(rng, r.m.0, r.m.1);
-    let n = r.stages.0 + rng.below(r.stages.1 - r.stages.0 + 1);
+    let mut n = r.stages.0 + rng.below(r.stages.1 - r.stages.0 + 1);
     let skew = log_uniform(rng, 0.3, 3.0);
     let dp = if r.model == Model::Rigorous { uniform(rng, 400.0, 900.0) } else { 0.0 };
-    let p_bottom = r.p_top + (n - 1) as f64 * dp;
-    let volatility = |s: Option<Split>| match (r.pkg, s) {
-        (None, _) => r.alpha,
-        (Some(p), None) => thermo::alpha(p, 0.5 * (r.p_top + p_bottom), &[r.zf, 1.0 - r.zf]),
-        (Some(p), Some(s)) => {
-            (thermo::alpha(p, r.p_top, &[s.xd, 1.0 - s.xd]) * thermo::alpha(p, p_bottom, &[s.xb, 1.0 - s.xb])).sqrt()
-        }
-    };
-    let mut alpha = volatility(None);
-    let mut split = r.split.unwrap_or_else(|| reachable_split(alpha, r.zf, r.q, m, (n - 1) as f64, skew, 0.8));
-    if r.pkg.is_some() {
-        alpha = volatility(Some(split));
-        split = r.split.unwrap_or_else(|| reachable_split(alpha, r.zf, r.q, m, (n - 1) as f64, skew, 0.8));
+    let (mut alpha, mut split) = volatility_and_split(r, m, n, skew, dp);
+    if r.split.is_none() && 1.0 - split.xd <= PUREST * (1.0 + 1e-9) {
+        let needed = ((stages_for(alpha, r.zf, r.q, m, split) - 1.0) / 0.8).ceil() as usize + 1;
+        n = needed.clamp(10, n);
+        (alpha, split) = volatility_and_split(r, m, n, skew, dp);
     }
+    let p_bottom = r.p_top + (n - 1) as f64 * dp;
     let d = r.f * (r.zf - split.xb) / (split.xd - split.xb);
     let b = r.f - d;
     let l = m * underwood(alpha, r.zf, r.q, split.xd) * d;
@@ -168,6 +165,28 @@ pub fn design(rng: &mut Rng, r: &Request<'_>, names: [&str; 2]) -> Column {
     c.unit = unit_description(rng, r, &c, drum, sump, dp);
     c.levels = level_loops(rng, &c, drum, sump, names);
     c
+}
+
+/// The design volatility and the split `n` stages reach at `m` R_min (a library pair's volatility
+/// at the top and bottom of the split, estimated at the feed first).
+fn volatility_and_split(r: &Request<'_>, m: f64, n: usize, skew: f64, dp: f64) -> (f64, Split) {
+    let p_bottom = r.p_top + (n - 1) as f64 * dp;
+    let volatility = |s: Option<Split>| match (r.pkg, s) {
+        (None, _) => r.alpha,
+        (Some(p), None) => thermo::alpha(p, 0.5 * (r.p_top + p_bottom), &[r.zf, 1.0 - r.zf]),
+        (Some(p), Some(s)) => {
+            (thermo::alpha(p, r.p_top, &[s.xd, 1.0 - s.xd]) * thermo::alpha(p, p_bottom, &[s.xb, 1.0 - s.xb])).sqrt()
+        }
+    };
+    let reach = |alpha: f64| r.split.unwrap_or_else(|| reachable_split(alpha, r.zf, r.q, m, (n - 1) as f64, skew, 0.8));
+    let alpha = volatility(None);
+    match r.pkg {
+        Some(_) => {
+            let alpha = volatility(Some(reach(alpha)));
+            (alpha, reach(alpha))
+        }
+        None => (alpha, reach(alpha)),
+    }
 }
 
 /// `"units": {"<name>": …}` of the column.
@@ -268,13 +287,17 @@ pub fn quality_loops(
     let tau_i = uniform(rng, 1.0, 3.0) * (holdup / feed).max(600.0);
     let (xd, flow) = (value(&top_pv), *rng.pick(FLOW));
     let delta_d = round_sig(1.0 - xd, 3).max(1e-9);
+    // The gains move the input 1–4 % for an error the size of the impurity, but no faster than
+    // for an impurity of 0.1 %: a user does not type 2e7 mol/s per mole fraction (the engine
+    // refuses a `kc` beyond 1e6 mol/s).
+    let span = |x: f64| x.max(1e-3);
     let l = value(&format!("{}.reflux", c.name));
     let top = obj([
         ("type", "pid".into()),
         ("pv", top_pv.into()),
         ("output", format!("{}.reflux", c.name).into()),
         ("sp", J::N(round_sig(1.0 - delta_d, 12))),
-        ("kc", q(uniform(rng, 0.01, 0.04) * l / delta_d, flow, 3)),
+        ("kc", q(uniform(rng, 0.01, 0.04) * l / span(delta_d), flow, 3)),
         ("tau_i", q(tau_i, *rng.pick(TIME), 3)),
         ("action", "reverse".into()),
         ("op_min", q(0.0, flow, 3)),
@@ -288,13 +311,14 @@ pub fn quality_loops(
     let (pv, sp, kc, action) = match bottom {
         BottomLoop::Composition => {
             let xb = round_sig(value(&bottom_pv), 3).max(1e-9);
-            (bottom_pv, J::N(xb), q(uniform(rng, 0.01, 0.04) * u0 / xb, unit, 3), "direct")
+            (bottom_pv, J::N(xb), q(uniform(rng, 0.01, 0.04) * u0 / span(xb), unit, 3), "direct")
         }
         BottomLoop::Temperature(k) => {
             let span = value(&format!("{}.T[1]", c.name)) - value(&format!("{}.T[{}]", c.name, c.stages));
             let t = value(&format!("{}.T[{k}]", c.name));
             let per_k = uniform(rng, 0.5, 2.0) * u0 / span.max(1.0);
-            let kc = J::S(format!("{} {unit}/K", round_sig(plantwide::units::convert_from_si(per_k, unit).unwrap(), 3)));
+            let kc =
+                J::S(format!("{} {unit}/K", round_sig(plantwide::units::convert_from_si(per_k, unit).unwrap(), 3)));
             (format!("{}.T[{k}]", c.name), q(t, *rng.pick(TEMPERATURE), 7), kc, "reverse")
         }
     };

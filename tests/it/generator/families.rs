@@ -162,10 +162,13 @@ fn close(rng: &mut Rng, seed: u64, family: Family, mut d: Draft) -> Result<Case,
         closed.set(&["controllers", &name], ctrl);
     }
     let light = d.roles.light.clone();
-    d.roles.cvs = [format!("{}.x[{light}]", products[0]), match bottom {
-        BottomLoop::Composition => format!("{}.x[{light}]", products[1]),
-        BottomLoop::Temperature(k) => format!("{}.T[{k}]", c.name),
-    }];
+    d.roles.cvs = [
+        format!("{}.x[{light}]", products[0]),
+        match bottom {
+            BottomLoop::Composition => format!("{}.x[{light}]", products[1]),
+            BottomLoop::Temperature(k) => format!("{}.T[{k}]", c.name),
+        },
+    ];
     d.roles.mvs = [format!("{}.reflux", c.name), c.heat_input()];
     d.roles.quality = d.quality.map(String::from);
     d.roles.edits.extend(quality_edits(rng, &closed, &d.roles, &value));
@@ -200,7 +203,10 @@ fn quality_edits(rng: &mut Rng, closed: &J, roles: &Roles, value: &dyn Fn(&str) 
 
 /// An edit of a unit's field given as a quantity.
 fn unit_edit(unit: &str, field: &str, text: String) -> Edit {
-    Edit { set: format!("{unit}.{field}={text}"), file: vec![(vec!["units".into(), unit.into(), field.into()], J::S(text))] }
+    Edit {
+        set: format!("{unit}.{field}={text}"),
+        file: vec![(vec!["units".into(), unit.into(), field.into()], J::S(text))],
+    }
 }
 
 /// The throughput edits of a binary feed: its flow in another unit, its light fraction moved.
@@ -286,7 +292,11 @@ fn hypothetical(rng: &mut Rng, names: [&str; 2], alpha: f64) -> (J, f64) {
 
 fn names(rng: &mut Rng) -> ([&'static str; 2], [&'static str; 2], [&'static str; 2]) {
     match rng.below(3) {
-        0 => (["condenser_level", "reboiler_level"], ["top_composition", "bottom_composition"], ["distillate", "bottoms"]),
+        0 => (
+            ["condenser_level", "reboiler_level"],
+            ["top_composition", "bottom_composition"],
+            ["distillate", "bottoms"],
+        ),
         1 => (["drum_level", "sump_level"], ["xd_control", "xb_control"], ["top", "bottom"]),
         _ => (["LC101", "LC102"], ["AC101", "AC102"], ["D", "B"]),
     }
@@ -298,7 +308,13 @@ fn simple_column(rng: &mut Rng) -> Draft {
     let alpha_min = (5.889 / (0.6 * (n - 1) as f64)).exp().max(1.3);
     let alpha = round_sig(log_uniform(rng, alpha_min, (1.6 * alpha_min).max(4.0)), 3);
     let light = *rng.pick(&["light", "A", "lk"]);
-    let heavy = if light == "lk" { "hk" } else if light == "A" { "B" } else { "heavy" };
+    let heavy = if light == "lk" {
+        "hk"
+    } else if light == "A" {
+        "B"
+    } else {
+        "heavy"
+    };
     let (components, mw) = hypothetical(rng, [light, heavy], alpha);
     let f = log_uniform(rng, 10.0, 500.0) / 3.6;
     let zf = round_sig(uniform(rng, 0.2, 0.8), 2);
@@ -391,7 +407,8 @@ fn rigorous_column(rng: &mut Rng) -> Draft {
     let feed = "feed_source";
     let p_feed = bin.p_top + col.stages as f64 * 900.0 + uniform(rng, 10e3, 40e3);
     let (f_text, f_si) = quantity(f, *rng.pick(column::FLOW), 5);
-    let mut doc = skeleton(format!("generated {light}/{heavy} column"), col.about(), bin.components.clone(), bin.pair.vle);
+    let mut doc =
+        skeleton(format!("generated {light}/{heavy} column"), col.about(), bin.components.clone(), bin.pair.vle);
     let feed_unit = obj([
         ("type", "feed".into()),
         ("F", f_text.into()),
@@ -401,14 +418,16 @@ fn rigorous_column(rng: &mut Rng) -> Draft {
     ]);
     doc.set(&["units", feed], feed_unit);
     let mw = bin.pkg.components.iter().map(|c| (c.name.clone(), c.mw)).collect();
-    let mut roles = Roles { throughput: format!("{feed}.F"), throughput_si: f_si, light: light.into(), mw, ..Roles::default() };
+    let mut roles =
+        Roles { throughput: format!("{feed}.F"), throughput_si: f_si, light: light.into(), mw, ..Roles::default() };
     let sinks = ["top_product", "bottom_product"];
     add_column(&mut doc, &mut roles, &Layout { feed_stream: "feed", feed_from: feed, column: &col, products, sinks });
     roles.vessels = vec!["column.sump".into(), products[1].to_string()];
     roles.edits = feed_edits(rng, feed, f, Some((light, heavy, zf)));
     let sump = plantwide::units::convert_from_si(60.0 * 5.0 * (col.v + col.b), "kmol").unwrap();
     roles.edits.push(unit_edit("column", "reboiler_holdup", format!("{} kmol", round_sig(sump, 3))));
-    let about = format!("rigorous {light}/{heavy} ({}): F {f_si:.4} mol/s, zF {zf}, P {:.0} Pa", bin.pair.vle, bin.p_top);
+    let about =
+        format!("rigorous {light}/{heavy} ({}): F {f_si:.4} mol/s, zF {zf}, P {:.0} Pa", bin.pair.vle, bin.p_top);
     Draft { doc, column: col, temperature_loop: rng.chance(0.4), quality, roles, about }
 }
 
@@ -469,8 +488,12 @@ fn train(rng: &mut Rng) -> Draft {
         split: None,
     };
     let col = column::design(rng, &r, levels);
-    let mut doc =
-        skeleton(format!("generated {light}/{heavy} flash-tank-column train"), col.about(), bin.components.clone(), bin.pair.vle);
+    let mut doc = skeleton(
+        format!("generated {light}/{heavy} flash-tank-column train"),
+        col.about(),
+        bin.components.clone(),
+        bin.pair.vle,
+    );
     let (f_text, f_si) = quantity(f, *rng.pick(column::FLOW), 5);
     let temp = *rng.pick(column::TEMPERATURE);
     let feed = obj([
@@ -489,7 +512,13 @@ fn train(rng: &mut Rng) -> Draft {
     let vessel = |rng: &mut Rng, kind: &str, p: f64, d: f64, h: f64| {
         let pressure = q(p, *rng.pick(column::PRESSURE), 4);
         let out = outflow();
-        obj([("type", kind.into()), ("P", pressure), ("diameter", q(d, "m", 2)), ("height", q(h, "m", 2)), ("outflow", out)])
+        obj([
+            ("type", kind.into()),
+            ("P", pressure),
+            ("diameter", q(d, "m", 2)),
+            ("height", q(h, "m", 2)),
+            ("outflow", out),
+        ])
     };
     doc.set(&["units", "feed_source"], feed);
     doc.set(&["units", "preheater"], obj([("type", "heater".into()), ("T_out", q(t_out, temp, 6))]));
@@ -516,7 +545,11 @@ fn train(rng: &mut Rng) -> Draft {
         roles.streams.push((name.into(), unit(from), unit(to)));
     }
     let sinks = ["top_product", "bottom_product"];
-    add_column(&mut doc, &mut roles, &Layout { feed_stream: "column_feed", feed_from: "surge", column: &col, products, sinks });
+    add_column(
+        &mut doc,
+        &mut roles,
+        &Layout { feed_stream: "column_feed", feed_from: "surge", column: &col, products, sinks },
+    );
     let flash_level = vessel_level(rng, "flash", flash_h, liquid, true);
     doc.set(&["controllers", "flash_level"], flash_level);
     let pi = rng.chance(0.3);
@@ -526,8 +559,14 @@ fn train(rng: &mut Rng) -> Draft {
     roles.edits = feed_edits(rng, "feed_source", f, Some((light, heavy, zf)));
     let t_new = t_bub + uniform(rng, 0.05, 0.3) * (t_dew - t_bub);
     roles.edits.push(unit_edit("preheater", "T_out", quantity(t_new, *rng.pick(column::TEMPERATURE), 5).0));
-    roles.edits.push(unit_edit("flash", "P", quantity(p_flash * uniform(rng, 0.95, 1.05), *rng.pick(column::PRESSURE), 4).0));
-    let about = format!("train {light}/{heavy}: F {f_si:.4} mol/s, zF {zf}, flash {t_out:.2} K / {p_flash:.0} Pa, vapour {beta:.3}");
+    roles.edits.push(unit_edit(
+        "flash",
+        "P",
+        quantity(p_flash * uniform(rng, 0.95, 1.05), *rng.pick(column::PRESSURE), 4).0,
+    ));
+    let about = format!(
+        "train {light}/{heavy}: F {f_si:.4} mol/s, zF {zf}, flash {t_out:.2} K / {p_flash:.0} Pa, vapour {beta:.3}"
+    );
     Draft { doc, column: col, temperature_loop: rng.chance(0.3), quality, roles, about }
 }
 
@@ -565,7 +604,12 @@ fn recycle(rng: &mut Rng) -> Draft {
     let k = f0 * (1.0 - split.xb) / (z * holdup);
     let structure = if rng.chance(0.6) { 1 } else { 2 };
     let flow = *rng.pick(column::FLOW);
-    let mut doc = skeleton(format!("generated reactor-column recycle, structure {structure}"), col.about(), components, "constant_alpha");
+    let mut doc = skeleton(
+        format!("generated reactor-column recycle, structure {structure}"),
+        col.about(),
+        components,
+        "constant_alpha",
+    );
     let (f0_text, f0_si) = quantity(f0, flow, 5);
     let fresh = obj([
         ("type", "feed".into()),
@@ -581,7 +625,10 @@ fn recycle(rng: &mut Rng) -> Draft {
         ("height", format!("{height} m").into()),
         ("level", format!("{} m", 0.5 * height).into()),
         ("outflow", obj([("type", "flow".into()), ("flow", effluent_text.into())])),
-        ("reactions", J::A(vec![obj([("stoichiometry", obj([("A", J::N(-1.0)), ("B", J::N(1.0))])), ("k0", q(k, "1/h", 7))])])),
+        (
+            "reactions",
+            J::A(vec![obj([("stoichiometry", obj([("A", J::N(-1.0)), ("B", J::N(1.0))])), ("k0", q(k, "1/h", 7))])]),
+        ),
     ]);
     doc.set(&["units", "fresh"], fresh);
     doc.set(&["units", "mixer"], obj([("type", "mixer".into()), ("inlets", J::I(2))]));
@@ -593,7 +640,17 @@ fn recycle(rng: &mut Rng) -> Draft {
         roles.streams.push((name.into(), from.into(), to.split('.').next().unwrap_or(to).into()));
     }
     let products = ["recycle", "bottoms"];
-    add_column(&mut doc, &mut roles, &Layout { feed_stream: "effluent", feed_from: "reactor", column: &col, products, sinks: ["mixer.in2", "product"] });
+    add_column(
+        &mut doc,
+        &mut roles,
+        &Layout {
+            feed_stream: "effluent",
+            feed_from: "reactor",
+            column: &col,
+            products,
+            sinks: ["mixer.in2", "product"],
+        },
+    );
     if rng.chance(0.7) {
         doc.set(&["streams", "recycle", "tear"], J::B(true));
     }
@@ -614,14 +671,17 @@ fn recycle(rng: &mut Rng) -> Draft {
         1 => ("fresh.F".into(), f0_si),
         _ => ("reactor.outflow".into(), effluent_si),
     };
-    roles.vessels = if structure == 1 { vec!["reactor".into(), "column.sump".into()] } else { vec!["column.sump".into()] };
+    roles.vessels =
+        if structure == 1 { vec!["reactor".into(), "column.sump".into()] } else { vec!["column.sump".into()] };
     let (unit, field, base) = if structure == 1 { ("fresh", "F", f0) } else { ("reactor", "outflow", f0 + d) };
     roles.edits = vec![Edit {
         set: format!("{unit}.{field}={}", quantity(base * uniform(rng, 0.9, 1.1), *rng.pick(column::FLOW), 5).0),
         file: vec![],
     }];
     fix_outflow_edit(&mut roles.edits[0], unit, field);
-    let about = format!("recycle structure {structure}: F0 {f0_si:.4} mol/s, z {z}, k {k:.4e} 1/s, reactor {area} m2 x {height} m");
+    let about = format!(
+        "recycle structure {structure}: F0 {f0_si:.4} mol/s, z {z}, k {k:.4e} 1/s, reactor {area} m2 x {height} m"
+    );
     Draft { doc, column: col, temperature_loop: false, quality, roles, about }
 }
 

@@ -15,13 +15,23 @@ const PROMISED: &[&str] = &["gain/*/*", "rga/*/*", "singular_values/*", "conditi
 fn signals(cx: &Cx<'_>) -> (Vec<String>, Vec<String>) {
     let r = &cx.case.roles;
     let inputs = vec![r.mvs[0].clone(), r.mvs[1].clone(), r.throughput.clone()];
-    let outputs =
-        vec![format!("{}.x[{}]", r.products[0], r.light), format!("{}.x[{}]", r.products[1], r.light), format!("{}.F", r.products[1])];
+    let outputs = vec![
+        format!("{}.x[{}]", r.products[0], r.light),
+        format!("{}.x[{}]", r.products[1], r.light),
+        format!("{}.F", r.products[1]),
+    ];
     (inputs, outputs)
 }
 
 fn gains(cx: &mut Cx<'_>, inputs: &[String], outputs: &[String], extra: &[&str]) -> (Output, Option<Value>) {
-    let mut args = vec!["gains".to_string(), "open.json".into(), "--inputs".into(), inputs.join(","), "--outputs".into(), outputs.join(",")];
+    let mut args = vec![
+        "gains".to_string(),
+        "open.json".into(),
+        "--inputs".into(),
+        inputs.join(","),
+        "--outputs".into(),
+        outputs.join(","),
+    ];
     args.extend(extra.iter().map(|s| s.to_string()));
     args.push("--json".into());
     let out = cx.pw(&args);
@@ -39,7 +49,8 @@ pub fn gains_relations(cx: &mut Cx<'_>, perturb: bool) -> Option<Vec<Vec<f64>>> 
     cx.agree(rga_rows_sum_to_one(&rga), "gains: RGA rows do not sum to 1", &[&base]);
     // The same signals listed in another order: G and the RGA permuted, the rest unchanged.
     let sigma = [2usize, 0, 1];
-    let (pi, po): (Vec<String>, Vec<String>) = (sigma.iter().map(|&k| inputs[k].clone()).collect(), sigma.iter().map(|&k| outputs[k].clone()).collect());
+    let (pi, po): (Vec<String>, Vec<String>) =
+        (sigma.iter().map(|&k| inputs[k].clone()).collect(), sigma.iter().map(|&k| outputs[k].clone()).collect());
     let (out, w) = gains(cx, &pi, &po, &[]);
     if let Some(w) = w {
         let class = "gains: permuting inputs and outputs does not permute G and the RGA";
@@ -49,7 +60,9 @@ pub fn gains_relations(cx: &mut Cx<'_>, perturb: bool) -> Option<Vec<Vec<f64>>> 
         cx.agree(pr, class, &[&base, &out]);
         for key in ["condition_number", "niederlinski"] {
             let (a, b) = (v[key].as_f64().unwrap_or(f64::NAN), w[key].as_f64().unwrap_or(f64::NAN));
-            cx.check(super::relations::near(a, b, 1e-7, 0.0), class, &[&base, &out], || format!("{key}: {a:e} against {b:e}"));
+            cx.check(super::relations::near(a, b, 1e-7, 0.0), class, &[&base, &out], || {
+                format!("{key}: {a:e} against {b:e}")
+            });
         }
     }
     if perturb {
@@ -65,7 +78,15 @@ pub fn gains_relations(cx: &mut Cx<'_>, perturb: bool) -> Option<Vec<Vec<f64>>> 
 /// `identify`'s exact model is `gains`'s, and a short test's gains have the exact ones' signs.
 pub fn identify(cx: &mut Cx<'_>, g: &[Vec<f64>]) {
     let (inputs, outputs) = signals(cx);
-    let out = cx.pw(&["identify", "open.json", "--inputs", &inputs[..2].join(","), "--outputs", &outputs[..2].join(","), "--json"]);
+    let out = cx.pw(&[
+        "identify",
+        "open.json",
+        "--inputs",
+        &inputs[..2].join(","),
+        "--outputs",
+        &outputs[..2].join(","),
+        "--json",
+    ]);
     let Some(v) = cx.succeeded(&out, "identify", true, &["gain/*/*", "rga/*/*", "exact/gain/*/*"]) else { return };
     let exact = matrix(&v["exact"]["gain"]).unwrap_or_default();
     let g2: Vec<Vec<f64>> = g[..2].iter().map(|r| r[..2].to_vec()).collect();
@@ -75,11 +96,14 @@ pub fn identify(cx: &mut Cx<'_>, g: &[Vec<f64>]) {
         .flat_map(|i| (0..2).map(move |j| (i, j)))
         .filter(|&(i, j)| {
             let scale = exact[i].iter().fold(0.0f64, |m, x| m.max(x.abs()));
-            exact[i][j].abs() >= 0.1 * scale && found.get(i).and_then(|r| r.get(j)).is_none_or(|f| f * exact[i][j] <= 0.0)
+            exact[i][j].abs() >= 0.1 * scale
+                && found.get(i).and_then(|r| r.get(j)).is_none_or(|f| f * exact[i][j] <= 0.0)
         })
         .map(|(i, j)| format!("G[{i}][{j}] identified {:e}, exact {:e}", found[i][j], exact[i][j]))
         .collect();
-    cx.check(wrong.is_empty(), "identify: exit 0 with identified gains of the wrong sign", &[&out], || wrong.join("; "));
+    cx.check(wrong.is_empty(), "identify: exit 0 with identified gains of the wrong sign", &[&out], || {
+        wrong.join("; ")
+    });
 }
 
 /// `screen --column`: every configuration converged or reported, the LV gains are `gains`'s.
@@ -100,6 +124,9 @@ pub fn screen_column(cx: &mut Cx<'_>, g: &[Vec<f64>]) {
     let mut ranks: Vec<u64> = list.iter().filter_map(|s| s["rank"].as_u64()).collect();
     ranks.sort_unstable();
     let unranked = list.iter().filter(|s| s["rank"].is_null() && !s["singular"].as_bool().unwrap_or(false)).count();
-    let fine = ranks.iter().enumerate().all(|(i, &r)| r == i as u64 + 1) && (unranked == 0 || !v["failed"].as_array().is_none_or(Vec::is_empty));
-    cx.check(fine, "screen --column: ranks are not 1..n over the converged configurations", &[&out], || format!("ranks {ranks:?}, {unranked} unranked"));
+    let fine = ranks.iter().enumerate().all(|(i, &r)| r == i as u64 + 1)
+        && (unranked == 0 || !v["failed"].as_array().is_none_or(Vec::is_empty));
+    cx.check(fine, "screen --column: ranks are not 1..n over the converged configurations", &[&out], || {
+        format!("ranks {ranks:?}, {unranked} unranked")
+    });
 }

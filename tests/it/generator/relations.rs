@@ -13,7 +13,9 @@ pub fn matches<'v>(v: &'v Value, pattern: &str) -> Vec<(String, &'v Value)> {
                 (Value::Object(m), "*") => m.iter().map(|(k, c)| (k.clone(), c)).collect(),
                 (Value::Array(a), "*") => a.iter().enumerate().map(|(i, c)| (i.to_string(), c)).collect(),
                 (Value::Object(m), k) => m.get(k).map(|c| (k.to_string(), c)).into_iter().collect(),
-                (Value::Array(a), k) => k.parse::<usize>().ok().and_then(|i| a.get(i)).map(|c| (k.to_string(), c)).into_iter().collect(),
+                (Value::Array(a), k) => {
+                    k.parse::<usize>().ok().and_then(|i| a.get(i)).map(|c| (k.to_string(), c)).into_iter().collect()
+                }
                 _ => Vec::new(),
             };
             next.extend(children.into_iter().map(|(k, c)| (format!("{path}/{k}"), c)));
@@ -70,7 +72,9 @@ pub fn honest(v: &Value, code: Option<i32>, promised: &[&str]) -> Result<(), Str
             }
             Ok(())
         }
-        Some(2) if listed.is_empty() => Err("exit 2 with a report whose parts all succeeded (no `failed`, no `failure`)".into()),
+        Some(2) if listed.is_empty() => {
+            Err("exit 2 with a report whose parts all succeeded (no `failed`, no `failure`)".into())
+        }
         _ => Ok(()),
     }
 }
@@ -100,7 +104,10 @@ pub fn same_values(a: &Map<String, Value>, b: &Map<String, Value>, rel: f64, abs
     }
     match worst {
         None => Ok(()),
-        Some((_, k, x, y)) => Err(format!("`{k}`: {x:e} against {y:e} (relative difference {:.2e})", (x - y).abs() / x.abs().max(y.abs()))),
+        Some((_, k, x, y)) => Err(format!(
+            "`{k}`: {x:e} against {y:e} (relative difference {:.2e})",
+            (x - y).abs() / x.abs().max(y.abs())
+        )),
     }
 }
 
@@ -115,7 +122,13 @@ pub fn matrix(v: &Value) -> Option<Vec<Vec<f64>>> {
 /// `b[i][j] = a[rows[i]][cols[j]]` to `rel` of the largest entry of the row in `a`.
 pub fn permuted(a: &[Vec<f64>], b: &[Vec<f64>], rows: &[usize], cols: &[usize], rel: f64) -> Result<(), String> {
     if b.len() != rows.len() || b.iter().any(|r| r.len() != cols.len()) {
-        return Err(format!("shape {}×{} against {}×{}", b.len(), b.first().map_or(0, Vec::len), rows.len(), cols.len()));
+        return Err(format!(
+            "shape {}×{} against {}×{}",
+            b.len(),
+            b.first().map_or(0, Vec::len),
+            rows.len(),
+            cols.len()
+        ));
     }
     for (i, &r) in rows.iter().enumerate() {
         let scale = a[r].iter().fold(0.0f64, |m, x| m.max(x.abs()));
@@ -171,9 +184,11 @@ pub fn first_difference(a: &Value, b: &Value, rel: f64, ignore: &[&str], path: &
                 _ => Some(format!("{path}/{k} is in one only")),
             })
         }
-        (Value::Array(x), Value::Array(y)) if x.len() == y.len() => {
-            x.iter().zip(y).enumerate().find_map(|(i, (p, q))| first_difference(p, q, rel, ignore, &format!("{path}/{i}")))
-        }
+        (Value::Array(x), Value::Array(y)) if x.len() == y.len() => x
+            .iter()
+            .zip(y)
+            .enumerate()
+            .find_map(|(i, (p, q))| first_difference(p, q, rel, ignore, &format!("{path}/{i}"))),
         (Value::Number(p), Value::Number(q)) => {
             let (p, q) = (p.as_f64().unwrap_or(f64::NAN), q.as_f64().unwrap_or(f64::NAN));
             (!near(p, q, rel, 1e-300)).then(|| format!("{path}: {p:e} against {q:e}"))
@@ -186,7 +201,11 @@ pub fn first_difference(a: &Value, b: &Value, rel: f64, ignore: &[&str], path: &
 fn candidate_key(s: &Value) -> String {
     let mut pairs: Vec<String> = s["pairs"]
         .as_array()
-        .map(|a| a.iter().map(|p| format!("{}<-{}", p["cv"].as_str().unwrap_or("?"), p["mv"].as_str().unwrap_or("?"))).collect())
+        .map(|a| {
+            a.iter()
+                .map(|p| format!("{}<-{}", p["cv"].as_str().unwrap_or("?"), p["mv"].as_str().unwrap_or("?")))
+                .collect()
+        })
         .unwrap_or_default();
     pairs.sort();
     format!("{} [{}]", s["throughput"].as_str().unwrap_or("-"), pairs.join(", "))
@@ -212,7 +231,11 @@ pub fn same_pairings(a: &Value, b: &Value) -> Result<(), String> {
     };
     let (ta, tb) = (table(a), table(b));
     if ta.keys().ne(tb.keys()) {
-        return Err(format!("candidates {:?} against {:?}", ta.keys().collect::<Vec<_>>(), tb.keys().collect::<Vec<_>>()));
+        return Err(format!(
+            "candidates {:?} against {:?}",
+            ta.keys().collect::<Vec<_>>(),
+            tb.keys().collect::<Vec<_>>()
+        ));
     }
     for (k, x) in &ta {
         if let Some(d) = first_difference(x, &tb[k], 1e-6, &[], k) {
@@ -234,14 +257,19 @@ pub fn ranking_follows_evidence(v: &Value) -> Result<(), String> {
             && d["runs"].as_array().is_some_and(|r| r.iter().all(|r| r["failure"].is_null()))
     };
     let tested: Vec<&Value> = list.iter().filter(|s| completed(s)).collect();
-    let Some(best) = tested.iter().min_by(|a, b| a["dynamic"]["score"].as_f64().unwrap().total_cmp(&b["dynamic"]["score"].as_f64().unwrap())) else {
+    let Some(best) = tested
+        .iter()
+        .min_by(|a, b| a["dynamic"]["score"].as_f64().unwrap().total_cmp(&b["dynamic"]["score"].as_f64().unwrap()))
+    else {
         return Ok(());
     };
     let first = list.iter().find(|s| s["rank"].as_u64() == Some(1));
     let verdict = v["verdict"].as_str().unwrap_or("");
     let says = verdict.contains("disagree") || verdict.contains("does not");
     match first {
-        Some(f) if std::ptr::eq(f, *best) || (completed(f) && f["dynamic"]["score"] == best["dynamic"]["score"]) => Ok(()),
+        Some(f) if std::ptr::eq(f, *best) || (completed(f) && f["dynamic"]["score"] == best["dynamic"]["score"]) => {
+            Ok(())
+        }
         _ if says => Ok(()),
         Some(f) => Err(format!(
             "rank 1 is {} (score {}), the best dynamic score is {}'s ({}); the verdict: {}",
@@ -261,14 +289,19 @@ pub fn conserved(run: &Value) -> Result<(), String> {
     let (worst, tol) = (c["max_relative_error"].as_f64(), c["tolerance"].as_f64());
     match (worst, tol) {
         (Some(w), Some(t)) if w <= t => Ok(()),
-        (Some(w), Some(t)) => Err(format!("conservation error {w:e} over its tolerance {t:e} ({})", clip(&c["balances"].to_string()))),
+        (Some(w), Some(t)) => {
+            Err(format!("conservation error {w:e} over its tolerance {t:e} ({})", clip(&c["balances"].to_string())))
+        }
         _ => Err(format!("no conservation figures: {}", clip(&c.to_string()))),
     }
 }
 
-/// A step and a very short ramp to the same value end at the same state: each recorded path's
-/// final value agrees to `rel` of its value or of how far it moved.
-pub fn same_end(step: &Value, ramp: &Value, rel: f64) -> Result<(), String> {
+/// A step and a very short ramp to the same value end at the same state. A ramp of `d` seconds
+/// is, to first order, the step delayed by `d/2`, so a path still moving at the end (at `slope`
+/// per second, from the step's record) ends `slope·d/2` behind: each path's final value agrees with
+/// that to `rel` of how far it moved, plus a tenth of the correction (the slope is a backward
+/// difference over one record interval).
+pub fn same_end(step: &Value, ramp: &Value, slopes: &[(String, f64)], d: f64, rel: f64) -> Result<(), String> {
     let (a, b) = (step["paths"].as_array(), ramp["paths"].as_array());
     let (Some(a), Some(b)) = (a, b) else { return Err("no `paths` summary".into()) };
     if a.len() != b.len() {
@@ -277,12 +310,34 @@ pub fn same_end(step: &Value, ramp: &Value, rel: f64) -> Result<(), String> {
     for (p, q) in a.iter().zip(b) {
         let num = |v: &Value, k: &str| v[k].as_f64().unwrap_or(f64::NAN);
         let (x, y, x0) = (num(p, "last"), num(q, "last"), num(p, "initial"));
-        let moved = (x - x0).abs();
-        if !near(x, y, rel * 1e-2, rel * moved + 1e-12) {
-            return Err(format!("{}: the step ends at {x:e}, the ramp at {y:e} (moved {moved:e})", p["path"]));
+        let name = p["path"].as_str().unwrap_or("");
+        let slope = slopes.iter().find(|(n, _)| n == name).map_or(0.0, |s| s.1);
+        let (shift, moved) = (slope * d / 2.0, (x - x0).abs());
+        let expected = x - shift;
+        if !near(expected, y, rel * 1e-2, rel * moved + 0.1 * shift.abs() + 1e-12) {
+            return Err(format!(
+                "{name}: the step ends at {x:e} (moving {slope:e}/s, so a {d} s ramp is expected at {expected:e}), the ramp at {y:e} (moved {moved:e})"
+            ));
         }
     }
     Ok(())
+}
+
+/// The slope [per second] of each column of a run's CSV over its last record interval (the
+/// header's `time [min]` or `time [s]`).
+pub fn end_slopes(csv: &str) -> Vec<(String, f64)> {
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
+    let rows: Vec<Vec<f64>> = lines.map(|l| l.split(',').map(|c| c.parse().unwrap_or(f64::NAN)).collect()).collect();
+    let per_s = if header.first().is_some_and(|h| h.contains("[min]")) { 60.0 } else { 1.0 };
+    let [.., r0, r1] = rows.as_slice() else { return Vec::new() };
+    let dt = (r1[0] - r0[0]) * per_s;
+    header
+        .iter()
+        .enumerate()
+        .skip(1)
+        .map(|(j, h)| (h.split(" [").next().unwrap_or(h).to_string(), (r1[j] - r0[j]) / dt))
+        .collect()
 }
 
 #[cfg(test)]
@@ -334,7 +389,8 @@ mod tests {
         assert!(ranking_follows_evidence(&fine).is_ok());
         let wrong = json!({"structures": [cand("a", 1, 1.4), cand("b", 2, 1.0)], "verdict": "recommended: a"});
         assert!(ranking_follows_evidence(&wrong).is_err());
-        let said = json!({"structures": [cand("a", 1, 1.4), cand("b", 2, 1.0)], "verdict": "…; the evidence disagrees: …"});
+        let said =
+            json!({"structures": [cand("a", 1, 1.4), cand("b", 2, 1.0)], "verdict": "…; the evidence disagrees: …"});
         assert!(ranking_follows_evidence(&said).is_ok());
         assert!(same_pairings(&fine, &fine).is_ok());
         let swapped = json!({"structures": [cand("a", 2, 1.0), cand("b", 1, 1.4)], "verdict": "recommended: b"});
@@ -346,8 +402,13 @@ mod tests {
         assert!(conserved(&json!({"conservation": {"max_relative_error": 1e-12, "tolerance": 1e-9}})).is_ok());
         assert!(conserved(&json!({"conservation": {"max_relative_error": 1e-6, "tolerance": 1e-9}})).is_err());
         let run = |last: f64| json!({"paths": [{"path": "x", "initial": 1.0, "last": last}]});
-        assert!(same_end(&run(2.0), &run(2.0 + 1e-9), 1e-5).is_ok());
-        assert!(same_end(&run(2.0), &run(2.01), 1e-5).is_err());
+        assert!(same_end(&run(2.0), &run(2.0 + 1e-9), &[], 1.0, 1e-5).is_ok());
+        assert!(same_end(&run(2.0), &run(2.01), &[], 1.0, 1e-5).is_err());
+        // Still rising at 1e-3/s: a one-second ramp ends 5e-4 behind the step, not level with it.
+        let slopes = end_slopes("time [min],x [1]\n0,1.5\n1,1.94\n2,2.0\n");
+        assert!((slopes[0].1 - 1e-3).abs() < 1e-12, "{slopes:?}");
+        assert!(same_end(&run(2.0), &run(2.0 - 5e-4), &slopes, 1.0, 1e-5).is_ok());
+        assert!(same_end(&run(2.0), &run(2.0), &slopes, 1.0, 1e-5).is_err());
         let a = json!({"name": "a", "gain": [[1.0]]});
         assert!(first_difference(&a, &json!({"name": "b", "gain": [[1.0]]}), 1e-9, &["name"], "").is_none());
         assert!(first_difference(&a, &json!({"name": "a", "gain": [[1.1]]}), 1e-9, &["name"], "").is_some());

@@ -31,25 +31,49 @@ fn vessel_figures(cx: &Cx<'_>, v: &str) -> (f64, f64) {
 
 fn size(cx: &mut Cx<'_>, vessel: &str, band: &str, rate: &str) -> (Output, Option<Value>) {
     let t = format!("{}=+10%", cx.case.roles.throughput);
-    let out = cx.pw(&["size", "plant.json", "--vessel", vessel, "--disturbance", &t, "--level-band", band, "--max-outflow-rate", rate, "--json"]);
-    let promised = ["designs/*/area", "designs/*/verified/max_level_deviation", "designs/*/verified/max_outflow_rate", "flow_change"];
+    let out = cx.pw(&[
+        "size",
+        "plant.json",
+        "--vessel",
+        vessel,
+        "--disturbance",
+        &t,
+        "--level-band",
+        band,
+        "--max-outflow-rate",
+        rate,
+        "--json",
+    ]);
+    let promised = [
+        "designs/*/area",
+        "designs/*/verified/max_level_deviation",
+        "designs/*/verified/max_outflow_rate",
+        "flow_change",
+    ];
     let v = cx.succeeded(&out, "size", true, &promised);
     (out, v)
 }
 
 /// Every "meets" of a size answer agrees with its figures and limits (1 % either way).
 fn meets_consistent(v: &Value) -> Result<(), String> {
-    let (band, rate) = (v["level_band"].as_f64().unwrap_or(f64::NAN), v["max_outflow_rate"].as_f64().unwrap_or(f64::NAN));
+    let (band, rate) =
+        (v["level_band"].as_f64().unwrap_or(f64::NAN), v["max_outflow_rate"].as_f64().unwrap_or(f64::NAN));
     let mut runs: Vec<(String, &Value)> = matches(v, "designs/*/verified");
     runs.push(("/current".into(), &v["current"]));
     for (path, r) in runs {
-        let (Some(meets), Some(dev), Some(out)) = (r["meets"].as_bool(), r["max_level_deviation"].as_f64().or(r["max_deviation"].as_f64()), r["max_outflow_rate"].as_f64()) else {
+        let (Some(meets), Some(dev), Some(out)) = (
+            r["meets"].as_bool(),
+            r["max_level_deviation"].as_f64().or(r["max_deviation"].as_f64()),
+            r["max_outflow_rate"].as_f64(),
+        ) else {
             continue;
         };
         let inside = dev.abs() <= band * 1.01 && out.abs() <= rate * 1.01;
         let outside = dev.abs() > band * 0.99 || out.abs() > rate * 0.99;
         if (meets && !inside) || (!meets && !outside && r["failure"].is_null()) {
-            return Err(format!("{path}: meets = {meets} with largest level deviation {dev:e} m (band {band:e}) and outflow rate {out:e} (limit {rate:e})"));
+            return Err(format!(
+                "{path}: meets = {meets} with largest level deviation {dev:e} m (band {band:e}) and outflow rate {out:e} (limit {rate:e})"
+            ));
         }
     }
     Ok(())
@@ -71,16 +95,26 @@ pub fn size_relations(cx: &mut Cx<'_>, pick: usize) {
     let si_rate = plantwide::units::convert_to_si(per_min, "kmol/h").unwrap() / 60.0;
     let (b, vb) = size(cx, vessel, &format!("{feet} ft"), &format!("{si_rate} mol/s/s"));
     if let Some(vb) = vb {
-        let d = first_difference(&va, &vb, 1e-6, &["duration", "disturbance"], "");
-        cx.check(d.is_none(), "size: the same limits in other units give another design", &[&a, &b], || d.unwrap_or_default());
+        // The limits differ by a rounding of their last bit; the figures come from nonlinear runs
+        // (and a design iterated on them), which agree to their integration tolerance, not to the bit.
+        let d = first_difference(&va, &vb, 1e-4, &["duration", "disturbance"], "");
+        cx.check(d.is_none(), "size: the same limits in other units give another design", &[&a, &b], || {
+            d.unwrap_or_default()
+        });
     }
 }
 
 fn compare(cx: &mut Cx<'_>, other: &str) -> (Output, Option<Value>) {
     let r = cx.case.roles.clone();
     let outputs = r.cvs.join(",");
-    let out = cx.pw(&["compare", "plant.json", other, "--disturbances", &r.throughput, "--outputs", &outputs, "--json"]);
-    let v = cx.succeeded(&out, "compare", true, &["schemes/*/gain/*/*", "schemes/*/condition_number", "schemes/*/energy/heating"]);
+    let out =
+        cx.pw(&["compare", "plant.json", other, "--disturbances", &r.throughput, "--outputs", &outputs, "--json"]);
+    let v = cx.succeeded(
+        &out,
+        "compare",
+        true,
+        &["schemes/*/gain/*/*", "schemes/*/condition_number", "schemes/*/energy/heating"],
+    );
     (out, v)
 }
 
@@ -106,6 +140,11 @@ pub fn compare_relations(cx: &mut Cx<'_>) {
     cx.check(differs, "compare A B: a scheme with another setpoint shows no difference", &[&b], || edit.set.clone());
     for key in OWN {
         let d = first_difference(&s0[key], &t0[key], 1e-9, &["dynamic"], key);
-        cx.check(d.is_none(), "compare: a scheme's steady-state figures depend on the scheme beside it", &[&a, &b], || d.unwrap_or_default());
+        cx.check(
+            d.is_none(),
+            "compare: a scheme's steady-state figures depend on the scheme beside it",
+            &[&a, &b],
+            || d.unwrap_or_default(),
+        );
     }
 }

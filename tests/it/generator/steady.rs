@@ -19,7 +19,9 @@ pub fn converges(cx: &mut Cx<'_>) -> bool {
     let Some(v) = cx.succeeded(&out, "steady", true, &["values/*", "iterations"]) else { return false };
     cx.values = v["values"].as_object().cloned().unwrap_or_default();
     let warnings = v["warnings"].as_array().map_or(0, Vec::len);
-    cx.check(warnings == 0, "steady: a loop saturates at the generated design point", &[&out], || v["warnings"].to_string());
+    cx.check(warnings == 0, "steady: a loop saturates at the generated design point", &[&out], || {
+        v["warnings"].to_string()
+    });
     let cert = certificate(cx);
     cx.agree(cert, "steady: the converged state fails the certificate (balances, fractions, holdups)", &[&out]);
     true
@@ -36,7 +38,9 @@ fn flows(values: &Map<String, Value>, stream: &str, comps: &[(String, f64)]) -> 
 pub fn certificate(cx: &Cx<'_>) -> Result<(), String> {
     let (case, values) = (cx.case, &cx.values);
     let comps = &case.roles.mw;
-    let kind = |u: &str| case.closed.at(&["units", u, "type"]).and_then(|t| if let J::S(s) = t { Some(s.clone()) } else { None });
+    let kind = |u: &str| {
+        case.closed.at(&["units", u, "type"]).and_then(|t| if let J::S(s) = t { Some(s.clone()) } else { None })
+    };
     let mut boundary = (vec![0.0; comps.len()], vec![0.0; comps.len()]);
     let mut units: Vec<&str> = Vec::new();
     for (s, from, to) in &case.roles.streams {
@@ -51,7 +55,11 @@ pub fn certificate(cx: &Cx<'_>) -> Result<(), String> {
         if kind(to).as_deref() == Some("product") {
             boundary.1.iter_mut().zip(&fl).for_each(|(a, b)| *a += b);
         }
-        units.extend([from.as_str(), to.as_str()].into_iter().filter(|u| !matches!(kind(u).as_deref(), Some("feed" | "product"))));
+        units.extend(
+            [from.as_str(), to.as_str()]
+                .into_iter()
+                .filter(|u| !matches!(kind(u).as_deref(), Some("feed" | "product"))),
+        );
     }
     units.sort_unstable();
     units.dedup();
@@ -79,12 +87,19 @@ fn balance(what: &str, inn: &[f64], out: &[f64], comps: &[(String, f64)], mass: 
         let m = |f: &[f64]| f.iter().zip(comps).map(|(x, (_, mw))| x * mw).sum::<f64>();
         let scale = inn.iter().zip(comps).map(|(x, (_, mw))| x * mw).sum::<f64>().max(1e-300);
         let off = (m(inn) - m(out)).abs() / scale;
-        return if off <= 1e-9 { Ok(()) } else { Err(format!("{what}: mass balance off by {off:.2e} of its throughput")) };
+        return if off <= 1e-9 {
+            Ok(())
+        } else {
+            Err(format!("{what}: mass balance off by {off:.2e} of its throughput"))
+        };
     }
     for (k, (a, b)) in inn.iter().zip(out).enumerate() {
         let off = (a - b).abs() / total.max(1e-300);
         if !(off <= 1e-9) {
-            return Err(format!("{what}: balance of {} off by {off:.2e} of its throughput (in {a:e}, out {b:e} mol/s)", comps[k].0));
+            return Err(format!(
+                "{what}: balance of {} off by {off:.2e} of its throughput (in {a:e}, out {b:e} mol/s)",
+                comps[k].0
+            ));
         }
     }
     Ok(())
@@ -146,7 +161,8 @@ pub fn set_equals_file(cx: &mut Cx<'_>, k: usize) {
 }
 
 fn same_answer(cx: &mut Cx<'_>, a: &Value, b: &Value, class: &str, outs: &[&super::exec::Output]) -> bool {
-    let (va, vb) = (a["values"].as_object().cloned().unwrap_or_default(), b["values"].as_object().cloned().unwrap_or_default());
+    let (va, vb) =
+        (a["values"].as_object().cloned().unwrap_or_default(), b["values"].as_object().cloned().unwrap_or_default());
     let same = same_values(&va, &vb, REL, ABS);
     let ok = cx.agree(same, class, outs);
     let (ia, ib) = (&a["iterations"], &b["iterations"]);

@@ -50,7 +50,16 @@ pub fn package(components: &J, vle: &str) -> ThermoPackage {
         (
             "units",
             obj([
-                ("src", obj([("type", "feed".into()), ("F", J::N(1.0)), ("T", J::N(300.0)), ("P", J::N(101325.0)), ("z", z)])),
+                (
+                    "src",
+                    obj([
+                        ("type", "feed".into()),
+                        ("F", J::N(1.0)),
+                        ("T", J::N(300.0)),
+                        ("P", J::N(101325.0)),
+                        ("z", z),
+                    ]),
+                ),
                 ("sink", obj([("type", "product".into())])),
             ]),
         ),
