@@ -22,7 +22,7 @@ mod doc;
 mod exec;
 mod guard;
 mod mutate;
-mod rng;
+pub(crate) mod rng;
 mod targeted;
 
 use std::io::Write;

@@ -29,9 +29,14 @@ pub const PRESSURE: &[&str] = &["atm", "kPa", "bar", "psia"];
 pub const TEMPERATURE: &[&str] = &["K", "degC", "degF"];
 pub const DUTY: &[&str] = &["MW", "kW", "Btu/h"];
 
+/// One of `units`, drawn.
+pub fn unit_of(rng: &mut Rng, units: &[&'static str]) -> &'static str {
+    units[rng.below(units.len())]
+}
+
 /// A level loop's gain written as a flow per amount (`"0.5 kmol/min/kmol"`) for `per_s` [1/s].
 pub fn per_time(rng: &mut Rng, per_s: f64) -> J {
-    let (f, a) = (*rng.pick(FLOW), *rng.pick(AMOUNT));
+    let (f, a) = (*rng.pick(FLOW), unit_of(rng, AMOUNT));
     let factor =
         plantwide::units::convert_from_si(1.0, f).unwrap() / plantwide::units::convert_from_si(1.0, a).unwrap();
     J::S(format!("{} {f}/{a}", round_sig(per_s * factor, 4)))
@@ -191,7 +196,7 @@ fn volatility_and_split(r: &Request<'_>, m: f64, n: usize, skew: f64, dp: f64) -
 
 /// `"units": {"<name>": …}` of the column.
 fn unit_description(rng: &mut Rng, r: &Request<'_>, c: &Column, drum: f64, sump: f64, dp: f64) -> J {
-    let (flow, amount) = (*rng.pick(FLOW), *rng.pick(AMOUNT));
+    let (flow, amount) = (*rng.pick(FLOW), unit_of(rng, AMOUNT));
     let mut feed = obj([("port", "feed".into()), ("stage", c.feed_stage.into())]);
     if r.model == Model::Simple && r.pkg.is_none() {
         feed.set(&["q"], J::N(r.q));
@@ -201,7 +206,7 @@ fn unit_description(rng: &mut Rng, r: &Request<'_>, c: &Column, drum: f64, sump:
         ("model", if r.model == Model::Simple { "simple" } else { "rigorous" }.into()),
         ("stages", c.stages.into()),
         ("feeds", J::A(vec![feed])),
-        ("P", q(r.p_top, *rng.pick(PRESSURE), 5)),
+        ("P", q(r.p_top, unit_of(rng, PRESSURE), 5)),
     ]);
     if r.model == Model::Simple {
         let tray = uniform(rng, 0.3, 1.0) * 60.0 * r.f;
@@ -210,7 +215,7 @@ fn unit_description(rng: &mut Rng, r: &Request<'_>, c: &Column, drum: f64, sump:
     u.set(&["condenser_holdup"], q(drum, amount, 3));
     u.set(&["reboiler_holdup"], q(sump, amount, 3));
     if r.model == Model::Simple {
-        u.set(&["tau_l"], q(uniform(rng, 0.04, 0.15) * 60.0, *rng.pick(&["min", "s"]), 3));
+        u.set(&["tau_l"], q(uniform(rng, 0.04, 0.15) * 60.0, unit_of(rng, &["min", "s"]), 3));
     }
     u.set(&["reflux"], q(c.l, flow, 6));
     if r.model == Model::Simple {
@@ -222,7 +227,7 @@ fn unit_description(rng: &mut Rng, r: &Request<'_>, c: &Column, drum: f64, sump:
         let p_scale = (101_325.0 / r.p_top).sqrt();
         let area = c.v * 0.022 * p_scale * uniform(rng, 0.8, 1.3);
         let mut rig = obj([
-            ("reboiler_duty", q(c.duty, *rng.pick(DUTY), 6)),
+            ("reboiler_duty", q(c.duty, unit_of(rng, DUTY), 6)),
             ("tray_pressure_drop", q(dp, "kPa", 2)),
             ("weir_length", q(0.75 * area.sqrt() * uniform(rng, 0.9, 1.1), "m", 2)),
             ("weir_height", q(uniform(rng, 0.04, 0.06), "mm", 2)),
@@ -250,7 +255,7 @@ fn level_loops(rng: &mut Rng, c: &Column, drum: f64, sump: f64, names: [&str; 2]
             ("kc", per_time(rng, 1.0 / tau)),
         ]);
         if rng.chance(0.25) {
-            ctrl.set(&["tau_i"], q(uniform(rng, 10.0, 60.0) * 60.0, *rng.pick(TIME), 3));
+            ctrl.set(&["tau_i"], q(uniform(rng, 10.0, 60.0) * 60.0, unit_of(rng, TIME), 3));
         }
         ctrl.set(&["action"], "direct".into());
         ctrl
@@ -285,7 +290,7 @@ pub fn quality_loops(
     let holdup: f64 = (1..=c.stages).map(|k| value(&format!("{}.M[{k}]", c.name))).sum();
     let feed = c.d + c.b;
     let tau_i = uniform(rng, 1.0, 3.0) * (holdup / feed).max(600.0);
-    let (xd, flow) = (value(&top_pv), *rng.pick(FLOW));
+    let (xd, flow) = (value(&top_pv), unit_of(rng, FLOW));
     let delta_d = round_sig(1.0 - xd, 3).max(1e-9);
     // The gains move the input 1–4 % for an error the size of the impurity, but no faster than
     // for an impurity of 0.1 %: a user does not type 2e7 mol/s per mole fraction (the engine
@@ -298,7 +303,7 @@ pub fn quality_loops(
         ("output", format!("{}.reflux", c.name).into()),
         ("sp", J::N(round_sig(1.0 - delta_d, 12))),
         ("kc", q(uniform(rng, 0.01, 0.04) * l / span(delta_d), flow, 3)),
-        ("tau_i", q(tau_i, *rng.pick(TIME), 3)),
+        ("tau_i", q(tau_i, unit_of(rng, TIME), 3)),
         ("action", "reverse".into()),
         ("op_min", q(0.0, flow, 3)),
         ("op_max", q(3.0 * l, flow, 3)),
@@ -306,7 +311,7 @@ pub fn quality_loops(
     let heat = c.heat_input();
     let (u0, unit) = match c.model {
         Model::Simple => (value(&heat), flow),
-        Model::Rigorous => (value(&heat), *rng.pick(DUTY)),
+        Model::Rigorous => (value(&heat), unit_of(rng, DUTY)),
     };
     let (pv, sp, kc, action) = match bottom {
         BottomLoop::Composition => {
@@ -319,7 +324,7 @@ pub fn quality_loops(
             let per_k = uniform(rng, 0.5, 2.0) * u0 / span.max(1.0);
             let kc =
                 J::S(format!("{} {unit}/K", round_sig(plantwide::units::convert_from_si(per_k, unit).unwrap(), 3)));
-            (format!("{}.T[{k}]", c.name), q(t, *rng.pick(TEMPERATURE), 7), kc, "reverse")
+            (format!("{}.T[{k}]", c.name), q(t, unit_of(rng, TEMPERATURE), 7), kc, "reverse")
         }
     };
     let bottom = obj([
@@ -328,7 +333,7 @@ pub fn quality_loops(
         ("output", heat.into()),
         ("sp", sp),
         ("kc", kc),
-        ("tau_i", q(tau_i, *rng.pick(TIME), 3)),
+        ("tau_i", q(tau_i, unit_of(rng, TIME), 3)),
         ("action", action.into()),
         ("op_min", q(0.0, unit, 3)),
         ("op_max", q(3.0 * u0, unit, 3)),

@@ -9,7 +9,7 @@
 use plantwide::flowsheet::{Override, load_str_with};
 use plantwide::solve::{StrategySettings, converge};
 
-use super::column::{self, BottomLoop, Column, Model, Request, log_uniform, uniform};
+use super::column::{self, BottomLoop, Column, Model, Request, log_uniform, uniform, unit_of};
 use super::doc::{J, obj, q, quantity, round_sig};
 use super::rng::Rng;
 use super::shortcut::Split;
@@ -211,7 +211,7 @@ fn unit_edit(unit: &str, field: &str, text: String) -> Edit {
 
 /// The throughput edits of a binary feed: its flow in another unit, its light fraction moved.
 fn feed_edits(rng: &mut Rng, feed: &str, f: f64, z: Option<(&str, &str, f64)>) -> Vec<Edit> {
-    let (text, _) = quantity(f * uniform(rng, 0.9, 1.1), *rng.pick(column::FLOW), 5);
+    let (text, _) = quantity(f * uniform(rng, 0.9, 1.1), unit_of(rng, column::FLOW), 5);
     let mut edits = vec![unit_edit(feed, "F", text)];
     if let Some((light, heavy, z0)) = z {
         let z1 = round_sig(z0 + uniform(rng, -0.03, 0.03), 3);
@@ -337,12 +337,12 @@ fn simple_column(rng: &mut Rng) -> Draft {
     };
     let col = column::design(rng, &r, levels);
     let feed = *rng.pick(&["feed_source", "supply"]);
-    let (f_text, f_si) = quantity(f, *rng.pick(column::FLOW), 5);
+    let (f_text, f_si) = quantity(f, unit_of(rng, column::FLOW), 5);
     let mut doc = skeleton(format!("generated simple column {n}"), col.about(), components, "constant_alpha");
     let feed_unit = obj([
         ("type", "feed".into()),
         ("F", f_text.into()),
-        ("P", q(p * 1.1, *rng.pick(column::PRESSURE), 4)),
+        ("P", q(p * 1.1, unit_of(rng, column::PRESSURE), 4)),
         ("z", obj([(light, J::N(zf)), (heavy, J::N(round_sig(1.0 - zf, 12)))])),
         ("condition", "saturated_liquid".into()),
     ]);
@@ -406,13 +406,13 @@ fn rigorous_column(rng: &mut Rng) -> Draft {
     let col = column::design(rng, &r, levels);
     let feed = "feed_source";
     let p_feed = bin.p_top + col.stages as f64 * 900.0 + uniform(rng, 10e3, 40e3);
-    let (f_text, f_si) = quantity(f, *rng.pick(column::FLOW), 5);
+    let (f_text, f_si) = quantity(f, unit_of(rng, column::FLOW), 5);
     let mut doc =
         skeleton(format!("generated {light}/{heavy} column"), col.about(), bin.components.clone(), bin.pair.vle);
     let feed_unit = obj([
         ("type", "feed".into()),
         ("F", f_text.into()),
-        ("P", q(p_feed, *rng.pick(column::PRESSURE), 4)),
+        ("P", q(p_feed, unit_of(rng, column::PRESSURE), 4)),
         ("z", obj([(light, J::N(zf)), (heavy, J::N(round_sig(1.0 - zf, 12)))])),
         ("condition", "saturated_liquid".into()),
     ]);
@@ -444,7 +444,7 @@ fn vessel_level(rng: &mut Rng, vessel: &str, height: f64, flow: f64, pi: bool) -
         ("kc", format!("{kc} {flow_unit}/m").into()),
     ]);
     if pi {
-        c.set(&["tau_i"], q(uniform(rng, 3.0, 10.0) * 60.0, *rng.pick(column::TIME), 3));
+        c.set(&["tau_i"], q(uniform(rng, 3.0, 10.0) * 60.0, unit_of(rng, column::TIME), 3));
     }
     c.set(&["action"], "direct".into());
     c
@@ -494,13 +494,13 @@ fn train(rng: &mut Rng) -> Draft {
         bin.components.clone(),
         bin.pair.vle,
     );
-    let (f_text, f_si) = quantity(f, *rng.pick(column::FLOW), 5);
+    let (f_text, f_si) = quantity(f, unit_of(rng, column::FLOW), 5);
     let temp = *rng.pick(column::TEMPERATURE);
     let feed = obj([
         ("type", "feed".into()),
         ("F", f_text.into()),
         ("T", q(t_bub - uniform(rng, 10.0, 30.0), temp, 4)),
-        ("P", q(p_flash + 101_325.0, *rng.pick(column::PRESSURE), 4)),
+        ("P", q(p_flash + 101_325.0, unit_of(rng, column::PRESSURE), 4)),
         ("z", obj([(light, J::N(zf)), (heavy, J::N(round_sig(1.0 - zf, 12)))])),
         ("condition", "liquid".into()),
     ]);
@@ -510,7 +510,7 @@ fn train(rng: &mut Rng) -> Draft {
     let flow_unit = *rng.pick(column::FLOW);
     let outflow = || obj([("type", "flow".into()), ("flow", q(liquid, flow_unit, 5))]);
     let vessel = |rng: &mut Rng, kind: &str, p: f64, d: f64, h: f64| {
-        let pressure = q(p, *rng.pick(column::PRESSURE), 4);
+        let pressure = q(p, unit_of(rng, column::PRESSURE), 4);
         let out = outflow();
         obj([
             ("type", kind.into()),
@@ -558,11 +558,11 @@ fn train(rng: &mut Rng) -> Draft {
     roles.vessels = vec!["surge".into(), "flash".into()];
     roles.edits = feed_edits(rng, "feed_source", f, Some((light, heavy, zf)));
     let t_new = t_bub + uniform(rng, 0.05, 0.3) * (t_dew - t_bub);
-    roles.edits.push(unit_edit("preheater", "T_out", quantity(t_new, *rng.pick(column::TEMPERATURE), 5).0));
+    roles.edits.push(unit_edit("preheater", "T_out", quantity(t_new, unit_of(rng, column::TEMPERATURE), 5).0));
     roles.edits.push(unit_edit(
         "flash",
         "P",
-        quantity(p_flash * uniform(rng, 0.95, 1.05), *rng.pick(column::PRESSURE), 4).0,
+        quantity(p_flash * uniform(rng, 0.95, 1.05), unit_of(rng, column::PRESSURE), 4).0,
     ));
     let about = format!(
         "train {light}/{heavy}: F {f_si:.4} mol/s, zF {zf}, flash {t_out:.2} K / {p_flash:.0} Pa, vapour {beta:.3}"
@@ -663,7 +663,7 @@ fn recycle(rng: &mut Rng) -> Draft {
         ("output", output.into()),
         ("sp", format!("{} m", 0.5 * height).into()),
         ("kc", kc.into()),
-        ("tau_i", q(uniform(rng, 20.0, 90.0) * 60.0, *rng.pick(column::TIME), 3)),
+        ("tau_i", q(uniform(rng, 20.0, 90.0) * 60.0, unit_of(rng, column::TIME), 3)),
         ("action", action.into()),
     ]);
     doc.set(&["controllers", "reactor_level"], level);
@@ -675,7 +675,7 @@ fn recycle(rng: &mut Rng) -> Draft {
         if structure == 1 { vec!["reactor".into(), "column.sump".into()] } else { vec!["column.sump".into()] };
     let (unit, field, base) = if structure == 1 { ("fresh", "F", f0) } else { ("reactor", "outflow", f0 + d) };
     roles.edits = vec![Edit {
-        set: format!("{unit}.{field}={}", quantity(base * uniform(rng, 0.9, 1.1), *rng.pick(column::FLOW), 5).0),
+        set: format!("{unit}.{field}={}", quantity(base * uniform(rng, 0.9, 1.1), unit_of(rng, column::FLOW), 5).0),
         file: vec![],
     }];
     fix_outflow_edit(&mut roles.edits[0], unit, field);

@@ -43,6 +43,14 @@ const OPEN: &[Known] = &[
                setpoint (open; screen is being reworked by another helper)",
     },
     Known {
+        class: "screen --column: refused (exit 1) on a generated plant",
+        shows: |t| t.contains("error: configuration ") && t.contains("the steady state is not determined"),
+        note: "found by this suite: on a reactor-column recycle whose fresh feed is fixed, one \
+               configuration (LB: the recycle's inventory is left uncontrolled) takes the whole \
+               `screen --column` down with exit 1 and no report, where that configuration should be \
+               marked infeasible and the others ranked (open; screen is being reworked by another helper)",
+    },
+    Known {
         class: "size: the same limits in other units give another design",
         shows: |t| t.contains("\n/designs/"),
         note: "found by this suite: size's design refinement (iterated on nonlinear runs) turns a \

@@ -1,12 +1,13 @@
 //! Steady-state gains of the open plant (quality loops removed, as a user studies a design before
 //! closing its loops): by linearization, with inputs and outputs permuted, by perturbation; and
-//! the studies that report the same gains (`identify`'s exact model, `screen --column`'s LV).
+//! the studies that report the same gains (`identify`'s exact model, `screen --column`'s LV,
+//! `linearize`'s state space).
 
 use serde_json::Value;
 
 use super::cx::Cx;
 use super::exec::Output;
-use super::relations::{gains_agree, matrix, permuted, rga_rows_sum_to_one};
+use super::relations::{gains_agree, matrix, permuted, ranking_follows_evidence, rga_rows_sum_to_one};
 
 const PROMISED: &[&str] = &["gain/*/*", "rga/*/*", "singular_values/*", "condition_number", "niederlinski"];
 
@@ -129,4 +130,100 @@ pub fn screen_column(cx: &mut Cx<'_>, g: &[Vec<f64>]) {
     cx.check(fine, "screen --column: ranks are not 1..n over the converged configurations", &[&out], || {
         format!("ranks {ranks:?}, {unranked} unranked")
     });
+    // Holds vacuously while `screen --column` ranks on steady-state measures alone (no `dynamic`).
+    let follows = ranking_follows_evidence(&v);
+    cx.agree(follows, "screen --column: rank 1 is not the best dynamic score and the verdict does not say so", &[&out]);
+}
+
+/// `linearize` of the open plant: its steady-state gain `D − C A⁻¹ B` is `gains`'s; with the
+/// signals listed the other way round and time in minutes, the gain is permuted and the
+/// eigenvalues are the same rates per minute (60 × per second).
+pub fn linearize(cx: &mut Cx<'_>, g: &[Vec<f64>]) {
+    let (inputs, outputs) = signals(cx);
+    let rev = |v: &[String]| v.iter().rev().cloned().collect::<Vec<_>>().join(",");
+    let a = cx.pw(&[
+        "linearize",
+        "open.json",
+        "--inputs",
+        &inputs.join(","),
+        "--outputs",
+        &outputs.join(","),
+        "--out",
+        "lin-s.json",
+    ]);
+    let b = cx.pw(&[
+        "linearize",
+        "open.json",
+        "--inputs",
+        &rev(&inputs),
+        "--outputs",
+        &rev(&outputs),
+        "--time-unit",
+        "min",
+        "--out",
+        "lin-min.json",
+    ]);
+    let (Some(_), Some(_)) = (cx.succeeded(&a, "linearize", false, &[]), cx.succeeded(&b, "linearize", false, &[]))
+    else {
+        return;
+    };
+    let read = |name: &str| -> Value {
+        serde_json::from_str(&std::fs::read_to_string(cx.dir.join(name)).unwrap_or_default()).unwrap_or_default()
+    };
+    let (s, m) = (read("lin-s.json"), read("lin-min.json"));
+    let gain = matrix(&s["steady_state_gain"]).unwrap_or_default();
+    cx.agree(gains_agree(g, &gain, 1e-7, 1e-3), "linearize: its steady-state gain is not gains --json's", &[&a]);
+    let reversed: Vec<usize> = (0..inputs.len()).rev().collect();
+    let pg = permuted(&gain, &matrix(&m["steady_state_gain"]).unwrap_or_default(), &reversed, &reversed, 1e-9);
+    cx.agree(pg, "linearize: listing the signals the other way round does not permute the gain", &[&a, &b]);
+    let per_s: Vec<(f64, f64)> = eigenvalues(&m).into_iter().map(|(re, im)| (re / 60.0, im / 60.0)).collect();
+    cx.agree(
+        same_spectrum(&eigenvalues(&s), &per_s, 1e-6),
+        "linearize: --time-unit min does not scale the eigenvalues by 60",
+        &[&a, &b],
+    );
+}
+
+fn eigenvalues(v: &Value) -> Vec<(f64, f64)> {
+    let num = |e: &Value, k: &str| e[k].as_f64().unwrap_or(f64::NAN);
+    v["eigenvalues"].as_array().map(|a| a.iter().map(|e| (num(e, "re"), num(e, "im"))).collect()).unwrap_or_default()
+}
+
+/// Two lists of eigenvalues are the same multiset to `rel` of the spectral radius (each matched
+/// to its nearest unmatched partner).
+fn same_spectrum(a: &[(f64, f64)], b: &[(f64, f64)], rel: f64) -> Result<(), String> {
+    if a.len() != b.len() {
+        return Err(format!("{} against {} eigenvalues", a.len(), b.len()));
+    }
+    let radius = a.iter().fold(0.0f64, |r, (x, y)| r.max(x.hypot(*y)));
+    let mut free: Vec<(f64, f64)> = b.to_vec();
+    for &(x, y) in a {
+        let (k, d) = free
+            .iter()
+            .enumerate()
+            .map(|(k, (p, q))| (k, (x - p).hypot(y - q)))
+            .min_by(|u, v| u.1.total_cmp(&v.1))
+            .unwrap_or((0, f64::NAN));
+        if d.is_nan() || d > rel * radius {
+            return Err(format!(
+                "eigenvalue {x:e}{y:+e}i has no partner within {:e} (nearest {d:e} away)",
+                rel * radius
+            ));
+        }
+        free.swap_remove(k);
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::same_spectrum;
+
+    #[test]
+    fn spectra_match_as_multisets() {
+        let a = [(-1.0, 2.0), (-1.0, -2.0), (-3.0, 0.0)];
+        assert!(same_spectrum(&a, &[(-3.0, 0.0), (-1.0, -2.0), (-1.0, 2.0 + 1e-9)], 1e-6).is_ok());
+        assert!(same_spectrum(&a, &[(-3.0, 0.0), (-1.0, 2.0), (-1.0, 2.0)], 1e-6).is_err());
+        assert!(same_spectrum(&a, &a[..2], 1e-6).is_err());
+    }
 }

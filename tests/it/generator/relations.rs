@@ -98,7 +98,7 @@ pub fn same_values(a: &Map<String, Value>, b: &Map<String, Value>, rel: f64, abs
     for (k, x) in a {
         let (x, y) = (x.as_f64().unwrap_or(f64::NAN), b[k].as_f64().unwrap_or(f64::NAN));
         let excess = (x - y).abs() / (rel * x.abs().max(y.abs()) + abs);
-        if !(excess <= 1.0) && worst.is_none_or(|w| excess > w.0 || excess.is_nan()) {
+        if (excess.is_nan() || excess > 1.0) && worst.is_none_or(|w| excess > w.0 || excess.is_nan()) {
             worst = Some((excess, k, x, y));
         }
     }
@@ -146,7 +146,7 @@ pub fn rga_rows_sum_to_one(rga: &[Vec<f64>]) -> Result<(), String> {
     for (i, row) in rga.iter().enumerate() {
         let sum: f64 = row.iter().sum();
         let scale = row.iter().fold(1.0f64, |m, x| m.max(x.abs()));
-        if !((sum - 1.0).abs() <= 1e-8 * scale) {
+        if sum.is_nan() || (sum - 1.0).abs() > 1e-8 * scale {
             return Err(format!("row {i} of the RGA sums to {sum}"));
         }
     }

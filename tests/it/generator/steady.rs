@@ -46,7 +46,7 @@ pub fn certificate(cx: &Cx<'_>) -> Result<(), String> {
     for (s, from, to) in &case.roles.streams {
         let fl = flows(values, s, comps).ok_or_else(|| format!("stream {s} is missing from the answer"))?;
         let sum: f64 = comps.iter().map(|(c, _)| values[&format!("{s}.x[{c}]")].as_f64().unwrap_or(f64::NAN)).sum();
-        if !((sum - 1.0).abs() <= 1e-9) {
+        if sum.is_nan() || (sum - 1.0).abs() > 1e-9 {
             return Err(format!("stream {s}: mole fractions sum to {sum:.15}"));
         }
         if kind(from).as_deref() == Some("feed") {
@@ -95,7 +95,7 @@ fn balance(what: &str, inn: &[f64], out: &[f64], comps: &[(String, f64)], mass: 
     }
     for (k, (a, b)) in inn.iter().zip(out).enumerate() {
         let off = (a - b).abs() / total.max(1e-300);
-        if !(off <= 1e-9) {
+        if off.is_nan() || off > 1e-9 {
             return Err(format!(
                 "{what}: balance of {} off by {off:.2e} of its throughput (in {a:e}, out {b:e} mol/s)",
                 comps[k].0
@@ -111,7 +111,7 @@ fn holdups(values: &Map<String, Value>) -> Result<(), String> {
         let field = k.rsplit('.').next().unwrap_or("");
         field == "M" || field == "level" || (field.starts_with("M[") && !field.contains("]["))
     };
-    match values.iter().find(|(k, v)| holdup(k) && !(v.as_f64().unwrap_or(f64::NAN) > 1e-9)) {
+    match values.iter().find(|(k, v)| holdup(k) && v.as_f64().is_none_or(|x| x.is_nan() || x <= 1e-9)) {
         Some((k, v)) => Err(format!("{k} = {v}: a holdup at its floor")),
         None => Ok(()),
     }
