@@ -564,10 +564,40 @@ fn train(rng: &mut Rng) -> Draft {
         "P",
         quantity(p_flash * uniform(rng, 0.95, 1.05), unit_of(rng, column::PRESSURE), 4).0,
     ));
+    let flash = Flash { pkg: &bin.pkg, t: t_out, p: p_flash, z: zf };
+    roles.edits.retain(|e| flash.stays_two_phase(e));
     let about = format!(
         "train {light}/{heavy}: F {f_si:.4} mol/s, zF {zf}, flash {t_out:.2} K / {p_flash:.0} Pa, vapour {beta:.3}"
     );
     Draft { doc, column: col, temperature_loop: rng.chance(0.3), quality, roles, about }
+}
+
+/// A train's flash drum at its design point.
+struct Flash<'a> {
+    pkg: &'a plantwide::thermo::ThermoPackage,
+    t: f64,
+    p: f64,
+    z: f64,
+}
+
+impl Flash<'_> {
+    /// Whether the drum stays two-phase after edit `e` of its feed's light fraction, its heater's
+    /// outlet temperature or its pressure: a flash drum must (its module says so; a subcooled drum
+    /// has no steady state and the engine stops with `Stalled` on `flash_vapour.F`), so an edit
+    /// that moves its feed below the bubble point is no question to ask of it.
+    fn stays_two_phase(&self, e: &Edit) -> bool {
+        let Some((path, value)) = e.set.split_once('=') else { return true };
+        let si = |v: &str| plantwide::units::parse_quantity(v).map(|q| q.value_si).ok();
+        let (t, p, z) = match path {
+            "preheater.T_out" => (si(value), Some(self.p), Some(self.z)),
+            "flash.P" => (Some(self.t), si(value), Some(self.z)),
+            p if p.starts_with("feed_source.z[") => (Some(self.t), Some(self.p), value.parse().ok()),
+            _ => return true,
+        };
+        let (Some(t), Some(p), Some(z)) = (t, p, z) else { return false };
+        let z = [z, 1.0 - z];
+        thermo::bubble_t(self.pkg, p, &z) < t && t < thermo::dew_t(self.pkg, p, &z)
+    }
 }
 
 /// Luyben's snowball plant, drawn: fresh A → mixer → CSTR (A → B) → column, distillate recycled.

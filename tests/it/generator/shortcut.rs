@@ -17,7 +17,8 @@ pub fn fenske(alpha: f64, s: Split) -> f64 {
 }
 
 /// Underwood's minimum reflux ratio for a binary feed `zf` of quality `q`: θ in (1, α) solves
-/// `α zF/(α − θ) + (1 − zF)/(1 − θ) = 1 − q`, then `R_min + 1 = α xD/(α − θ) + (1 − xD)/(1 − θ)`.
+/// `α zF/(α − θ) + (1 − zF)/(1 − θ) = 1 − q`, then `R_min + 1 = α xD/(α − θ) + (1 − xD)/(1 − θ)`,
+/// at least 0.1.
 pub fn underwood(alpha: f64, zf: f64, q: f64, xd: f64) -> f64 {
     let f = |t: f64| alpha * zf / (alpha - t) + (1.0 - zf) / (1.0 - t) - (1.0 - q);
     // f rises from −∞ just above 1 to +∞ just below α: bisection.
@@ -27,7 +28,10 @@ pub fn underwood(alpha: f64, zf: f64, q: f64, xd: f64) -> f64 {
         if f(mid) < 0.0 { lo = mid } else { hi = mid }
     }
     let t = 0.5 * (lo + hi);
-    alpha * xd / (alpha - t) + (1.0 - xd) / (1.0 - t) - 1.0
+    // A rich feed whose equilibrium vapour is already purer than the distillate gives R_min ≤ 0
+    // (methanol–water at zF 0.68 for xD 0.90); a column still refluxes, at least a tenth of its
+    // distillate.
+    (alpha * xd / (alpha - t) + (1.0 - xd) / (1.0 - t) - 1.0).max(0.1)
 }
 
 /// Gilliland (Molokanov 1972): the equilibrium stages a reflux ratio `r` needs, given `n_min` and
