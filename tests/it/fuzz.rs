@@ -1,10 +1,13 @@
 //! Seeded, structure-aware mutation fuzz of the shipped flowsheets and scenarios, in process.
 //!
-//! Each mutant is made from its own seed: a shipped file, a mode (84 % load, 12 % steady, 4 %
-//! run) and one to three mutations chosen by the kind and key of the JSON nodes (`tests/fuzz/`).
-//! It fails on a panic, a mutant over 10 s or 2 GiB (the process aborts after printing the
-//! mutant; a crash leaves it in `target/fuzz-current.txt`), a steady state reported converged
-//! that fails the independent certificate, or a run that returns non-finite values.
+//! Each mutant is made from its own seed: a file of one kind the engine reads (flowsheet loaded,
+//! converged or run; transfer-function model; MPC step model; snapshot), a study command line, or
+//! a request to a live server, with one to three mutations chosen by the kind and key of the JSON
+//! nodes (`tests/fuzz/`). It fails on a panic, a mutant over 10 s of both wall and CPU time (or a
+//! minute of wall time) or 2 GiB (the process aborts after printing the mutant; a crash leaves it
+//! in `target/fuzz-current.txt`), a steady state reported converged that fails the independent
+//! certificate, a run that returns non-finite values, a study that exits 0 with a failed part, or
+//! a server answer outside its documented statuses.
 //!
 //! * `cargo test --test it fuzz::`: the fast sample (2 000 mutants, seed fixed).
 //! * `PLANTWIDE_FUZZ_MUTANTS=100000`: a large sample; `PLANTWIDE_FUZZ_SEED=<n|0x..>`: another seed.
@@ -21,6 +24,7 @@ mod corpus;
 mod doc;
 mod exec;
 mod guard;
+mod kinds;
 mod mutate;
 pub(crate) mod rng;
 mod targeted;
@@ -29,7 +33,7 @@ use std::io::Write;
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
-use corpus::{Corpus, Mode, Mutant};
+use corpus::{Corpus, Mode, Mutant, Other};
 use exec::{Dishonest, Outcome, execute};
 
 #[global_allocator]
@@ -61,7 +65,7 @@ fn env_u64(name: &str) -> Option<u64> {
 /// Counts and extremes of a campaign.
 #[derive(Default)]
 struct Report {
-    by_mode: [(usize, Duration); 3],
+    by_mode: [(usize, Duration); Mode::ALL.len()],
     ok: usize,
     user: usize,
     numerical: usize,
@@ -74,15 +78,20 @@ struct Report {
 }
 
 impl Report {
-    fn record(&mut self, m: &Mutant, took: Duration, result: std::thread::Result<Result<Outcome, Dishonest>>) {
+    fn record(
+        &mut self,
+        m: &Mutant,
+        (took, cpu): (Duration, Duration),
+        result: std::thread::Result<Result<Outcome, Dishonest>>,
+    ) {
         let slot = &mut self.by_mode[m.mode as usize];
         slot.0 += 1;
         slot.1 += took;
         if took > self.slowest.0 {
             self.slowest = (took, m.describe());
         }
-        if took > guard::TIME_LIMIT {
-            self.failures.push(("over the time limit".into(), m.describe(), format!("{took:?}")));
+        if guard::over_limit(took, cpu) {
+            self.failures.push(("over the time limit".into(), m.describe(), format!("{took:?} wall, {cpu:?} CPU")));
         }
         if let Ok(Ok(Outcome::User(msg) | Outcome::Numerical(msg))) = &result
             && msg.len() > MAX_MESSAGE
@@ -110,19 +119,18 @@ impl Report {
 
     fn summary(&self, wall: Duration) -> String {
         let rate = |(n, t): (usize, Duration)| n as f64 / t.as_secs_f64().max(1e-9);
-        let [l, s, r] = self.by_mode;
+        let kinds: Vec<String> = Mode::ALL
+            .iter()
+            .zip(&self.by_mode)
+            .map(|(m, &slot)| format!("{} {} at {:.1}/s", format!("{m:?}").to_lowercase(), slot.0, rate(slot)))
+            .collect();
         format!(
-            "fuzz: {} shipped runs, then {} mutants in {:.1} s (load {} at {:.0}/s, steady {} at {:.1}/s, run {} at {:.1}/s; {} skipped): \
+            "fuzz: {} shipped runs, then {} mutants in {:.1} s ({}; {} skipped): \
              ok {}, user error {}, numerical failure {}, FAILURES {}; slowest {:.2} s ({}); peak allocation {:.1} MiB above a {:.0} MiB baseline; longest message {} chars (seed {:#x})",
             self.warmup,
-            l.0 + s.0 + r.0,
+            self.by_mode.iter().map(|s| s.0).sum::<usize>(),
             wall.as_secs_f64(),
-            l.0,
-            rate(l),
-            s.0,
-            rate(s),
-            r.0,
-            rate(r),
+            kinds.join(", "),
             self.skipped,
             self.ok,
             self.user,
@@ -145,6 +153,19 @@ fn dump(m: &Mutant) {
     let fs = dir.join("flowsheet.json");
     let _ = std::fs::write(&fs, &m.text);
     let sets: String = m.sets.iter().map(|s| format!(" --set '{s}'")).collect();
+    if let Some(other) = &m.other {
+        let what = match other {
+            Other::Tf(_, text) => write_as(&dir, "model.tf.json", text, "tune --tf {} --method zn"),
+            Other::StepModel(text) => write_as(&dir, "sm.json", text, "(column A's MPC reading {})"),
+            Other::Snapshot(text) => {
+                write_as(&dir, "snapshot.json", text, "run flowsheets/surge_tank_pi.json --resume {}")
+            }
+            Other::Study(args) => args.join(" "),
+            Other::Serve(raw) => write_as(&dir, "request.txt", raw, "(an HTTP request to serve: {})"),
+        };
+        say(&format!("fuzz replay files: plantwide {what}"));
+        return;
+    }
     let command = match &m.scenario {
         Some((_, text)) => {
             let sc = dir.join("scenario.json");
@@ -155,6 +176,13 @@ fn dump(m: &Mutant) {
         None => format!("steady {}{sets}", fs.display()),
     };
     say(&format!("fuzz replay files: plantwide {command}"));
+}
+
+/// Write `text` to `dir/name` and fill the file's path into `command`.
+fn write_as(dir: &std::path::Path, name: &str, text: &str, command: &str) -> String {
+    let file = dir.join(name);
+    let _ = std::fs::write(&file, text);
+    command.replace("{}", &file.display().to_string())
 }
 
 /// Make and run `n` mutants from `seed` (mutant 0 has the seed itself).
@@ -169,7 +197,7 @@ fn campaign(seed: u64, n: usize, skip: &[String]) -> Report {
     }
     for m in &shipped {
         guard::begin(&m.describe());
-        let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| execute(m)));
+        let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| execute(m, &corpus)));
         guard::end();
         if !matches!(result, Ok(Ok(Outcome::Ok))) {
             report.failures.push(("shipped file".into(), m.describe(), format!("{result:?}")));
@@ -195,13 +223,16 @@ fn campaign(seed: u64, n: usize, skip: &[String]) -> Report {
             dump(&m);
         }
         guard::begin(&description);
-        let started = Instant::now();
-        let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| execute(&m)));
+        let (started, cpu) = (Instant::now(), guard::cpu_time(None));
+        let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| execute(&m, &corpus)));
         guard::end();
         if n == 1 {
             say(&format!("fuzz replay: {description}\n    -> {result:?}"));
         }
-        report.record(&m, started.elapsed(), result);
+        report.record(&m, (started.elapsed(), guard::cpu_time(None).saturating_sub(cpu)), result);
+    }
+    if let Err(why) = kinds::stop_server() {
+        report.failures.push(("serve".into(), "the live server after the campaign".into(), why));
     }
     report
 }

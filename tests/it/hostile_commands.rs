@@ -294,3 +294,56 @@ fn study_flags_out_of_range_are_refused_naming_the_flag() {
         ],
     );
 }
+
+/// Found by the grown fuzz: an absolute tolerance of 1e-300 made the reactor's run take a million
+/// steps (minutes) for 2 s; tolerances below the floors where the error test is more than
+/// rounding are refused by field.
+#[test]
+fn integrator_tolerances_below_rounding_are_refused_by_field() {
+    let dir = scratch("tolerance");
+    for (field, value) in [("atol", "1e-300"), ("rtol", "1e-15")] {
+        let scenario = dir.join(format!("{field}.json"));
+        std::fs::write(
+            &scenario,
+            format!(r#"{{"format_version": 1, "duration": "100 s", "integrator": {{"{field}": {value}}}}}"#),
+        )
+        .unwrap();
+        let csv = dir.join("o.csv");
+        let args = [
+            "run",
+            &harness::flowsheet("surge_tank_pi.json"),
+            "--scenario",
+            scenario.to_str().unwrap(),
+            "--csv",
+            csv.to_str().unwrap(),
+        ];
+        expect(&args, 1, &[&format!("integrator.{field}"), "more than rounding"]);
+    }
+}
+
+/// Found by the grown fuzz: a transfer-function file quoted a 100 kB name back in its message,
+/// and kept one of two keys given twice unseen; both are refused by field, briefly.
+#[test]
+fn a_transfer_function_file_with_a_key_twice_or_an_endless_name_is_refused_briefly() {
+    let dir = scratch("tf_walk");
+    let twice = dir.join("twice.tf.json");
+    std::fs::write(
+        &twice,
+        r#"{"format_version": 1, "name": "t", "inputs": [{"name": "u"}], "inputs": [{"name": "v"}],
+            "outputs": [{"name": "y"}], "elements": [{"output": "y", "input": "u", "gain": 1.0, "lags": ["1 min"]}]}"#,
+    )
+    .unwrap();
+    expect(&["linearize", "--tf", twice.to_str().unwrap()], 1, &["twice.tf.json", "inputs"]);
+    let long = dir.join("long.tf.json");
+    let name = "u".repeat(100_000);
+    std::fs::write(
+        &long,
+        format!(
+            r#"{{"format_version": 1, "name": "t", "inputs": [{{"name": "{name}"}}], "outputs": [{{"name": "y"}}],
+                "elements": [{{"output": "y", "input": "{name}", "gain": 1.0, "lags": ["1 min"]}}]}}"#
+        ),
+    )
+    .unwrap();
+    let err = expect(&["linearize", "--tf", long.to_str().unwrap()], 1, &["long.tf.json"]);
+    assert!(err.len() < 2000, "a {} character message", err.len());
+}

@@ -493,6 +493,13 @@ struct Cx<'a> {
     ongoing: Ongoing,
 }
 
+/// Smallest relative tolerance of a run: about 4500 units of rounding, where the corrector's
+/// convergence test still sees more than rounding noise.
+pub const MIN_RTOL: f64 = 1e-12;
+/// Smallest absolute tolerance of a run (SI): a variable near zero is not asked for less than the
+/// rounding of the unit-sized quantities it is computed from.
+pub const MIN_ATOL: f64 = 1e-16;
+
 /// What a run has going when a scenario continues it (a live command is resolved as a one-event
 /// scenario): the inputs in a fault, the frozen analyzers and the analyzers it samples, so that a
 /// repair of a fault made earlier is accepted.
@@ -636,11 +643,19 @@ fn resolve_in(mut cx: Cx<'_>, spec: &ScenarioSpec, file: &str, limits: &Limits) 
     let int = &spec.integrator;
     let rtol = int.rtol.unwrap_or(1e-6);
     let atol = int.atol.unwrap_or(1e-8);
-    for (name, v) in [("integrator.rtol", rtol), ("integrator.atol", atol)] {
-        if !(v.is_finite() && v > 0.0 && v < 1.0) {
+    // The floors bound the work a file can ask for: below them the error test asks a variable
+    // near zero for less than the rounding of the quantities it is computed from, and the steps
+    // shrink without end (an atol of 1e-300 took a million steps for 2 s of a reactor).
+    for (name, v, floor) in [("integrator.rtol", rtol, MIN_RTOL), ("integrator.atol", atol, MIN_ATOL)] {
+        if !(v.is_finite() && v >= floor && v < 1.0) {
             cx.diags.push(Diagnostic::new(
                 name,
-                format!("must be a number between 0 and 1 (got {})", plantwide_model::limits::number(v)),
+                format!(
+                    "must be a number from {} up to 1, the range in which the integrator's error test is more than \
+                     rounding (got {})",
+                    plantwide_model::limits::number(floor),
+                    plantwide_model::limits::number(v)
+                ),
             ));
         }
     }

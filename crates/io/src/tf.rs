@@ -89,6 +89,13 @@ fn times(file: &str, path: &str, values: &[QuantityValue]) -> Result<Vec<f64>, I
 
 /// Parse and check a transfer-function file (`file` names it in messages).
 pub fn parse(text: &str, file: &str) -> Result<TfModel, IoError> {
+    // Keys given twice and overlong strings first, as a flowsheet's: serde keeps one of two keys
+    // unseen, and would quote a 100 kB name in its message.
+    if serde_json::from_str::<serde::de::IgnoredAny>(text).is_ok()
+        && let Some(d) = plantwide_flowsheet::parse::walk_diagnostics(text).into_iter().next()
+    {
+        return Err(tf_error(file, if d.path.is_empty() { "(top level)".to_string() } else { d.path }, d.message));
+    }
     let de = &mut serde_json::Deserializer::from_str(text);
     let spec: TfFile = serde_path_to_error::deserialize(de).map_err(|e| {
         let path = e.path().to_string();

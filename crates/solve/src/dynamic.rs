@@ -50,7 +50,7 @@ mod waveform;
 
 pub use conservation::{CONSERVATION_TOL, Conservation, ConservationError};
 pub use live::{Clock, LIVE_MAX_STEP, Live, LiveError, MAX_SNAPSHOTS, PlantCommand};
-pub use mpc::{MpcError, MpcLog, StepModelFile, mv_limits};
+pub use mpc::{MpcError, MpcLog, StepModelFile, file_model, mv_limits};
 pub use session::{Session, SessionError};
 pub use snapshot::{DriverState, SNAPSHOT_VERSION, Snapshot};
 pub use table::{Rows, Table};

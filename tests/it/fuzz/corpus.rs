@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 use serde_json::Value;
 
 use super::doc::Doc;
+use super::kinds;
 use super::mutate::{Names, mutate};
 use super::rng::Rng;
 use super::targeted;
@@ -46,6 +47,8 @@ pub struct Corpus {
     pub small: Vec<usize>,
     /// Scenarios with at least one flowsheet.
     pub scenarios: Vec<Scenario>,
+    /// The other inputs' starting points (models, a snapshot).
+    pub seeds: kinds::Seeds,
 }
 
 fn json_files(dir: &Path, out: &mut Vec<PathBuf>) {
@@ -92,7 +95,7 @@ impl Corpus {
             })
             .filter(|s| !s.flowsheets.is_empty())
             .collect();
-        Corpus { flowsheets, small, scenarios }
+        Corpus { flowsheets, small, scenarios, seeds: kinds::Seeds::load() }
     }
 }
 
@@ -126,6 +129,37 @@ pub enum Mode {
     Steady,
     /// Also a (short) scenario through the integrator.
     Run,
+    /// A transfer-function model file: parsed, tuned, exported.
+    Tf,
+    /// An MPC step-model file read by its controller.
+    StepModel,
+    /// A snapshot resumed.
+    Snapshot,
+    /// A study command line (`gains`, `tune`, `size`, `screen`, `sensitivity`, `steady --spec`).
+    Study,
+    /// A request to the live server.
+    Serve,
+}
+
+impl Mode {
+    /// Every mode, in the order of the report.
+    pub const ALL: [Mode; 8] =
+        [Mode::Load, Mode::Steady, Mode::Run, Mode::Tf, Mode::StepModel, Mode::Snapshot, Mode::Study, Mode::Serve];
+}
+
+/// The input of a mutant of a kind beyond flowsheets and scenarios.
+#[derive(Debug, Clone)]
+pub enum Other {
+    /// A transfer-function model: (file it came from, text).
+    Tf(String, String),
+    /// A step-model file's text.
+    StepModel(String),
+    /// A snapshot's text.
+    Snapshot(String),
+    /// A study's command line.
+    Study(Vec<String>),
+    /// An HTTP request (`{port}` and `{token}` filled in when sent).
+    Serve(String),
 }
 
 /// One mutant: everything needed to run it, and what was changed.
@@ -144,24 +178,32 @@ pub struct Mutant {
     pub sets: Vec<String>,
     /// The changes made, one line each (`path: before -> after [class]`).
     pub changes: Vec<String>,
+    /// The input of the other kinds.
+    pub other: Option<Other>,
 }
 
 impl Mutant {
-    /// Make the mutant of `seed`: 84 % load, 12 % steady, 4 % run; 1-3 changes (3 % none).
+    /// Make the mutant of `seed`: 70 % load, 12 % steady, 4 % run, 4 % transfer-function
+    /// models, 2 % step models, 2 % snapshots, 1 % studies, 5 % server requests; 1-3 changes
+    /// (3 % none).
     pub fn new(seed: u64, corpus: &Corpus) -> Mutant {
         let mut rng = Rng::new(seed);
         let r = rng.unit();
-        let mode = if r < 0.84 {
+        let mode = if r < 0.70 {
             Mode::Load
-        } else if r < 0.96 || corpus.scenarios.is_empty() {
+        } else if r < 0.82 || (r < 0.86 && corpus.scenarios.is_empty()) {
             Mode::Steady
-        } else {
+        } else if r < 0.86 {
             Mode::Run
+        } else {
+            let kind = [(0.90, Mode::Tf), (0.92, Mode::StepModel), (0.94, Mode::Snapshot), (0.95, Mode::Study)];
+            let mode = kind.iter().find(|&&(p, _)| r < p).map_or(Mode::Serve, |&(_, m)| m);
+            return Mutant::other(seed, mode, &mut rng, corpus);
         };
         let (fi, scenario) = match mode {
             Mode::Load => (rng.below(corpus.flowsheets.len()), None),
             Mode::Steady => (*rng.pick(&corpus.small), None),
-            Mode::Run => {
+            _ => {
                 let s = rng.pick(&corpus.scenarios);
                 (*rng.pick(&s.flowsheets), Some(s))
             }
@@ -175,6 +217,7 @@ impl Mutant {
             scenario: None,
             sets: Vec::new(),
             changes: Vec::new(),
+            other: None,
         };
         let mut doc = Doc::new(base.value.clone());
         let n = if rng.chance(0.03) { 0 } else { *rng.pick(&[1, 1, 1, 1, 1, 1, 1, 2, 2, 3]) };
@@ -218,6 +261,45 @@ impl Mutant {
             scenario: scenario.map(|s| (s.file.clone(), Doc::new(s.value.clone()).render())),
             sets: Vec::new(),
             changes: Vec::new(),
+            other: None,
+        }
+    }
+
+    /// A mutant of the other kinds: its input made from the corpus's seeds.
+    fn other(seed: u64, mode: Mode, rng: &mut Rng, corpus: &Corpus) -> Mutant {
+        let seeds = &corpus.seeds;
+        let (file, other, changes) = match mode {
+            Mode::Tf => {
+                let (file, value) = rng.pick(&seeds.tf);
+                let (text, lines) = kinds::mutated(rng, value);
+                (file.clone(), Other::Tf(file.clone(), text), lines)
+            }
+            Mode::StepModel => {
+                let (text, lines) = kinds::mutated(rng, &seeds.step_model);
+                ("docs/identify_column_a/step_model.json".into(), Other::StepModel(text), lines)
+            }
+            Mode::Snapshot => {
+                let (text, lines) = kinds::mutated(rng, &seeds.snapshot.0);
+                ("flowsheets/surge_tank_pi.json".into(), Other::Snapshot(text), lines)
+            }
+            Mode::Study => {
+                let (args, lines) = kinds::study_args(rng);
+                (args.get(1).cloned().unwrap_or_default(), Other::Study(args), lines)
+            }
+            _ => {
+                let (raw, lines) = kinds::serve_request(rng);
+                ("flowsheets/surge_tank_pi.json".into(), Other::Serve(raw), lines)
+            }
+        };
+        Mutant {
+            seed,
+            mode,
+            file,
+            text: String::new(),
+            scenario: None,
+            sets: Vec::new(),
+            changes: changes.into_iter().map(|c| format!("{c} [{mode:?}]")).collect(),
+            other: Some(other),
         }
     }
 
@@ -226,6 +308,10 @@ impl Mutant {
         let scen = self.scenario.as_ref().map_or(String::new(), |(f, _)| format!(" --scenario {f}"));
         let changes =
             if self.changes.is_empty() { "unmutated [identity]".to_string() } else { self.changes.join("; ") };
-        format!("seed={:#018x} {:?} {}{scen}: {changes}", self.seed, self.mode, self.file)
+        let study = match &self.other {
+            Some(Other::Study(args)) => format!(" (plantwide {})", args.join(" ")),
+            _ => String::new(),
+        };
+        format!("seed={:#018x} {:?} {}{scen}{study}: {changes}", self.seed, self.mode, self.file)
     }
 }

@@ -9,7 +9,8 @@ use plantwide::solve::{DofProbe, dof_check};
 use plantwide::solve::{Solution, StrategySettings, converge};
 
 use super::certificate;
-use super::corpus::{Mode, Mutant};
+use super::corpus::{Corpus, Mode, Mutant, Other};
+use super::kinds;
 
 /// What an honest engine may answer.
 #[derive(Debug)]
@@ -27,7 +28,16 @@ pub enum Outcome {
 pub struct Dishonest(pub String);
 
 /// Run `m`.
-pub fn execute(m: &Mutant) -> Result<Outcome, Dishonest> {
+pub fn execute(m: &Mutant, corpus: &Corpus) -> Result<Outcome, Dishonest> {
+    if let Some(other) = &m.other {
+        return match other {
+            Other::Tf(file, text) => kinds::tf(file, text),
+            Other::StepModel(text) => kinds::step_model(&corpus.seeds.mpc_flowsheet, text),
+            Other::Snapshot(text) => kinds::snapshot(text, &corpus.seeds.snapshot.1),
+            Other::Study(args) => kinds::study(args),
+            Other::Serve(raw) => kinds::serve(raw),
+        };
+    }
     let (mut plant, u) = match load(m) {
         Ok(p) => p,
         Err(e) => return Ok(Outcome::User(e)),
@@ -49,6 +59,7 @@ pub fn execute(m: &Mutant) -> Result<Outcome, Dishonest> {
             plant.set_input_values(&u);
             run(m, &plant, &u)
         }
+        _ => unreachable!("a mutant of another kind carries its input"),
     }
 }
 

@@ -11,8 +11,28 @@ use std::time::{Duration, Instant};
 
 /// Largest single allocation, and largest live total, a mutant may ask for.
 pub const MEMORY_LIMIT: usize = 2 << 30;
-/// Wall time a mutant may take.
+/// Time a mutant may take: it fails when both its wall time and its CPU time pass this (wall time
+/// alone would fail a mutant for the other builds sharing the machine, CPU time alone one that
+/// multiplies matrices on two threads), or when its wall time passes [`STALL_LIMIT`].
 pub const TIME_LIMIT: Duration = Duration::from_secs(10);
+/// Wall time after which a mutant fails however little CPU it used (a stall or a deadlock).
+pub const STALL_LIMIT: Duration = Duration::from_secs(60);
+
+/// CPU time used so far by process `pid` (this one when `None`), from `/proc/<pid>/stat` (user
+/// and system time in the kernel's fixed 100 ticks a second); zero where there is no `/proc`.
+pub fn cpu_time(pid: Option<u32>) -> Duration {
+    let path = pid.map_or_else(|| "/proc/self/stat".to_string(), |p| format!("/proc/{p}/stat"));
+    let Ok(stat) = std::fs::read_to_string(path) else { return Duration::ZERO };
+    // Fields after the command name (which may hold spaces) end in `)`: state is field 3, utime 14.
+    let after = stat.rsplit_once(')').map_or("", |(_, rest)| rest);
+    let ticks: u64 = after.split_whitespace().skip(11).take(2).filter_map(|f| f.parse::<u64>().ok()).sum();
+    Duration::from_millis(ticks * 10)
+}
+
+/// Whether a mutant that has run `wall` and used `cpu` is over the limit.
+pub fn over_limit(wall: Duration, cpu: Duration) -> bool {
+    (wall > TIME_LIMIT && cpu > TIME_LIMIT) || wall > STALL_LIMIT
+}
 
 static LIVE: AtomicUsize = AtomicUsize::new(0);
 /// Live bytes after the warm-up: per-thread scratch the engine keeps for good (faer's gemm
@@ -21,6 +41,8 @@ static BASELINE: AtomicUsize = AtomicUsize::new(usize::MAX / 2);
 static PEAK: AtomicUsize = AtomicUsize::new(0);
 /// Milliseconds since [`epoch`] at which the current mutant started (0: none running).
 static STARTED_MS: AtomicU64 = AtomicU64::new(0);
+/// This process's CPU time when the current mutant started [ms].
+static STARTED_CPU_MS: AtomicU64 = AtomicU64::new(0);
 /// Description of the mutant running now (read without allocating by the guards).
 static CURRENT: Mutex<String> = Mutex::new(String::new());
 
@@ -39,6 +61,7 @@ pub fn begin(description: &str) {
     let _ = std::fs::write(current_file(), description);
     let text = description.to_string();
     *CURRENT.lock().unwrap_or_else(|e| e.into_inner()) = text;
+    STARTED_CPU_MS.store(cpu_time(None).as_millis() as u64, Ordering::SeqCst);
     STARTED_MS.store(epoch().elapsed().as_millis() as u64 + 1, Ordering::SeqCst);
 }
 
@@ -87,8 +110,9 @@ pub fn start_watchdog() {
                 continue;
             }
             let ms = (epoch().elapsed().as_millis() as u64 + 1).saturating_sub(started);
-            if ms > TIME_LIMIT.as_millis() as u64 {
-                die("mutant over the time limit of 10 s", ms as usize, "ms");
+            let cpu = (cpu_time(None).as_millis() as u64).saturating_sub(STARTED_CPU_MS.load(Ordering::SeqCst));
+            if over_limit(Duration::from_millis(ms), Duration::from_millis(cpu)) {
+                die("mutant over the time limit of 10 s of wall and CPU time (ms of wall)", ms as usize, "ms");
             }
         }
     });

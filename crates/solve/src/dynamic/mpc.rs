@@ -171,6 +171,23 @@ pub fn mv_limits(plant: &Plant, name: &str) -> Result<Vec<(f64, f64)>, MpcError>
     Ok(p.mv_scales.iter().enumerate().map(|(k, sc)| (s.u_min[k] * sc, s.u_max[k] * sc)).collect())
 }
 
+/// The step-response model that controller `name` of `plant` reads from its model file, checked
+/// as a run checks it (size limit, known keys, its channels, sample time, full-rank gain).
+///
+/// # Errors
+/// [`MpcError`] when `name` is not a model predictive controller reading a file, or the file is
+/// refused.
+pub fn file_model(plant: &Plant, name: &str) -> Result<StepModel, MpcError> {
+    let Some(ControllerSpec::Mpc(cfg)) = plant.spec().controllers.get(name) else {
+        return Err(fail(name, "not a model predictive controller of the plant"));
+    };
+    let (p, ..) = resolve(plant, name, cfg)?;
+    match &p.model {
+        MpcModelSource::File { file } => model_file(plant, name, cfg, file, &p),
+        MpcModelSource::Builtin(_) => Err(fail(name, "its model is measured by step tests, not read from a file")),
+    }
+}
+
 fn build(plant: &Plant, x: &[f64], name: &str, cfg: &MpcConfig) -> Result<MpcRun, MpcError> {
     let (p, cvs, mv_inputs, sp_inputs) = resolve(plant, name, cfg)?;
     let (model, source) = match &p.model {
@@ -264,6 +281,11 @@ fn model_file(plant: &Plant, name: &str, cfg: &MpcConfig, file: &str, p: &MpcPla
     let path = base.join(file);
     let bad = |reason: String| fail(name, format!("model file {}: {reason}", path.display()));
     let text = plantwide_flowsheet::read_text(&path).map_err(|e| bad(e.to_string()))?;
+    if serde_json::from_str::<serde::de::IgnoredAny>(&text).is_ok()
+        && let Some(d) = plantwide_flowsheet::parse::walk_diagnostics(&text).into_iter().next()
+    {
+        return Err(bad(format!("{}: {}", d.path, d.message)));
+    }
     let de = &mut serde_json::Deserializer::from_str(&text);
     let m: StepModelFile = serde_path_to_error::deserialize(de).map_err(|e| {
         let at = e.path().to_string();
