@@ -182,10 +182,13 @@ fn quality_edits(rng: &mut Rng, closed: &J, roles: &Roles, value: &dyn Fn(&str) 
     let top = &roles.quality[0];
     let xd = value(&roles.cvs[0]);
     let sp = round_sig(1.0 - round_sig((1.0 - xd) * uniform(rng, 1.1, 1.5), 3), 12);
-    let mut edits = vec![Edit {
-        set: format!("{top}.sp={sp}"),
-        file: vec![(vec!["controllers".into(), top.clone(), "sp".into()], J::N(sp))],
-    }];
+    let mut edits = Vec::new();
+    // A purity, not a column that barely separates (a rigorous design whose duty estimate fell
+    // short: xD 0.45 would become a setpoint of 0.28, no question a user asks).
+    if xd > 0.9 {
+        let file = vec![(vec!["controllers".into(), top.clone(), "sp".into()], J::N(sp))];
+        edits.push(Edit { set: format!("{top}.sp={sp}"), file });
+    }
     let level = &roles.levels[rng.below(2)];
     if let Some(J::S(kc)) = closed.at(&["controllers", level, "kc"]) {
         let per_s = plantwide::units::parse_quantity(kc).map(|q| q.value_si).unwrap_or(1e-3);
