@@ -26,7 +26,7 @@ mod exec;
 mod guard;
 mod kinds;
 mod mutate;
-mod rng;
+pub(crate) mod rng;
 mod targeted;
 
 use std::io::Write;

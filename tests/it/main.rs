@@ -5,7 +5,8 @@
 //! paths, converge-and-read helpers, conservation checks). Data live beside the modules:
 //! `tests/broken/`, `tests/hostile/`, `tests/data/`. Run one module with
 //! `cargo test --test it columns::` (a name filter); opt-in slow parts are switched on by
-//! environment variables (`PLANTWIDE_FULL_STUDY=1`, `PLANTWIDE_FUZZ_MUTANTS=…`).
+//! environment variables (`PLANTWIDE_FULL_STUDY=1`, `PLANTWIDE_FUZZ_MUTANTS=…`,
+//! `PLANTWIDE_PLANTS=…`).
 
 mod harness;
 
@@ -22,6 +23,7 @@ mod faults;
 mod fehe;
 mod flowsheets;
 mod fuzz;
+mod generator;
 mod heat_integration;
 mod hostile;
 mod hostile_commands;

@@ -78,8 +78,40 @@ fn check_regular(sv: &[f64], what: &str) -> Result<(), AnalysisError> {
     Ok(())
 }
 
-/// Relative gain array `Λ = G ∘ (G⁻¹)ᵀ` (`G⁺` when `G` is not square).
+/// `D₁ G D₂` with positive diagonal `D₁`, `D₂` that bring every row's and column's largest
+/// magnitude to 1 (alternate row and column sweeps, powers of two so that the scaling is exact).
+/// The relative gains, the Niederlinski index and the minimized condition number of a square `G`
+/// do not depend on the units of its signals, and neither does whether it is singular: a gain
+/// from a reboiler duty in W to a bottoms impurity of 1e-9 is 1e-13, beside 1 mol/s per mol/s,
+/// without the plant being any less controllable. They are computed on this matrix.
+pub fn equilibrated(g: MatRef<'_, f64>) -> Mat<f64> {
+    let mut e = g.to_owned();
+    let pow2 = |m: f64| if m > 0.0 && m.is_finite() { 2f64.powi(-(m.log2().round() as i32)) } else { 1.0 };
+    for _ in 0..4 {
+        for i in 0..e.nrows() {
+            let f = pow2((0..e.ncols()).map(|j| e[(i, j)].abs()).fold(0.0, f64::max));
+            (0..e.ncols()).for_each(|j| e[(i, j)] *= f);
+        }
+        for j in 0..e.ncols() {
+            let f = pow2((0..e.nrows()).map(|i| e[(i, j)].abs()).fold(0.0, f64::max));
+            (0..e.nrows()).for_each(|i| e[(i, j)] *= f);
+        }
+    }
+    e
+}
+
+/// Whether `g` is numerically regular: `σ_min/σ_max` above [`SINGULAR_RATIO`], of the
+/// [`equilibrated`] matrix when `g` is square (whatever the units of its signals).
+pub fn is_regular(g: MatRef<'_, f64>) -> Result<bool, AnalysisError> {
+    let judged = if g.nrows() == g.ncols() { equilibrated(g) } else { g.to_owned() };
+    Ok(check_regular(&svd(judged.as_ref())?.singular_values, "gain matrix").is_ok())
+}
+
+/// Relative gain array `Λ = G ∘ (G⁻¹)ᵀ` (`G⁺` when `G` is not square; a square `G` is
+/// [`equilibrated`] first, which leaves `Λ` as it is).
 pub fn rga(g: MatRef<'_, f64>) -> Result<Mat<f64>, AnalysisError> {
+    let e = if g.nrows() == g.ncols() { Some(equilibrated(g)) } else { None };
+    let g = e.as_ref().map_or(g, |e| e.as_ref());
     let s = svd(g)?;
     check_regular(&s.singular_values, "gain matrix")?;
     let inv = if g.nrows() == g.ncols() {
@@ -389,6 +421,22 @@ pub(crate) mod tests {
     fn singular_gains_are_reported() {
         let g = from_rows(&[vec![1.0, 2.0], vec![2.0, 4.0]]);
         assert!(matches!(rga(g.as_ref()), Err(AnalysisError::Singular(_))));
+        assert!(!is_regular(g.as_ref()).unwrap());
+    }
+
+    #[test]
+    fn gains_in_badly_matched_units_are_not_singular() {
+        // Skogestad's LV column with its boilup in W (×1e-5 per unit) and its bottoms impurity
+        // in ppb-sized units (×1e-9): σ_min/σ_max ≈ 1e-16, yet the same plant, the same RGA.
+        let g = sp_lv();
+        let odd = Mat::from_fn(2, 2, |i, j| g[(i, j)] * [1.0, 1e-9][i] * [1.0, 1e-5][j]);
+        let s = svd(odd.as_ref()).unwrap();
+        assert!(s.singular_values[1] < SINGULAR_RATIO * s.singular_values[0]);
+        assert!(is_regular(odd.as_ref()).unwrap());
+        let (l, m) = (rga(g.as_ref()).unwrap(), rga(odd.as_ref()).unwrap());
+        assert!((0..2).all(|i| (0..2).all(|j| (l[(i, j)] - m[(i, j)]).abs() < 1e-9 * l[(i, j)].abs())), "{m:?}");
+        let e = equilibrated(odd.as_ref());
+        assert!((0..2).all(|i| (0..2).map(|j| e[(i, j)].abs()).fold(0.0, f64::max) > 0.5));
     }
 
     #[test]

@@ -37,10 +37,13 @@ pub fn minimized_condition_number(g: MatRef<'_, f64>) -> Result<f64, AnalysisErr
             g.ncols()
         )));
     }
+    // γ* does not depend on the units of the signals; the equilibrated matrix keeps the
+    // minimization (and its singularity test) away from entries 1e13 apart.
+    let e = crate::measures::equilibrated(g);
     match g.nrows() {
         1 => Ok(1.0),
-        2 => minimized_condition_number_2x2(g),
-        _ => minimized_condition_number_convex(g),
+        2 => minimized_condition_number_2x2(e.as_ref()),
+        _ => minimized_condition_number_convex(e.as_ref()),
     }
 }
 

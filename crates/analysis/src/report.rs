@@ -77,7 +77,8 @@ impl GainReport {
     ) -> Result<GainReport, AnalysisError> {
         let svd = measures::svd(gain.as_ref())?;
         let cond = measures::condition_number(&svd.singular_values);
-        let regular = cond < 1.0 / measures::SINGULAR_RATIO;
+        // Judged whatever the units of the signals (a square G equilibrated first).
+        let regular = measures::is_regular(gain.as_ref())?;
         // A numerically singular G has an infinite condition number (null in JSON).
         let condition_number = if regular { cond } else { f64::INFINITY };
         let rga = if regular { Some(measures::rga(gain.as_ref())?) } else { None };

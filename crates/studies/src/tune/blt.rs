@@ -141,7 +141,7 @@ pub struct LoopSystem<'a> {
 /// Luyben's BLT tuning of the diagonal pairing (output i ↔ input i) of a square model.
 ///
 /// # Errors
-/// [`TuneError::NotSquare`], [`TuneError::SingularGain`] (σ_min/σ_max of `G(0)` below 1e-10),
+/// [`TuneError::NotSquare`], [`TuneError::SingularGain`] (σ_min/σ_max of `G(0)`, equilibrated, below 1e-10),
 /// [`TuneError::NoPhaseCrossover`] naming a diagonal element without an ultimate gain,
 /// [`TuneError::Svd`] when the SVD of `G(0)` fails, [`TuneError::DetuningLimit`] from [`blt_detuning`].
 pub fn blt(model: &TfModel, settings: &BltSettings) -> Result<Tuning, TuneError> {
@@ -167,7 +167,10 @@ pub fn blt_system(system: &LoopSystem<'_>, settings: &BltSettings) -> Result<Tun
     if n != system.inputs.len() || system.ultimates.len() != n {
         return Err(TuneError::NotSquare { model: system.name.clone(), n_outputs: n, n_inputs: system.inputs.len() });
     }
-    let sv = system.gain.singular_values().map_err(|e| TuneError::Svd { detail: format!("{e:?}") })?;
+    // Integral action needs det G(0) ≠ 0, which the units of the signals do not change: judged on
+    // G(0) equilibrated (a reboiler duty in W against a ppm impurity is not a singular plant).
+    let equilibrated = plantwide_analysis::measures::equilibrated(system.gain.as_ref());
+    let sv = equilibrated.singular_values().map_err(|e| TuneError::Svd { detail: format!("{e:?}") })?;
     let (s_max, s_min) = (sv.iter().cloned().fold(0.0, f64::max), sv.iter().cloned().fold(f64::INFINITY, f64::min));
     let ratio = if s_max > 0.0 { s_min / s_max } else { 0.0 };
     if ratio.is_nan() || ratio < 1e-10 {

@@ -1,0 +1,416 @@
+//! The relations, as pure functions of the commands' JSON: `Ok` when a relation holds, else what
+//! breaks it. Each is tested here on a deliberately broken input, so none of them holds vacuously.
+
+use serde_json::{Map, Value};
+
+/// Members of `v` matching `pattern` (`a/*/b`: `*` any key or index), with their paths.
+pub fn matches<'v>(v: &'v Value, pattern: &str) -> Vec<(String, &'v Value)> {
+    let mut found = vec![(String::new(), v)];
+    for seg in pattern.split('/').filter(|s| !s.is_empty()) {
+        let mut next = Vec::new();
+        for (path, node) in found {
+            let children: Vec<(String, &Value)> = match (node, seg) {
+                (Value::Object(m), "*") => m.iter().map(|(k, c)| (k.clone(), c)).collect(),
+                (Value::Array(a), "*") => a.iter().enumerate().map(|(i, c)| (i.to_string(), c)).collect(),
+                (Value::Object(m), k) => m.get(k).map(|c| (k.to_string(), c)).into_iter().collect(),
+                (Value::Array(a), k) => {
+                    k.parse::<usize>().ok().and_then(|i| a.get(i)).map(|c| (k.to_string(), c)).into_iter().collect()
+                }
+                _ => Vec::new(),
+            };
+            next.extend(children.into_iter().map(|(k, c)| (format!("{path}/{k}"), c)));
+        }
+        found = next;
+    }
+    found
+}
+
+/// Every member named `key`, anywhere, with its path.
+fn members<'v>(v: &'v Value, key: &str, path: &str, out: &mut Vec<(String, &'v Value)>) {
+    match v {
+        Value::Object(m) => {
+            for (k, c) in m {
+                let p = format!("{path}/{k}");
+                if k == key {
+                    out.push((p.clone(), c));
+                }
+                members(c, key, &p, out);
+            }
+        }
+        Value::Array(a) => a.iter().enumerate().for_each(|(i, c)| members(c, key, &format!("{path}/{i}"), out)),
+        _ => {}
+    }
+}
+
+/// Exit 0 ⇔ every part succeeded: on exit 0 no `failed` list holds anything, no `failure` is
+/// set and every promised number is there and finite (JSON writes NaN and ∞ as `null`); on exit
+/// 2 with a JSON report, some part is marked failed.
+pub fn honest(v: &Value, code: Option<i32>, promised: &[&str]) -> Result<(), String> {
+    let mut failed = Vec::new();
+    members(v, "failed", "", &mut failed);
+    let mut failure = Vec::new();
+    members(v, "failure", "", &mut failure);
+    let listed: Vec<String> = failed
+        .iter()
+        .filter(|(_, f)| f.as_array().is_some_and(|a| !a.is_empty()))
+        .map(|(p, f)| format!("{p} = {f}"))
+        .chain(failure.iter().filter(|(_, f)| !f.is_null()).map(|(p, f)| format!("{p} = {f}")))
+        .collect();
+    match code {
+        Some(0) => {
+            if let Some(first) = listed.first() {
+                return Err(format!("exit 0 with a failed part: {}", clip(first)));
+            }
+            for pattern in promised {
+                let found = matches(v, pattern);
+                if found.is_empty() {
+                    return Err(format!("exit 0 without the promised `{pattern}`"));
+                }
+                if let Some((p, x)) = found.iter().find(|(_, x)| !x.as_f64().is_some_and(f64::is_finite)) {
+                    return Err(format!("exit 0 with {p} = {x} where a number is promised"));
+                }
+            }
+            Ok(())
+        }
+        Some(2) if listed.is_empty() => {
+            Err("exit 2 with a report whose parts all succeeded (no `failed`, no `failure`)".into())
+        }
+        _ => Ok(()),
+    }
+}
+
+fn clip(s: &str) -> String {
+    s.chars().take(400).collect()
+}
+
+/// `a` and `b` agree to `rel` of the larger magnitude, or `abs`.
+pub fn near(a: f64, b: f64, rel: f64, abs: f64) -> bool {
+    (a - b).abs() <= rel * a.abs().max(b.abs()) + abs
+}
+
+/// Two steady states (`values` maps, path → SI number) name the same variables with the same
+/// values.
+pub fn same_values(a: &Map<String, Value>, b: &Map<String, Value>, rel: f64, abs: f64) -> Result<(), String> {
+    if let Some(k) = a.keys().find(|k| !b.contains_key(*k)).or_else(|| b.keys().find(|k| !a.contains_key(*k))) {
+        return Err(format!("`{k}` is in one answer only ({} against {} values)", a.len(), b.len()));
+    }
+    let mut worst: Option<(f64, &str, f64, f64)> = None;
+    for (k, x) in a {
+        let (x, y) = (x.as_f64().unwrap_or(f64::NAN), b[k].as_f64().unwrap_or(f64::NAN));
+        let excess = (x - y).abs() / (rel * x.abs().max(y.abs()) + abs);
+        if (excess.is_nan() || excess > 1.0) && worst.is_none_or(|w| excess > w.0 || excess.is_nan()) {
+            worst = Some((excess, k, x, y));
+        }
+    }
+    match worst {
+        None => Ok(()),
+        Some((_, k, x, y)) => Err(format!(
+            "`{k}`: {x:e} against {y:e} (relative difference {:.2e})",
+            (x - y).abs() / x.abs().max(y.abs())
+        )),
+    }
+}
+
+/// A JSON matrix of numbers (`null` as NaN).
+pub fn matrix(v: &Value) -> Option<Vec<Vec<f64>>> {
+    v.as_array()?
+        .iter()
+        .map(|row| row.as_array().map(|r| r.iter().map(|x| x.as_f64().unwrap_or(f64::NAN)).collect()))
+        .collect()
+}
+
+/// `b[i][j] = a[rows[i]][cols[j]]` to `rel` of the largest entry of the row in `a`.
+pub fn permuted(a: &[Vec<f64>], b: &[Vec<f64>], rows: &[usize], cols: &[usize], rel: f64) -> Result<(), String> {
+    if b.len() != rows.len() || b.iter().any(|r| r.len() != cols.len()) {
+        return Err(format!(
+            "shape {}×{} against {}×{}",
+            b.len(),
+            b.first().map_or(0, Vec::len),
+            rows.len(),
+            cols.len()
+        ));
+    }
+    for (i, &r) in rows.iter().enumerate() {
+        let scale = a[r].iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        for (j, &c) in cols.iter().enumerate() {
+            if !near(a[r][c], b[i][j], rel, rel * scale * 1e-3) {
+                return Err(format!("entry ({i}, {j}) is {:e}, the permuted entry ({r}, {c}) {:e}", b[i][j], a[r][c]));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The rows of a relative gain array sum to 1.
+pub fn rga_rows_sum_to_one(rga: &[Vec<f64>]) -> Result<(), String> {
+    for (i, row) in rga.iter().enumerate() {
+        let sum: f64 = row.iter().sum();
+        let scale = row.iter().fold(1.0f64, |m, x| m.max(x.abs()));
+        if sum.is_nan() || (sum - 1.0).abs() > 1e-8 * scale {
+            return Err(format!("row {i} of the RGA sums to {sum}"));
+        }
+    }
+    Ok(())
+}
+
+/// Two gain matrices agree element by element to `rel` (an element small against its row's
+/// largest is allowed `rel` of that largest, times `floor`).
+pub fn gains_agree(a: &[Vec<f64>], b: &[Vec<f64>], rel: f64, floor: f64) -> Result<(), String> {
+    let n = a.len();
+    let rows: Vec<usize> = (0..n).collect();
+    let cols: Vec<usize> = (0..a.first().map_or(0, Vec::len)).collect();
+    if b.len() != n {
+        return Err("shapes differ".into());
+    }
+    for i in 0..n {
+        let scale = a[i].iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        for &j in &cols {
+            if !near(a[i][j], b[i][j], rel, rel * floor * scale) {
+                return Err(format!("G[{i}][{j}]: {:e} against {:e}", a[i][j], b[i][j]));
+            }
+        }
+    }
+    let _ = rows;
+    Ok(())
+}
+
+/// The first place where `a` and `b` differ beyond `rel`, members named in `ignore` left out.
+pub fn first_difference(a: &Value, b: &Value, rel: f64, ignore: &[&str], path: &str) -> Option<String> {
+    match (a, b) {
+        (Value::Object(x), Value::Object(y)) => {
+            let keys: std::collections::BTreeSet<&String> = x.keys().chain(y.keys()).collect();
+            keys.into_iter().filter(|k| !ignore.contains(&k.as_str())).find_map(|k| match (x.get(k), y.get(k)) {
+                (Some(p), Some(q)) => first_difference(p, q, rel, ignore, &format!("{path}/{k}")),
+                _ => Some(format!("{path}/{k} is in one only")),
+            })
+        }
+        (Value::Array(x), Value::Array(y)) if x.len() == y.len() => x
+            .iter()
+            .zip(y)
+            .enumerate()
+            .find_map(|(i, (p, q))| first_difference(p, q, rel, ignore, &format!("{path}/{i}"))),
+        (Value::Number(p), Value::Number(q)) => {
+            let (p, q) = (p.as_f64().unwrap_or(f64::NAN), q.as_f64().unwrap_or(f64::NAN));
+            (!near(p, q, rel, 1e-300)).then(|| format!("{path}: {p:e} against {q:e}"))
+        }
+        _ => (a != b).then(|| format!("{path}: {} against {}", clip(&a.to_string()), clip(&b.to_string()))),
+    }
+}
+
+/// A pairing screen's candidate as a comparable key: throughput and sorted pairs.
+fn candidate_key(s: &Value) -> String {
+    let mut pairs: Vec<String> = s["pairs"]
+        .as_array()
+        .map(|a| {
+            a.iter()
+                .map(|p| format!("{}<-{}", p["cv"].as_str().unwrap_or("?"), p["mv"].as_str().unwrap_or("?")))
+                .collect()
+        })
+        .unwrap_or_default();
+    pairs.sort();
+    format!("{} [{}]", s["throughput"].as_str().unwrap_or("-"), pairs.join(", "))
+}
+
+/// Two pairing screens of the same CVs and MVs listed in other orders found the same candidates,
+/// with the same relative gains, filters and ranks.
+pub fn same_pairings(a: &Value, b: &Value) -> Result<(), String> {
+    let table = |v: &Value| -> std::collections::BTreeMap<String, Value> {
+        let list = v["structures"].as_array().cloned().unwrap_or_default();
+        list.iter()
+            .map(|s| {
+                let mut gains: Vec<(String, f64)> = s["pairs"]
+                    .as_array()
+                    .map(|a| a.iter().map(|p| (p["cv"].to_string(), p["relative_gain"].as_f64().unwrap_or(f64::NAN))).collect())
+                    .unwrap_or_default();
+                gains.sort_by(|x, y| x.0.cmp(&y.0));
+                let row = serde_json::json!({"passed": s["passed"], "rank": s["rank"], "rga_number": s["rga_number"],
+                    "niederlinski": s["niederlinski"], "relative_gains": gains.iter().map(|g| g.1).collect::<Vec<_>>()});
+                (candidate_key(s), row)
+            })
+            .collect()
+    };
+    let (ta, tb) = (table(a), table(b));
+    if ta.keys().ne(tb.keys()) {
+        return Err(format!(
+            "candidates {:?} against {:?}",
+            ta.keys().collect::<Vec<_>>(),
+            tb.keys().collect::<Vec<_>>()
+        ));
+    }
+    for (k, x) in &ta {
+        if let Some(d) = first_difference(x, &tb[k], 1e-6, &[], k) {
+            return Err(d);
+        }
+    }
+    Ok(())
+}
+
+/// A ranking agrees with its own dynamic evidence: the candidate ranked first has the best score
+/// of those whose dynamic test completed, or the verdict says the evidence disagrees.
+pub fn ranking_follows_evidence(v: &Value) -> Result<(), String> {
+    let list = v["structures"].as_array().cloned().unwrap_or_default();
+    let completed = |s: &Value| {
+        let d = &s["dynamic"];
+        d.is_object()
+            && d["failure"].is_null()
+            && d["score"].as_f64().is_some()
+            && d["runs"].as_array().is_some_and(|r| r.iter().all(|r| r["failure"].is_null()))
+    };
+    let tested: Vec<&Value> = list.iter().filter(|s| completed(s)).collect();
+    let Some(best) = tested
+        .iter()
+        .min_by(|a, b| a["dynamic"]["score"].as_f64().unwrap().total_cmp(&b["dynamic"]["score"].as_f64().unwrap()))
+    else {
+        return Ok(());
+    };
+    let first = list.iter().find(|s| s["rank"].as_u64() == Some(1));
+    let verdict = v["verdict"].as_str().unwrap_or("");
+    let says = verdict.contains("disagree") || verdict.contains("does not");
+    match first {
+        Some(f) if std::ptr::eq(f, *best) || (completed(f) && f["dynamic"]["score"] == best["dynamic"]["score"]) => {
+            Ok(())
+        }
+        _ if says => Ok(()),
+        Some(f) => Err(format!(
+            "rank 1 is {} (score {}), the best dynamic score is {}'s ({}); the verdict: {}",
+            candidate_key(f),
+            f["dynamic"]["score"],
+            candidate_key(best),
+            best["dynamic"]["score"],
+            clip(verdict)
+        )),
+        None => Err(format!("{} candidates tested, none ranked first; the verdict: {}", tested.len(), clip(verdict))),
+    }
+}
+
+/// A run's conservation entry is within its tolerance.
+pub fn conserved(run: &Value) -> Result<(), String> {
+    let c = &run["conservation"];
+    let (worst, tol) = (c["max_relative_error"].as_f64(), c["tolerance"].as_f64());
+    match (worst, tol) {
+        (Some(w), Some(t)) if w <= t => Ok(()),
+        (Some(w), Some(t)) => {
+            Err(format!("conservation error {w:e} over its tolerance {t:e} ({})", clip(&c["balances"].to_string())))
+        }
+        _ => Err(format!("no conservation figures: {}", clip(&c.to_string()))),
+    }
+}
+
+/// A step and a very short ramp to the same value end at the same state. A ramp of `d` seconds
+/// is, to first order, the step delayed by `d/2`, so a path still moving at the end (at `slope`
+/// per second, from the step's record) ends `slope·d/2` behind: each path's final value agrees with
+/// that to `rel` of how far it moved, plus a tenth of the correction (the slope is a backward
+/// difference over one record interval).
+pub fn same_end(step: &Value, ramp: &Value, slopes: &[(String, f64)], d: f64, rel: f64) -> Result<(), String> {
+    let (a, b) = (step["paths"].as_array(), ramp["paths"].as_array());
+    let (Some(a), Some(b)) = (a, b) else { return Err("no `paths` summary".into()) };
+    if a.len() != b.len() {
+        return Err(format!("{} against {} recorded paths", a.len(), b.len()));
+    }
+    for (p, q) in a.iter().zip(b) {
+        let num = |v: &Value, k: &str| v[k].as_f64().unwrap_or(f64::NAN);
+        let (x, y, x0) = (num(p, "last"), num(q, "last"), num(p, "initial"));
+        let name = p["path"].as_str().unwrap_or("");
+        let slope = slopes.iter().find(|(n, _)| n == name).map_or(0.0, |s| s.1);
+        let (shift, moved) = (slope * d / 2.0, (x - x0).abs());
+        let expected = x - shift;
+        if !near(expected, y, rel * 1e-2, rel * moved + 0.1 * shift.abs() + 1e-12) {
+            return Err(format!(
+                "{name}: the step ends at {x:e} (moving {slope:e}/s, so a {d} s ramp is expected at {expected:e}), the ramp at {y:e} (moved {moved:e})"
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The slope [per second] of each column of a run's CSV over its last record interval (the
+/// header's `time [min]` or `time [s]`).
+pub fn end_slopes(csv: &str) -> Vec<(String, f64)> {
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
+    let rows: Vec<Vec<f64>> = lines.map(|l| l.split(',').map(|c| c.parse().unwrap_or(f64::NAN)).collect()).collect();
+    let per_s = if header.first().is_some_and(|h| h.contains("[min]")) { 60.0 } else { 1.0 };
+    let [.., r0, r1] = rows.as_slice() else { return Vec::new() };
+    let dt = (r1[0] - r0[0]) * per_s;
+    header
+        .iter()
+        .enumerate()
+        .skip(1)
+        .map(|(j, h)| (h.split(" [").next().unwrap_or(h).to_string(), (r1[j] - r0[j]) / dt))
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    #[test]
+    fn honesty_catches_a_failed_part_a_null_number_and_an_empty_failure_list() {
+        let good = json!({"gain": [[1.0, 2.0]], "failed": [], "x": {"failure": null}});
+        assert!(honest(&good, Some(0), &["gain/*/*"]).is_ok());
+        assert!(honest(&json!({"failed": ["run 1: diverged"]}), Some(0), &[]).is_err());
+        assert!(honest(&json!({"a": [{"failure": "no crossover"}]}), Some(0), &[]).is_err());
+        assert!(honest(&json!({"gain": [[1.0, null]]}), Some(0), &["gain/*/*"]).is_err());
+        assert!(honest(&json!({"gain": []}), Some(0), &["rga/*/*"]).is_err());
+        assert!(honest(&json!({"failed": []}), Some(2), &[]).is_err());
+        assert!(honest(&json!({"failed": ["x"]}), Some(2), &[]).is_ok());
+    }
+
+    #[test]
+    fn steady_states_must_match_value_for_value() {
+        let a: Map<String, Value> = serde_json::from_value(json!({"s.F": 1.0, "s.x[a]": 1e-7})).unwrap();
+        let mut b = a.clone();
+        assert!(same_values(&a, &b, 1e-9, 1e-12).is_ok());
+        b.insert("s.x[a]".into(), json!(1.01e-7));
+        assert!(same_values(&a, &b, 1e-9, 1e-12).unwrap_err().contains("s.x[a]"));
+        b.remove("s.x[a]");
+        assert!(same_values(&a, &b, 1e-9, 1e-12).is_err());
+    }
+
+    #[test]
+    fn a_permutation_must_be_the_right_one() {
+        let g = vec![vec![1.0, 2.0], vec![3.0, 4.0]];
+        let swapped = vec![vec![4.0, 3.0], vec![2.0, 1.0]];
+        assert!(permuted(&g, &swapped, &[1, 0], &[1, 0], 1e-12).is_ok());
+        assert!(permuted(&g, &swapped, &[0, 1], &[1, 0], 1e-12).is_err());
+        assert!(rga_rows_sum_to_one(&[vec![2.0, -1.0], vec![-1.0, 2.0]]).is_ok());
+        assert!(rga_rows_sum_to_one(&[vec![2.0, -1.5]]).is_err());
+        assert!(gains_agree(&g, &[vec![1.0, 2.0], vec![3.0, 4.001]], 1e-4, 1e-3).is_err());
+    }
+
+    #[test]
+    fn a_ranking_must_follow_its_dynamic_scores_or_say_so() {
+        let cand = |cv: &str, rank: u64, score: f64| {
+            json!({"throughput": null, "pairs": [{"cv": cv, "mv": "m", "relative_gain": 1.0}], "rank": rank,
+                   "dynamic": {"score": score, "failure": null, "runs": [{"failure": null}]}})
+        };
+        let fine = json!({"structures": [cand("a", 1, 1.0), cand("b", 2, 1.4)], "verdict": "recommended: a"});
+        assert!(ranking_follows_evidence(&fine).is_ok());
+        let wrong = json!({"structures": [cand("a", 1, 1.4), cand("b", 2, 1.0)], "verdict": "recommended: a"});
+        assert!(ranking_follows_evidence(&wrong).is_err());
+        let said =
+            json!({"structures": [cand("a", 1, 1.4), cand("b", 2, 1.0)], "verdict": "…; the evidence disagrees: …"});
+        assert!(ranking_follows_evidence(&said).is_ok());
+        assert!(same_pairings(&fine, &fine).is_ok());
+        let swapped = json!({"structures": [cand("a", 2, 1.0), cand("b", 1, 1.4)], "verdict": "recommended: b"});
+        assert!(same_pairings(&fine, &swapped).is_err());
+    }
+
+    #[test]
+    fn runs_must_conserve_and_a_step_must_end_where_its_ramp_does() {
+        assert!(conserved(&json!({"conservation": {"max_relative_error": 1e-12, "tolerance": 1e-9}})).is_ok());
+        assert!(conserved(&json!({"conservation": {"max_relative_error": 1e-6, "tolerance": 1e-9}})).is_err());
+        let run = |last: f64| json!({"paths": [{"path": "x", "initial": 1.0, "last": last}]});
+        assert!(same_end(&run(2.0), &run(2.0 + 1e-9), &[], 1.0, 1e-5).is_ok());
+        assert!(same_end(&run(2.0), &run(2.01), &[], 1.0, 1e-5).is_err());
+        // Still rising at 1e-3/s: a one-second ramp ends 5e-4 behind the step, not level with it.
+        let slopes = end_slopes("time [min],x [1]\n0,1.5\n1,1.94\n2,2.0\n");
+        assert!((slopes[0].1 - 1e-3).abs() < 1e-12, "{slopes:?}");
+        assert!(same_end(&run(2.0), &run(2.0 - 5e-4), &slopes, 1.0, 1e-5).is_ok());
+        assert!(same_end(&run(2.0), &run(2.0), &slopes, 1.0, 1e-5).is_err());
+        let a = json!({"name": "a", "gain": [[1.0]]});
+        assert!(first_difference(&a, &json!({"name": "b", "gain": [[1.0]]}), 1e-9, &["name"], "").is_none());
+        assert!(first_difference(&a, &json!({"name": "a", "gain": [[1.1]]}), 1e-9, &["name"], "").is_some());
+    }
+}

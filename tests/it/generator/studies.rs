@@ -1,0 +1,231 @@
+//! The studies on the plant as written: `tune` (BLT, a plant test), `screen --cvs/--mvs`, `size`
+//! and `compare`, each asked the same question another way (loops, CVs and MVs listed in another
+//! order; a quantity in other units; a scheme compared with itself) and held to its own evidence.
+
+use serde_json::Value;
+
+use super::cx::Cx;
+use super::doc::J;
+use super::exec::Output;
+use super::relations::{first_difference, matrix, near, ranking_follows_evidence, same_pairings, same_values};
+
+fn tune_blt(cx: &mut Cx<'_>, loops: &[String], write: Option<&str>) -> (Output, Option<Value>) {
+    let mut args = vec!["tune", "plant.json", "--method", "blt", "--measurement-dead-time", "1 min", "--json"];
+    let list = loops.join(",");
+    args.extend(["--loops", &list]);
+    if let Some(w) = write {
+        args.extend(["--write", w]);
+    }
+    let out = cx.pw(&args);
+    let v = cx.succeeded(
+        &out,
+        "tune --method blt",
+        true,
+        &["detuning_factor", "loops/*/kc", "loops/*/tau_i", "loops/*/ku", "loops/*/pu"],
+    );
+    (out, v)
+}
+
+/// BLT of the quality loops: listed the other way round, the same loops get the same settings;
+/// the written file changes only tunings, and its steady state is the plant's.
+pub fn tune_blt_relations(cx: &mut Cx<'_>) {
+    let q = cx.case.roles.quality.to_vec();
+    let (a, va) = tune_blt(cx, &q, Some("tuned.json"));
+    let Some(va) = va else { return };
+    let reversed: Vec<String> = q.iter().rev().cloned().collect();
+    let (b, vb) = tune_blt(cx, &reversed, None);
+    if let Some(vb) = vb {
+        let by_name = |v: &Value| -> Value {
+            let mut m = serde_json::Map::new();
+            for l in v["loops"].as_array().cloned().unwrap_or_default() {
+                m.insert(l["controller"].as_str().unwrap_or("?").to_string(), l);
+            }
+            serde_json::json!({"detuning_factor": v["detuning_factor"], "loops": m})
+        };
+        let d = first_difference(&by_name(&va), &by_name(&vb), 1e-6, &[], "");
+        cx.check(
+            d.is_none(),
+            "tune --method blt: listing the loops in another order changes their tuning",
+            &[&a, &b],
+            || d.unwrap_or_default(),
+        );
+    }
+    let written = std::fs::read_to_string(cx.dir.join("tuned.json")).unwrap_or_default();
+    let (orig, new): (Value, Value) = (
+        serde_json::from_str(&cx.case.closed.render()).unwrap_or_default(),
+        serde_json::from_str(&written).unwrap_or_default(),
+    );
+    let d = first_difference(&orig, &new, 0.0, &["kc", "tau_i", "tau_d"], "");
+    cx.check(d.is_none(), "tune --write changes more than kc, tau_i, tau_d", &[&a], || d.unwrap_or_default());
+    let s = cx.pw(&["steady", "tuned.json", "--json"]);
+    if let Some(v) = cx.succeeded(&s, "steady", true, &["values/*"]) {
+        let tuned = v["values"].as_object().cloned().unwrap_or_default();
+        let same = same_values(&physical(cx, &cx.values), &physical(cx, &tuned), 1e-8, 1e-12);
+        cx.agree(same, "tune --write: the tuned plant's steady state is not the plant's", &[&a, &s]);
+    }
+}
+
+/// A steady state without the controllers' own states: a PI's integral sits at
+/// `(op − bias) τ_I / Kc`, so retuning moves it while the plant stays where it was.
+fn physical(cx: &Cx<'_>, values: &serde_json::Map<String, Value>) -> serde_json::Map<String, Value> {
+    let controllers: Vec<String> = match cx.case.closed.get("controllers") {
+        Some(J::O(m)) => m.iter().map(|(k, _)| k.clone()).collect(),
+        _ => Vec::new(),
+    };
+    let internal = |k: &str| controllers.iter().any(|c| k == format!("{c}.I") || k == format!("{c}.xf"));
+    values.iter().filter(|(k, _)| !internal(k)).map(|(k, v)| (k.clone(), v.clone())).collect()
+}
+
+/// One plant test on the nonlinear model, chosen by `pick`: a relay test against BLT's linear
+/// ultimate gain, a SIMC step test against the exact gain, averaging level against its closed form.
+pub fn tune_plant_test(cx: &mut Cx<'_>, pick: usize) {
+    let r = cx.case.roles.clone();
+    let k = pick / 3 % 2;
+    let manual = format!("{}.auto=0", r.quality[1 - k]);
+    match pick % 3 {
+        0 => {
+            let args = [
+                "tune",
+                "plant.json",
+                "--loop",
+                &r.quality[k],
+                "--method",
+                "relay",
+                "--measurement-dead-time",
+                "1 min",
+                "--set",
+                &manual,
+                "--json",
+            ];
+            let out = cx.pw(&args);
+            let Some(v) = cx.succeeded(&out, "tune --method relay", true, &["loops/0/ku", "loops/0/pu", "loops/0/kc"])
+            else {
+                return;
+            };
+            let args = [
+                "tune",
+                "plant.json",
+                "--loops",
+                &r.quality[k],
+                "--method",
+                "blt",
+                "--measurement-dead-time",
+                "1 min",
+                "--set",
+                &manual,
+                "--json",
+            ];
+            let lin = cx.pw(&args);
+            let Some(w) = cx.succeeded(&lin, "tune --method blt", true, &["loops/0/ku"]) else { return };
+            let (ku, linear) = (
+                v["loops"][0]["ku"].as_f64().unwrap_or(f64::NAN).abs(),
+                w["loops"][0]["ku"].as_f64().unwrap_or(f64::NAN).abs(),
+            );
+            let fine = ku / linear > 0.6 && ku / linear < 1.6;
+            cx.check(
+                fine,
+                "tune --method relay: Ku off the linear model's by more than a describing function's error",
+                &[&out, &lin],
+                || format!("relay Ku {ku:e}, linear {linear:e}"),
+            );
+        }
+        1 => {
+            let args = ["tune", "plant.json", "--loop", &r.quality[k], "--method", "simc", "--set", &manual, "--json"];
+            let out = cx.pw(&args);
+            let Some(v) =
+                cx.succeeded(&out, "tune --method simc", true, &["loops/0/kc", "loops/0/tau_i", "loops/0/fit/model/k"])
+            else {
+                return;
+            };
+            let g = cx.pw(&["gains", "open.json", "--inputs", &r.mvs[k], "--outputs", &r.cvs[k], "--json"]);
+            let Some(w) = cx.succeeded(&g, "gains", true, &["gain/0/0"]) else { return };
+            let (fit, exact) = (
+                v["loops"][0]["fit"]["model"]["k"].as_f64().unwrap_or(f64::NAN),
+                w["gain"][0][0].as_f64().unwrap_or(f64::NAN),
+            );
+            let ratio = fit / exact;
+            cx.check(
+                ratio > 0.5 && ratio < 2.0,
+                "tune --method simc: the fitted gain is off the exact gain by over 2x",
+                &[&out, &g],
+                || format!("fitted {fit:e}, exact {exact:e}"),
+            );
+        }
+        _ => {
+            let level = &r.levels[k];
+            let out = cx.pw(&["tune", "plant.json", "--loop", level, "--method", "averaging", "--json"]);
+            let Some(v) = cx.succeeded(&out, "tune --method averaging", true, &["loops/0/kc"]) else { return };
+            // The defaults are 10 % of the output and a quarter of the measurement, both at the
+            // steady state (a P-only level sits off its setpoint).
+            let field = |f: &str| match cx.case.closed.at(&["controllers", level, f]) {
+                Some(J::S(s)) => s.clone(),
+                _ => String::new(),
+            };
+            let flow = cx.value(&format!("{level}.op")).unwrap_or(f64::NAN);
+            let level_now = cx.value(&field("pv")).unwrap_or(f64::NAN);
+            let (kc, expected) =
+                (v["loops"][0]["kc"].as_f64().unwrap_or(f64::NAN).abs(), 0.1 * flow.abs() / (0.25 * level_now.abs()));
+            cx.check(
+                near(kc, expected, 1e-9, 0.0),
+                "tune --method averaging: P gain is not 10 % of the flow over a quarter of the level",
+                &[&out],
+                || format!("kc {kc:e}, closed form {expected:e} (op {flow:e}, level {level_now:e})"),
+            );
+        }
+    }
+}
+
+fn screen(cx: &mut Cx<'_>, cvs: &[String], mvs: &[String], throughput: &[String]) -> (Output, Option<Value>) {
+    let t = cx.case.roles.throughput.clone();
+    let (c, m) = (cvs.join(","), mvs.join(","));
+    let mut args = vec!["screen", "plant.json", "--cvs", &c, "--mvs", &m, "--disturbances", &t, "--json"];
+    let tp = throughput.join(",");
+    if !throughput.is_empty() {
+        args.extend(["--throughput", &tp]);
+    }
+    let out = cx.pw(&args);
+    let v = cx.succeeded(
+        &out,
+        "screen --cvs/--mvs",
+        true,
+        &["gain/*/*", "structures/*/rga_number", "structures/*/pairs/*/relative_gain"],
+    );
+    (out, v)
+}
+
+/// `screen --cvs/--mvs` with dynamic tests: its ranking follows its own runs, and the CVs and
+/// MVs listed the other way round find the same candidates ranked the same.
+pub fn screen_pairings(cx: &mut Cx<'_>, with_throughput: bool) {
+    let r = cx.case.roles.clone();
+    let (cvs, mut mvs) = (r.cvs.to_vec(), r.mvs.to_vec());
+    let throughput = if with_throughput {
+        mvs.push(r.throughput.clone());
+        vec![r.throughput.clone(), r.mvs[0].clone()]
+    } else {
+        Vec::new()
+    };
+    let (a, va) = screen(cx, &cvs, &mvs, &throughput);
+    let Some(va) = va else { return };
+    cx.agree(
+        ranking_follows_evidence(&va),
+        "screen --cvs/--mvs: rank 1 is not the best dynamic score and the verdict does not say so",
+        &[&a],
+    );
+    let rev = |v: &[String]| v.iter().rev().cloned().collect::<Vec<_>>();
+    let (b, vb) = screen(cx, &rev(&cvs), &rev(&mvs), &throughput);
+    if let Some(vb) = vb {
+        cx.agree(
+            same_pairings(&va, &vb),
+            "screen --cvs/--mvs: listing CVs and MVs in another order changes the candidates or their ranks",
+            &[&a, &b],
+        );
+        let (ga, gb) = (matrix(&va["gain"]).unwrap_or_default(), matrix(&vb["gain"]).unwrap_or_default());
+        let (n, m) = (cvs.len(), mvs.len());
+        let (rows, cols): (Vec<usize>, Vec<usize>) = ((0..n).rev().collect(), (0..m).rev().collect());
+        cx.agree(
+            super::relations::permuted(&ga, &gb, &rows, &cols, 1e-9),
+            "screen --cvs/--mvs: the open plant's gains are not permuted with the lists",
+            &[&a, &b],
+        );
+    }
+}
