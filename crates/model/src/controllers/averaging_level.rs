@@ -230,7 +230,7 @@ fn optimal(c: &AveragingLevelConfig, cx: &mut BuildCx<'_>, links: &ControllerLin
 
 fn error_squared(c: &AveragingLevelConfig, cx: &mut BuildCx<'_>, links: &ControllerLinks) -> Law {
     let kc = match &c.kc {
-        Some(k) => cx.positive("kc", k, gain_dimension(links)),
+        Some(k) => cx.gain("kc", k, gain_dimension(links)),
         None => {
             cx.error("kc", "is required by \"law\": \"error_squared\"");
             f64::NAN

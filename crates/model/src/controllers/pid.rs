@@ -116,7 +116,7 @@ impl Pid {
             Setpoint::Value(v) => (None, cx.quantity("sp", v, links.pv_dim)),
             Setpoint::Remote { from } => (Some(from.clone()), f64::NAN),
         };
-        let kc = cx.positive("kc", &c.kc, gain_dimension(links));
+        let kc = cx.gain("kc", &c.kc, gain_dimension(links));
         let tau_i = c.tau_i.as_ref().map(|t| cx.positive("tau_i", t, Dimension::TIME));
         let tau_d = c.tau_d.as_ref().map(|t| cx.positive("tau_d", t, Dimension::TIME));
         let filter_ratio = c.filter_ratio.unwrap_or(10.0);
