@@ -88,6 +88,16 @@ pub fn identify(cx: &mut Cx<'_>, g: &[Vec<f64>]) {
         &outputs[..2].join(","),
         "--json",
     ]);
+    // A model the test cannot resolve (a short test of a high-purity column) is refused by its
+    // verdict, exit 2 naming the failed criteria: the honest answer, not a failure of the study.
+    if out.code == Some(2)
+        && let Some(v) = out.json()
+    {
+        let refused =
+            v["verdict"]["reliable"] == false && v["verdict"]["failed"].as_array().is_some_and(|a| !a.is_empty());
+        cx.check(refused, "identify: exit 2 without a verdict naming what failed", &[&out], || out.brief());
+        return;
+    }
     let Some(v) = cx.succeeded(&out, "identify", true, &["gain/*/*", "rga/*/*", "exact/gain/*/*"]) else { return };
     let exact = matrix(&v["exact"]["gain"]).unwrap_or_default();
     let g2: Vec<Vec<f64>> = g[..2].iter().map(|r| r[..2].to_vec()).collect();

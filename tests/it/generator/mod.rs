@@ -39,7 +39,6 @@ mod studies;
 mod thermo;
 
 use std::collections::BTreeMap;
-use std::io::Write;
 use std::path::PathBuf;
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
@@ -53,20 +52,7 @@ const DEFAULT_SEED: u64 = 0x9e4e_2a70_0053_0005;
 /// Plants in the CI sample.
 const CI_PLANTS: usize = 20;
 
-/// Print to the real stderr (the summary shows without `--nocapture`).
-fn say(line: &str) {
-    let _ = writeln!(std::io::stderr(), "{line}");
-}
-
-fn env_u64(name: &str) -> Option<u64> {
-    let v = std::env::var(name).ok()?;
-    let v = v.trim();
-    match v.strip_prefix("0x") {
-        Some(hex) => u64::from_str_radix(hex, 16).ok(),
-        None => v.parse().ok(),
-    }
-    .or_else(|| panic!("{name}={v}: not a number"))
-}
+use crate::harness::{env_u64, say};
 
 fn target() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target")

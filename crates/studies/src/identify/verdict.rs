@@ -143,6 +143,9 @@ pub struct Verdict {
     pub model: String,
     /// Every criterion, deciding ones first.
     pub criteria: Vec<Criterion>,
+    /// The deciding criteria that failed, one line each (empty for a usable model): the
+    /// `failed` entry every study's JSON carries for a part it could not do.
+    pub failed: Vec<String>,
 }
 
 impl Verdict {
@@ -234,10 +237,12 @@ pub(super) fn judge(r: &Reference<'_>, chosen: &[&Fitted]) -> Verdict {
         criteria.extend(residual_criteria(&f.validation, &o.path));
     }
     criteria.sort_by_key(|c| !c.decides);
+    let failed = criteria.iter().filter(|c| c.decides && !c.pass).map(Criterion::line).collect();
     Verdict {
         reliable: criteria.iter().all(|c| c.pass || !c.decides),
         model: chosen.first().map_or_else(String::new, |f| f.model.to_string()),
         criteria,
+        failed,
     }
 }
 
