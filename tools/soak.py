@@ -143,11 +143,22 @@ def disturbances(s, parts, n):
         s.add(at, event)
 
 
-def faults(s, parts, n):
-    """`n` random faults, each ended by the scenario."""
+def is_level(pid):
+    """A level (inventory) loop: its measurement a level or a holdup."""
+    return ".level" in pid["pv"] or ".M[" in pid["pv"]
+
+
+def faults(s, parts, n, severe=False):
+    """`n` random faults, each ended by the scenario. Without `severe` they are those a plant rides
+    through: valves stuck where they are, feeds lost and restored, analyzers frozen, quality loops
+    to manual. `severe` adds valves failed closed and level loops to manual, after which a plant
+    may trip (a drum drawn dry by its reflux once the boilup valve has failed closed): the run
+    then stops naming the vessel, which the soak counts as a trip, not a failure."""
     rng = s.rng
+    kinds = ["stuck", "feed_lost", "analyzer", "manual"] + (["failed"] if severe else [])
+    pids = sorted(c for c, p in parts["pids"].items() if severe or not is_level(p))
     for _ in range(n):
-        kind = rng.choice(["stuck", "failed", "feed_lost", "analyzer", "manual"])
+        kind = rng.choice(kinds)
         length = rng.uniform(0.25, 4.0)
         if kind in ("stuck", "failed") and parts["outputs"]:
             path = rng.choice(parts["outputs"])
@@ -172,19 +183,19 @@ def faults(s, parts, n):
             if at is not None:
                 s.add(at, {"type": "analyzer_frozen", "controller": c})
                 s.add(at + length, {"type": "analyzer_repaired", "controller": c})
-        elif kind == "manual":
-            c = rng.choice(sorted(parts["pids"]))
+        elif kind == "manual" and pids:
+            c = rng.choice(pids)
             at = s.slot(parts["pids"][c]["output"], length)
             if at is not None:
                 s.add(at, {"type": "mode", "controller": c, "mode": "manual"})
                 s.add(at + length, {"type": "mode", "controller": c, "mode": "auto"})
 
 
-def scenario(parts, seed, days, snap_dir):
+def scenario(parts, seed, days, snap_dir, severe=False):
     hours = 24 * days
     s = Schedule(random.Random(seed), hours)
     disturbances(s, parts, hours // 3)
-    faults(s, parts, hours // 8)
+    faults(s, parts, hours // 8, severe)
     return {
         "format_version": 1,
         "name": f"soak seed {seed}",
@@ -210,13 +221,13 @@ def run(args, bin_path):
         return proc.returncode, out.read(), err.read(), took, usage.ru_maxrss / 1024
 
 
-def soak_one(bin_path, plant, seed, days, work):
+def soak_one(bin_path, plant, seed, days, work, severe=False):
     fs = os.path.join(ROOT, "flowsheets", f"{plant}.json")
     parts = plant_parts(fs)
     snap_dir = os.path.join(work, f"{plant}_{seed}")
     os.makedirs(snap_dir, exist_ok=True)
     result = {"plant": plant, "seed": seed, "failures": []}
-    sc = scenario(parts, seed, days, snap_dir)
+    sc = scenario(parts, seed, days, snap_dir, severe)
     sc_path = os.path.join(snap_dir, "scenario.json")
     with open(sc_path, "w") as f:
         json.dump(sc, f, indent=1)
@@ -282,6 +293,8 @@ def main():
     ap.add_argument("--bin", default=os.path.join(ROOT, "target", "release", "plantwide"))
     ap.add_argument("--work", default=None, help="folder for scenarios, snapshots and CSVs (default: a temporary one)")
     ap.add_argument("--serve-minutes", type=float, default=0)
+    ap.add_argument("--severe", action="store_true",
+                    help="also valves failed closed and level loops to manual (plants may trip, named)")
     ap.add_argument("--json", action="store_true", help="print the report as JSON")
     a = ap.parse_args()
     a.days = int(a.days) if a.days == int(a.days) else a.days
@@ -289,7 +302,7 @@ def main():
     results = []
     for plant in a.plants.split(","):
         for seed in [int(s) for s in a.seeds.split(",")]:
-            r = soak_one(a.bin, plant, seed, a.days, work)
+            r = soak_one(a.bin, plant, seed, a.days, work, a.severe)
             results.append(r)
             print(f"{plant} seed {seed}: {r.get('events', 0)} events, {r.get('hours', 0)} h in {r.get('seconds', 0):.2f} s, "
                   f"{r.get('resumed', 0)} resumes, conservation {r.get('conservation', float('nan')):.1e}, "

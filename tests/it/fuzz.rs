@@ -29,7 +29,6 @@ mod mutate;
 pub(crate) mod rng;
 mod targeted;
 
-use std::io::Write;
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
@@ -47,20 +46,7 @@ const DEFAULT_MUTANTS: usize = 2000;
 /// Message and place of the last panic (the quiet hook keeps it here instead of printing).
 static LAST_PANIC: Mutex<String> = Mutex::new(String::new());
 
-/// Print to the real stderr (not captured by the test harness: the summary always shows).
-fn say(line: &str) {
-    let _ = writeln!(std::io::stderr(), "{line}");
-}
-
-fn env_u64(name: &str) -> Option<u64> {
-    let v = std::env::var(name).ok()?;
-    let v = v.trim();
-    match v.strip_prefix("0x") {
-        Some(hex) => u64::from_str_radix(hex, 16).ok(),
-        None => v.parse().ok(),
-    }
-    .or_else(|| panic!("{name}={v}: not a number"))
-}
+use crate::harness::{env_u64, say};
 
 /// Counts and extremes of a campaign.
 #[derive(Default)]

@@ -79,3 +79,21 @@ pub fn component_balance_error(plant: &Plant, x: &[f64], generating: &[&str]) ->
     }
     worst
 }
+
+/// Print to the real stderr (not captured by the test harness: a campaign's summary always shows).
+pub fn say(line: &str) {
+    use std::io::Write;
+    let _ = writeln!(std::io::stderr(), "{line}");
+}
+
+/// An environment variable read as a count or a seed (decimal or `0x` hex); a value that is not a
+/// number fails the test naming it.
+pub fn env_u64(name: &str) -> Option<u64> {
+    let v = std::env::var(name).ok()?;
+    let v = v.trim();
+    match v.strip_prefix("0x") {
+        Some(hex) => u64::from_str_radix(hex, 16).ok(),
+        None => v.parse().ok(),
+    }
+    .or_else(|| panic!("{name}={v}: not a number"))
+}
