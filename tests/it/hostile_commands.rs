@@ -378,3 +378,47 @@ fn a_transfer_function_of_ten_thousand_lags_is_refused_by_field() {
     .unwrap();
     expect(&["tune", "--tf", file.to_str().unwrap(), "--method", "zn"], 1, &["elements[0].lags", "more than the 200"]);
 }
+
+/// Found by the 100 000-mutant fuzz: a step model or transfer-function file with more after its
+/// JSON was read as if the rest were not there, an empty transfer-function model exported null
+/// coefficients, and a snapshot whose history is empty panicked before it was checked.
+#[test]
+fn trailing_text_empty_models_and_hollow_snapshots_are_refused() {
+    let dir = scratch("fuzz100k");
+    let tf = dir.join("empty.tf.json");
+    std::fs::write(
+        &tf,
+        r#"{"format_version": 1, "name": "t", "inputs": [{"name": "u"}], "outputs": [{"name": "y"}], "elements": []}"#,
+    )
+    .unwrap();
+    expect(&["linearize", "--tf", tf.to_str().unwrap()], 1, &["elements", "at least one element"]);
+    let trailing = dir.join("trailing.tf.json");
+    std::fs::write(
+        &trailing,
+        r#"{"format_version": 1, "name": "t", "inputs": [{"name": "u"}], "outputs": [{"name": "y"}],
+            "elements": [{"output": "y", "input": "u", "gain": 1.0, "lags": ["1 min"]}]} extra"#,
+    )
+    .unwrap();
+    expect(&["linearize", "--tf", trailing.to_str().unwrap()], 1, &["trailing characters"]);
+    // A snapshot of the surge tank with its history emptied.
+    let tank = harness::flowsheet("surge_tank_pi.json");
+    let scenario = dir.join("s.json");
+    let snap = dir.join("snap.json");
+    std::fs::write(
+        &scenario,
+        format!(
+            r#"{{"format_version": 1, "duration": "100 s", "snapshots": [{{"at": "50 s", "file": "{}"}}]}}"#,
+            snap.display()
+        ),
+    )
+    .unwrap();
+    let csv = dir.join("o.csv");
+    let run = ["run", &tank, "--scenario", scenario.to_str().unwrap(), "--csv", csv.to_str().unwrap()];
+    expect(&run, 0, &[]);
+    let mut s: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&snap).unwrap()).unwrap();
+    s["integrator"]["d"] = serde_json::json!([]);
+    let hollow = dir.join("hollow.json");
+    std::fs::write(&hollow, s.to_string()).unwrap();
+    let resume = [&run[..], &["--resume", hollow.to_str().unwrap()]].concat();
+    expect(&resume, 1, &["does not fit this plant", "integrator state"]);
+}

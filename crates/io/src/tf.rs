@@ -97,10 +97,18 @@ pub fn parse(text: &str, file: &str) -> Result<TfModel, IoError> {
         return Err(tf_error(file, if d.path.is_empty() { "(top level)".to_string() } else { d.path }, d.message));
     }
     let de = &mut serde_json::Deserializer::from_str(text);
-    let spec: TfFile = serde_path_to_error::deserialize(de).map_err(|e| {
+    let spec: TfFile = serde_path_to_error::deserialize(&mut *de).map_err(|e| {
         let path = e.path().to_string();
         tf_error(file, if path == "." { "(top level)".to_string() } else { path }, e.into_inner().to_string())
     })?;
+    de.end().map_err(|e| tf_error(file, "(top level)", e.to_string()))?;
+    if spec.elements.is_empty() {
+        return Err(tf_error(
+            file,
+            "elements",
+            "a model needs at least one element (an output's response to an input)",
+        ));
+    }
     if spec.format_version != 1 {
         return Err(tf_error(
             file,

@@ -513,7 +513,7 @@ pub fn serve(raw: &str) -> Result<Outcome, Dishonest> {
     let raw = raw.replace("{port}", &s.port.to_string()).replace("{token}", &s.token);
     match request(s.port, &raw) {
         Ok(200) => Ok(Outcome::Ok),
-        Ok(c @ (400 | 401 | 403 | 404 | 405 | 413 | 415 | 429)) => Ok(Outcome::User(format!("HTTP {c}"))),
+        Ok(c @ (400 | 401 | 403 | 404 | 405 | 409 | 413 | 415 | 429)) => Ok(Outcome::User(format!("HTTP {c}"))),
         Ok(c) => Err(Dishonest(format!("HTTP {c}"))),
         Err(e) => Err(Dishonest(format!("the server did not answer: {e}"))),
     }

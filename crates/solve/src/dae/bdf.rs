@@ -184,6 +184,27 @@ pub struct BdfState {
     pub stats: BdfStats,
 }
 
+impl BdfState {
+    /// Whether this state fits a system of `n` variables: the history rows, the order and the
+    /// Jacobian's indices (a snapshot file is read from outside).
+    ///
+    /// # Errors
+    /// What does not fit, in a sentence.
+    pub fn check(&self, n: usize) -> Result<(), String> {
+        if self.d.len() != MAX_ORDER + 3 || self.d.iter().any(|r| r.len() != n) {
+            return Err(format!("expected {} history rows of length {n}", MAX_ORDER + 3));
+        }
+        if !(1..=MAX_ORDER).contains(&self.order) || self.jac.iter().any(|&(i, j, _)| i >= n || j >= n) {
+            return Err("order or Jacobian out of range".into());
+        }
+        let finite = |v: f64| v.is_finite();
+        if !(finite(self.t) && finite(self.h_abs) && self.h_abs > 0.0) {
+            return Err("time or step size not a positive finite number".into());
+        }
+        Ok(())
+    }
+}
+
 /// The BDF integrator (see the module documentation).
 #[derive(Debug)]
 pub struct Bdf {
@@ -587,13 +608,7 @@ impl Bdf {
     /// Continue from a saved state (the same system): the trajectory continues exactly as it would
     /// have without the interruption.
     pub fn restore(&mut self, sys: &dyn DaeSystem, state: BdfState) -> Result<(), DaeError> {
-        let n = sys.n();
-        if state.d.len() != MAX_ORDER + 3 || state.d.iter().any(|r| r.len() != n) {
-            return Err(DaeError::BadState(format!("expected {} history rows of length {n}", MAX_ORDER + 3)));
-        }
-        if !(1..=MAX_ORDER).contains(&state.order) || state.jac.iter().any(|&(i, j, _)| i >= n || j >= n) {
-            return Err(DaeError::BadState("order or Jacobian out of range".into()));
-        }
+        state.check(sys.n()).map_err(DaeError::BadState)?;
         self.bind(sys);
         self.st = state;
         if !self.hist_all {

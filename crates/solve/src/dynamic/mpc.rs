@@ -287,11 +287,13 @@ fn model_file(plant: &Plant, name: &str, cfg: &MpcConfig, file: &str, p: &MpcPla
         return Err(bad(format!("{}: {}", d.path, d.message)));
     }
     let de = &mut serde_json::Deserializer::from_str(&text);
-    let m: StepModelFile = serde_path_to_error::deserialize(de).map_err(|e| {
+    let m: StepModelFile = serde_path_to_error::deserialize(&mut *de).map_err(|e| {
         let at = e.path().to_string();
         let at = if at == "." { String::new() } else { format!("{at}: ") };
         bad(format!("{at}{}", e.into_inner()))
     })?;
+    // Nothing after the model: a file with more in it is not the file it seems.
+    de.end().map_err(|e| bad(e.to_string()))?;
     let (ny, nu) = (cfg.cvs.len(), cfg.mvs.len());
     if m.model.ny != ny || m.model.nu != nu {
         return Err(bad(format!("is {}×{} but the controller has {ny} CVs and {nu} MVs", m.model.ny, m.model.nu)));

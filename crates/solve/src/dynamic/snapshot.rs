@@ -115,7 +115,7 @@ pub(super) struct Resumed {
 pub(super) fn mapped_state(plant: &Plant, paths: &[String], n_state: usize, s: &Snapshot) -> Vec<f64> {
     let mut v = plant.initial_guess();
     v.resize(n_state, 0.0);
-    for (p, val) in s.paths.iter().zip(&s.integrator.d[0]) {
+    for (p, val) in s.paths.iter().zip(s.integrator.d.first().into_iter().flatten()) {
         if let Some(k) = paths.iter().position(|q| q == p) {
             v[k] = *val;
         }
@@ -167,5 +167,10 @@ pub(super) fn resume(
     }
     driver.snapshots_done.resize(sc.snapshots.len(), true);
     driver.frozen.resize(sc.analyzers.len(), false);
+    // Checked here, where a snapshot that does not fit is refused as such: found at the start of
+    // the run, the run had no state to hand out with its failure.
+    if same {
+        s.integrator.check(paths.len()).map_err(|why| bad(format!("its integrator state: {why}")))?;
+    }
     Ok(Resumed { driver, integrator: same.then(|| s.integrator.clone()) })
 }
