@@ -45,8 +45,15 @@ impl StepModel {
         if self.steps.is_empty() {
             return Err(MpcError::invalid("steps", "need at least one coefficient"));
         }
+        // A row of ny·nu coefficients: sizes whose product overflows cannot match any row.
+        let Some(width) = self.ny.checked_mul(self.nu) else {
+            return Err(MpcError::invalid(
+                "ny",
+                format!("{} × {} channels is not a size a model can have", self.ny, self.nu),
+            ));
+        };
         for (k, row) in self.steps.iter().enumerate() {
-            check_len("steps", row, self.ny * self.nu)?;
+            check_len("steps", row, width)?;
             if row.iter().any(|x| !x.is_finite()) {
                 return Err(MpcError::invalid("steps", format!("row {k} has a non-finite entry")));
             }

@@ -200,7 +200,7 @@ fn horizons(c: &MpcConfig, cx: &mut BuildCx<'_>) -> (usize, usize, usize) {
     if m < 1 || m > p {
         cx.error("control_horizon", format!("must be 1 … prediction_horizon = {p} samples (got {m})"));
     }
-    let n = c.model_length.unwrap_or(2 * p);
+    let n = c.model_length.unwrap_or(p.saturating_mul(2));
     if !(1..=MAX_HORIZON).contains(&n) {
         cx.error("model_length", format!("must be 1 … {MAX_HORIZON} samples (got {n})"));
     }
