@@ -141,8 +141,11 @@ pub(super) fn resume(
         return Err(bad(format!("snapshot format_version {} (this build reads {SNAPSHOT_VERSION})", s.format_version)));
     }
     for p in &s.driver.stuck {
-        let i =
-            plant.inputs().iter().position(|i| i.path == *p).ok_or_else(|| bad(format!("no input `{p}` to freeze")))?;
+        let i = plant
+            .inputs()
+            .iter()
+            .position(|i| i.path == *p)
+            .ok_or_else(|| bad(format!("no input `{}` to freeze", plantwide_model::limits::clip(p))))?;
         plant.hold_input(i);
         sampled.iter_mut().for_each(|s| s.retain(|&(j, _)| j != i));
     }
