@@ -184,6 +184,14 @@ pub struct BdfState {
     pub stats: BdfStats,
 }
 
+impl Bdf {
+    /// Whether the integrator holds a state (started or restored): a run that fails at its very
+    /// start has none to hand out.
+    pub fn has_state(&self) -> bool {
+        !self.st.d.is_empty()
+    }
+}
+
 impl BdfState {
     /// Whether this state fits a system of `n` variables: the history rows, the order and the
     /// Jacobian's indices (a snapshot file is read from outside).

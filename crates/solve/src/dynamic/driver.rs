@@ -726,7 +726,8 @@ impl<'p> Driver<'p> {
     /// Material balances from `x0` to the integrator's state.
     fn conservation(&self) -> Conservation {
         let (plant, nc, np) = (&self.plant, self.plant.components().len(), self.plant.n_vars());
-        let (t, x1) = (self.bdf.t(), self.bdf.x());
+        // A run that failed at its start ends where it started.
+        let (t, x1) = if self.bdf.has_state() { (self.bdf.t(), self.bdf.x()) } else { (self.t0, &self.x0[..]) };
         let u = values_at(&self.st.waveforms, t);
         let held = [
             conservation::plant_holdup(plant, &self.x0[..np], &u, self.t0),
@@ -763,7 +764,9 @@ impl<'p> Driver<'p> {
     /// they cannot be (a run that failed), they are NaN in the final state, not stale values.
     pub(super) fn finish(mut self) -> SimulationResult {
         // The error, if any, is the run's own failure seen again or left as NaN: nothing to add.
-        let _ = self.complete_outputs();
+        if self.bdf.has_state() {
+            let _ = self.complete_outputs();
+        }
         let conservation = self.conservation();
         let columns = self.columns();
         let n_tot = columns.len() - self.refs.len();
@@ -784,8 +787,8 @@ impl<'p> Driver<'p> {
             rows: self.rows,
             references,
             events: self.events,
-            x: self.bdf.x().to_vec(),
-            t: self.bdf.t(),
+            x: if self.bdf.has_state() { self.bdf.x().to_vec() } else { self.x0.clone() },
+            t: if self.bdf.has_state() { self.bdf.t() } else { self.t0 },
             stats: self.bdf.stats(),
             conservation,
             mpc: self.mpcs.into_iter().map(|m| m.log).collect::<Vec<MpcLog>>(),

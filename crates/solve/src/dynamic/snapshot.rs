@@ -150,6 +150,14 @@ pub(super) fn resume(
         sampled.iter_mut().for_each(|s| s.retain(|&(j, _)| j != i));
     }
     let input_paths: Vec<String> = plant.inputs().iter().map(|i| i.path.clone()).collect();
+    if s.inputs.len() != s.driver.waveforms.len() || s.inputs.len() != s.driver.saved.len() {
+        return Err(bad(format!(
+            "{} inputs but {} waveforms and {} saved values: the file was changed after it was written",
+            s.inputs.len(),
+            s.driver.waveforms.len(),
+            s.driver.saved.len()
+        )));
+    }
     let same = s.fingerprint == fingerprint && s.paths == paths && s.inputs == input_paths;
     let mut driver = s.driver.clone();
     if !same {
