@@ -328,7 +328,13 @@ fn check_channels(plant: &Plant, cfg: &MpcConfig, m: &StepModelFile) -> Result<(
         } else {
             ""
         };
-        format!("\"{what}\" are [{}] but the controller's {field} are [{}]{order}", got.join(", "), want.join(", "))
+        // At most 8 names, each clipped: a file may list thousands.
+        let list = |v: &[&str]| {
+            let shown: Vec<String> = v.iter().take(8).map(|n| plantwide_model::limits::clip(n)).collect();
+            if v.len() > 8 { format!("{}, … ({} in all)", shown.join(", "), v.len()) } else { shown.join(", ") }
+        };
+        let got: Vec<&str> = got.iter().map(String::as_str).collect();
+        format!("\"{what}\" are [{}] but the controller's {field} are [{}]{order}", list(&got), list(want))
     };
     if m.outputs.len() != want_out.len() || !m.outputs.iter().zip(&want_out).all(|(a, b)| same_var(a, b)) {
         return Err(mismatch("outputs", "CVs (cvs[k].pv)", &m.outputs, &want_out));
