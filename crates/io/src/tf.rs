@@ -224,9 +224,17 @@ fn element(e: &ElementSpec, file: &str, at: &dyn Fn(&str) -> String) -> Result<E
     Ok(Element { gain: e.gain, lags, leads, dead_time })
 }
 
+/// The entry of an element the model does not have: the zero transfer function 0/1, written out
+/// (not `null`) so that a reader building a transfer-function matrix (python-control's `tf`,
+/// MATLAB's `tf`) gets a full, finite matrix.
+fn zero_element() -> serde_json::Value {
+    serde_json::json!({"gain": 0.0, "num": [0.0], "den": [1.0], "dead_time": 0.0, "poles": []})
+}
+
 /// A transfer-function model as JSON for python-control and MATLAB: per element its numerator
 /// and denominator in descending powers of `s` (rad per `time_unit`) and its dead time (in
-/// `time_unit`), with the poles, the steady-state gain and, if asked, `G(jω)`:
+/// `time_unit`), with the poles, the steady-state gain and, if asked, `G(jω)`; an element the
+/// model does not have is the zero transfer function 0/1:
 ///
 /// ```python
 /// import json, control
@@ -265,7 +273,7 @@ pub fn export(
     let elements: Vec<Vec<serde_json::Value>> = (0..model.outputs.len())
         .map(|i| {
             (0..model.inputs.len())
-                .map(|j| model.element(i, j).map_or(Ok(serde_json::Value::Null), |e| element(i, j, e)))
+                .map(|j| model.element(i, j).map_or(Ok(zero_element()), |e| element(i, j, e)))
                 .collect::<Result<_, _>>()
         })
         .collect::<Result<_, _>>()?;
@@ -323,6 +331,19 @@ mod tests {
         // |e^(−jωθ)| = 1 and the phase of the delay is −ωθ.
         let delay_only = Element { gain: 1.0, lags: vec![], leads: vec![], dead_time: 7.0 };
         assert!((delay_only.response(0.3).arg() - (-2.1)).abs() < 1e-14);
+    }
+
+    #[test]
+    fn export_writes_a_missing_element_as_the_zero_transfer_function() {
+        let m = parse(TWO_BY_TWO, "t.tf.json").unwrap();
+        let doc = export(&m, ("s", 1.0), None).unwrap();
+        assert!(!doc.to_string().contains("null"), "{doc}");
+        let e = &doc["elements"][0][1];
+        assert_eq!((e["gain"].as_f64(), e["num"][0].as_f64(), e["den"][0].as_f64()), (Some(0.0), Some(0.0), Some(1.0)));
+        // y1 <- u1 = 2 (1 - 3s) / ((1 + 10s)(1 + 5s)): den 50 s^2 + 15 s + 1, poles -0.1 and -0.2.
+        let g11 = &doc["elements"][0][0];
+        assert_eq!(g11["den"], serde_json::json!([50.0, 15.0, 1.0]));
+        assert_eq!(g11["num"], serde_json::json!([-6.0, 2.0]));
     }
 
     #[test]
