@@ -345,6 +345,65 @@ fn snapshot_and_resume_continue_the_uninterrupted_trajectory() {
     assert!(diff < 1e-6, "level tuning does not move the compositions' steady state: {diff}");
 }
 
+/// A snapshot resumed with *another* scenario (what-if runs from one saved state): its events
+/// are the new scenario's from the snapshot's time on, its rows the new interval's after it. The
+/// saved counters meant other instants: the next event index (1 in the old scenario) skipped the
+/// new one, and the next recording (k = 700 of 1 min) fell at 2100 s of a 3 s interval, rows
+/// extrapolated 11 hours backwards (exit 0; soak seed 2). The check is the continuous run with
+/// both events and the same snapshot: after it, it is the resumed run (same history, same stops).
+#[test]
+fn a_snapshot_resumed_with_another_scenario_runs_that_scenario_from_its_time() {
+    let first = COLUMN_A_STEP.replace(
+        r#""duration": "2000 min","#,
+        r#""duration": "1200 min", "snapshots": [{"at": "700 min", "file": "snap.json"}],"#,
+    );
+    let (plant, x0) = converged("column_a.json", &[]);
+    let mut saved = None;
+    run_from(&plant, &first, Start::Steady(&x0), &mut |p| {
+        if let Progress::Snapshot { snapshot, .. } = p {
+            saved = Some(snapshot.clone());
+        }
+    });
+    let snap = saved.expect("snapshot taken");
+    let what_if = |events: &str| {
+        format!(
+            r#"{{"format_version": 1, "duration": "1000 min", "events": [{events}
+                {{"type": "step", "at": "900 min", "path": "feed_source.F", "to": "0.95 kmol/min"}}],
+            "record": {{"interval": "3 min", "paths": ["bottoms.x[light]", "feed_source.F"],
+                        "totals": ["feed", "distillate", "bottoms"]}}}}"#
+        )
+    };
+    let resumed = run_from(&plant, &what_if(""), Start::Snapshot(&snap), &mut |_| {});
+    let both = r#"{"type": "step", "at": "0 min", "path": "feed_source.F", "to": "1.01 kmol/min"},"#;
+    // The continuous run takes the same snapshot (and so goes on from the state it saved) and
+    // records the same totals (integrator states).
+    let with_snapshot =
+        what_if(both).replace(r#""events""#, r#""snapshots": [{"at": "700 min", "file": "s"}], "events""#);
+    let continuous = run_from(&plant, &with_snapshot, Start::Steady(&x0), &mut |_| {});
+    assert!(resumed.times[0] > snap.t && resumed.times[0] <= snap.t + 180.0, "first row at {} s", resumed.times[0]);
+    let feed = column(&resumed, "feed_source.F");
+    let near = |a: f64, b: f64| (a - b).abs() <= 1e-12 * b;
+    assert!(near(feed[0], 1.01e3 / 60.0) && near(*feed.last().unwrap(), 0.95e3 / 60.0), "the new step acted: {feed:?}");
+    let (xb, xb_full) = (column(&resumed, "bottoms.x[light]"), column(&continuous, "bottoms.x[light]"));
+    let mut worst: f64 = 0.0;
+    for (i, t) in resumed.times.iter().enumerate() {
+        let j = continuous
+            .times
+            .iter()
+            .position(|u| u == t)
+            .unwrap_or_else(|| panic!("time {t} not in the continuous run"));
+        worst = worst.max((xb[i] - xb_full[j]).abs());
+    }
+    eprintln!("resumed with another scenario: {} rows, largest difference in xB {worst:.1e}", resumed.times.len());
+    assert!(worst < 1e-9, "{worst}");
+    // A duration that ends before the snapshot's time has nothing to run: refused, by name.
+    let spec =
+        parse_scenario(&what_if("").replace("1000 min", "500 min").replace("900 min", "400 min"), "s.json").unwrap();
+    let sc = resolve(&spec, &plant, "s.json").unwrap();
+    let e = simulate(&plant, &sc, Start::Snapshot(&snap), "test", &mut |_| {}).unwrap_err();
+    assert!(e.is_user_error() && e.to_string().contains("the duration must reach past it"), "{e}");
+}
+
 /// Level per mole `v` of the surge tank and its initial state.
 fn tank(fields: &[(&str, &str)]) -> (Plant, Vec<f64>, f64) {
     let (plant, x0) = converged("surge_tank_pi.json", fields);

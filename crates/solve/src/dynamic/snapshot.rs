@@ -109,6 +109,36 @@ pub(super) struct Resumed {
     pub(super) integrator: Option<BdfState>,
 }
 
+/// Fit the driver's counters to `sc` at the snapshot's time `t`. A snapshot resumed with the
+/// scenario it was taken in keeps them (the continuous run's own, so resuming is exact). With
+/// another scenario (other events, recording interval, scan or sample times) a counter of the
+/// old one means another instant in the new: the next event index would skip or replay events
+/// and the next recording could lie before `t` (rows extrapolated backwards). Such counters are
+/// recomputed from `t`: the next event is the first at or after `t`, the next recording, scan
+/// and sample the first instant after it.
+fn realign(driver: &mut DriverState, sc: &Scenario, t: f64) {
+    let fits = |k: u64, period: f64| (k == 0 || (k - 1) as f64 * period <= t) && k as f64 * period >= t;
+    let k = driver.next_event;
+    let event_fits =
+        k <= sc.events.len() && (k == 0 || sc.events[k - 1].t <= t) && sc.events.get(k).is_none_or(|e| e.t >= t);
+    if !event_fits {
+        driver.next_event = sc.events.partition_point(|e| e.t < t);
+    }
+    if !fits(driver.next_record, sc.interval) {
+        driver.next_record = super::instants::after(t, sc.interval);
+    }
+    for (k, &(_, scan)) in driver.next_scan.iter_mut().zip(&sc.sampling) {
+        if !fits(*k, scan) {
+            *k = super::instants::after(t, scan);
+        }
+    }
+    for (k, &(_, ts, _)) in driver.next_sample.iter_mut().zip(&sc.analyzers) {
+        if !fits(*k, ts) {
+            *k = super::instants::after(t, ts);
+        }
+    }
+}
+
 /// The state vector of length `n_state` for a run resumed from `s`: the plant's initial guess,
 /// overwritten by path with the snapshot's values (`paths` are this run's state paths; entries
 /// the snapshot lacks keep the guess, quadratures start at 0).
@@ -178,6 +208,14 @@ pub(super) fn resume(
     }
     driver.snapshots_done.resize(sc.snapshots.len(), true);
     driver.frozen.resize(sc.analyzers.len(), false);
+    if sc.duration <= s.t {
+        return Err(bad(format!(
+            "it was taken at t = {} s and the scenario ends at {} s: a resumed run goes on from the snapshot's \
+             time, so the duration must reach past it",
+            s.t, sc.duration
+        )));
+    }
+    realign(&mut driver, sc, s.t);
     // Checked here, where a snapshot that does not fit is refused as such: found at the start of
     // the run, the run had no state to hand out with its failure.
     if same {
