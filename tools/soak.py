@@ -153,15 +153,19 @@ def faults(s, parts, n, severe=False):
     through: valves stuck where they are, feeds lost and restored, analyzers frozen, quality loops
     to manual. `severe` adds valves failed closed and level loops to manual, after which a plant
     may trip (a drum drawn dry by its reflux once the boilup valve has failed closed): the run
-    then stops naming the vessel, which the soak counts as a trip, not a failure."""
+    then stops naming the vessel, which the soak counts as a trip, not a failure. A level loop's
+    valve stuck is severe too: with the level uncontrolled, the vessel drains or fills with any
+    change of its other flows (seed 2 drew column 2's drum dry with its distillate valve stuck
+    while the plant recovered from a lost feed)."""
     rng = s.rng
     kinds = ["stuck", "feed_lost", "analyzer", "manual"] + (["failed"] if severe else [])
     pids = sorted(c for c, p in parts["pids"].items() if severe or not is_level(p))
+    outputs = sorted(p["output"] for c, p in parts["pids"].items() if severe or not is_level(p))
     for _ in range(n):
         kind = rng.choice(kinds)
         length = rng.uniform(0.25, 4.0)
-        if kind in ("stuck", "failed") and parts["outputs"]:
-            path = rng.choice(parts["outputs"])
+        if kind in ("stuck", "failed") and outputs:
+            path = rng.choice(outputs)
             at = s.slot(path, length)
             if at is None:
                 continue

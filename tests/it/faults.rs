@@ -234,6 +234,46 @@ fn a_plant_running_down_after_a_lost_feed_keeps_running_and_recovers() {
     assert!(error < 1e-12, "conservation {error:e}");
 }
 
+/// Every inflow of the two-column plant's mixer stopped (fresh B lost, the recycle's distillate
+/// valve failed closed, then fresh A lost) and fresh A restored: at zero flow the mixer's
+/// balances read 0 = 0 and the run stopped ("iteration matrix singular"; soak seed 2 stopped the
+/// same way on restoring fresh A). Independent checks: a stopped mixer carries the unweighted
+/// mean of its inlets (its documented stopped-flow rule, to the solver's tolerance); once fresh A flows alone, the reactor
+/// feed is fresh A (its flow and pure A); the balances close.
+#[test]
+fn a_mixer_whose_inflows_all_stop_carries_its_inlets_mean_and_takes_a_restored_feed() {
+    let dir = scratch("stopped_mixer");
+    let scenario = dir.join("s.json");
+    std::fs::write(
+        &scenario,
+        r#"{"format_version": 1, "duration": "2 h", "record": {"interval": "1 min", "time_unit": "h",
+            "paths": ["reactor_feed.F", "reactor_feed.x[A]", "recycle.x[A]", "feed_B.x[A]", "feed_A.F"]},
+          "events": [{"type": "valve_stuck", "at": "0.5 h", "path": "column1.distillate", "to": "0 kmol/h"},
+                     {"type": "feed_lost", "at": "0.5 h", "unit": "fresh_B"},
+                     {"type": "feed_lost", "at": "0.6 h", "unit": "fresh_A"},
+                     {"type": "feed_restored", "at": "0.8 h", "unit": "fresh_A"},
+                     {"type": "feed_restored", "at": "0.9 h", "unit": "fresh_B"},
+                     {"type": "valve_repaired", "at": "1 h", "path": "column1.distillate"}]}"#,
+    )
+    .unwrap();
+    let (summary, csv) = run_json(&harness::flowsheet("two_column_plant.json"), scenario.to_str().unwrap(), &dir, &[]);
+    let rows: Vec<Vec<f64>> = csv.lines().skip(1).map(|l| l.split(',').map(|v| v.parse().unwrap()).collect()).collect();
+    let stopped: Vec<&Vec<f64>> = rows.iter().filter(|r| r[0] > 0.61 && r[0] < 0.79).collect();
+    assert!(stopped.len() > 5 && stopped.iter().all(|r| r[1] == 0.0), "no inflow: {stopped:?}");
+    for r in &stopped {
+        let mean = (1.0 + r[4] + r[3]) / 3.0;
+        assert!((r[2] - mean).abs() < 1e-8, "x[A] {} against the inlets' mean {mean}", r[2]);
+    }
+    let alone: Vec<&Vec<f64>> = rows.iter().filter(|r| r[0] > 0.81 && r[0] < 0.89).collect();
+    let fresh_a = 100.0 / 3.6;
+    for r in &alone {
+        assert!((r[1] - fresh_a).abs() < 1e-9 * fresh_a && (r[2] - 1.0).abs() < 1e-12, "fresh A alone: {r:?}");
+    }
+    assert_eq!(rows.last().unwrap()[0], 2.0);
+    let error = summary["conservation"]["max_relative_error"].as_f64().unwrap();
+    assert!(error < 1e-12, "conservation {error:e}");
+}
+
 /// The soak's seed-11 week (`tests/data/soak`, from `../shared/cases/soak`): a random event every
 /// 2 h, a stuck valve, a pulse, a sinusoid and the fresh-A feed lost at 151 h. It stopped at
 /// 155.09 h on too small a step; it now runs its seven days with the balances closed.
@@ -246,6 +286,25 @@ fn the_seed_11_week_with_a_lost_feed_runs_to_its_end() {
     assert!((last - 168.0).abs() < 1e-9, "ends at {last} h");
     let error = summary["conservation"]["max_relative_error"].as_f64().unwrap();
     assert!(error < 1e-9, "conservation {error:e}");
+}
+
+/// The soak's seed-2 week (`tests/data/soak`): fresh A lost at 145.715 h while every inflow of the
+/// mixer dies away, restored at 147.021 h, where the run stopped in consistent initialization
+/// (the stopped mixer's singular balances). It now takes the feed back, and ends where the plant
+/// does: column 2's drum, its level valve stuck at 147.467 h while the plant recovers, runs dry
+/// (an honest `stopped:`, exit 2, naming the vessel; the soak's ridable faults no longer stick
+/// level valves).
+#[test]
+fn the_seed_2_week_takes_the_restored_feed_and_stops_where_a_stuck_level_valve_drains_a_drum() {
+    let scenario = format!("{}/tests/data/soak/two_column_restore_seed2.json", env!("CARGO_MANIFEST_DIR"));
+    let csv = scratch("seed2").join("o.csv");
+    let flowsheet = harness::flowsheet("two_column_plant.json");
+    let out = harness::plantwide(&["run", &flowsheet, "--scenario", &scenario, "--csv", csv.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    let at = err.split("stopped: `column2.M[32]` ran dry at t = ").nth(1).unwrap_or_else(|| panic!("{err}"));
+    let t: f64 = at.split(' ').next().unwrap().parse().unwrap();
+    assert!(t > 147.467 * 3600.0 && t < 148.0 * 3600.0, "stopped at {} h: {err}", t / 3600.0);
 }
 
 /// A resume is the continuous run bit for bit also where nothing happens at the snapshot: the

@@ -9,6 +9,16 @@
 //! - pressure `P = P_in1` (the first inlet sets the pressure; put the lowest-pressure stream there),
 //!   or a given outlet pressure;
 //! - temperature from the outlet phase: `h = h_phase(T, z)`.
+//!
+//! At zero flow the composition and energy balances read `0 = 0`: the outlet's `z` and `h` are
+//! undetermined and the Jacobian singular (a mixer all of whose feeds are lost stopped the run,
+//! "iteration matrix singular"). Below a flow of [`STOPPED`] they are written
+//! `(F + ε) z_i = Σ_k F_k z_k,i + ε z̄_i` and `(F + ε) h = Σ_k F_k h_k + ε h̄` with the inlets'
+//! unweighted means `z̄`, `h̄` and `ε = STOPPED (1 − F/STOPPED)²` (continuous with its slope at
+//! `STOPPED`, zero above it): a stopped mixer carries the mean of its inlets, and a flowing one
+//! the exact balances. The component flow it passes differs from the inlets' by
+//! `εF (z̄_i − z_i*)/(F + ε)` (`z*` the exact mixture), at most `F ≤ 1e-9 mol/s` and only while
+//! the flow passes through `(0, 1e-9)` mol/s.
 
 use plantwide_units::{Dimension, QuantityValue};
 use schemars::JsonSchema;
@@ -43,6 +53,9 @@ impl crate::registry::UnitConfig for MixerConfig {
     }
 }
 
+/// Flow [mol/s] below which a mixer's outlet leans on its inlets' mean (see the module text).
+pub const STOPPED: f64 = 1e-9;
+
 /// A mixer.
 #[derive(Debug, Clone)]
 pub struct Mixer {
@@ -62,6 +75,22 @@ impl Mixer {
         }
         let pressure = config.pressure.as_ref().map(|p| cx.positive("P", p, Dimension::PRESSURE));
         cx.finish(Mixer { n_in: config.inlets, phase: config.phase, pressure })
+    }
+}
+
+impl Mixer {
+    /// The stopped-flow terms: `ε (h − h̄)` and `ε (z_i − z̄_i)` added to the balances, with
+    /// `ε = STOPPED (1 − F/STOPPED)²` (for `F < STOPPED`).
+    fn lean_on_inlets<S: Scalar>(&self, io: &UnitIo<'_, S>, r: &mut [S]) {
+        let out = io.outlet(0);
+        let gap = S::from(1.0) - out.f() / STOPPED;
+        let eps = gap * gap * STOPPED;
+        let share = 1.0 / self.n_in as f64;
+        let mean = |value: &dyn Fn(usize) -> S| (0..self.n_in).fold(S::from(0.0), |acc, k| acc + value(k) * share);
+        r[H] += eps * (out.h() - mean(&|k| io.inlet(k).h()));
+        for i in 0..io.n_comp() {
+            r[Z0 + i] += eps * (out.z()[i] - mean(&|k| io.inlet(k).z()[i]));
+        }
     }
 }
 
@@ -93,6 +122,9 @@ impl UnitModel for Mixer {
         r[H] = out.f() * out.h() - fh;
         for i in 0..n {
             r[Z0 + i] = out.f() * out.z()[i] - fz[i];
+        }
+        if out.f().re() < STOPPED {
+            self.lean_on_inlets(io, r);
         }
         r[P] = match self.pressure {
             Some(p) => out.p() - p,
