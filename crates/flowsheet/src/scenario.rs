@@ -513,6 +513,33 @@ pub struct Ongoing {
     pub analyzers: Vec<usize>,
 }
 
+impl Ongoing {
+    /// The faults and frozen analyzers once `events` have acted (a live run's queued commands).
+    pub fn follow(&mut self, events: &[Event]) {
+        for e in events {
+            match e.action {
+                Action::Stuck { input, .. } => self.faulted.push(input),
+                Action::Repair { input } => self.faulted.retain(|&i| i != input),
+                Action::Analyzer { block, frozen: true } => self.frozen.push(block),
+                Action::Analyzer { block, frozen: false } => self.frozen.retain(|&b| b != block),
+                _ => {}
+            }
+        }
+    }
+}
+
+impl Action {
+    /// Whether this is a fault (a valve stuck or failed, a feed lost, an analyzer frozen).
+    pub fn is_fault(&self) -> bool {
+        matches!(self, Action::Stuck { .. } | Action::Analyzer { frozen: true, .. })
+    }
+    /// Whether this is the repair of a fault (`valve_repaired`, `feed_restored`,
+    /// `analyzer_repaired`).
+    pub fn is_repair(&self) -> bool {
+        matches!(self, Action::Repair { .. } | Action::Analyzer { frozen: false, .. })
+    }
+}
+
 impl Cx<'_> {
     fn quantity(&mut self, path: &str, q: &QuantityValue, dim: Dimension) -> f64 {
         let v = q.to_si(dim);

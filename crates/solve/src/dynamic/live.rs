@@ -205,10 +205,37 @@ impl Live {
             )));
         }
         let events = self.resolve_one(&spec)?.into_boxed_slice();
-        let target = events.first().map(|e| e.action.target());
-        self.pending.retain(|q| q.events.first().map(|e| e.action.target()) != target);
+        let Some(first) = events.first().map(|e| e.action.clone()) else { return Ok(()) };
+        let queued =
+            self.pending.iter().position(|q| q.events.first().is_some_and(|e| e.action.target() == first.target()));
+        if let Some(k) = queued {
+            let before = &self.pending[k].events[0].action;
+            if before.is_fault() && first.is_repair() {
+                // A fault repaired at the sync point it was queued for never happens: neither goes
+                // into the journal (a scenario may not hold both at one time).
+                self.pending.remove(k);
+                return Ok(());
+            }
+            if before.is_repair() && first.is_fault() {
+                return Err(LiveError::Refused(format!(
+                    "its repair is queued for the sync point at t = {} s, and a scenario may not repair and fail \
+                     it again at one time: step or resume first",
+                    self.driver.t()
+                )));
+            }
+            // Another change of the same target at the same sync point: the later one stands.
+            self.pending.remove(k);
+        }
         self.pending.push(Queued { spec, events });
         Ok(())
+    }
+
+    /// The faults in force once the queued commands apply: what a new command is checked against
+    /// (a repair of a fault queued at this sync point, a second fault of one queued).
+    fn ongoing(&self) -> plantwide_flowsheet::scenario::Ongoing {
+        let mut ongoing = self.driver.ongoing();
+        self.pending.iter().for_each(|q| ongoing.follow(&q.events));
+        ongoing
     }
 
     /// Check every one of `cmds` and queue them all, or none if one is refused.
@@ -245,7 +272,7 @@ impl Live {
             record: Default::default(),
             snapshots: Vec::new(),
         };
-        match resolve_continuing(&spec, &plant, "command", self.driver.ongoing()) {
+        match resolve_continuing(&spec, &plant, "command", self.ongoing()) {
             Ok(sc) => Ok(sc.events),
             Err(LoadError::Invalid { diagnostics, .. }) => Err(LiveError::Refused(message(&diagnostics))),
             Err(e) => Err(LiveError::Refused(e.to_string())),
@@ -535,6 +562,45 @@ mod tests {
         }
         live.load("a").expect("loads");
         assert_eq!(live.journal().events.len(), 2);
+    }
+
+    /// Commands at one sync point (a paused session) are checked against the faults the queued
+    /// ones leave: a stuck valve repaired before time moves cancels (the journal holds neither
+    /// and replays), a second fault of a queued one is refused, and so is a fault of a valve
+    /// whose repair is queued (a serve soak had 239 refusals "has failed already" of faults
+    /// repaired moments before, the repair still queued).
+    #[test]
+    fn commands_at_one_sync_point_see_the_faults_queued_before_them() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../flowsheets/surge_tank_pi.json");
+        let plant = plantwide_flowsheet::load_file(std::path::Path::new(path)).expect("loads");
+        let x0 = crate::steady_state(&plant, &plant.input_values(), None, &crate::NewtonSettings::default())
+            .expect("converges")
+            .x;
+        let spec = parse_scenario(r#"{"format_version": 1, "name": "live", "duration": "1 h"}"#, "live").unwrap();
+        let sc = resolve(&spec, &plant, "live").expect("resolves");
+        let mut live = Live::new(&plant, &x0, &spec, &sc, "test").expect("starts");
+        let event = |text: &str| PlantCommand::Event(serde_json::from_str(text).expect("an event"));
+        let stuck = r#"{"type": "valve_stuck", "at": 0, "path": "tank.outflow"}"#;
+        let repaired = r#"{"type": "valve_repaired", "at": 0, "path": "tank.outflow"}"#;
+        live.command(event(stuck)).expect("a fault");
+        let twice = live.command(event(stuck)).expect_err("a second fault of a queued one");
+        assert!(twice.to_string().contains("has failed already"), "{twice}");
+        live.command(event(repaired)).expect("the queued fault repaired");
+        assert_eq!(live.pending(), 0, "fault and repair cancel");
+        live.step().expect("steps");
+        assert!(live.journal().events.is_empty());
+        live.command(event(stuck)).expect("a fault");
+        live.step().expect("steps");
+        live.command(event(repaired)).expect("a repair");
+        let again = live.command(event(stuck)).expect_err("a fault while its repair is queued");
+        assert!(again.to_string().contains("its repair is queued"), "{again}");
+        live.step().expect("steps");
+        live.command(event(stuck)).expect("a fault after the repair applied");
+        live.step().expect("steps");
+        let journal = live.journal();
+        assert_eq!(journal.events.len(), 3, "{:?}", journal.events);
+        let text = serde_json::to_string(&journal).unwrap();
+        resolve(&parse_scenario(&text, "journal").unwrap(), &plant, "journal").expect("the journal replays");
     }
 
     #[test]
