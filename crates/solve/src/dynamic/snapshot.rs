@@ -208,6 +208,11 @@ pub(super) fn resume(
     }
     driver.snapshots_done.resize(sc.snapshots.len(), true);
     driver.frozen.resize(sc.analyzers.len(), false);
+    // Checked here, where a snapshot that does not fit is refused as such: found at the start of
+    // the run, the run had no state to hand out with its failure.
+    if same {
+        s.integrator.check(paths.len()).map_err(|why| bad(format!("its integrator state: {why}")))?;
+    }
     if sc.duration <= s.t {
         return Err(bad(format!(
             "it was taken at t = {} s and the scenario ends at {} s: a resumed run goes on from the snapshot's \
@@ -216,10 +221,5 @@ pub(super) fn resume(
         )));
     }
     realign(&mut driver, sc, s.t);
-    // Checked here, where a snapshot that does not fit is refused as such: found at the start of
-    // the run, the run had no state to hand out with its failure.
-    if same {
-        s.integrator.check(paths.len()).map_err(|why| bad(format!("its integrator state: {why}")))?;
-    }
     Ok(Resumed { driver, integrator: same.then(|| s.integrator.clone()) })
 }
