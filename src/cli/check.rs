@@ -2,14 +2,14 @@
 
 use std::path::Path;
 
-use plantwide::flowsheet::{BlockKind, load_file};
+use plantwide::flowsheet::BlockKind;
 use plantwide::solve::{DofProbe, dof_check};
 use plantwide::units::{Dimension, UnitSystem};
 
 use super::CliError;
 
 pub fn run(file: &Path, system: UnitSystem) -> Result<(), CliError> {
-    let plant = load_file(file).map_err(|e| CliError::user(e.to_string()))?;
+    let plant = super::steady::load_plant(file, &[])?;
     outln!("flowsheet `{}` ({})", plant.name(), file.display());
     outln!("components ({}): {}", plant.components().len(), plant.components().join(", "));
     let units: Vec<_> = plant.blocks().iter().filter(|b| b.kind == BlockKind::Unit).collect();

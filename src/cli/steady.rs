@@ -32,7 +32,11 @@ pub fn load_with_overrides(file: &Path, sets: &[String]) -> Result<(Plant, Vec<f
 pub fn load_plant(file: &Path, sets: &[String]) -> Result<Plant, CliError> {
     let user = |e: plantwide::flowsheet::OverrideError| CliError::user(e.to_string());
     let overrides = sets.iter().map(|s| s.parse()).collect::<Result<Vec<_>, _>>().map_err(user)?;
-    plantwide::flowsheet::load_with(file, &overrides).map_err(user)
+    let plant = plantwide::flowsheet::load_with(file, &overrides).map_err(user)?;
+    for note in plant.notes() {
+        eprintln!("note: {}: {note}", file.display());
+    }
+    Ok(plant)
 }
 
 /// `--spec PATH=VALUE` paired in order with `--vary INPUT`, added to `plant`'s own specs.

@@ -167,3 +167,32 @@ fn set_of_an_input_converges_as_the_same_edit_in_the_file() {
         String::from_utf8_lossy(&out.stderr)
     );
 }
+
+/// A number without a unit is read in SI, which a user may not have meant (newcomer3 D6: `--set
+/// feed_source.T=80` made an 80 K liquid feed, and a file's `"F": 150` is 150 mol/s, not kmol/h):
+/// each gets a note naming the field, what it was read as and what to write. A number with its
+/// unit, a dimensionless one, and every shipped flowsheet get none.
+#[test]
+fn a_number_without_a_unit_gets_a_note_of_what_it_was_read_as() {
+    let stderr = |args: &[&str]| {
+        let out = plantwide(args);
+        assert!(out.status.success(), "{:?}: {}", args, String::from_utf8_lossy(&out.stderr));
+        String::from_utf8_lossy(&out.stderr).into_owned()
+    };
+    let hx = harness::fixture("data/newcomer3/with_hx.json");
+    let note = stderr(&["steady", &hx, "--set", "feed_source.T=80"]);
+    assert!(note.contains("--set feed_source.T: 80 has no unit and is read in SI, as 80 K"), "{note}");
+    assert!(note.contains(r#""80 degC""#), "{note}");
+    assert!(!stderr(&["steady", &hx, "--set", "feed_source.T=80 degC"]).contains("no unit"));
+    assert!(!stderr(&["steady", &hx, "--set", "feed_source.z[benzene]=0.45"]).contains("no unit"));
+    let bare = stderr(&["check", &harness::fixture("data/newcomer3/unit_bare_number_150.json")]);
+    assert!(bare.contains("units.feed_source.F: 150 has no unit and is read in SI, as 150 mol/s"), "{bare}");
+    for entry in std::fs::read_dir(format!("{}/flowsheets", env!("CARGO_MANIFEST_DIR"))).unwrap() {
+        let path = entry.unwrap().path();
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        if name.ends_with(".json") && !name.ends_with(".schema.json") {
+            let text = stderr(&["check", path.to_str().unwrap()]);
+            assert!(!text.contains("no unit"), "{name}: {text}");
+        }
+    }
+}

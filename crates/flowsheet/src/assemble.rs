@@ -80,6 +80,8 @@ struct Assembler<'s> {
     thermo: ThermoPackage,
     stream_layout: StreamLayout,
     diags: Vec<Diagnostic>,
+    /// Bare numbers read in SI, noted by the units' and controllers' builds.
+    notes: plantwide_model::build::Notes,
     blocks: Vec<Block>,
     vars: Vec<VarInfo>,
     inputs: Vec<InputInfo>,
@@ -115,6 +117,7 @@ impl<'s> Assembler<'s> {
             thermo,
             stream_layout,
             diags,
+            notes: Default::default(),
             blocks: Vec::new(),
             vars: Vec::new(),
             inputs: Vec::new(),
@@ -177,7 +180,7 @@ impl<'s> Assembler<'s> {
     fn build_units(&mut self) -> Result<Units, LoadError> {
         let mut units = Vec::new();
         for (name, u) in &self.spec.units {
-            let cx = BuildCx::new(&self.components, &self.thermo, format!("units.{name}"));
+            let cx = BuildCx::new(&self.components, &self.thermo, format!("units.{name}")).noting(self.notes.clone());
             match u.build(cx, ()) {
                 Ok(unit) => units.push((name.clone(), unit)),
                 Err(errs) => self.diags.extend(errs.into_iter().map(|e| Diagnostic::new(e.path, e.message))),
@@ -413,7 +416,8 @@ impl<'s> Assembler<'s> {
     fn push_controllers(&mut self, pending: &[Pending<'s>]) -> Result<(), LoadError> {
         for c in pending {
             let links = self.controller_links(pending, c);
-            let cx = BuildCx::new(&self.components, &self.thermo, format!("controllers.{}", c.name));
+            let cx = BuildCx::new(&self.components, &self.thermo, format!("controllers.{}", c.name))
+                .noting(self.notes.clone());
             match c.config.build(cx, &links) {
                 Ok(unit) => self.push_block(c.name.to_string(), BlockKind::Controller, unit, &[]),
                 Err(errs) => self.diags.extend(errs.into_iter().map(|e| Diagnostic::new(e.path, e.message))),
@@ -582,6 +586,10 @@ impl<'s> Assembler<'s> {
             spec: Arc::new(self.spec.clone()),
             assembled_inputs: Vec::new(),
             specs: Vec::new(),
+            notes: std::mem::take(&mut *self.notes.lock().unwrap_or_else(std::sync::PoisonError::into_inner))
+                .into_iter()
+                .map(|n| n.to_string())
+                .collect(),
         };
         let mut plant = plant;
         plant.assembled_inputs = plant.input_values();

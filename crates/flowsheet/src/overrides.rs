@@ -116,6 +116,9 @@ pub(crate) fn apply_inputs(plant: &mut Plant, overrides: &[Override]) -> Result<
         if !set_input(plant, &mut u, &o.path, &o.value)? {
             return Err(OverrideError::NoTarget { path: o.path.clone(), hint: String::new() });
         }
+        let dim = resolve_input(plant, &o.path).map(|i| plant.inputs[i].dim);
+        let note = dim.and_then(|d| plantwide_model::build::bare_note(&o.value.as_str().into(), d));
+        plant.notes.extend(note.map(|n| format!("--set {}: {n}", o.path)));
     }
     check_compositions(plant, &u)?;
     if !overrides.is_empty() {

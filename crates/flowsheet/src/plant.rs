@@ -133,9 +133,17 @@ pub struct Plant {
     pub(crate) assembled_inputs: Vec<f64>,
     /// Design specifications still to be met ([`crate::design`]).
     pub(crate) specs: Vec<crate::design::DesignSpec>,
+    /// Notes on the description: numbers without a unit read in SI (`units.feed.T: 80 has no
+    /// unit …`), from the file and from overrides.
+    pub(crate) notes: Vec<String>,
 }
 
 impl Plant {
+    /// Notes on its description for the user: numbers without a unit read in SI, each as
+    /// `` `path`: what it was read as and what to write ``.
+    pub fn notes(&self) -> &[String] {
+        &self.notes
+    }
     /// File the plant came from (for messages).
     pub fn file(&self) -> &str {
         &self.file

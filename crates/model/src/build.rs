@@ -27,12 +27,23 @@ pub struct BuildCx<'a> {
     pub path: String,
     /// Errors collected while building.
     pub errors: Vec<FieldError>,
+    /// Where the notes of bare numbers go (see [`BuildCx::noting`]).
+    notes: Notes,
 }
+
+/// A shared list of notes on a flowsheet's fields: numbers given without a unit for a quantity
+/// that has one, read in SI (`"T": 80` is 80 K), which a user may not have meant.
+pub type Notes = std::sync::Arc<std::sync::Mutex<Vec<FieldError>>>;
 
 impl<'a> BuildCx<'a> {
     /// A context for the unit at JSON path `path`.
     pub fn new(components: &'a [String], thermo: &'a ThermoPackage, path: impl Into<String>) -> BuildCx<'a> {
-        BuildCx { components, thermo, path: path.into(), errors: Vec::new() }
+        BuildCx { components, thermo, path: path.into(), errors: Vec::new(), notes: Notes::default() }
+    }
+    /// Send the notes of bare numbers to `notes` (the assembler's list for the whole flowsheet).
+    pub fn noting(mut self, notes: Notes) -> BuildCx<'a> {
+        self.notes = notes;
+        self
     }
     /// Record an error on `field` of the current unit.
     pub fn error(&mut self, field: &str, message: impl Into<String>) {
@@ -45,6 +56,13 @@ impl<'a> BuildCx<'a> {
     }
     /// `value` in SI, finite and at most `max` in magnitude (else NaN and an error saying `what`).
     fn within(&mut self, field: &str, value: &QuantityValue, dim: Dimension, max: f64, what: &str) -> f64 {
+        if let Some(note) = bare_note(value, dim) {
+            let path = if field.is_empty() { self.path.clone() } else { format!("{}.{field}", self.path) };
+            self.notes
+                .lock()
+                .unwrap_or_else(std::sync::PoisonError::into_inner)
+                .push(FieldError { path, message: note });
+        }
         match value.to_si(dim) {
             Ok(v) if v.is_finite() && v.abs() <= max => v,
             Ok(v) if v.is_finite() => {
@@ -145,6 +163,18 @@ impl<'a> BuildCx<'a> {
     pub fn finish<T>(self, value: T) -> Result<T, Vec<FieldError>> {
         if self.errors.is_empty() { Ok(value) } else { Err(self.errors) }
     }
+}
+
+/// The note on `value` if it is a bare number for a quantity of dimension `dim` (zero needs no
+/// unit, except a temperature's): what it is read as, and what to write instead.
+pub fn bare_note(value: &QuantityValue, dim: Dimension) -> Option<String> {
+    let x = value.bare()?;
+    if dim == Dimension::DIMENSIONLESS || (x == 0.0 && dim != Dimension::TEMPERATURE) {
+        return None;
+    }
+    let example =
+        if dim == Dimension::TEMPERATURE { format!("\"{x} degC\" or \"{x} K\"") } else { format!("\"{x} {dim}\"") };
+    Some(format!("{x} has no unit and is read in SI, as {x} {dim}; write the unit meant (e.g. {example})"))
 }
 
 /// How far a controller gain may exceed the largest magnitude of its dimension: the output's

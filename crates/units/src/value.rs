@@ -20,6 +20,15 @@ pub enum QuantityValue {
 }
 
 impl QuantityValue {
+    /// The number if this is a bare number (JSON `150` or text `"150"`): a value read in SI
+    /// units, which a user may not have meant.
+    pub fn bare(&self) -> Option<f64> {
+        match self {
+            QuantityValue::Number(x) => Some(*x),
+            QuantityValue::Text(s) => s.trim().parse().ok(),
+        }
+    }
+
     /// The SI value, checking that a text value has dimension `expected`. Offset units standing
     /// alone are absolute values (`"80 degC"` is 353.15 K).
     pub fn to_si(&self, expected: Dimension) -> Result<f64, UnitError> {
