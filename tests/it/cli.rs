@@ -196,3 +196,31 @@ fn a_number_without_a_unit_gets_a_note_of_what_it_was_read_as() {
         }
     }
 }
+
+/// A step of a temperature by a percentage is refused (newcomer3 D16: "+5 %" of the feed's
+/// 313.15 K was 15.66 K, unstated, where 5 % of its 40 degC is 2 K), naming both readings and
+/// the form to use (the same step as a difference runs: `compare.rs`, `feed_source.T=+5 K`).
+#[test]
+fn a_percentage_step_of_a_temperature_is_refused_with_both_readings() {
+    let files = [harness::fixture("data/newcomer3/with_hx.json"), harness::fixture("data/newcomer3/without_hx.json")];
+    let compare = |step: &str| {
+        plantwide(&["compare", &files[0], &files[1], "--disturbances", step, "--outputs", "distillate.x[benzene]"])
+    };
+    let out = compare("feed_source.T=+5%");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("5 % of 313.15 K is 15.6575 K, of 40 degC 2 K") && err.contains("feed_source.T=+5 K"),
+        "{err}"
+    );
+    let bare = plantwide(&[
+        "compare",
+        &files[0],
+        &files[1],
+        "--disturbances",
+        "feed_source.T",
+        "--outputs",
+        "distillate.x[benzene]",
+    ]);
+    assert_eq!(bare.status.code(), Some(1), "PATH alone steps 10 %: {}", String::from_utf8_lossy(&bare.stderr));
+}

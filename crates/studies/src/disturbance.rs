@@ -285,6 +285,21 @@ impl Disturbance {
                 );
                 return Err(DisturbanceError::Unit { text, why });
             }
+            StepSize::Fraction(f) if info.dim == Dimension::TEMPERATURE => {
+                let (k, c) = (f * info.value, f * (info.value - 273.15));
+                let why = format!(
+                    "`{}` is a temperature, and a percentage of one depends on its scale: {} % of {} K is {} K, of \
+                     {} degC {} K; give the step as a temperature difference, e.g. {}=+5 K",
+                    self.path,
+                    number(100.0 * f),
+                    number(info.value),
+                    number(k),
+                    number(info.value - 273.15),
+                    number(c),
+                    self.path
+                );
+                return Err(DisturbanceError::Unit { text, why });
+            }
             StepSize::Fraction(_) if info.value == 0.0 => {
                 return Err(DisturbanceError::ZeroBase { text, path: self.path.clone(), file });
             }
