@@ -422,3 +422,64 @@ fn trailing_text_empty_models_and_hollow_snapshots_are_refused() {
     let resume = [&run[..], &["--resume", hollow.to_str().unwrap()]].concat();
     expect(&resume, 1, &["does not fit this plant", "integrator state"]);
 }
+
+/// The second 100 000-mutant fuzz (seed 20261209: 7 failures, 4 classes besides a harness slip):
+/// a reaction order of -1e308 overflowed the rate constant's dimension (a panic), a scenario of
+/// 1000 events on a 1000-character path quoted it whole in each of 50 lines (52 kB), and a
+/// snapshot's statistics count at the top of `usize` overflowed when counted on.
+#[test]
+fn huge_reaction_orders_long_paths_and_overflowing_counts_are_refused_by_field() {
+    let dir = scratch("fuzz20261209");
+    let text = std::fs::read_to_string(harness::flowsheet("two_column_plant.json")).unwrap();
+    let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    v["units"]["reactor"]["reactions"][0]["orders"] = serde_json::json!({"A": 1, "B": -1e308});
+    let orders = dir.join("orders.json");
+    std::fs::write(&orders, v.to_string()).unwrap();
+    expect(
+        &["check", orders.to_str().unwrap()],
+        1,
+        &["units.reactor.reactions[0].orders.B: an order of -1e308 is beyond ±20"],
+    );
+    let tank = harness::flowsheet("surge_tank_pi.json");
+    let path = "F_in".repeat(250);
+    let events: Vec<String> =
+        (0..1000).map(|k| format!(r#"{{"type": "step", "at": "{k} s", "path": "{path}", "to": "1 mol/s"}}"#)).collect();
+    let scenario = dir.join("long.json");
+    std::fs::write(
+        &scenario,
+        format!(r#"{{"format_version": 1, "duration": "2000 s", "events": [{}]}}"#, events.join(",")),
+    )
+    .unwrap();
+    let csv = dir.join("o.csv");
+    let (out, _) =
+        run_in(&dir, &["run", &tank, "--scenario", scenario.to_str().unwrap(), "--csv", csv.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("(1000 characters)") && err.len() < 10_000, "{} bytes: {err:.300}", err.len());
+    // A snapshot whose Newton count is at the top of usize.
+    let snap = dir.join("snap.json");
+    let take = format!(
+        r#"{{"format_version": 1, "duration": "100 s", "snapshots": [{{"at": "50 s", "file": "{}"}}]}}"#,
+        snap.display()
+    );
+    let first = dir.join("first.json");
+    std::fs::write(&first, take).unwrap();
+    let run = ["run", &tank, "--scenario", first.to_str().unwrap(), "--csv", csv.to_str().unwrap()];
+    expect(&run, 0, &[]);
+    let mut s: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&snap).unwrap()).unwrap();
+    s["integrator"]["stats"]["n_newton_iters"] = serde_json::json!(u64::MAX);
+    std::fs::write(&snap, s.to_string()).unwrap();
+    let longer = dir.join("longer.json");
+    std::fs::write(&longer, r#"{"format_version": 1, "duration": "200 s"}"#).unwrap();
+    let resume = [
+        "run",
+        &tank,
+        "--scenario",
+        longer.to_str().unwrap(),
+        "--csv",
+        csv.to_str().unwrap(),
+        "--resume",
+        snap.to_str().unwrap(),
+    ];
+    expect(&resume, 1, &["a statistics count above 9007199254740992"]);
+}

@@ -200,7 +200,13 @@ fn resolve_among(
     }
     let input = resolve_input(plant, &e.vary).ok_or_else(|| {
         let hint = did_you_mean(&e.vary, plant.inputs.iter().map(|i| i.path.as_str()));
-        ("vary", format!("no input `{}`{hint}; the inputs are listed by `plantwide check`", e.vary))
+        (
+            "vary",
+            format!(
+                "no input `{}`{hint}; the inputs are listed by `plantwide check`",
+                plantwide_model::limits::clip(&e.vary)
+            ),
+        )
     })?;
     let vary = plant.inputs[input].path.clone();
     if let Some(v) = plant.inputs[input].driven_by {

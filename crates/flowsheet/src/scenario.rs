@@ -577,7 +577,10 @@ impl Cx<'_> {
         let Some(i) = resolve_input(self.plant, path) else {
             let names =
                 self.plant.inputs.iter().map(|i| i.path.as_str()).chain(self.plant.aliases.keys().map(String::as_str));
-            self.diags.push(Diagnostic::new(field, format!("no input `{path}`{}", did_you_mean(path, names))));
+            self.diags.push(Diagnostic::new(
+                field,
+                format!("no input `{}`{}", plantwide_model::limits::clip(path), did_you_mean(path, names)),
+            ));
             return None;
         };
         if free && let Some(v) = self.plant.inputs[i].driven_by {

@@ -98,8 +98,9 @@ pub fn scenario(rng: &mut Rng, doc: &mut Doc, names: &Names) -> String {
             return set_path(v, &format!("events[{i}]"), &format!("/events/{i}"), new, "scen_huge_step");
         }
         3 => {
-            let mut rec = v.get("record").cloned().unwrap_or(json!({"paths": []}));
-            let old = rec.clone();
+            // An earlier mutation may have made `record` something other than an object.
+            let old = v.get("record").cloned().unwrap_or(json!({"paths": []}));
+            let mut rec = if old.is_object() { old.clone() } else { json!({"paths": []}) };
             rec["interval"] = json!(*rng.pick(&["1e-6 s", "0 s", "-5 s", "1e-300 s", "1e-3 s"]));
             ("record", old, rec, "scen_tiny_record")
         }

@@ -158,6 +158,9 @@ pub struct Cstr {
     t_guess: Option<f64>,
 }
 
+/// The largest magnitude of a reaction's order in one component.
+const MAX_ORDER: f64 = 20.0;
+
 fn by_component(cx: &mut BuildCx<'_>, field: &str, map: &BTreeMap<String, f64>) -> Vec<f64> {
     let mut v = vec![0.0; cx.components.len()];
     for (name, &c) in map {
@@ -194,13 +197,25 @@ fn build_reaction(cx: &mut BuildCx<'_>, f: &str, c: &ReactionConfig) -> Reaction
         Some(o) => by_component(cx, &format!("{f}.orders"), o),
         None => nu.iter().map(|v| (-v).max(0.0)).collect(),
     };
+    if let Some(i) = orders.iter().position(|o| !(o.abs() <= MAX_ORDER)) {
+        let order = crate::limits::number(orders[i]);
+        let field = format!("{f}.orders.{}", cx.components[i]);
+        cx.error(&field, format!("an order of {order} is beyond ±{MAX_ORDER}, where no rate law lies"));
+    }
     let (n, fk0): (f64, String) = (orders.iter().sum(), format!("{f}.k0"));
-    let dim = (n.fract() == 0.0).then(|| (Dimension::VOLUME / Dimension::AMOUNT).checked_pow(n as i32 - 1)).flatten();
+    let whole = n.fract() == 0.0 && n.abs() <= MAX_ORDER * orders.len() as f64;
+    let dim = whole.then(|| (Dimension::VOLUME / Dimension::AMOUNT).checked_pow(n as i32 - 1)).flatten();
     let k0 = match (dim, &c.k0) {
         (Some(d), q) => cx.non_negative(&fk0, q, Dimension::INVERSE_TIME * d),
         (None, q @ QuantityValue::Number(_)) => cx.non_negative(&fk0, q, Dimension::DIMENSIONLESS),
         (None, _) => {
-            cx.error(&fk0, format!("the total order {n} is not an integer: give k0 as a bare number in SI units"));
+            cx.error(
+                &fk0,
+                format!(
+                    "the total order {} is not an integer: give k0 as a bare number in SI units",
+                    crate::limits::number(n)
+                ),
+            );
             f64::NAN
         }
     };

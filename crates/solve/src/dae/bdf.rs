@@ -209,9 +209,28 @@ impl BdfState {
         if !(finite(self.t) && finite(self.h_abs) && self.h_abs > 0.0) {
             return Err("time or step size not a positive finite number".into());
         }
+        let s = &self.stats;
+        let counts = [
+            s.n_steps,
+            s.n_error_test_failures,
+            s.n_newton_failures,
+            s.n_newton_iters,
+            s.n_residual_evals,
+            s.n_jacobian_evals,
+            s.n_lu,
+            s.n_restarts,
+        ];
+        // A run counts up from these: a count near the top of `usize` is no run's (a hand-edited
+        // file), and counting on would overflow.
+        if counts.iter().any(|&c| c > MAX_COUNT) {
+            return Err(format!("a statistics count above {MAX_COUNT}, which no run reaches"));
+        }
         Ok(())
     }
 }
+
+/// The largest statistics count a restored state may hold (2⁵³: far beyond any run's).
+const MAX_COUNT: usize = 1 << 53;
 
 /// The BDF integrator (see the module documentation).
 #[derive(Debug)]
