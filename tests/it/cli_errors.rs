@@ -180,12 +180,15 @@ const SCENARIO_CASES: &[ScenarioCase] = &[
     ScenarioCase {
         name: "pulse_end_meets_step",
         flowsheet: "surge_tank_pi.json",
+        // A pulse listed after a step, ending at the step's time: its end would undo the step.
+        // (Listed before it, the pulse ends and then the step acts: accepted, as a live run's
+        // journal has it.)
         scenario: r#"{"format_version": 1, "duration": "10 min", "events": [
-            {"type": "pulse", "at": "1 min", "path": "F_in", "by": "5 mol/s", "width": "1 min"},
-            {"type": "step", "at": "2 min", "path": "F_in", "to": "70 mol/s"}]}"#,
+            {"type": "step", "at": "2 min", "path": "F_in", "to": "70 mol/s"},
+            {"type": "pulse", "at": "1 min", "path": "F_in", "by": "5 mol/s", "width": "1 min"}]}"#,
         env: &[],
         code: 1,
-        fragments: &["events[0] (its end at 120 s) and events[1] both act on `F_in`"],
+        fragments: &["events[0] and events[1] (its end at 120 s) both act on `F_in`"],
     },
     ScenarioCase {
         name: "same_time_same_controller_mode",

@@ -274,6 +274,50 @@ fn a_mixer_whose_inflows_all_stop_carries_its_inlets_mean_and_takes_a_restored_f
     assert!(error < 1e-12, "conservation {error:e}");
 }
 
+/// A step listed after a pulse, at the pulse's end: the end acts first, then the step (file
+/// order), and the step holds. A live run's journal has this whenever a command arrives at the
+/// sync point where a pulse ends; it was refused as ambiguous, so the journal of a 1114-command
+/// serve soak did not replay.
+#[test]
+fn a_step_where_an_earlier_pulse_ends_acts_after_the_end() {
+    let scenario = r#"{"format_version": 1, "duration": "600 s",
+      "record": {"interval": "30 s", "time_unit": "s", "paths": ["inflow.F"]},
+      "events": [{"type": "pulse", "at": "60 s", "path": "F_in", "by": "5 mol/s", "width": "60 s"},
+                 {"type": "step", "at": "120 s", "path": "F_in", "to": "70 mol/s"}]}"#;
+    let (_, rows) = run("surge_tank_pi.json", "pulse_then_step", scenario);
+    let flow = |t: f64| at(&rows, t).last().map(|r| r[1]).unwrap_or_else(|| panic!("no row at {t} s"));
+    assert_eq!((flow(90.0), flow(150.0), flow(600.0)), (55.0, 70.0, 70.0), "{rows:?}");
+}
+
+/// Changes of a feed while it is lost go on behind the loss, as a setpoint moved at a dead valve:
+/// a pulse that ends during the loss and a step during it leave the feed at zero (each made the
+/// lost feed flow again: a serve soak's pulse on a lost feed jumped its flow into a mixer with
+/// nothing else flowing and stopped the run), and the repair gives back where the scenario has
+/// it by then: the pulse's base (50 mol/s), not its top; the stepped 70 mol/s.
+#[test]
+fn changes_of_a_lost_feed_go_on_behind_the_loss_and_the_repair_gives_them_back() {
+    let scenario = r#"{"format_version": 1, "duration": "600 s",
+      "record": {"interval": "30 s", "time_unit": "s", "paths": ["inflow.F"]},
+      "events": [{"type": "pulse", "at": "60 s", "path": "F_in", "to": "60 mol/s", "width": "120 s"},
+                 {"type": "feed_lost", "at": "100 s", "unit": "inflow"},
+                 {"type": "feed_restored", "at": "300 s", "unit": "inflow"}]}"#;
+    let (_, rows) = run("surge_tank_pi.json", "pulse_in_fault", scenario);
+    let flow = |t: f64| at(&rows, t).last().map(|r| r[1]).unwrap_or_else(|| panic!("no row at {t} s"));
+    assert_eq!(
+        (flow(90.0), flow(150.0), flow(210.0), flow(270.0), flow(330.0)),
+        (60.0, 0.0, 0.0, 0.0, 50.0),
+        "{rows:?}"
+    );
+    let scenario = r#"{"format_version": 1, "duration": "600 s",
+      "record": {"interval": "30 s", "time_unit": "s", "paths": ["inflow.F"]},
+      "events": [{"type": "feed_lost", "at": "100 s", "unit": "inflow"},
+                 {"type": "step", "at": "150 s", "path": "F_in", "to": "70 mol/s"},
+                 {"type": "feed_restored", "at": "300 s", "unit": "inflow"}]}"#;
+    let (_, rows) = run("surge_tank_pi.json", "step_in_fault", scenario);
+    let flow = |t: f64| at(&rows, t).last().map(|r| r[1]).unwrap_or_else(|| panic!("no row at {t} s"));
+    assert_eq!((flow(90.0), flow(150.0), flow(270.0), flow(330.0)), (50.0, 0.0, 0.0, 70.0), "{rows:?}");
+}
+
 /// The soak's seed-11 week (`tests/data/soak`, from `../shared/cases/soak`): a random event every
 /// 2 h, a stuck valve, a pulse, a sinusoid and the fresh-A feed lost at 151 h. It stopped at
 /// 155.09 h on too small a step; it now runs its seven days with the balances closed.

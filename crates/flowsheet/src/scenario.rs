@@ -58,7 +58,8 @@ pub struct ScenarioSpec {
     /// on different targets (inputs, or the modes of different controllers); they are then
     /// applied in file order, each seeing the inputs the earlier ones left. Two at the same time
     /// on one target are an error (which one wins would be an accident of order), and so is the
-    /// end of a ramp, pulse or sinusoid at the time of another event on its input. A ramp, pulse
+    /// end of a pulse or sinusoid at the time of an event on its input listed before it; an event
+    /// listed after it may start where it ends (the end acts first). A ramp, pulse
     /// or sinusoid still running at the end of the run is cut by it.
     #[serde(default)]
     pub events: Vec<EventSpec>,
@@ -896,8 +897,11 @@ fn events_of(cx: &mut Cx<'_>, specs: &[EventSpec], duration: f64, limits: &Limit
     for (i, (a, la)) in events.iter().enumerate() {
         let origin = |l: &str| l.split(' ').next().unwrap_or_default().to_string();
         for (b, lb) in events[i + 1..].iter().take_while(|(b, _)| b.t == a.t) {
-            // One event's start and end at one time: its duration is zero, reported already.
-            if target(&a.action) == target(&b.action) && origin(la) != origin(lb) {
+            // One event's start and end at one time: its duration is zero, reported already. An
+            // event listed after a pulse or sinusoid may start where it ends: the end acts first
+            // (the order of the file, and of a live run's journal, whose commands come after).
+            let starts_at_an_earlier_end = la.contains(" (its end at ") && !lb.contains(" (its end at ");
+            if target(&a.action) == target(&b.action) && origin(la) != origin(lb) && !starts_at_an_earlier_end {
                 let what = target_name(cx.plant, &a.action);
                 cx.diags.push(Diagnostic::new(
                     origin(lb),
@@ -919,7 +923,6 @@ fn events_of(cx: &mut Cx<'_>, specs: &[EventSpec], duration: f64, limits: &Limit
 fn check_values(cx: &mut Cx<'_>, events: &[(Event, String)]) {
     let mut u = cx.plant.input_values();
     let mut saved: Vec<Option<f64>> = vec![None; u.len()];
-    let mut before_fault: Vec<Option<f64>> = vec![None; u.len()];
     for (k, (e, label)) in events.iter().enumerate() {
         let (input, values): (usize, Vec<f64>) = match e.action {
             Action::Step { input, change } | Action::Ramp { input, change, .. } => {
@@ -934,15 +937,16 @@ fn check_values(cx: &mut Cx<'_>, events: &[(Event, String)]) {
                 saved[input] = Some(u[input]);
                 (input, vec![u[input] - amplitude.abs(), u[input] + amplitude.abs()])
             }
+            // `u` follows the values the scenario gives its inputs: a fault holds the input
+            // apart from them (changes during it go on behind it, and the repair gives the input
+            // back to them, or to its controller, whose output the check does not follow), so
+            // the failed value is checked and `u` kept.
             Action::Stuck { input, value: Some(v) } => {
-                before_fault[input] = Some(u[input]);
-                (input, vec![v])
-            }
-            // The repaired input is back at its value before the fault (a free input), or with
-            // its controller, whose output the check does not follow: either way not the failed value.
-            Action::Repair { input } => {
-                if let Some(v) = before_fault[input].take() {
-                    u[input] = v;
+                if let Err(why) = crate::overrides::check_input_value(cx.plant, input, v) {
+                    let path = &cx.plant.inputs[input].path;
+                    let origin = label.split(' ').next().unwrap_or_default();
+                    cx.diags.push(Diagnostic::new(origin, format!("takes `{path}` out of its range: {why}")));
+                    return;
                 }
                 continue;
             }
@@ -1176,6 +1180,7 @@ fn check_faults(cx: &mut Cx<'_>, events: &[Event], analyzers: &[(usize, f64, f64
             Action::Repair { input } if !faulted.remove(&input) => {
                 format!("{what} has no fault to repair at {} s (no valve_stuck or feed_lost before it)", secs(e.t))
             }
+
             Action::Analyzer { block, .. } if !sampled.contains(&block) => {
                 format!("{what} is no scenario analyzer: list the controller under `analyzers` to sample it")
             }

@@ -448,8 +448,34 @@ impl<'p> Driver<'p> {
         changed
     }
 
-    /// Apply one scenario action at `t`, state `x`.
+    /// Apply one scenario action at `t`, state `x`. A change of an input in a fault goes on
+    /// behind the fault ([`snapshot::Fault::behind`]): the fault holds the input, as a stuck
+    /// valve or a lost feed does whatever the setpoint.
     fn apply(&mut self, action: &Action, t: f64, x: &[f64]) {
+        let changed = match *action {
+            Action::Step { input, .. }
+            | Action::Ramp { input, .. }
+            | Action::Hold { input }
+            | Action::Pulse { input, .. }
+            | Action::Sinusoid { input, .. }
+            | Action::Restore { input } => Some(input),
+            _ => None,
+        };
+        let path = changed.map(|i| self.plant.inputs()[i].path.clone());
+        let fault = path.and_then(|p| self.st.faults.iter().position(|f| f.path == p));
+        if let (Some(input), Some(k)) = (changed, fault) {
+            let before = Waveform::Constant(self.st.faults[k].before);
+            let behind = self.st.faults[k].behind.take().unwrap_or(before);
+            let held = std::mem::replace(&mut self.st.waveforms[input], behind);
+            self.apply_free(action, t, x);
+            self.st.faults[k].behind = Some(std::mem::replace(&mut self.st.waveforms[input], held));
+            return;
+        }
+        self.apply_free(action, t, x);
+    }
+
+    /// [`Driver::apply`] to the inputs' waveforms as they stand.
+    fn apply_free(&mut self, action: &Action, t: f64, x: &[f64]) {
         let w = &mut self.st.waveforms;
         match *action {
             Action::Step { input, change } => w[input] = Waveform::Constant(change.apply(w[input].at(t))),
@@ -495,7 +521,8 @@ impl<'p> Driver<'p> {
     /// A fault on `input` at `t`: it leaves the controller that drove it (or the scans that held
     /// it) and stays where it is, or at `value`; what its repair gives it back to is kept.
     fn fail_input(&mut self, input: usize, value: Option<f64>, t: f64, x: &[f64]) {
-        let current = self.st.waveforms[input].at(t);
+        let scheduled = self.st.waveforms[input];
+        let current = scheduled.at(t);
         let op = self.plant.to_mut().hold_input(input);
         let before = op.map_or(current, |op| x[op]);
         let scanned_by = self.sampled.iter().enumerate().find_map(|(k, s)| {
@@ -505,7 +532,8 @@ impl<'p> Driver<'p> {
         self.st.waveforms[input] = Waveform::Constant(value.unwrap_or(before));
         let path = self.plant.inputs()[input].path.clone();
         let driven_by = op.map(|op| self.plant.vars()[op].path.clone());
-        self.st.faults.push(snapshot::Fault { path: path.clone(), before, driven_by, scanned_by });
+        let behind = Some(scheduled);
+        self.st.faults.push(snapshot::Fault { path: path.clone(), before, driven_by, scanned_by, behind });
         self.st.stuck.push(path);
     }
 
@@ -529,7 +557,9 @@ impl<'p> Driver<'p> {
                 }
                 None => self.st.waveforms[input] = Waveform::Constant(fault.before),
             },
-            (None, None) => self.st.waveforms[input] = Waveform::Constant(fault.before),
+            (None, None) => {
+                self.st.waveforms[input] = fault.behind.unwrap_or(Waveform::Constant(fault.before));
+            }
         }
     }
 

@@ -223,6 +223,21 @@ impl Live {
                     self.driver.t()
                 )));
             }
+            if before.is_fault() || before.is_repair() || first.is_fault() || first.is_repair() {
+                // A change would silently drop a fault or repair already acknowledged, or go
+                // into the journal beside it at one time on one target.
+                return Err(LiveError::Refused(format!(
+                    "a {} of it is queued for the sync point at t = {} s: step or resume first",
+                    if before.is_fault() {
+                        "fault"
+                    } else if before.is_repair() {
+                        "repair"
+                    } else {
+                        "change"
+                    },
+                    self.driver.t()
+                )));
+            }
             // Another change of the same target at the same sync point: the later one stands.
             self.pending.remove(k);
         }
@@ -568,7 +583,8 @@ mod tests {
     /// ones leave: a stuck valve repaired before time moves cancels (the journal holds neither
     /// and replays), a second fault of a queued one is refused, and so is a fault of a valve
     /// whose repair is queued (a serve soak had 239 refusals "has failed already" of faults
-    /// repaired moments before, the repair still queued).
+    /// repaired moments before, the repair still queued), and a change of an input whose fault is
+    /// queued (it replaced the fault, acknowledged and then dropped).
     #[test]
     fn commands_at_one_sync_point_see_the_faults_queued_before_them() {
         let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../flowsheets/surge_tank_pi.json");
@@ -597,8 +613,13 @@ mod tests {
         live.step().expect("steps");
         live.command(event(stuck)).expect("a fault after the repair applied");
         live.step().expect("steps");
+        // A change of a feed whose loss is queued would drop the acknowledged fault: refused.
+        live.command(event(r#"{"type": "feed_lost", "at": 0, "unit": "inflow"}"#)).expect("a lost feed");
+        let set = live.command(PlantCommand::Set { path: "F_in".into(), value: "60 mol/s".into() });
+        assert!(set.expect_err("a change over a queued fault").to_string().contains("a fault of it is queued"));
+        live.step().expect("steps");
         let journal = live.journal();
-        assert_eq!(journal.events.len(), 3, "{:?}", journal.events);
+        assert_eq!(journal.events.len(), 4, "{:?}", journal.events);
         let text = serde_json::to_string(&journal).unwrap();
         resolve(&parse_scenario(&text, "journal").unwrap(), &plant, "journal").expect("the journal replays");
     }

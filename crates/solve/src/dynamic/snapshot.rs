@@ -78,6 +78,11 @@ pub struct Fault {
     /// The sampled controller (index in the scenario's `sampling`) and output variable whose
     /// scans held it, if any.
     pub scanned_by: Option<(usize, String)>,
+    /// The input as the scenario has it behind the fault: its waveform when the fault came, then
+    /// changed by the scenario's events on the input during the fault (a step, a pulse's end),
+    /// which do not reach the plant; a free input's repair gives it back this.
+    #[serde(default)]
+    pub behind: Option<Waveform>,
 }
 
 /// Everything needed to continue a run (serialize it with serde).
