@@ -185,7 +185,9 @@ pub enum EventSpec {
         to: Option<QuantityValue>,
     },
     /// A stuck or failed input works again: a controller that drove it takes it back (from
-    /// wherever its output has wound to), a free input returns to its value before the fault.
+    /// wherever its output has wound to), a free input returns to where the scenario has it:
+    /// its value before the fault, moved by the events on it during the fault (which go on
+    /// behind the fault and do not reach the plant).
     ValveRepaired {
         /// Time.
         at: QuantityValue,
