@@ -199,5 +199,8 @@ fn print_table(t: &Tuning, model: &TfModel, file: &Path, tu: &TimeUnit) {
             l.kc,
             l.tau_i
         );
+        if let Some(m) = &l.margins {
+            outln!("  {}", super::tune_plant::margins_line(m, u, "its element under its PI, the other loops open"));
+        }
     }
 }

@@ -8,7 +8,9 @@ use plantwide::flowsheet::Plant;
 use plantwide::model::limits::number;
 use plantwide::studies::identify::number as significant;
 use plantwide::studies::tune::averaging::AveragingForm;
-use plantwide::studies::tune::flowsheet::{FlowsheetLoop, FlowsheetTuning, averaging_loop, blt_loops, edits, kc_text};
+use plantwide::studies::tune::flowsheet::{
+    FlowsheetLoop, FlowsheetTuning, averaging_loop, blt_loops, edits, flowsheet_margins, kc_text,
+};
 use plantwide::studies::tune::loops::{Measurement, PlantLoop, inner_first, plant_loop, plant_loops};
 use plantwide::studies::tune::plant_tests::{Linearity, StepTry};
 use plantwide::units::{Dimension, parse_quantity_as};
@@ -24,10 +26,12 @@ pub fn run(a: &TuneArgs, tu: &TimeUnit) -> Result<(), CliError> {
     let (plant, u) = load_with_overrides(file, &a.set)?;
     let names = loop_names(a)?;
     let loops: Vec<PlantLoop> = plant_loops(&plant, &names).map_err(tune_error)?;
-    let tuning = match a.method {
-        MethodArg::Blt => blt_loops(&plant, &converge(&plant, &u)?.x, &loops, measurement(a)?).map_err(tune_error)?,
+    let x = converge(&plant, &u)?.x;
+    let mut tuning = match a.method {
+        MethodArg::Blt => blt_loops(&plant, &x, &loops, measurement(a)?).map_err(tune_error)?,
         _ => in_sequence(a, file, &plant, &loops, tu)?,
     };
+    flowsheet_margins(&plant, &x, &mut tuning, measurement(a)?).map_err(tune_error)?;
     if let Some(out) = &a.write {
         write(file, out, &plant, &tuning, tu)?;
     }
@@ -201,6 +205,22 @@ fn print_details(l: &FlowsheetLoop, u: &str) {
     if let Some(av) = &l.averaging {
         outln!("  averaging {:?}: largest level deviation {} at {:.4} {u}", av.form, av.band, av.time);
     }
+    if let Some(m) = &l.margins {
+        outln!("  {}", margins_line(m, u, "on the plant's linear model, the tuned loops open"));
+    }
+}
+
+/// A loop's margins as one line (`GM 3.14 at ω = 0.785 rad/min, PM 61.4° at ω = 0.25 rad/min`).
+pub(super) fn margins_line(m: &plantwide::studies::tune::margins::Margins, u: &str, alone: &str) -> String {
+    let gm = match (m.gain_margin, m.phase_crossover) {
+        (Some(gm), Some(w)) => format!("GM {} at ω = {} rad/{u}", significant(gm), significant(w)),
+        _ => "GM ∞ (the phase never reaches −180° where |L| < 1)".to_string(),
+    };
+    let pm = match (m.phase_margin, m.gain_crossover) {
+        (Some(pm), Some(w)) => format!("PM {:.1}° at ω = {} rad/{u}", pm, significant(w)),
+        _ => "no gain crossover (|L| never falls through 1)".to_string(),
+    };
+    format!("margins (this loop alone, {alone}): {gm}, {pm}")
 }
 
 /// The step tests behind a fit against the linearized gain: the step the fit comes from, and the

@@ -26,6 +26,42 @@ fn blt_json_on_wood_berry_in_minutes() {
     assert!(table.contains("Tyreus–Luyben") && table.contains("xB      S"), "{table}");
 }
 
+/// The margins of each ZN-tuned Wood–Berry loop (its element under its PI, the other loop open)
+/// against python-control 0.10's `stability_margins` on the same loop's frequency response
+/// (exact dead time, `frd` on 200 001 log-spaced points from 1e-4 to 100 rad/min):
+///
+/// ```python
+/// L = k e^{-θs}/(τs+1) · Kc (1 + 1/(τI s)),  s = jω
+/// xD-R (12.8, 16.7, 1, 0.95428, 3.25618):   GM 1.8675243930, PM 28.0815315810°, ω180 1.3972741883, ωc 0.7833413694
+/// xB-S (-19.4, 14.4, 3, -0.19186, 9.27697): GM 1.9042665573, PM 36.3143487472°, ω180 0.4987639212, ωc 0.2695754295
+/// ```
+/// (the peer's figures for the settings rounded to five digits, as printed; the tolerance
+/// covers that rounding and the peer's interpolation between its points).
+#[test]
+fn zn_margins_on_wood_berry_agree_with_python_control() {
+    let wb = flowsheet("transfer_functions/wood_berry.tf.json");
+    let out = plantwide(&["tune", "--tf", &wb, "--method", "zn", "--time-unit", "min", "--json"]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let peer = [
+        (1.8675243930, 28.0815315810, 1.3972741883, 0.7833413694),
+        (1.9042665573, 36.3143487472, 0.4987639212, 0.2695754295),
+    ];
+    for (l, (gm, pm, w180, wc)) in v["loops"].as_array().unwrap().iter().zip(peer) {
+        let m = &l["margins"];
+        let near = |key: &str, want: f64| {
+            let got = m[key].as_f64().unwrap();
+            assert!((got - want).abs() <= 2e-4 * want.abs(), "{key}: {got} against python-control's {want}");
+        };
+        near("gain_margin", gm);
+        near("phase_margin", pm);
+        near("phase_crossover", w180);
+        near("gain_crossover", wc);
+    }
+    let table =
+        String::from_utf8(plantwide(&["tune", "--tf", &wb, "--method", "zn", "--time-unit", "min"]).stdout).unwrap();
+    assert!(table.contains("GM 1.868 at ω = 1.397 rad/min, PM 28.1° at ω = 0.7833 rad/min"), "{table}");
+}
+
 #[test]
 fn bad_models_exit_1_naming_the_problem() {
     let dir = std::env::temp_dir().join(format!("plantwide-tune-{}", std::process::id()));
@@ -468,4 +504,37 @@ fn a_step_test_whose_gain_never_agrees_with_g0_exits_2_listing_the_steps() {
     assert!(err.contains("`bottom_composition`") && err.contains("disagrees with the linearized gain"), "{err}");
     assert!(err.matches("step ").count() >= 2 && err.contains("a smaller step did not bring it closer"), "{err}");
     assert!(out.stdout.is_empty(), "no settings printed");
+}
+
+/// The margins `tune` reports on a flowsheet loop come from the plant's exact linear model: the
+/// surge tank's level under a PI on its outflow is `L = K_c v (1 + 1/(τ_I s))/s` (`v` the level
+/// per mole), whose gain crossover `x = ω_c τ_I` solves `x⁴ − (aτ_I)² x² − (aτ_I)² = 0` with
+/// `a = |K_c| v`, with phase margin `atan(x)` and no phase crossover (critically damped
+/// averaging: `aτ_I = 4`, PM = 76.35°).
+#[test]
+fn flowsheet_loop_margins_are_the_closed_forms_of_a_level_loop() {
+    let out = plantwide(&[
+        "tune",
+        &flowsheet("surge_tank.json"),
+        "--loop",
+        "level_control",
+        "--method",
+        "averaging",
+        "--form",
+        "pi",
+        "--json",
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let l = &v["loops"][0];
+    let (kc, tau_i) = (l["kc"].as_f64().unwrap(), l["tau_i"].as_f64().unwrap());
+    let (plant, ss) = crate::harness::converge("surge_tank.json");
+    let per_mole = crate::harness::value(&plant, &ss.x, "tank.level") / crate::harness::value(&plant, &ss.x, "tank.M");
+    let at = kc.abs() * per_mole * tau_i;
+    let x = ((at * at + (at.powi(4) + 4.0 * at * at).sqrt()) / 2.0).sqrt();
+    let m = &l["margins"];
+    let (wc, pm) = (m["gain_crossover"].as_f64().unwrap(), m["phase_margin"].as_f64().unwrap());
+    assert!((wc * tau_i - x).abs() < 1e-8 * x, "ωc τI {} against {x}", wc * tau_i);
+    assert!((pm - x.atan().to_degrees()).abs() < 1e-6, "PM {pm} against {}", x.atan().to_degrees());
+    assert!(m["gain_margin"].is_null() && m["phase_crossover"].is_null(), "{m}");
 }

@@ -18,6 +18,7 @@ pub mod blt;
 pub mod fit;
 pub mod flowsheet;
 pub mod loops;
+pub mod margins;
 pub mod plant_tests;
 pub mod relay;
 pub mod rules;
@@ -81,10 +82,13 @@ pub struct LoopTuning {
     pub kc: f64,
     /// Reset (integral) time \[s, or the unit of [`Tuning::in_time_unit`]\].
     pub tau_i: f64,
+    /// Gain and phase margins of the loop alone, `g_ii c_i` ([`with_margins`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub margins: Option<margins::Margins>,
 }
 
 /// Tuning of a set of loops; serializes to
-/// `{"method", "detuning_factor" (BLT only), "loops": [{"output", "input", "ku", "pu", "kc", "tau_i"}]}`.
+/// `{"method", "detuning_factor" (BLT only), "loops": [{"output", "input", "ku", "pu", "kc", "tau_i", "margins"}]}`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Tuning {
     /// Method.
@@ -108,6 +112,7 @@ impl Tuning {
         for l in &mut self.loops {
             l.pu /= seconds;
             l.tau_i /= seconds;
+            l.margins = l.margins.map(|m| m.in_time_unit(seconds));
         }
         self.peak_omega = self.peak_omega.map(|w| w * seconds);
         self
@@ -179,8 +184,21 @@ pub fn single_loop(model: &TfModel, rule: PiRule) -> Result<Tuning, TuneError> {
                 pu: u.pu,
                 kc,
                 tau_i,
+                margins: None,
             }
         })
         .collect();
-    Ok(Tuning { method, detuning_factor: None, loops, max_lcm_db: None, peak_omega: None })
+    Ok(with_margins(model, Tuning { method, detuning_factor: None, loops, max_lcm_db: None, peak_omega: None }))
+}
+
+/// `tuning` of the diagonal loops of `model` (SI times) with each loop's margins: its element
+/// `g_ii` under its PI, the other loops open.
+pub fn with_margins(model: &TfModel, mut tuning: Tuning) -> Tuning {
+    for (i, l) in tuning.loops.iter_mut().enumerate() {
+        let Some(e) = model.element(i, i) else { continue };
+        let Some((lo, hi)) = ultimate::element_frequency_range(e) else { continue };
+        let c = |w: f64| margins::pid(l.kc, Some(l.tau_i), None, w);
+        l.margins = Some(margins::margins(|w| e.response(w) * c(w), lo, hi));
+    }
+    tuning
 }

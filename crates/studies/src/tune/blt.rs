@@ -155,7 +155,7 @@ pub fn blt(model: &TfModel, settings: &BltSettings) -> Result<Tuning, TuneError>
         gain: model.gain(),
         ultimates,
     };
-    blt_system(&system, settings)
+    Ok(super::with_margins(model, blt_system(&system, settings)?))
 }
 
 /// Luyben's BLT tuning of a [`LoopSystem`].
@@ -190,6 +190,7 @@ pub fn blt_system(system: &LoopSystem<'_>, settings: &BltSettings) -> Result<Tun
             pu: ultimates[i].pu,
             kc: zn[i].0 / f,
             tau_i: zn[i].1 * f,
+            margins: None,
         })
         .collect();
     Ok(Tuning {

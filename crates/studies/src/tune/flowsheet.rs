@@ -19,7 +19,8 @@ use super::averaging::{AveragingForm, AveragingSettings, averaging};
 use super::bench::RelayCycle;
 use super::blt::BltSettings;
 use super::fit::{ModelFit, ProcessModel};
-use super::loops::{Measurement, PlantLoop, low_frequency_probe, plant_blt};
+use super::loops::{LoopResponse, Measurement, PlantLoop, loop_model, low_frequency_probe, plant_blt};
+use super::margins::{Margins, margins, pid};
 use super::plant_tests::{Linearity, StepResult};
 use super::rules::{ModelRule, model_rule};
 use super::ultimate::Ultimate;
@@ -71,6 +72,10 @@ pub struct FlowsheetLoop {
     /// SIMC's τc or IMC's λ used \[s or the time unit asked for\].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub tau_c: Option<f64>,
+    /// Gain and phase margins of the loop with these settings on the plant's exact linear model
+    /// ([`flowsheet_margins`]); frequencies in rad per second or per the time unit asked for.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub margins: Option<Margins>,
 }
 
 /// The tuning of a set of loops of a flowsheet.
@@ -93,6 +98,7 @@ impl FlowsheetTuning {
             l.pu = l.pu.map(|p| p / seconds);
             l.tau_i = l.tau_i.map(|t| t / seconds);
             l.tau_d = l.tau_d.map(|t| t / seconds);
+            l.margins = l.margins.map(|m| m.in_time_unit(seconds));
             l.tau_c = l.tau_c.map(|t| t / seconds);
             if let Some(r) = &mut l.relay {
                 r.pu /= seconds;
@@ -138,6 +144,7 @@ fn entry(l: &PlantLoop, kc: f64, tau_i: Option<f64>, tau_d: Option<f64>) -> Flow
         settled: None,
         linearity: None,
         tau_c: None,
+        margins: None,
     }
 }
 
@@ -305,4 +312,29 @@ mod tests {
         assert_eq!(quantity(600.0, None, Some("min")), "\"10 min\"");
         assert_eq!(quantity(600.0, None, Some("s")), "600");
     }
+}
+
+/// The gain and phase margins of each tuned loop of `tuning` (SI, before [`FlowsheetTuning::in_time_unit`])
+/// on the exact linear model of `plant` at its steady state `x`: each loop alone, `g_ii(jω)`
+/// seen through `measurement` times its PID, with the tuned loops open (in manual) and every
+/// other loop as in the file — the single-loop margins python-control's `stability_margins`
+/// gives for `g_ii c_i`. Written into each loop's `margins`.
+///
+/// # Errors
+/// As [`super::loops::loop_model`].
+pub fn flowsheet_margins(
+    plant: &Plant,
+    x: &[f64],
+    tuning: &mut FlowsheetTuning,
+    measurement: Measurement,
+) -> Result<(), TuneError> {
+    let names: Vec<&str> = tuning.loops.iter().map(|l| l.controller.as_str()).collect();
+    let loops = super::loops::plant_loops(plant, &names)?;
+    let response = LoopResponse::new(loop_model(plant, x, &loops)?, measurement);
+    let (lo, hi) = super::loops::frequency_range(&response.model().ss, &loops)?;
+    for (i, l) in tuning.loops.iter_mut().enumerate() {
+        let c = |w: f64| pid(l.kc, l.tau_i, l.tau_d, w);
+        l.margins = Some(margins(|w| response.at(w)[(i, i)] * c(w), lo, hi));
+    }
+    Ok(())
 }

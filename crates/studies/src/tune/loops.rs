@@ -198,7 +198,7 @@ impl LoopResponse {
 
 /// The frequency range in which a state-space model's phase crossovers lie: three decades
 /// below its slowest and above its fastest eigenvalue \[rad/s\].
-fn frequency_range(ss: &StateSpace, loops: &[PlantLoop]) -> Result<(f64, f64), TuneError> {
+pub(crate) fn frequency_range(ss: &StateSpace, loops: &[PlantLoop]) -> Result<(f64, f64), TuneError> {
     let ev = ss.eigenvalues().map_err(|e| TuneError::Linear(Box::new(e)))?;
     let mags: Vec<f64> = ev.iter().map(|l| l.norm()).filter(|m| *m > 0.0 && m.is_finite()).collect();
     let lo = mags.iter().cloned().fold(f64::INFINITY, f64::min);
