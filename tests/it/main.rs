@@ -41,4 +41,5 @@ mod size_newcomer;
 mod snowball;
 mod specs;
 mod tune;
+mod tutorial;
 mod two_column_study;
