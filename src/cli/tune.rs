@@ -164,8 +164,9 @@ fn load(file: &Path) -> Result<TfModel, CliError> {
 fn print_table(t: &Tuning, model: &TfModel, file: &Path, tu: &TimeUnit) {
     let what = match (t.detuning_factor, t.max_lcm_db, t.peak_omega) {
         (Some(f), Some(db), Some(w)) => format!(
-            "BLT (Luyben 1986): detuning factor F = {f:.4}, biggest log modulus {db:.3} dB at ω = {w:.4} rad/{}",
-            tu.name
+            "BLT (Luyben 1986): detuning factor F = {f:.4}, biggest log modulus {db:.3} dB at ω = {w:.4} rad/{}{}",
+            tu.name,
+            super::tune_plant::raised(t.unstable_at)
         ),
         _ if t.method == TuneMethod::TyreusLuyben => "Tyreus–Luyben PI, each loop tuned alone".to_string(),
         _ => "Ziegler–Nichols PI, each loop tuned alone".to_string(),

@@ -146,7 +146,12 @@ fn write(file: &Path, out: &Path, plant: &Plant, t: &FlowsheetTuning, tu: &TimeU
 
 fn print_table(t: &FlowsheetTuning, plant: &Plant, tu: &TimeUnit) {
     match t.detuning_factor {
-        Some(f) => outln!("tuning of `{}`: {} (Luyben 1986), detuning factor F = {f:.4}\n", plant.name(), t.method),
+        Some(f) => outln!(
+            "tuning of `{}`: {} (Luyben 1986), detuning factor F = {f:.4}{}\n",
+            plant.name(),
+            t.method,
+            raised(t.unstable_at)
+        ),
         None => outln!("tuning of `{}`: {}\n", plant.name(), t.method),
     }
     let u = &tu.name;
@@ -208,6 +213,16 @@ fn print_details(l: &FlowsheetLoop, u: &str) {
     if let Some(m) = &l.margins {
         outln!("  {}", margins_line(m, u, "on the plant's linear model, the tuned loops open"));
     }
+}
+
+/// The note on a BLT factor raised for a stable closed loop (empty if it was not).
+pub(super) fn raised(unstable_at: Option<f64>) -> String {
+    unstable_at.map_or(String::new(), |f| {
+        format!(
+            " (raised from F = {f:.4}, which met the log-modulus target but left the loops unstable by the \
+             generalized Nyquist criterion)"
+        )
+    })
 }
 
 /// A loop's margins as one line (`GM 3.14 at ω = 0.785 rad/min, PM 61.4° at ω = 0.25 rad/min`).

@@ -329,7 +329,14 @@ fn loops_tuned_in_sequence_are_each_tested_with_the_ones_before_them_tuned() {
     let both = json_in(&dir, &[&["tune", &fs, "--loops", "top_composition,bottom_composition"], &tl[..]].concat());
     json_in(&dir, &[&["tune", &fs, "--loop", "top_composition", "--write", first.to_str().unwrap()], &tl[..]].concat());
     let second = json_in(&dir, &[&["tune", first.to_str().unwrap(), "--loop", "bottom_composition"], &tl[..]].concat());
-    assert_eq!(both["loops"][1], second["loops"][0]);
+    // The same test and settings; the margins differ by design (in `both` they are taken with
+    // both tuned loops open, in `second` with the top loop closed at its new settings).
+    let without_margins = |v: &serde_json::Value| {
+        let mut v = v.clone();
+        v.as_object_mut().unwrap().remove("margins");
+        v
+    };
+    assert_eq!(without_margins(&both["loops"][1]), without_margins(&second["loops"][0]));
     assert_eq!(both["loops"][0]["controller"], "top_composition");
     // The bottom loop tested with the top one open would give other settings (the interaction is strong).
     let alone = json_in(&dir, &[&["tune", &fs, "--loop", "bottom_composition"], &tl[..]].concat());
@@ -537,4 +544,35 @@ fn flowsheet_loop_margins_are_the_closed_forms_of_a_level_loop() {
     assert!((wc * tau_i - x).abs() < 1e-8 * x, "ωc τI {} against {x}", wc * tau_i);
     assert!((pm - x.atan().to_degrees()).abs() < 1e-6, "PM {pm} against {}", x.atan().to_degrees());
     assert!(m["gain_margin"].is_null() && m["phase_crossover"].is_null(), "{m}");
+}
+
+/// BLT on the tutorial's DV column at a 1-min analyzer dead time: the ZN settings already meet
+/// the 4 dB log-modulus target (F = 1), yet the loops close unstably, which BLT's target presumes
+/// they do not; the run limit-cycled and `tune` exited 0 (found writing the tutorial). The factor is
+/// raised until the generalized Nyquist criterion holds, and says so. The independent check: the
+/// written file, linearized with its loops closed (state-space eigenvalues, no dead time), has no
+/// unstable mode, where the F = 1 settings had a pair at 2.6e-4 ± 2.5e-3j 1/s.
+#[test]
+fn blt_raises_its_detuning_until_the_loops_close_stably() {
+    let dir = std::env::temp_dir().join(format!("plantwide_it_blt_stable_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let written = dir.join("dv.json");
+    let dv = format!("{}/docs/tutorial/bt_column_dv.json", crate::harness::ROOT);
+    let args = ["tune", &dv, "--loops", "top_composition,tray_temperature", "--method", "blt"];
+    let more = ["--measurement-dead-time", "1 min", "--json", "--write", written.to_str().unwrap()];
+    let out = plantwide(&[&args[..], &more[..]].concat());
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let (f, from) = (v["detuning_factor"].as_f64().unwrap(), v["unstable_at"].as_f64().unwrap());
+    assert!(from == 1.0 && f > 1.5 && f < 3.0, "F {f} raised from {from}");
+    let lin = plantwide(&[
+        "linearize",
+        written.to_str().unwrap(),
+        "--inputs",
+        "feed_source.F",
+        "--outputs",
+        "distillate.x[benzene]",
+    ]);
+    let text = String::from_utf8_lossy(&lin.stdout);
+    assert!(lin.status.success() && text.contains("62 states") && !text.contains("unstable modes"), "{text}");
 }

@@ -149,6 +149,16 @@ pub enum TuneError {
         /// The largest detuning factor tried (at least `max_detuning`).
         detuning: f64,
     },
+    /// No detuning factor up to the limit closes the loops stably.
+    #[error(
+        "BLT: the loops close unstably at every detuning factor up to F = {detuning} (generalized Nyquist \
+         criterion on det(I + G K)): the pairing cannot be closed by detuned PI loops (check the pairing and \
+         the signs of the gains)"
+    )]
+    NeverStable {
+        /// The largest detuning factor tried.
+        detuning: f64,
+    },
     /// The singular values of `G(0)` could not be computed.
     #[error("SVD of G(0): {detail}")]
     Svd {
@@ -295,6 +305,7 @@ impl TuneError {
         !matches!(
             self,
             TuneError::DetuningLimit { .. }
+                | TuneError::NeverStable { .. }
                 | TuneError::Svd { .. }
                 | TuneError::Linear(_)
                 | TuneError::Simulation(_)

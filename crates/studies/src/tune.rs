@@ -96,6 +96,10 @@ pub struct Tuning {
     /// BLT detuning factor F ≥ 1 (`None` for a single-loop rule).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub detuning_factor: Option<f64>,
+    /// BLT: the factor that met the log-modulus target but left the loops unstable, when the
+    /// detuning was raised from it for a stable closed loop.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub unstable_at: Option<f64>,
     /// One entry per loop, in the model's output order.
     pub loops: Vec<LoopTuning>,
     /// BLT: the biggest log modulus reached at F \[dB\] (not serialized).
@@ -188,7 +192,8 @@ pub fn single_loop(model: &TfModel, rule: PiRule) -> Result<Tuning, TuneError> {
             }
         })
         .collect();
-    Ok(with_margins(model, Tuning { method, detuning_factor: None, loops, max_lcm_db: None, peak_omega: None }))
+    let tuning = Tuning { method, detuning_factor: None, unstable_at: None, loops, max_lcm_db: None, peak_omega: None };
+    Ok(with_margins(model, tuning))
 }
 
 /// `tuning` of the diagonal loops of `model` (SI times) with each loop's margins: its element

@@ -45,6 +45,11 @@ static STARTED_MS: AtomicU64 = AtomicU64::new(0);
 static STARTED_CPU_MS: AtomicU64 = AtomicU64::new(0);
 /// Description of the mutant running now (read without allocating by the guards).
 static CURRENT: Mutex<String> = Mutex::new(String::new());
+/// Live heap when the current mutant began [bytes].
+static LIVE_AT_BEGIN: AtomicUsize = AtomicUsize::new(0);
+/// The mutant that left the most live heap behind it (a cache or buffer it grew and the engine
+/// keeps): bytes and description. A limit crossed later by an innocent mutant names it too.
+static GREW_MOST: Mutex<(usize, String)> = Mutex::new((0, String::new()));
 
 fn epoch() -> Instant {
     static EPOCH: std::sync::OnceLock<Instant> = std::sync::OnceLock::new();
@@ -63,11 +68,19 @@ pub fn begin(description: &str) {
     *CURRENT.lock().unwrap_or_else(|e| e.into_inner()) = text;
     STARTED_CPU_MS.store(cpu_time(None).as_millis() as u64, Ordering::SeqCst);
     STARTED_MS.store(epoch().elapsed().as_millis() as u64 + 1, Ordering::SeqCst);
+    LIVE_AT_BEGIN.store(LIVE.load(Ordering::SeqCst), Ordering::SeqCst);
 }
 
-/// The mutant finished: stop its clock.
+/// The mutant finished: stop its clock, and remember it if it left more live heap behind than
+/// any before it.
 pub fn end() {
     STARTED_MS.store(0, Ordering::SeqCst);
+    let left = LIVE.load(Ordering::SeqCst).saturating_sub(LIVE_AT_BEGIN.load(Ordering::SeqCst));
+    let mut most = GREW_MOST.lock().unwrap_or_else(|e| e.into_inner());
+    if left > most.0 {
+        let current = CURRENT.lock().unwrap_or_else(|e| e.into_inner()).clone();
+        *most = (left, current);
+    }
 }
 
 /// Take the live heap now as the baseline the limit counts from; reset the peak.
@@ -96,6 +109,9 @@ fn die(what: &str, amount: usize, unit: &str) -> ! {
         }
     }
     let _ = writeln!(err, "(also in target/fuzz-current.txt)");
+    if let Ok(most) = GREW_MOST.try_lock() {
+        let _ = writeln!(err, "the mutant that left the most live heap behind ({} bytes): {}", most.0, most.1.as_str());
+    }
     std::process::abort()
 }
 

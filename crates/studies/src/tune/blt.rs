@@ -121,6 +121,81 @@ pub fn blt_detuning(
     Ok((f, w, db))
 }
 
+/// Whether PI loops `(K_c,i, τ_I,i)` on the stable `G` close stably, by the generalized Nyquist
+/// criterion on `d(jω) = det(I + G(jω) K(jω))` (MacFarlane & Postlethwaite 1977; Skogestad &
+/// Postlethwaite, *Multivariable Feedback Control*, Thm 4.9). With `n` integrators in `K`
+/// (indented around `s = 0`) and `d → 1` at high frequency, the closed loop is stable iff the
+/// phase of `d` rises by `nπ/2` from `ω → 0` to `ω → ∞` (each pair of closed-loop poles in the
+/// right half plane takes `2π` from it); `d`'s low-frequency phase is `−nπ/2 + arg det(G(0) K_c
+/// T_I⁻¹)`, so a plant `det(G(0) K_c T_I⁻¹) < 0` fails too (Niederlinski). The phase is unwrapped
+/// on a log grid from `omega_lo` (steps turning it by at most π/16), and the march goes on past
+/// `omega_hi` until `|d − 1| < 0.1`; `None` when it does not get there by `1e4 · omega_hi` (the
+/// criterion cannot be read).
+pub fn nyquist_stable(
+    g: &dyn Fn(f64) -> Mat<c64>,
+    kc: &[f64],
+    tau_i: &[f64],
+    (omega_lo, omega_hi): (f64, f64),
+) -> Option<bool> {
+    let n = kc.len();
+    let d = |w: f64| {
+        let k: Vec<c64> = (0..n).map(|j| c64::new(kc[j], -kc[j] / (w * tau_i[j]))).collect();
+        let gw = g(w);
+        Mat::from_fn(n, n, |i, j| gw[(i, j)] * k[j] + if i == j { 1.0 } else { 0.0 }).determinant()
+    };
+    let pi = std::f64::consts::PI;
+    let (mut w, mut dw) = (omega_lo, d(omega_lo));
+    let (mut phase, mut ratio) = (0.0, 1.1_f64);
+    while w < omega_hi || (dw - 1.0).norm() >= 0.1 {
+        if w > 1e4 * omega_hi || !dw.norm().is_finite() || dw.norm() == 0.0 {
+            return None;
+        }
+        let w_next = w * ratio;
+        let d_next = d(w_next);
+        let step = (d_next / dw).arg();
+        if step.abs() > pi / 16.0 && ratio > 1.0 + 1e-6 {
+            ratio = 1.0 + 0.5 * (ratio - 1.0);
+            continue;
+        }
+        (w, dw, phase, ratio) = (w_next, d_next, phase + step, 1.1);
+    }
+    // From ω_lo (near the −nπ/2 + arg det(G(0) K_c T_I⁻¹) limit) to where d ≈ 1: the rise.
+    Some((phase - 0.5 * pi * n as f64).abs() < 0.5 * pi)
+}
+
+/// The ZN settings detuned by `f`: `(K_c,i / f, τ_I,i f)`.
+fn detuned(zn: &[(f64, f64)], f: f64) -> (Vec<f64>, Vec<f64>) {
+    (zn.iter().map(|(k, _)| k / f).collect(), zn.iter().map(|(_, t)| t * f).collect())
+}
+
+/// The smallest detuning factor from `blt_f` up (steps of 10 %) at which the loops close stably
+/// ([`nyquist_stable`]): BLT's log-modulus target presumes a stable closed loop, which a strongly
+/// interacting pairing at F = 1 may not have (a DV column at 1-min analyzer dead time: ZN settings
+/// below the target and two right-half-plane poles). `blt_f` itself when stable or when the
+/// criterion cannot be read.
+///
+/// # Errors
+/// [`TuneError::NeverStable`] past `max_detuning`.
+fn stable_detuning(
+    g: &dyn Fn(f64) -> Mat<c64>,
+    zn: &[(f64, f64)],
+    range: (f64, f64),
+    blt_f: f64,
+    settings: &BltSettings,
+) -> Result<f64, TuneError> {
+    let mut f = blt_f;
+    loop {
+        let (kc, ti) = detuned(zn, f);
+        if nyquist_stable(g, &kc, &ti, (range.0 / f, range.1)) != Some(false) {
+            return Ok(f);
+        }
+        if f > settings.max_detuning {
+            return Err(TuneError::NeverStable { detuning: f });
+        }
+        f *= 1.1;
+    }
+}
+
 /// A square system of loops to tune together: output i paired with input i, its frequency
 /// response, steady-state gain and the ultimate gain and period of each diagonal element.
 pub struct LoopSystem<'a> {
@@ -181,7 +256,15 @@ pub fn blt_system(system: &LoopSystem<'_>, settings: &BltSettings) -> Result<Tun
     let w_min = ultimates.iter().map(|u| u.omega_u).fold(f64::INFINITY, f64::min);
     let w_max = ultimates.iter().map(|u| u.omega_u).fold(0.0, f64::max);
     let target = settings.target_db.unwrap_or(2.0 * n as f64);
-    let (f, w_peak, db) = blt_detuning(system.response, &zn, (1e-4 * w_min, 10.0 * w_max), target, settings)?;
+    let range = (1e-4 * w_min, 10.0 * w_max);
+    let (blt_f, w_peak, db) = blt_detuning(system.response, &zn, range, target, settings)?;
+    let f = stable_detuning(system.response, &zn, range, blt_f, settings)?;
+    let (w_peak, db) = if f == blt_f {
+        (w_peak, db)
+    } else {
+        let (kc, ti) = detuned(&zn, f);
+        max_log_modulus(system.response, &kc, &ti, (range.0 / f, range.1), settings.points_per_decade)
+    };
     let loops = (0..n)
         .map(|i| LoopTuning {
             output: system.outputs[i].clone(),
@@ -196,6 +279,7 @@ pub fn blt_system(system: &LoopSystem<'_>, settings: &BltSettings) -> Result<Tun
     Ok(Tuning {
         method: TuneMethod::Blt,
         detuning_factor: Some(f),
+        unstable_at: (f != blt_f).then_some(blt_f),
         loops,
         max_lcm_db: Some(db),
         peak_omega: Some(w_peak),
@@ -205,6 +289,20 @@ pub fn blt_system(system: &LoopSystem<'_>, settings: &BltSettings) -> Result<Tun
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `g = 1/((s+1)(0.5s+1))` under PI `K_c(1 + 1/(0.1 s))`: the characteristic polynomial
+    /// `0.05 s³ + 0.15 s² + 0.1(1+K_c) s + K_c` is stable by Routh–Hurwitz iff
+    /// `0.15 · 0.1(1+K_c) > 0.05 K_c`, i.e. `K_c < 3/7`.
+    #[test]
+    fn the_nyquist_check_agrees_with_routh_hurwitz() {
+        let g = |w: f64| {
+            let s = c64::new(0.0, w);
+            Mat::from_fn(1, 1, |_, _| (((s + 1.0) * (s * 0.5 + 1.0)).inv()))
+        };
+        for (kc, stable) in [(0.1, true), (0.4, true), (0.42, true), (0.44, false), (0.6, false), (3.0, false)] {
+            assert_eq!(nyquist_stable(&g, &[kc], &[0.1], (1e-4, 1e2)), Some(stable), "Kc = {kc}");
+        }
+    }
 
     #[test]
     fn one_loop_blt_is_the_classical_2_db_closed_loop_peak() {

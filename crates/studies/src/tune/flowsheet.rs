@@ -86,6 +86,10 @@ pub struct FlowsheetTuning {
     /// BLT detuning factor.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub detuning_factor: Option<f64>,
+    /// BLT: the factor that met the log-modulus target but left the loops unstable, when the
+    /// detuning was raised from it for a stable closed loop.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub unstable_at: Option<f64>,
     /// One entry per loop, in the order asked for.
     pub loops: Vec<FlowsheetLoop>,
 }
@@ -164,7 +168,12 @@ pub fn blt_loops(
         .zip(&t.loops)
         .map(|(l, s)| FlowsheetLoop { ku: Some(s.ku), pu: Some(s.pu), ..entry(l, s.kc, Some(s.tau_i), None) })
         .collect();
-    Ok(FlowsheetTuning { method: "blt", detuning_factor: t.detuning_factor, loops: entries })
+    Ok(FlowsheetTuning {
+        method: "blt",
+        detuning_factor: t.detuning_factor,
+        unstable_at: t.unstable_at,
+        loops: entries,
+    })
 }
 
 /// The integrating gain `k = lim_{s→0} s g(s)` of a level loop's element at `x` (level units per
@@ -204,7 +213,7 @@ pub fn averaging_loop(
     let a = averaging(k, du, band, form).map_err(TuneError::from)?;
     let mut e = entry(l, a.kc, a.tau_i, None);
     e.averaging = Some(a);
-    Ok(FlowsheetTuning { method: "averaging", detuning_factor: None, loops: vec![e] })
+    Ok(FlowsheetTuning { method: "averaging", detuning_factor: None, unstable_at: None, loops: vec![e] })
 }
 
 /// Ziegler–Nichols or Tyreus–Luyben PI settings of loop `l` from its relay `cycle`; `method`
@@ -218,7 +227,7 @@ pub fn from_relay(l: &PlantLoop, cycle: &RelayCycle, rule: PiRule, method: &'sta
         relay: Some(cycle.clone()),
         ..entry(l, kc, Some(tau_i), None)
     };
-    FlowsheetTuning { method, detuning_factor: None, loops: vec![e] }
+    FlowsheetTuning { method, detuning_factor: None, unstable_at: None, loops: vec![e] }
 }
 
 /// SIMC or IMC settings of loop `l` from the model fitted to its step test.
@@ -244,7 +253,7 @@ pub fn from_step(
         ModelRule::Simc => "simc",
         ModelRule::Imc => "imc",
     };
-    Ok(FlowsheetTuning { method, detuning_factor: None, loops: vec![e] })
+    Ok(FlowsheetTuning { method, detuning_factor: None, unstable_at: None, loops: vec![e] })
 }
 
 /// The controller gain `|kc|` as the file of `plant` would write it (in the unit of its `kc`).
