@@ -224,3 +224,35 @@ fn a_percentage_step_of_a_temperature_is_refused_with_both_readings() {
     ]);
     assert_eq!(bare.status.code(), Some(1), "PATH alone steps 10 %: {}", String::from_utf8_lossy(&bare.stderr));
 }
+
+/// A controller's inputs in `gains`: a driven input's message names what to move given the
+/// controller's mode (in manual its setpoint moves nothing, and `gains` on it printed an all-zero
+/// matrix with exit 0; the message sent the tutorial's writer there), and a manual controller's
+/// setpoint is refused.
+#[test]
+fn gains_on_a_controllers_inputs_name_what_moves_in_its_mode() {
+    let file = format!("{}/docs/tutorial/bt_column.json", harness::ROOT);
+    let outputs = "distillate.x[benzene],column.T[8]";
+    let manual = ["--set", "top_composition.auto=0", "--set", "tray_temperature.auto=0"];
+    let err = |args: &[&str]| {
+        let out = plantwide(args);
+        assert_eq!(out.status.code(), Some(1), "{args:?}");
+        String::from_utf8_lossy(&out.stderr).into_owned()
+    };
+    let driven = ["gains", &file, "--inputs", "column.reflux,column.reboiler_duty", "--outputs", outputs];
+    let e = err(&[&driven[..], &manual[..]].concat());
+    assert!(e.contains("`top_composition` is in manual: move its manual output `top_composition.op_manual`"), "{e}");
+    assert!(
+        err(&driven).contains("or its manual output `top_composition.op_manual` with `--set top_composition.auto=0`")
+    );
+    let sp = ["gains", &file, "--inputs", "top_composition.sp,tray_temperature.sp", "--outputs", outputs];
+    let e = err(&[&sp[..], &manual[..]].concat());
+    assert!(
+        e.contains("`top_composition.sp` is the setpoint of `top_composition`, which is in manual: it moves nothing"),
+        "{e}"
+    );
+    let open =
+        ["gains", &file, "--inputs", "top_composition.op_manual,tray_temperature.op_manual", "--outputs", outputs];
+    let out = plantwide(&[&open[..], &manual[..]].concat());
+    assert!(out.status.success() && String::from_utf8_lossy(&out.stdout).contains("RGA number: 6.0310"));
+}

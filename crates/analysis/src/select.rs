@@ -114,8 +114,28 @@ pub fn select_input(plant: &Plant, text: &str) -> Result<Signal, AnalysisError> 
     let info = &plant.inputs()[index];
     if let Some(op) = info.driven_by {
         let ctrl = &plant.blocks()[plant.vars()[op].block].name;
+        let auto = plant.input(&format!("{ctrl}.auto")).map(|i| plant.inputs()[i].value);
+        let instead = match auto {
+            // In manual its setpoint moves nothing (a zero gain): its manual output is the input.
+            Some(a) if a == 0.0 => format!("`{ctrl}` is in manual: move its manual output `{ctrl}.op_manual` instead"),
+            Some(_) => format!(
+                "move its setpoint `{ctrl}.sp` instead (the loop closed), or its manual output \
+                 `{ctrl}.op_manual` with `--set {ctrl}.auto=0` (the loop open)"
+            ),
+            None => format!("move its setpoint `{ctrl}.sp` instead"),
+        };
         return Err(request(format!(
-            "{}: input `{path}` is driven by controller `{ctrl}`; move its setpoint `{ctrl}.sp` instead, or choose an input no controller drives",
+            "{}: input `{path}` is driven by controller `{ctrl}`; {instead}, or choose an input no controller drives",
+            plant.file()
+        )));
+    }
+    let block = &plant.blocks()[info.block].name;
+    let manual = plant.input(&format!("{block}.auto")).is_some_and(|i| plant.inputs()[i].value == 0.0);
+    if manual && info.path.strip_prefix(block.as_str()).is_some_and(|rest| rest.starts_with(".sp")) {
+        // A gain of zero would be reported, and every measure from it meaningless.
+        return Err(request(format!(
+            "{}: `{path}` is the setpoint of `{block}`, which is in manual: it moves nothing; move its manual \
+             output `{block}.op_manual`, or leave `{block}` in auto",
             plant.file()
         )));
     }
