@@ -140,23 +140,18 @@ fn run_csv(file: &str, scenario: &str, csv: &std::path::Path) -> String {
 /// configuration is tuned and stepped by the default disturbances (feed rate ±10 %, feed
 /// composition ±0.05), its loops pair as its verdict recommends, its scaled IAE is the sum of its
 /// runs' IAEs over the allowed deviations, the ranks follow it and the first choice has the least.
-/// `--write-dir` writes each tuned configuration: each passes `plantwide check`, and the first
+/// `--write-dir` writes each tuned configuration: each passes `plantwide check` with no bare
+/// number (the tutorial's writer found 7 notes in one), and the first
 /// choice run through the written scenario gives the IAE the screen reported (integrated here from
 /// the CSV).
 #[test]
 fn the_dynamic_check_ranks_column_a_and_its_flowsheets_run_as_screened() {
     let dir = std::env::temp_dir().join(format!("plantwide-screen-column-{}", std::process::id()));
     let (code, v, err) = screen(&flowsheet("column_a.json"), A_QUALITIES, &["--write-dir", dir.to_str().unwrap()]);
-    // DV holds the reboiler's 0.5 kmol (nine seconds of boilup) by the bottoms valve alone: with
-    // the valve closed (`op_min`) the boilup its composition loop asks for drains it, and each
-    // of its runs stops naming `column.M[1]`. (It ran before on a reversed bottoms flow.)
-    assert_eq!(code, Some(2), "{err}");
-    let failed: Vec<&str> = v["failed"].as_array().unwrap().iter().map(|f| f.as_str().unwrap()).collect();
-    assert!(
-        failed.len() == 4
-            && failed.iter().all(|f| f.starts_with("configuration DV") && f.contains("`column.M[1]` ran dry")),
-        "{failed:?}"
-    );
+    // DV's BLT settings at F = 1 closed its loops unstably, and each run drained the 0.5 kmol
+    // reboiler (`column.M[1]` ran dry); BLT now detunes until the loops close stably, and DV runs.
+    assert_eq!(code, Some(0), "{err}");
+    assert!(v["failed"].as_array().is_none_or(|f| f.is_empty()), "{}", v["failed"]);
     assert_eq!(v["ranked_by"], "dynamic check");
     assert_eq!(v["disturbances"].as_array().unwrap().len(), 4, "{}", v["disturbances"]);
     let allowed = [f(&v["scaling"]["allowed_deviation"][0]), f(&v["scaling"]["allowed_deviation"][1])];
@@ -173,9 +168,9 @@ fn the_dynamic_check_ranks_column_a_and_its_flowsheets_run_as_screened() {
         assert!(close(f(&c["iae_scaled"]), sum, 1e-12), "{}", c["name"]);
         ranked.push((sum, c["rank"].as_u64().unwrap(), c["name"].as_str().unwrap()));
     }
-    assert_eq!(ranked.len(), 5);
+    assert_eq!(ranked.len(), 6);
     ranked.sort_by(|a, b| a.0.total_cmp(&b.0));
-    assert_eq!(ranked.iter().map(|r| r.1).collect::<Vec<_>>(), [1, 2, 3, 4, 5], "{ranked:?}");
+    assert_eq!(ranked.iter().map(|r| r.1).collect::<Vec<_>>(), [1, 2, 3, 4, 5, 6], "{ranked:?}");
     let best = ranked[0].2;
     assert!(v["verdict"].as_str().unwrap().starts_with(&format!("recommended: {best} (")), "{}", v["verdict"]);
     // The written flowsheets (DB is singular, not tuned) and scenarios.
@@ -184,7 +179,10 @@ fn the_dynamic_check_ranks_column_a_and_its_flowsheets_run_as_screened() {
     for (_, stem) in stems {
         let file = dir.join(format!("{stem}.json"));
         let out = plantwide(&["check", file.to_str().unwrap()]);
-        assert!(out.status.success(), "{stem}: {}", String::from_utf8_lossy(&out.stderr));
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{stem}: {stderr}");
+        // Every quantity written with its unit: a bare SI number gets a note on loading.
+        assert!(!stderr.contains("has no unit"), "{stem}: {stderr}");
     }
     assert!(!dir.join("DB.json").exists());
     let stem = stems.iter().find(|s| s.0 == best).unwrap().1;
@@ -201,11 +199,13 @@ fn the_dynamic_check_ranks_column_a_and_its_flowsheets_run_as_screened() {
 }
 
 /// Exit status is the truth: a configuration whose dynamic run fails (the low-reflux column's feed
-/// quintupled) is marked failed with the simulation's reason, naming the variable, is not ranked,
-/// is listed in `failed`, and `screen` exits 2 naming it; the others are still judged.
+/// cut by 95 %: its sump level loop asks for a reversed bottoms flow; a quintupled feed failed
+/// only while BLT left some configurations unstable) is marked failed with the simulation's
+/// reason, naming the variable, is not ranked, is listed in `failed`, and `screen` exits 2
+/// naming it; the others are still judged.
 #[test]
 fn a_configuration_whose_dynamic_run_fails_is_marked_and_screen_exits_2() {
-    let extra = ["--disturbances", "feed_source.F=+400%", "--duration", "5 h"];
+    let extra = ["--disturbances", "feed_source.F=-95%", "--duration", "5 h"];
     let (code, v, err) = screen(&fixture(BT), BT_QUALITIES, &extra);
     assert_eq!(code, Some(2), "{err}");
     let structures = v["structures"].as_array().unwrap();
@@ -217,11 +217,12 @@ fn a_configuration_whose_dynamic_run_fails_is_marked_and_screen_exits_2() {
         // The plant stops where it can no longer run (a tray or drum of `column` run dry), or the
         // integrator names the column variable it failed on.
         let named = why.contains("stopped: `column.")
+            || (why.contains("stopped: `") && why.contains("` drives `column."))
             || (why.contains("integration failed") && why.contains("failed on column."));
         assert!(named, "{why}");
         assert!(s["rank"].is_null() && s["iae_scaled"].is_null(), "{s}");
         assert!(
-            err.contains(&format!("configuration {}, run feed_source.F +400 %", s["name"].as_str().unwrap())),
+            err.contains(&format!("configuration {}, run feed_source.F -95 %", s["name"].as_str().unwrap())),
             "{err}"
         );
     }
@@ -237,17 +238,10 @@ fn a_configuration_whose_dynamic_run_fails_is_marked_and_screen_exits_2() {
 fn on_the_low_reflux_column_feed_composition_steps_confirm_lv() {
     let extra = ["--disturbances", "feed_source.z[benzene]=±0.045", "--duration", "12 h"];
     let (code, v, err) = screen(&fixture(BT), BT_QUALITIES, &extra);
-    // The newcomer's drum level loop has no lower limit: in LB (where it keeps the drum on D) a
-    // composition step asks it for a reversed distillate flow, and that configuration's runs
-    // stop, marked and named (exit 2); every other configuration is judged.
-    assert_eq!(code, Some(2), "{err}");
-    for failed in v["failed"].as_array().unwrap() {
-        let failed = failed.as_str().unwrap();
-        assert!(
-            failed.starts_with("configuration LB") && failed.contains("drives `column.distillate` out of its range"),
-            "{failed}"
-        );
-    }
+    // Every configuration runs (LB's runs stopped on a reversed distillate flow while BLT left its
+    // loops unstable: they now close stably).
+    assert_eq!(code, Some(0), "{err}");
+    assert!(v["failed"].as_array().is_none_or(|f| f.is_empty()), "{}", v["failed"]);
     let lv = by_name(&v, "LV");
     assert_eq!(lv["rank"], 1, "{}", v["verdict"]);
     let least = regular(&v).iter().map(|c| f(&c["iae_scaled"])).fold(f64::INFINITY, f64::min);

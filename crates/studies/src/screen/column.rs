@@ -517,7 +517,10 @@ fn move_level(plant: &Plant, name: &str, to: &str, flows: &[f64; 4], paths: &[St
             QuantityValue::Number(n) => *n,
             QuantityValue::Text(t) => plantwide_units::parse_quantity(t).map_or(f64::NAN, |q| q.value_si),
         };
-        c.kc = QuantityValue::Number(kc * value(to) / value(&from));
+        let gain_dim =
+            dim(to).zip(plant.var(&cfg.pv).map(|v| plant.vars()[v].spec.dim)).and_then(|(o, m)| o.checked_div(m));
+        let kc = kc * value(to) / value(&from);
+        c.kc = gain_dim.map_or(QuantityValue::Number(kc), |d| format!("{kc} {d}").into());
     }
     c.output = Some(to.to_string());
     (c.bias, c.op_min, c.op_max) = (None, None, None);

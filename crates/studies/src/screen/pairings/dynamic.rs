@@ -14,6 +14,7 @@ use plantwide_analysis::figures::summary;
 use plantwide_flowsheet::{Plant, StructureEdit};
 use plantwide_solve::dynamic::{Start, simulate};
 use plantwide_solve::{NewtonSettings, steady_state};
+use plantwide_units::Dimension;
 use rayon::prelude::*;
 use serde::{Deserialize, Deserializer, Serialize};
 
@@ -354,9 +355,20 @@ pub(crate) struct Tuned {
 fn loop_spec(open: &OpenPlant, s: &PairingStructure, i: usize, kc: f64, tau_i: f64, action: &str) -> serde_json::Value {
     let p = &s.pairs[i];
     let Limited { lo, hi, .. } = pair_outputs(open, s).swap_remove(i);
-    let c = open.plant.var(&p.cv).map_or(f64::NAN, |v| open.x[v]);
-    serde_json::json!({"type": "pid", "pv": p.cv, "output": p.mv, "sp": c, "kc": kc, "tau_i": tau_i,
-                       "action": action, "op_min": lo, "op_max": hi})
+    let cv = open.plant.var(&p.cv);
+    let c = cv.map_or(f64::NAN, |v| open.x[v]);
+    let cv_dim = cv.map_or(Dimension::DIMENSIONLESS, |v| open.plant.vars()[v].spec.dim);
+    let mv_dim = open.plant.input(&p.mv).map_or(Dimension::DIMENSIONLESS, |i| open.plant.inputs()[i].dim);
+    let gain_dim = mv_dim.checked_div(cv_dim).unwrap_or(Dimension::DIMENSIONLESS);
+    serde_json::json!({"type": "pid", "pv": p.cv, "output": p.mv, "sp": si(c, cv_dim), "kc": si(kc, gain_dim),
+                       "tau_i": si(tau_i, Dimension::TIME), "action": action, "op_min": si(lo, mv_dim),
+                       "op_max": si(hi, mv_dim)})
+}
+
+/// `v` (SI) as a flowsheet quantity: with its SI unit, so that the file a study writes reads
+/// without a note of a bare number (a plain number for a dimensionless one).
+pub(crate) fn si(v: f64, dim: Dimension) -> serde_json::Value {
+    if dim.is_dimensionless() { serde_json::json!(v) } else { format!("{v} {dim}").into() }
 }
 
 /// The open plant with the candidate's loops, tuned by BLT, and its steady state.
@@ -393,10 +405,10 @@ fn remote_ratio(open: &OpenPlant, mv: &str, name: &str, spec: &mut serde_json::V
     let Some(plantwide_model::ControllerSpec::Ratio(cfg)) = open.plant.spec().controllers.get(station) else {
         return None;
     };
-    let u0 = open.plant.input(mv).map(|i| open.plant.inputs()[i].value)?;
+    let (u0, dim) = open.plant.input(mv).map(|i| (open.plant.inputs()[i].value, open.plant.inputs()[i].dim))?;
     let obj = spec.as_object_mut()?;
     obj.remove("output");
-    obj.insert("bias".into(), u0.into());
+    obj.insert("bias".into(), si(u0, dim));
     let mut cfg = cfg.clone();
     cfg.ratio = plantwide_model::controllers::ratio::RatioValue::Remote { from: format!("{name}.op") };
     let station_spec = serde_json::to_value(plantwide_model::ControllerSpec::Ratio(cfg)).ok()?;
