@@ -184,7 +184,7 @@ fn campaign(seed: u64, n: usize, skip: &[String]) -> Report {
     for m in &shipped {
         guard::begin(&m.describe());
         let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| execute(m, &corpus)));
-        guard::end();
+        let _ = guard::end();
         if !matches!(result, Ok(Ok(Outcome::Ok))) {
             report.failures.push(("shipped file".into(), m.describe(), format!("{result:?}")));
         }
@@ -192,6 +192,7 @@ fn campaign(seed: u64, n: usize, skip: &[String]) -> Report {
     report.baseline = guard::set_baseline();
     report.warmup = shipped.len();
     let mut seeds = rng::Rng::new(seed);
+    let mut left = [0isize; Mode::ALL.len()];
     for i in 0..n {
         let s = if i == 0 { seed } else { seeds.next_u64() };
         let made = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| Mutant::new(s, &corpus)));
@@ -211,7 +212,13 @@ fn campaign(seed: u64, n: usize, skip: &[String]) -> Report {
         guard::begin(&description);
         let (started, cpu) = (Instant::now(), guard::cpu_time(None));
         let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| execute(&m, &corpus)));
-        guard::end();
+        left[m.mode as usize] += guard::end();
+        if (i + 1) % 5000 == 0 {
+            // Where the live heap goes, by kind: a slow leak shows here before the limit.
+            let by: Vec<String> =
+                Mode::ALL.iter().zip(&left).map(|(k, b)| format!("{k:?} {:+.1} MiB", *b as f64 / 1048576.0)).collect();
+            say(&format!("fuzz: after {} mutants the live heap they left behind: {}", i + 1, by.join(", ")));
+        }
         if n == 1 {
             say(&format!("fuzz replay: {description}\n    -> {result:?}"));
         }

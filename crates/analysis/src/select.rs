@@ -117,7 +117,7 @@ pub fn select_input(plant: &Plant, text: &str) -> Result<Signal, AnalysisError> 
         let auto = plant.input(&format!("{ctrl}.auto")).map(|i| plant.inputs()[i].value);
         let instead = match auto {
             // In manual its setpoint moves nothing (a zero gain): its manual output is the input.
-            Some(a) if a == 0.0 => format!("`{ctrl}` is in manual: move its manual output `{ctrl}.op_manual` instead"),
+            Some(0.0) => format!("`{ctrl}` is in manual: move its manual output `{ctrl}.op_manual` instead"),
             Some(_) => format!(
                 "move its setpoint `{ctrl}.sp` instead (the loop closed), or its manual output \
                  `{ctrl}.op_manual` with `--set {ctrl}.auto=0` (the loop open)"

@@ -72,15 +72,17 @@ pub fn begin(description: &str) {
 }
 
 /// The mutant finished: stop its clock, and remember it if it left more live heap behind than
-/// any before it.
-pub fn end() {
+/// any before it. Returns the live heap it left behind (or freed) [bytes].
+pub fn end() -> isize {
     STARTED_MS.store(0, Ordering::SeqCst);
-    let left = LIVE.load(Ordering::SeqCst).saturating_sub(LIVE_AT_BEGIN.load(Ordering::SeqCst));
+    let (now, then) = (LIVE.load(Ordering::SeqCst), LIVE_AT_BEGIN.load(Ordering::SeqCst));
+    let left = now.saturating_sub(then);
     let mut most = GREW_MOST.lock().unwrap_or_else(|e| e.into_inner());
     if left > most.0 {
         let current = CURRENT.lock().unwrap_or_else(|e| e.into_inner()).clone();
         *most = (left, current);
     }
+    now as isize - then as isize
 }
 
 /// Take the live heap now as the baseline the limit counts from; reset the peak.

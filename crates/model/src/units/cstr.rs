@@ -197,7 +197,7 @@ fn build_reaction(cx: &mut BuildCx<'_>, f: &str, c: &ReactionConfig) -> Reaction
         Some(o) => by_component(cx, &format!("{f}.orders"), o),
         None => nu.iter().map(|v| (-v).max(0.0)).collect(),
     };
-    if let Some(i) = orders.iter().position(|o| !(o.abs() <= MAX_ORDER)) {
+    if let Some(i) = orders.iter().position(|o| o.is_nan() || o.abs() > MAX_ORDER) {
         let order = crate::limits::number(orders[i]);
         let field = format!("{f}.orders.{}", cx.components[i]);
         cx.error(&field, format!("an order of {order} is beyond ±{MAX_ORDER}, where no rate law lies"));

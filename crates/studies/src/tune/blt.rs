@@ -297,7 +297,7 @@ mod tests {
     fn the_nyquist_check_agrees_with_routh_hurwitz() {
         let g = |w: f64| {
             let s = c64::new(0.0, w);
-            Mat::from_fn(1, 1, |_, _| (((s + 1.0) * (s * 0.5 + 1.0)).inv()))
+            Mat::from_fn(1, 1, |_, _| ((s + 1.0) * (s * 0.5 + 1.0)).inv())
         };
         for (kc, stable) in [(0.1, true), (0.4, true), (0.42, true), (0.44, false), (0.6, false), (3.0, false)] {
             assert_eq!(nyquist_stable(&g, &[kc], &[0.1], (1e-4, 1e2)), Some(stable), "Kc = {kc}");

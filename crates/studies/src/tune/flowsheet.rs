@@ -308,21 +308,6 @@ fn significant(v: f64) -> String {
     s.parse::<f64>().map_or(s, |x| x.to_string())
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn quantities_are_written_in_the_files_unit() {
-        let old = QuantityValue::Text("20 kmol/h/K".into());
-        // 1 kmol/h/K = 1000/3600 mol/(s K).
-        assert_eq!(quantity(2.5 * 1000.0 / 3600.0, Some(&old), None), "\"2.5 kmol/h/K\"");
-        assert_eq!(quantity(1234.5678, Some(&QuantityValue::Number(3.0)), None), "1234.57");
-        assert_eq!(quantity(600.0, None, Some("min")), "\"10 min\"");
-        assert_eq!(quantity(600.0, None, Some("s")), "600");
-    }
-}
-
 /// The gain and phase margins of each tuned loop of `tuning` (SI, before [`FlowsheetTuning::in_time_unit`])
 /// on the exact linear model of `plant` at its steady state `x`: each loop alone, `g_ii(jω)`
 /// seen through `measurement` times its PID, with the tuned loops open (in manual) and every
@@ -346,4 +331,19 @@ pub fn flowsheet_margins(
         l.margins = Some(margins(|w| response.at(w)[(i, i)] * c(w), lo, hi));
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quantities_are_written_in_the_files_unit() {
+        let old = QuantityValue::Text("20 kmol/h/K".into());
+        // 1 kmol/h/K = 1000/3600 mol/(s K).
+        assert_eq!(quantity(2.5 * 1000.0 / 3600.0, Some(&old), None), "\"2.5 kmol/h/K\"");
+        assert_eq!(quantity(1234.5678, Some(&QuantityValue::Number(3.0)), None), "1234.57");
+        assert_eq!(quantity(600.0, None, Some("min")), "\"10 min\"");
+        assert_eq!(quantity(600.0, None, Some("s")), "600");
+    }
 }
