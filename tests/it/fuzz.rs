@@ -11,7 +11,8 @@
 //!
 //! * `cargo test --test it fuzz::`: the fast sample (2 000 mutants, seed fixed).
 //! * `PLANTWIDE_FUZZ_MUTANTS=100000`: a large sample; `PLANTWIDE_FUZZ_SEED=<n|0x..>`: another seed.
-//! * Replay one mutant: `PLANTWIDE_FUZZ_SEED=<its seed> PLANTWIDE_FUZZ_MUTANTS=1`.
+//! * Replay one mutant: `PLANTWIDE_FUZZ_SEED=<its seed> PLANTWIDE_FUZZ_MUTANTS=1`; a stretch of a
+//!   campaign: `PLANTWIDE_FUZZ_START=<k>` runs its mutants from the k-th on.
 //! * `PLANTWIDE_FUZZ_SKIP=class,class`: temporary, opt-in: skip mutants whose description holds
 //!   one of these words (known defect classes while their fixes land elsewhere).
 //!
@@ -193,8 +194,14 @@ fn campaign(seed: u64, n: usize, skip: &[String]) -> Report {
     report.warmup = shipped.len();
     let mut seeds = rng::Rng::new(seed);
     let mut left = [0isize; Mode::ALL.len()];
+    // Replay a stretch of a campaign: its mutants from `PLANTWIDE_FUZZ_START` on (a failure that
+    // depends on what ran before it).
+    let start = env_u64("PLANTWIDE_FUZZ_START").unwrap_or(0) as usize;
     for i in 0..n {
         let s = if i == 0 { seed } else { seeds.next_u64() };
+        if i < start {
+            continue;
+        }
         let made = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| Mutant::new(s, &corpus)));
         let Ok(m) = made else {
             let why = std::mem::take(&mut *LAST_PANIC.lock().unwrap_or_else(|e| e.into_inner()));

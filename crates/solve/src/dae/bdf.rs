@@ -209,6 +209,17 @@ impl BdfState {
         if !(finite(self.t) && finite(self.h_abs) && self.h_abs > 0.0) {
             return Err("time or step size not a positive finite number".into());
         }
+        // The differences of a run's history are steps' changes of its state: a difference 1e12
+        // times the largest state value is no run's (a hand-edited file), and summing it into the
+        // predictor loses the state to rounding.
+        let x0 = self.d.first().map_or(&[][..], Vec::as_slice);
+        let largest = x0.iter().fold(1.0_f64, |m, v| m.max(v.abs()));
+        let bound = |i: usize| 1e12 * x0[i].abs().max(1e-3 * largest);
+        if self.d.iter().any(|r| r.iter().enumerate().any(|(i, v)| !(v.abs() <= bound(i)))) {
+            return Err(
+                "a history entry beyond 1e12 times its variable's value (or 1e-3 of the largest), or not finite".into(),
+            );
+        }
         let s = &self.stats;
         let counts = [
             s.n_steps,
@@ -1212,11 +1223,12 @@ impl Bdf {
             let (lo, hi) = dd.split_at_mut(i + 1);
             lo[i].iter_mut().zip(&hi[0]).for_each(|(a, b)| *a += b);
         }
-        // To rounding of the largest history entry summed (a restored snapshot may hold any).
+        // To rounding of the largest history entry summed (a restored snapshot may hold any, even
+        // entries whose sums overflow: the error test rejects such a step).
         debug_assert!(self.hist.iter().enumerate().all(|(pos, &j)| {
             let (a, b) = (w.x[j], dd[0][pos]);
             let scale = dd.iter().map(|r| r[pos].abs()).fold(1.0 + a.abs(), f64::max);
-            (a - b).abs() <= 1e-9 * scale
+            !(a - b).is_finite() || !scale.is_finite() || (a - b).abs() <= 1e-9 * scale
         }));
         if !self.hist_all {
             // The accepted iterate is the state: the untracked variables' values as they are,
