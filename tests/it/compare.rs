@@ -30,7 +30,7 @@ fn the_reactor_with_and_without_its_exchanger() {
         &["fehe_reactor.json", "fehe_reactor_without_fehe.json"],
         &[
             "--disturbances",
-            "feed_T=+1%,feed_rate=+10%",
+            "feed_T=+3 K,feed_rate=+10%",
             "--outputs",
             "effluent.T,effluent.x[A]",
             "--report",
@@ -125,7 +125,7 @@ fn compare_mistakes_exit_1_naming_the_scheme() {
         &flowsheet("fehe_reactor.json"),
         &flowsheet("column_a.json"),
         "--disturbances",
-        "feed_T",
+        "feed_T=+3 K",
         "--outputs",
         "effluent.T",
     ]);

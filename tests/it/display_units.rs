@@ -227,7 +227,7 @@ fn compare_shows_outputs_and_tuning_in_display_units() {
         &flowsheet("fehe_reactor.json"),
         &flowsheet("fehe_reactor_without_fehe.json"),
         "--disturbances",
-        "feed_T=+1%",
+        "feed_T=+3 K",
         "--outputs",
         "effluent.T,effluent.x[A]@1",
         "--tuning",

@@ -100,7 +100,7 @@ fn a_compare_report_is_also_an_html_page_with_its_tables_and_figures() {
         &flowsheet("fehe_reactor.json"),
         &flowsheet("fehe_reactor_without_fehe.json"),
         "--disturbances",
-        "feed_T=+1%",
+        "feed_T=+3 K",
         "--outputs",
         "effluent.T",
         "--tuning",
