@@ -109,13 +109,14 @@ fn print_controllers_and_specs(plant: &plantwide::flowsheet::Plant) {
             })
             .map(|i| i.path.as_str())
             .collect();
-        outln!(
-            "  {:<16} {:<12} reads {} drives {}",
-            b.name,
-            b.unit.type_name(),
-            measured.join(", "),
+        // A controller with no input of its own (a PID whose output a ratio station or a
+        // cascade slave reads as its setpoint) is read by other blocks instead.
+        let drives = if driven.is_empty() {
+            format!("no input (its output `{}.op` is read by other controllers)", b.name)
+        } else {
             driven.join(", ")
-        );
+        };
+        outln!("  {:<16} {:<12} reads {} drives {drives}", b.name, b.unit.type_name(), measured.join(", "));
     }
     if !plant.specs().is_empty() {
         outln!("design specs ({}), each with its varied input as one more unknown:", plant.specs().len());

@@ -180,12 +180,13 @@ fn print_table(t: &FlowsheetTuning, plant: &Plant, tu: &TimeUnit) {
             opt(l.tau_d),
             l.action
         );
-        print_details(l, u);
+        let pv_unit = plant.var(&l.output).map_or(String::new(), |v| plant.vars()[v].spec.dim.to_string());
+        print_details(l, u, &pv_unit);
     }
 }
 
 /// The test behind a loop's settings: the relay cycle, the fitted model, the averaging design.
-fn print_details(l: &FlowsheetLoop, u: &str) {
+fn print_details(l: &FlowsheetLoop, u: &str, pv_unit: &str) {
     if let Some(r) = &l.relay {
         outln!(
             "  relay: {} cycles after {} switches, amplitude {:.5e}, period spread {:.2} %, amplitude spread {:.2} %, \
@@ -208,7 +209,7 @@ fn print_details(l: &FlowsheetLoop, u: &str) {
         outln!("{}", linearity_line(c));
     }
     if let Some(av) = &l.averaging {
-        outln!("  averaging {:?}: largest level deviation {} at {:.4} {u}", av.form, av.band, av.time);
+        outln!("  averaging {:?}: largest level deviation {} {pv_unit} at {:.4} {u}", av.form, av.band, av.time);
     }
     if let Some(m) = &l.margins {
         outln!("  {}", margins_line(m, u, "on the plant's linear model, the tuned loops open"));
