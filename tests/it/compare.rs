@@ -362,3 +362,31 @@ fn a_controller_driven_input_is_an_output() {
         assert!(duty(up) > 0.0 && duty(down) < 0.0, "{up} {down}");
     }
 }
+
+/// A scheme whose quality loops set ratio stations (screen's (L/D)(V/B), written by
+/// `--write-dir`) is refused by name, not compared without its quality control: `compare` listed
+/// it as having "no quality loops", ran no closed loop for it and exited 0 (found writing the
+/// tutorial).
+#[test]
+fn a_scheme_of_ratio_masters_is_refused_not_compared_without_its_loops() {
+    let dir = std::env::temp_dir().join(format!("plantwide_compare_ratio_{}", std::process::id()));
+    let column = format!("{}/docs/tutorial/bt_column.json", crate::harness::ROOT);
+    let qualities = "distillate.x[benzene],column.T[8]";
+    let written =
+        ["screen", &column, "--column", "column", "--outputs", qualities, "--write-dir", dir.to_str().unwrap()];
+    assert!(plantwide(&written).status.success());
+    let ratio = dir.join("LD-VB.json");
+    let out = plantwide(&[
+        "compare",
+        &column,
+        ratio.to_str().unwrap(),
+        "--disturbances",
+        "feed_source.F=+10%",
+        "--outputs",
+        qualities,
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("LD-VB.json: quality loop `pair1` drives no input"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}

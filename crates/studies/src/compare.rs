@@ -392,9 +392,25 @@ fn quality_loops(plant: &Plant, named: &[String]) -> Result<Vec<QualityLoop>, Co
     let mut loops = Vec::new();
     for (name, c) in &plant.spec().controllers {
         let ControllerSpec::Pid(pid) = c else { continue };
-        let Some(mv) = pid.output.clone() else { continue };
         let dim = plant.var(&pid.pv).map(|v| plant.vars()[v].spec.dim);
         let quality = pid.tau_i.is_some() && dim.is_some_and(|d| !inventory.contains(&d));
+        let Some(mv) = pid.output.clone() else {
+            // A quality loop that sets another controller (a ratio station's ratio, a cascade
+            // slave's setpoint) cannot be opened at an input: left out, the scheme would be
+            // compared without its quality control and say nothing of it.
+            if (named.is_empty() && quality) || named.contains(name) {
+                return Err(CompareError::Request {
+                    file: plant.file().to_string(),
+                    what: format!(
+                        "quality loop `{name}` drives no input (its output `{name}.op` sets another controller, \
+                         e.g. a ratio station's ratio): compare opens and tunes quality loops at the inputs they \
+                         drive, so a scheme of ratio masters or cascade masters cannot be compared yet; compare \
+                         its loops' gains with `plantwide gains --inputs {name}.op_manual,…` instead"
+                    ),
+                });
+            }
+            continue;
+        };
         if (named.is_empty() && quality) || named.contains(name) {
             loops.push(QualityLoop { controller: name.clone(), cv: pid.pv.clone(), mv });
         }
