@@ -215,7 +215,7 @@ impl BdfState {
         let x0 = self.d.first().map_or(&[][..], Vec::as_slice);
         let largest = x0.iter().fold(1.0_f64, |m, v| m.max(v.abs()));
         let bound = |i: usize| 1e12 * x0[i].abs().max(1e-3 * largest);
-        if self.d.iter().any(|r| r.iter().enumerate().any(|(i, v)| !(v.abs() <= bound(i)))) {
+        if self.d.iter().any(|r| r.iter().enumerate().any(|(i, v)| v.is_nan() || v.abs() > bound(i))) {
             return Err(
                 "a history entry beyond 1e12 times its variable's value (or 1e-3 of the largest), or not finite".into(),
             );
