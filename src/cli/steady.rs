@@ -167,7 +167,7 @@ pub fn run(a: &SteadyArgs<'_>) -> Result<(), CliError> {
     for w in &sol.warnings {
         outln!("warning: {}\n", w.message);
     }
-    print_specs(&plant, &sol);
+    print_specs(&plant, &sol, a.units);
     print_streams(&plant, &sol, a.units);
     print_blocks(&plant, &sol, a.units);
     Ok(())
@@ -252,17 +252,19 @@ pub(super) fn shown(v: f64, dim: plantwide::units::Dimension, system: UnitSystem
 }
 
 /// Each spec met: the varied input's value found (and the file's), the held variable's value.
-fn print_specs(plant: &Plant, sol: &Solution) {
+fn print_specs(plant: &Plant, sol: &Solution, units: Option<UnitSystem>) {
+    // In the `--units` system asked for, as the streams are; else SI.
+    let value = |v: f64, dim| units.map_or_else(|| with_unit(v, dim), |u| shown(v, dim, u));
     for s in plant.specs() {
         let (was, dim) = (plant.inputs()[s.input].value, plant.inputs()[s.input].dim);
         outln!(
             "design spec {}: met with `{}` = {} (from {}), `{}` = {}",
             s.origin,
             s.vary,
-            with_unit(sol.u[s.input], dim),
-            with_unit(was, dim),
+            value(sol.u[s.input], dim),
+            value(was, dim),
             s.path,
-            with_unit(sol.x[s.var], plant.vars()[s.var].spec.dim)
+            value(sol.x[s.var], plant.vars()[s.var].spec.dim)
         );
     }
     if !plant.specs().is_empty() {
