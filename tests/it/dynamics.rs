@@ -300,11 +300,9 @@ fn reactor_plants_conserve_mass_to_round_off() {
     }
 }
 
-/// Snapshot at 700 min → JSON → resume: the same trajectory as the uninterrupted run (bit for
-/// bit: the snapshot holds the BDF history and Jacobian). A resume with a retuned level loop
-/// (changed fingerprint) restarts from the same state and settles on the same compositions.
-#[test]
-fn snapshot_and_resume_continue_the_uninterrupted_trajectory() {
+/// Column A's feed step run for 1200 min with a snapshot at 700 min: the plant, its steady state,
+/// the scenario, the run and the snapshot (through its JSON, as a file holds it).
+fn column_a_snapshot_at_700_min() -> (Plant, Vec<f64>, String, SimulationResult, Snapshot) {
     let scenario = COLUMN_A_STEP.replace(
         r#""duration": "2000 min","#,
         r#""duration": "1200 min", "snapshots": [{"at": "700 min", "file": "snap.json"}],"#,
@@ -318,6 +316,15 @@ fn snapshot_and_resume_continue_the_uninterrupted_trajectory() {
         }
     });
     let snap: Snapshot = serde_json::from_str(&saved.expect("snapshot taken")).unwrap();
+    (plant, x0, scenario, full, snap)
+}
+
+/// Snapshot at 700 min → JSON → resume: the same trajectory as the uninterrupted run (bit for
+/// bit: the snapshot holds the BDF history and Jacobian). A resume with a retuned level loop
+/// (changed fingerprint) restarts from the same state and settles on the same compositions.
+#[test]
+fn snapshot_and_resume_continue_the_uninterrupted_trajectory() {
+    let (_, _, scenario, full, snap) = column_a_snapshot_at_700_min();
     assert!(snap.t >= 700.0 * 60.0 && snap.t < 800.0 * 60.0, "{}", snap.t);
     let (plant2, _) = converged("column_a.json", &[]);
     let resumed = run_from(&plant2, &scenario, Start::Snapshot(&snap), &mut |_| {});
@@ -353,18 +360,7 @@ fn snapshot_and_resume_continue_the_uninterrupted_trajectory() {
 /// both events and the same snapshot: after it, it is the resumed run (same history, same stops).
 #[test]
 fn a_snapshot_resumed_with_another_scenario_runs_that_scenario_from_its_time() {
-    let first = COLUMN_A_STEP.replace(
-        r#""duration": "2000 min","#,
-        r#""duration": "1200 min", "snapshots": [{"at": "700 min", "file": "snap.json"}],"#,
-    );
-    let (plant, x0) = converged("column_a.json", &[]);
-    let mut saved = None;
-    run_from(&plant, &first, Start::Steady(&x0), &mut |p| {
-        if let Progress::Snapshot { snapshot, .. } = p {
-            saved = Some(snapshot.clone());
-        }
-    });
-    let snap = saved.expect("snapshot taken");
+    let (plant, x0, _, _, snap) = column_a_snapshot_at_700_min();
     let what_if = |events: &str| {
         format!(
             r#"{{"format_version": 1, "duration": "1000 min", "events": [{events}

@@ -172,7 +172,7 @@ mod tests {
     use faer::c64;
 
     use super::*;
-    use crate::numeric::root_bracketed;
+    use crate::tune::margins::{margins, pid};
 
     /// `g(jω)` of a model.
     fn g(model: &ProcessModel, w: f64) -> c64 {
@@ -188,17 +188,7 @@ mod tests {
 
     /// The ideal-form PID `c(jω)` (no derivative filter).
     fn c(p: &PidSettings, w: f64) -> c64 {
-        let s = c64::new(0.0, w);
-        (c64::new(1.0, 0.0) + (s * p.tau_i).inv() + s * p.tau_d.unwrap_or(0.0)) * p.kc
-    }
-
-    /// Gain margin of the loop `g c`: one over the loop gain where it crosses the negative real
-    /// axis inside `[lo, hi]` (rad/s).
-    fn gain_margin(model: &ProcessModel, p: &PidSettings, lo: f64, hi: f64) -> f64 {
-        let w = root_bracketed(|w| (g(model, w) * c(p, w)).im, lo, hi, 1e-14);
-        let l = g(model, w) * c(p, w);
-        assert!(l.re < 0.0 && l.im.abs() < 1e-12 * l.norm(), "{l}");
-        1.0 / l.norm()
+        pid(p.kc, Some(p.tau_i), p.tau_d, w)
     }
 
     #[test]
@@ -209,7 +199,8 @@ mod tests {
         let model = ProcessModel::Foptd { k: 2.0, tau: 10.0, theta: 2.0 };
         let p = model_rule(ModelRule::Simc, &model, None, false).unwrap();
         assert!((p.kc - 10.0 / (2.0 * 4.0)).abs() < 1e-15 && p.tau_i == 10.0 && p.tau_c == 2.0, "{p:?}");
-        assert!((gain_margin(&model, &p, 0.5, 1.0) - std::f64::consts::PI).abs() < 1e-9);
+        let gm = margins(|w| g(&model, w) * c(&p, w), 0.5, 1.0).gain_margin.expect("a phase crossover");
+        assert!((gm - std::f64::consts::PI).abs() < 1e-9, "{gm}");
         let w = 1.0 / (2.0 * 2.0);
         let l = g(&model, w) * c(&p, w);
         assert!((l.norm() - 1.0).abs() < 1e-12, "{l}");
