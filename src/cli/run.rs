@@ -227,6 +227,7 @@ fn print_summary(
                 "balances": res.conservation.balances,
             },
             "mpc": res.mpc,
+            "tripped": res.tripped,
         });
         outln!("{}", serde_json::to_string_pretty(&out).map_err(|e| CliError::user(e.to_string()))?);
         return Ok(());
@@ -242,6 +243,12 @@ fn print_summary(
         s.n_lu,
         s.n_restarts
     );
+    for (t, origin) in res.events.iter().filter(|(_, o)| o.starts_with("when[")) {
+        outln!("{origin} at t = {:.4} {time_unit}", t * time_factor);
+    }
+    if let Some(why) = &res.tripped {
+        outln!("stopped by the scenario: {why}; the run ends there");
+    }
     outln!(
         "{:<28} {:<10} {:>10} {:>14} {:>14} {:>14} {:>14} {:>14} {:>12}",
         "path",

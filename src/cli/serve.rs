@@ -62,6 +62,7 @@ fn empty_scenario() -> ScenarioSpec {
         duration: QuantityValue::Text("1000 h".into()),
         integrator: Default::default(),
         events: Vec::new(),
+        when: Vec::new(),
         sampling: Default::default(),
         analyzers: Default::default(),
         record: Default::default(),

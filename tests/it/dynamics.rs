@@ -18,7 +18,7 @@ fn run(name: &str, fields: &[(&str, &str)], scenario: &str) -> (Plant, Vec<f64>,
     (plant, x0, res)
 }
 
-fn converged(name: &str, fields: &[(&str, &str)]) -> (Plant, Vec<f64>) {
+pub(crate) fn converged(name: &str, fields: &[(&str, &str)]) -> (Plant, Vec<f64>) {
     let path = flowsheet(name);
     let text = std::fs::read_to_string(&path).unwrap();
     let mut spec: FlowsheetSpec = parse_spec(&text, &path).unwrap();
@@ -30,7 +30,7 @@ fn converged(name: &str, fields: &[(&str, &str)]) -> (Plant, Vec<f64>) {
     (plant, ss.x)
 }
 
-fn run_from(
+pub(crate) fn run_from(
     plant: &Plant,
     scenario: &str,
     start: Start<'_>,
@@ -41,7 +41,7 @@ fn run_from(
     simulate(plant, &sc, start, "test", observer).unwrap_or_else(|e| panic!("{e}"))
 }
 
-fn column(res: &SimulationResult, path: &str) -> Vec<f64> {
+pub(crate) fn column(res: &SimulationResult, path: &str) -> Vec<f64> {
     let k = res.columns.iter().position(|c| c.path == path).unwrap_or_else(|| panic!("no column {path}"));
     res.rows.iter().map(|r| r[k]).collect()
 }

@@ -16,6 +16,7 @@ mod cli_errors;
 mod columns;
 mod columns_rigorous;
 mod compare;
+mod conditions;
 mod core;
 mod display_units;
 mod dynamics;

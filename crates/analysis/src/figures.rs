@@ -92,6 +92,7 @@ mod tests {
             stats: BdfStats::default(),
             conservation: Conservation::new(&[], None, [&[], &[]], &[], &[]),
             mpc: Vec::new(),
+            tripped: None,
         }
     }
 

@@ -33,6 +33,9 @@ use crate::plant::{BlockKind, Plant, Read};
 
 pub use plantwide_model::limits::{Limits, LimitsError};
 
+mod when;
+pub use when::{Condition, WhenSpec};
+
 /// The scenario format version this build reads.
 pub const SCENARIO_FORMAT_VERSION: u32 = 1;
 
@@ -63,6 +66,10 @@ pub struct ScenarioSpec {
     /// or sinusoid still running at the end of the run is cut by it.
     #[serde(default)]
     pub events: Vec<EventSpec>,
+    /// Conditional events: what happens when a variable crosses a value (a trip, an interlock,
+    /// the end of the run), each acting once ([`WhenSpec`]).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub when: Vec<WhenSpec>,
     /// DCS scan interval by controller name: the controller's output is held between scans.
     #[serde(default)]
     pub sampling: IndexMap<String, QuantityValue>,
@@ -434,6 +441,8 @@ pub struct Scenario {
     pub first_step: Option<f64>,
     /// Events sorted by time (stable).
     pub events: Vec<Event>,
+    /// Conditional events, in file order.
+    pub conditions: Vec<Condition>,
     /// `(controller block, scan interval [s])`.
     pub sampling: Vec<(usize, f64)>,
     /// `(controller block, sample time [s], dead time [s])`.
@@ -694,7 +703,7 @@ fn resolve_in(mut cx: Cx<'_>, spec: &ScenarioSpec, file: &str, limits: &Limits) 
     }
     let max_step = int.max_step.as_ref().map_or(f64::INFINITY, |q| cx.time("integrator.max_step", q, true));
     let first_step = int.first_step.as_ref().map(|q| cx.time("integrator.first_step", q, true));
-    let events = events_of(&mut cx, &spec.events, duration, limits);
+    let events = events_of(&mut cx, "events", &spec.events, duration, limits);
     let mut sampling = Vec::new();
     for (name, q) in &spec.sampling {
         let field = format!("sampling.{name}");
@@ -719,6 +728,8 @@ fn resolve_in(mut cx: Cx<'_>, spec: &ScenarioSpec, file: &str, limits: &Limits) 
         }
     }
     check_faults(&mut cx, &events, &analyzers);
+    let blocks: Vec<usize> = analyzers.iter().map(|&(b, ..)| b).chain(cx.ongoing.analyzers.iter().copied()).collect();
+    let conditions = when::conditions_of(&mut cx, &spec.when, &blocks, limits);
     let rec = &spec.record;
     let interval = rec.interval.as_ref().map_or(duration / 1000.0, |q| cx.time("record.interval", q, true));
     let time_unit = rec.time_unit.clone().unwrap_or_else(|| "min".into());
@@ -728,7 +739,7 @@ fn resolve_in(mut cx: Cx<'_>, spec: &ScenarioSpec, file: &str, limits: &Limits) 
             format!("`{time_unit}` is not a unit of time (e.g. \"s\", \"min\", \"h\")"),
         ));
     }
-    let record = recorded(&mut cx, rec, &events);
+    let record = recorded(&mut cx, rec, &events, &conditions);
     let mut totals = Vec::new();
     for (k, name) in rec.totals.iter().enumerate() {
         match plant.streams.iter().position(|s| s.name == *name) {
@@ -750,7 +761,8 @@ fn resolve_in(mut cx: Cx<'_>, spec: &ScenarioSpec, file: &str, limits: &Limits) 
         snapshots.push((cx.time(&format!("snapshots[{k}].at"), &s.at, false), s.file.clone()));
     }
     let n_columns = record.len() + totals.len() * plant.components.len();
-    record_budget(&mut cx, (duration, interval), events.len(), n_columns, limits);
+    let n_events = events.len() + conditions.iter().map(|c| c.then.len()).sum::<usize>();
+    record_budget(&mut cx, (duration, interval), n_events, n_columns, limits);
     if !cx.diags.is_empty() {
         return Err(LoadError::Invalid { file: file.into(), diagnostics: cx.diags });
     }
@@ -762,6 +774,7 @@ fn resolve_in(mut cx: Cx<'_>, spec: &ScenarioSpec, file: &str, limits: &Limits) 
         max_step,
         first_step,
         events,
+        conditions,
         sampling,
         analyzers,
         interval,
@@ -772,12 +785,12 @@ fn resolve_in(mut cx: Cx<'_>, spec: &ScenarioSpec, file: &str, limits: &Limits) 
     })
 }
 
-/// The recorded quantities: `rec.paths`, or by default every controller's measurement and output
-/// and every input an event moves.
-fn recorded(cx: &mut Cx<'_>, rec: &RecordSpec, events: &[Event]) -> Vec<Recorded> {
+/// The recorded quantities: `rec.paths`, or by default every controller's measurement and output,
+/// every input an event moves and every variable a condition watches.
+fn recorded(cx: &mut Cx<'_>, rec: &RecordSpec, events: &[Event], conditions: &[Condition]) -> Vec<Recorded> {
     let mut record = Vec::new();
     let paths: Vec<(String, Option<String>)> = if rec.paths.is_empty() {
-        default_paths(cx.plant, events)
+        default_paths(cx.plant, events, conditions)
     } else {
         rec.paths
             .iter()
@@ -868,15 +881,16 @@ fn record_budget(cx: &mut Cx<'_>, times: (f64, f64), n_events: usize, n_columns:
 /// event after the end of the run, more events than `limits.max_events`, and two events at the
 /// same time on the same target (an input, or a controller's mode), whose order would decide the
 /// result; events at the same time on different targets are applied in file order.
-fn events_of(cx: &mut Cx<'_>, specs: &[EventSpec], duration: f64, limits: &Limits) -> Vec<Event> {
+/// `list` names the list in messages (`events`, `when[0].then`).
+fn events_of(cx: &mut Cx<'_>, list: &str, specs: &[EventSpec], duration: f64, limits: &Limits) -> Vec<Event> {
     // (event, label for messages)
     let mut events: Vec<(Event, String)> = Vec::new();
     // Counted before expansion too, so that a flood of events is not expanded and checked first.
-    if too_many_events(cx, specs.len(), limits) {
+    if too_many_events(cx, list, specs.len(), limits) {
         return Vec::new();
     }
     for (k, e) in specs.iter().enumerate() {
-        let base = format!("events[{k}]");
+        let base = format!("{list}[{k}]");
         let expanded = event(cx, &base, e);
         if let Some(first) = expanded.first()
             && first.t > duration
@@ -891,7 +905,7 @@ fn events_of(cx: &mut Cx<'_>, specs: &[EventSpec], duration: f64, limits: &Limit
             events.push((ev, label));
         }
     }
-    if too_many_events(cx, events.len(), limits) {
+    if too_many_events(cx, list, events.len(), limits) {
         return Vec::new();
     }
     events.retain(|(e, _)| e.t.is_finite());
@@ -978,12 +992,13 @@ fn check_values(cx: &mut Cx<'_>, events: &[(Event, String)]) {
     }
 }
 
-/// Report `n` events above [`Limits::max_events`] (a ramp, a pulse or a timed sinusoid counts two).
-fn too_many_events(cx: &mut Cx<'_>, n: usize, limits: &Limits) -> bool {
+/// Report `n` events in `list` above [`Limits::max_events`] (a ramp, a pulse or a timed sinusoid
+/// counts two).
+fn too_many_events(cx: &mut Cx<'_>, list: &str, n: usize, limits: &Limits) -> bool {
     let over = n > limits.max_events;
     if over {
         cx.diags.push(Diagnostic::new(
-            "events",
+            list,
             format!(
                 "{n} events (a ramp, a pulse or a sinusoid with a duration counts two) are more than the limit of {} ({} raises it)",
                 limits.max_events,
@@ -1036,8 +1051,9 @@ fn target_name(plant: &Plant, a: &Action) -> String {
     }
 }
 
-/// Every controller's measurement and output, and every input an event moves.
-fn default_paths(plant: &Plant, events: &[Event]) -> Vec<(String, Option<String>)> {
+/// Every controller's measurement and output, every input an event moves (a conditional one too)
+/// and every variable a condition watches.
+fn default_paths(plant: &Plant, events: &[Event], conditions: &[Condition]) -> Vec<(String, Option<String>)> {
     let mut paths: Vec<String> = Vec::new();
     for b in plant.blocks.iter().filter(|b| b.kind == BlockKind::Controller) {
         paths.extend(b.unit.signals().into_iter().filter(|s| s.role == "pv").map(|s| s.path));
@@ -1048,7 +1064,8 @@ fn default_paths(plant: &Plant, events: &[Event]) -> Vec<(String, Option<String>
                 .map(|v| v.path.clone()),
         );
     }
-    for e in events {
+    paths.extend(conditions.iter().map(|c| plant.vars[c.var].path.clone()));
+    for e in events.iter().chain(conditions.iter().flat_map(|c| &c.then)) {
         if let Action::Step { input, .. }
         | Action::Ramp { input, .. }
         | Action::Pulse { input, .. }

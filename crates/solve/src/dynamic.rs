@@ -190,6 +190,9 @@ pub struct SimulationResult {
     pub conservation: Conservation,
     /// Per model predictive controller: its QP statuses and solve times.
     pub mpc: Vec<MpcLog>,
+    /// The condition (`when` with `"stop": true`) that ended the run before its duration, and
+    /// where: the trip the scenario asked for (the run is complete up to `t`).
+    pub tripped: Option<String>,
 }
 
 /// Run `scenario` on `plant` from `start`. A copy of the plant is rewired for sampled

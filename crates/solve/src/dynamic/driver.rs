@@ -11,6 +11,8 @@
 
 use std::borrow::Cow;
 
+mod conditions;
+
 use plantwide_flowsheet::scenario::{Action, Event, Scenario};
 use plantwide_flowsheet::{Plant, Read};
 
@@ -82,6 +84,8 @@ pub(super) struct Driver<'p> {
     state_buf: Vec<f64>,
     /// The last step's dense output of the recorded entries (its buffers kept between steps).
     dense: DenseOutput,
+    /// Why the run ended before its duration at a condition's `stop` (a trip the scenario asked for).
+    tripped: Option<String>,
 }
 
 /// Why a run stopped early.
@@ -206,11 +210,14 @@ impl<'p> Driver<'p> {
         reads.extend(recorded.iter().copied().filter(|&v| v < plant.n_vars()));
         reads.extend(analyzers.iter().map(|&(_, v)| v));
         reads.extend(sampled.iter().flatten().map(|&(_, op)| op));
+        reads.extend(sc.conditions.iter().map(|c| c.var));
         let shape = DaeShape::new(&plant, &quad.streams, mpcs.is_empty().then_some(reads.as_slice()));
         // Between steps only the recorded variables are interpolated: the integrator need not
         // keep the history of the other explicit ones.
         let mut bdf = integrator(bdf_settings(sc));
-        bdf.watch(&recorded);
+        // The watched variables of conditions are interpolated too, to locate their crossings.
+        let watched: Vec<usize> = recorded.iter().copied().chain(sc.conditions.iter().map(|c| c.var)).collect();
+        bdf.watch(&watched);
         Ok(Driver {
             shape,
             recorded,
@@ -237,6 +244,7 @@ impl<'p> Driver<'p> {
             driven,
             state_buf: Vec::new(),
             dense: DenseOutput::default(),
+            tripped: None,
         })
     }
 
@@ -265,6 +273,11 @@ impl<'p> Driver<'p> {
         } else {
             self.bdf.interpolate(t, out);
         }
+    }
+
+    /// Why a condition ended the run, if one did.
+    pub(super) fn tripped(&self) -> Option<&str> {
+        self.tripped.as_deref()
     }
 
     /// The value of input `i` at `t` (SI).
@@ -331,6 +344,9 @@ impl<'p> Driver<'p> {
         for m in &self.mpcs {
             next = next.min(m.next_time());
         }
+        if let Some(due) = self.next_triggered() {
+            next = next.min(due);
+        }
         next.max(t)
     }
 
@@ -361,6 +377,7 @@ impl<'p> Driver<'p> {
     /// true if the integrator must restart.
     fn apply_due_at(&mut self, t: f64, x: &mut [f64]) -> bool {
         let scenario_event = self.apply_events(t, x);
+        let scenario_event = self.apply_triggered(t, x, scenario_event);
         let scanned = self.apply_scans(t, x);
         let sampled = self.apply_samples(t, x);
         let moved = self.apply_mpc(t, x);
@@ -566,11 +583,11 @@ impl<'p> Driver<'p> {
     /// (Re)start the integrator at `t` from `x` after applying what is due there; a row after the
     /// scenario events applied, if any.
     fn restart_after_due(&mut self, t: f64, x: &mut [f64]) -> Result<(), DaeError> {
-        let events = self.st.next_event;
+        let events = self.events.len();
         if self.apply_due_at(t, x) {
             let sys = PlantDae::new(&self.plant, &self.st.waveforms, &self.shape);
             self.bdf.restart_after_discontinuity(&sys, t, x)?;
-            if self.st.next_event > events {
+            if self.events.len() > events {
                 x.copy_from_slice(self.bdf.x());
                 self.push_row(t, x);
             }
@@ -586,6 +603,7 @@ impl<'p> Driver<'p> {
             let sys = PlantDae::new(&self.plant, &self.st.waveforms, &self.shape);
             self.bdf.restore(&sys, state)?;
             x.copy_from_slice(self.bdf.x());
+            self.conditions_at_start();
             return Ok(x);
         }
         let (t0, interval) = (self.t0, self.sc.interval);
@@ -593,14 +611,15 @@ impl<'p> Driver<'p> {
             self.push_row(t0, &x);
             self.st.next_record = instants::after(t0, interval);
         }
-        let events = self.st.next_event;
+        let events = self.events.len();
         self.apply_due_at(t0, &mut x);
         let sys = PlantDae::new(&self.plant, &self.st.waveforms, &self.shape);
         self.bdf.restart(&sys, t0, &x)?;
-        if self.st.next_event > events {
+        if self.events.len() > events {
             x.copy_from_slice(self.bdf.x());
             self.push_row(t0, &x);
         }
+        self.conditions_at_start();
         Ok(x)
     }
 
@@ -626,6 +645,9 @@ impl<'p> Driver<'p> {
         if let Some(e) = self.failure.take() {
             return Err(RunError::Mpc(e));
         }
+        if self.tripped.is_some() {
+            return Ok(false);
+        }
         let t = self.t();
         let mut x = std::mem::take(&mut self.state_buf);
         // The state is copied out only when something is due now (`next_stop` is the earliest
@@ -646,8 +668,14 @@ impl<'p> Driver<'p> {
         let t_stop = self.next_stop(t);
         let sys = PlantDae::new(&self.plant, &self.st.waveforms, &self.shape);
         self.bdf.step(&sys, t_stop)?;
+        if !self.conditions_after_step(&mut x)? {
+            self.record_through(self.bdf.t(), &mut x);
+        }
         let now = self.bdf.t();
-        self.record_through(now, &mut x);
+        if self.tripped.is_some() && self.times.last() != Some(&now) {
+            x.copy_from_slice(self.bdf.x());
+            self.push_row(now, &x);
+        }
         self.state_buf = x;
         if let Some(why) = self.ran_dry().or_else(|| self.driven_out_of_range()) {
             return Err(RunError::Stopped(why));
@@ -720,7 +748,7 @@ impl<'p> Driver<'p> {
             && self.st.next_record as f64 * interval <= self.sc.duration
         {
             let tr = self.st.next_record as f64 * interval;
-            if tr == now {
+            if tr == self.bdf.t() {
                 xi.copy_from_slice(self.bdf.x());
             } else {
                 if !gathered {
@@ -822,6 +850,7 @@ impl<'p> Driver<'p> {
             stats: self.bdf.stats(),
             conservation,
             mpc: self.mpcs.into_iter().map(|m| m.log).collect::<Vec<MpcLog>>(),
+            tripped: self.tripped,
         };
         SPARE.set(Some(self.bdf));
         result

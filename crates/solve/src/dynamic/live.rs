@@ -282,6 +282,7 @@ impl Live {
             duration: QuantityValue::Number(1.0),
             integrator: Default::default(),
             events: vec![e.clone()],
+            when: Vec::new(),
             sampling: Default::default(),
             analyzers: Default::default(),
             record: Default::default(),
@@ -313,7 +314,7 @@ impl Live {
     ///
     /// # Errors
     /// [`LiveError::Failed`] when the integrator fails (the run then stays stopped),
-    /// [`LiveError::Stopped`] after such a failure.
+    /// [`LiveError::Stopped`] after such a failure, or when a scenario condition ends the run.
     pub fn step(&mut self) -> Result<(), LiveError> {
         if let Some(why) = &self.failed {
             return Err(LiveError::Stopped(why.clone()));
@@ -322,7 +323,15 @@ impl Live {
         let done = self.driver.step_once(&mut |_| {});
         self.driver.forget_records();
         match done {
-            Ok(_) => Ok(()),
+            Ok(_) => match self.driver.tripped() {
+                // A condition's `stop` ends a live run as it ends a run: it stays stopped.
+                Some(why) => {
+                    let why = format!("{}: stopped: {why}", self.plant.file());
+                    self.failed = Some(why.clone());
+                    Err(LiveError::Stopped(why))
+                }
+                None => Ok(()),
+            },
             Err(e) => {
                 let why = failure(&self.plant, e);
                 self.failed = Some(why.clone());

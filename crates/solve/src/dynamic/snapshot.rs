@@ -42,6 +42,25 @@ pub struct DriverState {
     pub next_record: u64,
     /// Snapshots already taken.
     pub snapshots_done: Vec<bool>,
+    /// The conditions (`when`) that have acted, by [`Condition::key`](plantwide_flowsheet::scenario::Condition::key).
+    #[serde(default)]
+    pub fired: Vec<String>,
+    /// The events of conditions that have acted, not applied yet, by the time they are due.
+    #[serde(default)]
+    pub triggered: Vec<Triggered>,
+}
+
+/// An event a condition started: the `event`-th of its `then` list, due its delay after `at`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Triggered {
+    /// When the condition acted [s].
+    pub at: f64,
+    /// Its due time [s]: `at` plus the event's delay.
+    pub due: f64,
+    /// The condition, by [`Condition::key`](plantwide_flowsheet::scenario::Condition::key).
+    pub when: String,
+    /// The event's index in the condition's `then` list.
+    pub event: usize,
 }
 
 impl DriverState {
@@ -60,6 +79,8 @@ impl DriverState {
             pending: vec![Vec::new(); sc.analyzers.len()],
             next_record: 0,
             snapshots_done: vec![false; sc.snapshots.len()],
+            fired: Vec::new(),
+            triggered: Vec::new(),
         }
     }
 }
@@ -144,6 +165,18 @@ fn realign(driver: &mut DriverState, sc: &Scenario, t: f64) {
     }
 }
 
+/// Keep the acted conditions and their pending events that `sc` has (by key and event index): a
+/// snapshot resumed with its own scenario keeps them all; with another, that scenario's
+/// conditions are armed afresh and the old ones' pending events dropped.
+fn keep_conditions(driver: &mut DriverState, sc: &Scenario) {
+    let keys: Vec<String> = sc.conditions.iter().map(|c| c.key()).collect();
+    driver.fired.retain(|f| keys.contains(f));
+    driver.triggered.retain(|t| {
+        let c = keys.iter().position(|k| *k == t.when);
+        c.is_some_and(|c| t.event < sc.conditions[c].then.len()) && t.due.is_finite() && t.due >= t.at
+    });
+}
+
 /// The state vector of length `n_state` for a run resumed from `s`: the plant's initial guess,
 /// overwritten by path with the snapshot's values (`paths` are this run's state paths; entries
 /// the snapshot lacks keep the guess, quadratures start at 0).
@@ -226,5 +259,6 @@ pub(super) fn resume(
         )));
     }
     realign(&mut driver, sc, s.t);
+    keep_conditions(&mut driver, sc);
     Ok(Resumed { driver, integrator: same.then(|| s.integrator.clone()) })
 }
