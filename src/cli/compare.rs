@@ -8,7 +8,7 @@ use plantwide::analysis::faer::Mat;
 use plantwide::analysis::measures::{rga, rows};
 use plantwide::io::html::markdown_to_html;
 use plantwide::io::plot::{LabelledMatrix, Overlay, write_bars, write_matrices, write_overlays};
-use plantwide::studies::compare::{CompareRequest, Comparison, Scheme, compare};
+use plantwide::studies::compare::{CompareRequest, Comparison, Prices, Scheme, compare};
 use plantwide::studies::screen::pairings::STEP_AT;
 use plantwide::studies::screen::pairings::mpc::MpcAlternative;
 use plantwide::studies::screen::pairings::{DisturbanceRun, DynamicResult, DynamicSettings};
@@ -50,6 +50,15 @@ pub struct CompareArgs {
     /// Length of each closed-loop run (default: 20 reset times of the slowest tuned loop).
     #[arg(long, value_name = "TIME")]
     duration: Option<String>,
+    /// Price of the heating utility in $/GJ (default: low-pressure steam, 7.78 $/GJ, Luyben 2013).
+    #[arg(long, value_name = "USD_PER_GJ", allow_negative_numbers = true, default_value_t = Prices::default().heating)]
+    heating_price: f64,
+    /// Price of the cooling utility in $/GJ (default: cooling water, 0.354 $/GJ, Turton et al. 2012).
+    #[arg(long, value_name = "USD_PER_GJ", allow_negative_numbers = true, default_value_t = Prices::default().cooling)]
+    cooling_price: f64,
+    /// Operating hours a year for the yearly utility cost.
+    #[arg(long, value_name = "H", allow_negative_numbers = true, default_value_t = Prices::default().hours)]
+    hours: f64,
     /// Print the comparison as JSON.
     #[arg(long)]
     json: bool,
@@ -86,6 +95,7 @@ pub fn run(a: &CompareArgs, system: UnitSystem) -> Result<(), CliError> {
         outputs: outputs.iter().map(|(p, _)| p.clone()).collect(),
         loops: a.loops.clone(),
         file_tuning: a.tuning == TuningArg::File,
+        prices: prices(a)?,
         dynamic: DynamicSettings {
             candidates: 1,
             duration: a.duration.as_deref().map(|d| time(d, "duration")).transpose()?,
@@ -111,6 +121,22 @@ pub fn run(a: &CompareArgs, system: UnitSystem) -> Result<(), CliError> {
         outln!("{}", markdown(&c, &shown));
     }
     super::screen::failed_parts("compare", &c.failed)
+}
+
+/// The utility prices of the command line: each finite and not negative, the hours within a year.
+fn prices(a: &CompareArgs) -> Result<Prices, CliError> {
+    for (flag, v) in [("--heating-price", a.heating_price), ("--cooling-price", a.cooling_price)] {
+        if !(v.is_finite() && v >= 0.0) {
+            return Err(CliError::user(format!("{flag} {v}: give a price in $/GJ, zero or more")));
+        }
+    }
+    if !(a.hours > 0.0 && a.hours <= 8784.0) {
+        return Err(CliError::user(format!(
+            "--hours {}: give the operating hours in a year, more than 0 and at most 8784",
+            a.hours
+        )));
+    }
+    Ok(Prices { heating: a.heating_price, cooling: a.cooling_price, hours: a.hours })
 }
 
 fn write_report(dir: &Path, c: &Comparison, json: &str, shown: &Shown) -> Result<(), CliError> {
@@ -225,6 +251,7 @@ fn sig(v: f64) -> String {
 /// The comparison as markdown: one table per question.
 fn markdown(c: &Comparison, shown: &Shown) -> String {
     let mut t = String::from("# Schemes compared\n\n");
+    t.push_str(&format!("## Verdict\n\n{}\n\n", c.verdict));
     t.push_str(&energy_table(c));
     t.push_str(&structure_table(c));
     t.push_str(&stability_table(c));
@@ -236,7 +263,7 @@ fn markdown(c: &Comparison, shown: &Shown) -> String {
 
 fn energy_table(c: &Comparison) -> String {
     let mut t = String::from(
-        "## Energy at steady state\n\n| scheme | heating kW | cooling kW | recovered kW | duties |\n|---|---|---|---|---|\n",
+        "## Energy at steady state\n\n| scheme | heating kW | cooling kW | recovered kW | utility cost $/yr | duties |\n|---|---|---|---|---|---|\n",
     );
     for s in &c.schemes {
         let e = &s.energy;
@@ -244,15 +271,21 @@ fn energy_table(c: &Comparison) -> String {
             e.duties.iter().map(|d| format!("{} {} {:.3} kW", d.path, d.kind, d.duty / 1e3)).collect();
         items.extend(e.other.iter().map(|o| format!("{} {} {}", o.path, sig(o.value), o.unit)));
         t.push_str(&format!(
-            "| {} | {:.3} | {:.3} | {:.3} | {} |\n",
+            "| {} | {:.3} | {:.3} | {:.3} | {:.0} | {} |\n",
             s.name,
             e.heating / 1e3,
             e.cooling / 1e3,
             e.recovered / 1e3,
+            s.cost.total,
             items.join("; ")
         ));
     }
-    t + "\n"
+    let p = &c.prices;
+    t + &format!(
+        "\nUtility cost: heating at {} $/GJ, cooling at {} $/GJ, {} h/yr (`--heating-price`, `--cooling-price`, \
+         `--hours`); heat recovered costs nothing here.\n\n",
+        p.heating, p.cooling, p.hours
+    )
 }
 
 fn structure_table(c: &Comparison) -> String {

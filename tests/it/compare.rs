@@ -65,7 +65,99 @@ fn the_reactor_with_and_without_its_exchanger() {
     }
     let md = std::fs::read_to_string(dir.join("compare.md")).unwrap();
     assert!(md.contains("## Stability") && md.contains("BLT does not apply"), "{md}");
+    assert!(md.contains("## Verdict") && md.contains("| utility cost $/yr |"), "{md}");
     std::fs::remove_dir_all(&dir).ok();
+
+    // Utility cost: the heater-only scheme's 135 kW of steam, F c_p (390 − 300 K), and the
+    // exchanger's 117.757 kW it must cool away, for a year at the default prices.
+    let year_gj = |w: f64| w * 3600.0 * 8760.0 / 1e9;
+    let steam = year_gj(10.0 * 150.0 * 90.0) * 7.78;
+    assert!((f(&without["cost"]["heating"]) - steam).abs() < 1e-6 * steam, "{}", without["cost"]);
+    let water = year_gj(e(with, "recovered")) * 0.354;
+    assert!((f(&without["cost"]["cooling"]) - water).abs() < 1e-6 * water, "{}", without["cost"]);
+    assert!((f(&with["cost"]["total"]) - year_gj(e(with, "heating")) * 7.78).abs() < 1e-3);
+    let verdict = verdict_agrees_with_its_evidence(&c);
+    assert!(verdict.contains("fehe_reactor costs the least in utilities, $4.2k/yr"), "{verdict}");
+    assert!(verdict.contains("fehe_reactor is unstable with its quality loops in manual"), "{verdict}");
+}
+
+/// The verdict's claims against the comparison's own figures, recounted here: each scheme's
+/// count of responses (disturbance × variable) with the least IAE, and the conclusion — one
+/// scheme better on both counts when the cheapest also wins the most responses, else a
+/// trade-off. Returns the verdict.
+fn verdict_agrees_with_its_evidence(c: &serde_json::Value) -> String {
+    let verdict = c["verdict"].as_str().expect("a verdict").to_string();
+    let schemes = c["schemes"].as_array().unwrap();
+    let runs: Vec<&Vec<serde_json::Value>> =
+        schemes.iter().map(|s| s["structure"]["dynamic"]["runs"].as_array().unwrap()).collect();
+    let mut wins = vec![0; schemes.len()];
+    let mut n = 0;
+    for (d, run) in runs[0].iter().enumerate() {
+        for v in run["cvs"].as_array().unwrap() {
+            let iae: Vec<f64> = runs
+                .iter()
+                .map(|r| {
+                    let cvs = r[d]["cvs"].as_array().unwrap();
+                    f(&cvs.iter().find(|w| w["cv"] == v["cv"]).unwrap()["iae"])
+                })
+                .collect();
+            let best = iae.iter().copied().fold(f64::INFINITY, f64::min);
+            n += 1;
+            iae.iter().enumerate().filter(|&(_, &e)| e == best).for_each(|(k, _)| wins[k] += 1);
+        }
+    }
+    for (k, s) in schemes.iter().enumerate() {
+        let claim = format!("{} has the least IAE in {} of {n}", s["name"].as_str().unwrap(), wins[k]);
+        assert!(verdict.contains(&claim), "`{claim}` in: {verdict}");
+    }
+    let costs: Vec<f64> = schemes.iter().map(|s| f(&s["cost"]["total"])).collect();
+    let cheapest = (0..costs.len()).min_by(|&a, &b| costs[a].total_cmp(&costs[b])).unwrap();
+    let most = *wins.iter().max().unwrap();
+    let same_cost = costs.iter().all(|&v| (v - costs[cheapest]).abs() <= 0.005 * v.max(1e-300));
+    if same_cost {
+        assert!(verdict.contains("cost the same"), "{verdict}");
+    } else if wins[cheapest] == most {
+        assert!(verdict.contains("better scheme on both counts"), "{verdict}");
+    } else {
+        assert!(verdict.contains("The choice is a trade-off"), "{verdict}");
+    }
+    verdict
+}
+
+/// The heat-integrated methanol–water column pair saves steam and rejects the disturbances worse:
+/// the verdict calls it a trade-off and gives both sides; a dearer steam price scales the costs
+/// and wrong prices are refused.
+#[test]
+fn a_cheaper_scheme_that_controls_worse_is_called_a_trade_off() {
+    let files = ["methanol_water_pressure_staged.json", "methanol_water_pressure_staged_without_integration.json"];
+    let args = [
+        "--disturbances",
+        "throughput=+10%",
+        "--outputs",
+        "hp_D.x[methanol],lp_B.x[methanol]",
+        "--tuning",
+        "file",
+        "--heating-price",
+        "15.56",
+    ];
+    let c = compare(&files, &args);
+    let verdict = verdict_agrees_with_its_evidence(&c);
+    assert!(verdict.contains("heating at 15.56 $/GJ"), "{verdict}");
+    for s in c["schemes"].as_array().unwrap() {
+        let steam = f(&s["energy"]["heating"]) * 3600.0 * 8760.0 / 1e9 * 15.56;
+        assert!((f(&s["cost"]["heating"]) - steam).abs() < 1e-6 * steam, "{}", s["cost"]);
+    }
+    for (flag, value) in [("--heating-price", "-1"), ("--cooling-price", "nan"), ("--hours", "9000")] {
+        let mut argv = vec!["compare".to_string()];
+        argv.extend(files.iter().map(|f| flowsheet(f)));
+        argv.extend(
+            ["--disturbances", "throughput=+10%", "--outputs", "hp_D.x[methanol]", flag, value].map(String::from),
+        );
+        let out = plantwide(&argv.iter().map(String::as_str).collect::<Vec<_>>());
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{flag} {value}: {err}");
+        assert!(err.contains(flag), "{err}");
+    }
 }
 
 /// Luyben's rule: structure 1 (fresh feed fixed, reactor holdup held) snowballs — +20 % fresh feed
@@ -97,6 +189,9 @@ fn the_snowball_plant_in_its_two_structures() {
     assert!(f(&p2["high"]) > 1.05 * f(&p2["base"]) && f(&d2["high"]) < f(&d2["base"]), "structure 2 does not");
     let gain = |s: usize| f(&c["schemes"][s]["recycles"][0]["loop_gain"]);
     assert!(gain(0) > 10.0 * gain(1), "loop gains {} and {}", gain(0), gain(1));
+    // The simple column's boilup has no duty: not costed, and the verdict says so.
+    let verdict = verdict_agrees_with_its_evidence(&c);
+    assert!(verdict.contains("Not costed (no duty in the model): column.boilup"), "{verdict}");
 }
 
 /// A sweep end outside the input's physical range (pure A feed + 5 %, the mirror of the −5 %

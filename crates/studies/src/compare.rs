@@ -26,6 +26,7 @@
 //!    tuning, and says so; [`CompareRequest::file_tuning`] keeps every file's tuning.
 
 pub mod energy;
+pub mod verdict;
 
 use plantwide_analysis::linear::Linearization;
 use plantwide_analysis::measures::{condition_number, svd};
@@ -42,7 +43,7 @@ use crate::screen::ScreenError;
 use crate::screen::pairings::dynamic::Limited;
 use crate::screen::pairings::mpc::{MpcAlternative, assess_mpc, controllers, output_name};
 use crate::screen::pairings::{Disturbance, DynamicSettings, PairingRequest, PairingStructure, Tuning, assess_pairing};
-pub use energy::{Energy, energy};
+pub use energy::{Energy, Prices, UtilityCost, cost, energy};
 
 /// What to compare.
 #[derive(Debug, Clone, PartialEq)]
@@ -59,6 +60,8 @@ pub struct CompareRequest {
     pub dynamic: DynamicSettings,
     /// Keep the files' own tuning in every scheme (like for like) instead of BLT where it applies.
     pub file_tuning: bool,
+    /// Utility prices for the yearly cost of each scheme's duties.
+    pub prices: Prices,
 }
 
 impl CompareRequest {
@@ -215,6 +218,8 @@ pub struct Scheme {
     pub file: String,
     /// Energy use.
     pub energy: Energy,
+    /// Its yearly utility cost at the request's prices.
+    pub cost: UtilityCost,
     /// Quality loops.
     pub loops: Vec<QualityLoop>,
     /// Steady-state gains of the opened quality loops, CVs × MVs (SI).
@@ -251,6 +256,10 @@ pub struct Comparison {
     /// end the continuation could not reach), also marked where they stand; empty when all went
     /// through.
     pub failed: Vec<String>,
+    /// The utility prices the costs are at.
+    pub prices: Prices,
+    /// One paragraph from the evidence above ([`verdict::verdict`]).
+    pub verdict: String,
 }
 
 /// Compare `plants` on `request`; schemes are judged in parallel.
@@ -293,13 +302,17 @@ pub fn compare(plants: &[Plant], request: &CompareRequest) -> Result<Comparison,
         });
     }
     let failed = failed_parts(&schemes);
-    Ok(Comparison {
+    let mut c = Comparison {
         disturbances: request.disturbances.iter().map(Disturbance::label).collect(),
         outputs: request.outputs.clone(),
         duration,
         schemes,
         failed,
-    })
+        prices: request.prices,
+        verdict: String::new(),
+    };
+    c.verdict = verdict::verdict(&c);
+    Ok(c)
 }
 
 /// The parts of the comparison that failed, each with its reason: closed-loop tests and runs of
@@ -352,10 +365,12 @@ fn scheme(plant: &Plant, r: &CompareRequest) -> Result<Scheme, CompareError> {
         None => sensitivity(plant, &sol.x, &sol.u, r, &outputs, &[]),
     }
     .map_err(analysis)?;
+    let energy = energy(plant, &sol.x, &sol.u);
     Ok(Scheme {
         name: plant.name().to_string(),
         file,
-        energy: energy(plant, &sol.x, &sol.u),
+        cost: cost(&energy, &r.prices),
+        energy,
         loops,
         gain,
         condition_number: condition,
