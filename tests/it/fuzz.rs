@@ -202,6 +202,7 @@ fn campaign(seed: u64, n: usize, skip: &[String]) -> Report {
         if i < start {
             continue;
         }
+        guard::making(s);
         let made = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| Mutant::new(s, &corpus)));
         let Ok(m) = made else {
             let why = std::mem::take(&mut *LAST_PANIC.lock().unwrap_or_else(|e| e.into_inner()));
