@@ -104,6 +104,11 @@ pub fn set_baseline() -> usize {
     live
 }
 
+/// Live heap now above the baseline [bytes] (negative below it).
+pub fn above_baseline() -> isize {
+    LIVE.load(Ordering::SeqCst) as isize - BASELINE.load(Ordering::SeqCst) as isize
+}
+
 /// Peak live heap above the baseline [bytes].
 pub fn peak() -> usize {
     PEAK.load(Ordering::Relaxed).saturating_sub(BASELINE.load(Ordering::Relaxed))
