@@ -71,6 +71,15 @@ pub fn begin(description: &str) {
     LIVE_AT_BEGIN.store(LIVE.load(Ordering::SeqCst), Ordering::SeqCst);
 }
 
+/// Name the mutant of `seed` as the one running while the mutator makes it: a limit crossed by
+/// the mutator itself (a flood of an already long value) then names that seed, not the mutant
+/// run before it.
+pub fn making(seed: u64) {
+    let text = format!("seed={seed:#018x} (while the mutator makes it, before it runs)");
+    let _ = std::fs::write(current_file(), &text);
+    *CURRENT.lock().unwrap_or_else(|e| e.into_inner()) = text;
+}
+
 /// The mutant finished: stop its clock, and remember it if it left more live heap behind than
 /// any before it. Returns the live heap it left behind (or freed) [bytes].
 pub fn end() -> isize {
@@ -85,12 +94,19 @@ pub fn end() -> isize {
     now as isize - then as isize
 }
 
-/// Take the live heap now as the baseline the limit counts from; reset the peak.
+/// Take the live heap now as the baseline the limit counts from; reset the peak, and the mutant
+/// that left the most heap (what the warm-up keeps is in the baseline, not a suspect).
 pub fn set_baseline() -> usize {
     let live = LIVE.load(Ordering::SeqCst);
     BASELINE.store(live, Ordering::SeqCst);
     PEAK.store(live, Ordering::SeqCst);
+    *GREW_MOST.lock().unwrap_or_else(|e| e.into_inner()) = (0, String::new());
     live
+}
+
+/// Live heap now above the baseline [bytes] (negative below it).
+pub fn above_baseline() -> isize {
+    LIVE.load(Ordering::SeqCst) as isize - BASELINE.load(Ordering::SeqCst) as isize
 }
 
 /// Peak live heap above the baseline [bytes].

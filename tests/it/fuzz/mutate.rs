@@ -55,6 +55,20 @@ const UNITS: &[&str] = &[
 /// Unit texts that must be rejected.
 const GARBAGE_UNITS: &[&str] = &["furlong", "kmol//min", "kmol/min/", "1 1", "mol/s/s/s", "kmol^2", "°C", "(", "e5"];
 
+/// Most bytes of JSON text one flood may make. Mutations compose: a flood of a value an earlier
+/// mutation made long (a 100 000-character string) would otherwise be 10 GB, and exhaust the
+/// harness's own memory before the engine ever reads it. A flood of the shipped values' size
+/// (100 000 events of about 100 bytes) stays whole.
+pub const FLOOD_BYTES: usize = 32 << 20;
+
+/// How many copies of `items` (cycled) a flood asked for `wanted` elements makes: `wanted`, or
+/// fewer so that the copies stay within [`FLOOD_BYTES`] (at least one).
+pub fn flood_len(items: &[Value], wanted: usize) -> usize {
+    let bytes: usize = items.iter().map(|v| v.to_string().len() + 1).sum();
+    let each = bytes.div_ceil(items.len().max(1)).max(1);
+    wanted.min(FLOOD_BYTES / each).max(1)
+}
+
 /// What the mutators may refer to: names defined in the document and the unit table.
 pub struct Names {
     /// Unit, stream, controller, input and component names of the document.
@@ -212,7 +226,8 @@ fn array(rng: &mut Rng, a: &[Value]) -> (&'static str, Value) {
             "arr_duplicate"
         }
         2 => {
-            b.extend(std::iter::repeat_n(a[i].clone(), *rng.pick(&[100, 10_000])));
+            let n = flood_len(std::slice::from_ref(&a[i]), *rng.pick(&[100, 10_000]));
+            b.extend(std::iter::repeat_n(a[i].clone(), n));
             "arr_flood"
         }
         3 => {
@@ -358,4 +373,19 @@ fn raw_at(doc: &mut Doc, site: &Site, text: String, what: &str) -> String {
         *slot = marker;
     }
     format!("{}: -> {what}", site.path)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A flood of short values is made whole; one of long values stops at the byte budget.
+    #[test]
+    fn a_flood_stays_within_its_byte_budget() {
+        assert_eq!(flood_len(&[json!({"at": "0 s", "type": "step"})], 100_000), 100_000);
+        let long = json!("step".repeat(25_000));
+        let n = flood_len(std::slice::from_ref(&long), 100_000);
+        assert!(n * long.to_string().len() <= FLOOD_BYTES, "{n} copies of 100 kB");
+        assert!(n >= FLOOD_BYTES / 200_000, "{n} copies: the budget is used");
+    }
 }

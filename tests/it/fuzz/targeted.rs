@@ -6,7 +6,7 @@
 use serde_json::{Value, json};
 
 use super::doc::{Doc, Site, brief};
-use super::mutate::{Names, mutate, set};
+use super::mutate::{Names, flood_len, mutate, set};
 use super::rng::Rng;
 use plantwide::flowsheet::Plant;
 
@@ -122,7 +122,7 @@ pub fn scenario(rng: &mut Rng, doc: &mut Doc, names: &Names) -> String {
             )
         }
         6 if !events.is_empty() => {
-            let n = *rng.pick(&[1000, 100_000]);
+            let n = flood_len(&events, *rng.pick(&[1000, 100_000]));
             let new: Vec<Value> = events.iter().cycle().take(n).cloned().collect();
             ("events", json!(events), Value::Array(new), "scen_event_flood")
         }
@@ -194,5 +194,29 @@ pub fn assignment(rng: &mut Rng, plant: &Plant, spec: &Value, names: &Names) -> 
             let bad = ["nosuch.F=1 mol/s", "F", "=1", "column.=3", "a.b.c=1", "feed_source.F=", "x=1e400 mol/s"];
             (rng.pick(&bad).to_string(), "set_unknown".into())
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fuzz::mutate::FLOOD_BYTES;
+
+    /// An event flood of events an earlier mutation made long stays within the flood budget: the
+    /// mutant of seed 0xcc87ee2a81025caf (campaign 20261210, mutant 14 961) flooded an event
+    /// holding a 100 kB string 100 000 times, 10 GB, and the harness crossed its 2 GiB limit.
+    #[test]
+    fn an_event_flood_of_long_events_stays_within_the_budget() {
+        let value = json!({"events": [{"type": "step".repeat(25_000), "at": "0 s"}]});
+        let names = Names::of(&value);
+        let flooded = (0..256u64)
+            .find_map(|seed| {
+                let mut doc = Doc::new(value.clone());
+                scenario(&mut Rng::new(seed), &mut doc, &names).contains("scen_event_flood").then_some(doc)
+            })
+            .expect("one of the seeds floods the events");
+        let text = flooded.render();
+        assert!(text.len() <= FLOOD_BYTES + (1 << 20), "{} bytes", text.len());
+        assert!(text.len() >= FLOOD_BYTES / 2, "{} bytes: the budget is used", text.len());
     }
 }
