@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use plantwide::analysis::faer::Mat;
 use plantwide::analysis::measures::{rga, rows};
 use plantwide::io::html::markdown_to_html;
-use plantwide::io::plot::{LabelledMatrix, Overlay, write_bars, write_matrices, write_overlays};
+use plantwide::io::plot::{LabelledMatrix, Overlay, write_bars, write_matrices};
 use plantwide::studies::compare::{CompareRequest, Comparison, Prices, Scheme, compare};
 use plantwide::studies::screen::pairings::STEP_AT;
 use plantwide::studies::screen::pairings::mpc::MpcAlternative;
@@ -231,7 +231,7 @@ fn write_responses(dir: &Path, c: &Comparison, shown: &Shown) -> Result<Vec<Stri
         let times: Vec<f64> = run.times.iter().map(|t| t / 3600.0).collect();
         let name = format!("responses_{}.png", d + 1);
         let step = STEP_AT * times.last().copied().unwrap_or(0.0);
-        write_overlays(
+        plantwide::io::plot::write_responses(
             &dir.join(&name),
             &format!("{}: closed-loop responses (tuning in compare.md)", run.disturbance),
             "time [h]",

@@ -358,8 +358,7 @@ fn write_report(
                     v.predicted.iter().map(|v| v / o.factor).collect(),
                 ),
             ],
-            dashed: Vec::new(),
-            limits: Vec::new(),
+            ..Overlay::default()
         })
         .collect();
     write_overlays(

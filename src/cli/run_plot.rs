@@ -1,5 +1,6 @@
 //! The trend plot of `plantwide run`: the recorded paths grouped into panels (`"panel"` in the
-//! scenario's record), each with its setpoint dashed, its controller's output limits dotted and
+//! scenario's record), each with its setpoint dashed, its controller's output limits (a PID's
+//! `op_min`/`op_max`, a model predictive controller's own MV and CV limits) dotted and
 //! the same paths of earlier runs (`--compare OTHER.csv`) dashed, and the events as markers.
 
 use std::path::{Path, PathBuf};
@@ -7,6 +8,7 @@ use std::path::{Path, PathBuf};
 use plantwide::flowsheet::Plant;
 use plantwide::flowsheet::scenario::{EventSpec, RecordPathSpec, ScenarioSpec};
 use plantwide::io::plot::Overlay;
+use plantwide::model::registry::ControllerSpec;
 use plantwide::solve::dynamic::SimulationResult;
 use plantwide::units::{Display, convert_from_si, convert_to_si};
 
@@ -87,6 +89,29 @@ fn limits(plant: &Plant, path: &str) -> Option<(f64, f64)> {
     plant.blocks()[plant.vars()[var].block].unit.output_limits()
 }
 
+/// The limits a model predictive controller keeps on `path`, named by the controller (SI): the
+/// hard `min`/`max` of an MV it drives, the soft ones of a CV it controls; a controller that does
+/// not state one has none drawn.
+fn mpc_limits(plant: &Plant, path: &str) -> Vec<(String, f64)> {
+    let dim =
+        plant.var(path).map(|v| plant.vars()[v].spec.dim).or_else(|| plant.input(path).map(|i| plant.inputs()[i].dim));
+    let Some(dim) = dim else { return Vec::new() };
+    let mut out = Vec::new();
+    for (name, c) in &plant.spec().controllers {
+        let ControllerSpec::Mpc(cfg) = c else { continue };
+        let mvs = cfg.mvs.iter().filter(|m| m.output == path).map(|m| (&m.min, &m.max, ""));
+        let cvs = cfg.cvs.iter().filter(|c| c.pv == path).map(|c| (&c.min, &c.max, " (soft)"));
+        for (min, max, kind) in mvs.chain(cvs) {
+            for (what, q) in [("min", min), ("max", max)] {
+                if let Some(v) = q.as_ref().and_then(|q| q.to_si(dim).ok()) {
+                    out.push((format!("{name} {what}{kind}"), v));
+                }
+            }
+        }
+    }
+    out
+}
+
 /// The panels of the run's plot.
 pub fn panels(
     res: &SimulationResult,
@@ -137,10 +162,10 @@ pub fn panels(
                     o.dashed.push((label(&other.name), Some(m), resample(&other.times, v, &res.times)));
                 }
             }
-            if let Some((lo, hi)) = limits(plant, &c.path) {
-                for (what, v) in [("op_min", lo), ("op_max", hi)].into_iter().filter(|(_, v)| v.is_finite()) {
-                    o.limits.push((label(what), convert_from_si(v, unit).unwrap_or(v)));
-                }
+            let pid = limits(plant, &c.path)
+                .map_or(Vec::new(), |(lo, hi)| vec![("op_min".to_string(), lo), ("op_max".to_string(), hi)]);
+            for (what, v) in pid.into_iter().chain(mpc_limits(plant, &c.path)).filter(|(_, v)| v.is_finite()) {
+                o.limits.push((label(&what), convert_from_si(v, unit).unwrap_or(v)));
             }
         }
         if single && !o.dashed.is_empty() {

@@ -9,7 +9,7 @@
 use std::path::{Path, PathBuf};
 
 use plantwide::io::html::markdown_to_html;
-use plantwide::io::plot::{LabelledMatrix, Overlay, write_bars, write_matrices, write_overlays};
+use plantwide::io::plot::{LabelledMatrix, Overlay, write_bars, write_matrices};
 use plantwide::studies::screen::column::file_stem;
 use plantwide::studies::screen::pairings::STEP_AT;
 use plantwide::studies::screen::pairings::mpc::MpcAlternative;
@@ -373,7 +373,7 @@ fn write_responses(dir: &Path, s: &PairingScreen, shown: &Shown) -> Result<Vec<S
         let name = format!("responses_{}.png", d + 1);
         let title = format!("{}: the best structures' responses", run.disturbance);
         let step = [(STEP_AT * times.last().copied().unwrap_or(0.0), run.disturbance.clone())];
-        write_overlays(&dir.join(&name), &title, "time [h]", &times, &panels, &step)
+        plantwide::io::plot::write_responses(&dir.join(&name), &title, "time [h]", &times, &panels, &step)
             .map_err(|e| CliError::user(e.to_string()))?;
         names.push(name);
     }

@@ -7,7 +7,7 @@
 use std::path::{Path, PathBuf};
 
 use plantwide::flowsheet::Plant;
-use plantwide::io::plot::{Overlay, write_bars, write_overlays};
+use plantwide::io::plot::{Overlay, write_bars, write_responses};
 use plantwide::studies::size::{
     Attenuation, CandidateRanking, Design, Disturbance, PARTS_PER_VESSEL, Progress, RankedCandidate, Shape, SizeError,
     SizeRequest, VesselSizing, rank_candidates_observed, size_vessel_observed,
@@ -579,14 +579,14 @@ fn plot_designs(out: &Path, s: &VesselSizing, u: &SizeUnits) -> Result<(), CliEr
     let level = Overlay {
         label: format!("level deviation [{}]", u.length.unit()),
         curves: level,
-        limits: vec![(format!("+{band:.3} {}", u.length.unit()), band), (format!("−{band:.3}"), -band)],
+        band: Some((format!("band ±{band:.3} {}", u.length.unit()), -band, band)),
         ..Overlay::default()
     };
     let panels =
         [level, Overlay { label: format!("{} [{}]", s.outflow, u.flow.unit()), curves: flow, ..Overlay::default() }];
     let hours: Vec<f64> = grid.iter().map(|t| t / 3600.0).collect();
     let title = format!("surge designs of `{}` for a change of {}{note}", s.vessel, s.disturbance_path);
-    write_overlays(out, &title, "time after the step [h]", &hours, &panels, &[])
+    write_responses(out, &title, "time after the step [h]", &hours, &panels, &[])
         .map_err(|e| CliError::user(e.to_string()))
 }
 

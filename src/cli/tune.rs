@@ -1,6 +1,7 @@
-//! `plantwide tune --tf MODEL.tf.json --method blt|zn|tl [--time-unit min] [--json]`: PI settings
+//! `plantwide tune --tf MODEL.tf.json --method blt|zn|tl [--time-unit min] [--json] [--plot OUT.png]`: PI settings
 //! of the diagonal loops of a transfer-function model from the ultimate gains and periods of its
-//! diagonal elements (Ziegler–Nichols, Tyreus–Luyben), or Luyben's BLT detuning of the ZN settings.
+//! diagonal elements (Ziegler–Nichols, Tyreus–Luyben), or Luyben's BLT detuning of the ZN settings;
+//! `--plot` draws each loop's Bode diagram with its margins.
 //!
 //! `plantwide tune FILE --loop CTRL --method relay|zn|tl|simc|imc|averaging` and
 //! `plantwide tune FILE --loops C1,C2,… --method blt` tune the PID loops of a flowsheet
@@ -9,9 +10,11 @@
 use std::path::{Path, PathBuf};
 
 use plantwide::analysis::tf::TfModel;
+use plantwide::io::plot::{BodeLoop, write_bode};
 use plantwide::io::tf;
 use plantwide::studies::TuneError;
-use plantwide::studies::tune::{BltSettings, PiRule, TuneMethod, Tuning, blt, single_loop};
+use plantwide::studies::tune::margins::Bode;
+use plantwide::studies::tune::{BltSettings, PiRule, TuneMethod, Tuning, blt, bode_diagrams, single_loop};
 
 use super::CliError;
 use super::linearize::TimeUnit;
@@ -102,6 +105,10 @@ pub struct TuneArgs {
     /// Print JSON instead of a table.
     #[arg(long)]
     pub(super) json: bool,
+    /// Draw each tuned loop's Bode diagram here (`.png` or `.svg`): |L| and ∠L of L = g·c against
+    /// ω, the crossovers marked and the gain and phase margins read off them.
+    #[arg(long, value_name = "OUT.png", value_parser = super::output_file)]
+    pub(super) plot: Option<PathBuf>,
 }
 
 /// Model fitted to a step test.
@@ -146,14 +153,40 @@ pub fn run(a: &TuneArgs) -> Result<(), CliError> {
             )));
         }
     }
-    .map_err(tune_error)?
-    .in_time_unit(tu.seconds);
+    .map_err(tune_error)?;
+    if let Some(out) = &a.plot {
+        let diagrams = bode_diagrams(&model, &tuning).into_iter().zip(&tuning.loops);
+        let loops = diagrams.filter_map(|(b, l)| Some((format!("{} ← {}", l.output, l.input), b?))).collect();
+        plot_bode(out, &format!("Bode diagrams of the loops of `{}`, each alone", model.name), &tu, loops)?;
+    }
+    let tuning = tuning.in_time_unit(tu.seconds);
     if a.json {
         outln!("{}", serde_json::to_string_pretty(&tuning).map_err(|e| CliError::user(e.to_string()))?);
         return Ok(());
     }
     print_table(&tuning, &model, tf_file, &tu);
     Ok(())
+}
+
+/// Draw the Bode diagrams of `loops` (label, diagram with SI frequencies) to `out`, ω in rad per
+/// `tu`.
+pub(super) fn plot_bode(out: &Path, title: &str, tu: &TimeUnit, loops: Vec<(String, Bode)>) -> Result<(), CliError> {
+    let drawn: Vec<BodeLoop> = loops
+        .into_iter()
+        .map(|(label, b)| {
+            let b = b.in_time_unit(tu.seconds);
+            let m = b.margins;
+            BodeLoop {
+                label,
+                gain_crossover: m.gain_crossover.zip(m.phase_margin),
+                phase_crossover: m.phase_crossover.zip(m.gain_margin),
+                omega: b.omega,
+                magnitude_db: b.magnitude_db,
+                phase_deg: b.phase_deg,
+            }
+        })
+        .collect();
+    write_bode(out, title, &format!("ω [rad/{}]", tu.name), &drawn).map_err(|e| CliError::user(e.to_string()))
 }
 
 fn load(file: &Path) -> Result<TfModel, CliError> {

@@ -31,7 +31,12 @@ pub fn run(a: &TuneArgs, tu: &TimeUnit) -> Result<(), CliError> {
         MethodArg::Blt => blt_loops(&plant, &x, &loops, measurement(a)?).map_err(tune_error)?,
         _ => in_sequence(a, file, &plant, &loops, tu)?,
     };
-    flowsheet_margins(&plant, &x, &mut tuning, measurement(a)?).map_err(tune_error)?;
+    let diagrams = flowsheet_margins(&plant, &x, &mut tuning, measurement(a)?).map_err(tune_error)?;
+    if let Some(out) = &a.plot {
+        let labels = tuning.loops.iter().map(|l| format!("{} ({})", l.controller, l.output));
+        let title = format!("Bode diagrams of the tuned loops of `{}`, each alone", plant.name());
+        super::tune::plot_bode(out, &title, tu, labels.zip(diagrams).collect())?;
+    }
     if let Some(out) = &a.write {
         write(file, out, &plant, &tuning, tu)?;
     }

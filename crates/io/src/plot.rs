@@ -1,13 +1,17 @@
 //! Figures as PNG or SVG files (chosen by the file extension), drawn with plotters: trend plots
 //! of a dynamic run ([`write_trends`], several runs overlaid with [`write_overlays`]), sensitivity
-//! plots ([`write_sensitivity`]), heat maps of small matrices ([`write_matrices`]) and rankings as bar
-//! charts ([`write_bars`]). Text is
+//! plots ([`write_sensitivity`]), heat maps of small matrices ([`write_matrices`]), rankings as bar
+//! charts ([`write_bars`]) and Bode diagrams of tuned loops ([`write_bode`]). Curves are told
+//! apart by colour, line pattern and marker, legends stand beside the data, and titles are sized
+//! to fit. Text is
 //! drawn with the embedded DejaVu Sans font under the family `sans-serif`, so no system font
 //! library is needed.
 
 mod bars;
+mod bode;
 mod matrices;
 mod sensitivity;
+mod style;
 mod trends;
 
 use std::path::Path;
@@ -18,9 +22,11 @@ use plotters::prelude::*;
 use plotters::style::{FontStyle, register_font};
 
 pub use bars::write_bars;
+pub use bode::{BodeLoop, write_bode};
 pub use matrices::{LabelledMatrix, write_matrices};
 pub use sensitivity::write_sensitivity;
-pub use trends::{Overlay, Trend, write_overlays, write_trends};
+pub use style::{CurveStyle, Marker, curve_style, legend_width, marker_indices, title_font_size};
+pub use trends::{Overlay, Trend, YScale, settled_end, write_overlays, write_responses, write_trends, y_scale};
 
 use crate::error::IoError;
 

@@ -200,10 +200,29 @@ pub fn single_loop(model: &TfModel, rule: PiRule) -> Result<Tuning, TuneError> {
 /// `g_ii` under its PI, the other loops open.
 pub fn with_margins(model: &TfModel, mut tuning: Tuning) -> Tuning {
     for (i, l) in tuning.loops.iter_mut().enumerate() {
-        let Some(e) = model.element(i, i) else { continue };
-        let Some((lo, hi)) = ultimate::element_frequency_range(e) else { continue };
-        let c = |w: f64| margins::pid(l.kc, Some(l.tau_i), None, w);
-        l.margins = Some(margins::margins(|w| e.response(w) * c(w), lo, hi));
+        if let Some((response, lo, hi)) = loop_response(model, i, l) {
+            l.margins = Some(margins::margins(response, lo, hi));
+        }
     }
     tuning
+}
+
+/// The Bode diagram of each loop of `tuning` (SI times; `None` where its element has no
+/// frequency range): the loop [`with_margins`] judges, drawn by [`margins::bode`].
+pub fn bode_diagrams(model: &TfModel, tuning: &Tuning) -> Vec<Option<margins::Bode>> {
+    let diagram = |(i, l)| loop_response(model, i, l).map(|(response, lo, hi)| margins::bode(response, lo, hi));
+    tuning.loops.iter().enumerate().map(diagram).collect()
+}
+
+/// Loop `i`'s open-loop response `L(jω) = g_ii(jω) c_i(jω)` (ω in rad/s) and the frequency range
+/// its margins are searched in; `None` where the element is missing or has no range.
+fn loop_response<'a>(
+    model: &'a TfModel,
+    i: usize,
+    l: &LoopTuning,
+) -> Option<(impl Fn(f64) -> faer::c64 + 'a, f64, f64)> {
+    let e = model.element(i, i)?;
+    let (lo, hi) = ultimate::element_frequency_range(e)?;
+    let (kc, tau_i) = (l.kc, l.tau_i);
+    Some((move |w: f64| e.response(w) * margins::pid(kc, Some(tau_i), None, w), lo, hi))
 }

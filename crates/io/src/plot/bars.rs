@@ -6,6 +6,7 @@ use std::path::Path;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use super::style::titled;
 use super::{Figure, write_figure};
 use crate::error::IoError;
 
@@ -13,28 +14,40 @@ use crate::error::IoError;
 /// values are drawn as an empty row marked `–`.
 pub fn write_bars(file: &Path, title: &str, value_label: &str, bars: &[(String, f64)]) -> Result<(), IoError> {
     let height = 110 + 36 * bars.len().max(1) as u32;
-    write_figure(file, (1000, height), &Bars { title, value_label, bars })
+    let label_w = label_width(bars.iter().map(|(l, _)| l.as_str()));
+    write_figure(file, (670 + label_w, height), &Bars { title, value_label, bars, label_w })
 }
 
 struct Bars<'a> {
     title: &'a str,
     value_label: &'a str,
     bars: &'a [(String, f64)],
+    /// Room for the candidates' names left of the bars [px].
+    label_w: u32,
+}
+
+/// The room [px] the longest of `labels` takes at the axis's font, with a little to spare.
+fn label_width<'a>(labels: impl Iterator<Item = &'a str>) -> u32 {
+    super::register_fonts();
+    let font = ("sans-serif", 12).into_font();
+    let widest = labels.map(|l| font.box_size(l).map_or(7 * l.chars().count() as u32, |s| s.0)).max();
+    (widest.unwrap_or(0) + 30).clamp(120, 700)
 }
 
 impl Figure for Bars<'_> {
     fn draw<DB: DrawingBackend>(&self, root: DrawingArea<DB, Shift>) -> Result<(), IoError> {
         let err = |e: DrawingAreaErrorKind<DB::ErrorType>| IoError::Draw(e.to_string());
         root.fill(&WHITE).map_err(err)?;
-        let root = root.titled(self.title, ("sans-serif", 20).into_font()).map_err(err)?;
+        let root = titled(&root, self.title, 20.0)?;
         let n = self.bars.len().max(1);
         let top = self.bars.iter().map(|(_, v)| *v).filter(|v| v.is_finite()).fold(0.0, f64::max);
         let top = if top > 0.0 { 1.15 * top } else { 1.0 };
         let mut chart = ChartBuilder::on(&root)
             .margin(10)
             .x_label_area_size(35)
-            .y_label_area_size(330)
-            .build_cartesian_2d(0.0..top, (0..n).into_segmented())
+            .y_label_area_size(self.label_w)
+            // An integer range is inclusive: `0..n - 1` holds the n rows.
+            .build_cartesian_2d(0.0..top, (0..n - 1).into_segmented())
             .map_err(err)?;
         let labels: Vec<&str> = self.bars.iter().map(|(l, _)| l.as_str()).collect();
         let label = |v: &SegmentValue<usize>| match v {
@@ -49,6 +62,7 @@ impl Figure for Bars<'_> {
             .x_desc(self.value_label)
             .y_label_formatter(&label)
             .y_labels(n)
+            .label_style(("sans-serif", 12))
             .axis_desc_style(("sans-serif", 15))
             .draw()
             .map_err(err)?;

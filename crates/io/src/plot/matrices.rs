@@ -1,13 +1,14 @@
 //! Heat maps of small matrices side by side, e.g. the relative gain arrays of a column's inventory
 //! configurations: each cell coloured by its value on a log scale (blue for λ near 1, through
 //! yellow to red for large |λ|; grey for a negative λ) and labelled with it; a matrix without
-//! values (singular) drawn as an empty frame.
+//! values (singular) drawn as an empty frame; a colour key under them reads the colours back.
 
 use std::path::Path;
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use super::style::titled;
 use super::{Figure, write_figure};
 use crate::error::IoError;
 
@@ -27,13 +28,16 @@ pub struct LabelledMatrix {
 /// Room [px] for row and column labels when a matrix has them.
 const LABELS: (i32, i32) = (130, 22);
 
+/// Height of the colour key under the matrices [px].
+const KEY: u32 = 64;
+
 /// Write the matrices side by side to `file` (`.png` or `.svg`), 240 × 300 pixels each (more
-/// with row and column labels).
+/// with row and column labels), with the colour key under them.
 pub fn write_matrices(file: &Path, title: &str, matrices: &[LabelledMatrix]) -> Result<(), IoError> {
     let labelled = matrices.iter().any(|m| !m.rows.is_empty() || !m.cols.is_empty());
     let (dx, dy) = if labelled { (LABELS.0 as u32, LABELS.1 as u32) } else { (0, 0) };
-    let width = 40 + (240 + dx) * matrices.len().max(1) as u32;
-    write_figure(file, (width, 330 + dy), &Matrices { title, matrices })
+    let width = (40 + (240 + dx) * matrices.len().max(1) as u32).max(660);
+    write_figure(file, (width, 330 + dy + KEY), &Matrices { title, matrices })
 }
 
 struct Matrices<'a> {
@@ -57,11 +61,42 @@ fn colour(v: f64) -> RGBColor {
     RGBColor(r as u8, g as u8, b as u8)
 }
 
+/// The colour key: a bar from λ = 1 to |ln λ| = ln 1000 with λ and 1/λ at its ticks, and the
+/// grey of a negative λ.
+fn draw_key<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>) -> Result<(), IoError> {
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| IoError::Draw(e.to_string());
+    let (x0, y0, width, height) = (30, 22, 420, 14);
+    let font = ("sans-serif", 13).into_font().color(&BLACK);
+    area.draw(&Text::new("colour of λ:", (x0, 4), font.clone())).map_err(err)?;
+    for i in 0..width {
+        let v = 1000f64.powf(f64::from(i) / f64::from(width - 1));
+        let x = x0 + i;
+        area.draw(&Rectangle::new([(x, y0), (x + 1, y0 + height)], colour(v).filled())).map_err(err)?;
+    }
+    for (k, tick) in ["1", "10 or 0.1", "100 or 0.01", "≥ 1000 or ≤ 0.001"].into_iter().enumerate() {
+        let x = x0 + (k as i32 * (width - 1)) / 3;
+        area.draw(&PathElement::new(vec![(x, y0 + height), (x, y0 + height + 4)], BLACK)).map_err(err)?;
+        // The first label starts at its tick, the last a little before it, the others centred.
+        let shift = match k {
+            0 => 0,
+            3 => 30,
+            _ => 7 * tick.chars().count() as i32 / 2,
+        };
+        area.draw(&Text::new(tick, (x - shift, y0 + height + 6), font.clone())).map_err(err)?;
+    }
+    let grey = x0 + width + 130;
+    area.draw(&Rectangle::new([(grey, y0), (grey + 30, y0 + height)], colour(-1.0).filled())).map_err(err)?;
+    area.draw(&Text::new("λ ≤ 0", (grey + 36, y0), font)).map_err(err)?;
+    Ok(())
+}
+
 impl Figure for Matrices<'_> {
     fn draw<DB: DrawingBackend>(&self, root: DrawingArea<DB, Shift>) -> Result<(), IoError> {
         let err = |e: DrawingAreaErrorKind<DB::ErrorType>| IoError::Draw(e.to_string());
         root.fill(&WHITE).map_err(err)?;
-        let root = root.titled(self.title, ("sans-serif", 20).into_font()).map_err(err)?;
+        let root = titled(&root, self.title, 20.0)?;
+        let (root, key) = root.split_vertically(root.dim_in_pixel().1.saturating_sub(KEY));
+        draw_key(&key)?;
         let root = root.margin(10, 10, 20, 20);
         for (panel, m) in root.split_evenly((1, self.matrices.len().max(1))).iter().zip(self.matrices) {
             let panel = panel.titled(&m.label, ("sans-serif", 16).into_font()).map_err(err)?;
@@ -126,6 +161,7 @@ mod tests {
         let svg = std::fs::read_to_string(&file).unwrap();
         assert!(svg.contains("35.900") && svg.contains("-34.900") && svg.contains("singular"), "{svg}");
         assert!(svg.contains("reflux") && svg.contains("xB"), "labels drawn");
+        assert!(svg.contains("colour of λ:") && svg.contains("λ ≤ 0") && svg.contains("10 or 0.1"), "key drawn");
         write_matrices(&dir.join("rga.png"), "relative gains", &m).unwrap();
         assert!(std::fs::metadata(dir.join("rga.png")).unwrap().len() > 1000);
         std::fs::remove_dir_all(&dir).unwrap();

@@ -1,5 +1,6 @@
 //! Sensitivity plots (*Practical Distillation Control* fig. 6-6): one panel per output, one curve
-//! per disturbance against "% change from base".
+//! per disturbance against "% change from base", told apart by colour, line pattern and marker,
+//! named in a legend right of the data.
 
 use std::path::Path;
 
@@ -8,6 +9,7 @@ use plantwide_analysis::sensitivity::Curve;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use super::style::{Sample, curve_style, draw_curve, draw_legend, legend_width, titled};
 use super::{Figure, write_figure};
 use crate::error::IoError;
 
@@ -19,7 +21,8 @@ fn plot_error<E: std::fmt::Debug>(e: E) -> IoError {
 /// of 900 × 380 pixels per output.
 pub fn write_sensitivity(file: &Path, title: &str, curves: &[Curve], outputs: &[Signal]) -> Result<(), IoError> {
     let height = 120 + 380 * outputs.len() as u32;
-    write_figure(file, (900, height), &Sensitivity { title, curves, outputs })
+    let legend_w = legend_width(curves.iter().map(|c| c.disturbance.signal.path.as_str()));
+    write_figure(file, (900 + legend_w, height), &Sensitivity { title, curves, outputs, legend_w })
 }
 
 /// One panel per output, one curve per disturbance.
@@ -27,17 +30,21 @@ struct Sensitivity<'a> {
     title: &'a str,
     curves: &'a [Curve],
     outputs: &'a [Signal],
+    /// Width of the legend column right of every panel [px].
+    legend_w: u32,
 }
 
 impl Figure for Sensitivity<'_> {
     fn draw<DB: DrawingBackend>(&self, root: DrawingArea<DB, Shift>) -> Result<(), IoError> {
-        let Sensitivity { title, curves, outputs } = *self;
+        let Sensitivity { title, curves, outputs, legend_w } = *self;
         root.fill(&WHITE).map_err(plot_error)?;
-        let root = root.titled(title, ("sans-serif", 24)).map_err(plot_error)?;
+        let root = titled(&root, title, 24.0)?;
         let panels = root.split_evenly((outputs.len().max(1), 1));
         let by_percent = curves.iter().all(|c| c.disturbance.base != 0.0);
         let x_desc = if by_percent { "% change from base".to_string() } else { "disturbance value (SI)".to_string() };
         for (k, (panel, out)) in panels.iter().zip(outputs).enumerate() {
+            let (w, h) = panel.dim_in_pixel();
+            let (panel, legend_area) = panel.split_horizontally(w.saturating_sub(legend_w));
             let series: Vec<(String, Vec<(f64, f64)>)> = curves
                 .iter()
                 .map(|c| {
@@ -63,7 +70,7 @@ impl Figure for Sensitivity<'_> {
                 (lo - 0.05 * span, hi + 0.05 * span)
             };
             let ((x0, x1), (y0, y1)) = (pad(x0, x1), pad(y0, y1));
-            let mut chart = ChartBuilder::on(panel)
+            let mut chart = ChartBuilder::on(&panel)
                 .margin(12)
                 .x_label_area_size(45)
                 .y_label_area_size(90)
@@ -76,22 +83,14 @@ impl Figure for Sensitivity<'_> {
                 .axis_desc_style(("sans-serif", 16))
                 .draw()
                 .map_err(plot_error)?;
+            let n = series.len();
+            let mut legend = Vec::new();
             for (idx, (name, pts)) in series.into_iter().enumerate() {
-                let color = Palette99::pick(idx).to_rgba();
-                chart
-                    .draw_series(LineSeries::new(pts.clone(), color.stroke_width(2)))
-                    .map_err(plot_error)?
-                    .label(name)
-                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2)));
-                chart.draw_series(pts.into_iter().map(|p| Circle::new(p, 3, color.filled()))).map_err(plot_error)?;
+                let style = curve_style(idx, true);
+                draw_curve(&mut chart, &pts, &style, (idx, n))?;
+                legend.push((name, Sample::Line(style)));
             }
-            chart
-                .configure_series_labels()
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .label_font(("sans-serif", 14))
-                .draw()
-                .map_err(plot_error)?;
+            draw_legend(&legend_area, &legend, &[], h as i32 - 57)?;
         }
         root.present().map_err(plot_error)?;
         Ok(())

@@ -20,7 +20,7 @@ use super::bench::RelayCycle;
 use super::blt::BltSettings;
 use super::fit::{ModelFit, ProcessModel};
 use super::loops::{LoopResponse, Measurement, PlantLoop, loop_model, low_frequency_probe, plant_blt};
-use super::margins::{Margins, margins, pid};
+use super::margins::{Bode, Margins, bode, pid};
 use super::plant_tests::{Linearity, StepResult};
 use super::rules::{ModelRule, model_rule};
 use super::ultimate::Ultimate;
@@ -312,7 +312,8 @@ fn significant(v: f64) -> String {
 /// on the exact linear model of `plant` at its steady state `x`: each loop alone, `g_ii(jω)`
 /// seen through `measurement` times its PID, with the tuned loops open (in manual) and every
 /// other loop as in the file — the single-loop margins python-control's `stability_margins`
-/// gives for `g_ii c_i`. Written into each loop's `margins`.
+/// gives for `g_ii c_i`. Written into each loop's `margins`; returned with each loop's Bode
+/// diagram ([`bode`], SI: ω in rad/s), in the order of `tuning.loops`.
 ///
 /// # Errors
 /// As [`super::loops::loop_model`].
@@ -321,16 +322,19 @@ pub fn flowsheet_margins(
     x: &[f64],
     tuning: &mut FlowsheetTuning,
     measurement: Measurement,
-) -> Result<(), TuneError> {
+) -> Result<Vec<Bode>, TuneError> {
     let names: Vec<&str> = tuning.loops.iter().map(|l| l.controller.as_str()).collect();
     let loops = super::loops::plant_loops(plant, &names)?;
     let response = LoopResponse::new(loop_model(plant, x, &loops)?, measurement);
     let (lo, hi) = super::loops::frequency_range(&response.model().ss, &loops)?;
+    let mut diagrams = Vec::new();
     for (i, l) in tuning.loops.iter_mut().enumerate() {
         let c = |w: f64| pid(l.kc, l.tau_i, l.tau_d, w);
-        l.margins = Some(margins(|w| response.at(w)[(i, i)] * c(w), lo, hi));
+        let b = bode(|w| response.at(w)[(i, i)] * c(w), lo, hi);
+        l.margins = Some(b.margins);
+        diagrams.push(b);
     }
-    Ok(())
+    Ok(diagrams)
 }
 
 #[cfg(test)]
