@@ -176,27 +176,66 @@ pub fn panels(
     Ok(out)
 }
 
-/// The scenario's applied events as `(time in the plot's unit, label)`.
+/// The scenario's applied events as `(time in the plot's unit, label)`, the labels of events at
+/// one time joined (an interlock's crossing and the events it starts at once are one marker).
 pub fn events(res: &SimulationResult, spec: &ScenarioSpec, time_factor: f64) -> Vec<(f64, String)> {
-    let label = |origin: &str| {
-        let k: Option<usize> =
-            origin.strip_prefix("events[").and_then(|s| s.strip_suffix(']')).and_then(|s| s.parse().ok());
-        match k.and_then(|k| spec.events.get(k)) {
-            Some(EventSpec::Step { path, .. }) => format!("step {path}"),
-            Some(EventSpec::Ramp { path, .. }) => format!("ramp {path}"),
-            Some(EventSpec::Pulse { path, .. }) => format!("pulse {path}"),
-            Some(EventSpec::Sinusoid { path, .. }) => format!("sinusoid {path}"),
-            Some(EventSpec::Mode { controller, mode, .. }) => format!("{controller} {mode:?}").to_lowercase(),
-            Some(EventSpec::ValveStuck { path, .. }) => format!("{path} stuck"),
-            Some(EventSpec::ValveRepaired { path, .. }) => format!("{path} repaired"),
-            Some(EventSpec::FeedLost { unit, .. }) => format!("{unit} lost"),
-            Some(EventSpec::FeedRestored { unit, .. }) => format!("{unit} restored"),
-            Some(EventSpec::AnalyzerFrozen { controller, .. }) => format!("{controller} analyzer frozen"),
-            Some(EventSpec::AnalyzerRepaired { controller, .. }) => format!("{controller} analyzer repaired"),
-            None => origin.to_string(),
+    labelled(&res.events, spec, time_factor)
+}
+
+/// [`events`] of the list `(time [s], origin)`.
+fn labelled(events: &[(f64, String)], spec: &ScenarioSpec, time_factor: f64) -> Vec<(f64, String)> {
+    let mut out: Vec<(f64, String)> = Vec::new();
+    for (t, origin) in events {
+        let (t, text) = (t * time_factor, event_label(origin, spec));
+        match out.last_mut() {
+            Some((last, joined)) if *last == t => {
+                joined.push_str(", ");
+                joined.push_str(&text);
+            }
+            _ => out.push((t, text)),
         }
+    }
+    out
+}
+
+/// A short label for the event `origin` names: `events[k]`, a condition acting
+/// (`` when[k] (`path` above v) ``: its crossing, `path > v`), or one of its events
+/// (`when[k].then[j]`, perhaps `… skipped: why`).
+fn event_label(origin: &str, spec: &ScenarioSpec) -> String {
+    let index = |s: &str, prefix: &str| -> Option<(usize, usize)> {
+        let rest = s.strip_prefix(prefix)?;
+        let close = rest.find(']')?;
+        Some((rest[..close].parse().ok()?, prefix.len() + close + 1))
     };
-    res.events.iter().map(|(t, o)| (t * time_factor, label(o))).collect()
+    if let Some((k, _)) = index(origin, "events[") {
+        return spec.events.get(k).map_or_else(|| origin.to_string(), kind_label);
+    }
+    let Some((k, end)) = index(origin, "when[") else { return origin.to_string() };
+    let rest = &origin[end..];
+    if let Some((j, end)) = index(rest, ".then[") {
+        let skipped = if rest[end..].contains("skipped") { " (skipped)" } else { "" };
+        let then = spec.when.get(k).and_then(|w| w.then.get(j));
+        return then.map_or_else(|| origin.to_string(), |e| format!("{}{skipped}", kind_label(e)));
+    }
+    let crossing = rest.trim_start().trim_start_matches('(').trim_end_matches(')').replace('`', "");
+    crossing.replace(" above ", " > ").replace(" below ", " < ")
+}
+
+/// What an event does, in a few words.
+fn kind_label(e: &EventSpec) -> String {
+    match e {
+        EventSpec::Step { path, .. } => format!("step {path}"),
+        EventSpec::Ramp { path, .. } => format!("ramp {path}"),
+        EventSpec::Pulse { path, .. } => format!("pulse {path}"),
+        EventSpec::Sinusoid { path, .. } => format!("sinusoid {path}"),
+        EventSpec::Mode { controller, mode, .. } => format!("{controller} {mode:?}").to_lowercase(),
+        EventSpec::ValveStuck { path, .. } => format!("{path} stuck"),
+        EventSpec::ValveRepaired { path, .. } => format!("{path} repaired"),
+        EventSpec::FeedLost { unit, .. } => format!("{unit} lost"),
+        EventSpec::FeedRestored { unit, .. } => format!("{unit} restored"),
+        EventSpec::AnalyzerFrozen { controller, .. } => format!("{controller} analyzer frozen"),
+        EventSpec::AnalyzerRepaired { controller, .. } => format!("{controller} analyzer repaired"),
+    }
 }
 
 #[cfg(test)]
@@ -209,5 +248,35 @@ mod tests {
         assert_eq!(&v[..3], &[1.0, 1.5, 3.0]);
         assert!(v[3].is_nan());
         assert_eq!(axis_unit("1"), "-");
+    }
+
+    /// A condition's crossing and the events it starts at once are one marker; later ones,
+    /// skipped ones and timed ones are labelled by what they do.
+    #[test]
+    fn conditional_events_are_labelled_by_what_they_do() {
+        let spec = plantwide::flowsheet::scenario::parse_scenario(
+            r#"{"format_version": 1, "duration": "1 h",
+                "events": [{"type": "step", "at": "5 min", "path": "F", "to": "2 mol/s"}],
+                "when": [{"path": "tank.level", "above": "3 m",
+                          "then": [{"type": "feed_lost", "at": "0 s", "unit": "inflow"},
+                                   {"type": "feed_restored", "at": "10 min", "unit": "inflow"}]}]}"#,
+            "s.json",
+        )
+        .unwrap();
+        let raw = [
+            (300.0, "events[0]".to_string()),
+            (600.0, "when[0] (`tank.level` above 3 m)".to_string()),
+            (600.0, "when[0].then[0]".to_string()),
+            (1200.0, "when[0].then[1] skipped: `inflow.F` has no fault to repair".to_string()),
+        ];
+        let got = labelled(&raw, &spec, 1.0 / 60.0);
+        assert_eq!(
+            got,
+            vec![
+                (5.0, "step F".to_string()),
+                (10.0, "tank.level > 3 m, inflow lost".to_string()),
+                (20.0, "inflow restored (skipped)".to_string()),
+            ]
+        );
     }
 }

@@ -9,6 +9,7 @@ use std::path::Path;
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use super::style::{
     COLOURS, CurveStyle, GREY, Marker, Sample, curve_style, draw_curve, draw_legend, legend_width, titled,
@@ -252,6 +253,29 @@ fn legend(o: &Overlay, s: &YScale) -> Legend {
 }
 
 /// Points of `values` at `times` where both are finite.
+/// Width of a character of the event labels (12 px sans-serif) \[px\], a generous average.
+const LABEL_CHAR_PX: f64 = 6.6;
+/// Rows of event labels before they start again at the top.
+const LABEL_ROWS: usize = 4;
+
+/// Where each event label goes on a plot `width` px wide spanning the times `(t0, t1)`: its row
+/// (0 at the top), the first in which it overlaps no label placed before it, and whether it is
+/// anchored on its right (a label that would run past the plot's right edge ends at its marker).
+fn label_places(events: &[&(f64, String)], (t0, t1): (f64, f64), width: f64) -> Vec<(usize, bool)> {
+    let mut ends = [f64::NEG_INFINITY; LABEL_ROWS];
+    let mut out = Vec::with_capacity(events.len());
+    for (t, label) in events {
+        let x = (t - t0) / (t1 - t0).max(f64::MIN_POSITIVE) * width;
+        let w = label.chars().count() as f64 * LABEL_CHAR_PX;
+        let right = x + w > width;
+        let (from, to) = if right { (x - w, x) } else { (x, x + w) };
+        let row = (0..LABEL_ROWS).find(|&r| ends[r] + 4.0 <= from).unwrap_or(0);
+        ends[row] = to;
+        out.push((row, right));
+    }
+    out
+}
+
 fn points(times: &[f64], values: &[f64]) -> Vec<(f64, f64)> {
     times.iter().copied().zip(values.iter().copied()).filter(|(_, v)| v.is_finite()).collect()
 }
@@ -288,10 +312,17 @@ impl Trends<'_> {
             .y_label_formatter(&|v| format!("{v:.decimals$}"))
             .draw()
             .map_err(err)?;
-        for (t, label) in self.events.iter().filter(|(t, _)| (t0..=t1).contains(t)) {
+        let shown: Vec<&(f64, String)> = self.events.iter().filter(|(t, _)| (t0..=t1).contains(t)).collect();
+        let plot = chart.plotting_area().dim_in_pixel();
+        let places = label_places(&shown, (t0, t1), plot.0 as f64);
+        // A row of labels is 14 px of the plot's height.
+        let row = (hi - lo) * 14.0 / f64::from(plot.1.max(1));
+        for ((t, label), (rows_down, right)) in shown.iter().zip(places) {
             let line = DashedLineSeries::new(vec![(*t, lo), (*t, hi)], 4, 4, GREY.stroke_width(1));
             chart.draw_series(line).map_err(err)?;
-            let text = Text::new(label.clone(), (*t, hi), ("sans-serif", 12).into_font().color(&GREY));
+            let anchor = Pos::new(if right { HPos::Right } else { HPos::Left }, VPos::Top);
+            let font = ("sans-serif", 12).into_font().color(&GREY).pos(anchor);
+            let text = Text::new(label.clone(), (*t, hi - rows_down as f64 * row), font);
             chart.draw_series(std::iter::once(text)).map_err(err)?;
         }
         for (_, v) in &scale.inside {
@@ -325,6 +356,18 @@ impl Figure for Trends<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Labels that would overlap go a row down; one past the right edge ends at its marker.
+    #[test]
+    fn event_labels_do_not_overlap_and_stay_inside() {
+        let ev = [(0.0, "step F".to_string()), (1.0, "a long label here".to_string()), (50.0, "x".to_string())];
+        let ev: Vec<&(f64, String)> = ev.iter().collect();
+        let wide = label_places(&ev, (0.0, 100.0), 1000.0);
+        assert_eq!(wide, vec![(0, false), (1, false), (0, false)]);
+        let at_end = [(99.0, "tank.level < 0.5 m".to_string())];
+        let at_end: Vec<&(f64, String)> = at_end.iter().collect();
+        assert_eq!(label_places(&at_end, (0.0, 100.0), 1000.0), vec![(0, true)]);
+    }
 
     #[test]
     fn png_and_svg_are_written_and_other_extensions_refused() {
