@@ -473,8 +473,12 @@ pub fn run_sensors(a: &SensorsArgs, units: UnitSystem) -> Result<(), CliError> {
     }
     outln!("temperature-sensor selection for `{}` in `{}` (gains in {tu} per input unit)\n", a.column, plant.name());
     out!("{:>6} {:>10} {:>9}", "stage", format!("T [{tu}]"), format!("ΔT [{tu}]"));
-    for i in &inputs {
-        out!(" {:>22}", format!("dT/d{} [{tu}/{}]", i.path.rsplit('.').next().unwrap_or(&i.path), i.unit));
+    // Each input by its whole path (two loops' `op_manual` would read alike), the gain's unit as
+    // "per" the input's (a compound unit after `/` would read as a quotient of the two).
+    let headers: Vec<String> = inputs.iter().map(|i| format!("dT/d({}) [{tu} per {}]", i.path, i.unit)).collect();
+    let widths: Vec<usize> = headers.iter().map(|h| h.chars().count().max(12)).collect();
+    for (h, w) in headers.iter().zip(&widths) {
+        out!(" {h:>w$}");
     }
     for k in 0..s.singular_values.len() {
         out!(" {:>8}", format!("|U{}|", k + 1));
@@ -487,8 +491,8 @@ pub fn run_sensors(a: &SensorsArgs, units: UnitSystem) -> Result<(), CliError> {
             String::new()
         };
         out!("{:>6} {:>10.4} {:>9}", stage, temperature.value(s.temperatures[r]), dt);
-        for j in 0..inputs.len() {
-            out!(" {:>22}", sig(temperature.difference(s.gains[(r, j)])));
+        for (j, w) in widths.iter().enumerate() {
+            out!(" {:>w$}", sig(temperature.difference(s.gains[(r, j)])));
         }
         for k in 0..s.singular_values.len() {
             out!(" {:>8.4}", s.u[(r, k)].abs());

@@ -347,11 +347,12 @@ fn table(s: &VesselSizing, plant: &Plant, u: &SizeUnits) -> String {
     let normal = if holdup { format!(" normal holdup [{}] (its depth) |", u.amount.unit()) } else { String::new() };
     t.push_str(&format!(
         "| controller | area [{}] | band volume [{}] |{normal} kc [{kc_unit}] | τI [{}] | max level deviation [{l}] | \
-         max outflow rate [{}] | meets |\n",
+         max outflow rate [{}] | meets (to {} % of the limits) |\n",
         u.area.unit(),
         u.volume.unit(),
         u.time.unit(),
-        u.rate_unit()
+        u.rate_unit(),
+        plantwide::studies::size::VERIFY_TOLERANCE * 100.0
     ));
     t.push_str(if holdup { "|---|---|---|---|---|---|---|---|---|\n" } else { "|---|---|---|---|---|---|---|---|\n" });
     for d in &s.designs {

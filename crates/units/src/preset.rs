@@ -51,8 +51,23 @@ impl UnitSystem {
         match (self, entry) {
             (UnitSystem::Metric, Some((_, m, _))) => m.to_string(),
             (UnitSystem::Field, Some((_, _, f))) => f.to_string(),
-            _ => dim.to_string(),
+            (UnitSystem::Si, _) => dim.to_string(),
+            (_, None) => self.integral_unit(dim).unwrap_or_else(|| dim.to_string()),
         }
+    }
+
+    /// The unit of a quantity integrated over time (a controller's integral of its error, `K·s`,
+    /// `Pa·s`): the listed unit of the integrand (a temperature as a difference, K or degR) times
+    /// the system's time unit, so that a plant's integrals read in one time unit.
+    fn integral_unit(&self, dim: Dimension) -> Option<String> {
+        let time = self.unit_for(Dimension::TIME);
+        let (d, _, _) = TABLE.iter().find(|(d, _, _)| *d != Dimension::TIME && *d * Dimension::TIME == dim)?;
+        let integrand = match *d {
+            Dimension::TEMPERATURE if *self == UnitSystem::Field => "degR".to_string(),
+            Dimension::TEMPERATURE => "K".to_string(),
+            _ => self.unit_for(*d),
+        };
+        Some(format!("{integrand}*{time}"))
     }
 }
 
@@ -96,6 +111,22 @@ mod tests {
         assert_eq!(UnitSystem::Metric.unit_for(Dimension::DIMENSIONLESS), Dimension::DIMENSIONLESS.to_string());
         assert_eq!(UnitSystem::parse("Field"), Some(UnitSystem::Field));
         assert_eq!(UnitSystem::parse("imperial"), None);
+    }
+
+    /// A controller's integral of a temperature error, 60 K·s, reads 1 K·min in metric units and
+    /// 1.8 degR·min in field units; of a flow error, 3600 mol, 3.6 kmol (the table's own entry).
+    #[test]
+    fn integrals_read_in_the_systems_time_unit() {
+        let ks = Dimension::TEMPERATURE * Dimension::TIME;
+        assert_eq!(UnitSystem::Metric.unit_for(ks), "K*min");
+        assert_eq!(UnitSystem::Field.unit_for(ks), "degR*min");
+        assert_eq!(UnitSystem::Si.unit_for(ks), ks.to_string());
+        assert!((Display::new("K*min").unwrap().value(60.0) - 1.0).abs() < 1e-12);
+        assert!((Display::new("degR*min").unwrap().value(60.0) - 1.8).abs() < 1e-12);
+        let pa_s = UnitSystem::Metric.unit_for(Dimension::PRESSURE * Dimension::TIME);
+        assert_eq!(pa_s, "kPa*min");
+        assert!((Display::new(&pa_s).unwrap().value(60_000.0) - 1.0).abs() < 1e-12);
+        assert_eq!(UnitSystem::Metric.unit_for(Dimension::MOLAR_FLOW * Dimension::TIME), "kmol");
     }
 
     #[test]
