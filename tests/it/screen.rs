@@ -264,7 +264,7 @@ fn two_column_pairings_rank_lb_on_both_columns_first_and_the_dynamic_test_agrees
 #[test]
 fn bad_pairing_requests_exit_1_naming_what_is_wrong() {
     let fs = flowsheet("two_column_plant.json");
-    let cases: [(&[&str], &str); 7] = [
+    let cases: [(&[&str], &str); 9] = [
         (&["--cvs", "column1.T[99]", "--mvs", "column1.reflux"], "--cvs: no variable `column1.T[99]`"),
         (
             &["--cvs", "column1.T[21]", "--mvs", "column1.reflux", "--watch", "bottoms1.x[B]=0:1"],
@@ -284,6 +284,25 @@ fn bad_pairing_requests_exit_1_naming_what_is_wrong() {
         (
             &["--cvs", "column1.T[21]", "--mvs", "column1.reflux", "--disturbances", "fresh_A.F=ten"],
             "expected PATH (+10 %), PATH=±x%",
+        ),
+        // A disturbance on an MV a candidate pairs (found by the plant generator: the run of that
+        // candidate failed with exit 2 on "driven by controller pair2").
+        (
+            &["--cvs", "column1.T[21]", "--mvs", "column1.reflux,fresh_A.F", "--disturbances", "fresh_A.F"],
+            "--disturbances fresh_A.F: it is also one of the --mvs, and a candidate that pairs it drives it",
+        ),
+        (
+            &[
+                "--cvs",
+                "column1.T[21]",
+                "--mvs",
+                "column1.reflux,fresh_A.F",
+                "--throughput",
+                "fresh_A.F,column1.reflux",
+                "--disturbances",
+                "fresh_A.F",
+            ],
+            "(the candidates holding column1.reflux pair it;",
         ),
     ];
     for (extra, msg) in cases {

@@ -121,6 +121,20 @@ pub enum ScreenError {
         /// The path.
         path: String,
     },
+    /// A disturbance on an input that a candidate pairs: its controller drives it there, so the
+    /// step cannot be applied.
+    #[error(
+        "--disturbances {path}: it is also one of the --mvs, and a candidate that pairs it drives it with a \
+         controller, so it cannot be stepped there{held}: disturb an input no candidate pairs, or give it as \
+         the only --throughput candidate (held in every candidate, as a throughput manipulator is)"
+    )]
+    DisturbedMv {
+        /// The disturbance's path.
+        path: String,
+        /// The other throughput candidates, whose candidates pair it (` (the candidates holding
+        /// column.reflux pair it; a throughput change there is a step of column.reflux)`), or empty.
+        held: String,
+    },
     /// Not as many free MVs as CVs.
     #[error(
         "{cvs} CVs and {mvs} MVs{}: pairing needs as many MVs as CVs (one more with --throughput), 1 to 8 of them",

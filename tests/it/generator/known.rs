@@ -35,14 +35,6 @@ const OPEN: &[Known] = &[
                sign against the exact gains it prints (open; identify is being reworked by another helper)",
     },
     Known {
-        class: "screen --cvs/--mvs: fails (exit 2) on a generated plant",
-        shows: |t| t.contains("--throughput") && t.contains("is driven by controller"),
-        note: "found by this suite: screen --cvs/--mvs accepts a disturbance that a candidate \
-               pairs as an MV, then fails that candidate's run ('input is driven by controller \
-               pairN') with exit 2, where it should refuse the request up front or step the loop's \
-               setpoint (open; screen is being reworked by another helper)",
-    },
-    Known {
         class: "screen --column: refused (exit 1) on a generated plant",
         shows: |t| t.contains("error: configuration ") && t.contains("the steady state is not determined"),
         note: "found by this suite: on a reactor-column recycle whose fresh feed is fixed, one \

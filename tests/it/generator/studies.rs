@@ -198,9 +198,11 @@ fn screen(cx: &mut Cx<'_>, cvs: &[String], mvs: &[String], throughput: &[String]
 pub fn screen_pairings(cx: &mut Cx<'_>, with_throughput: bool) {
     let r = cx.case.roles.clone();
     let (cvs, mut mvs) = (r.cvs.to_vec(), r.mvs.to_vec());
+    // The throughput input is the disturbance: held in every candidate (the only throughput
+    // candidate), it can be stepped; a second candidate would pair it, and screen refuses that.
     let throughput = if with_throughput {
         mvs.push(r.throughput.clone());
-        vec![r.throughput.clone(), r.mvs[0].clone()]
+        vec![r.throughput.clone()]
     } else {
         Vec::new()
     };

@@ -346,6 +346,7 @@ fn check_request(plant: &Plant, r: &PairingRequest) -> Result<(), ScreenError> {
     if let Some(t) = r.throughput.iter().find(|t| !r.mvs.contains(t)) {
         return Err(ScreenError::ThroughputNotMv { path: t.clone() });
     }
+    disturbances_unpaired(plant, r)?;
     let free = r.mvs.len().saturating_sub(usize::from(!r.throughput.is_empty()));
     if r.cvs.is_empty() || free != r.cvs.len() || r.cvs.len() > 8 {
         return Err(ScreenError::NotSquare {
@@ -353,6 +354,33 @@ fn check_request(plant: &Plant, r: &PairingRequest) -> Result<(), ScreenError> {
             mvs: r.mvs.len(),
             throughput: !r.throughput.is_empty(),
         });
+    }
+    Ok(())
+}
+
+/// No disturbance steps an input a candidate pairs: an MV is stepped only as the one throughput
+/// candidate, which every candidate holds.
+fn disturbances_unpaired(plant: &Plant, r: &PairingRequest) -> Result<(), ScreenError> {
+    let same = |a: &str, b: &str| plant.input(a).is_some() && plant.input(a) == plant.input(b);
+    for d in &r.disturbances {
+        if !r.mvs.iter().any(|m| same(m, &d.path)) {
+            continue;
+        }
+        let others: Vec<&String> = r.throughput.iter().filter(|t| !same(t, &d.path)).collect();
+        if r.throughput.len() == 1 && others.is_empty() {
+            continue;
+        }
+        let held = match others.as_slice() {
+            [] => String::new(),
+            list => {
+                let names: Vec<&str> = list.iter().map(|s| s.as_str()).collect();
+                format!(
+                    " (the candidates holding {} pair it; a throughput change there is a step of the input they hold)",
+                    names.join(" or ")
+                )
+            }
+        };
+        return Err(ScreenError::DisturbedMv { path: d.path.clone(), held });
     }
     Ok(())
 }
