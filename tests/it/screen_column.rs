@@ -297,3 +297,16 @@ fn a_recycle_column_is_stepped_by_its_fresh_feed_and_an_undetermined_configurati
     let ranks: Vec<u64> = regular(&v).iter().filter_map(|s| s["rank"].as_u64()).collect();
     assert_eq!(ranks.len(), 5, "{ranks:?}");
 }
+
+/// A column fed by a reactor whose fresh feed a level loop sets (Luyben's snowball structure 2)
+/// has no feed of free rate upstream; its throughput manipulator is the reactor's effluent flow,
+/// which the dynamic check steps ±10 % by default (the plant generator's recycle plants were
+/// refused with exit 1 "no feed of free rate upstream").
+#[test]
+fn a_free_outflow_upstream_is_the_default_throughput_step() {
+    let (code, v, err) =
+        screen(&flowsheet("reactor_column_recycle_fixed_effluent.json"), "recycle.x[A],bottoms.x[A]", &[]);
+    assert_eq!(code, Some(0), "{err}");
+    assert_eq!(v["disturbances"], serde_json::json!(["reactor.outflow +10 %", "reactor.outflow -10 %"]));
+    assert_eq!(v["failed"], serde_json::json!([]));
+}

@@ -82,13 +82,23 @@ pub(super) fn disturbances(
 
 /// The feed rate ±10 % and a feed mole fraction ± a tenth of its distance to 0 or 1 (that of the
 /// top quality's component, or else of the component with the most room), of every feed upstream
-/// of the column whose rate is free.
+/// of the column whose rate is free; and ±10 % of every free outflow upstream (a reactor's or a
+/// tank's `outflow` that no controller drives: the throughput manipulator of a plant whose fresh
+/// feed a level loop sets, Luyben's snowball structure 2).
 fn defaults(plant: &Plant, column: &str, outputs: &[String]) -> Result<Vec<Disturbance>, ScreenError> {
     let free = |p: &str| plant.input(p).filter(|&i| plant.inputs()[i].driven_by.is_none());
     let top = VarPath::parse(&outputs[0]);
     let component = top.field().and_then(|f| Some(f.split_once('[')?.1.trim_end_matches(']')));
-    let (feeds, sources) = upstream_feeds(plant, column);
-    let mut list = Vec::new();
+    let (feeds, sources, outflows) = upstream_feeds(plant, column);
+    let mut list: Vec<Disturbance> = outflows
+        .iter()
+        .map(|u| Disturbance {
+            path: format!("{u}.outflow"),
+            size: StepSize::Fraction(0.1),
+            direction: Direction::Both,
+            shown: "10 %".into(),
+        })
+        .collect();
     for unit in &feeds {
         let flow = format!("{unit}.F");
         list.push(Disturbance {
@@ -127,13 +137,11 @@ fn defaults(plant: &Plant, column: &str, outputs: &[String]) -> Result<Vec<Distu
 
 /// The units with a free feed rate (`unit.F`, an input no controller drives) upstream of `column`,
 /// found by walking its inlet streams back through every unit (heaters, tanks, splits, reactors,
-/// other columns; a recycle is walked once), in the flowsheet's stream order; and the units
-/// feeding the column directly.
-fn upstream_feeds<'a>(plant: &'a Plant, column: &'a str) -> (Vec<&'a str>, Vec<&'a str>) {
-    let is_feed = |u: &str| {
-        let flow = plant.input(&format!("{u}.F"));
-        flow.is_some_and(|i| plant.inputs()[i].driven_by.is_none())
-    };
+/// other columns; a recycle is walked once), in the flowsheet's stream order; the units
+/// feeding the column directly; and the units upstream whose `outflow` is a free input.
+fn upstream_feeds<'a>(plant: &'a Plant, column: &'a str) -> (Vec<&'a str>, Vec<&'a str>, Vec<&'a str>) {
+    let free = |path: String| plant.input(&path).is_some_and(|i| plant.inputs()[i].driven_by.is_none());
+    let is_feed = |u: &str| free(format!("{u}.F"));
     let sources_of = |unit: &str| -> Vec<&'a str> {
         // A stream's ends are `unit.port`, or `unit` alone for a unit of one inlet or outlet.
         let owner = |end: &'a str| end.split('.').next().unwrap_or(end);
@@ -141,19 +149,22 @@ fn upstream_feeds<'a>(plant: &'a Plant, column: &'a str) -> (Vec<&'a str>, Vec<&
         streams.map(|s| owner(&s.from)).collect()
     };
     let direct = sources_of(column);
-    let (mut seen, mut feeds, mut queue) = (vec![column], Vec::new(), direct.clone());
+    let (mut seen, mut feeds, mut outflows, mut queue) = (vec![column], Vec::new(), Vec::new(), direct.clone());
     while !queue.is_empty() {
         let unit = queue.remove(0);
         if seen.contains(&unit) {
             continue;
         }
         seen.push(unit);
+        if free(format!("{unit}.outflow")) {
+            outflows.push(unit);
+        }
         match is_feed(unit) {
             true => feeds.push(unit),
             false => queue.extend(sources_of(unit)),
         }
     }
-    (feeds, direct)
+    (feeds, direct, outflows)
 }
 
 /// A configuration ready for the pairing screen's dynamic test.
