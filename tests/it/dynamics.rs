@@ -792,15 +792,16 @@ fn flash_feed_step_restarts_consistently_and_matches_a_short_ramp() {
 
 /// A failure of the consistent start names the unit, equation and variable wherever it reaches
 /// the user: through a `Session` (plant tests, surge sizing) as through `simulate`, with the
-/// variable it left on a bound. The flash's feed cooled below the drum's bubble point asks for a
-/// negative vapour flow, so no consistent state exists after the change.
+/// variable it left on a bound. The flash's feed cooled to 40 K, where the K-values vanish and the
+/// incipient vapour has no composition, has no consistent state after the change (a feed merely
+/// below the bubble point runs the drum all liquid: the next test).
 #[test]
 fn a_failed_consistent_start_names_its_unit_and_variable_in_a_session() {
     use plantwide::solve::dynamic::Session;
     let (plant, x0) = min_flash();
     let mut s = Session::new(&plant, &x0).unwrap();
     s.advance_to(60.0).unwrap();
-    s.set_input(plant.input("preheater.T_out").unwrap(), 368.15);
+    s.set_input(plant.input("preheater.T_out").unwrap(), 40.0);
     // `in equation 24 (preheater: equation for hot.T, variable hot.T)`: which equation is worst
     // where the line search stops is Newton's business; that it is named is this test's.
     let named = |msg: &str| {
@@ -819,10 +820,46 @@ fn a_failed_consistent_start_names_its_unit_and_variable_in_a_session() {
     );
     // `simulate` says the same.
     let scenario =
-        min_flash_scenario(r#"{"type": "step", "at": "1 min", "path": "preheater.T_out", "to": "95 degC"}"#, "5 min");
+        min_flash_scenario(r#"{"type": "step", "at": "1 min", "path": "preheater.T_out", "to": "40 K"}"#, "5 min");
     let spec = parse_scenario(&scenario, "scenario.json").unwrap();
     let sc = resolve(&spec, &plant, "scenario.json").unwrap();
     let msg = simulate(&plant, &sc, Start::Steady(&x0), "test", &mut |_| {}).unwrap_err().to_string();
     eprintln!("{msg}");
     assert!(named(&msg), "{msg}");
+}
+
+/// A flash drum whose feed turns subcooled runs all liquid and comes back (issue 53: the plant
+/// generator's flash → tank → column trains stopped with "flash_vapour.F at its lower bound 0" when a
+/// feed change took the drum below its bubble point, as the newcomer's D2 drum did). The preheater's
+/// outlet falls from 108 to 90 °C (below the bubble point at 1.3 atm) for 20 min: no vapour while it
+/// is cold, the liquid leaving with the feed's enthalpy, material conserved, and the first steady
+/// state again once it is warm.
+#[test]
+fn a_flash_drum_runs_all_liquid_while_its_feed_is_subcooled_and_comes_back() {
+    let (plant, x0) = min_flash();
+    let scenario = r#"{"format_version": 1, "duration": "300 min",
+        "events": [{"type": "step", "at": "10 min", "path": "preheater.T_out", "to": "90 degC"},
+                   {"type": "step", "at": "30 min", "path": "preheater.T_out", "to": "108 degC"}],
+        "record": {"interval": "1 min", "paths": ["flash_vapour.F", "flash_liquid.T", "flash_liquid.h", "hot.h"]}}"#;
+    let res = run_from(&plant, scenario, Start::Steady(&x0), &mut |_| {});
+    let (v, t) = (column(&res, "flash_vapour.F"), column(&res, "flash_liquid.T"));
+    let (h_l, h_f) = (column(&res, "flash_liquid.h"), column(&res, "hot.h"));
+    let v0 = v[0];
+    let bubble = plant.thermo().bubble_t(1.3 * 101_325.0, &[0.45, 0.55]).unwrap().t;
+    assert!(v0 > 1.0 && bubble > 363.15 + 5.0, "two-phase at the start: V = {v0} mol/s; bubble point {bubble} K");
+    for (k, time) in res.times.iter().enumerate().filter(|(_, t)| **t > 10.0 * 60.0 && **t < 30.0 * 60.0) {
+        // No vapour, so the drum's energy balance says the liquid leaves with the feed's enthalpy
+        // (at a temperature near the feed's, the drum's composition lagging the feed's), below the
+        // bubble point.
+        assert!(v[k].abs() < 1e-6 * v0, "no vapour at t = {time} s: {}", v[k]);
+        assert!((h_l[k] - h_f[k]).abs() < 1e-6 * h_f[k].abs(), "t = {time} s: h_L {} h_F {}", h_l[k], h_f[k]);
+        assert!((t[k] - 363.15).abs() < 0.5 && t[k] < bubble - 3.0, "t = {time} s: {} K", t[k]);
+    }
+    let (v_end, t_end) = (*v.last().unwrap(), *t.last().unwrap());
+    assert!(
+        (v_end - v0).abs() < 1e-6 * v0 && (t_end - t[0]).abs() < 1e-6,
+        "back: V {v_end} vs {v0}, T {t_end} vs {}",
+        t[0]
+    );
+    assert!(res.conservation.worst() < 1e-9, "{}", res.conservation.worst());
 }

@@ -12,10 +12,11 @@
 //! Equations:
 //! - `dN_i/dt = F z_i − V y_i − L x_i` [mol/s];
 //! - the holdup equations `M = Σ N_i`, `x_i M = N_i`, `V = M v_L(T, x)`, `A · level = V`;
-//! - phase equilibrium `y_i = K_i(T, P, x) x_i` [-] and the bubble-point condition
-//!   `Σ_i K_i(T, P, x) x_i = 1`, which fixes `T` [K] (for constant relative volatility, whose
-//!   K-values do not depend on `T`, the Raoult bubble point `Σ_i x_i P_sat,i(T) = P` instead, as in
-//!   `ThermoPackage::bubble_t`); `T_vapour = T`;
+//! - phase equilibrium `y_i Σ_j K_j x_j = K_i(T, P, x) x_i` [-] and the phase condition: the
+//!   bubble point `Σ_i K_i(T, P, x) x_i = 1`, which fixes `T` [K], while vapour forms, or no
+//!   vapour (`V = 0`) and the liquid below its bubble point (`phase_condition`: a complementarity;
+//!   for constant relative volatility, whose K-values do not depend on `T`, the Raoult bubble point
+//!   `Σ_i x_i P_sat,i(T) = P` instead, as in `ThermoPackage::bubble_t`); `T_vapour = T`;
 //! - quasi-steady energy balance `0 = F (h_F − h_L) + Q − V (h_V − h_L)` [W] (gives `V`), `Q` the
 //!   input `duty`, `h_V = h_vap(T, y)`, `h_L = h_liq(T, x)` [J/mol];
 //! - `P_vapour = P` [Pa]; the outflow law for `L` [mol/s] and the liquid's outlet pressure [Pa]
@@ -34,10 +35,12 @@
 //! enthalpies are negative, and no consistent state existed. At steady state `F = V + L` and both
 //! forms are the exact energy balance: the drum is an isobaric PH flash of the feed at `h_F + Q/F`.
 //!
-//! The drum must operate two-phase. For a subcooled feed (`h_F + Q/F` below the bubble-point
-//! enthalpy) the energy balance asks for `V < 0`; the bound `F ≥ 0` on the vapour stream then stops
-//! Newton short of a solution, which is correct: no two-phase drum exists. Use a `tank` for liquid
-//! service. The guess puts such a drum at the feed's bubble point with `V = 0`.
+//! A subcooled feed (`h_F + Q/F` below the bubble-point enthalpy) makes no vapour: the drum runs
+//! all liquid, `V = 0`, and the energy balance then sets the liquid's temperature below its bubble
+//! point (`h_L(T, x) = h_F + Q/F` at steady state). A feed that turns heavier or colder in a run
+//! takes the drum there and back without a discontinuity in the equations (before, the bubble-point
+//! condition asked for `V < 0` and the run stopped at the bound). The guess puts such a drum at
+//! the feed's bubble point with `V = 0`.
 
 use plantwide_units::{Dimension, QuantityValue};
 use schemars::JsonSchema;
@@ -141,16 +144,19 @@ impl UnitModel for Flash {
         io.thermo.k_values(t, p, x, &mut k);
         let vl = io.thermo.v_liq(t, x);
         let mut res = vec![S::from(0.0); io.layout.n_own()];
+        // Σ K_i x_i: 1 on the bubble point; the vapour (or, with none, the incipient vapour) is
+        // normalized by it.
+        let sum_kx = k.iter().zip(x).fold(S::from(0.0), |acc, (ki, xi)| acc + *ki * *xi);
         for i in 0..nc {
             res[2 * len + i] = inlet.f() * inlet.z()[i] - vap.f() * y[i] - liq.f() * x[i];
-            res[Z0 + i] = y[i] - k[i] * x[i];
+            res[Z0 + i] = y[i] * sum_kx - k[i] * x[i];
         }
         self.holdup.residuals(n, x, mlv, vl, &mut res, (len + Z0, 2 * len + nc));
         res[F] = inlet.f() * (inlet.h() - liq.h()) + q - vap.f() * (vap.h() - liq.h());
         res[T] = vap.t() - t;
         res[P] = vap.p() - p;
         res[H] = vap.h() - io.thermo.h_vap(t, y);
-        res[len + T] = io.thermo.bubble_residual(t, p, x);
+        res[len + T] = phase_condition(vap.f(), io.thermo.bubble_residual(t, p, x));
         res[len + H] = liq.h() - io.thermo.h_liq(t, x);
         let state = LiquidState { p, level: mlv[1], mw: io.thermo.mw(x), v: vl };
         self.law.close(io, len, N_FIXED_INPUTS, &state, res, r);
@@ -161,9 +167,18 @@ impl UnitModel for Flash {
         let (p, q, f) = (io.input(0), io.input(1), inlet.f());
         let z = normalized(inlet.z());
         let h = if f > 0.0 { inlet.h() + q / f } else { inlet.h() };
-        // The drum's steady state is the PH flash of the feed; a subcooled feed sits at its bubble point.
+        // The drum's steady state is the PH flash of the feed: two-phase, or all liquid (a subcooled
+        // feed, at its own enthalpy, with the vapour it would first make as `y`); else it sits at
+        // the feed's bubble point.
         let (t, beta, x, y) = match io.thermo.flash_ph(p, h, &z) {
             Ok(s) if s.beta > 0.0 && s.beta < 1.0 => (s.t, s.beta, s.x, s.y),
+            Ok(s) if s.beta <= 0.0 => {
+                let mut k = vec![0.0; nc];
+                io.thermo.k_values(s.t, p, &z, &mut k);
+                let sum: f64 = k.iter().zip(&z).map(|(k, z)| k * z).sum();
+                let y = k.iter().zip(&z).map(|(k, z)| k * z / sum).collect();
+                (s.t, 0.0, z.clone(), y)
+            }
             _ => match io.thermo.bubble_t(p, &z) {
                 Ok(b) => (b.t, 0.0, z.clone(), b.incipient),
                 Err(_) => (inlet.t(), 0.0, z.clone(), z.clone()),
@@ -181,6 +196,27 @@ impl UnitModel for Flash {
         own[2 * len + nc..].copy_from_slice(&mlv);
     }
 }
+
+/// Flow scale of the phase condition's complementarity \[mol/s\]: where a vapour flow counts as
+/// large against the bubble-point residual. Any positive value has the same roots.
+const PHASE_FLOW_SCALE: f64 = 1.0;
+
+/// The phase condition of the drum: two-phase on the bubble point (`Σ K_i x_i = 1`, `V ≥ 0`), or
+/// all liquid below it (`V = 0`, `Σ K_i x_i < 1`), one of the two: the complementarity
+/// `V ≥ 0, 1 − Σ K_i x_i ≥ 0, V·(1 − Σ K_i x_i) = 0` as the Fischer–Burmeister function
+/// `φ(a, b) = a + b − √(a² + b²)`, zero exactly when `a, b ≥ 0` and `ab = 0` (Fischer 1992; the
+/// complementarity form of phase disappearance, Sahlodin, Watson & Barton, *AIChE J.* 62, 2016),
+/// with `a = V / (1 mol/s)` and `b = −bubble_residual`. On the bubble point with vapour flowing
+/// `φ = b`: the two-phase drum's roots are those of the bubble-point condition alone.
+fn phase_condition<S: Scalar>(vapour: S, bubble_residual: S) -> S {
+    let (a, b) = (vapour / S::from(PHASE_FLOW_SCALE), -bubble_residual);
+    a + b - (a * a + b * b + S::from(PHASE_SMOOTHING * PHASE_SMOOTHING)).sqrt()
+}
+
+/// Smoothing of the phase condition (Kanzow 1996): `√(a² + b² + ε²)` keeps its slope finite at
+/// `a = b = 0` (a drum on the bubble point with no vapour: the guess of a subcooled feed), and
+/// moves its roots to `ab = ε²/2`: 5e-22 on the bubble residual with 1 mol/s of vapour.
+const PHASE_SMOOTHING: f64 = 1e-10;
 
 #[cfg(test)]
 mod tests {
@@ -291,14 +327,54 @@ mod tests {
         }
     }
 
+    /// A subcooled feed runs the drum all liquid: the state with no vapour and the liquid the feed
+    /// itself at the feed's enthalpy (330 K, 45 K below the bubble point at 3 atm) satisfies every
+    /// equation, on either VLE model, and the two-phase bubble-point state does not.
     #[test]
-    fn subcooled_feed_guess_sits_at_the_bubble_point() {
+    fn a_subcooled_feed_runs_the_drum_all_liquid() {
+        for thermo in [binary_package(), alpha_package()] {
+            let u = build_unit(r#"{"P": "3 atm", "area": 1, "outflow": {"type": "free"}}"#, &thermo, Flash::build);
+            let (lay, local) = at_guess(&u, &thermo, &feed(&thermo));
+            let n_eq = (lay.n_own() as isize + UnitModel::extra_equations(&u)) as usize;
+            let residual = |local: &[f64]| {
+                let mut r = vec![0.0; n_eq];
+                UnitModel::eval(&u, &UnitIo { local, layout: &lay, thermo: &thermo, time: 0.0 }, &mut r);
+                r
+            };
+            let len = lay.stream.len();
+            // The all-liquid state, written out: V = 0, L = F, T = 330 K, x = z, y the incipient vapour.
+            let mut state = local.clone();
+            let (t, p) = (330.0, 3.0 * 101_325.0);
+            let mut k = [0.0; 2];
+            thermo.k_values(t, p, &[0.5, 0.5], &mut k);
+            let s = 0.5 * (k[0] + k[1]);
+            let y = [0.5 * k[0] / s, 0.5 * k[1] / s];
+            state[..Z0].copy_from_slice(&[0.0, t, p, thermo.h_vap(t, &y)]);
+            state[Z0..len].copy_from_slice(&y);
+            state[len + F] = 10.0;
+            state[len + T] = t;
+            state[len + H] = thermo.h_liq(t, &[0.5, 0.5]);
+            state[len + Z0..2 * len].copy_from_slice(&[0.5, 0.5]);
+            let r = residual(&state);
+            let worst = r.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            eprintln!("all liquid at 330 K ({:?}): largest residual {worst:.1e}", thermo.vle);
+            assert!(worst < 1e-9, "{r:?}");
+            assert_eq!(state[..lay.n_own()], local[..lay.n_own()], "the guess is that state");
+            // The old model's state for it, at the bubble point with no vapour, is no solution.
+            let bubble = thermo.bubble_t(p, &[0.5, 0.5]).unwrap().t;
+            let mut old = state.clone();
+            (old[T], old[len + T], old[len + H]) = (bubble, bubble, thermo.h_liq(bubble, &[0.5, 0.5]));
+            assert!(residual(&old).iter().any(|v| v.abs() > 1.0), "bubble point {bubble} K");
+        }
+    }
+
+    #[test]
+    fn subcooled_feed_guess_is_all_liquid_at_its_enthalpy() {
         let thermo = binary_package();
         let u = build_unit(r#"{"P": "3 atm", "area": 1, "outflow": {"type": "free"}}"#, &thermo, Flash::build);
         let (lay, local) = at_guess(&u, &thermo, &feed(&thermo));
         let io = UnitIo { local: &local, layout: &lay, thermo: &thermo, time: 0.0 };
-        let b = thermo.bubble_t(io.input(0), &[0.5, 0.5]).unwrap();
-        assert!(io.outlet(0).f().abs() < 1e-300 && (io.outlet(1).t() - b.t).abs() < 1e-9);
+        assert!(io.outlet(0).f().abs() < 1e-300 && (io.outlet(1).t() - 330.0).abs() < 1e-6, "{}", io.outlet(1).t());
         let vars: Vec<String> = UnitModel::internal_vars(&u).into_iter().map(|v| v.name).collect();
         assert_eq!(vars, ["N[light]", "N[heavy]", "M", "level", "V"]);
         assert_eq!(UnitModel::extra_equations(&u), -1);
