@@ -131,14 +131,33 @@ pub fn permuted(a: &[Vec<f64>], b: &[Vec<f64>], rows: &[usize], cols: &[usize], 
         ));
     }
     for (i, &r) in rows.iter().enumerate() {
-        let scale = a[r].iter().fold(0.0f64, |m, x| m.max(x.abs()));
         for (j, &c) in cols.iter().enumerate() {
-            if !near(a[r][c], b[i][j], rel, rel * scale * 1e-3) {
+            if !near(a[r][c], b[i][j], rel, rel * natural_size(a, r, c) * 1e-3) {
                 return Err(format!("entry ({i}, {j}) is {:e}, the permuted entry ({r}, {c}) {:e}", b[i][j], a[r][c]));
             }
         }
     }
     Ok(())
+}
+
+/// The size element `(i, j)` of a gain matrix has by its units: `max_k |G_ik| · max_l |G_lj| /
+/// max |G|`, its own size for a matrix of rank one (`G = u vᵀ`). Rows and columns carry units (a
+/// gain per watt beside one per mol/s), so a row's largest element does not size the others; an
+/// element far below its natural size is a structural zero computed to rounding, whose relative
+/// digits are noise (8.35e-13 against 8.36e-13 for a composition's gain to a flow it does not
+/// see, on a generated flash train).
+pub fn natural_size(g: &[Vec<f64>], i: usize, j: usize) -> f64 {
+    let row = g[i].iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let col = g.iter().fold(0.0f64, |m, r| m.max(r.get(j).map_or(0.0, |x| x.abs())));
+    let all = g.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+    if all > 0.0 { row * col / all } else { 0.0 }
+}
+
+/// A condition number `κ` is computed to a relative error of about `ε κ` (rounding moves the
+/// smallest singular value by `ε ‖G‖`): two of them agree within that, or `rel` if larger.
+pub fn condition_numbers_agree(a: f64, b: f64, rel: f64) -> bool {
+    let rounding = 100.0 * f64::EPSILON * a.abs().max(b.abs());
+    near(a, b, rel.max(rounding), 0.0)
 }
 
 /// The rows of a relative gain array sum to 1.
@@ -163,9 +182,8 @@ pub fn gains_agree(a: &[Vec<f64>], b: &[Vec<f64>], rel: f64, floor: f64) -> Resu
         return Err("shapes differ".into());
     }
     for i in 0..n {
-        let scale = a[i].iter().fold(0.0f64, |m, x| m.max(x.abs()));
         for &j in &cols {
-            if !near(a[i][j], b[i][j], rel, rel * floor * scale) {
+            if !near(a[i][j], b[i][j], rel, rel * floor * natural_size(a, i, j)) {
                 return Err(format!("G[{i}][{j}]: {:e} against {:e}", a[i][j], b[i][j]));
             }
         }
@@ -342,6 +360,29 @@ pub fn end_slopes(csv: &str) -> Vec<(String, f64)> {
 
 #[cfg(test)]
 mod tests {
+    /// A rank-one matrix's elements are their own natural size; an element of units-mixed gains
+    /// far below it is compared to rounding of that size, and a real difference still shows.
+    #[test]
+    fn gains_are_compared_at_the_size_their_units_give() {
+        let g = vec![vec![2e-3, 4e-9, 6e-6], vec![1e-1, 2e-7, 3e-4]];
+        for (i, row) in g.iter().enumerate() {
+            for (j, x) in row.iter().enumerate() {
+                assert!((natural_size(&g, i, j) - x).abs() <= 1e-15 * x, "({i}, {j})");
+            }
+        }
+        let mut noisy = g.clone();
+        noisy[0][1] = 4e-9;
+        noisy[1][1] = 2e-7 * (1.0 + 1e-3);
+        assert!(gains_agree(&g, &noisy, 1e-4, 1e-3).is_err(), "a 1e-3 difference of a full-size element");
+        let mut zero = g.clone();
+        zero[0][2] = 8.35e-13;
+        let mut zero2 = zero.clone();
+        zero2[0][2] = 8.36e-13;
+        assert!(gains_agree(&zero, &zero2, 1e-4, 1e-3).is_ok(), "a structural zero's rounding");
+        assert!(condition_numbers_agree(7.251842e16, 7.251841e16, 1e-7));
+        assert!(!condition_numbers_agree(12.0, 12.1, 1e-7));
+    }
+
     use super::*;
     use serde_json::json;
 
