@@ -63,10 +63,12 @@ pub struct TuneArgs {
     /// Write the flowsheet with the tuned settings (only those fields change) to this file.
     #[arg(long, value_name = "OUT.json")]
     pub(super) write: Option<PathBuf>,
-    /// Measurement dead time of every loop that the model leaves out (blt, relay, zn, tl), e.g. "1 min".
+    /// Measurement dead time of every loop that the model leaves out (blt, relay, zn, tl; simc and
+    /// imc add it to the fitted model's dead time), e.g. "1 min".
     #[arg(long, value_name = "TIME")]
     pub(super) measurement_dead_time: Option<String>,
-    /// Measurement first-order lag of every loop (blt, relay, zn, tl), e.g. "30 s".
+    /// Measurement first-order lag of every loop (blt, relay, zn, tl; simc and imc by Skogestad's
+    /// half rule), e.g. "30 s".
     #[arg(long, value_name = "TIME")]
     pub(super) measurement_lag: Option<String>,
     /// Relay amplitude in the controller's output unit (default: 5 % of the output's steady value).

@@ -50,7 +50,8 @@ pub fn run(
             let test = step_loop(plant, x, l, o).map_err(tune_error)?;
             let tau_c = quantity(&a.tau_c, "tau-c", Dimension::TIME)?;
             let rule = if method == MethodArg::Imc { ModelRule::Imc } else { ModelRule::Simc };
-            from_step(l, test, rule, tau_c, a.pid).map_err(tune_error)
+            let measurement = super::tune_plant::measurement(a)?;
+            from_step(l, test, rule, (tau_c, a.pid), measurement).map_err(tune_error)
         }
     }
 }

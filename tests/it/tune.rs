@@ -486,7 +486,20 @@ fn simc_shrinks_a_step_that_leaves_the_linear_range_until_its_gain_is_g0() {
     let out = plantwide(&args[..8]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{err}");
-    assert!(err.contains("--tau-c"), "{err}");
+    assert!(err.contains("--tau-c") && err.contains("--measurement-dead-time"), "{err}");
+    // With the analyzer's 3-min dead time the loop has a delay: SIMC's default τc is it (the fit's
+    // θ, zero, plus 3 min) and its settings are Skogestad's on the fitted τ: Kc = τ/(k (τc + θ)),
+    // τI = min(τ, 4 (τc + θ)).
+    let analyzer = json_of(&[&args[..8], &["--measurement-dead-time", "3 min", "--json"]].concat());
+    let l = &analyzer["loops"][0];
+    let model = &l["fit"]["model"];
+    let (k, tau, theta) =
+        (model["k"].as_f64().unwrap(), model["tau"].as_f64().unwrap(), model["theta"].as_f64().unwrap());
+    let theta = theta + 180.0;
+    assert!((l["tau_c"].as_f64().unwrap() - theta).abs() < 1e-9, "{l}");
+    let (kc, tau_i) = (l["kc"].as_f64().unwrap(), l["tau_i"].as_f64().unwrap());
+    assert!((kc.abs() - tau / (k.abs() * 2.0 * theta)).abs() < 1e-9 * kc.abs(), "{kc} vs τ {tau} k {k} θ {theta}");
+    assert!((tau_i - tau.min(8.0 * theta)).abs() < 1e-9 * tau_i, "{tau_i}");
 }
 
 /// Run `plantwide ARGS`, assert success and parse its JSON output.

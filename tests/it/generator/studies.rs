@@ -130,7 +130,21 @@ pub fn tune_plant_test(cx: &mut Cx<'_>, pick: usize) {
             );
         }
         1 => {
-            let args = ["tune", "plant.json", "--loop", &r.quality[k], "--method", "simc", "--set", &manual, "--json"];
+            // The quality loop's analyzer dead time, 1 min as `compare` and `screen` assume: the
+            // plant's model has none, and a fit without one leaves SIMC no default τc (refused).
+            let args = [
+                "tune",
+                "plant.json",
+                "--loop",
+                &r.quality[k],
+                "--method",
+                "simc",
+                "--set",
+                &manual,
+                "--measurement-dead-time",
+                "1 min",
+                "--json",
+            ];
             let out = cx.pw(&args);
             let Some(v) =
                 cx.succeeded(&out, "tune --method simc", true, &["loops/0/kc", "loops/0/tau_i", "loops/0/fit/model/k"])

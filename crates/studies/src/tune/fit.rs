@@ -85,6 +85,27 @@ pub enum ProcessModel {
 }
 
 impl ProcessModel {
+    /// The model seen through a measurement (an analyzer) with dead time `θ_m` and lag `τ_m`:
+    /// `θ_m` adds to the dead time; `τ_m` by Skogestad's half rule (*J. Process Control* 13,
+    /// 2003, §2): half to the dead time and half to the smallest lag kept, or all of it to the
+    /// dead time of an integrating model (which keeps no lag). A lag above the model's own
+    /// smallest kept one takes its place, that one then split instead.
+    pub fn measured(&self, dead_time: f64, lag: f64) -> ProcessModel {
+        match *self {
+            ProcessModel::Foptd { k, tau, theta } => {
+                let (big, small) = (tau.max(lag), tau.min(lag));
+                ProcessModel::Foptd { k, tau: big + 0.5 * small, theta: theta + dead_time + 0.5 * small }
+            }
+            ProcessModel::Soptd { k, tau1, tau2, theta } => {
+                let mut lags = [tau1, tau2, lag];
+                lags.sort_by(|a, b| b.total_cmp(a));
+                let (tau1, tau2) = (lags[0], lags[1] + 0.5 * lags[2]);
+                ProcessModel::Soptd { k, tau1, tau2, theta: theta + dead_time + 0.5 * lags[2] }
+            }
+            ProcessModel::Integrating { k, theta } => ProcessModel::Integrating { k, theta: theta + dead_time + lag },
+        }
+    }
+
     /// The unit-gain step response shape at `t` \[s\] (the response to a unit step divided by `k`).
     pub fn shape(&self, t: f64) -> f64 {
         match *self {
@@ -300,6 +321,21 @@ fn check(data: &StepResponse) -> Result<(), FitError> {
 
 #[cfg(test)]
 mod tests {
+    /// Skogestad's half rule for a measurement in series: its dead time adds to θ; its lag is split
+    /// half to θ and half to the smallest lag kept (or becomes the lag, when larger), all of it to
+    /// θ of an integrating model.
+    #[test]
+    fn a_measurement_adds_its_dead_time_and_half_its_lag() {
+        let f = ProcessModel::Foptd { k: 2.0, tau: 10.0, theta: 1.0 };
+        assert_eq!(f.measured(3.0, 2.0), ProcessModel::Foptd { k: 2.0, tau: 11.0, theta: 5.0 });
+        assert_eq!(f.measured(0.0, 20.0), ProcessModel::Foptd { k: 2.0, tau: 25.0, theta: 6.0 });
+        assert_eq!(f.measured(0.0, 0.0), f);
+        let s = ProcessModel::Soptd { k: 1.0, tau1: 10.0, tau2: 4.0, theta: 0.5 };
+        assert_eq!(s.measured(1.0, 2.0), ProcessModel::Soptd { k: 1.0, tau1: 10.0, tau2: 5.0, theta: 2.5 });
+        let i = ProcessModel::Integrating { k: 0.1, theta: 2.0 };
+        assert_eq!(i.measured(1.0, 3.0), ProcessModel::Integrating { k: 0.1, theta: 6.0 });
+    }
+
     use super::*;
 
     fn record(model: &ProcessModel, du: f64, horizon: f64, n: usize) -> StepResponse {

@@ -230,7 +230,9 @@ pub fn from_relay(l: &PlantLoop, cycle: &RelayCycle, rule: PiRule, method: &'sta
     FlowsheetTuning { method, detuning_factor: None, unstable_at: None, loops: vec![e] }
 }
 
-/// SIMC or IMC settings of loop `l` from the model fitted to its step test.
+/// SIMC or IMC settings of loop `l` from the model fitted to its step test, seen through
+/// `measurement` (its dead time and lag, which the plant's model leaves out, added to the fitted
+/// model by [`ProcessModel::measured`]).
 ///
 /// # Errors
 /// [`TuneError::Rule`] for a degenerate model.
@@ -238,10 +240,11 @@ pub fn from_step(
     l: &PlantLoop,
     test: StepResult,
     rule: ModelRule,
-    tau_c: Option<f64>,
-    derivative: bool,
+    (tau_c, derivative): (Option<f64>, bool),
+    measurement: Measurement,
 ) -> Result<FlowsheetTuning, TuneError> {
-    let p = model_rule(rule, &test.fit.model, tau_c, derivative)?;
+    let model = test.fit.model.measured(measurement.dead_time, measurement.lag);
+    let p = model_rule(rule, &model, tau_c, derivative)?;
     let e = FlowsheetLoop {
         fit: Some(test.fit),
         settled: Some(test.settled),

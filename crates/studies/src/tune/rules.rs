@@ -55,7 +55,8 @@ pub enum RuleError {
     /// The model has no dead time (below a thousandth of its lag) and no `τ_c` was given.
     #[error(
         "the fitted model has no dead time, so the default closed-loop time constant τc = θ is zero; give \
-         --tau-c (a time about the dead time of the loop's measurement and valve, or a fraction of τ)"
+         the loop's measurement dead time (--measurement-dead-time, an analyzer's: it adds to θ) or --tau-c \
+         (a time about the dead time of the loop's measurement and valve, or a fraction of τ)"
     )]
     NoDeadTime,
     /// A gain or time of the model or `τ_c` is zero, negative or not finite.
