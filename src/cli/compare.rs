@@ -11,7 +11,7 @@ use plantwide::io::plot::{LabelledMatrix, Overlay, write_bars, write_matrices};
 use plantwide::studies::compare::{CompareRequest, Comparison, Prices, Scheme, compare};
 use plantwide::studies::screen::pairings::STEP_AT;
 use plantwide::studies::screen::pairings::mpc::MpcAlternative;
-use plantwide::studies::screen::pairings::{DisturbanceRun, DynamicResult, DynamicSettings};
+use plantwide::studies::screen::pairings::{DisturbanceRun, DynamicSettings};
 use plantwide::studies::tune::loops::Measurement;
 use plantwide::units::UnitSystem;
 
@@ -182,29 +182,15 @@ fn write_rga(file: &Path, c: &Comparison) -> Result<bool, plantwide::io::IoError
     Ok(true)
 }
 
-/// A scheme's closed-loop runs, if its loops were tuned: its PI loops', else its first model
-/// predictive controller's.
-fn runs(s: &Scheme) -> Option<&DynamicResult> {
-    tests(s).into_iter().map(|(_, d)| d).find(|d| d.failure.is_none())
-}
-
-/// Every closed-loop test of a scheme with its label: the file's PI pairing, then each model
-/// predictive controller.
-fn tests(s: &Scheme) -> Vec<(String, &DynamicResult)> {
-    let pi = s.structure.as_ref().and_then(|t| t.dynamic.as_ref()).map(|d| (s.name.clone(), d));
-    let mpc = s.mpc.iter().filter_map(|m| Some((format!("{} (MPC `{}`)", s.name, m.controller), m.dynamic.as_ref()?)));
-    pi.into_iter().chain(mpc).collect()
-}
-
 /// Run `d` of a scheme's closed-loop runs, if it went through.
 fn ran(s: &Scheme, d: usize) -> Option<&DisturbanceRun> {
-    runs(s).and_then(|t| t.runs.get(d)).filter(|r| r.failure.is_none())
+    s.runs().and_then(|t| t.runs.get(d)).filter(|r| r.failure.is_none())
 }
 
 /// One figure per disturbance: a panel per CV and output, a curve per scheme (schemes whose runs
 /// share the time grid; all do when the run length is common).
 fn write_responses(dir: &Path, c: &Comparison, shown: &Shown) -> Result<Vec<String>, plantwide::io::IoError> {
-    let Some(first) = c.schemes.iter().find_map(runs) else { return Ok(Vec::new()) };
+    let Some(first) = c.schemes.iter().find_map(Scheme::runs) else { return Ok(Vec::new()) };
     let mut names = Vec::new();
     for d in 0..first.runs.len() {
         // The time grid of the first scheme whose run went through (a failed run has none).
@@ -400,7 +386,7 @@ fn response_table(c: &Comparison, shown: &Shown) -> String {
         "## Closed-loop responses (tuning below; runs of {})\n\n| scheme | disturbance | variable [unit] | IAE [unit·s] | largest deviation [unit] | settling time [s] | MVs at a limit |\n|---|---|---|---|---|---|---|\n",
         c.duration.map_or("–".into(), |d| format!("{} s", sig(d)))
     );
-    for (label, d) in c.schemes.iter().flat_map(tests) {
+    for (label, d) in c.schemes.iter().flat_map(Scheme::tests) {
         if let Some(why) = &d.failure {
             t.push_str(&format!("| {label} | – | – | failed: {why} | | | |\n"));
             continue;

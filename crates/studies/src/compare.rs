@@ -42,7 +42,9 @@ use serde::Serialize;
 use crate::screen::ScreenError;
 use crate::screen::pairings::dynamic::Limited;
 use crate::screen::pairings::mpc::{MpcAlternative, assess_mpc, controllers, output_name};
-use crate::screen::pairings::{Disturbance, DynamicSettings, PairingRequest, PairingStructure, Tuning, assess_pairing};
+use crate::screen::pairings::{
+    Disturbance, DynamicResult, DynamicSettings, PairingRequest, PairingStructure, Tuning, assess_pairing,
+};
 pub use energy::{Energy, Prices, UtilityCost, cost, energy};
 
 /// What to compare.
@@ -241,6 +243,25 @@ pub struct Scheme {
     pub sensitivity: Vec<Sensitivity>,
 }
 
+impl Scheme {
+    /// Every closed-loop test of the scheme with its label: the file's PI pairing, then each
+    /// model predictive controller.
+    pub fn tests(&self) -> Vec<(String, &DynamicResult)> {
+        let pi = self.structure.as_ref().and_then(|t| t.dynamic.as_ref()).map(|d| (self.name.clone(), d));
+        let mpc = self.mpc.iter().filter_map(|m| {
+            let label = format!("{} (MPC `{}`)", self.name, m.controller);
+            Some((label, m.dynamic.as_ref()?))
+        });
+        pi.into_iter().chain(mpc).collect()
+    }
+
+    /// The scheme's closed-loop runs, if its loops were tuned: its PI loops', else its first
+    /// model predictive controller's that went through.
+    pub fn runs(&self) -> Option<&DynamicResult> {
+        self.tests().into_iter().map(|(_, d)| d).find(|d| d.failure.is_none())
+    }
+}
+
 /// The schemes side by side.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Comparison {
@@ -321,10 +342,7 @@ pub fn compare(plants: &[Plant], request: &CompareRequest) -> Result<Comparison,
 fn failed_parts(schemes: &[Scheme]) -> Vec<String> {
     let mut out = Vec::new();
     for s in schemes {
-        let pi = s.structure.as_ref().and_then(|t| t.dynamic.as_ref()).map(|d| (s.name.clone(), d));
-        let mpc =
-            s.mpc.iter().filter_map(|m| Some((format!("{} (MPC `{}`)", s.name, m.controller), m.dynamic.as_ref()?)));
-        out.extend(pi.into_iter().chain(mpc).flat_map(|(label, d)| d.failures(&label)));
+        out.extend(s.tests().into_iter().flat_map(|(label, d)| d.failures(&label)));
         for r in &s.sensitivity {
             for f in &r.failures {
                 let part = format!("{}, sweep {}: {f}", s.name, r.disturbance);

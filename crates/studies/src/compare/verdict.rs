@@ -114,7 +114,7 @@ struct Responses {
 
 impl Responses {
     fn of(c: &Comparison) -> Option<Responses> {
-        let runs: Vec<&DynamicResult> = c.schemes.iter().map(runs).collect::<Option<_>>()?;
+        let runs: Vec<&DynamicResult> = c.schemes.iter().map(Scheme::runs).collect::<Option<_>>()?;
         if runs.len() < 2 {
             return None;
         }
@@ -170,13 +170,6 @@ impl Responses {
             .collect();
         format!("In the closed-loop responses (each disturbance, each variable), {}.", each.join("; "))
     }
-}
-
-/// The closed-loop runs of a scheme: its PI pairing's, else its first model predictive
-/// controller's that went through.
-fn runs(s: &Scheme) -> Option<&DynamicResult> {
-    let pi = s.structure.as_ref().and_then(|t| t.dynamic.as_ref());
-    pi.into_iter().chain(s.mpc.iter().filter_map(|m| m.dynamic.as_ref())).find(|d| d.failure.is_none())
 }
 
 /// The closing sentence: one scheme better on both counts, or the trade-off in figures.
