@@ -153,6 +153,9 @@ pub fn run(a: &SteadyArgs<'_>) -> Result<(), CliError> {
     if let Some(why) = &sol.sm_failure {
         outln!("sequential-modular start incomplete ({why}); Newton took over");
     }
+    if let Some(how) = &sol.closed_loops {
+        outln!("the cold start failed: {how}");
+    }
     match (&sol.newton, &sol.sm) {
         (None, Some(sm)) => outln!(
             "steady state of `{}`: converged by the sequential-modular method in {} passes, tear residual {residual:.2e}\n",

@@ -13,6 +13,7 @@ mod harness;
 mod analysis;
 mod cli;
 mod cli_errors;
+mod closing;
 mod columns;
 mod columns_rigorous;
 mod compare;

@@ -36,6 +36,7 @@
 //! the Newton it calls sees only a [`crate::System`] (one per solve group).
 
 mod accel;
+mod closing;
 mod groups;
 mod plan;
 mod report;

@@ -72,6 +72,9 @@ pub struct Solution {
     pub newton: Option<NewtonReport>,
     /// Controllers that hold their output at a limit with the measurement off setpoint.
     pub warnings: Vec<Warning>,
+    /// How the loops were closed from the open plant, where the cold start failed
+    /// ([`super::closing`]).
+    pub closed_loops: Option<String>,
 }
 
 impl Solution {
@@ -149,7 +152,15 @@ pub fn steady_state_by(
             })
         {
             let newton = Some(ss.report);
-            return Ok(Solution { x: ss.x, u: ss.u, sm: start.sm, sm_failure: None, newton, warnings: ss.warnings });
+            return Ok(Solution {
+                x: ss.x,
+                u: ss.u,
+                sm: start.sm,
+                sm_failure: None,
+                newton,
+                warnings: ss.warnings,
+                closed_loops: None,
+            });
         }
     }
     steady_state_from_cold(plant, u, settings, observer)
@@ -175,6 +186,7 @@ fn steady_state_from_cold(
                 sm_failure: None,
                 newton: Some(ss.report),
                 warnings: ss.warnings,
+                closed_loops: None,
             })
         }
         Method::Sm if !plant.specs().is_empty() => Err(SolveError::SpecsNeedNewton {
@@ -185,7 +197,15 @@ fn steady_state_from_cold(
             let sol = solve_sequential_observed(plant, u, None, &settings.sm, &mut |p| observer(Progress::Pass(p)))?;
             let tol = (10.0 * settings.sm.tol).max(crate::certify::TOL);
             let warnings = certify_to(plant, &sol.x, &sol.u, tol).map_err(|e| SteadyError::Certificate(Box::new(e)))?;
-            Ok(Solution { x: sol.x, u: sol.u, sm: Some(sol.report), sm_failure: None, newton: None, warnings })
+            Ok(Solution {
+                x: sol.x,
+                u: sol.u,
+                sm: Some(sol.report),
+                sm_failure: None,
+                newton: None,
+                warnings,
+                closed_loops: None,
+            })
         }
         Method::Auto => {
             let x0 = plant.initial_guess_at(u);
@@ -199,6 +219,7 @@ fn steady_state_from_cold(
                     sm_failure: None,
                     newton: Some(ss.report),
                     warnings,
+                    closed_loops: None,
                 });
             }
             let loose = SmSettings { tol: settings.auto_tol, ..settings.sm.clone() };
@@ -215,7 +236,15 @@ fn steady_state_from_cold(
                 Err(first) if sm_failure.is_none() => eo(Some(&x0), observer).map_err(|_| first)?,
                 Err(e) => return Err(e.into()),
             };
-            Ok(Solution { x: ss.x, u: ss.u, sm, sm_failure, newton: Some(ss.report), warnings: ss.warnings })
+            Ok(Solution {
+                x: ss.x,
+                u: ss.u,
+                sm,
+                sm_failure,
+                newton: Some(ss.report),
+                warnings: ss.warnings,
+                closed_loops: None,
+            })
         }
     }
 }
@@ -248,7 +277,10 @@ pub fn converge_observed(
     let sol = match steady_state_by(plant, &u, settings, observer) {
         Ok(sol) => sol,
         Err(e @ SolveError::Eo(SteadyError::Dof(_))) => return Err(e),
-        Err(e) => return Err(at_guess.map_or_else(|dof| SteadyError::Dof(dof).into(), |()| e)),
+        Err(e) => match super::closing::close_from_open(plant, settings, observer) {
+            Some(sol) if !e.is_user_error() => sol,
+            _ => return Err(at_guess.map_or_else(|dof| SteadyError::Dof(dof).into(), |()| e)),
+        },
     };
     if singular_at_guess {
         dof_check(plant, &u, &sol.x, DofProbe::Numerical).map_err(SteadyError::Dof)?;
