@@ -184,7 +184,7 @@ fn write_rga(file: &Path, c: &Comparison) -> Result<bool, plantwide::io::IoError
 
 /// Run `d` of a scheme's closed-loop runs, if it went through.
 fn ran(s: &Scheme, d: usize) -> Option<&DisturbanceRun> {
-    s.runs().and_then(|t| t.runs.get(d)).filter(|r| r.failure.is_none())
+    s.runs().and_then(|t| t.runs.get(d)).filter(|r| r.failure.is_none() && r.lost.is_none())
 }
 
 /// One figure per disturbance: a panel per CV and output, a curve per scheme (schemes whose runs
@@ -394,6 +394,10 @@ fn response_table(c: &Comparison, shown: &Shown) -> String {
         for run in &d.runs {
             if let Some(why) = &run.failure {
                 t.push_str(&format!("| {label} | {} | – | failed: {why} | | | |\n", run.disturbance));
+                continue;
+            }
+            if let Some(how) = &run.lost {
+                t.push_str(&format!("| {label} | {} | – | cannot ride through: {how} | | | |\n", run.disturbance));
                 continue;
             }
             for f in &run.cvs {

@@ -250,8 +250,14 @@ fn row(c: &ColumnStructure) -> String {
     let place = |r: Option<usize>| r.map_or("–".to_string(), |r| r.to_string());
     let iae = match (&c.dynamic, c.iae_scaled) {
         (_, Some(v)) => format!("{v:.4e}"),
+        (Some(_), None) if c.lost.is_some() => "lost".into(),
         (Some(_), None) => "failed".into(),
         (None, None) => "–".into(),
+    };
+    let note = match (&c.failure, &c.lost) {
+        (Some(why), _) => format!("failed: {why}"),
+        (None, Some(how)) => format!("{}; cannot ride through: {how}", c.verdict),
+        (None, None) => c.verdict.clone(),
     };
     format!(
         "| {} | {} | {} | {} | {} | {} | {} | {iae} | {} | {} |\n",
@@ -263,7 +269,7 @@ fn row(c: &ColumnStructure) -> String {
         num(c.condition_number),
         num(c.minimized_condition_number),
         place(c.steady_rank),
-        c.failure.as_ref().map_or(c.verdict.clone(), |why| format!("failed: {why}"))
+        note
     )
 }
 
@@ -476,15 +482,30 @@ fn mpc_description(file: &Path) -> Result<serde_json::Value, CliError> {
     serde_json::from_str(&text).map_err(|e| CliError::user(format!("--mpc {}: {e}", file.display())))
 }
 
+/// A dynamic test's score as the tables show it: `failed`, `lost` (the plant left its operating
+/// range in a run) or the number.
+fn score_text(d: &DynamicResult) -> String {
+    match (d.completed(), d.rides_through()) {
+        (false, _) => "failed".into(),
+        (true, false) => "lost".into(),
+        (true, true) => format!("{:.3}", d.score),
+    }
+}
+
+/// What did not finish in a dynamic test: its failed parts, else where the plant was lost.
+fn unfinished(d: &DynamicResult) -> Option<String> {
+    let failed = d.failures("failed");
+    let parts = if failed.is_empty() { d.losses("cannot ride through") } else { failed };
+    (!parts.is_empty()).then(|| parts.join("; "))
+}
+
 /// The model predictive controller's row of the pairing table.
 fn mpc_row(m: &MpcAlternative) -> String {
     let dynamic = m.dynamic.as_ref();
-    let score =
-        dynamic.map_or("–".to_string(), |d| if d.completed() { format!("{:.3}", d.score) } else { "failed".into() });
+    let score = dynamic.map_or("–".to_string(), score_text);
     let samples: usize = m.qp.iter().map(|l| l.samples).sum();
     let mean = m.qp.iter().map(|l| l.mean_solve_time * l.samples as f64).sum::<f64>() / samples.max(1) as f64;
-    let failures = dynamic.map(|d| d.failures("failed").join("; ")).filter(|f| !f.is_empty());
-    let note = failures.unwrap_or_else(|| {
+    let note = dynamic.and_then(unfinished).unwrap_or_else(|| {
         format!(
             "every {} s, P = {}, M = {}; {samples} QPs, mean solve {:.3} ms; condition number {}",
             m.sample_time,
@@ -544,10 +565,8 @@ fn pairing_table(s: &PairingScreen, shown: &Shown) -> String {
         let pairs: Vec<String> =
             c.pairs.iter().map(|p| format!("{} ← {} ({:.3})", p.cv, p.mv, p.relative_gain)).collect();
         let dynamic = c.dynamic.as_ref();
-        let score = dynamic
-            .map_or("–".to_string(), |d| if d.completed() { format!("{:.3}", d.score) } else { "failed".into() });
-        let failures = dynamic.map(|d| d.failures("failed").join("; ")).filter(|f| !f.is_empty());
-        let note = c.rejected.clone().or(failures).unwrap_or_default();
+        let score = dynamic.map_or("–".to_string(), score_text);
+        let note = c.rejected.clone().or(dynamic.and_then(unfinished)).unwrap_or_default();
         t.push_str(&format!(
             "| {} | {} | {} | {:.4} | {} | {:.3} | {score} | {note} |\n",
             c.rank.map_or("–".to_string(), |r| r.to_string()),

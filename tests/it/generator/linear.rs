@@ -136,8 +136,17 @@ pub fn screen_column(cx: &mut Cx<'_>, g: &[Vec<f64>]) {
     cx.agree(agree, "screen --column: LV gains are not gains --json's", &[&out]);
     let mut ranks: Vec<u64> = list.iter().filter_map(|s| s["rank"].as_u64()).collect();
     ranks.sort_unstable();
-    let unranked = list.iter().filter(|s| s["rank"].is_null() && !s["singular"].as_bool().unwrap_or(false)).count();
-    let fine = ranks.iter().enumerate().all(|(i, &r)| r == i as u64 + 1)
+    // A configuration that lost the plant in a run (it cannot ride through) is unranked by design,
+    // and says so.
+    let lost = |s: &&Value| !s["lost"].is_null();
+    let unranked =
+        list.iter().filter(|s| s["rank"].is_null() && !s["singular"].as_bool().unwrap_or(false) && !lost(s)).count();
+    let said = list
+        .iter()
+        .filter(lost)
+        .all(|s| s["rank"].is_null() && s["verdict"].as_str().is_some_and(|w| w.contains("cannot ride through")));
+    let fine = said
+        && ranks.iter().enumerate().all(|(i, &r)| r == i as u64 + 1)
         && (unranked == 0 || !v["failed"].as_array().is_none_or(Vec::is_empty));
     cx.check(fine, "screen --column: ranks are not 1..n over the converged configurations", &[&out], || {
         format!("ranks {ranks:?}, {unranked} unranked")

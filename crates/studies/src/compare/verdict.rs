@@ -1,7 +1,7 @@
 //! The comparison's verdict: one paragraph an engineer reads first, built from the comparison's
 //! own evidence and nothing else — the utility cost of each scheme, the modes that make one
 //! depend on its loops, a pairing that fails integrity, the closed-loop responses scheme against
-//! scheme, and the parts that failed. It recommends no scheme its evidence contradicts: where the
+//! scheme, the runs a scheme could not ride through, and the parts that failed. It recommends no scheme its evidence contradicts: where the
 //! cheapest scheme is not the one that rejects the disturbances best, it says the choice is a
 //! trade-off and gives both sides in figures.
 
@@ -21,6 +21,15 @@ pub fn verdict(c: &Comparison) -> String {
     if let Some(r) = &responses {
         parts.push(r.sentence(c));
     }
+    let lost: Vec<String> =
+        c.schemes.iter().flat_map(|s| s.tests().into_iter().flat_map(|(label, d)| d.losses(&label))).collect();
+    if !lost.is_empty() {
+        parts.push(format!(
+            "The plant left its operating range (a vessel ran dry or overflowed, a flow would reverse) in {}: that \
+             scheme cannot ride through that disturbance, and its figures there are left out.",
+            lost.join("; ")
+        ));
+    }
     if !c.failed.is_empty() {
         parts.push(format!(
             "{} part{} of the comparison failed (listed under \"failed\"): what follows rests on the rest.",
@@ -29,6 +38,18 @@ pub fn verdict(c: &Comparison) -> String {
         ));
     }
     parts.push(conclusion(c, cheapest, responses.as_ref()));
+    let losers: Vec<&str> = c
+        .schemes
+        .iter()
+        .filter(|s| s.tests().iter().any(|(_, d)| !d.losses("").is_empty()))
+        .map(|s| s.name.as_str())
+        .collect();
+    if !losers.is_empty() {
+        parts.push(format!(
+            "Whatever the figures above, {} cannot ride through every disturbance asked for.",
+            losers.join(" and ")
+        ));
+    }
     // A scheme compared with itself says its findings once.
     parts.dedup();
     parts.join(" ")
@@ -125,7 +146,7 @@ impl Responses {
                 let iae: Option<Vec<f64>> = runs
                     .iter()
                     .map(|t| {
-                        let run = t.runs.get(d).filter(|r| r.failure.is_none())?;
+                        let run = t.runs.get(d).filter(|r| r.failure.is_none() && r.lost.is_none())?;
                         run.cvs.iter().find(|f| f.cv == v.cv).map(|f| f.iae)
                     })
                     .collect();

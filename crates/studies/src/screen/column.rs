@@ -169,6 +169,11 @@ pub struct ColumnStructure {
     /// Why its steady state, gains or dynamic check failed (the solver's verdict, naming the
     /// unit, equation and variable), its measures then `null`; `null` when it was judged.
     pub failure: Option<String>,
+    /// Where the plant under this configuration left its operating range in the dynamic check (a
+    /// vessel ran dry or overflowed, a loop drove a flow below zero), run by run: the
+    /// configuration cannot ride through those disturbances, so it is not ranked; an answer, not
+    /// a failure. `null` when every run went through.
+    pub lost: Option<String>,
     /// The configuration with its loops as tuned, the text of a flowsheet file (kept when asked
     /// for).
     #[serde(skip)]
@@ -653,6 +658,7 @@ fn unjudged(name: &str) -> ColumnStructure {
         rank: None,
         verdict: String::new(),
         failure: None,
+        lost: None,
         flowsheet: None,
     }
 }

@@ -248,20 +248,30 @@ fn describe(s: &PairingStructure) -> String {
 fn verdict(structures: &[PairingStructure]) -> String {
     let Some(best) = structures.iter().find(|s| s.rank == Some(1)) else {
         return "no pairing recommended: no candidate passed the steady-state filters, or every tested candidate's \
-                dynamic test failed"
+                dynamic test failed or lost the plant"
             .into();
     };
-    let scored: Vec<&PairingStructure> =
-        structures.iter().filter(|s| s.rank.is_some() && s.dynamic.as_ref().is_some_and(|d| d.completed())).collect();
+    let scored: Vec<&PairingStructure> = structures
+        .iter()
+        .filter(|s| s.rank.is_some() && s.dynamic.as_ref().is_some_and(|d| d.rides_through()))
+        .collect();
     let mut by_rga = scored.clone();
     by_rga.sort_by(|a, b| a.rga_number.total_cmp(&b.rga_number));
     let mut by_score = scored.clone();
     by_score.sort_by_key(|s| s.rank);
-    let why = match best.dynamic.as_ref().filter(|d| d.completed()) {
+    let why = match best.dynamic.as_ref().filter(|d| d.rides_through()) {
         Some(d) => format!("best dynamic score ({:.3}) of {} tested on the nonlinear plant", d.score, scored.len()),
         None => format!("smallest RGA number ({:.3}); no dynamic test", best.rga_number),
     };
     let mut text = format!("recommended: {} — {why}", describe(best));
+    let lost: Vec<String> = structures
+        .iter()
+        .filter_map(|s| Some((s, s.dynamic.as_ref()?.losses("run").into_iter().next()?)))
+        .map(|(s, first)| format!("{} ({first})", describe(s)))
+        .collect();
+    if !lost.is_empty() {
+        text.push_str(&format!("; cannot ride through the disturbances, so not ranked: {}", lost.join("; ")));
+    }
     let same = by_rga.iter().zip(&by_score).all(|(a, b)| std::ptr::eq(*a, *b));
     if !same {
         let ranks: Vec<String> = by_rga.iter().map(|s| s.rank.map_or("–".into(), |r| r.to_string())).collect();
@@ -523,13 +533,14 @@ fn dic_necessary(g: &Mat<f64>, p: &[usize]) -> Result<bool, plantwide_analysis::
 }
 
 /// Rank: dynamically tested candidates by their score, then the other survivors by RGA number; a
-/// candidate whose dynamic test failed (it could not be tuned, or a run stopped) is not ranked.
+/// candidate whose dynamic test failed (it could not be tuned, or a run stopped) or that lost the
+/// plant in a run (a vessel ran dry, a flow would reverse) is not ranked.
 fn rank(structures: &mut [PairingStructure]) {
     let key = |s: &PairingStructure| {
         let score = s.dynamic.as_ref().map_or(f64::INFINITY, |d| d.score);
         (score, s.rga_number)
     };
-    let failed = |s: &PairingStructure| s.dynamic.as_ref().is_some_and(|d| !d.completed());
+    let failed = |s: &PairingStructure| s.dynamic.as_ref().is_some_and(|d| !d.rides_through());
     let mut order: Vec<usize> =
         (0..structures.len()).filter(|&k| structures[k].passed && !failed(&structures[k])).collect();
     order.sort_by(|&a, &b| key(&structures[a]).partial_cmp(&key(&structures[b])).unwrap_or(std::cmp::Ordering::Equal));

@@ -299,12 +299,17 @@ fn scenarios(
 }
 
 /// Each checked configuration's scaled IAE (`Σ_runs Σ_qualities IAE/Δy`) and its score (that over
-/// the best one's); a configuration whose check failed is marked failed with the reasons.
+/// the best one's); a configuration whose check failed is marked failed with the reasons, one that
+/// lost the plant in a run is marked lost with where and how.
 fn score(structures: &mut [ColumnStructure], allowed: &[f64]) {
     for s in structures.iter_mut() {
         let Some(d) = s.dynamic.as_ref() else { continue };
         if !d.completed() {
             s.failure = Some(d.failures("dynamic check").join("; "));
+            continue;
+        }
+        if !d.rides_through() {
+            s.lost = Some(d.losses("dynamic check").join("; "));
             continue;
         }
         let iae = d.runs.iter().map(|r| r.cvs.iter().zip(allowed).map(|(c, dy)| c.iae / dy).sum::<f64>()).sum();

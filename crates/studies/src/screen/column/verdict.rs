@@ -96,7 +96,10 @@ fn configuration(s: &ColumnStructure, all: &[ColumnStructure], dynamic: bool) ->
     }
     let Some(d) = s.dynamic.as_ref() else { return Some(text) };
     let Some(iae) = s.iae_scaled else {
-        text.push_str("; dynamic check failed (see failure); not ranked");
+        text.push_str(match s.lost {
+            Some(_) => "; dynamic check: cannot ride through the disturbances (see lost); not ranked",
+            None => "; dynamic check failed (see failure); not ranked",
+        });
         return Some(text);
     };
     let best = all.iter().filter_map(|o| o.iae_scaled).fold(f64::INFINITY, f64::min);
@@ -132,7 +135,7 @@ fn configuration(s: &ColumnStructure, all: &[ColumnStructure], dynamic: bool) ->
 fn overall(structures: &[ColumnStructure], dynamic: bool) -> String {
     let by = |f: fn(&ColumnStructure) -> Option<usize>| structures.iter().find(|s| f(s) == Some(1));
     let Some(best) = by(|s| s.rank) else {
-        return "no configuration recommended: none is regular, or every dynamic check failed".into();
+        return "no configuration recommended: none is regular, or every dynamic check failed or lost the plant".into();
     };
     let lambda = best.relative_gain.unwrap_or(f64::NAN);
     if !dynamic {
@@ -146,20 +149,32 @@ fn overall(structures: &[ColumnStructure], dynamic: bool) -> String {
     let checked = structures.iter().filter(|s| s.iae_scaled.is_some()).count();
     let steps = best.dynamic.as_ref().map_or(0, |d| d.runs.len());
     let mut text = format!(
-        "recommended: {} ({}, λ = {lambda:.3}) — the smallest scaled IAE ({:.4e} s) of {checked} configurations \
-         tuned by BLT and stepped by {steps} disturbances on the nonlinear plant",
+        "recommended: {} ({}, λ = {lambda:.3}) — the smallest scaled IAE ({:.4e} s) of {checked} configuration{} \
+         tuned by BLT and stepped by {steps} disturbance{} on the nonlinear plant",
         best.name,
         pairing(best),
-        best.iae_scaled.unwrap_or(f64::NAN)
+        best.iae_scaled.unwrap_or(f64::NAN),
+        if checked == 1 { "" } else { "s" },
+        if steps == 1 { "" } else { "s" }
     );
-    let failed: Vec<&str> =
-        structures.iter().filter(|s| s.dynamic.is_some() && s.iae_scaled.is_none()).map(|s| s.name.as_str()).collect();
+    let unranked = |lost: bool| -> Vec<&str> {
+        let out = structures.iter().filter(|s| s.dynamic.is_some() && s.iae_scaled.is_none());
+        out.filter(|s| s.lost.is_some() == lost).map(|s| s.name.as_str()).collect()
+    };
+    let (lost, failed) = (unranked(true), unranked(false));
+    if !lost.is_empty() {
+        text.push_str(&format!(
+            "; not ranked: {} cannot ride through the disturbances (the plant left its operating range, see lost)",
+            lost.join(", ")
+        ));
+    }
     if !failed.is_empty() {
         text.push_str(&format!("; not compared: {} (dynamic check failed, see failed)", failed.join(", ")));
     }
     if let Some(first) = by(|s| s.steady_rank).filter(|f| f.name != best.name) {
         let dynamic = match (first.rank, first.iae_scaled, best.iae_scaled) {
             (Some(r), Some(v), Some(b)) => format!("ranks {r} (scaled IAE {:.2}× the best)", v / b),
+            _ if first.lost.is_some() => "finds cannot ride through the disturbances".to_string(),
             _ => "could not run".to_string(),
         };
         text.push_str(&format!(

@@ -117,6 +117,12 @@ pub struct DisturbanceRun {
     /// a run that went through.
     #[serde(default)]
     pub failure: Option<String>,
+    /// Where and how the plant left its operating range under these loops (a vessel ran dry or
+    /// overflowed, a loop drove a flow below zero), as the simulation reports it: what this
+    /// structure cannot ride through. Its figures are then `null`; `null` for a run that went
+    /// through.
+    #[serde(default)]
+    pub lost: Option<String>,
     /// Recorded times \[s\] (for plots; not serialized).
     #[serde(skip)]
     pub times: Vec<f64>,
@@ -147,6 +153,17 @@ impl DynamicResult {
     /// The loops were tuned and every run went through.
     pub fn completed(&self) -> bool {
         self.failure.is_none() && self.runs.iter().all(|r| r.failure.is_none())
+    }
+
+    /// Every run went through with the plant within its operating range (none [`lost`](DisturbanceRun::lost)).
+    pub fn rides_through(&self) -> bool {
+        self.completed() && self.runs.iter().all(|r| r.lost.is_none())
+    }
+
+    /// The runs the plant was lost in, each with how, for the test labelled `label`.
+    pub fn losses(&self, label: &str) -> Vec<String> {
+        let lost = self.runs.iter().filter_map(|r| Some((&r.disturbance, r.lost.as_ref()?)));
+        lost.map(|(d, how)| format!("{label}, run {d}: {how}")).collect()
     }
 
     /// What failed, each with its reason, for the test labelled `label`: the test as a whole, or
@@ -274,18 +291,18 @@ pub(super) fn test_picked(
 
 /// Score each result that ran: the mean over its runs (`steps`) and CVs of its IAE over the best
 /// IAE of all `results` there (1 when best everywhere); a result whose test or one of whose runs
-/// failed has an infinite score (it cannot be compared run by run).
+/// failed, or lost the plant, has an infinite score (it cannot be compared run by run).
 pub(crate) fn score(results: &mut [&mut DynamicResult], steps: usize, cvs: usize) {
     let best: Vec<Vec<f64>> = (0..steps)
         .map(|d| {
-            let ok = || results.iter().filter(|t| t.completed());
+            let ok = || results.iter().filter(|t| t.rides_through());
             (0..cvs).map(|c| ok().map(|t| t.runs[d].cvs[c].iae).fold(f64::INFINITY, f64::min)).collect()
         })
         .collect();
-    for t in results.iter_mut().filter(|t| !t.completed()) {
+    for t in results.iter_mut().filter(|t| !t.rides_through()) {
         t.score = f64::INFINITY;
     }
-    for t in results.iter_mut().filter(|t| t.completed()) {
+    for t in results.iter_mut().filter(|t| t.rides_through()) {
         let n = (steps * cvs).max(1) as f64;
         let sum: f64 = (0..steps)
             .flat_map(|d| (0..cvs).map(move |c| (d, c)))
@@ -313,15 +330,26 @@ pub(crate) fn candidate(tuned: &TunedCandidate, r: &PairingRequest, ops: &[Limit
     let runs: Vec<DisturbanceRun> = r
         .steps()
         .iter()
-        .map(|d| run(plant, x, r, d, duration, ops).map_or_else(|why| failed_run(r, d, why.to_string()), |o| o.0))
+        .map(|d| run(plant, x, r, d, duration, ops).map_or_else(|why| unfinished_run(r, d, why), |o| o.0))
         .collect();
-    let score = if runs.iter().all(|r| r.failure.is_none()) { f64::NAN } else { f64::INFINITY };
+    let score = if runs.iter().all(|r| r.failure.is_none() && r.lost.is_none()) { f64::NAN } else { f64::INFINITY };
     DynamicResult { detuning_factor: tuned.detuning, loops: tuned.loops.clone(), runs, score, failure: None }
 }
 
 /// The paths a run of `r` records figures of: its CVs, then its other recorded variables.
 fn watched(r: &PairingRequest) -> Vec<&String> {
     r.cvs.iter().chain(r.record.iter().filter(|p| !r.cvs.contains(p))).collect()
+}
+
+/// A run of step `d` that did not finish: lost where the plant left its operating range (the
+/// simulation stopped it), failed for any other reason.
+pub(crate) fn unfinished_run(r: &PairingRequest, d: &super::Disturbance, why: CandidateFailure) -> DisturbanceRun {
+    match &why {
+        CandidateFailure::Simulation(e) if matches!(**e, plantwide_solve::dynamic::SimError::Stopped { .. }) => {
+            DisturbanceRun { failure: None, lost: Some(why.to_string()), ..failed_run(r, d, String::new()) }
+        }
+        _ => failed_run(r, d, why.to_string()),
+    }
 }
 
 /// A run of step `d` that failed for `why`: every figure `null`, nothing recorded.
@@ -335,6 +363,7 @@ pub(crate) fn failed_run(r: &PairingRequest, d: &super::Disturbance, why: String
         cvs,
         saturated: Vec::new(),
         failure: Some(why),
+        lost: None,
         times: Vec::new(),
         series: Vec::new(),
     }
@@ -580,7 +609,14 @@ pub(crate) fn run(
         .map(|(_, o)| o.mv.clone())
         .collect();
     let series = (0..watched.len()).map(|k| res.rows.iter().map(|row| row[k]).collect()).collect();
-    let run =
-        DisturbanceRun { disturbance: d.label(), cvs, saturated, failure: None, times: res.times.clone(), series };
+    let run = DisturbanceRun {
+        disturbance: d.label(),
+        cvs,
+        saturated,
+        failure: None,
+        lost: None,
+        times: res.times.clone(),
+        series,
+    };
     Ok((run, res.mpc))
 }

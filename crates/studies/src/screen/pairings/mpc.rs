@@ -24,7 +24,7 @@ use serde::Serialize;
 
 use plantwide_solve::{NewtonSettings, SolveError, steady_state};
 
-use super::dynamic::{DynamicResult, Limited, failed_run, run};
+use super::dynamic::{DynamicResult, Limited, run, unfinished_run};
 use super::{OpenPlant, PairingRequest};
 use crate::screen::ScreenError;
 
@@ -195,7 +195,7 @@ fn runs(
                 qp.extend(logs);
             }
             Err(why) => {
-                result.runs.push(failed_run(r, &d, why.to_string()));
+                result.runs.push(unfinished_run(r, &d, why));
                 result.score = f64::INFINITY;
             }
         }
