@@ -309,3 +309,27 @@ fn a_free_outflow_upstream_is_the_default_throughput_step() {
     assert_eq!(v["disturbances"], serde_json::json!(["reactor.outflow +10 %", "reactor.outflow -10 %"]));
     assert_eq!(v["failed"], serde_json::json!([]));
 }
+
+/// A plant the generator drew (tests/data/generated): a 16-stage column at 9.7 R_min whose drum
+/// level is held by D. Under LB (D on the drum) a 10 % feed cut leaves less vapour than the reflux
+/// the top loop holds, so the drum's level loop asks for a negative distillate: LB is marked lost
+/// (exit 0, not failed), the other regular configurations are ranked 1..5.
+#[test]
+fn a_generated_high_reflux_column_loses_its_drum_under_lb() {
+    let file = fixture("data/generated/simple_e4df598c_open.json");
+    let args = ["screen", &file, "--column", "C1", "--outputs", "D.x[light],B.x[light]", "--json"];
+    let out = plantwide(&args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let lb = by_name(&v, "LB");
+    let how = lb["lost"].as_str().unwrap_or_else(|| panic!("{lb}"));
+    assert!(
+        how.contains("run feed_source.F -10 %") && how.contains("drives `C1.distillate` out of its range"),
+        "{how}"
+    );
+    assert!(lb["rank"].is_null() && lb["failure"].is_null(), "{lb}");
+    let mut ranks: Vec<u64> = v["structures"].as_array().unwrap().iter().filter_map(|s| s["rank"].as_u64()).collect();
+    ranks.sort_unstable();
+    assert_eq!(ranks, [1, 2, 3, 4, 5], "{v}");
+}
