@@ -6,8 +6,8 @@
 //! throughput input, the column and its qualities and handles, the vessels to size, and the
 //! `--set` edits with the same edits written into the file.
 
-use plantwide::flowsheet::{Override, load_str_with};
-use plantwide::solve::{StrategySettings, converge};
+use plantwide::flowsheet::{Override, Plant, load_str_with};
+use plantwide::solve::{Solution, StrategySettings, converge};
 
 use super::column::{self, BottomLoop, Column, Model, Request, log_uniform, uniform, unit_of};
 use super::doc::{J, obj, q, quantity, round_sig};
@@ -141,12 +141,74 @@ pub struct Draft {
     pub about: String,
 }
 
+/// The open draft with its column's reflux and heat input at the values that meet the design split,
+/// written into the document in the units it has, and that plant converged. The values are found
+/// as a user of a dynamic simulator finds them: two PI loops hold `x_D` by the reflux and `x_B` by
+/// the heat input at the design split and the plant is converged (from the open plant's state,
+/// the loops closed along their setpoints where the cold start fails: `converge`'s homotopy). The
+/// shortcut design (Underwood, Fenske, a mean α, a flash taken isothermal where the plant's is
+/// adiabatic) can miss the split by orders of magnitude on a nonideal pair (a 1e-15 bottoms
+/// impurity for a designed 1.2e-4), and a user designs to the split, not to the shortcut's flows.
+/// `None` (the draft kept) where that plant does not converge.
+fn meet_design(d: &mut Draft, plant: &Plant, sol: &Solution) -> Option<(Plant, Solution)> {
+    let c = &d.column;
+    let (light, products) = (&d.roles.light, &d.roles.products);
+    let value = |path: &str| plant.input(path).map(|i| sol.u[i]);
+    let (reflux, heat) = (format!("{}.reflux", c.name), c.heat_input());
+    let unit = if c.model == Model::Simple { "mol/s" } else { "W" };
+    let pi = |stream: &str, sp: f64, output: &str, kc: f64, unit: &str, action: &str| {
+        obj([
+            ("type", "pid".into()),
+            ("pv", format!("{stream}.x[{light}]").into()),
+            ("output", output.into()),
+            ("sp", J::N(sp)),
+            ("kc", J::S(format!("{kc:e} {unit}"))),
+            ("tau_i", "1 h".into()),
+            ("action", action.into()),
+        ])
+    };
+    let mut held = d.doc.clone();
+    let top = pi(
+        &products[0],
+        c.split.xd,
+        &reflux,
+        0.02 * value(&reflux)? / (1.0 - c.split.xd).max(1e-3),
+        "mol/s",
+        "reverse",
+    );
+    let bottom = pi(&products[1], c.split.xb, &heat, 0.02 * value(&heat)? / c.split.xb.max(1e-3), unit, "direct");
+    held.set(&["controllers", "design_top"], top);
+    held.set(&["controllers", "design_bottom"], bottom);
+    let held_plant = load_str_with(&held.render(), "generated", &[] as &[Override]).ok()?;
+    let met = converge(&held_plant, &StrategySettings::default()).ok()?;
+    let mut designed = d.doc.clone();
+    for (path, ctrl) in [(&reflux, "design_top"), (&heat, "design_bottom")] {
+        let op = met.x[held_plant.var(&format!("{ctrl}.op"))?];
+        let field = path.rsplit('.').next().unwrap_or_default();
+        let at: Vec<&str> = match field {
+            "reboiler_duty" => vec!["units", &c.name, "rigorous", field],
+            _ => vec!["units", &c.name, field],
+        };
+        let Some(J::S(text)) = designed.at(&at) else { return None };
+        let unit = text.split_once(' ')?.1.to_string();
+        designed.set(&at, q(op, &unit, 6));
+    }
+    let plant = load_str_with(&designed.render(), "generated", &[] as &[Override]).ok()?;
+    let sol = converge(&plant, &StrategySettings::default()).ok()?;
+    d.doc = designed;
+    Some((plant, sol))
+}
+
 /// Converge the draft, add the quality loops at its steady state, finish the roles and edits.
 fn close(rng: &mut Rng, seed: u64, family: Family, mut d: Draft) -> Result<Case, Box<Unfinished>> {
     let text = d.doc.render();
     let unfinished = |message: String| Box::new(Unfinished { family, open: text.clone(), message });
     let plant = load_str_with(&text, "generated", &[] as &[Override]).map_err(|e| unfinished(e.to_string()))?;
     let sol = converge(&plant, &StrategySettings::default()).map_err(|e| unfinished(e.to_string()))?;
+    let (plant, sol) = match meet_design(&mut d, &plant, &sol) {
+        Some(met) => met,
+        None => (plant, sol),
+    };
     let values: std::collections::HashMap<String, f64> = sol.values(&plant).into_iter().collect();
     let get = |p: &str| values.get(p).copied();
     let value = |p: &str| get(p).unwrap_or_else(|| panic!("generator: the open plant has no `{p}`"));
