@@ -78,9 +78,6 @@ pub enum TuningArg {
 
 /// Run `plantwide compare`.
 pub fn run(a: &CompareArgs, system: UnitSystem) -> Result<(), CliError> {
-    // Schemes run in parallel; faer's kernels sequential inside each, so no digit depends on the
-    // thread count.
-    plantwide::analysis::faer::set_global_parallelism(plantwide::analysis::faer::Par::Seq);
     let plants = a.files.iter().map(|f| load_with_overrides(f, &[]).map(|(p, _)| p)).collect::<Result<Vec<_>, _>>()?;
     let outputs: Vec<(String, Option<String>)> = a
         .outputs

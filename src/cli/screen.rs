@@ -105,9 +105,6 @@ fn screen_error(e: ScreenError) -> CliError {
 
 /// Run `plantwide screen`.
 pub fn run(a: &ScreenArgs, system: UnitSystem) -> Result<(), CliError> {
-    // The candidates run in parallel (rayon); faer's kernels then run sequentially inside each, so
-    // that no reduction's order, and no digit of the results, depends on the number of threads.
-    plantwide::analysis::faer::set_global_parallelism(plantwide::analysis::faer::Par::Seq);
     let (plant, _) = load_with_overrides(&a.file, &a.set)?;
     let Some(column) = &a.column else { return pairings(a, &plant, system) };
     if a.shard.is_shard() {

@@ -83,7 +83,6 @@ fn size_error(e: SizeError) -> CliError {
 /// the command exits 2 when a part failed or the plot had nothing to show.
 pub fn run(a: &SizeArgs, system: UnitSystem) -> Result<(), CliError> {
     let units = SizeUnits::new(system)?;
-    plantwide::analysis::faer::set_global_parallelism(plantwide::analysis::faer::Par::Seq);
     let (plant, u) = load_with_overrides(&a.file, &a.set)?;
     let request = request(a, &plant)?;
     if let Some(out) = &a.plot {

@@ -42,6 +42,7 @@ mod size;
 mod size_newcomer;
 mod snowball;
 mod specs;
+mod threads;
 mod tune;
 mod tutorial;
 mod two_column_study;

@@ -149,18 +149,11 @@ pub fn sensitivity(
     Ok((sweep(&plant, &ss.x, &ss.u, &disturbances, &idx, &settings)?, outs))
 }
 
-/// `plantwide screen --column`: the column's inventory configurations. As the CLI does, faer's
-/// kernels run sequentially meanwhile (the candidates run in parallel), so that no digit depends
-/// on the thread count; the process's setting is restored afterwards.
+/// `plantwide screen --column`: the column's inventory configurations.
 pub fn screen(src: &Source, sets: &[String], column: &str, outputs: &[String]) -> Result<ColumnScreen, FaceError> {
-    use plantwide_analysis::faer::{Par, get_global_parallelism, set_global_parallelism};
     let mut plant = src.load(sets)?;
     fix_design_point(&mut plant)?;
-    let before = get_global_parallelism();
-    set_global_parallelism(Par::Seq);
-    let result = screen_column(&plant, column, outputs);
-    set_global_parallelism(before);
-    Ok(result?)
+    Ok(screen_column(&plant, column, outputs)?)
 }
 
 /// A pairing screen as Python asks for it (the CLI's `screen --cvs …` options by name).
@@ -195,11 +188,9 @@ fn time(text: &str, field: &str) -> Result<f64, FaceError> {
 }
 
 /// `plantwide screen --cvs … --mvs … --json`, or a shard of its dynamic tests: JSON text, the
-/// screen's (as the CLI prints it) or `{"tasks": N, "results": {t: …}}` for a shard. As the CLI
-/// does, faer's kernels run sequentially meanwhile (the candidates run in parallel), so that no
-/// digit depends on the thread count or on the shard a candidate ran in.
+/// screen's (as the CLI prints it) or `{"tasks": N, "results": {t: …}}` for a shard. No digit
+/// depends on the thread count or on the shard a candidate ran in.
 pub fn pairings(src: &Source, sets: &[String], args: &str, share: PairingShare) -> Result<String, FaceError> {
-    use plantwide_analysis::faer::{Par, get_global_parallelism, set_global_parallelism};
     let a: PairingArgs = serde_json::from_str(args).map_err(|e| FaceError::Input(format!("screen_pairings: {e}")))?;
     let share = match share {
         PairingShare::All => Share::All,
@@ -233,11 +224,7 @@ pub fn pairings(src: &Source, sets: &[String], args: &str, share: PairingShare) 
     };
     let mut plant = src.load(sets)?;
     fix_design_point(&mut plant)?;
-    let before = get_global_parallelism();
-    set_global_parallelism(Par::Seq);
-    let result = screen_pairings(&plant, &request);
-    set_global_parallelism(before);
-    let screen = result?;
+    let screen = screen_pairings(&plant, &request)?;
     if request.share.is_shard() {
         let results: std::collections::BTreeMap<usize, CandidateTask> = screen
             .tested

@@ -63,14 +63,6 @@ const OPEN: &[Known] = &[
                plus dead time (R² 0.03) and SIMC gives up, where the exact model is at hand (open)",
     },
     Known {
-        class: "steady: fails (exit 2) on a generated plant",
-        shows: |t| t.contains("plantwide steady tuned.json"),
-        note: "found by this suite: the plant retuned by `tune --write` (only kc and tau_i \
-               changed, so the same steady state) does not converge from its cold start (Singular \
-               with a sump at its bound, or Stalled): the steady solve depends on the tuning (open; \
-               crates/solve)",
-    },
-    Known {
         class: "steady: the generated design (open plant) does not converge",
         shows: stalls_near_a_root,
         note: "found by this suite: Newton stalls at a scaled residual of 1e-7 to 1e-5 on a \
