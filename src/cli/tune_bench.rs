@@ -46,11 +46,11 @@ pub fn run(
                 ModelArg::Soptd => ModelOrder::Soptd,
                 ModelArg::Integrating => ModelOrder::Integrating,
             });
-            let o = StepOptions { step: quantity(&a.step, "step", out_dim)?, scan, order };
+            let measurement = super::tune_plant::measurement(a)?;
+            let o = StepOptions { step: quantity(&a.step, "step", out_dim)?, scan, order, measurement };
             let test = step_loop(plant, x, l, o).map_err(tune_error)?;
             let tau_c = quantity(&a.tau_c, "tau-c", Dimension::TIME)?;
             let rule = if method == MethodArg::Imc { ModelRule::Imc } else { ModelRule::Simc };
-            let measurement = super::tune_plant::measurement(a)?;
             from_step(l, test, rule, (tau_c, a.pid), measurement).map_err(tune_error)
         }
     }

@@ -37,7 +37,8 @@ pub fn run(a: &TuneArgs, tu: &TimeUnit) -> Result<(), CliError> {
         let title = format!("Bode diagrams of the tuned loops of `{}`, each alone", plant.name());
         super::tune::plot_bode(out, &title, tu, labels.zip(diagrams).collect())?;
     }
-    if let Some(out) = &a.write {
+    let refuted = tuning.loops.iter().any(|l| l.failure.is_some());
+    if let Some(out) = a.write.as_ref().filter(|_| !refuted) {
         write(file, out, &plant, &tuning, tu)?;
     }
     let shown = tuning.clone().in_time_unit(tu.seconds);
@@ -46,7 +47,16 @@ pub fn run(a: &TuneArgs, tu: &TimeUnit) -> Result<(), CliError> {
     } else {
         print_table(&shown, &plant, tu);
     }
-    Ok(())
+    let failed: Vec<String> =
+        shown.loops.iter().filter_map(|l| l.failure.as_ref().map(|f| format!("`{}`: {f}", l.controller))).collect();
+    match failed.is_empty() {
+        true => Ok(()),
+        false => Err(CliError::numerical(format!(
+            "{}{}",
+            failed.join("\n"),
+            if a.write.is_some() { "\nnothing written" } else { "" }
+        ))),
+    }
 }
 
 /// The loops asked for: `--loop CTRL` or `--loops C1,C2,…` (BLT tunes them together, the other
@@ -209,6 +219,15 @@ fn print_details(l: &FlowsheetLoop, u: &str, pv_unit: &str) {
         let settled =
             if l.settled == Some(false) { "; the response had not settled: the fit extrapolates" } else { "" };
         outln!("  fit ({u}): {model}, R² = {:.4}, RMSE/max = {:.2e}{settled}", f.r2, f.nrmse);
+        if let Some(i) = &l.initial_fit {
+            outln!(
+                "  lag-dominant: dead time {:.5e} {u} from the integrating model fitted to the response's first {} points \
+                 (R² = {:.4}), the slow approach fitted over the whole test",
+                i.model.dead_time(),
+                i.points,
+                i.r2
+            );
+        }
     }
     if let Some(c) = &l.linearity {
         outln!("{}", linearity_line(c));

@@ -446,29 +446,38 @@ fn two_column_quality_loops_tuned_by_blt_ride_out_the_shipped_production_step() 
 /// SIMC's default 5 % step of the reboiler duty drives the bottoms composition out of its linear
 /// range, and the FOPTD fit of that secant had a gain 5.7× below G(0) with R² 0.994. The step test
 /// now checks its fitted gain against the linearized one and shrinks the step until they agree
-/// within 10 %. The reference G(0) comes from another command, `plantwide gains` on the same
-/// column without its composition loops (`bt_column.json`, levels by D and B as here), and the
-/// first step from the steady reboiler duty of `plantwide steady`.
+/// within 10 %; its first step is at most the one whose linear response takes a tenth of the
+/// composition's room to its bound. The reference G(0) comes from another command, `plantwide
+/// gains` on the same column without its composition loops (`bt_column.json`, levels by D and B as
+/// here), the duty and the composition from `plantwide steady`.
 #[test]
 fn simc_shrinks_a_step_that_leaves_the_linear_range_until_its_gain_is_g0() {
     let (lv, open) = (fixture("data/newcomer3/bt_column_lv.json"), fixture("data/newcomer3/bt_column.json"));
     let gains =
         json_of(&["gains", &open, "--inputs", "column.reboiler_duty", "--outputs", "bottoms.x[benzene]", "--json"]);
     let g0 = gains["gain"][0][0].as_f64().unwrap();
-    let duty = json_of(&["steady", &lv, "--set", "top_x.auto=0", "--json"])["values"]["bottom_x.op"].as_f64().unwrap();
+    let steady = json_of(&["steady", &lv, "--set", "top_x.auto=0", "--json"]);
+    let duty = steady["values"]["bottom_x.op"].as_f64().unwrap();
+    let xb = steady["values"]["bottoms.x[benzene]"].as_f64().unwrap();
     let args = ["tune", &lv, "--loop", "bottom_x", "--method", "simc", "--set", "top_x.auto=0", "--tau-c", "5 min"];
+    let field = |t: &serde_json::Value, f: &str| t[f].as_f64().unwrap();
+    // The defect's own step, 5 % of the duty, given: its secant is 5.7× below G(0).
+    let five = format!("{} W", 0.05 * duty);
+    let v = json_of(&[&args[..], &["--step", &five, "--json"]].concat());
+    let secant = g0 / field(&v["loops"][0]["linearity"]["tests"][0], "gain");
+    assert!(secant > 4.0 && secant < 8.0, "the 5 % step's gain is G(0)/{secant}");
     let v = json_of(&[&args[..], &["--json"]].concat());
     let l = &v["loops"][0];
     let linear = l["linearity"]["linear_gain"].as_f64().unwrap();
     // The same linearization reached through the loops' steady state (bottoms composition held by PI).
     assert!((linear / g0 - 1.0).abs() < 1e-3, "linearized gain {linear} vs plantwide gains {g0}");
     let tests = l["linearity"]["tests"].as_array().unwrap();
-    let field = |t: &serde_json::Value, f: &str| t[f].as_f64().unwrap();
-    // The first step is the default 5 % of the duty; its secant is the defect's (5.7× below G(0)).
+    // The default first step: a tenth of the room to the nearer bound over |G(0)|, below 5 % of the
+    // duty, and still outside the linear range (over 10 % off), so the step is shrunk.
     let first = &tests[0];
-    assert!((field(first, "step") / (0.05 * duty) - 1.0).abs() < 1e-9, "{first} vs duty {duty}");
-    let secant = g0 / field(first, "gain");
-    assert!(secant > 4.0 && secant < 8.0, "the 5 % step's gain is G(0)/{secant}");
+    let room = 0.1 * xb.min(1.0 - xb) / g0.abs();
+    assert!(room < 0.05 * duty && (field(first, "step") / room - 1.0).abs() < 2e-3, "{first} vs {room}");
+    assert!(field(first, "gain_error") > 0.1 && tests.len() >= 2, "{tests:?}");
     // The settings come from the last, smaller step, whose fitted gain is G(0) within 10 %.
     let k = l["fit"]["model"]["k"].as_f64().unwrap();
     let last = tests.last().unwrap();
@@ -512,17 +521,26 @@ fn json_of(args: &[&str]) -> serde_json::Value {
 /// When no step gives the linearized gain, the step test fails (exit 2) listing every step with
 /// its fitted gain, rather than tuning on one of them: column A's bottom composition loop (the top
 /// loop in auto) fits FOPTD gains 24 %, 11 % and 16 % off its G(0) at steps of 2.67, 0.275 and
-/// 0.064 mol/s (5 % of the boilup, then smaller); the last smaller step brought it no closer, so the
+/// 0.064 mol/s (5 % of the boilup given, then smaller); the last smaller step brought it no closer, so the
 /// difference is not the plant's curvature (with the top loop fighting it, the response rises and
 /// then creeps: FOPTD explains R² 0.03-0.46 of longer tests).
 #[test]
 fn a_step_test_whose_gain_never_agrees_with_g0_exits_2_listing_the_steps() {
     let fs = flowsheet("column_a_lv.json");
-    let out = plantwide(&["tune", &fs, "--loop", "bottom_composition", "--method", "simc", "--tau-c", "5 min"]);
+    let args = ["tune", &fs, "--loop", "bottom_composition", "--method", "simc", "--tau-c", "5 min"];
+    let out = plantwide(&[&args[..], &["--step", "2.672 mol/s"]].concat());
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(err.contains("`bottom_composition`") && err.contains("disagrees with the linearized gain"), "{err}");
     assert!(err.matches("step ").count() >= 2 && err.contains("a smaller step did not bring it closer"), "{err}");
+    assert!(out.stdout.is_empty(), "no settings printed");
+    // The default first step (a tenth of x_B's room to 0 over |G(0)|: 0.55 mol/s) fits a gain
+    // within 10 % of G(0), and the fit is then seen not to describe the response (R² 0.02): the
+    // model asked for is refused (exit 1, another model or a relay test), no settings printed.
+    let out = plantwide(&args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("first-order-plus-dead-time model explains R²"), "{err}");
     assert!(out.stdout.is_empty(), "no settings printed");
 }
 
@@ -588,4 +606,91 @@ fn blt_raises_its_detuning_until_the_loops_close_stably() {
     ]);
     let text = String::from_utf8_lossy(&lin.stdout);
     assert!(lin.status.success() && text.contains("62 states") && !text.contains("unstable modes"), "{text}");
+}
+
+/// A lag-dominant composition loop (the plant generator's simple column, seed 0x25e7509f3d978deb:
+/// the top loop with the bottom one in manual, `T` ≈ 30 h against a `P_u` of minutes): sampled at
+/// `T/100` only, the fit sees no dead time, and SIMC's `τc = θ` (the analyzer's minute) tuned a
+/// loop whose phase margin on the plant's exact linear model is −36.6°, exit 0. Its start is now
+/// sampled at `P_u/50`, the model takes the dead time of the integrating model fitted there
+/// (Skogestad's integrating approximation), and the settings are SIMC's on that model with a
+/// positive phase margin; the old sampling, asked for with `--scan`, is refused by its margins
+/// (exit 2, nothing written).
+#[test]
+fn simc_on_a_lag_dominant_loop_takes_the_dead_time_of_its_start() {
+    let fs = fixture("data/generated/simple_25e7509f.json");
+    let args = ["tune", &fs, "--loop", "AC101", "--method", "simc", "--set", "AC102.auto=0"];
+    let args = [&args[..], &["--measurement-dead-time", "1 min", "--json"]].concat();
+    let v = json_of(&args);
+    let l = &v["loops"][0];
+    let (fit, initial) = (&l["fit"]["model"], &l["initial_fit"]["model"]);
+    assert_eq!(initial["type"], "integrating", "{l}");
+    assert!(l["initial_fit"]["r2"].as_f64().unwrap() > 0.99, "{l}");
+    let (k, tau, theta) = (fit["k"].as_f64().unwrap(), fit["tau"].as_f64().unwrap(), fit["theta"].as_f64().unwrap());
+    assert_eq!(theta, initial["theta"].as_f64().unwrap(), "the model takes the start's dead time");
+    // Over a minute of effective delay (the column's fast lags), far below the slow lag.
+    assert!(theta > 60.0 && theta < 1e-2 * tau, "θ {theta} τ {tau}");
+    // SIMC on the FOPTD model seen through the analyzer: θ + 60 s, τc = that, Kc = τ/(k (τc + θ)).
+    let delay = theta + 60.0;
+    assert!((l["tau_c"].as_f64().unwrap() / delay - 1.0).abs() < 1e-12, "{l}");
+    let (kc, tau_i) = (l["kc"].as_f64().unwrap(), l["tau_i"].as_f64().unwrap());
+    assert!((kc.abs() / (tau / (k.abs() * 2.0 * delay)) - 1.0).abs() < 1e-9, "{kc}");
+    assert!((tau_i / (tau.min(8.0 * delay)) - 1.0).abs() < 1e-9, "{tau_i}");
+    // The fitted gain is the exact linearization's within 10 %.
+    let linear = l["linearity"]["linear_gain"].as_f64().unwrap();
+    assert!((k / linear - 1.0).abs() < 0.1, "{k} vs {linear}");
+    let pm = l["margins"]["phase_margin"].as_f64().unwrap();
+    assert!(pm > 20.0, "phase margin {pm}");
+    assert!(l.get("failure").is_none(), "{l}");
+    // The old sampling: no dead time seen, an unstable loop, refused by its own margins.
+    let dir = std::env::temp_dir().join(format!("plantwide-tune-lag-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let written = dir.join("tuned.json");
+    let coarse = [&args[..], &["--scan", "1000 s", "--write", written.to_str().unwrap()]].concat();
+    let out = plantwide(&coarse);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("unstable on the plant's exact linear model") && err.contains("nothing written"), "{err}");
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let l = &v["loops"][0];
+    assert!(l["margins"]["phase_margin"].as_f64().unwrap() < 0.0 && l["failure"].is_string(), "{l}");
+    assert!(l.get("initial_fit").is_none(), "{l}");
+    assert!(!written.exists(), "refuted settings written");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Where even the start's integrating model does not describe the loop (the generator's rigorous
+/// hexane–heptane column, seed 0xdc13c1b09864a6e6: the start is a fast lag of 1 % of G(0), then
+/// the slow ramp; R² 0.31), SIMC's settings leave the loop unstable on the plant's exact linear
+/// model: `tune` exits 2 saying so, the report keeps the settings and margins with a `failure`.
+#[test]
+fn simc_settings_the_linear_model_refutes_exit_2() {
+    let fs = fixture("data/generated/rigorous_dc13c1b0.json");
+    let args = ["tune", &fs, "--loop", "AC101", "--method", "simc", "--set", "AC102.auto=0"];
+    let out = plantwide(&[&args[..], &["--measurement-dead-time", "1 min", "--json"]].concat());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("`AC101`") && err.contains("phase margin -"), "{err}");
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let l = &v["loops"][0];
+    assert!(l["margins"]["phase_margin"].as_f64().unwrap() < 0.0 && l["failure"].is_string(), "{l}");
+    // The same loop by BLT (the linear model's own ultimate gain, detuned) is stable and accepted.
+    let blt = json_of(
+        &[
+            &args[..2],
+            &[
+                "--loops",
+                "AC101",
+                "--method",
+                "blt",
+                "--set",
+                "AC102.auto=0",
+                "--measurement-dead-time",
+                "1 min",
+                "--json",
+            ],
+        ]
+        .concat(),
+    );
+    assert!(blt["loops"][0]["margins"]["phase_margin"].as_f64().unwrap() > 0.0, "{blt}");
 }

@@ -230,25 +230,48 @@ pub struct StepTest {
     /// Settled when the last third of the record moved less than this fraction of the total
     /// change (default 0.2 %).
     pub settle: f64,
+    /// A finer sampling `(interval, until)` \[s\] for the response's start, before `scan` takes
+    /// over: a lag-dominant element's initial response (its effective dead time) at the loop's
+    /// own time scale, its slow approach at its own.
+    pub fine: Option<(f64, f64)>,
 }
 
-/// Run a step test on `bench` from its steady state `u0`: the record and whether it settled.
+impl StepTest {
+    /// Samples taken at the finer interval.
+    pub fn fine_samples(&self) -> usize {
+        self.fine.map_or(0, |(f, until)| (until / f).ceil() as usize)
+    }
+
+    /// Time of sample `i` since the step (sample 0 at the step).
+    fn sample_time(&self, i: usize) -> f64 {
+        let n = self.fine_samples();
+        match self.fine {
+            Some((f, _)) if i <= n => i as f64 * f,
+            Some((f, _)) => n as f64 * f + (i - n) as f64 * self.scan,
+            None => i as f64 * self.scan,
+        }
+    }
+}
+
+/// Run a step test on `bench` from its steady state `u0`: the record and whether it settled
+/// (judged on the samples at `scan`, after any finer start).
 ///
 /// # Errors
-/// The bench's error.
+/// The bench's, when it cannot advance.
 pub fn step<B: Bench>(bench: &mut B, u0: f64, s: &StepTest) -> Result<(super::fit::StepResponse, bool), B::Error> {
     let (t0, y0) = (bench.time(), bench.measurement());
     bench.set_output(u0 + s.step);
     let (mut t, mut y) = (vec![0.0], vec![0.0]);
-    let check_every = 50;
+    let (check_every, fine) = (50, s.fine_samples());
     loop {
-        let next = t0 + t.len() as f64 * s.scan;
+        let next = t0 + s.sample_time(t.len());
         bench.advance_to(next)?;
         t.push(next - t0);
         y.push(bench.measurement() - y0);
         let done = *t.last().unwrap_or(&0.0) >= s.max_duration;
-        if y.len() % check_every == 0 || done {
-            let settled = settled(&y, s.settle);
+        let coarse = y.len().saturating_sub(fine + 1);
+        if (coarse > 0 && coarse % check_every == 0) || done {
+            let settled = settled(&y, fine + 1, s.settle);
             if settled || done {
                 return Ok((super::fit::StepResponse { t, y, du: s.step }, settled));
             }
@@ -256,12 +279,13 @@ pub fn step<B: Bench>(bench: &mut B, u0: f64, s: &StepTest) -> Result<(super::fi
     }
 }
 
-/// Whether the last third of `y` moved less than `frac` of the largest deviation.
-fn settled(y: &[f64], frac: f64) -> bool {
+/// Whether the last third of `y[from..]` moved less than `frac` of the largest deviation.
+fn settled(y: &[f64], from: usize, frac: f64) -> bool {
     let largest = y.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    let tail = &y[2 * y.len() / 3..];
+    let judged = &y[from.min(y.len())..];
+    let tail = &judged[2 * judged.len() / 3..];
     let (lo, hi) = tail.iter().fold((f64::MAX, f64::MIN), |(a, b), &v| (a.min(v), b.max(v)));
-    largest > 0.0 && hi - lo < frac * largest
+    largest > 0.0 && !tail.is_empty() && hi - lo < frac * largest
 }
 
 #[cfg(test)]
@@ -390,9 +414,12 @@ mod tests {
 
     #[test]
     fn a_step_test_records_until_the_response_settles() {
-        let (record, settled) =
-            step(&mut foptd(-1.5, 20.0, 4.0), 0.0, &StepTest { step: 0.2, scan: 0.5, max_duration: 1e4, settle: 2e-3 })
-                .unwrap();
+        let (record, settled) = step(
+            &mut foptd(-1.5, 20.0, 4.0),
+            0.0,
+            &StepTest { step: 0.2, scan: 0.5, max_duration: 1e4, settle: 2e-3, fine: None },
+        )
+        .unwrap();
         assert!(settled);
         let fit = crate::tune::fit::fit_step(&record, crate::tune::fit::ModelOrder::Foptd).unwrap();
         let crate::tune::fit::ProcessModel::Foptd { k, tau, theta } = fit.model else { panic!() };

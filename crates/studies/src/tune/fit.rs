@@ -286,6 +286,13 @@ fn smith_start(data: &StepResponse) -> (f64, f64) {
 }
 
 /// The fit statistics of `model` on `data` with sum of squared errors `sse`.
+/// How well a given `model` (its gain as given) describes the record `data`.
+pub fn assess(data: &StepResponse, model: ProcessModel) -> ModelFit {
+    let k = model.gain() * data.du;
+    let sse = data.t.iter().zip(&data.y).map(|(&t, y)| (y - k * model.shape(t)).powi(2)).sum();
+    quality(data, model, sse)
+}
+
 fn quality(data: &StepResponse, model: ProcessModel, sse: f64) -> ModelFit {
     let n = data.y.len() as f64;
     let mean = data.y.iter().sum::<f64>() / n;

@@ -22,7 +22,7 @@ use super::fit::{ModelFit, ProcessModel};
 use super::loops::{LoopResponse, Measurement, PlantLoop, loop_model, low_frequency_probe, plant_blt};
 use super::margins::{Bode, Margins, bode, pid};
 use super::plant_tests::{Linearity, StepResult};
-use super::rules::{ModelRule, model_rule};
+use super::rules::{ModelRule, model_rule, tuned_dead_time};
 use super::ultimate::Ultimate;
 use crate::TuneError;
 
@@ -69,6 +69,10 @@ pub struct FlowsheetLoop {
     /// The step tests run and the linearized gain their fitted gains were checked against.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub linearity: Option<Linearity>,
+    /// A lag-dominant element's integrating model fitted to its response's start, whose dead time
+    /// `fit` takes ([`super::plant_tests::LAG_DOMINANT`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub initial_fit: Option<ModelFit>,
     /// SIMC's τc or IMC's λ used \[s or the time unit asked for\].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub tau_c: Option<f64>,
@@ -76,6 +80,31 @@ pub struct FlowsheetLoop {
     /// ([`flowsheet_margins`]); frequencies in rad per second or per the time unit asked for.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub margins: Option<Margins>,
+    /// Why these settings cannot be used, where the study's own check refutes them: a negative
+    /// phase margin on the plant's exact linear model is a loop these settings make unstable.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub failure: Option<String>,
+}
+
+impl FlowsheetLoop {
+    /// The failure its margins show: a negative phase margin (the element open-loop stable, its
+    /// Nyquist curve then encircles −1: the loop alone is unstable with these settings).
+    fn refuted(&self) -> Option<String> {
+        let m = self.margins?;
+        let pm = m.phase_margin.filter(|pm| *pm < 0.0)?;
+        let fit = match self.tau_c {
+            Some(_) => {
+                "; the fitted model does not describe the response at the loop's time scale: tune for a larger \
+                 closed-loop time constant τc, or by the BLT or relay method"
+            }
+            None => "",
+        };
+        Some(format!(
+            "these settings leave the loop unstable on the plant's exact linear model: phase margin {pm:.1}° at \
+             ω = {:.4e} rad/s{fit}",
+            m.gain_crossover.unwrap_or(f64::NAN)
+        ))
+    }
 }
 
 /// The tuning of a set of loops of a flowsheet.
@@ -110,6 +139,9 @@ impl FlowsheetTuning {
             if let Some(f) = &mut l.fit {
                 let integrating = matches!(f.model, ProcessModel::Integrating { .. });
                 l.linearity = l.linearity.take().map(|c| c.in_time_unit(seconds, integrating));
+                f.model = f.model.in_time_unit(seconds);
+            }
+            if let Some(f) = &mut l.initial_fit {
                 f.model = f.model.in_time_unit(seconds);
             }
             if let Some(a) = &mut l.averaging {
@@ -147,7 +179,9 @@ fn entry(l: &PlantLoop, kc: f64, tau_i: Option<f64>, tau_d: Option<f64>) -> Flow
         fit: None,
         settled: None,
         linearity: None,
+        initial_fit: None,
         tau_c: None,
+        failure: None,
         margins: None,
     }
 }
@@ -244,11 +278,16 @@ pub fn from_step(
     measurement: Measurement,
 ) -> Result<FlowsheetTuning, TuneError> {
     let model = test.fit.model.measured(measurement.dead_time, measurement.lag);
+    // A measurement's dead time or lag is a delay of the loop however slow the process: `τc = θ`
+    // then, where a fitted dead time under a thousandth of the lag alone counts as none.
+    let measured = measurement.dead_time > 0.0 || measurement.lag > 0.0;
+    let tau_c = tau_c.or_else(|| measured.then(|| tuned_dead_time(&model, derivative)));
     let p = model_rule(rule, &model, tau_c, derivative)?;
     let e = FlowsheetLoop {
         fit: Some(test.fit),
         settled: Some(test.settled),
         linearity: test.linearity,
+        initial_fit: test.initial,
         tau_c: Some(p.tau_c),
         ..entry(l, p.kc, Some(p.tau_i), p.tau_d)
     };
@@ -335,6 +374,7 @@ pub fn flowsheet_margins(
         let c = |w: f64| pid(l.kc, l.tau_i, l.tau_d, w);
         let b = bode(|w| response.at(w)[(i, i)] * c(w), lo, hi);
         l.margins = Some(b.margins);
+        l.failure = l.refuted();
         diagrams.push(b);
     }
     Ok(diagrams)

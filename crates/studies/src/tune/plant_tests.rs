@@ -14,7 +14,7 @@ use plantwide_solve::dynamic::{Session, SessionError};
 use serde::Serialize;
 
 use super::bench::{Bench, RelayCycle, SampledRelay, StepTest, relay, step};
-use super::fit::{ModelFit, ModelOrder, fit_step};
+use super::fit::{ModelFit, ModelOrder, ProcessModel, StepResponse, assess, fit_step};
 use super::loops::{LoopResponse, Measurement, PlantLoop, in_manual, loop_model, loop_ultimates, low_frequency_probe};
 use crate::TuneError;
 
@@ -127,12 +127,16 @@ pub const MIN_R2: f64 = 0.9;
 /// Options of a step test; `None` takes the default.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct StepOptions {
-    /// Output step (output units; default 5 % of its steady value), the first one tried.
+    /// Output step (output units), the first one tried; default 5 % of its steady value, or less
+    /// where the linear response would take over a tenth of the measurement's room to its bound.
     pub step: Option<f64>,
     /// Sampling interval \[s\].
     pub scan: Option<f64>,
     /// Model to fit (default FOPTD, IPDT for an integrating element).
     pub order: Option<ModelOrder>,
+    /// The measurement's dead time and lag that the model leaves out: with them the loop's
+    /// ultimate period, the time scale a lag-dominant element's start is sampled at.
+    pub measurement: Measurement,
 }
 
 /// Largest relative difference between the gain fitted to a step test and the element's gain
@@ -190,6 +194,9 @@ pub struct StepResult {
     /// of the element's kind (an integrating model of a lag-dominant element, SIMC's approximation,
     /// has a slope, not `G(0)`), so that one test is run with the step asked for, unchecked.
     pub linearity: Option<Linearity>,
+    /// For a lag-dominant element, the integrating model fitted to the response's start, whose
+    /// dead time the model `fit` takes (see [`LAG_DOMINANT`]).
+    pub initial: Option<ModelFit>,
 }
 
 /// A step test of loop `l` at the steady state `x` and the model fitted to it. The fitted gain is
@@ -216,17 +223,21 @@ pub fn step_loop(plant: &Plant, x: &[f64], l: &PlantLoop, o: StepOptions) -> Res
         (None, None) => return Err(TuneError::ResidenceTime { controller: l.name.clone() }),
     };
     check_scan(l, scan, max_duration / 100.0, "a hundredth of the test's length")?;
-    let first = o.step.unwrap_or(0.05 * u0.abs());
+    let fine = match (o.scan, order) {
+        (None, ModelOrder::Foptd) if !element.integrating => lag_dominant_start(plant, x, l, o.measurement, scan)?,
+        _ => None,
+    };
+    let first = o.step.unwrap_or_else(|| default_step(plant, x, l, &element));
     if !(first != 0.0 && first.is_finite()) {
         return Err(TuneError::RelayAmplitude { controller: l.name.clone(), amplitude: first });
     }
     within_range(plant, l, u0 + first)?;
-    let mut settings = StepTest { step: first, scan, max_duration, settle: 2e-3 };
+    let mut settings = StepTest { step: first, scan, max_duration, settle: 2e-3, fine };
     let mut tests: Vec<StepTry> = Vec::new();
     loop {
         let mut b = bench(plant, x, l, Measurement::default(), settings.scan)?;
         let (record, settled) = step(&mut b, u0, &settings).map_err(|e| TuneError::Simulation(Box::new(e)))?;
-        let fit = fit_step(&record, order).map_err(TuneError::from)?;
+        let (fit, initial) = fit_test(&record, order, settings.fine_samples())?;
         let gain = fit.model.gain();
         let gain_error = ((gain - element.gain) / element.gain).abs();
         tests.push(StepTry {
@@ -244,7 +255,7 @@ pub fn step_loop(plant: &Plant, x: &[f64], l: &PlantLoop, o: StepOptions) -> Res
                 });
             }
             let linearity = comparable.then_some(Linearity { linear_gain: element.gain, tests });
-            return Ok(StepResult { fit, settled: settled || element.integrating, linearity });
+            return Ok(StepResult { fit, settled: settled || element.integrating, linearity, initial });
         }
         let stalled = tests.len() >= 2 && gain_error > 0.8 * tests[tests.len() - 2].gain_error;
         if stalled || tests.len() == MAX_STEP_TESTS {
@@ -259,6 +270,67 @@ pub fn step_loop(plant: &Plant, x: &[f64], l: &PlantLoop, o: StepOptions) -> Res
         }
         settings.step *= (MAX_GAIN_ERROR / (4.0 * gain_error)).clamp(1.0 / 32.0, 0.5);
     }
+}
+
+/// The largest fraction of the measurement's room to its nearer bound that a default step's
+/// linear response may take: a high-purity composition (1 − x of 3e-4) would otherwise be driven
+/// into the bound, where its response saturates and the fit sees a secant 100 times below `G(0)`.
+/// Near a bound a composition is about linear in `ln(1 − x)`, so a response of a tenth of the room
+/// fits a gain within ~5 % of the tangent's, inside [`MAX_GAIN_ERROR`].
+const MAX_ROOM_FRACTION: f64 = 0.1;
+
+/// The default first step: 5 % of the output's steady value, shrunk so that the linear response
+/// `|G(0) Δu|` of a stable element stays within [`MAX_ROOM_FRACTION`] of the measurement's room to
+/// its nearer bound (a mole fraction's 0 or 1).
+fn default_step(plant: &Plant, x: &[f64], l: &PlantLoop, element: &Element) -> f64 {
+    let step = 0.05 * x[l.op].abs();
+    let spec = &plant.vars()[l.pv].spec;
+    let room = (x[l.pv] - spec.lower).min(spec.upper - x[l.pv]);
+    if element.integrating || !(room.is_finite() && room > 0.0) {
+        return step;
+    }
+    step.min(MAX_ROOM_FRACTION * room / element.gain.abs())
+}
+
+/// A stable element is lag-dominant for a step test when its default scan (`T/100`) is coarser
+/// than this fraction of the loop's ultimate period: a record sampled so sparsely cannot show the
+/// lags and delays that limit the loop (a high-purity column's composition with its other loop
+/// open: `T` of 200 h, `P_u` of 12 min), and SIMC's `τc = θ` on its fit (`θ ≈ 0`) tunes an
+/// unstable loop. Its start is then sampled at `P_u/50` for `10 P_u`, and the model takes the
+/// dead time of the integrating model fitted there: Skogestad's integrating approximation of a
+/// lag-dominant process (SIMC, 2003, §3.3: `k' = k/τ₁`, read from the initial response), whose
+/// settings are those of the FOPTD model with that dead time (`k/τ₁ · τ₁ = k`).
+pub const LAG_DOMINANT: f64 = 1.0 / 20.0;
+
+/// The finer sampling `(P_u/50, 10 P_u)` of a lag-dominant element's start (see
+/// [`LAG_DOMINANT`]), or `None` for one that is not, or has no phase crossover to size it by.
+fn lag_dominant_start(
+    plant: &Plant,
+    x: &[f64],
+    l: &PlantLoop,
+    measurement: Measurement,
+    scan: f64,
+) -> Result<Option<(f64, f64)>, TuneError> {
+    let response = LoopResponse::new(loop_model(plant, x, std::slice::from_ref(l))?, measurement);
+    let Ok(u) = loop_ultimates(&response, std::slice::from_ref(l)) else { return Ok(None) };
+    let pu = u[0].pu;
+    Ok((pu.is_finite() && pu > 0.0 && scan > LAG_DOMINANT * pu).then_some((pu / 50.0, 10.0 * pu)))
+}
+
+/// The model fitted to a step test's record and, where its first `fine` samples are a finer
+/// start, the integrating model fitted to that start, whose dead time the model takes.
+fn fit_test(record: &StepResponse, order: ModelOrder, fine: usize) -> Result<(ModelFit, Option<ModelFit>), TuneError> {
+    let fit = fit_step(record, order).map_err(TuneError::from)?;
+    if fine == 0 || record.t.len() <= fine + 1 {
+        return Ok((fit, None));
+    }
+    let start = StepResponse { t: record.t[..=fine].to_vec(), y: record.y[..=fine].to_vec(), du: record.du };
+    let initial = fit_step(&start, ModelOrder::Integrating).map_err(TuneError::from)?;
+    let model = match fit.model {
+        ProcessModel::Foptd { k, tau, .. } => ProcessModel::Foptd { k, tau, theta: initial.model.dead_time() },
+        m => m,
+    };
+    Ok((assess(record, model), Some(initial)))
 }
 
 /// Most scans a plant test's characteristic time may span (a relay's cycle, a step response's

@@ -118,6 +118,12 @@ fn lag(model: &ProcessModel) -> f64 {
     }
 }
 
+/// The dead time a rule tunes `model` for \[s\]: `θ` after Skogestad's half rule for a PI
+/// (`derivative` false), `θ` as fitted for a PID, the default `τc`.
+pub fn tuned_dead_time(model: &ProcessModel, derivative: bool) -> f64 {
+    if derivative { model.dead_time() } else { half_rule(model).dead_time() }
+}
+
 /// Skogestad's half rule on a SOPTD model (half of `τ₂` to `τ₁`, half to the dead time); other
 /// models unchanged.
 fn half_rule(model: &ProcessModel) -> ProcessModel {
