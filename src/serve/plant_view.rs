@@ -15,8 +15,8 @@ pub fn describe(plant: &Plant, paths: &[String]) -> Value {
     let units_json: Vec<Value> = units
         .iter()
         .map(|&b| {
-            let (name, kind) = (&plant.blocks()[b].name, plant.blocks()[b].unit.type_name());
-            json!({ "name": name, "type": kind, "col": depth[b], "row": row[b] })
+            let (name, unit) = (&plant.blocks()[b].name, &plant.blocks()[b].unit);
+            json!({ "name": name, "type": unit.type_name(), "shape": unit.shape(), "col": depth[b], "row": row[b] })
         })
         .collect();
     let streams: Vec<Value> = plant

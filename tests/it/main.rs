@@ -4,13 +4,14 @@
 //! One module per subject; [`harness`] holds what they share (the binary as a command, fixture
 //! paths, converge-and-read helpers, conservation checks). Data live beside the modules:
 //! `tests/broken/`, `tests/hostile/`, `tests/data/`. Run one module with
-//! `cargo test --test it columns::` (a name filter); opt-in slow parts are switched on by
-//! environment variables (`PLANTWIDE_FULL_STUDY=1`, `PLANTWIDE_FUZZ_MUTANTS=…`,
-//! `PLANTWIDE_PLANTS=…`).
+//! `cargo test --test it columns::` (a name filter); slow tests are `#[ignore]`d with their reason
+//! (`-- --include-ignored` runs them), larger campaigns are sized by environment variables
+//! (`PLANTWIDE_FUZZ_MUTANTS=…`, `PLANTWIDE_PLANTS=…`).
 
 mod harness;
 
 mod analysis;
+mod capabilities;
 mod cli;
 mod cli_errors;
 mod closing;

@@ -19,6 +19,7 @@
 
 use faer::Mat;
 use plantwide_flowsheet::Plant;
+use plantwide_model::Shape;
 
 use crate::error::{AnalysisError, request};
 use crate::linear::Linearization;
@@ -67,7 +68,7 @@ pub fn select_temperature_sensors(
     }
     if stages.len() < 2 {
         let columns: Vec<&str> =
-            plant.blocks().iter().filter(|b| b.unit.type_name() == "column").map(|b| b.name.as_str()).collect();
+            plant.blocks().iter().filter(|b| b.unit.shape() == Shape::Column).map(|b| b.name.as_str()).collect();
         return Err(request(format!(
             "{}: `{column}` has no stage temperatures `{column}.T[1]`, `{column}.T[2]`, …; columns in this flowsheet: {}",
             plant.file(),

@@ -21,6 +21,7 @@
 use std::collections::HashMap;
 
 use indexmap::IndexMap;
+use plantwide_model::Boundary;
 use plantwide_model::controllers::Mode;
 use plantwide_units::{Dimension, QuantityValue, convert_from_si, unit_dimension};
 use schemars::JsonSchema;
@@ -1178,7 +1179,7 @@ fn event(cx: &mut Cx<'_>, base: &str, e: &EventSpec) -> Vec<Event> {
 /// The flow input `F` of feed unit `unit` (refused, naming `base.unit`, if there is none).
 fn feed_flow(cx: &mut Cx<'_>, base: &str, unit: &str) -> Option<usize> {
     let input = cx.plant.input(&format!("{unit}.F"));
-    if input.is_none() || !cx.plant.blocks.iter().any(|b| b.name == *unit && b.unit.type_name() == "feed") {
+    if input.is_none() || !cx.plant.blocks.iter().any(|b| b.name == *unit && b.unit.boundary() == Boundary::Source) {
         cx.diags.push(Diagnostic::new(format!("{base}.unit"), format!("no feed unit `{unit}` with an input `F`")));
     }
     input

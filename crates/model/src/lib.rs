@@ -12,6 +12,7 @@
 #![warn(missing_docs)]
 
 pub mod build;
+pub mod capability;
 pub mod controllers;
 pub mod error;
 pub mod limits;
@@ -23,6 +24,7 @@ pub mod units;
 pub mod var;
 
 pub use build::{BuildCx, FieldError};
+pub use capability::{Booking, Boundary, Duty, DutySource, Shape, UtilityFlow};
 pub use error::{Error, InputError, SpecError};
 pub use registry::{ControllerSpec, UnitSpec};
 pub use stream::{Stream, StreamLayout};

@@ -1,6 +1,7 @@
 //! The registries: flowsheet descriptions (`"type": "..."` in JSON) mapped to unit models.
 //! Adding a unit type is one line in `unit_registry!` below (plus its file and `pub mod` line).
 
+use plantwide_units::QuantityValue;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
@@ -15,6 +16,22 @@ pub trait UnitConfig: std::fmt::Debug {
     fn ports() -> &'static str
     where
         Self: Sized;
+    /// The geometry of the vessel whose liquid level the unit holds, as written, for sizing
+    /// (default: none; `size` then refuses the unit as a vessel).
+    fn vessel(&self) -> Option<VesselGeometry<'_>> {
+        None
+    }
+}
+
+/// A vessel's cross-section (by diameter or area) and height as its description writes them.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct VesselGeometry<'a> {
+    /// Diameter, where written.
+    pub diameter: Option<&'a QuantityValue>,
+    /// Cross-sectional area, where written.
+    pub area: Option<&'a QuantityValue>,
+    /// Height, where written.
+    pub height: Option<&'a QuantityValue>,
 }
 
 macro_rules! registry {

@@ -18,6 +18,7 @@ use num_dual::Dual64;
 use plantwide_thermo::ThermoPackage;
 use plantwide_units::Dimension;
 
+use crate::capability::{Boundary, Duty, Shape, UtilityFlow};
 use crate::{InputError, Scalar, Stream, StreamLayout, VarSpec};
 
 /// A manipulable input declared by a unit.
@@ -248,6 +249,30 @@ pub trait UnitModel: Send + Sync + std::fmt::Debug {
     fn input_range(&self, _k: usize) -> Option<(f64, f64)> {
         None
     }
+    /// Its place at the plant's boundary, for the certificate and the conservation check
+    /// (default: interior; a feed is a source, a product a sink).
+    fn boundary(&self) -> Boundary {
+        Boundary::Interior
+    }
+    /// The duties it books in an energy balance of utilities, in the order reported (default:
+    /// none; a unit with a heat duty must declare it, or `compare` leaves it out of the energy use).
+    fn duties(&self) -> &'static [Duty] {
+        &[]
+    }
+    /// The utilities it uses that are flows, not duties (default: none).
+    fn utility_flows(&self) -> &'static [UtilityFlow] {
+        &[]
+    }
+    /// Whether it moves heat between process streams (a condenser–reboiler): a duty input it
+    /// drives is recovered heat, not a utility (default: false).
+    fn moves_process_heat(&self) -> bool {
+        false
+    }
+    /// How the browser simulator draws it; [`Shape::Column`] also marks the unit whose stage
+    /// temperatures sensor selection reads (default: a block).
+    fn shape(&self) -> Shape {
+        Shape::Block
+    }
 }
 
 /// Object-safe view of a [`UnitModel`], used by assembly and solvers.
@@ -304,6 +329,16 @@ pub trait Unit: Send + Sync + std::fmt::Debug {
     fn check_inputs(&self, thermo: &ThermoPackage, inputs: &[f64]) -> Result<(), InputError>;
     /// See [`UnitModel::input_range`].
     fn input_range(&self, k: usize) -> Option<(f64, f64)>;
+    /// See [`UnitModel::boundary`].
+    fn boundary(&self) -> Boundary;
+    /// See [`UnitModel::duties`].
+    fn duties(&self) -> &'static [Duty];
+    /// See [`UnitModel::utility_flows`].
+    fn utility_flows(&self) -> &'static [UtilityFlow];
+    /// See [`UnitModel::moves_process_heat`].
+    fn moves_process_heat(&self) -> bool;
+    /// See [`UnitModel::shape`].
+    fn shape(&self) -> Shape;
 }
 
 /// A controller output held at a limit with the measurement off its setpoint.
@@ -320,6 +355,21 @@ pub struct Saturation {
 impl<U: UnitModel + 'static> Unit for U {
     fn type_name(&self) -> &'static str {
         UnitModel::type_name(self)
+    }
+    fn boundary(&self) -> Boundary {
+        UnitModel::boundary(self)
+    }
+    fn duties(&self) -> &'static [Duty] {
+        UnitModel::duties(self)
+    }
+    fn utility_flows(&self) -> &'static [UtilityFlow] {
+        UnitModel::utility_flows(self)
+    }
+    fn moves_process_heat(&self) -> bool {
+        UnitModel::moves_process_heat(self)
+    }
+    fn shape(&self) -> Shape {
+        UnitModel::shape(self)
     }
     fn reacts(&self) -> bool {
         UnitModel::reacts(self)

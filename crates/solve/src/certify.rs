@@ -14,7 +14,7 @@
 //! true steady state but not the one asked for: it is returned as a [`Warning`].
 
 use plantwide_flowsheet::{BlockKind, Plant};
-use plantwide_model::{UnitIo, limits::number};
+use plantwide_model::{Boundary, UnitIo, limits::number};
 use serde::Serialize;
 
 /// Relative tolerance of the balances and of the mole-fraction sums of a Newton-converged steady
@@ -97,7 +97,7 @@ pub fn certify_to(plant: &Plant, x: &[f64], u: &[f64], tol: f64) -> Result<Vec<W
     let reacting = plant.blocks().iter().any(|b| b.unit.reacts());
     let scale = (0..plant.streams().len()).map(|s| x[plant.stream_flow_var(s)]).fold(0.0, f64::max).max(1e-12);
     for (bi, b) in plant.blocks().iter().enumerate() {
-        if b.kind != BlockKind::Unit || matches!(b.unit.type_name(), "feed" | "product") {
+        if b.kind != BlockKind::Unit || b.unit.boundary() != Boundary::Interior {
             continue;
         }
         let ins = (0..plant.streams().len()).filter(|&s| plant.streams()[s].to.0 == bi);
@@ -109,9 +109,9 @@ pub fn certify_to(plant: &Plant, x: &[f64], u: &[f64], tol: f64) -> Result<Vec<W
             return Err(fail(&b.name, format!("the holdup {path} − its lower bound"), 0.0, vec![path]));
         }
     }
-    let kind = |bi: usize| plant.blocks()[bi].unit.type_name();
-    let feeds = (0..plant.streams().len()).filter(|&s| kind(plant.streams()[s].from.0) == "feed");
-    let products = (0..plant.streams().len()).filter(|&s| kind(plant.streams()[s].to.0) == "product");
+    let boundary = |bi: usize| plant.blocks()[bi].unit.boundary();
+    let feeds = (0..plant.streams().len()).filter(|&s| boundary(plant.streams()[s].from.0) == Boundary::Source);
+    let products = (0..plant.streams().len()).filter(|&s| boundary(plant.streams()[s].to.0) == Boundary::Sink);
     if let Some((equation, rel)) = imbalance(plant, x, (feeds, products), reacting, 1e-6 * scale, tol) {
         return Err(fail("plant", format!("{equation} (feeds against products)"), rel, Vec::new()));
     }

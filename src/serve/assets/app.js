@@ -73,7 +73,7 @@ function layout(plant) {
   const w = 900 / cols, h = 300 / rows;
   const pos = {};
   for (const u of plant.units) {
-    const tall = u.type === 'column';
+    const tall = u.shape === 'column';
     pos[u.name] = { x: 40 + u.col * w + w / 2 - 40, y: 20 + u.row * h + (tall ? 10 : h / 2 - 25), w: 80, h: tall ? Math.min(h - 20, 230) : 50, u };
   }
   return pos;
@@ -81,17 +81,17 @@ function layout(plant) {
 
 function drawUnit(svg, p) {
   const g = el('g', { class: 'unit', id: 'unit-' + p.u.name }, svg);
-  const t = p.u.type;
-  if (t === 'column') {
+  const t = p.u.type, shape = p.u.shape;
+  if (shape === 'column') {
     el('rect', { x: p.x + 20, y: p.y, width: 40, height: p.h, rx: 18, fill: '#b8c4cf', stroke: '#334', 'stroke-width': 2 }, g);
     for (let k = 1; k < 8; k++) {
       const y = p.y + (p.h * k) / 8;
       el('line', { x1: p.x + 22, x2: p.x + 58, y1: y, y2: y, stroke: '#667', 'stroke-dasharray': '4 3' }, g);
     }
-  } else if (t === 'feed' || t === 'product') {
+  } else if (shape === 'source' || shape === 'sink') {
     const x = p.x + 10, y = p.y + 12;
-    el('polygon', { points: `${x},${y} ${x + 45},${y} ${x + 60},${y + 13} ${x + 45},${y + 26} ${x},${y + 26}`, fill: t === 'feed' ? '#cfe3cf' : '#e3dccf', stroke: '#334', 'stroke-width': 1.5 }, g);
-  } else if (t === 'cstr' || t === 'flash' || t === 'tank') {
+    el('polygon', { points: `${x},${y} ${x + 45},${y} ${x + 60},${y + 13} ${x + 45},${y + 26} ${x},${y + 26}`, fill: shape === 'source' ? '#cfe3cf' : '#e3dccf', stroke: '#334', 'stroke-width': 1.5 }, g);
+  } else if (shape === 'vessel') {
     el('rect', { x: p.x + 12, y: p.y, width: 56, height: 50, rx: 14, fill: '#c9d6c4', stroke: '#334', 'stroke-width': 2 }, g);
   } else {
     el('rect', { x: p.x + 10, y: p.y + 8, width: 60, height: 34, rx: 4, fill: '#d6cfc4', stroke: '#334', 'stroke-width': 1.5 }, g);

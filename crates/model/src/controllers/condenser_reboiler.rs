@@ -30,6 +30,7 @@
 //! Variables: `op` (Q_R,LP = Q [W]) and `op2` (Q_C,HP = Q [W]), algebraic. Input: `ua`.
 //! Signals: `condensing`, `boiling`.
 
+use crate::capability::{Booking, Duty, DutySource};
 use plantwide_units::{Dimension, QuantityValue};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -124,6 +125,13 @@ impl CondenserReboiler {
 impl UnitModel for CondenserReboiler {
     fn type_name(&self) -> &'static str {
         "condenser_reboiler"
+    }
+    /// Its output `op` \[W\], the heat one column's condenser gives the other's reboiler.
+    fn duties(&self) -> &'static [Duty] {
+        &[Duty { source: DutySource::Var("op"), booking: Booking::Recovered }]
+    }
+    fn moves_process_heat(&self) -> bool {
+        true
     }
     fn internal_vars(&self) -> Vec<VarSpec> {
         let nominal = self.start.max(self.ua).max(1.0);

@@ -28,6 +28,7 @@
 //! reaction enthalpy at `T` is `Δh_k + Σ_i ν_ik h_L,i(T)`, which is `Δh_k` when the components share
 //! their enthalpy function (e.g. isomers in a constant-cp model).
 
+use crate::capability::{Booking, Duty, DutySource, Shape};
 use std::collections::BTreeMap;
 
 use num_dual::Dual64;
@@ -124,6 +125,13 @@ pub struct CstrConfig {
 impl crate::registry::UnitConfig for CstrConfig {
     fn ports() -> &'static str {
         "inlet `in`, outlet `out`"
+    }
+    fn vessel(&self) -> Option<crate::registry::VesselGeometry<'_>> {
+        Some(crate::registry::VesselGeometry {
+            diameter: self.diameter.as_ref(),
+            area: self.area.as_ref(),
+            height: self.height.as_ref(),
+        })
     }
 }
 
@@ -314,6 +322,13 @@ impl Cstr {
 impl UnitModel for Cstr {
     fn type_name(&self) -> &'static str {
         "cstr"
+    }
+    fn shape(&self) -> Shape {
+        Shape::Vessel
+    }
+    /// The jacket's `Q` \[W\], heating when positive.
+    fn duties(&self) -> &'static [Duty] {
+        &[Duty { source: DutySource::Var("Q"), booking: Booking::Utility }]
     }
     fn inlet_ports(&self) -> Vec<String> {
         vec!["in".into()]

@@ -7,6 +7,7 @@
 //! Equations: `F = F_in`, `P = P_in`, `z_i = z_in,i`, and either `T = T_in` or, for a saturated
 //! liquid, the bubble-point condition `Σ K_i(T, P, z) z_i = 1`; `h = h_phase(T, z)`.
 
+use crate::capability::{Boundary, Shape};
 use std::collections::BTreeMap;
 
 use plantwide_units::{Dimension, QuantityValue};
@@ -106,6 +107,12 @@ impl Feed {
 impl UnitModel for Feed {
     fn type_name(&self) -> &'static str {
         "feed"
+    }
+    fn shape(&self) -> Shape {
+        Shape::Source
+    }
+    fn boundary(&self) -> Boundary {
+        Boundary::Source
     }
     fn inlet_ports(&self) -> Vec<String> {
         Vec::new()

@@ -42,6 +42,7 @@
 //! condition asked for `V < 0` and the run stopped at the bound). The guess puts such a drum at
 //! the feed's bubble point with `V = 0`.
 
+use crate::capability::Shape;
 use plantwide_units::{Dimension, QuantityValue};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -80,6 +81,13 @@ impl crate::registry::UnitConfig for FlashConfig {
     fn ports() -> &'static str {
         "inlet `in`, outlets `vapour` and `liquid`"
     }
+    fn vessel(&self) -> Option<crate::registry::VesselGeometry<'_>> {
+        Some(crate::registry::VesselGeometry {
+            diameter: self.diameter.as_ref(),
+            area: self.area.as_ref(),
+            height: self.height.as_ref(),
+        })
+    }
 }
 
 /// A flash drum.
@@ -108,6 +116,9 @@ impl Flash {
 impl UnitModel for Flash {
     fn type_name(&self) -> &'static str {
         "flash"
+    }
+    fn shape(&self) -> Shape {
+        Shape::Vessel
     }
     fn inlet_ports(&self) -> Vec<String> {
         vec!["in".into()]

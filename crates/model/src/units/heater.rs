@@ -6,6 +6,7 @@
 //! Equations: `F_out = F_in`, `z_out = z_in`, `P_out = P_in − ΔP`, energy `F (h_out − h_in) = Q`,
 //! outlet state `h_out = h_phase(T_out, z)`, and either `Q = duty` or `T_out = T_set`.
 
+use crate::capability::{Booking, Duty, DutySource};
 use plantwide_units::{Dimension, QuantityValue};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -76,6 +77,10 @@ impl Heater {
 impl UnitModel for Heater {
     fn type_name(&self) -> &'static str {
         "heater"
+    }
+    /// `Q` \[W\], heating when positive.
+    fn duties(&self) -> &'static [Duty] {
+        &[Duty { source: DutySource::Var("Q"), booking: Booking::Utility }]
     }
     fn inlet_ports(&self) -> Vec<String> {
         vec!["in".into()]

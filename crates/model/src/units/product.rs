@@ -2,6 +2,7 @@
 //!
 //! Port: inlet `in`.
 
+use crate::capability::{Boundary, Shape};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
@@ -32,6 +33,12 @@ impl Product {
 impl UnitModel for Product {
     fn type_name(&self) -> &'static str {
         "product"
+    }
+    fn shape(&self) -> Shape {
+        Shape::Sink
+    }
+    fn boundary(&self) -> Boundary {
+        Boundary::Sink
     }
     fn inlet_ports(&self) -> Vec<String> {
         vec!["in".into()]

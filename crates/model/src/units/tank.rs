@@ -17,6 +17,7 @@
 //! With a `flow` outflow the tank is a pure integrator: at steady state its holdup is undetermined
 //! unless a level controller moves `outflow`.
 
+use crate::capability::Shape;
 use plantwide_units::{Dimension, QuantityValue};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -56,6 +57,13 @@ impl crate::registry::UnitConfig for TankConfig {
     fn ports() -> &'static str {
         "inlet `in`, outlet `out`"
     }
+    fn vessel(&self) -> Option<crate::registry::VesselGeometry<'_>> {
+        Some(crate::registry::VesselGeometry {
+            diameter: self.diameter.as_ref(),
+            area: self.area.as_ref(),
+            height: self.height.as_ref(),
+        })
+    }
 }
 
 /// A surge tank.
@@ -84,6 +92,9 @@ impl Tank {
 impl UnitModel for Tank {
     fn type_name(&self) -> &'static str {
         "tank"
+    }
+    fn shape(&self) -> Shape {
+        Shape::Vessel
     }
     fn inlet_ports(&self) -> Vec<String> {
         vec!["in".into()]

@@ -11,7 +11,7 @@
 use serde::Serialize;
 
 use plantwide_flowsheet::{BlockKind, Plant};
-use plantwide_model::UnitIo;
+use plantwide_model::{Boundary, UnitIo};
 
 /// Largest relative conservation error [`Conservation::check`] accepts.
 ///
@@ -139,16 +139,16 @@ impl Conservation {
     }
 }
 
-/// The boundary streams: `(stream, +1)` for the outlets of `feed` units, `(stream, −1)` for the
-/// inlets of `product` units.
+/// The boundary streams: `(stream, +1)` for the outlets of source units (feeds), `(stream, −1)`
+/// for the inlets of sink units (products), as each unit declares its [`Boundary`].
 pub fn boundary_streams(plant: &Plant) -> Vec<(usize, f64)> {
-    let type_of = |b: usize| (plant.blocks()[b].kind == BlockKind::Unit).then(|| plant.blocks()[b].unit.type_name());
+    let boundary = |b: usize| (plant.blocks()[b].kind == BlockKind::Unit).then(|| plant.blocks()[b].unit.boundary());
     let mut v = Vec::new();
     for (k, s) in plant.streams().iter().enumerate() {
-        if type_of(s.from.0) == Some("feed") {
+        if boundary(s.from.0) == Some(Boundary::Source) {
             v.push((k, 1.0));
         }
-        if type_of(s.to.0) == Some("product") {
+        if boundary(s.to.0) == Some(Boundary::Sink) {
             v.push((k, -1.0));
         }
     }

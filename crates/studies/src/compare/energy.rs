@@ -1,6 +1,7 @@
 //! The energy a scheme uses at its steady state: every duty of its units, read from the units'
 //! own variables and inputs, classed as heating (a utility in), cooling (a utility out) or
-//! recovered (heat moved between process streams by an exchanger).
+//! recovered (heat moved between process streams by an exchanger). Each unit declares its duties
+//! ([`plantwide_model::UnitModel::duties`]); those of the library's units:
 //!
 //! - `heater` (heater or cooler): its duty `Q` [W], heating when positive, cooling when negative;
 //! - `cstr`: `Q` [W], the heat into the reactor (a jacket's is negative: cooling);
@@ -60,54 +61,65 @@ fn input_value(plant: &Plant, x: &[f64], u: &[f64], path: &str) -> Option<f64> {
     Some(plant.inputs()[i].driven_by.map_or(u[i], |v| x[v]))
 }
 
-/// Whether input `path` is driven by a condenser–reboiler (heat recovered, not a utility).
+/// Whether input `path` is driven by a unit that moves heat between process streams (a
+/// condenser–reboiler): heat recovered, not a utility.
 fn driven_by_coupling(plant: &Plant, path: &str) -> bool {
     let driver = plant.input(path).and_then(|i| plant.inputs()[i].driven_by);
-    driver.is_some_and(|v| plant.blocks()[plant.vars()[v].block].unit.type_name() == "condenser_reboiler")
+    driver.is_some_and(|v| plant.blocks()[plant.vars()[v].block].unit.moves_process_heat())
 }
 
-/// The energy use of `plant` at steady state `(x, u)`.
+/// The energy use of `plant` at steady state `(x, u)`: each unit's declared duties
+/// ([`plantwide_model::UnitModel::duties`]) and utility flows, in the order of its blocks.
 pub fn energy(plant: &Plant, x: &[f64], u: &[f64]) -> Energy {
     let mut duties = Vec::new();
     let mut other = Vec::new();
-    let mut push = |path: String, value: f64, positive: &'static str, negative: &'static str| {
-        if value != 0.0 {
-            duties.push(Duty { path, kind: if value > 0.0 { positive } else { negative }, duty: value.abs() });
-        }
-    };
     for b in plant.blocks() {
-        let var = |name: &str| plant.var(&format!("{}.{name}", b.name)).map(|v| x[v]);
-        match b.unit.type_name() {
-            "heater" | "cstr" => push(format!("{}.Q", b.name), var("Q").unwrap_or(0.0), "heating", "cooling"),
-            "heat_exchanger" => push(format!("{}.Q", b.name), var("Q").unwrap_or(0.0), "recovered", "recovered"),
-            "condenser_reboiler" => push(format!("{}.op", b.name), var("op").unwrap_or(0.0), "recovered", "recovered"),
-            "column" => {
-                for name in ["reboiler_duty", "auxiliary_reboiler_duty"] {
-                    let path = format!("{}.{name}", b.name);
-                    if let Some(q) = input_value(plant, x, u, &path).filter(|_| !driven_by_coupling(plant, &path)) {
-                        push(path, q, "heating", "cooling");
-                    }
-                }
-                let condenser = format!("{}.condenser_duty", b.name);
-                let coupled = match driven_by_coupling(plant, &condenser) {
-                    true => input_value(plant, x, u, &condenser).unwrap_or(0.0),
-                    false => 0.0,
-                };
-                if let Some(qc) = var("Qc") {
-                    push(format!("{}.Qc", b.name), coupled - qc, "heating", "cooling");
-                }
-                for (name, unit) in [("steam_flow", "kg/s"), ("boilup", "mol/s")] {
-                    let path = format!("{}.{name}", b.name);
-                    if let Some(value) = input_value(plant, x, u, &path) {
-                        other.push(OtherUtility { path, value, unit: unit.into() });
-                    }
-                }
+        for d in b.unit.duties() {
+            if let Some(duty) = booked(plant, x, u, &b.name, d) {
+                duties.push(duty);
             }
-            _ => {}
+        }
+        for f in b.unit.utility_flows() {
+            let path = format!("{}.{}", b.name, f.input);
+            if let Some(value) = input_value(plant, x, u, &path) {
+                other.push(OtherUtility { path, value, unit: f.unit.into() });
+            }
         }
     }
     let total = |kind: &str| duties.iter().filter(|d| d.kind == kind).map(|d| d.duty).sum::<f64>() + 0.0;
     Energy { heating: total("heating"), cooling: total("cooling"), recovered: total("recovered"), duties, other }
+}
+
+/// Duty `d` of unit `unit` as booked at `(x, u)`; `None` where it is absent (a variable or input
+/// this unit's configuration does not have, an input driven by a coupling) or zero.
+fn booked(plant: &Plant, x: &[f64], u: &[f64], unit: &str, d: &plantwide_model::Duty) -> Option<Duty> {
+    use plantwide_model::{Booking, DutySource};
+    let (path, value) = match d.source {
+        DutySource::Var(name) => {
+            let path = format!("{unit}.{name}");
+            let value = plant.var(&path).map(|v| x[v]);
+            (path, value)
+        }
+        DutySource::Input(name) => {
+            let path = format!("{unit}.{name}");
+            let value = input_value(plant, x, u, &path).filter(|_| !driven_by_coupling(plant, &path));
+            (path, value)
+        }
+    };
+    let value = value?;
+    let (value, positive, negative) = match d.booking {
+        Booking::Utility => (value, "heating", "cooling"),
+        Booking::Recovered => (value, "recovered", "recovered"),
+        Booking::Removed { coupled } => {
+            let input = format!("{unit}.{coupled}");
+            let coupled = match driven_by_coupling(plant, &input) {
+                true => input_value(plant, x, u, &input).unwrap_or(0.0),
+                false => 0.0,
+            };
+            (coupled - value, "heating", "cooling")
+        }
+    };
+    (value != 0.0).then(|| Duty { path, kind: if value > 0.0 { positive } else { negative }, duty: value.abs() })
 }
 
 /// Utility prices and the hours a year the plant runs, to cost the duties of [`Energy`].

@@ -45,7 +45,7 @@ pub fn residence_times(plant: &Plant, x: &[f64]) -> Vec<Residence> {
                     (format!("{name}.sump"), at(&format!("{name}.M[1]")), sump),
                 ]
             }
-            UnitSpec::Tank(_) | UnitSpec::Cstr(_) | UnitSpec::Flash(_) => {
+            u if u.config().vessel().is_some() => {
                 let out_flow: f64 = outlet_streams(plant, name).iter().filter_map(|s| at(&format!("{s}.F"))).sum();
                 vec![(name.clone(), at(&format!("{name}.M")), Some(out_flow))]
             }

@@ -15,7 +15,6 @@
 
 use plantwide_analysis::linear::Linearization;
 use plantwide_flowsheet::{Plant, StructureEdit};
-use plantwide_model::UnitSpec;
 use plantwide_solve::SteadyError;
 
 use super::run::near_limits;
@@ -60,7 +59,7 @@ pub(super) fn design_steady(
     };
     match (&v.kind, normal) {
         (Kind::Area { area: a0, unit, .. }, _) => {
-            let reacts = matches!(v.plant.spec().units.get(unit), Some(UnitSpec::Cstr(_)));
+            let reacts = v.plant.block_index(unit).is_some_and(|b| v.plant.blocks()[b].unit.reacts());
             let why = match (reacts, area < *a0) {
                 (false, _) => String::new(),
                 (true, smaller) => format!(

@@ -199,14 +199,10 @@ impl Vessel {
 
 /// `(written as diameter, area [m²], height [m])` of a unit with a level.
 fn geometry(u: &UnitSpec) -> Option<(bool, f64, Option<f64>)> {
-    let (d, a, h) = match u {
-        UnitSpec::Tank(c) => (&c.diameter, &c.area, &c.height),
-        UnitSpec::Cstr(c) => (&c.diameter, &c.area, &c.height),
-        UnitSpec::Flash(c) => (&c.diameter, &c.area, &c.height),
-        _ => return None,
-    };
+    let g = u.config().vessel()?;
+    let (d, a, h) = (g.diameter, g.area, g.height);
     let si = |q: &QuantityValue, dim| q.to_si(dim).ok();
-    let height = h.as_ref().and_then(|h| si(h, Dimension::LENGTH));
+    let height = h.and_then(|h| si(h, Dimension::LENGTH));
     match (d, a) {
         (Some(d), _) => si(d, Dimension::LENGTH).map(|d| (true, std::f64::consts::PI * d * d / 4.0, height)),
         (None, Some(a)) => si(a, Dimension::AREA).map(|a| (false, a, height)),

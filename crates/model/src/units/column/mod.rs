@@ -20,6 +20,7 @@
 pub mod rigorous;
 pub mod simple;
 
+use crate::capability::{Booking, Duty, DutySource, Shape, UtilityFlow};
 use plantwide_units::QuantityValue;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -296,6 +297,22 @@ macro_rules! delegate {
 impl UnitModel for Column {
     fn type_name(&self) -> &'static str {
         "column"
+    }
+    /// The reboilers' inputs (utilities unless a condenser–reboiler drives them) and the
+    /// condenser's `Qc`, cooling less what a coupled `condenser_duty` gives another column.
+    fn duties(&self) -> &'static [Duty] {
+        &[
+            Duty { source: DutySource::Input("reboiler_duty"), booking: Booking::Utility },
+            Duty { source: DutySource::Input("auxiliary_reboiler_duty"), booking: Booking::Utility },
+            Duty { source: DutySource::Var("Qc"), booking: Booking::Removed { coupled: "condenser_duty" } },
+        ]
+    }
+    /// A rigorous column's reboiler steam \[kg/s\], a simple column's boilup \[mol/s\].
+    fn utility_flows(&self) -> &'static [UtilityFlow] {
+        &[UtilityFlow { input: "steam_flow", unit: "kg/s" }, UtilityFlow { input: "boilup", unit: "mol/s" }]
+    }
+    fn shape(&self) -> Shape {
+        Shape::Column
     }
     fn inlet_ports(&self) -> Vec<String> {
         delegate!(self, inlet_ports())

@@ -36,6 +36,7 @@
 
 pub mod dynamic;
 
+use crate::capability::{Booking, Duty, DutySource};
 use num_dual::Dual64;
 use plantwide_units::{Dimension, QuantityValue};
 use schemars::JsonSchema;
@@ -206,6 +207,10 @@ fn holdups(config: &HeatExchangerConfig, cx: &mut BuildCx<'_>) -> Option<dynamic
 impl UnitModel for HeatExchanger {
     fn type_name(&self) -> &'static str {
         "heat_exchanger"
+    }
+    /// `Q` \[W\], moved from the hot side to the cold.
+    fn duties(&self) -> &'static [Duty] {
+        &[Duty { source: DutySource::Var("Q"), booking: Booking::Recovered }]
     }
     fn inlet_ports(&self) -> Vec<String> {
         vec!["hot_in".into(), "cold_in".into()]

@@ -1,0 +1,76 @@
+//! What units declare of themselves (`crates/model/src/capability.rs`), checked against their
+//! structure on every shipped flowsheet, so that a unit which forgets a declaration fails here
+//! rather than giving a silently wrong certificate or energy balance.
+
+use plantwide::flowsheet::{BlockKind, Plant, load_file};
+use plantwide::model::{Boundary, DutySource};
+
+fn shipped() -> Vec<(String, Plant)> {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("flowsheets");
+    let mut plants = Vec::new();
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        let name = path.file_name().unwrap().to_string_lossy().to_string();
+        if path.extension().is_some_and(|e| e == "json") && !name.ends_with("schema.json") {
+            plants.push((name, load_file(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))));
+        }
+    }
+    assert!(plants.len() >= 15, "{} flowsheets", plants.len());
+    plants
+}
+
+/// A source has no inlet and a sink no outlet; every unit without an inlet is a source and every
+/// one without an outlet a sink (material cannot appear or vanish elsewhere).
+#[test]
+fn boundaries_are_where_material_enters_and_leaves() {
+    for (file, plant) in shipped() {
+        for b in plant.blocks().iter().filter(|b| b.kind == BlockKind::Unit) {
+            let (ins, outs) = (b.unit.inlet_ports().len(), b.unit.outlet_ports().len());
+            let expected = match (ins, outs) {
+                (0, _) => Boundary::Source,
+                (_, 0) => Boundary::Sink,
+                _ => Boundary::Interior,
+            };
+            assert_eq!(b.unit.boundary(), expected, "{file}: unit `{}` ({})", b.name, b.unit.type_name());
+        }
+    }
+}
+
+/// Every heat duty a unit carries (an own variable `Q` or `Qc`, an input named `…_duty`) is one
+/// it declares, so that `compare`'s energy use cannot leave it out; a coupled condenser duty is
+/// declared through its condenser's booking.
+#[test]
+fn every_heat_duty_is_declared() {
+    use plantwide::model::Booking;
+    for (file, plant) in shipped() {
+        for (bi, b) in plant.blocks().iter().enumerate() {
+            let declared: Vec<&str> = b
+                .unit
+                .duties()
+                .iter()
+                .flat_map(|d| {
+                    let source = match d.source {
+                        DutySource::Var(n) | DutySource::Input(n) => n,
+                    };
+                    let coupled = match d.booking {
+                        Booking::Removed { coupled } => Some(coupled),
+                        _ => None,
+                    };
+                    std::iter::once(source).chain(coupled)
+                })
+                .collect();
+            let local = |path: &str| path.strip_prefix(&format!("{}.", b.name)).map(str::to_string);
+            let vars = plant.vars().iter().filter(|v| v.block == bi).filter_map(|v| local(&v.path));
+            let inputs = plant.inputs().iter().filter(|i| i.block == bi).filter_map(|i| local(&i.path));
+            let duties = vars.filter(|n| n == "Q" || n == "Qc").chain(inputs.filter(|n| n.ends_with("_duty")));
+            for name in duties {
+                assert!(
+                    declared.contains(&name.as_str()),
+                    "{file}: `{}.{name}` is a duty `{}` does not declare",
+                    b.name,
+                    b.unit.type_name()
+                );
+            }
+        }
+    }
+}
