@@ -11,8 +11,8 @@ section so that any number can be reproduced by hand.
 
 Outputs: `<out>/two_column_plant.md`, `<out>/two_column_plant/*.png|csv`, the variant
 flowsheets and scenarios under `<out>/two_column_plant/inputs/`, and
-`<out>/two_column_plant/results.json` (the numbers the test pins with PLANTWIDE_FULL_STUDY=1:
-`cargo test --test it two_column_study::`).
+`<out>/two_column_plant/results.json` (the numbers the test pins, ignored by default:
+`cargo test --test it two_column_study:: -- --include-ignored`).
 """
 
 import argparse

@@ -213,13 +213,10 @@ fn the_certificate_fails_on_a_state_that_violates_a_balance() {
 /// trays (a singular Jacobian there), which was reported as "the inventory of `lp` is uncontrolled"
 /// although every drum and sump has a level loop. The diagnosis is now confirmed or refuted at the
 /// converged point: the plant converges, and the true problem — `lp_xB` saturated at op_min — is a
-/// warning. About 10 s in release, a minute in the test profile: opt-in with PLANTWIDE_SLOW_TESTS=1.
+/// warning. About 10 s in release, a minute in the test profile: run with `-- --include-ignored`.
 #[test]
+#[ignore = "slow: a two-column methanol-water plant from a dry-tray guess, about a minute in the test profile"]
 fn a_singular_guess_is_not_called_an_uncontrolled_inventory() {
-    if std::env::var_os("PLANTWIDE_SLOW_TESTS").is_none() {
-        eprintln!("skipped: set PLANTWIDE_SLOW_TESTS=1 to run");
-        return;
-    }
     let file = case("meoh_2col_design.json");
     let out = harness::command().args(["steady", &file, "--json"]).output().unwrap();
     assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
