@@ -119,7 +119,7 @@ fn poisoned() -> ApiError {
 
 /// `POST /api/command`: one command object; `{"ok": true, "at": sync point}` or 400.
 pub async fn command(State(app): State<App>, body: Bytes) -> Result<Json<Value>, ApiError> {
-    let cmd = parse_command(&body).map_err(|m| ApiError(StatusCode::BAD_REQUEST, m))?;
+    let cmd = parse_command(&body).map_err(|e| ApiError(StatusCode::BAD_REQUEST, e.to_string()))?;
     let at = ask(&app, |tx| Request::Command(cmd, tx)).await??;
     Ok(Json(json!({ "ok": true, "at": at })))
 }
