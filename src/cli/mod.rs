@@ -240,22 +240,33 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
     }
 }
 
+/// Why a flag's value cannot name a file to write.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub(crate) enum OutputFileError {
+    /// The value is empty.
+    #[error("an empty path: give a file name")]
+    Empty,
+    /// It names a folder.
+    #[error("`{0}` is a folder: give a file name in it")]
+    Folder(String),
+    /// Its folder does not exist.
+    #[error("the folder `{0}` does not exist: create it, or write the file elsewhere")]
+    NoFolder(String),
+}
+
 /// The value of a flag naming a file to write: its folder must exist and it must not be a folder,
 /// checked when the command line is read (a run is not started only to fail at its end).
-pub(crate) fn output_file(value: &str) -> Result<PathBuf, String> {
+pub(crate) fn output_file(value: &str) -> Result<PathBuf, OutputFileError> {
     let path = PathBuf::from(value);
     if value.is_empty() {
-        return Err("an empty path: give a file name".into());
+        return Err(OutputFileError::Empty);
     }
     if path.is_dir() {
-        return Err(format!("`{value}` is a folder: give a file name in it"));
+        return Err(OutputFileError::Folder(value.to_string()));
     }
     let folder = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
     if !folder.is_dir() {
-        return Err(format!(
-            "the folder `{}` does not exist: create it, or write the file elsewhere",
-            folder.display()
-        ));
+        return Err(OutputFileError::NoFolder(folder.display().to_string()));
     }
     Ok(path)
 }

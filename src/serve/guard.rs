@@ -232,8 +232,8 @@ impl Guard {
             return Err(Refusal::Site(clip(s)));
         }
         let command = !matches!(*req.method(), Method::GET | Method::HEAD);
-        if command && let Err(got) = json_content(req.headers()) {
-            return Err(Refusal::ContentType(got));
+        if command {
+            json_content(req.headers())?;
         }
         if !self.carries_token(req) {
             if self.everywhere {
@@ -259,10 +259,11 @@ fn clip(value: &str) -> String {
     value.chars().take(100).collect()
 }
 
-/// `Ok` for `application/json` with at most a `charset=utf-8` parameter; else what was sent.
-fn json_content(headers: &HeaderMap) -> Result<(), String> {
-    let Some(value) = headers.get(header::CONTENT_TYPE) else { return Err("(none)".into()) };
-    let got = || clip(&String::from_utf8_lossy(value.as_bytes()));
+/// `Ok` for `application/json` with at most a `charset=utf-8` parameter; else the refusal
+/// quoting what was sent.
+fn json_content(headers: &HeaderMap) -> Result<(), Refusal> {
+    let Some(value) = headers.get(header::CONTENT_TYPE) else { return Err(Refusal::ContentType("(none)".into())) };
+    let got = || Refusal::ContentType(clip(&String::from_utf8_lossy(value.as_bytes())));
     let text = value.to_str().map_err(|_| got())?;
     let mut parts = text.split(';').map(str::trim);
     let essence = parts.next().is_some_and(|m| m.eq_ignore_ascii_case("application/json"));
@@ -370,8 +371,8 @@ mod tests {
             "application/json; charset=utf-8; x=y",
             "application/jsonx",
         ] {
-            assert_eq!(with(bad), Err(bad.to_string()), "{bad}");
+            assert_eq!(with(bad), Err(Refusal::ContentType(bad.to_string())), "{bad}");
         }
-        assert_eq!(json_content(&HeaderMap::new()), Err("(none)".into()));
+        assert_eq!(json_content(&HeaderMap::new()), Err(Refusal::ContentType("(none)".into())));
     }
 }

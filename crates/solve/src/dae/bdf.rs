@@ -197,17 +197,17 @@ impl BdfState {
     /// Jacobian's indices (a snapshot file is read from outside).
     ///
     /// # Errors
-    /// What does not fit, in a sentence.
-    pub fn check(&self, n: usize) -> Result<(), String> {
+    /// [`StateMismatch`]: what does not fit.
+    pub fn check(&self, n: usize) -> Result<(), StateMismatch> {
         if self.d.len() != MAX_ORDER + 3 || self.d.iter().any(|r| r.len() != n) {
-            return Err(format!("expected {} history rows of length {n}", MAX_ORDER + 3));
+            return Err(StateMismatch::History { rows: MAX_ORDER + 3, n });
         }
         if !(1..=MAX_ORDER).contains(&self.order) || self.jac.iter().any(|&(i, j, _)| i >= n || j >= n) {
-            return Err("order or Jacobian out of range".into());
+            return Err(StateMismatch::OrderOrJacobian);
         }
         let finite = |v: f64| v.is_finite();
         if !(finite(self.t) && finite(self.h_abs) && self.h_abs > 0.0) {
-            return Err("time or step size not a positive finite number".into());
+            return Err(StateMismatch::TimeOrStep);
         }
         // The differences of a run's history are steps' changes of its state: a difference 1e12
         // times the largest state value is no run's (a hand-edited file), and summing it into the
@@ -216,9 +216,7 @@ impl BdfState {
         let largest = x0.iter().fold(1.0_f64, |m, v| m.max(v.abs()));
         let bound = |i: usize| 1e12 * x0[i].abs().max(1e-3 * largest);
         if self.d.iter().any(|r| r.iter().enumerate().any(|(i, v)| v.is_nan() || v.abs() > bound(i))) {
-            return Err(
-                "a history entry beyond 1e12 times its variable's value (or 1e-3 of the largest), or not finite".into(),
-            );
+            return Err(StateMismatch::Difference);
         }
         let s = &self.stats;
         let counts = [
@@ -234,7 +232,7 @@ impl BdfState {
         // A run counts up from these: a count near the top of `usize` is no run's (a hand-edited
         // file), and counting on would overflow.
         if counts.iter().any(|&c| c > MAX_COUNT) {
-            return Err(format!("a statistics count above {MAX_COUNT}, which no run reaches"));
+            return Err(StateMismatch::Count);
         }
         Ok(())
     }
@@ -242,6 +240,31 @@ impl BdfState {
 
 /// The largest statistics count a restored state may hold (2⁵³: far beyond any run's).
 const MAX_COUNT: usize = 1 << 53;
+
+/// Why a restored integrator state does not fit the system.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum StateMismatch {
+    /// The history's shape.
+    #[error("expected {rows} history rows of length {n}")]
+    History {
+        /// Rows expected.
+        rows: usize,
+        /// The system's size.
+        n: usize,
+    },
+    /// The order or a Jacobian index.
+    #[error("order or Jacobian out of range")]
+    OrderOrJacobian,
+    /// The time or the step size.
+    #[error("time or step size not a positive finite number")]
+    TimeOrStep,
+    /// A history entry no run makes.
+    #[error("a history entry beyond 1e12 times its variable's value (or 1e-3 of the largest), or not finite")]
+    Difference,
+    /// A statistics count no run reaches.
+    #[error("a statistics count above {MAX_COUNT}, which no run reaches")]
+    Count,
+}
 
 /// The BDF integrator (see the module documentation).
 #[derive(Debug)]

@@ -168,7 +168,7 @@ pub enum DaeError {
     },
     /// A restored state does not fit the system.
     #[error("integrator state does not fit the system: {0}")]
-    BadState(String),
+    BadState(bdf::StateMismatch),
 }
 
 /// A consistent initialization that failed: where, and what the algebraic equations asked for.

@@ -73,10 +73,10 @@ struct RawStepModelFile {
 }
 
 impl TryFrom<RawStepModelFile> for StepModelFile {
-    type Error = String;
-    fn try_from(r: RawStepModelFile) -> Result<Self, String> {
+    type Error = plantwide_mpc::MpcError;
+    fn try_from(r: RawStepModelFile) -> Result<Self, Self::Error> {
         let model = StepModel { ts: r.ts, ny: r.ny, nu: r.nu, steps: r.steps };
-        model.validate().map_err(|e| e.to_string())?;
+        model.validate()?;
         Ok(StepModelFile { inputs: r.inputs, outputs: r.outputs, model })
     }
 }
@@ -298,25 +298,23 @@ fn model_file(plant: &Plant, name: &str, cfg: &MpcConfig, file: &str, p: &MpcPla
     if m.model.ny != ny || m.model.nu != nu {
         return Err(bad(format!("is {}×{} but the controller has {ny} CVs and {nu} MVs", m.model.ny, m.model.nu)));
     }
-    check_channels(plant, cfg, &m).map_err(bad)?;
+    check_channels(plant, cfg, &m).map_err(|e| bad(e.to_string()))?;
     if (m.model.ts - p.sample_time).abs() > 1e-9 * p.sample_time {
         return Err(bad(format!(
             "is sampled every {} s but the controller executes every {} s: give sample_time = {} s",
             m.model.ts, p.sample_time, m.model.ts
         )));
     }
-    check_gain(&scaled(&m.model, p)).map_err(bad)?;
+    check_gain(&scaled(&m.model, p)).map_err(|e| bad(e.to_string()))?;
     Ok(m.model)
 }
 
 /// The file's `outputs` must be the controller's CVs (`cvs[k].pv`) and its `inputs` the inputs
 /// its MVs drive (`mvs[k].output`), in the same order, compared as resolved variables and inputs
 /// (so `stream.z[c]` and `stream.x[c]` are one).
-fn check_channels(plant: &Plant, cfg: &MpcConfig, m: &StepModelFile) -> Result<(), String> {
+fn check_channels(plant: &Plant, cfg: &MpcConfig, m: &StepModelFile) -> Result<(), ModelMismatch> {
     if m.inputs.is_empty() || m.outputs.is_empty() {
-        return Err("names no channels: give \"inputs\" (the MVs' driven inputs) and \"outputs\" (the CVs), in the \
-                    order of the controller's mvs and cvs, as `plantwide identify --report` writes them"
-            .to_string());
+        return Err(ModelMismatch::NoChannels);
     }
     let want_out: Vec<&str> = cfg.cvs.iter().map(|c| c.pv.as_str()).collect();
     let want_in: Vec<&str> = cfg.mvs.iter().map(|v| v.output.as_str()).collect();
@@ -334,7 +332,11 @@ fn check_channels(plant: &Plant, cfg: &MpcConfig, m: &StepModelFile) -> Result<(
             if v.len() > 8 { format!("{}, … ({} in all)", shown.join(", "), v.len()) } else { shown.join(", ") }
         };
         let got: Vec<&str> = got.iter().map(String::as_str).collect();
-        format!("\"{what}\" are [{}] but the controller's {field} are [{}]{order}", list(&got), list(want))
+        ModelMismatch::Channels(format!(
+            "\"{what}\" are [{}] but the controller's {field} are [{}]{order}",
+            list(&got),
+            list(want)
+        ))
     };
     if m.outputs.len() != want_out.len() || !m.outputs.iter().zip(&want_out).all(|(a, b)| same_var(a, b)) {
         return Err(mismatch("outputs", "CVs (cvs[k].pv)", &m.outputs, &want_out));
@@ -348,24 +350,53 @@ fn check_channels(plant: &Plant, cfg: &MpcConfig, m: &StepModelFile) -> Result<(
 /// A model the controller can use: finite in its scaled variables, and a steady-state gain of
 /// full rank (σ_min > 1e-12 σ_max): with a singular gain no move sets the CVs independently, and
 /// the QP drives the MVs along the null direction without bound.
-fn check_gain(scaled: &StepModel) -> Result<(), String> {
+fn check_gain(scaled: &StepModel) -> Result<(), ModelMismatch> {
     if scaled.steps.iter().flatten().any(|v| !v.is_finite()) {
-        return Err("its coefficients overflow in the controller's scaled variables (coefficient × MV scale / CV \
-                    scale): check the coefficients' units (SI) and the scales"
-            .to_string());
+        return Err(ModelMismatch::Overflow);
     }
     let g = scaled.gain();
     let (ny, nu) = (scaled.ny, scaled.nu);
-    let svd = faer::Mat::<f64>::from_fn(ny, nu, |i, j| g[i][j]).thin_svd().map_err(|_| "its gain has no SVD")?;
+    let svd = faer::Mat::<f64>::from_fn(ny, nu, |i, j| g[i][j]).thin_svd().map_err(|_| ModelMismatch::NoSvd)?;
     let s = svd.S().column_vector();
     let (hi, lo) = (s[0], s[ny.min(nu) - 1]);
     if lo.is_nan() || lo <= 1e-12 * hi {
-        return Err(format!(
-            "its steady-state gain (last step coefficients, in the controller's scales) is singular: singular values \
-             {hi:.4e} … {lo:.4e}; no MV move sets the CVs independently — check the model, or control fewer CVs"
-        ));
+        return Err(ModelMismatch::Singular { hi, lo });
     }
     Ok(())
+}
+
+/// Why a step-response model file does not fit its controller.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+enum ModelMismatch {
+    /// It lists no inputs or outputs.
+    #[error(
+        "names no channels: give \"inputs\" (the MVs' driven inputs) and \"outputs\" (the CVs), in the order of the \
+         controller's mvs and cvs, as `plantwide identify --report` writes them"
+    )]
+    NoChannels,
+    /// Its channels are not the controller's: which, against which.
+    #[error("{0}")]
+    Channels(String),
+    /// Its coefficients overflow once scaled.
+    #[error(
+        "its coefficients overflow in the controller's scaled variables (coefficient × MV scale / CV scale): check \
+         the coefficients' units (SI) and the scales"
+    )]
+    Overflow,
+    /// Its gain has no SVD.
+    #[error("its gain has no SVD")]
+    NoSvd,
+    /// Its steady-state gain is singular.
+    #[error(
+        "its steady-state gain (last step coefficients, in the controller's scales) is singular: singular values \
+         {hi:.4e} … {lo:.4e}; no MV move sets the CVs independently — check the model, or control fewer CVs"
+    )]
+    Singular {
+        /// Largest singular value.
+        hi: f64,
+        /// Smallest.
+        lo: f64,
+    },
 }
 
 impl MpcRun {

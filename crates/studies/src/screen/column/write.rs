@@ -28,7 +28,7 @@ pub(super) fn flowsheet(
     // default (a PID's bias follows its output's field), found in the next pass.
     let mut left = Vec::new();
     for _ in 0..4 {
-        let text = render(&doc, tuned).map_err(&fail)?;
+        let text = render(&doc, tuned).map_err(|e| fail(e.to_string()))?;
         let written =
             plantwide_flowsheet::load_str(&text, &s.name).map_err(|e| fail(format!("it does not load: {e}")))?;
         let value = |path: &str| written.input(path).map_or(f64::NAN, |j| written.inputs()[j].value);
@@ -66,15 +66,14 @@ pub(super) fn flowsheet(
 
 /// `doc` as file text in the description's own order: its sections as the format lists them, and
 /// units, streams, controllers and input names in `tuned`'s order (a JSON object would sort them).
-fn render(doc: &serde_json::Value, tuned: &Plant) -> Result<String, String> {
-    let mut spec: plantwide_flowsheet::FlowsheetSpec =
-        serde_json::from_value(doc.clone()).map_err(|e| e.to_string())?;
+fn render(doc: &serde_json::Value, tuned: &Plant) -> serde_json::Result<String> {
+    let mut spec: plantwide_flowsheet::FlowsheetSpec = serde_json::from_value(doc.clone())?;
     let order = tuned.spec();
     spec.units.sort_by_cached_key(|k, _| order.units.get_index_of(k));
     spec.streams.sort_by_cached_key(|k, _| order.streams.get_index_of(k));
     spec.controllers.sort_by_cached_key(|k, _| order.controllers.get_index_of(k));
     spec.inputs.sort_by_cached_key(|k, _| order.inputs.get_index_of(k));
-    serde_json::to_string_pretty(&spec).map(|t| t + "\n").map_err(|e| e.to_string())
+    serde_json::to_string_pretty(&spec).map(|t| t + "\n")
 }
 
 /// Set the field that holds input `path` (`unit.field`, in the unit's or controller's
