@@ -647,13 +647,8 @@ fn simc_on_a_lag_dominant_loop_takes_the_dead_time_of_its_start() {
     std::fs::create_dir_all(&dir).unwrap();
     let written = dir.join("tuned.json");
     let coarse = [&args[..], &["--scan", "1000 s", "--write", written.to_str().unwrap()]].concat();
-    let out = plantwide(&coarse);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "{err}");
+    let (err, l) = refuted_by_its_margins(&coarse);
     assert!(err.contains("unstable on the plant's exact linear model") && err.contains("nothing written"), "{err}");
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    let l = &v["loops"][0];
-    assert!(l["margins"]["phase_margin"].as_f64().unwrap() < 0.0 && l["failure"].is_string(), "{l}");
     assert!(l.get("initial_fit").is_none(), "{l}");
     assert!(!written.exists(), "refuted settings written");
     std::fs::remove_dir_all(&dir).ok();
@@ -667,13 +662,8 @@ fn simc_on_a_lag_dominant_loop_takes_the_dead_time_of_its_start() {
 fn simc_settings_the_linear_model_refutes_exit_2() {
     let fs = fixture("data/generated/rigorous_dc13c1b0.json");
     let args = ["tune", &fs, "--loop", "AC101", "--method", "simc", "--set", "AC102.auto=0"];
-    let out = plantwide(&[&args[..], &["--measurement-dead-time", "1 min", "--json"]].concat());
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "{err}");
+    let (err, _) = refuted_by_its_margins(&[&args[..], &["--measurement-dead-time", "1 min", "--json"]].concat());
     assert!(err.contains("`AC101`") && err.contains("phase margin -"), "{err}");
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    let l = &v["loops"][0];
-    assert!(l["margins"]["phase_margin"].as_f64().unwrap() < 0.0 && l["failure"].is_string(), "{l}");
     // The same loop by BLT (the linear model's own ultimate gain, detuned) is stable and accepted.
     let blt = json_of(
         &[
@@ -693,4 +683,16 @@ fn simc_settings_the_linear_model_refutes_exit_2() {
         .concat(),
     );
     assert!(blt["loops"][0]["margins"]["phase_margin"].as_f64().unwrap() > 0.0, "{blt}");
+}
+
+/// Run a `tune … --json` that its own margins refute: exit 2, and the report's one loop with a
+/// negative phase margin and a `failure`. Returns the error text and that loop.
+fn refuted_by_its_margins(args: &[&str]) -> (String, serde_json::Value) {
+    let out = plantwide(args);
+    let err = String::from_utf8_lossy(&out.stderr).to_string();
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let l = v["loops"][0].clone();
+    assert!(l["margins"]["phase_margin"].as_f64().unwrap() < 0.0 && l["failure"].is_string(), "{l}");
+    (err, l)
 }

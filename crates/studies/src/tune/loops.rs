@@ -182,6 +182,11 @@ impl LoopResponse {
         LoopResponse { model, measurement }
     }
 
+    /// The same model seen through `measurement` instead.
+    pub fn seen_through(self, measurement: Measurement) -> LoopResponse {
+        LoopResponse { measurement, ..self }
+    }
+
     /// `M(jω) G(jω)` (non-finite where `jωI − A` is singular, which every search treats as no
     /// crossing).
     pub fn at(&self, omega: f64) -> Mat<c64> {

@@ -209,7 +209,7 @@ pub struct StepResult {
 /// record determines no model, [`TuneError::OutsideLinearRange`] when no step tried gives the
 /// linearized gain, [`TuneError::PoorFit`] when the model does not describe the response.
 pub fn step_loop(plant: &Plant, x: &[f64], l: &PlantLoop, o: StepOptions) -> Result<StepResult, TuneError> {
-    let element = element(plant, x, l)?;
+    let (element, response) = element(plant, x, l)?;
     let order = o.order.unwrap_or(if element.integrating { ModelOrder::Integrating } else { ModelOrder::Foptd });
     let comparable = (order == ModelOrder::Integrating) == element.integrating;
     let u0 = x[l.op];
@@ -224,7 +224,9 @@ pub fn step_loop(plant: &Plant, x: &[f64], l: &PlantLoop, o: StepOptions) -> Res
     };
     check_scan(l, scan, max_duration / 100.0, "a hundredth of the test's length")?;
     let fine = match (o.scan, order) {
-        (None, ModelOrder::Foptd) if !element.integrating => lag_dominant_start(plant, x, l, o.measurement, scan)?,
+        (None, ModelOrder::Foptd) if !element.integrating => {
+            lag_dominant_start(response.seen_through(o.measurement), l, scan)
+        }
         _ => None,
     };
     let first = o.step.unwrap_or_else(|| default_step(plant, x, l, &element));
@@ -304,17 +306,9 @@ pub const LAG_DOMINANT: f64 = 1.0 / 20.0;
 
 /// The finer sampling `(P_u/50, 10 P_u)` of a lag-dominant element's start (see
 /// [`LAG_DOMINANT`]), or `None` for one that is not, or has no phase crossover to size it by.
-fn lag_dominant_start(
-    plant: &Plant,
-    x: &[f64],
-    l: &PlantLoop,
-    measurement: Measurement,
-    scan: f64,
-) -> Result<Option<(f64, f64)>, TuneError> {
-    let response = LoopResponse::new(loop_model(plant, x, std::slice::from_ref(l))?, measurement);
-    let Ok(u) = loop_ultimates(&response, std::slice::from_ref(l)) else { return Ok(None) };
-    let pu = u[0].pu;
-    Ok((pu.is_finite() && pu > 0.0 && scan > LAG_DOMINANT * pu).then_some((pu / 50.0, 10.0 * pu)))
+fn lag_dominant_start(response: LoopResponse, l: &PlantLoop, scan: f64) -> Option<(f64, f64)> {
+    let pu = loop_ultimates(&response, std::slice::from_ref(l)).ok()?[0].pu;
+    (pu.is_finite() && pu > 0.0 && scan > LAG_DOMINANT * pu).then_some((pu / 50.0, 10.0 * pu))
 }
 
 /// The model fitted to a step test's record and, where its first `fine` samples are a finer
@@ -386,7 +380,7 @@ struct Element {
 /// integrating element, `s g(s)` in place of `g`), the gain the real part, exact to `O((ωT)²)`;
 /// `T` is `None` when it has none (a pure integrator). For a stable element whose `T` comes out
 /// negative or nil, the slowest time constant.
-fn element(plant: &Plant, x: &[f64], l: &PlantLoop) -> Result<Element, TuneError> {
+fn element(plant: &Plant, x: &[f64], l: &PlantLoop) -> Result<(Element, LoopResponse), TuneError> {
     let (response, w, slow) = low_frequency_probe(plant, x, l)?;
     let g = response.at(w)[(0, 0)];
     let integrating = g.im.abs() > g.re.abs();
@@ -407,5 +401,5 @@ fn element(plant: &Plant, x: &[f64], l: &PlantLoop) -> Result<Element, TuneError
     if !(h.re.is_finite() && h.re != 0.0) {
         return Err(TuneError::NoSteadyGain { controller: l.name.clone() });
     }
-    Ok(Element { residence_time: t, integrating, gain: h.re })
+    Ok((Element { residence_time: t, integrating, gain: h.re }, response))
 }
