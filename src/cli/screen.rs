@@ -191,15 +191,7 @@ fn write_flowsheets(dir: &Path, s: &ColumnScreen) -> Result<usize, CliError> {
 /// Exit 2 when parts of a study failed (the report, already printed, marks them): the message
 /// counts them and gives each one's reason.
 pub(super) fn failed_parts(study: &str, failed: &[String]) -> Result<(), CliError> {
-    match failed {
-        [] => Ok(()),
-        [one] => Err(CliError::numerical(format!("{study}: 1 part failed (marked in the report): {one}"))),
-        many => Err(CliError::numerical(format!(
-            "{study}: {} parts failed (marked in the report): {}",
-            many.len(),
-            many.join("; ")
-        ))),
-    }
+    plantwide::studies::request::failed_parts(study, failed).map_or(Ok(()), |m| Err(CliError::numerical(m)))
 }
 
 /// The configurations as a markdown table, in the library's order, with the scaling and the

@@ -352,3 +352,39 @@ fn a_vanishing_ramp_is_sized_as_the_step_in_bounded_time() {
         assert_eq!(t["designs"][k]["verified"]["meets"], true, "{}", t["designs"][k]);
     }
 }
+
+/// A verification run's length asked (`--duration`) shorter than the designs take to settle: the
+/// peaks are not known, so no design is judged (before, a 1 s run of the 13 min PI design was
+/// "meets: yes" on a level that had barely moved). Each run is marked not settled, the file's
+/// vessel too, and the command exits 2; a length they settle within gives the default's designs.
+#[test]
+fn a_run_cut_short_by_the_length_asked_is_not_judged() {
+    let file = flowsheet("surge_tank_pi.json");
+    let args = ["size", &file, "--vessel", "tank", "--disturbance", "F_in=+10 mol/s", "--level-band", "0.2 m"];
+    let sized = |duration: &str| {
+        plantwide(&[&args[..], &["--max-outflow-rate", "3 mol/s/min", "--duration", duration, "--json"]].concat())
+    };
+    let out = sized("1 s");
+    assert_eq!(out.status.code(), Some(2), "{}", String::from_utf8_lossy(&out.stderr));
+    let s: Value = serde_json::from_slice(&out.stdout).unwrap();
+    for d in s["designs"].as_array().unwrap() {
+        let v = &d["verified"];
+        assert!(v["max_level_deviation"].is_null() && v["meets"] == false, "{d}");
+        assert!(v["failure"].as_str().unwrap().contains("the run's length was asked (`duration`)"), "{d}");
+    }
+    assert!(s["current"]["failure"].as_str().unwrap().starts_with("not settled after 1 s"), "{}", s["current"]);
+    assert_eq!(s["failed"].as_array().unwrap().len(), 4);
+    let out = sized("20 h");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let long: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let default = tank_sizing();
+    for k in 0..3 {
+        let (a, b) = (&long["designs"][k], &default["designs"][k]);
+        assert_eq!(a["area"], b["area"]);
+        assert!(a["verified"]["meets"] == true && b["verified"]["meets"] == true, "{a}");
+        // The default run stops once settled to 1e-3 of the band (P's level creeps up to its end
+        // Δu/kc from below), so the longer run's peak lies within that of the default's.
+        let (da, db) = (num(&a["verified"], "max_level_deviation"), num(&b["verified"], "max_level_deviation"));
+        assert!((da - db).abs() <= 1e-3 * 0.2, "{da} vs {db}");
+    }
+}

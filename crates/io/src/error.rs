@@ -44,4 +44,21 @@ pub enum IoError {
     /// form).
     #[error("{0}")]
     Draw(String),
+    /// A figure with nothing to draw: every part it would show failed, and a plot of what is left
+    /// would read as an answer.
+    #[error("{file}: not written: {why}")]
+    NothingToPlot {
+        /// The plot file.
+        file: String,
+        /// Why there is nothing (which parts failed).
+        why: String,
+    },
+}
+
+impl IoError {
+    /// True when the file is missing because the study has no result to show (exit code 2 at the
+    /// faces), false for a file that was asked wrongly or could not be written.
+    pub fn is_missing_result(&self) -> bool {
+        matches!(self, IoError::NothingToPlot { .. })
+    }
 }

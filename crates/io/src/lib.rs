@@ -6,10 +6,11 @@
 //!   signal names and the path each stands for.
 //! - [`npz`]: named arrays as a NumPy `.npz` archive (the state-space export's second format).
 //! - [`csv`]: sensitivity sweeps as CSV.
+//! - [`report`]: each study's report (its table, JSON, figures), the same from every face.
 //! - [`plot`]: trend plots of dynamic runs and sensitivity plots, PNG or SVG, with one embedded
 //!   font (DejaVu Sans) registered once, so no system font library is needed.
 //!
-//! **Architecture Invariant:** io sits above the numerical crates (units, analysis; later studies)
+//! **Architecture Invariant:** io sits above the numerical crates (units, analysis, studies)
 //! and is never imported by them: they compute typed results, io turns those into text and
 //! pictures. Writing a figure is the only file access here; reading a file's text is the
 //! caller's.
@@ -23,6 +24,7 @@ pub mod html;
 pub mod npz;
 pub mod part;
 pub mod plot;
+pub mod report;
 pub mod tf;
 
 pub use error::IoError;

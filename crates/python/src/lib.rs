@@ -183,6 +183,25 @@ fn screen_pairings(
     Ok(py.detach(|| plant::pairings(&src, &sets, &args, share))?)
 }
 
+/// `plantwide size --json`: the sizing's JSON text and the message of its failed parts (none
+/// when all have their answer); `request` is the study's request as JSON, `report` a folder to
+/// write the CLI's report to, in `units` (`si`, `metric` or `field`).
+#[pyfunction]
+#[pyo3(signature = (text, name, sets, request, report = None, units = "si"))]
+fn size(
+    py: Python<'_>,
+    text: String,
+    name: String,
+    sets: Vec<String>,
+    request: String,
+    report: Option<String>,
+    units: &str,
+) -> PyResult<plant::Sized> {
+    let system = plant::units(units)?;
+    let src = Source { text, name };
+    Ok(py.detach(|| plant::size(&src, &sets, &request, report.as_deref().map(|d| (d, system))))?)
+}
+
 /// The module `plantwide._plantwide`.
 #[pymodule]
 fn _plantwide(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -200,5 +219,6 @@ fn _plantwide(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sensitivity, m)?)?;
     m.add_function(wrap_pyfunction!(screen, m)?)?;
     m.add_function(wrap_pyfunction!(screen_pairings, m)?)?;
+    m.add_function(wrap_pyfunction!(size, m)?)?;
     Ok(())
 }

@@ -14,7 +14,9 @@ use plantwide_solve::dynamic::{SimulationResult, Start, simulate};
 use plantwide_solve::{Method, Solution, StrategySettings, converge, fix_design_point};
 use plantwide_studies::screen::pairings::{self, CandidateTask, DynamicSettings, PairingRequest};
 use plantwide_studies::screen::{ColumnScreen, screen_column, screen_pairings};
+use plantwide_studies::size::SizeRequest;
 use plantwide_studies::tune::loops::Measurement;
+use plantwide_units::UnitSystem;
 
 use crate::error::FaceError;
 
@@ -51,6 +53,16 @@ pub fn method(name: &str) -> Result<Method, FaceError> {
         "eo" => Ok(Method::Eo),
         "sm" => Ok(Method::Sm),
         _ => Err(FaceError::Input(format!("method `{name}`: expected `auto`, `eo` or `sm`"))),
+    }
+}
+
+/// `units=`: `si`, `metric` or `field`, the CLI's `--units`.
+pub fn units(name: &str) -> Result<UnitSystem, FaceError> {
+    match name {
+        "si" => Ok(UnitSystem::Si),
+        "metric" => Ok(UnitSystem::Metric),
+        "field" => Ok(UnitSystem::Field),
+        _ => Err(FaceError::Input(format!("units `{name}`: expected `si`, `metric` or `field`"))),
     }
 }
 
@@ -243,6 +255,36 @@ pub fn pairings(src: &Source, sets: &[String], args: &str, share: PairingShare) 
         )));
     }
     to_json(&screen)
+}
+
+/// What `Plant.size` returns: the sizing as `plantwide size --json` prints it, and the message of
+/// its failed parts (none when every part has its answer).
+pub type Sized = (String, Option<String>);
+
+/// `plantwide size --json [--report DIR]`: `request` is a [`SizeRequest`] as JSON (the fields of
+/// `Plant.size`); the report, when asked, is written in `report.1`'s display units, as the CLI's.
+pub fn size(
+    src: &Source,
+    sets: &[String],
+    request: &str,
+    report: Option<(&str, UnitSystem)>,
+) -> Result<Sized, FaceError> {
+    let request: SizeRequest =
+        serde_json::from_str(request).map_err(|e| FaceError::Input(format!("size: the request: {e}")))?;
+    let (plant, ss) = src.at_steady_state(sets)?;
+    let sizing = plantwide_studies::size::size(&plant, &ss.x, &request, &|_| {}).map_err(|e| {
+        let user = e.is_user_error();
+        FaceError::classify(e, user)
+    })?;
+    let io = |e: plantwide_io::IoError| {
+        let missing = e.is_missing_result();
+        FaceError::classify(e, !missing)
+    };
+    if let Some((dir, system)) = report {
+        plantwide_io::report::size::write_report(std::path::Path::new(dir), &sizing, &plant, system).map_err(io)?;
+    }
+    let failed = plantwide_studies::request::failed_parts("size", sizing.failed());
+    Ok((plantwide_io::report::json(&sizing).map_err(io)?, failed))
 }
 
 /// `v` as JSON text.

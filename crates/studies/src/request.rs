@@ -1,4 +1,16 @@
-//! Checks every study applies to the lists of its request (CVs, MVs, loops, candidate vessels).
+//! Checks every study applies to the lists of its request (CVs, MVs, loops, candidate vessels),
+//! and the one message of a result with parts that have no answer.
+
+/// The message every face gives for a result whose `failed` parts have no answer (after the
+/// report, which marks them; the CLI's exit 2, Python's `ConvergenceError`): `size: 1 part failed
+/// (marked in the report): …`. None when every part has its answer.
+pub fn failed_parts(study: &str, failed: &[String]) -> Option<String> {
+    match failed {
+        [] => None,
+        [one] => Some(format!("{study}: 1 part failed (marked in the report): {one}")),
+        many => Some(format!("{study}: {} parts failed (marked in the report): {}", many.len(), many.join("; "))),
+    }
+}
 
 /// A list of a request that names one item twice.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]

@@ -24,6 +24,7 @@
 
 pub mod candidates;
 pub mod closed_form;
+mod request;
 pub mod residence;
 mod run;
 mod steady;
@@ -37,6 +38,7 @@ use serde::Serialize;
 
 pub use candidates::{CandidateRanking, RankedCandidate, rank_candidates, rank_candidates_observed};
 pub use closed_form::LevelDesign;
+pub use request::{SizeRequest, Sizing, size};
 use vessel::Vessel;
 
 /// Relative tolerance of the verification: sampling, the integrator's tolerance and the optimal
@@ -135,7 +137,7 @@ impl Shape {
 
 /// What to size for.
 #[derive(Debug, Clone, PartialEq)]
-pub struct SizeRequest {
+pub struct SizeCriteria {
     /// The disturbance.
     pub disturbance: Disturbance,
     /// The largest allowed level deviation from the setpoint, either way \[m\].
@@ -149,7 +151,8 @@ pub struct SizeRequest {
     pub attenuation: Option<Attenuation>,
     /// Length of each verification run \[s\] (default: 12 filter times for P, 14 times `1/ω_n`
     /// for PI, 25 ramp times for the optimal law, and at least 5 of the plant's slowest time
-    /// constants).
+    /// constants). A run of a step or a ramp not settled by then is marked failed: its peaks are
+    /// not known (a sinusoid's runs for exactly this long).
     pub duration: Option<f64>,
 }
 
@@ -399,7 +402,7 @@ pub struct Stall {
 #[derive(Debug, Clone, thiserror::Error)]
 pub enum SizeError {
     /// More candidates than a ranking takes.
-    #[error("--candidates: {n} vessels, above the {max} a ranking sizes (each by three verified designs): rank fewer")]
+    #[error("candidates: {n} vessels, above the {max} a ranking sizes (each by three verified designs): rank fewer")]
     Candidates {
         /// As given.
         n: usize,
@@ -409,6 +412,14 @@ pub enum SizeError {
     /// A list of the request names one item twice.
     #[error(transparent)]
     Duplicate(#[from] crate::request::Duplicate),
+    /// A field of the request that does not parse, is missing, or does not go with another.
+    #[error("{field} {why}")]
+    Field {
+        /// The [`SizeRequest`] field.
+        field: &'static str,
+        /// What is wrong, after the field's name (`must be a positive time`, `0.3 kg: …`).
+        why: String,
+    },
     /// No vessel of that name.
     #[error("`{name}` is no vessel of the flowsheet: {why}; vessels with a level: {known}")]
     Vessel {
@@ -428,7 +439,7 @@ pub enum SizeError {
         why: String,
     },
     /// The band does not fit the vessel or is not positive.
-    #[error("--level-band {} m for `{vessel}`: {why}", plantwide_model::limits::number(*.band))]
+    #[error("level_band {} m for `{vessel}`: {why}", plantwide_model::limits::number(*.band))]
     Band {
         /// The vessel.
         vessel: String,
@@ -439,7 +450,7 @@ pub enum SizeError {
     },
     /// The rate limit is not positive.
     #[error(
-        "--max-outflow-rate {} (SI): must be a positive rate of change of the outflow (e.g. \"5 kmol/h/min\")",
+        "max_outflow_rate {} (SI): must be a positive rate of change of the outflow (e.g. \"5 kmol/h/min\")",
         plantwide_model::limits::number(*.value)
     )]
     Rate {
@@ -447,13 +458,13 @@ pub enum SizeError {
         value: f64,
     },
     /// The attenuation criterion is not a ratio in (0, 1) at a positive period.
-    #[error("--attenuation: {why}")]
+    #[error("attenuation: {why}")]
     Attenuation {
         /// Why.
         why: String,
     },
     /// The disturbance is no free input or is zero.
-    #[error("--disturbance {path}: {why}")]
+    #[error("disturbance {path}: {why}")]
     Disturbance {
         /// Its path.
         path: String,
@@ -512,6 +523,20 @@ pub enum SizeError {
 }
 
 impl SizeError {
+    /// The [`SizeRequest`] field a refusal is about, which its message starts with (a face that
+    /// calls the field otherwise, the CLI's `--level-band`, puts its own name there).
+    pub fn field(&self) -> Option<&'static str> {
+        match self {
+            SizeError::Field { field, .. } => Some(field),
+            SizeError::Candidates { .. } | SizeError::Duplicate(_) => Some("candidates"),
+            SizeError::Band { .. } => Some("level_band"),
+            SizeError::Rate { .. } => Some("max_outflow_rate"),
+            SizeError::Attenuation { .. } => Some("attenuation"),
+            SizeError::Disturbance { .. } => Some("disturbance"),
+            _ => None,
+        }
+    }
+
     /// True for problems of the request (exit code 1), false for numerical failures (exit code 2).
     pub fn is_user_error(&self) -> bool {
         !matches!(self, SizeError::Steady { .. } | SizeError::Simulation { .. } | SizeError::Continuation { .. })
@@ -525,7 +550,7 @@ impl SizeError {
 /// reach the vessel, or a plant that cannot be solved before or after the disturbance. A design
 /// or a run that has no answer is not an error: it is marked where it stands and listed under
 /// [`VesselSizing::failed`].
-pub fn size_vessel(plant: &Plant, x: &[f64], name: &str, r: &SizeRequest) -> Result<VesselSizing, SizeError> {
+pub fn size_vessel(plant: &Plant, x: &[f64], name: &str, r: &SizeCriteria) -> Result<VesselSizing, SizeError> {
     size_vessel_observed(plant, x, name, r, &|_| {})
 }
 
@@ -537,7 +562,7 @@ pub fn size_vessel_observed(
     plant: &Plant,
     x: &[f64],
     name: &str,
-    r: &SizeRequest,
+    r: &SizeCriteria,
     progress: &(dyn Fn(Progress<'_>) + Sync),
 ) -> Result<VesselSizing, SizeError> {
     check_request(plant, r)?;
@@ -545,7 +570,7 @@ pub fn size_vessel_observed(
     let flow_change = v.flow_change(r)?;
     let effective = r.attenuation.map(|a| {
         let omega = std::f64::consts::TAU / a.period;
-        SizeRequest {
+        SizeCriteria {
             disturbance: Disturbance { shape: Shape::Sine { period: a.period }, ..r.disturbance.clone() },
             max_outflow_rate: a.ratio * flow_change.abs() * omega,
             ..r.clone()
@@ -597,7 +622,7 @@ pub fn size_vessel_observed(
 }
 
 /// The checks that need no vessel: band, rate, disturbance.
-fn check_request(plant: &Plant, r: &SizeRequest) -> Result<(), SizeError> {
+fn check_request(plant: &Plant, r: &SizeCriteria) -> Result<(), SizeError> {
     match r.attenuation {
         Some(a) if a.ratio.is_nan() || a.ratio <= 0.0 || a.ratio >= 1.0 => {
             return Err(SizeError::Attenuation { why: format!("the ratio {} must lie between 0 and 1", a.ratio) });

@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import json
 import os
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import Any, Iterator
 
 import numpy as np
 
 from . import _plantwide as _native
+from ._plantwide import ConvergenceError
 
 
 def assignments(set: Mapping[str, Any] | None) -> list[str]:
@@ -242,6 +243,62 @@ class Plant:
         frame.attrs["units"] = {path: unit for path, unit in d["columns"]}
         frame.attrs["events"] = d["events"]
         return frame
+
+    def size(
+        self,
+        vessel: str | None = None,
+        *,
+        level_band: str | float,
+        disturbance: str | None = None,
+        max_outflow_rate: str | float | None = None,
+        candidates: Sequence[str] | None = None,
+        scenario: str | os.PathLike | Mapping | None = None,
+        ramp: str | float | None = None,
+        sine: str | float | None = None,
+        attenuation: float | None = None,
+        period: str | float | None = None,
+        duration: str | float | None = None,
+        set: Mapping[str, Any] | None = None,
+        report: str | os.PathLike | None = None,
+        units: str = "si",
+    ) -> dict:
+        """``plantwide size --json``: the cross-section and level controller (P, critically damped
+        PI, optimal averaging) that keep ``vessel``'s level within ``±level_band`` and its outflow's
+        rate under ``max_outflow_rate`` for ``disturbance`` (``"PATH=+10%"``), each verified by a
+        nonlinear run; or ``candidates`` ranked by the surge volume they need. Quantities are text
+        with units (``"0.3 m"``, ``"5 kmol/h/min"``) or SI numbers; ``scenario`` (a file or a
+        dict) gives the disturbance as its one step, ramp or sinusoid. Returns the dict the CLI
+        prints (SI); ``report`` writes the CLI's ``--report`` folder in ``units`` (si, metric,
+        field). Parts without an answer raise ``ConvergenceError`` after the report is written,
+        the result kept as the error's ``result``."""
+        request = {"level_band": level_band}
+        for key, value in (
+            ("vessel", vessel),
+            ("disturbance", disturbance),
+            ("max_outflow_rate", max_outflow_rate),
+            ("ramp", ramp),
+            ("sine", sine),
+            ("attenuation", attenuation),
+            ("period", period),
+            ("duration", duration),
+        ):
+            if value is not None:
+                request[key] = value
+        if candidates is not None:
+            request["candidates"] = list(candidates)
+        if scenario is not None:
+            if isinstance(scenario, Mapping):
+                request["scenario"] = dict(scenario)
+            else:
+                request["scenario"] = json.loads(_native.read_text(os.fspath(scenario)))
+        folder = None if report is None else os.fspath(report)
+        text, failed = _native.size(self._text, self._name, assignments(set), json.dumps(request), folder, units)
+        result = json.loads(text)
+        if failed is not None:
+            error = ConvergenceError(failed)
+            error.result = result
+            raise error
+        return result
 
     def __repr__(self) -> str:
         return f"<Plant {self.name} ({self._name}): {len(self.variables)} variables, {len(self.inputs)} free inputs>"

@@ -11,7 +11,7 @@ use plantwide_flowsheet::Plant;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use super::{LevelDesign, Progress, SizeError, SizeRequest, VesselSizing, size_vessel_observed};
+use super::{LevelDesign, Progress, SizeCriteria, SizeError, VesselSizing, size_vessel_observed};
 
 /// One ranked candidate.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -61,7 +61,7 @@ pub fn rank_candidates(
     plant: &Plant,
     x: &[f64],
     names: &[String],
-    r: &SizeRequest,
+    r: &SizeCriteria,
 ) -> Result<CandidateRanking, SizeError> {
     rank_candidates_observed(plant, x, names, r, &|_| {})
 }
@@ -74,10 +74,10 @@ pub fn rank_candidates_observed(
     plant: &Plant,
     x: &[f64],
     names: &[String],
-    r: &SizeRequest,
+    r: &SizeCriteria,
     progress: &(dyn Fn(Progress<'_>) + Sync),
 ) -> Result<CandidateRanking, SizeError> {
-    crate::request::unique("--candidates", names, |a, b| a == b)?;
+    crate::request::unique("candidates", names, |a, b| a == b)?;
     if names.len() > MAX_CANDIDATES {
         return Err(SizeError::Candidates { n: names.len(), max: MAX_CANDIDATES });
     }

@@ -21,7 +21,7 @@
 use plantwide_flowsheet::Plant;
 use plantwide_solve::dynamic::Session;
 
-use super::{Shape, SizeError, SizeRequest, Trace};
+use super::{Shape, SizeCriteria, SizeError, Trace};
 
 /// Most samples of a verification run's window (the window's sampling coarsens beyond it, so that
 /// no request makes a run record without bound).
@@ -54,7 +54,7 @@ pub(super) struct Run<'a> {
     pub pv: usize,
     pub op: usize,
     /// The level's and the outflow's steady values after the disturbance; none for a run of
-    /// exactly `t_min` (a sinusoid, a `--duration` asked).
+    /// exactly `t_min` (a sinusoid).
     pub end: Option<(f64, f64)>,
     /// What settling is measured against: the band (in the measurement's units) and the outflow's
     /// steady change.
@@ -74,7 +74,7 @@ impl Run<'_> {
     ///
     /// # Errors
     /// [`SizeError::Disturbance`] for a sinusoid too fast to follow over the run.
-    pub fn step(&self, r: &SizeRequest) -> Result<(Trace, Ending), SizeError> {
+    pub fn step(&self, r: &SizeCriteria) -> Result<(Trace, Ending), SizeError> {
         let d = &r.disturbance;
         let i = plantwide_flowsheet::overrides::resolve_input(self.plant, &d.path)
             .ok_or_else(|| SizeError::Disturbance { path: d.path.clone(), why: "no such input".into() })?;
@@ -117,9 +117,14 @@ impl Run<'_> {
                 return Ok((tr, Ending::Settled));
             }
             if t >= t_max {
+                let asked = r.duration.map_or(String::new(), |_| {
+                    "; the run's length was asked (`duration`): its peaks are not known before it settles, so \
+                     give a longer one, or none to run until settled"
+                        .to_string()
+                });
                 let why = format!(
                     "not settled after {t:.0} s: the level is still {:.2e} of the band and the outflow {:.2e} of its \
-                     steady change from the steady state after the disturbance (settled: both within {SETTLED:e})",
+                     steady change from the steady state after the disturbance (settled: both within {SETTLED:e}){asked}",
                     off.0, off.1
                 );
                 return Ok((tr, Ending::Unsettled(why)));
@@ -130,7 +135,7 @@ impl Run<'_> {
     /// A sinusoid does not settle: it runs its fixed length (at least 10 periods), and the
     /// integrator follows every period of it, so the work is bounded by refusing more than
     /// [`MAX_PERIODS`] of them.
-    fn sine_length(&self, r: &SizeRequest, period: f64) -> Result<f64, SizeError> {
+    fn sine_length(&self, r: &SizeCriteria, period: f64) -> Result<f64, SizeError> {
         let duration = self.t_min;
         if duration / period > MAX_PERIODS {
             return Err(SizeError::Disturbance {

@@ -19,7 +19,7 @@ use plantwide_solve::SteadyError;
 
 use super::run::near_limits;
 use super::vessel::{Kind, Vessel};
-use super::{SizeError, SizeRequest, Stall, newton};
+use super::{SizeCriteria, SizeError, Stall, newton};
 use crate::screen::column::mapped_guess;
 
 /// The smallest continuation step, as a fraction of the way from the file's size to the design's.
@@ -147,7 +147,7 @@ fn continuation(v: &Vessel, path: &Path<'_>, what: &str, first: SteadyError) -> 
 ///
 /// # Errors
 /// [`SizeError::Steady`] when no steady state is found.
-pub(super) fn after(plant: &Plant, x: &[f64], r: &SizeRequest, what: &str) -> Result<Vec<f64>, SizeError> {
+pub(super) fn after(plant: &Plant, x: &[f64], r: &SizeCriteria, what: &str) -> Result<Vec<f64>, SizeError> {
     let d = &r.disturbance;
     let i = plantwide_flowsheet::overrides::resolve_input(plant, &d.path)
         .ok_or_else(|| SizeError::Disturbance { path: d.path.clone(), why: "no such input".into() })?;

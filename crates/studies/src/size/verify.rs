@@ -14,7 +14,7 @@ use plantwide_flowsheet::Plant;
 use super::run::{Ending, Run, peaks, swings};
 use super::steady::{after, design_steady, slowest};
 use super::vessel::{Kind, Vessel};
-use super::{Current, Design, LevelDesign, Shape, SizeError, SizeRequest, Trace, Verified, verdict};
+use super::{Current, Design, LevelDesign, Shape, SizeCriteria, SizeError, Trace, Verified, verdict};
 use crate::tune::averaging::{AveragingForm, averaging};
 
 /// Most corrections of a closed-form design that the plant's run showed short.
@@ -40,7 +40,7 @@ const MAX_SLOW: f64 = 1000.0;
 /// carries the level past the band, the law is told a band smaller by the excess (it plans to stop
 /// short of the edge); when that does not at least halve the excess (in log), the area grows by it
 /// too. A design without figures (its steady state, its run) is returned as it is.
-pub(super) fn design(v: &Vessel, d: LevelDesign, du: f64, r: &SizeRequest) -> Result<Design, SizeError> {
+pub(super) fn design(v: &Vessel, d: LevelDesign, du: f64, r: &SizeCriteria) -> Result<Design, SizeError> {
     let closed = closed_form(v, d, du.abs(), r).0;
     let (mut s, mut f, mut plan, mut previous) = (1.0, 1.0, 1.0, f64::INFINITY);
     let mut k = 0;
@@ -77,7 +77,7 @@ pub(super) fn design(v: &Vessel, d: LevelDesign, du: f64, r: &SizeRequest) -> Re
 /// The closed-form cross-section of design `d` for the flow change `du` (a magnitude): by the
 /// attenuation closed forms when the request has that criterion and the design has one (then with
 /// the design's time, `τ_F` or `1/ω_n`), else by the rate closed form.
-fn closed_form(v: &Vessel, d: LevelDesign, du: f64, r: &SizeRequest) -> (f64, Option<f64>) {
+fn closed_form(v: &Vessel, d: LevelDesign, du: f64, r: &SizeCriteria) -> (f64, Option<f64>) {
     let by_attenuation = r
         .attenuation
         .and_then(|a| d.for_attenuation(v.v_l * du, a.ratio, std::f64::consts::TAU / a.period, r.level_band));
@@ -98,7 +98,7 @@ struct Scales {
 
 /// Design `d` for the flow change `s.flow·|du|` in a vessel of cross-section `area`, verified (a
 /// numerical failure of its steady state or run is the design's `failure`).
-fn attempt(v: &Vessel, d: LevelDesign, du: f64, s: Scales, area: f64, r: &SizeRequest) -> Result<Design, SizeError> {
+fn attempt(v: &Vessel, d: LevelDesign, du: f64, s: Scales, area: f64, r: &SizeCriteria) -> Result<Design, SizeError> {
     let (band_y, k_y) = v.measurement_scale(area, r.level_band);
     let normal = matches!(v.kind, Kind::Holdup { .. }).then(|| v.sp.max(2.0 * band_y));
     let sp = serde_json::json!(normal.unwrap_or(v.sp));
@@ -144,7 +144,7 @@ fn verify(
     law: &Law,
     (area, normal, band_y): (f64, Option<f64>, f64),
     du: f64,
-    r: &SizeRequest,
+    r: &SizeCriteria,
     what: &str,
 ) -> Result<Verified, SizeError> {
     let (plant, xs) = design_steady(v, &law.spec, area, normal, &format!("the steady state of {what}"))?;
@@ -189,7 +189,7 @@ fn verify(
 /// What a run settles to and how long it may take.
 struct Target {
     /// The level's and the outflow's values at the steady state after the disturbance; none for a
-    /// run of fixed length (a sinusoid, a `--duration` asked).
+    /// sinusoid's run of fixed length.
     end: Option<(f64, f64)>,
     /// The band (in the measurement's units) and the outflow's steady change (the request's
     /// `|du|` when it does not move) that settling is measured against.
@@ -204,11 +204,11 @@ fn target(
     plant: &Plant,
     x: &[f64],
     (pv, op): (usize, usize),
-    r: &SizeRequest,
+    r: &SizeCriteria,
     what: &str,
     (band_y, du, t_min): (f64, f64, f64),
 ) -> Result<Target, SizeError> {
-    if r.duration.is_some() || matches!(r.disturbance.shape, Shape::Sine { .. }) {
+    if matches!(r.disturbance.shape, Shape::Sine { .. }) {
         return Ok(Target { end: None, scale: (band_y, du.abs()), t_max: t_min });
     }
     let xe = after(plant, x, r, what)?;
@@ -217,7 +217,8 @@ fn target(
     Ok(Target {
         end: Some((xe[pv], xe[op])),
         scale: (band_y, if moves { change } else { du.abs() }),
-        t_max: longest(plant, x, t_min),
+        // A length asked is the run's: a run not settled by then has not shown its peaks.
+        t_max: r.duration.unwrap_or_else(|| longest(plant, x, t_min)),
     })
 }
 
@@ -249,7 +250,7 @@ struct Figures {
 
 impl Figures {
     /// The figures of `trace` for the request (`du` the inflow amplitude of a sinusoid).
-    fn of(trace: &Trace, r: &SizeRequest, du: f64) -> Figures {
+    fn of(trace: &Trace, r: &SizeCriteria, du: f64) -> Figures {
         let (dev, rate) = peaks(trace);
         let (level_amplitude, attenuation) = match r.disturbance.shape {
             Shape::Sine { period } => {
@@ -265,7 +266,7 @@ impl Figures {
     /// criterion its periodic swing) against the band, where the vessel shows a level; the
     /// outflow's largest rate against the limit (under an attenuation criterion its swing against
     /// the ratio).
-    fn judged(&self, r: &SizeRequest, level: Level) -> Vec<(Option<f64>, f64)> {
+    fn judged(&self, r: &SizeCriteria, level: Level) -> Vec<(Option<f64>, f64)> {
         let (y, q) = match (r.attenuation, self.level_amplitude, self.attenuation) {
             (Some(a), Some(amplitude), Some(att)) => ((amplitude, r.level_band), (att, a.ratio)),
             _ => ((self.dev, r.level_band), (self.rate, r.max_outflow_rate)),
@@ -342,7 +343,7 @@ fn law(
 /// The file's own vessel and level controller (for a new tank: the stream without it) through the
 /// disturbance (`du` the steady flow change, the inflow amplitude of a sinusoid), sampled at the
 /// designs' fastest time, over at least the designs' longest run and until settled.
-pub(super) fn current(v: &Vessel, r: &SizeRequest, designs: &[Design], du: f64) -> Result<Current, SizeError> {
+pub(super) fn current(v: &Vessel, r: &SizeCriteria, designs: &[Design], du: f64) -> Result<Current, SizeError> {
     let (plant, x) = (&v.original.0, &v.original.1);
     let fail = |why: String| SizeError::LevelLoop { vessel: v.measurement.clone(), why };
     let (pv, op, area, level, what) = match &v.kind {

@@ -6,7 +6,7 @@ use plantwide_model::controllers::Setpoint;
 use plantwide_model::{ControllerSpec, UnitSpec};
 use plantwide_units::{Dimension, QuantityValue};
 
-use super::{SizeError, SizeRequest, steady_from};
+use super::{SizeCriteria, SizeError, steady_from};
 
 /// How the vessel's size enters the flowsheet.
 #[derive(Debug, Clone, PartialEq)]
@@ -46,7 +46,7 @@ pub(super) struct Vessel {
 impl Vessel {
     /// The vessel `name` of `plant` at `x`: a unit with a level, `COL.drum`/`COL.sump`, or a
     /// stream (a new surge tank on it).
-    pub fn resolve(plant: &Plant, x: &[f64], name: &str, r: &SizeRequest) -> Result<Vessel, SizeError> {
+    pub fn resolve(plant: &Plant, x: &[f64], name: &str, r: &SizeCriteria) -> Result<Vessel, SizeError> {
         let original = (plant.clone(), x.to_vec());
         let spec = plant.spec();
         if let Some(u) = spec.units.get(name) {
@@ -77,7 +77,7 @@ impl Vessel {
         x: Vec<f64>,
         kind: Kind,
         measurement: &str,
-        r: &SizeRequest,
+        r: &SizeCriteria,
     ) -> Result<Vessel, SizeError> {
         let fail = |why: String| SizeError::LevelLoop { vessel: measurement.to_string(), why };
         let pv =
@@ -182,7 +182,7 @@ impl Vessel {
     }
 
     /// The steady change of the outflow after the disturbance (signed, SI).
-    pub fn flow_change(&self, r: &SizeRequest) -> Result<f64, SizeError> {
+    pub fn flow_change(&self, r: &SizeCriteria) -> Result<f64, SizeError> {
         let x1 = super::steady::after(&self.plant, &self.x, r, "the plant after the disturbance")?;
         let du = x1[self.op] - self.x[self.op];
         if du.abs() <= 1e-9 * self.x[self.op].abs().max(1e-12) {
@@ -255,7 +255,7 @@ fn not_a_vessel(plant: &Plant, name: &str, why: &str) -> SizeError {
 
 /// `plant` with a surge tank on `stream` (cross-section 1 m², P-only level loop on its pumped
 /// outflow, setpoint at twice the band in a tank four bands tall), its steady state and its name.
-fn new_tank(plant: &Plant, x: &[f64], stream: &str, r: &SizeRequest) -> Result<(Plant, Vec<f64>, String), SizeError> {
+fn new_tank(plant: &Plant, x: &[f64], stream: &str, r: &SizeCriteria) -> Result<(Plant, Vec<f64>, String), SizeError> {
     let at = |f: &str| plant.var(&format!("{stream}.{f}")).map(|i| x[i]);
     let (Some(flow), Some(p)) = (at("F"), at("P")) else {
         return Err(not_a_vessel(plant, stream, "the stream has no flow and pressure"));

@@ -1,0 +1,27 @@
+//! Each study's report, rendered here so that every face (the CLI, Python, the server) shows the
+//! same text, JSON and figures for the same result. A face maps its arguments to the study's
+//! request, calls the library, and prints or writes what these functions make of the result.
+//!
+//! - [`size`]: `plantwide size` and `Plant.size`: the designs' table or the candidates' ranking,
+//!   their figure, the report folder.
+
+pub mod size;
+
+use std::path::Path;
+
+use crate::IoError;
+
+/// `value` as the pretty JSON every face prints and writes (SI units, `--json`).
+///
+/// # Errors
+/// [`IoError::Draw`] if serde cannot write it (a non-string map key).
+pub fn json<T: serde::Serialize>(value: &T) -> Result<String, IoError> {
+    serde_json::to_string_pretty(value).map_err(|e| IoError::Draw(format!("JSON: {e}")))
+}
+
+/// Write `text` to `dir/name`, returning the name.
+fn write(dir: &Path, name: &str, text: &str) -> Result<String, IoError> {
+    let file = dir.join(name);
+    std::fs::write(&file, text).map_err(|e| IoError::Draw(format!("{}: {e}", file.display())))?;
+    Ok(name.to_string())
+}
