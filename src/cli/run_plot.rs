@@ -38,7 +38,8 @@ struct OtherRun {
 
 fn read_other(path: &Path) -> Result<OtherRun, CliError> {
     let bad = |why: String| CliError::user(format!("--compare {}: {why}", path.display()));
-    let text = std::fs::read_to_string(path).map_err(|e| bad(e.to_string()))?;
+    // The library's reader: its size limit holds for a CSV as for a flowsheet.
+    let text = plantwide::flowsheet::read_text(path).map_err(|e| CliError::user(format!("--compare {e}")))?;
     let mut lines = text.lines();
     let header: Vec<String> = lines
         .next()
