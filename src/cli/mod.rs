@@ -11,6 +11,32 @@ macro_rules! outln {
     ($($t:tt)*) => {{ $crate::cli::write_out(format_args!($($t)*)); $crate::cli::write_out(format_args!("\n")) }};
 }
 
+/// A library message with the request's fields named as this face's flags: a message that starts
+/// with its field (`level_band 5 kmol/h: …`), and each field it names in backticks (`` give a
+/// longer `scan` ``), get `--level-band`, `--scan`. A backticked name followed by `:` is the
+/// message's subject (a controller named `scan`), not a field, and is left as it is.
+pub fn with_flags(message: String, leading: Option<&str>, fields: &[&str]) -> String {
+    let flag = |f: &str| format!("--{}", f.replace('_', "-"));
+    let mut message = match leading.and_then(|f| message.strip_prefix(f).map(|rest| (f, rest))) {
+        Some((f, rest)) if rest.is_empty() || rest.starts_with([' ', ':']) => format!("{}{rest}", flag(f)),
+        _ => message,
+    };
+    for f in fields {
+        let (quoted, named) = (format!("`{f}`"), flag(f));
+        let mut out = String::with_capacity(message.len());
+        let mut rest = message.as_str();
+        while let Some(k) = rest.find(&quoted) {
+            let after = &rest[k + quoted.len()..];
+            out.push_str(&rest[..k]);
+            out.push_str(if after.starts_with(':') { &quoted } else { &named });
+            rest = after;
+        }
+        out.push_str(rest);
+        message = out;
+    }
+    message
+}
+
 /// Write to stdout; a closed pipe ends the process with success (the reader has what it wanted).
 pub fn write_out(args: std::fmt::Arguments<'_>) {
     use std::io::Write;
@@ -35,7 +61,6 @@ mod shown;
 mod size;
 mod steady;
 mod tune;
-mod tune_bench;
 mod tune_plant;
 
 use std::path::PathBuf;
@@ -269,4 +294,20 @@ pub(crate) fn output_file(value: &str) -> Result<PathBuf, OutputFileError> {
         return Err(OutputFileError::NoFolder(folder.display().to_string()));
     }
     Ok(path)
+}
+
+#[cfg(test)]
+mod flag_tests {
+    use super::with_flags;
+
+    #[test]
+    fn fields_read_as_flags_but_a_subject_named_like_one_does_not() {
+        let m = with_flags("scan 3 kg: not a time".into(), Some("scan"), &["scan"]);
+        assert_eq!(m, "--scan 3 kg: not a time");
+        let m = with_flags("`lc`: give a longer `scan`, or `method` relay".into(), None, &["scan", "method"]);
+        assert_eq!(m, "`lc`: give a longer --scan, or --method relay");
+        let m = with_flags("`scan`: its element has no lag; give `scan`".into(), None, &["scan"]);
+        assert_eq!(m, "`scan`: its element has no lag; give --scan");
+        assert_eq!(with_flags("scanner off".into(), Some("scan"), &[]), "scanner off");
+    }
 }

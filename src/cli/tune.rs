@@ -10,14 +10,13 @@
 use std::path::{Path, PathBuf};
 
 use plantwide::analysis::tf::TfModel;
-use plantwide::io::plot::{BodeLoop, write_bode};
+use plantwide::io::report::tune as report;
 use plantwide::io::tf;
-use plantwide::studies::TuneError;
-use plantwide::studies::tune::margins::Bode;
-use plantwide::studies::tune::{BltSettings, PiRule, TuneMethod, Tuning, blt, bode_diagrams, single_loop};
+use plantwide::studies::tune::{BltSettings, PiRule, blt, bode_diagrams, single_loop};
 
 use super::CliError;
 use super::linearize::TimeUnit;
+use super::tune_plant::tune_error;
 
 /// Tuning method.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -111,6 +110,10 @@ pub struct TuneArgs {
     /// ω, the crossovers marked and the gain and phase margins read off them.
     #[arg(long, value_name = "OUT.png", value_parser = super::output_file)]
     pub(super) plot: Option<PathBuf>,
+    /// Write the report of a flowsheet's tuning to this folder: tune.md and tune.html (the table
+    /// and the Bode diagrams), tune.json, tune.svg.
+    #[arg(long, value_name = "DIR", conflicts_with = "tf")]
+    pub(super) report: Option<PathBuf>,
 }
 
 /// Model fitted to a step test.
@@ -133,10 +136,6 @@ pub enum FormArg {
     Pi,
 }
 
-pub(super) fn tune_error(e: TuneError) -> CliError {
-    if e.is_user_error() { CliError::user(e.to_string()) } else { CliError::numerical(e.to_string()) }
-}
-
 pub fn run(a: &TuneArgs) -> Result<(), CliError> {
     let tu = TimeUnit::parse(&a.time_unit)?;
     let (Some(tf_file), None) = (&a.tf, &a.file) else {
@@ -156,87 +155,23 @@ pub fn run(a: &TuneArgs) -> Result<(), CliError> {
         }
     }
     .map_err(tune_error)?;
+    let tu = report::TimeUnit { name: tu.name.clone(), seconds: tu.seconds };
     if let Some(out) = &a.plot {
         let diagrams = bode_diagrams(&model, &tuning).into_iter().zip(&tuning.loops);
         let loops = diagrams.filter_map(|(b, l)| Some((format!("{} ← {}", l.output, l.input), b?))).collect();
-        plot_bode(out, &format!("Bode diagrams of the loops of `{}`, each alone", model.name), &tu, loops)?;
+        let title = format!("Bode diagrams of the loops of `{}`, each alone", model.name);
+        report::bode(out, &title, &tu, loops).map_err(|e| CliError::user(format!("--plot {e}")))?;
     }
-    let tuning = tuning.in_time_unit(tu.seconds);
     if a.json {
-        outln!("{}", serde_json::to_string_pretty(&tuning).map_err(|e| CliError::user(e.to_string()))?);
+        let shown = tuning.in_time_unit(tu.seconds);
+        outln!("{}", plantwide::io::report::json(&shown).map_err(|e| CliError::user(e.to_string()))?);
         return Ok(());
     }
-    print_table(&tuning, &model, tf_file, &tu);
+    out!("{}", report::model_text(&tuning, &model, &tf_file.display().to_string(), &tu));
     Ok(())
-}
-
-/// Draw the Bode diagrams of `loops` (label, diagram with SI frequencies) to `out`, ω in rad per
-/// `tu`.
-pub(super) fn plot_bode(out: &Path, title: &str, tu: &TimeUnit, loops: Vec<(String, Bode)>) -> Result<(), CliError> {
-    let drawn: Vec<BodeLoop> = loops
-        .into_iter()
-        .map(|(label, b)| {
-            let b = b.in_time_unit(tu.seconds);
-            let m = b.margins;
-            BodeLoop {
-                label,
-                gain_crossover: m.gain_crossover.zip(m.phase_margin),
-                phase_crossover: m.phase_crossover.zip(m.gain_margin),
-                omega: b.omega,
-                magnitude_db: b.magnitude_db,
-                phase_deg: b.phase_deg,
-            }
-        })
-        .collect();
-    write_bode(out, title, &format!("ω [rad/{}]", tu.name), &drawn).map_err(|e| CliError::user(e.to_string()))
 }
 
 fn load(file: &Path) -> Result<TfModel, CliError> {
     let text = plantwide::flowsheet::read_text(file).map_err(|e| CliError::user(e.to_string()))?;
     tf::parse(&text, &file.display().to_string()).map_err(|e| CliError::user(e.to_string()))
-}
-
-fn print_table(t: &Tuning, model: &TfModel, file: &Path, tu: &TimeUnit) {
-    let what = match (t.detuning_factor, t.max_lcm_db, t.peak_omega) {
-        (Some(f), Some(db), Some(w)) => format!(
-            "BLT (Luyben 1986): detuning factor F = {f:.4}, biggest log modulus {db:.3} dB at ω = {w:.4} rad/{}{}",
-            tu.name,
-            super::tune_plant::raised(t.unstable_at)
-        ),
-        _ if t.method == TuneMethod::TyreusLuyben => "Tyreus–Luyben PI, each loop tuned alone".to_string(),
-        _ => "Ziegler–Nichols PI, each loop tuned alone".to_string(),
-    };
-    outln!("tuning of `{}` (transfer-function model {})", model.name, file.display());
-    outln!("{what}\n");
-    let unit = |name: &str| model.inputs.iter().chain(&model.outputs).find(|s| s.name == name).map(|s| s.unit.clone());
-    let w_out = t.loops.iter().map(|l| l.output.len()).chain([6]).max().unwrap_or(6);
-    let w_in = t.loops.iter().map(|l| l.input.len()).chain([5]).max().unwrap_or(5);
-    let u = &tu.name;
-    outln!(
-        "{:<w_out$}  {:<w_in$}  {:>12}  {:>12}  {:>12}  {:>12}  gain unit",
-        "output",
-        "input",
-        "Ku",
-        format!("Pu [{u}]"),
-        "Kc",
-        format!("τI [{u}]")
-    );
-    for l in &t.loops {
-        let gain_unit = match (unit(&l.input), unit(&l.output)) {
-            (Some(i), Some(o)) if !i.is_empty() || !o.is_empty() => format!("({i})/({o})"),
-            _ => String::new(),
-        };
-        outln!(
-            "{:<w_out$}  {:<w_in$}  {:>12.5}  {:>12.5}  {:>12.5}  {:>12.5}  {gain_unit}",
-            l.output,
-            l.input,
-            l.ku,
-            l.pu,
-            l.kc,
-            l.tau_i
-        );
-        if let Some(m) = &l.margins {
-            outln!("  {}", super::tune_plant::margins_line(m, u, "its element under its PI, the other loops open"));
-        }
-    }
 }

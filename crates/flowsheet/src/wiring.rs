@@ -183,6 +183,15 @@ impl Plant {
                 StructureEdit::InsertOnStream { stream, unit, spec: u, outlet } => {
                     insert_on_stream(&mut spec, stream, unit, u, outlet)?;
                 }
+                StructureEdit::SetController { name, spec: c } => {
+                    if spec.units.contains_key(name) {
+                        return Err(OverrideError::Structure {
+                            controller: name.clone(),
+                            why: "the name is a unit's of the flowsheet".into(),
+                        });
+                    }
+                    spec.controllers.insert(name.clone(), (**c).clone());
+                }
                 StructureEdit::RemoveController(name) => {
                     if spec.controllers.shift_remove(name).is_none() {
                         let hint = crate::error::did_you_mean(name, spec.controllers.keys().map(String::as_str));
@@ -221,6 +230,14 @@ pub enum StructureEdit {
     },
     /// Remove a controller: the inputs it drove read their own values again.
     RemoveController(String),
+    /// Describe controller `name` anew (or add it): a typed description, as the file's
+    /// `controllers` section holds it (a tuned PID's new settings).
+    SetController {
+        /// Its name.
+        name: String,
+        /// Its description.
+        spec: Box<plantwide_model::ControllerSpec>,
+    },
     /// Put a new unit with one inlet and one outlet (a surge tank) on a stream: `stream` now ends
     /// at `unit`, and a new stream `outlet` runs from `unit` to where `stream` went.
     InsertOnStream {

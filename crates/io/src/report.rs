@@ -4,8 +4,11 @@
 //!
 //! - [`size`]: `plantwide size` and `Plant.size`: the designs' table or the candidates' ranking,
 //!   their figure, the report folder.
+//! - [`tune`]: `plantwide tune` and `Plant.tune`: the tuned loops, their Bode diagrams, the report
+//!   folder.
 
 pub mod size;
+pub mod tune;
 
 use std::path::Path;
 

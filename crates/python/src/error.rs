@@ -66,6 +66,13 @@ impl From<plantwide_studies::screen::ScreenError> for FaceError {
     }
 }
 
+impl From<plantwide_studies::TuneError> for FaceError {
+    fn from(e: plantwide_studies::TuneError) -> Self {
+        let user = e.is_user_error();
+        FaceError::classify(e, user)
+    }
+}
+
 impl From<plantwide_flowsheet::OverrideError> for FaceError {
     fn from(e: plantwide_flowsheet::OverrideError) -> Self {
         FaceError::input(e)

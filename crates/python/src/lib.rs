@@ -202,6 +202,24 @@ fn size(
     Ok(py.detach(|| plant::size(&src, &sets, &request, report.as_deref().map(|d| (d, system))))?)
 }
 
+/// `plantwide tune FILE --json`: the tuning's JSON text (times in the request's `time_unit`) and
+/// the message of the loops their margins refute (none when all hold); `report` a folder for the
+/// CLI's report, `write` a file for the tuned flowsheet (written only when no loop is refuted).
+#[pyfunction]
+#[pyo3(signature = (text, name, sets, request, report = None, write = None))]
+fn tune(
+    py: Python<'_>,
+    text: String,
+    name: String,
+    sets: Vec<String>,
+    request: String,
+    report: Option<String>,
+    write: Option<String>,
+) -> PyResult<plant::Sized> {
+    let src = Source { text, name };
+    Ok(py.detach(|| plant::tune(&src, &sets, &request, report.as_deref(), write.as_deref()))?)
+}
+
 /// The module `plantwide._plantwide`.
 #[pymodule]
 fn _plantwide(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -220,5 +238,6 @@ fn _plantwide(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(screen, m)?)?;
     m.add_function(wrap_pyfunction!(screen_pairings, m)?)?;
     m.add_function(wrap_pyfunction!(size, m)?)?;
+    m.add_function(wrap_pyfunction!(tune, m)?)?;
     Ok(())
 }

@@ -16,6 +16,7 @@ use plantwide_studies::screen::pairings::{self, CandidateTask, DynamicSettings, 
 use plantwide_studies::screen::{ColumnScreen, screen_column, screen_pairings};
 use plantwide_studies::size::SizeRequest;
 use plantwide_studies::tune::loops::Measurement;
+use plantwide_studies::tune::request::TuneRequest;
 use plantwide_units::UnitSystem;
 
 use crate::error::FaceError;
@@ -285,6 +286,37 @@ pub fn size(
     }
     let failed = plantwide_studies::request::failed_parts("size", sizing.failed());
     Ok((plantwide_io::report::json(&sizing).map_err(io)?, failed))
+}
+
+/// `plantwide tune FILE --json [--report DIR] [--write OUT]`: `request` is a
+/// [`TuneRequest`] as JSON (the fields of `Plant.tune`). Returns the tuning as the CLI prints
+/// it and the message of the loops its margins refute (none when all hold); `write` gets the
+/// tuned flowsheet only when none is refuted.
+pub fn tune(
+    src: &Source,
+    sets: &[String],
+    request: &str,
+    report: Option<&str>,
+    write: Option<&str>,
+) -> Result<Sized, FaceError> {
+    let request: TuneRequest =
+        serde_json::from_str(request).map_err(|e| FaceError::Input(format!("tune: the request: {e}")))?;
+    let (name, seconds) = request.time_unit()?;
+    let tu = plantwide_io::report::tune::TimeUnit { name, seconds };
+    let (plant, ss) = src.at_steady_state(sets)?;
+    let tuned = plantwide_studies::tune::request::tune(&plant, &ss.x, &request)?;
+    let io = |e: plantwide_io::IoError| FaceError::Input(e.to_string());
+    if let Some(dir) = report {
+        plantwide_io::report::tune::write_report(std::path::Path::new(dir), &tuned, &plant, &tu).map_err(io)?;
+    }
+    let failed = tuned.failed();
+    if let Some(out) = write.filter(|_| failed.is_empty()) {
+        let text = plantwide_studies::tune::request::tuned_text(&src.text, &src.name, &plant, &tuned.tuning, &tu.name)?;
+        std::fs::write(out, text).map_err(|e| FaceError::Input(format!("{out}: cannot write: {e}")))?;
+    }
+    let failed = (!failed.is_empty())
+        .then(|| format!("{}{}", failed.join("\n"), if write.is_some() { "\nnothing written" } else { "" }));
+    Ok((plantwide_io::report::tune::json(&tuned, &tu).map_err(io)?, failed))
 }
 
 /// `v` as JSON text.

@@ -105,7 +105,7 @@ pub enum TuneError {
     /// Averaging-level tuning of a measurement that does not integrate.
     #[error(
         "`{controller}` measures {measurement}, which settles at a finite gain when its output moves: averaging \
-         tuning is for levels (integrating measurements); use --method simc or blt"
+         tuning is for levels (integrating measurements); use `method` simc or blt"
     )]
     NotIntegrating {
         /// Controller.
@@ -171,7 +171,7 @@ pub enum TuneError {
     /// The loop's element has no time constant to size a test by (a pure integrator).
     #[error(
         "`{controller}`: its element has no lag or dead time of its own (a pure integrator?) to size the test by; \
-         give --scan (the test then runs 500 scans)"
+         give `scan` (the test then runs 500 scans)"
     )]
     ResidenceTime {
         /// Controller.
@@ -196,7 +196,7 @@ pub enum TuneError {
     },
     /// A test amplitude of zero (the output's steady value is zero).
     #[error(
-        "`{controller}`: the test amplitude is {} (5 % of an output at zero); give --relay-amplitude or --step",
+        "`{controller}`: the test amplitude is {} (5 % of an output at zero); give `relay_amplitude` or `step`",
         plantwide_model::limits::number(*.amplitude)
     )]
     RelayAmplitude {
@@ -218,7 +218,7 @@ pub enum TuneError {
     },
     /// A test would drive its input out of range (a valve past fully open).
     #[error(
-        "`{controller}`: the test moves {input} to {}: {why}; give a smaller --relay-amplitude or --step",
+        "`{controller}`: the test moves {input} to {}: {why}; give a smaller `relay_amplitude` or `step`",
         plantwide_model::limits::number(*.value)
     )]
     Saturates {
@@ -236,7 +236,7 @@ pub enum TuneError {
     #[error(
         "`{controller}`: its output has no steady-state effect on its measurement (the response returns to where it \
          started: something else — another loop, an inventory left free — cancels it); tune the loops that hold \
-         the plant around it first, or tune this one on a faster test (--method relay)"
+         the plant around it first, or tune this one on a faster test (`method` relay)"
     )]
     NoSteadyGain {
         /// Controller.
@@ -245,7 +245,7 @@ pub enum TuneError {
     /// The fitted model does not describe the step response: settings from it would be arbitrary.
     #[error(
         "`{controller}`: the {model} model explains R² = {r2:.3} of the step response (at least {min_r2} needed); \
-         choose another --model, a smaller --step, or a relay test"
+         choose another `model`, a smaller `step`, or a relay test"
     )]
     PoorFit {
         /// Controller.
@@ -267,14 +267,14 @@ pub enum TuneError {
         if *stalled {
             if *settled {
                 "a smaller step did not bring it closer, so the difference is not the plant's curvature: the model \
-                 does not describe the response; choose another --model, or a relay test (--method relay)"
+                 does not describe the response; choose another `model`, or a relay test (`method` relay)"
             } else {
                 "a smaller step did not bring it closer, and the response had not settled within the test: the fit \
-                 extrapolates; give a longer --scan, or a relay test (--method relay)"
+                 extrapolates; give a longer `scan`, or a relay test (`method` relay)"
             }
         } else {
-            "the response stays outside the linear range down to the last step; tune by a relay test (--method \
-             relay) or on the linear model (--method blt)"
+            "the response stays outside the linear range down to the last step; tune by a relay test (`method` \
+             relay) or on the linear model (`method` blt)"
         }
     )]
     OutsideLinearRange {
@@ -294,14 +294,48 @@ pub enum TuneError {
     /// The step record determines no model.
     #[error(transparent)]
     Fit(#[from] crate::tune::fit::FitError),
+    /// A field of the request that does not parse or does not fit.
+    #[error("{field} {why}")]
+    Field {
+        /// The [`crate::tune::request::TuneRequest`] field.
+        field: &'static str,
+        /// What is wrong, after the field's name (`must not be negative`, `3 kg: …`).
+        why: String,
+    },
+    /// No steady state of the plant with the loops tuned before this one.
+    #[error("the steady state with the loops before `{controller}` tuned: {source}")]
+    Steady {
+        /// The loop to be tested next.
+        controller: String,
+        /// The solver's reason.
+        source: Box<plantwide_solve::SolveError>,
+    },
+    /// The tuned settings could not be written into the plant.
+    #[error("writing the tuned settings into the flowsheet: {0}")]
+    Structure(Box<plantwide_flowsheet::OverrideError>),
+    /// The flowsheet's text could not be edited.
+    #[error(transparent)]
+    Edit(Box<plantwide_flowsheet::edit::EditError>),
     /// A model-based rule cannot be applied.
     #[error(transparent)]
     Rule(#[from] crate::tune::rules::RuleError),
 }
 
 impl TuneError {
+    /// The request field a refusal is about, which its message starts with.
+    pub fn field(&self) -> Option<&'static str> {
+        match self {
+            TuneError::Field { field, .. } => Some(field),
+            TuneError::Duplicate(_) => Some("loops"),
+            _ => None,
+        }
+    }
+
     /// True for problems of the request (exit code 1), false for numerical failures (exit code 2).
     pub fn is_user_error(&self) -> bool {
+        if let TuneError::Steady { source, .. } = self {
+            return source.is_user_error();
+        }
         !matches!(
             self,
             TuneError::DetuningLimit { .. }

@@ -21,6 +21,7 @@ pub mod loops;
 pub mod margins;
 pub mod plant_tests;
 pub mod relay;
+pub mod request;
 pub mod rules;
 pub mod ultimate;
 

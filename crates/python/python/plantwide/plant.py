@@ -293,15 +293,76 @@ class Plant:
                 request["scenario"] = json.loads(_native.read_text(os.fspath(scenario)))
         folder = None if report is None else os.fspath(report)
         text, failed = _native.size(self._text, self._name, assignments(set), json.dumps(request), folder, units)
-        result = json.loads(text)
-        if failed is not None:
-            error = ConvergenceError(failed)
-            error.result = result
-            raise error
-        return result
+        return _answer(text, failed)
+
+    def tune(
+        self,
+        loops: str | Sequence[str],
+        method: str,
+        *,
+        measurement_dead_time: str | float | None = None,
+        measurement_lag: str | float | None = None,
+        relay_amplitude: str | float | None = None,
+        hysteresis: str | float | None = None,
+        scan: str | float | None = None,
+        step: str | float | None = None,
+        model: str | None = None,
+        tau_c: str | float | None = None,
+        pid: bool = False,
+        level_band: str | float | None = None,
+        flow_change: str | float | None = None,
+        form: str = "p",
+        time_unit: str = "s",
+        set: Mapping[str, Any] | None = None,
+        report: str | os.PathLike | None = None,
+        write: str | os.PathLike | None = None,
+    ) -> dict:
+        """``plantwide tune FILE --json``: PI(D) settings of the PID ``loops`` (a name or a list) by
+        ``method`` (blt, zn, tl, relay, simc, imc, averaging), each with the test behind it and its
+        margins on the plant's linear model; times in ``time_unit``, as the CLI prints them.
+        Quantities are text with units (``"30 s"``) or SI numbers. ``report`` writes the CLI's
+        ``--report`` folder; ``write`` the flowsheet with the tuned settings. Loops whose own
+        margins refute their settings raise ``ConvergenceError`` (nothing written), the result
+        kept as the error's ``result``."""
+        request = {
+            "loops": [loops] if isinstance(loops, str) else list(loops),
+            "method": method,
+            "pid": pid,
+            "form": form,
+            "time_unit": time_unit,
+        }
+        for key, value in (
+            ("measurement_dead_time", measurement_dead_time),
+            ("measurement_lag", measurement_lag),
+            ("relay_amplitude", relay_amplitude),
+            ("hysteresis", hysteresis),
+            ("scan", scan),
+            ("step", step),
+            ("model", model),
+            ("tau_c", tau_c),
+            ("level_band", level_band),
+            ("flow_change", flow_change),
+        ):
+            if value is not None:
+                request[key] = value
+        folder = None if report is None else os.fspath(report)
+        out = None if write is None else os.fspath(write)
+        text, failed = _native.tune(self._text, self._name, assignments(set), json.dumps(request), folder, out)
+        return _answer(text, failed)
 
     def __repr__(self) -> str:
         return f"<Plant {self.name} ({self._name}): {len(self.variables)} variables, {len(self.inputs)} free inputs>"
+
+
+def _answer(text: str, failed: str | None) -> dict:
+    """A study's JSON as a dict; parts without an answer raise ``ConvergenceError`` with the same
+    message as the CLI's exit 2, the result kept as its ``result``."""
+    result = json.loads(text)
+    if failed is not None:
+        error = ConvergenceError(failed)
+        error.result = result
+        raise error
+    return result
 
 
 def load(path: str | os.PathLike) -> Plant:

@@ -15,10 +15,10 @@
 //!   `|k| Δu/(e ω_n)`. Setting it to `Δh`: `ω_n = |k| Δu/(e Δh)`, `|K_c| = 2 Δu/(e Δh)`,
 //!   `τ_I = 2/ω_n = 2 e Δh/(|k| Δu)`; the level returns to its setpoint.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// P-only or critically damped PI.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum AveragingForm {
     /// Proportional only: the level settles off its setpoint, the flow is filtered to first order.

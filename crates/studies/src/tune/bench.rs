@@ -96,7 +96,7 @@ pub enum RelayError<E: std::error::Error> {
     #[error(
         "no relay switch for {scans} scans (to t = {t:.4e} s): the measurement does not come back across its \
          steady value — the loop integrates, saturates at the relay's amplitude, or its scan is far too long; \
-         try a smaller amplitude or give --scan"
+         try a smaller amplitude or give `scan`"
     )]
     NoSwitch {
         /// Scans since the last switch.

@@ -29,7 +29,7 @@ pub struct StepResponse {
 }
 
 /// Which model to fit.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum ModelOrder {
     /// First order plus dead time.

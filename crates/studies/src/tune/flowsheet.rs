@@ -333,14 +333,23 @@ pub fn edits(plant: &Plant, tuning: &FlowsheetTuning, time_unit: &str) -> Result
 /// The JSON text of SI value `v` in the unit of `old` (a quantity string), else `fallback`, else
 /// the bare SI number; six significant digits.
 pub fn quantity(v: f64, old: Option<&QuantityValue>, fallback: Option<&str>) -> String {
+    match written(v, old, fallback) {
+        QuantityValue::Text(t) => format!("\"{t}\""),
+        QuantityValue::Number(_) => significant(v),
+    }
+}
+
+/// SI value `v` as a tuned file holds it: in the unit of `old` (a quantity string), else
+/// `fallback`, else the bare SI number; six significant digits (the value [`quantity`] writes).
+pub fn written(v: f64, old: Option<&QuantityValue>, fallback: Option<&str>) -> QuantityValue {
     let unit = match old {
         Some(QuantityValue::Text(t)) => t.trim().split_once(char::is_whitespace).map(|(_, u)| u.trim().to_string()),
         _ => None,
     };
     let unit = unit.or_else(|| fallback.filter(|u| *u != "s").map(str::to_string));
     match unit.as_deref().and_then(|u| convert_from_si(v, u).ok().map(|x| (x, u))) {
-        Some((x, u)) => format!("\"{} {u}\"", significant(x)),
-        None => significant(v),
+        Some((x, u)) => QuantityValue::Text(format!("{} {u}", significant(x))),
+        None => QuantityValue::Number(significant(v).parse().unwrap_or(v)),
     }
 }
 

@@ -62,7 +62,7 @@ pub fn plant_loop(plant: &Plant, name: &str) -> Result<PlantLoop, TuneError> {
 /// # Errors
 /// [`TuneError::Duplicate`] for a loop named twice, [`TuneError::NotALoop`] as [`plant_loop`].
 pub fn plant_loops<T: AsRef<str>>(plant: &Plant, names: &[T]) -> Result<Vec<PlantLoop>, TuneError> {
-    crate::request::unique("--loops", names, |a, b| a == b)?;
+    crate::request::unique("loops", names, |a, b| a == b)?;
     names.iter().map(|n| plant_loop(plant, n.as_ref())).collect()
 }
 

@@ -336,7 +336,7 @@ const MAX_SCANS_PER_TIME: f64 = 1e4;
 fn check_scan(l: &PlantLoop, scan: f64, time: f64, what: &str) -> Result<(), TuneError> {
     let bad = |why: String| Err(TuneError::Scan { controller: l.name.clone(), scan, why });
     if !(scan.is_finite() && scan > 0.0) {
-        return bad("is not a positive time: give --scan a positive time, or leave it out for the default".into());
+        return bad("is not a positive time: give `scan` a positive time, or leave it out for the default".into());
     }
     if time.is_finite() && scan < time / MAX_SCANS_PER_TIME {
         return bad(format!(

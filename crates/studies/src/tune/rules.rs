@@ -55,7 +55,7 @@ pub enum RuleError {
     /// The model has no dead time (below a thousandth of its lag) and no `τ_c` was given.
     #[error(
         "the fitted model has no dead time, so the default closed-loop time constant τc = θ is zero; give \
-         the loop's measurement dead time (--measurement-dead-time, an analyzer's: it adds to θ) or --tau-c \
+         the loop's measurement dead time (`measurement_dead_time`, an analyzer's: it adds to θ) or `tau_c` \
          (a time about the dead time of the loop's measurement and valve, or a fraction of τ)"
     )]
     NoDeadTime,
