@@ -57,7 +57,6 @@ mod screen;
 mod sensitivity;
 mod serve;
 mod shard;
-mod shown;
 mod size;
 mod steady;
 mod tune;

@@ -25,8 +25,8 @@ use plantwide::units::UnitSystem;
 
 use super::CliError;
 use super::shard::ShardArgs;
-use super::shown::Shown;
 use super::steady::load_with_overrides;
+use plantwide::io::report::shown::Shown;
 
 /// Arguments of `plantwide screen`.
 #[derive(Debug, clap::Args)]
@@ -442,7 +442,8 @@ fn pairings(a: &ScreenArgs, plant: &plantwide::flowsheet::Plant, system: UnitSys
     }
     a.shard.check_merged(screen.tested.len())?;
     let watched = request.watch.iter().map(|w| (w.path.clone(), None));
-    let shown = Shown::new(std::slice::from_ref(plant), cvs.iter().cloned().chain(watched), system)?;
+    let shown = Shown::new(std::slice::from_ref(plant), cvs.iter().cloned().chain(watched), system)
+        .map_err(|e| CliError::user(super::with_flags(e.to_string(), e.field(), &[])))?;
     let json = serde_json::to_string_pretty(&screen).map_err(|e| CliError::user(e.to_string()))?;
     if let Some(dir) = &a.report {
         let fail = |e: std::io::Error| CliError::user(format!("--report {}: {e}", dir.display()));

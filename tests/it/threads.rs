@@ -9,7 +9,7 @@ use plantwide::analysis::linear::Linearization;
 use plantwide::analysis::shard::Share;
 use plantwide::flowsheet::{Plant, load_file};
 use plantwide::solve::{StrategySettings, converge};
-use plantwide::studies::compare::{CompareRequest, Prices, compare};
+use plantwide::studies::compare::{CompareSettings, Prices, compare};
 use plantwide::studies::screen::pairings::{Disturbance, DynamicSettings, PairingRequest, screen_pairings};
 use plantwide::studies::tune::loops::Measurement;
 
@@ -57,7 +57,7 @@ fn screen_pairings_gives_the_same_digits_on_1_and_4_threads() {
 #[test]
 fn compare_gives_the_same_digits_on_1_and_4_threads() {
     let plants = [plant("data/newcomer3/bt_column_lv.json"), plant("data/newcomer3/bt_column_lv_blt.json")];
-    let request = CompareRequest {
+    let request = CompareSettings {
         disturbances: steps(),
         outputs: vec!["bottoms.x[benzene]".into()],
         loops: Vec::new(),

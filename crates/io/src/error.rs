@@ -44,6 +44,17 @@ pub enum IoError {
     /// form).
     #[error("{0}")]
     Draw(String),
+    /// A display unit asked for a path (`PATH@unit`) that is no unit, or not one of the path's
+    /// dimension.
+    #[error("outputs {path}@{unit}: {why}")]
+    DisplayUnit {
+        /// The path.
+        path: String,
+        /// The unit asked.
+        unit: String,
+        /// Why it cannot show the path.
+        why: String,
+    },
     /// A figure with nothing to draw: every part it would show failed, and a plot of what is left
     /// would read as an answer.
     #[error("{file}: not written: {why}")]
@@ -56,6 +67,11 @@ pub enum IoError {
 }
 
 impl IoError {
+    /// The request field an error is about, which its message starts with.
+    pub fn field(&self) -> Option<&'static str> {
+        matches!(self, IoError::DisplayUnit { .. }).then_some("outputs")
+    }
+
     /// True when the file is missing because the study has no result to show (exit code 2 at the
     /// faces), false for a file that was asked wrongly or could not be written.
     pub fn is_missing_result(&self) -> bool {

@@ -2,11 +2,16 @@
 //! same text, JSON and figures for the same result. A face maps its arguments to the study's
 //! request, calls the library, and prints or writes what these functions make of the result.
 //!
+//! - [`compare`]: `plantwide compare` and `plantwide.compare`: the schemes side by side, the report
+//!   folder.
+//! - [`shown`]: the display units of the paths a report shows.
 //! - [`size`]: `plantwide size` and `Plant.size`: the designs' table or the candidates' ranking,
 //!   their figure, the report folder.
 //! - [`tune`]: `plantwide tune` and `Plant.tune`: the tuned loops, their Bode diagrams, the report
 //!   folder.
 
+pub mod compare;
+pub mod shown;
 pub mod size;
 pub mod tune;
 

@@ -220,6 +220,23 @@ fn tune(
     Ok(py.detach(|| plant::tune(&src, &sets, &request, report.as_deref(), write.as_deref()))?)
 }
 
+/// `plantwide compare A.json B.json … --json`: the comparison's JSON text and the message of its
+/// failed parts (none when all have their answer); `schemes` are `(text, name)` of each flowsheet,
+/// `request` the study's request as JSON, `report` a folder for the CLI's report in `units`.
+#[pyfunction]
+#[pyo3(signature = (schemes, request, report = None, units = "si"))]
+fn compare(
+    py: Python<'_>,
+    schemes: Vec<(String, String)>,
+    request: String,
+    report: Option<String>,
+    units: &str,
+) -> PyResult<plant::Sized> {
+    let system = plant::units(units)?;
+    let sources: Vec<Source> = schemes.into_iter().map(|(text, name)| Source { text, name }).collect();
+    Ok(py.detach(|| plant::compare(&sources, &request, report.as_deref().map(|d| (d, system))))?)
+}
+
 /// The module `plantwide._plantwide`.
 #[pymodule]
 fn _plantwide(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -239,5 +256,6 @@ fn _plantwide(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(screen_pairings, m)?)?;
     m.add_function(wrap_pyfunction!(size, m)?)?;
     m.add_function(wrap_pyfunction!(tune, m)?)?;
+    m.add_function(wrap_pyfunction!(compare, m)?)?;
     Ok(())
 }

@@ -12,6 +12,7 @@ use plantwide_flowsheet::scenario::{Limits, parse_scenario, resolve_with};
 use plantwide_flowsheet::{Override, Plant};
 use plantwide_solve::dynamic::{SimulationResult, Start, simulate};
 use plantwide_solve::{Method, Solution, StrategySettings, converge, fix_design_point};
+use plantwide_studies::compare::CompareRequest;
 use plantwide_studies::screen::pairings::{self, CandidateTask, DynamicSettings, PairingRequest};
 use plantwide_studies::screen::{ColumnScreen, screen_column, screen_pairings};
 use plantwide_studies::size::SizeRequest;
@@ -317,6 +318,35 @@ pub fn tune(
     let failed = (!failed.is_empty())
         .then(|| format!("{}{}", failed.join("\n"), if write.is_some() { "\nnothing written" } else { "" }));
     Ok((plantwide_io::report::tune::json(&tuned, &tu).map_err(io)?, failed))
+}
+
+/// `plantwide compare A.json B.json … --json [--report DIR]`: `request` is a
+/// [`CompareRequest`] as JSON (the fields of `plantwide.compare`), each scheme loaded as the CLI
+/// loads it (at its design point). Returns the comparison as the CLI prints it and the message of
+/// its failed parts (none when every part has its answer); the report, when asked, is written in
+/// `report.1`'s display units.
+pub fn compare(schemes: &[Source], request: &str, report: Option<(&str, UnitSystem)>) -> Result<Sized, FaceError> {
+    let request: CompareRequest =
+        serde_json::from_str(request).map_err(|e| FaceError::Input(format!("compare: the request: {e}")))?;
+    let plants = schemes
+        .iter()
+        .map(|s| {
+            let mut p = s.load(&[])?;
+            fix_design_point(&mut p)?;
+            Ok(p)
+        })
+        .collect::<Result<Vec<_>, FaceError>>()?;
+    let c = plantwide_studies::compare::study(&plants, &request).map_err(|e| {
+        let user = e.is_user_error();
+        FaceError::classify(e, user)
+    })?;
+    let io = |e: plantwide_io::IoError| FaceError::Input(e.to_string());
+    if let Some((dir, system)) = report {
+        let shown = plantwide_io::report::compare::shown(&plants, &request.outputs, &c, system).map_err(io)?;
+        plantwide_io::report::compare::write_report(std::path::Path::new(dir), &c, &shown).map_err(io)?;
+    }
+    let failed = plantwide_studies::request::failed_parts("compare", &c.failed);
+    Ok((plantwide_io::report::json(&c).map_err(io)?, failed))
 }
 
 /// `v` as JSON text.

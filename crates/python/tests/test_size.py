@@ -53,6 +53,11 @@ def test_the_report_folder_is_the_clis(tank, cli, tmp_path):
     for name in names:
         assert (tmp_path / "py" / name).read_bytes() == (tmp_path / "cli" / name).read_bytes(), name
     assert "kmol/h" in (tmp_path / "py" / "size.md").read_text()
+    # A ranking's report: its bars drawn in one order on every run, so the files are equal too.
+    tank.size(candidates=["tank", "out"], **REQUEST, report=tmp_path / "py_rank")
+    cli(["size", SURGE, "--candidates", "tank,out", *ARGS, "--report", str(tmp_path / "cli_rank")])
+    for name in names:
+        assert (tmp_path / "py_rank" / name).read_bytes() == (tmp_path / "cli_rank" / name).read_bytes(), name
 
 
 def test_refusals_name_the_request_field(tank):

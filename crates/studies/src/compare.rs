@@ -23,9 +23,10 @@
 //!    compare. BLT assumes open-loop stable loops (its Nyquist test counts no right-half-plane
 //!    poles, and the steady-state gain of an open-loop unstable loop has the wrong sign for the
 //!    controller's action): a scheme unstable with its quality loops in manual keeps the file's
-//!    tuning, and says so; [`CompareRequest::file_tuning`] keeps every file's tuning.
+//!    tuning, and says so; [`CompareSettings::file_tuning`] keeps every file's tuning.
 
 pub mod energy;
+mod request;
 pub mod verdict;
 
 use plantwide_analysis::linear::Linearization;
@@ -46,10 +47,11 @@ use crate::screen::pairings::{
     Disturbance, DynamicResult, DynamicSettings, PairingRequest, PairingStructure, Tuning, assess_pairing,
 };
 pub use energy::{Energy, Prices, UtilityCost, cost, energy};
+pub use request::{CompareRequest, LoopTuning, study};
 
 /// What to compare.
 #[derive(Debug, Clone, PartialEq)]
-pub struct CompareRequest {
+pub struct CompareSettings {
     /// Disturbances, each an input stepped by a fraction of its steady value or by an amount, up,
     /// down or both ways (the sensitivity sweeps go to both sides by that size).
     pub disturbances: Vec<Disturbance>,
@@ -66,7 +68,7 @@ pub struct CompareRequest {
     pub prices: Prices,
 }
 
-impl CompareRequest {
+impl CompareSettings {
     /// The closed-loop runs of this request on a scheme's `cvs` and `mvs`: its disturbances, its
     /// outputs recorded.
     fn runs_of(&self, cvs: Vec<String>, mvs: Vec<String>) -> PairingRequest {
@@ -97,8 +99,16 @@ pub enum CompareError {
     },
     /// A disturbance a scheme refuses: no such input, a wrong unit, or a step outside the input's
     /// physical range.
-    #[error("--disturbances {0}")]
+    #[error("disturbances {0}")]
     Disturbance(Box<crate::disturbance::DisturbanceError>),
+    /// A field of the request that does not parse or does not fit.
+    #[error("{field} {why}")]
+    Field {
+        /// The [`CompareRequest`] field.
+        field: &'static str,
+        /// What is wrong, after the field's name.
+        why: String,
+    },
     /// An output or a loop the request names is not in a scheme.
     #[error("{file}: {what}")]
     Request {
@@ -132,11 +142,20 @@ impl From<crate::disturbance::DisturbanceError> for CompareError {
 }
 
 impl CompareError {
+    /// The request field a refusal is about, which its message starts with.
+    pub fn field(&self) -> Option<&'static str> {
+        match self {
+            CompareError::Field { field, .. } => Some(field),
+            CompareError::Disturbance(_) => Some("disturbances"),
+            _ => None,
+        }
+    }
+
     /// True for a request or a file at fault (exit 1), false for a numerical failure (exit 2).
     pub fn is_user_error(&self) -> bool {
         match self {
             CompareError::Steady { source, .. } => source.is_user_error(),
-            CompareError::Request { .. } | CompareError::Disturbance(_) => true,
+            CompareError::Request { .. } | CompareError::Disturbance(_) | CompareError::Field { .. } => true,
             CompareError::Screen { source, .. } => source.is_user_error(),
             CompareError::Analysis { source, .. } => source.is_user_error(),
         }
@@ -287,7 +306,7 @@ pub struct Comparison {
 ///
 /// # Errors
 /// [`CompareError`] naming the scheme's file and what failed.
-pub fn compare(plants: &[Plant], request: &CompareRequest) -> Result<Comparison, CompareError> {
+pub fn compare(plants: &[Plant], request: &CompareSettings) -> Result<Comparison, CompareError> {
     let first: Vec<Scheme> = plants.par_iter().map(|p| scheme(p, request)).collect::<Result<_, _>>()?;
     // One run length for all: given, or 20 reset times of the slowest tuned loop of any scheme.
     let longest = |s: &Scheme| {
@@ -302,8 +321,10 @@ pub fn compare(plants: &[Plant], request: &CompareRequest) -> Result<Comparison,
     });
     let schemes = match duration {
         Some(d) if request.dynamic.duration.is_none() && !request.disturbances.is_empty() => {
-            let again =
-                CompareRequest { dynamic: DynamicSettings { duration: Some(d), ..request.dynamic }, ..request.clone() };
+            let again = CompareSettings {
+                dynamic: DynamicSettings { duration: Some(d), ..request.dynamic },
+                ..request.clone()
+            };
             plants
                 .par_iter()
                 .zip(first)
@@ -356,7 +377,7 @@ fn failed_parts(schemes: &[Scheme]) -> Vec<String> {
 }
 
 /// One scheme judged on `r`.
-fn scheme(plant: &Plant, r: &CompareRequest) -> Result<Scheme, CompareError> {
+fn scheme(plant: &Plant, r: &CompareSettings) -> Result<Scheme, CompareError> {
     let file = plant.file().to_string();
     let outputs: Vec<usize> = r.outputs.iter().map(|o| output(plant, o)).collect::<Result<_, _>>()?;
     for d in &r.disturbances {
@@ -463,7 +484,7 @@ type StructureParts = (Vec<Vec<f64>>, Option<f64>, Option<PairingStructure>);
 
 fn structure(
     plant: &Plant,
-    r: &CompareRequest,
+    r: &CompareSettings,
     loops: &[QualityLoop],
     tuning: &Tuning,
 ) -> Result<StructureParts, CompareError> {
@@ -480,7 +501,7 @@ fn structure(
 
 /// Each model predictive controller of the scheme judged at its steady state `x` on `r`'s
 /// disturbances, its runs recording the controller's CVs and `r`'s outputs.
-fn mpc(plant: &Plant, x: &[f64], r: &CompareRequest) -> Result<Vec<MpcAlternative>, CompareError> {
+fn mpc(plant: &Plant, x: &[f64], r: &CompareSettings) -> Result<Vec<MpcAlternative>, CompareError> {
     let screen = |e| CompareError::Screen { file: plant.file().to_string(), source: Box::new(e) };
     controllers(plant)
         .iter()
@@ -585,7 +606,7 @@ fn sensitivity(
     plant: &Plant,
     x: &[f64],
     u: &[f64],
-    r: &CompareRequest,
+    r: &CompareSettings,
     outputs: &[usize],
     ops: &[Limited],
 ) -> Result<Vec<Sensitivity>, plantwide_analysis::AnalysisError> {

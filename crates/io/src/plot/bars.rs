@@ -66,12 +66,15 @@ impl Figure for Bars<'_> {
             .axis_desc_style(("sans-serif", 15))
             .draw()
             .map_err(err)?;
-        let finite = self.bars.iter().enumerate().filter(|(_, (_, v))| v.is_finite());
-        let histogram = Histogram::horizontal(&chart)
-            .style(RGBColor(70, 130, 220).mix(0.8).filled())
-            .margin(6)
-            .data(finite.map(|(k, (_, v))| (n - 1 - k, *v)));
-        chart.draw_series(histogram).map_err(err)?;
+        // One histogram a bar: plotters sums a histogram's data in a hash map, so several bars in
+        // one would be written in a different order on every run (the same picture, another file).
+        for (k, (_, v)) in self.bars.iter().enumerate().filter(|(_, (_, v))| v.is_finite()) {
+            let bar = Histogram::horizontal(&chart)
+                .style(RGBColor(70, 130, 220).mix(0.8).filled())
+                .margin(6)
+                .data(std::iter::once((n - 1 - k, *v)));
+            chart.draw_series(bar).map_err(err)?;
+        }
         for (k, (_, v)) in self.bars.iter().enumerate() {
             let text = if v.is_finite() { format!("{v:.4}") } else { "–".to_string() };
             let at = if v.is_finite() { *v } else { 0.0 };

@@ -5,6 +5,8 @@
 >>> plant.steady()["distillate.x[A]"]                      # SI, as ``plantwide steady --json``
 >>> g = plant.gains(["column.reflux", "column.boilup"], ["distillate.x[A]", "bottoms.x[A]"])
 >>> g.gain, g.rga, g.niederlinski
+>>> plant.tune(["top_composition", "bottom_composition"], "blt")   # as ``plantwide tune --json``
+>>> pw.compare(["a.json", "b.json"], disturbances=["feed.F=±10%"], outputs=["product.F"], report="out")
 >>> pw.sweep("flowsheets/column_a.json", sets=[{"feed_source.F": "1.01 kmol/min"}], outputs=["distillate.x[A]"])
 
 Every call goes through the same library functions as the CLI, so the numbers are the CLI's
@@ -14,7 +16,7 @@ value; an ill-posed plant), :class:`ConvergenceError` where it exits 2, with the
 """
 
 from ._plantwide import ConvergenceError, InputError, PlantwideError
-from .plant import Gains, LinearModel, Plant, SteadyState, load
+from .plant import Gains, LinearModel, Plant, SteadyState, compare, load
 from .sweeps import screen, screen_pairings, sensitivity, sweep
 
 __all__ = [
@@ -25,6 +27,7 @@ __all__ = [
     "Plant",
     "PlantwideError",
     "SteadyState",
+    "compare",
     "load",
     "screen",
     "screen_pairings",

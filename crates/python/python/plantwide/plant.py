@@ -370,3 +370,45 @@ def load(path: str | os.PathLike) -> Plant:
     JSON path)."""
     name = os.fspath(path)
     return Plant(_native.read_text(name), name)
+
+
+def compare(
+    schemes: Sequence[str | os.PathLike | Plant],
+    disturbances: Sequence[str],
+    outputs: Sequence[str],
+    *,
+    loops: Sequence[str] = (),
+    measurement_dead_time: str | float = "1 min",
+    tuning: str = "blt",
+    duration: str | float | None = None,
+    heating_price: float | None = None,
+    cooling_price: float | None = None,
+    hours: float | None = None,
+    report: str | os.PathLike | None = None,
+    units: str = "si",
+) -> dict:
+    """``plantwide compare A.json B.json … --json``: two or more schemes (files or plants) side by
+    side (energy and its yearly cost, control structure, stability, recycles, sensitivity,
+    closed-loop responses, a verdict) for ``disturbances`` (``"PATH=±10%"``) and ``outputs``
+    (``PATH[@unit]``). Returns the dict the CLI prints (SI); ``report`` writes the CLI's
+    ``--report`` folder in ``units`` (si, metric, field). Parts without an answer raise
+    ``ConvergenceError`` after the report is written, the result kept as the error's ``result``."""
+    plants = [s if isinstance(s, Plant) else load(s) for s in schemes]
+    request = {
+        "disturbances": list(disturbances),
+        "outputs": list(outputs),
+        "loops": list(loops),
+        "measurement_dead_time": measurement_dead_time,
+        "tuning": tuning,
+    }
+    for key, value in (
+        ("duration", duration),
+        ("heating_price", heating_price),
+        ("cooling_price", cooling_price),
+        ("hours", hours),
+    ):
+        if value is not None:
+            request[key] = value
+    folder = None if report is None else os.fspath(report)
+    text, failed = _native.compare([(p.text, p.file) for p in plants], json.dumps(request), folder, units)
+    return _answer(text, failed)

@@ -130,7 +130,7 @@ fn booked(plant: &Plant, x: &[f64], u: &[f64], unit: &str, d: &plantwide_model::
 /// (Turton et al., *Analysis, Synthesis and Design of Chemical Processes*, 4th ed., 2012) for
 /// every cooling duty, and continuous operation (8760 h/yr). Heat recovered between process
 /// streams costs nothing here: the exchanger's capital is not in the comparison.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, serde::Deserialize)]
 pub struct Prices {
     /// Heating utility \[$/GJ\].
     pub heating: f64,
