@@ -4,6 +4,8 @@
 //!
 //! - [`compare`]: `plantwide compare` and `plantwide.compare`: the schemes side by side, the report
 //!   folder.
+//! - [`identify`]: `plantwide identify` and `Plant.identify`: the test, the verdict, the models, the
+//!   report folder with the step model.
 //! - [`shown`]: the display units of the paths a report shows.
 //! - [`size`]: `plantwide size` and `Plant.size`: the designs' table or the candidates' ranking,
 //!   their figure, the report folder.
@@ -11,6 +13,7 @@
 //!   folder.
 
 pub mod compare;
+pub mod identify;
 pub mod shown;
 pub mod size;
 pub mod tune;

@@ -237,6 +237,24 @@ fn compare(
     Ok(py.detach(|| plant::compare(&sources, &request, report.as_deref().map(|d| (d, system))))?)
 }
 
+/// `plantwide identify FILE --json`: the identification's JSON text and, when the verdict finds
+/// the model not usable, the CLI's exit-2 message; `report` a folder for the CLI's report, `force`
+/// writes its step model even then.
+#[pyfunction]
+#[pyo3(signature = (text, name, sets, request, report = None, force = false))]
+fn identify(
+    py: Python<'_>,
+    text: String,
+    name: String,
+    sets: Vec<String>,
+    request: String,
+    report: Option<String>,
+    force: bool,
+) -> PyResult<plant::Sized> {
+    let src = Source { text, name };
+    Ok(py.detach(|| plant::identify(&src, &sets, &request, report.as_deref().map(|d| (d, force))))?)
+}
+
 /// The module `plantwide._plantwide`.
 #[pymodule]
 fn _plantwide(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -257,5 +275,6 @@ fn _plantwide(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(size, m)?)?;
     m.add_function(wrap_pyfunction!(tune, m)?)?;
     m.add_function(wrap_pyfunction!(compare, m)?)?;
+    m.add_function(wrap_pyfunction!(identify, m)?)?;
     Ok(())
 }

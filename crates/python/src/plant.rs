@@ -13,6 +13,7 @@ use plantwide_flowsheet::{Override, Plant};
 use plantwide_solve::dynamic::{SimulationResult, Start, simulate};
 use plantwide_solve::{Method, Solution, StrategySettings, converge, fix_design_point};
 use plantwide_studies::compare::CompareRequest;
+use plantwide_studies::identify::IdentifyRequest;
 use plantwide_studies::screen::pairings::{self, CandidateTask, DynamicSettings, PairingRequest};
 use plantwide_studies::screen::{ColumnScreen, screen_column, screen_pairings};
 use plantwide_studies::size::SizeRequest;
@@ -347,6 +348,39 @@ pub fn compare(schemes: &[Source], request: &str, report: Option<(&str, UnitSyst
     }
     let failed = plantwide_studies::request::failed_parts("compare", &c.failed);
     Ok((plantwide_io::report::json(&c).map_err(io)?, failed))
+}
+
+/// `plantwide identify FILE --json [--report DIR [--force]]`: `request` is an
+/// [`IdentifyRequest`] as JSON (the fields of `Plant.identify`). Returns the identification as the
+/// CLI prints it and, when the verdict finds the model not usable, the CLI's exit-2 message.
+pub fn identify(
+    src: &Source,
+    sets: &[String],
+    request: &str,
+    report: Option<(&str, bool)>,
+) -> Result<Sized, FaceError> {
+    use plantwide_io::report::identify::{StepModel, not_usable, write_report};
+    let request: IdentifyRequest =
+        serde_json::from_str(request).map_err(|e| FaceError::Input(format!("identify: the request: {e}")))?;
+    let (plant, ss) = src.at_steady_state(sets)?;
+    let identified = plantwide_studies::identify::study(&plant, &ss.x, &ss.u, &request).map_err(|e| {
+        let user = e.is_user_error();
+        FaceError::classify(e, user)
+    })?;
+    let id = &identified.identification;
+    let step_model = match (report, id.verdict.reliable) {
+        (None, _) => StepModel::NoReport,
+        (Some(_), true) => StepModel::Written,
+        (Some((_, true)), false) => StepModel::Forced,
+        (Some((_, false)), false) => StepModel::Withheld,
+    };
+    let dir = report.map(|(d, _)| std::path::Path::new(d));
+    let failed = not_usable(id, step_model, dir);
+    let io = |e: plantwide_io::IoError| FaceError::Input(e.to_string());
+    if let Some(dir) = dir {
+        write_report(dir, &src.name, &identified, step_model).map_err(io)?;
+    }
+    Ok((plantwide_io::report::json(id).map_err(io)?, failed))
 }
 
 /// `v` as JSON text.

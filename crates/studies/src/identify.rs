@@ -27,6 +27,7 @@ mod closed_loop;
 mod design;
 mod estimate;
 mod plant_test;
+mod request;
 mod verdict;
 
 use faer::Mat;
@@ -39,6 +40,7 @@ use serde::Serialize;
 pub use closed_loop::select_driven;
 pub use design::{Design, Directions, TestDesign};
 pub use estimate::{ModelSummary, OutputValidation};
+pub use request::{Identified, IdentifyRequest, study};
 pub use verdict::{Criterion, MAX_GAIN_ERROR, MAX_RGA_ERROR, MIN_FIT, NEGLIGIBLE, Verdict, number};
 
 /// Settings of an identification; `None` takes the default described on each field.
@@ -99,7 +101,7 @@ pub enum IdentifyError {
     Request(String),
     /// An input whose test moves would leave its physical range.
     #[error(
-        "input `{input}` cannot move by ±{amplitude:.4e} (SI) about {value:.6e}: {why}; give a smaller --amplitude"
+        "input `{input}` cannot move by ±{amplitude:.4e} (SI) about {value:.6e}: {why}; give a smaller `amplitude`"
     )]
     CannotMove {
         /// Input path.
@@ -115,7 +117,7 @@ pub enum IdentifyError {
     #[error(
         "the directional design needs a regular prior gain: G(0) of these inputs and outputs is singular \
          (smallest singular value of the amplitude-scaled gain {smallest:.1e}); remove a dependent output or \
-         input, or use --design prbs"
+         input, or use `design` prbs"
     )]
     SingularDesign {
         /// Smallest singular value of the prior gain scaled by the amplitudes.
@@ -325,21 +327,21 @@ fn check_settings(s: &IdentifySettings, n_outputs: usize) -> Result<(), Identify
         return bad("α (closed-loop speed factor) must be > 0");
     }
     if !(s.high_gain_boost.is_finite() && s.high_gain_boost > 0.0) {
-        return bad("--high-gain-boost must be > 0 (1: equal output amplitude in every direction)");
+        return bad("`high_gain_boost` must be > 0 (1: equal output amplitude in every direction)");
     }
     if !(s.beta.is_finite() && s.beta >= 1.0) {
         return bad("β (settling factor) must be ≥ 1 (3 for 95 % settling)");
     }
     if s.noise.iter().any(|v| !(v.is_finite() && *v >= 0.0)) {
-        return bad("--noise: every σ must be a finite number ≥ 0");
+        return bad("every σ of `noise` must be a finite number ≥ 0");
     }
     if s.noise.len() > 1 && s.noise.len() != n_outputs {
         return Err(IdentifyError::Request(format!(
-            "--noise gives {} values for {n_outputs} outputs: give one σ for all or one per output",
+            "`noise` gives {} values for {n_outputs} outputs: give one σ for all or one per output",
             s.noise.len()
         )));
     }
-    for (what, v) in [("--duration", s.duration), ("--sample-time", s.sample_time), ("--tau-dom", s.tau_dom)] {
+    for (what, v) in [("`duration`", s.duration), ("`sample_time`", s.sample_time), ("`tau_dom`", s.tau_dom)] {
         if v.is_some_and(|v| !(v.is_finite() && v > 0.0)) {
             return Err(IdentifyError::Request(format!("{what} must be > 0")));
         }
@@ -360,6 +362,6 @@ fn slowest_time_constant(lin: &Linearization, inputs: &[usize], outputs: &[usize
     let ss = lin.state_space(inputs, outputs)?;
     let taus = ss.time_constants()?;
     taus.first().copied().filter(|t| t.is_finite() && *t > 0.0).ok_or_else(|| {
-        IdentifyError::Request("the elements have no stable time constant to size the test by; give --tau-dom".into())
+        IdentifyError::Request("the elements have no stable time constant to size the test by; give `tau_dom`".into())
     })
 }

@@ -3,8 +3,9 @@
 
 use crate::{Dimension, Unit};
 
-/// A set of display units.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+/// A set of display units (`"si"`, `"metric"`, `"field"` in a study's request).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum UnitSystem {
     /// Coherent SI (mol/s, K, Pa, W): what JSON and CSV carry.
     #[default]

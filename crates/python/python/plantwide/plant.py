@@ -350,6 +350,55 @@ class Plant:
         text, failed = _native.tune(self._text, self._name, assignments(set), json.dumps(request), folder, out)
         return _answer(text, failed)
 
+    def identify(
+        self,
+        inputs: Sequence[str],
+        outputs: Sequence[str],
+        *,
+        design: str = "directional",
+        noise: float | Sequence[float] = (),
+        seed: int = 1,
+        duration: str | float | None = None,
+        sample_time: str | float | None = None,
+        tau_dom: str | float | None = None,
+        amplitude: float | Sequence[float] = (),
+        alpha: float = 2.0,
+        beta: float = 3.0,
+        high_gain_boost: float = 2.0,
+        closed_loop: bool = False,
+        units: str = "si",
+        set: Mapping[str, Any] | None = None,
+        report: str | os.PathLike | None = None,
+        force: bool = False,
+    ) -> dict:
+        """``plantwide identify FILE --json``: a plant test of ``inputs`` on ``outputs`` (each
+        ``PATH[@unit]``) on the nonlinear model, FIR/ARX/OE fits, their validation on a fresh test
+        and a verdict (the reference book's chapter 7). ``noise`` and ``amplitude`` are in the
+        signals' display units (``units``: si, metric, field, for a signal that names none).
+        Returns the dict the CLI prints; ``report`` writes the CLI's ``--report`` folder (with
+        ``step_model.json`` when the model is usable, or ``force``). A model the verdict finds not
+        usable raises ``ConvergenceError`` after the report, the result kept as its ``result``."""
+        listed = lambda v: [v] if isinstance(v, (int, float)) else list(v)
+        request = {
+            "inputs": list(inputs),
+            "outputs": list(outputs),
+            "design": design,
+            "noise": listed(noise),
+            "seed": seed,
+            "amplitude": listed(amplitude),
+            "alpha": alpha,
+            "beta": beta,
+            "high_gain_boost": high_gain_boost,
+            "closed_loop": closed_loop,
+            "units": units,
+        }
+        for key, value in (("duration", duration), ("sample_time", sample_time), ("tau_dom", tau_dom)):
+            if value is not None:
+                request[key] = value
+        folder = None if report is None else os.fspath(report)
+        text, failed = _native.identify(self._text, self._name, assignments(set), json.dumps(request), folder, force)
+        return _answer(text, failed)
+
     def __repr__(self) -> str:
         return f"<Plant {self.name} ({self._name}): {len(self.variables)} variables, {len(self.inputs)} free inputs>"
 

@@ -27,11 +27,11 @@ pub fn select_driven(plant: &Plant, texts: &[String]) -> Result<Vec<Signal>, Ide
         .map(|t| {
             let path = plantwide_analysis::select::split_unit(t).0;
             let Some(i) = plant.input(path) else {
-                return Err(IdentifyError::Request(format!("--closed-loop: `{path}` is no input of the plant")));
+                return Err(IdentifyError::Request(format!("with `closed_loop`, `{path}` is no input of the plant")));
             };
             if plant.inputs()[i].driven_by.is_none() {
                 return Err(IdentifyError::Request(format!(
-                    "--closed-loop: `{path}` is not driven by a controller: identify it in open loop (without --closed-loop)"
+                    "with `closed_loop`, `{path}` is not driven by a controller: identify it in open loop (without `closed_loop`)"
                 )));
             }
             let mut s = select_outputs(plant, std::slice::from_ref(t))?.remove(0);
@@ -56,18 +56,18 @@ pub(super) fn loops(plant: &Plant, x: &[f64], inputs: &[Signal], outputs: &[usiz
     let mut setpoints = Vec::new();
     for s in inputs {
         let v = plant.inputs()[s.index].driven_by.ok_or_else(|| {
-            IdentifyError::Request(format!("--closed-loop: `{}` is not driven by a controller", s.path))
+            IdentifyError::Request(format!("with `closed_loop`, `{}` is not driven by a controller", s.path))
         })?;
         let name = plant.blocks()[plant.vars()[v].block].name.clone();
         let l = plant_loop(plant, &name).map_err(|_| {
             IdentifyError::Request(format!(
-                "--closed-loop: `{}` is driven by `{name}`, which is no PID loop with a setpoint: setpoint injection needs one",
+                "with `closed_loop`, `{}` is driven by `{name}`, which is no PID loop with a setpoint: setpoint injection needs one",
                 s.path
             ))
         })?;
         let sp = plant.input(&format!("{name}.sp")).ok_or_else(|| {
             IdentifyError::Request(format!(
-                "--closed-loop: loop `{name}` has a remote setpoint: inject at its master's setpoint instead"
+                "with `closed_loop`, loop `{name}` has a remote setpoint: inject at its master's setpoint instead"
             ))
         })?;
         loops.push(l);

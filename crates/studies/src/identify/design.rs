@@ -12,7 +12,7 @@ use serde::Serialize;
 use super::{IdentifyError, IdentifySettings};
 
 /// How the inputs are moved.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Design {
     /// Delayed copies of one PRBS, `D = N T_cl/p` apart (Eq. 7-10).
@@ -94,7 +94,7 @@ fn amplitudes(plant: &Plant, u: &[f64], inputs: &[Signal], s: &IdentifySettings)
         Some(a) if a.len() == 1 => vec![a[0]; inputs.len()],
         Some(a) => {
             return Err(IdentifyError::Request(format!(
-                "--amplitude gives {} values for {} inputs: give one per input",
+                "`amplitude` gives {} values for {} inputs: give one per input",
                 a.len(),
                 inputs.len()
             )));
@@ -103,7 +103,7 @@ fn amplitudes(plant: &Plant, u: &[f64], inputs: &[Signal], s: &IdentifySettings)
     };
     for (sig, &ai) in inputs.iter().zip(&a) {
         if !(ai.is_finite() && ai > 0.0) {
-            return Err(IdentifyError::Request(format!("--amplitude of `{}` must be > 0", sig.path)));
+            return Err(IdentifyError::Request(format!("`amplitude` of `{}` must be > 0", sig.path)));
         }
         let v = u[sig.index];
         for moved in [v - ai, v + ai] {
@@ -193,7 +193,7 @@ pub(super) fn design(
     if duration < period {
         return Err(IdentifyError::Request(format!(
             "a test of {:.4e} s is shorter than one PRBS period N·T_cl = {} × {:.4e} s = {period:.4e} s \
-             (τ_dom = {tau_dom:.4e} s, α = {}, β = {}): give --duration of at least one period, or a larger α",
+             (τ_dom = {tau_dom:.4e} s, α = {}, β = {}): give a `duration` of at least one period, or a larger α",
             duration, p.period, p.clock_period, s.alpha, s.beta
         )));
     }
@@ -201,7 +201,7 @@ pub(super) fn design(
     let n_val = ((period.max(3.0 * t99)) / ts).round() as usize;
     if n_est.max(n_val) > MAX_SAMPLES {
         return Err(IdentifyError::Request(format!(
-            "the test would take {} samples (most {MAX_SAMPLES}): give a longer --sample-time or a shorter --duration",
+            "the test would take {} samples (most {MAX_SAMPLES}): give a longer `sample_time` or a shorter `duration`",
             n_est.max(n_val)
         )));
     }
