@@ -6,6 +6,8 @@
 //!   folder.
 //! - [`identify`]: `plantwide identify` and `Plant.identify`: the test, the verdict, the models, the
 //!   report folder with the step model.
+//! - [`screen`]: `plantwide screen` and `Plant.screen`: a column's configurations or the pairings,
+//!   the report folders, a column's tuned flowsheets.
 //! - [`shown`]: the display units of the paths a report shows.
 //! - [`size`]: `plantwide size` and `Plant.size`: the designs' table or the candidates' ranking,
 //!   their figure, the report folder.
@@ -14,6 +16,7 @@
 
 pub mod compare;
 pub mod identify;
+pub mod screen;
 pub mod shown;
 pub mod size;
 pub mod tune;

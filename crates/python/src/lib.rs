@@ -140,37 +140,27 @@ fn sensitivity<'py>(
     curves.iter().map(|c| convert::curve(py, c, &outs)).collect()
 }
 
-/// `plantwide screen --column --json`: the column's inventory configurations, as JSON text.
+/// `plantwide screen … --json`: the screen's JSON text (a column's configurations or the
+/// pairings) and the message of its failed parts; `request` is the study's request as JSON.
+/// `shard = (I, N)` runs that share of a pairing screen's dynamic tests (their results as JSON);
+/// `merged` (JSON by task number, as a Dask sweep gathers the shards') finishes it; `report` a
+/// folder for the CLI's report in `units`.
 #[pyfunction]
+#[pyo3(signature = (text, name, sets, request, shard = None, merged = None, report = None, units = "si"))]
+#[allow(clippy::too_many_arguments)] // one per keyword of the Python function
 fn screen(
     py: Python<'_>,
     text: String,
     name: String,
     sets: Vec<String>,
-    column: String,
-    outputs: Vec<String>,
-) -> PyResult<String> {
-    let src = Source { text, name };
-    let s = py.detach(|| plant::screen(&src, &sets, &column, &outputs))?;
-    serde_json::to_string(&s).map_err(|e| PlantwideError::new_err(e.to_string()))
-}
-
-/// `plantwide screen --cvs … --mvs … --json` (`args`: the options as JSON), all of it, shard
-/// `(I, N)` of its dynamic tests (their results as JSON), or finished from the shards' results
-/// (`merged`: JSON by task number), which a Dask sweep gathers.
-#[pyfunction]
-#[pyo3(signature = (text, name, sets, args, shard = None, merged = None))]
-fn screen_pairings(
-    py: Python<'_>,
-    text: String,
-    name: String,
-    sets: Vec<String>,
-    args: String,
+    request: String,
     shard: Option<(usize, usize)>,
     merged: Option<String>,
-) -> PyResult<String> {
+    report: Option<String>,
+    units: &str,
+) -> PyResult<plant::Answer> {
     let share = match (shard, merged) {
-        (Some(_), Some(_)) => return Err(InputError::new_err("screen_pairings: a shard or merged results, not both")),
+        (Some(_), Some(_)) => return Err(InputError::new_err("screen: a shard or merged results, not both")),
         (Some((index, count)), None) => {
             let s: plantwide_analysis::shard::Shard =
                 format!("{index}/{count}").parse().map_err(|e| InputError::new_err(format!("{e}")))?;
@@ -179,8 +169,9 @@ fn screen_pairings(
         (None, Some(m)) => plant::PairingShare::Merge(m),
         (None, None) => plant::PairingShare::All,
     };
+    let system = plant::units(units)?;
     let src = Source { text, name };
-    Ok(py.detach(|| plant::pairings(&src, &sets, &args, share))?)
+    Ok(py.detach(|| plant::screen(&src, &sets, &request, share, report.as_deref().map(|d| (d, system))))?)
 }
 
 /// `plantwide size --json`: the sizing's JSON text and the message of its failed parts (none
@@ -196,7 +187,7 @@ fn size(
     request: String,
     report: Option<String>,
     units: &str,
-) -> PyResult<plant::Sized> {
+) -> PyResult<plant::Answer> {
     let system = plant::units(units)?;
     let src = Source { text, name };
     Ok(py.detach(|| plant::size(&src, &sets, &request, report.as_deref().map(|d| (d, system))))?)
@@ -215,7 +206,7 @@ fn tune(
     request: String,
     report: Option<String>,
     write: Option<String>,
-) -> PyResult<plant::Sized> {
+) -> PyResult<plant::Answer> {
     let src = Source { text, name };
     Ok(py.detach(|| plant::tune(&src, &sets, &request, report.as_deref(), write.as_deref()))?)
 }
@@ -231,7 +222,7 @@ fn compare(
     request: String,
     report: Option<String>,
     units: &str,
-) -> PyResult<plant::Sized> {
+) -> PyResult<plant::Answer> {
     let system = plant::units(units)?;
     let sources: Vec<Source> = schemes.into_iter().map(|(text, name)| Source { text, name }).collect();
     Ok(py.detach(|| plant::compare(&sources, &request, report.as_deref().map(|d| (d, system))))?)
@@ -250,7 +241,7 @@ fn identify(
     request: String,
     report: Option<String>,
     force: bool,
-) -> PyResult<plant::Sized> {
+) -> PyResult<plant::Answer> {
     let src = Source { text, name };
     Ok(py.detach(|| plant::identify(&src, &sets, &request, report.as_deref().map(|d| (d, force))))?)
 }
@@ -271,7 +262,6 @@ fn _plantwide(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(sensitivity, m)?)?;
     m.add_function(wrap_pyfunction!(screen, m)?)?;
-    m.add_function(wrap_pyfunction!(screen_pairings, m)?)?;
     m.add_function(wrap_pyfunction!(size, m)?)?;
     m.add_function(wrap_pyfunction!(tune, m)?)?;
     m.add_function(wrap_pyfunction!(compare, m)?)?;

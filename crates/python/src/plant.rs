@@ -14,10 +14,9 @@ use plantwide_solve::dynamic::{SimulationResult, Start, simulate};
 use plantwide_solve::{Method, Solution, StrategySettings, converge, fix_design_point};
 use plantwide_studies::compare::CompareRequest;
 use plantwide_studies::identify::IdentifyRequest;
-use plantwide_studies::screen::pairings::{self, CandidateTask, DynamicSettings, PairingRequest};
-use plantwide_studies::screen::{ColumnScreen, screen_column, screen_pairings};
+use plantwide_studies::screen::pairings::CandidateTask;
+use plantwide_studies::screen::{ScreenRequest, Screened};
 use plantwide_studies::size::SizeRequest;
-use plantwide_studies::tune::loops::Measurement;
 use plantwide_studies::tune::request::TuneRequest;
 use plantwide_units::UnitSystem;
 
@@ -164,27 +163,9 @@ pub fn sensitivity(
     Ok((sweep(&plant, &ss.x, &ss.u, &disturbances, &idx, &settings)?, outs))
 }
 
-/// `plantwide screen --column`: the column's inventory configurations.
-pub fn screen(src: &Source, sets: &[String], column: &str, outputs: &[String]) -> Result<ColumnScreen, FaceError> {
-    let mut plant = src.load(sets)?;
-    fix_design_point(&mut plant)?;
-    Ok(screen_column(&plant, column, outputs)?)
-}
-
-/// A pairing screen as Python asks for it (the CLI's `screen --cvs …` options by name).
-#[derive(Debug, serde::Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct PairingArgs {
-    cvs: Vec<String>,
-    mvs: Vec<String>,
-    #[serde(default)]
-    throughput: Vec<String>,
-    #[serde(default)]
-    disturbances: Vec<String>,
-    candidates: usize,
-    duration: Option<String>,
-    measurement_dead_time: String,
-}
+/// What a study returns to Python: its JSON as the CLI prints it (`--json`), and the message of
+/// its parts without an answer, the CLI's exit 2 (none when every part has its answer).
+pub type Answer = (String, Option<String>);
 
 /// How much of a pairing screen's dynamic tests this call runs.
 pub enum PairingShare {
@@ -196,73 +177,62 @@ pub enum PairingShare {
     Merge(String),
 }
 
-/// A time quantity of a pairing request (`duration`, `measurement_dead_time`).
-fn time(text: &str, field: &str) -> Result<f64, FaceError> {
-    plantwide_units::parse_quantity_as(text, plantwide_units::Dimension::TIME)
-        .map_err(|e| FaceError::Input(format!("{field} `{text}`: {e}")))
-}
-
-/// `plantwide screen --cvs … --mvs … --json`, or a shard of its dynamic tests: JSON text, the
-/// screen's (as the CLI prints it) or `{"tasks": N, "results": {t: …}}` for a shard. No digit
-/// depends on the thread count or on the shard a candidate ran in.
-pub fn pairings(src: &Source, sets: &[String], args: &str, share: PairingShare) -> Result<String, FaceError> {
-    let a: PairingArgs = serde_json::from_str(args).map_err(|e| FaceError::Input(format!("screen_pairings: {e}")))?;
+/// `plantwide screen … --json [--report DIR]`: `request` is a [`ScreenRequest`] as JSON (the
+/// fields of `Plant.screen`), a column's configurations or the pairings, `share` of a pairing
+/// screen's dynamic tests run here. Returns the screen as the CLI prints it (for a shard,
+/// `{"tasks": N, "results": {t: …}}`) and the message of its failed parts. No digit depends on
+/// the thread count or on the shard a candidate ran in.
+pub fn screen(
+    src: &Source,
+    sets: &[String],
+    request: &str,
+    share: PairingShare,
+    report: Option<(&str, UnitSystem)>,
+) -> Result<Answer, FaceError> {
+    let request: ScreenRequest =
+        serde_json::from_str(request).map_err(|e| FaceError::Input(format!("screen: the request: {e}")))?;
     let share = match share {
         PairingShare::All => Share::All,
         PairingShare::Shard(s) => Share::Shard(s),
         PairingShare::Merge(text) => {
             let given: std::collections::BTreeMap<usize, CandidateTask> = serde_json::from_str(&text)
-                .map_err(|e| FaceError::Input(format!("screen_pairings: the shards' results: {e}")))?;
+                .map_err(|e| FaceError::Input(format!("screen: the shards' results: {e}")))?;
             Share::Merge(given.into_iter().map(|(t, c)| (t, c.into())).collect())
         }
     };
-    let merging = matches!(share, Share::Merge(_));
-    let request = PairingRequest {
-        disturbances: a
-            .disturbances
-            .iter()
-            .map(|d| d.parse::<pairings::Disturbance>())
-            .collect::<Result<_, _>>()
-            .map_err(|e| FaceError::Input(format!("--disturbances {e}")))?,
-        dynamic: DynamicSettings {
-            candidates: a.candidates,
-            duration: a.duration.as_deref().map(|d| time(d, "duration")).transpose()?,
-            measurement: Measurement { dead_time: time(&a.measurement_dead_time, "measurement_dead_time")?, lag: 0.0 },
-        },
-        cvs: a.cvs,
-        mvs: a.mvs,
-        throughput: a.throughput,
-        watch: Vec::new(),
-        record: Vec::new(),
-        mpc: None,
-        share,
-    };
+    let (sharded, merging) = (share.is_shard(), matches!(share, Share::Merge(_)));
     let mut plant = src.load(sets)?;
     fix_design_point(&mut plant)?;
-    let screen = screen_pairings(&plant, &request)?;
-    if request.share.is_shard() {
-        let results: std::collections::BTreeMap<usize, CandidateTask> = screen
-            .tested
-            .iter()
-            .enumerate()
-            .filter_map(|(t, &k)| screen.structures[k].dynamic.as_ref().map(|d| (t, CandidateTask::from(d))))
-            .collect();
-        return to_json(&serde_json::json!({"tasks": screen.tested.len(), "results": results}));
+    let screened = plantwide_studies::screen::study(&plant, &request, share)?;
+    let io = |e: plantwide_io::IoError| FaceError::Input(e.to_string());
+    if let Screened::Pairings(p) = &screened {
+        if sharded {
+            let results: std::collections::BTreeMap<usize, CandidateTask> = p
+                .tested
+                .iter()
+                .enumerate()
+                .filter_map(|(t, &k)| p.structures[k].dynamic.as_ref().map(|d| (t, CandidateTask::from(d))))
+                .collect();
+            return Ok((to_json(&serde_json::json!({"tasks": p.tested.len(), "results": results}))?, None));
+        }
+        if let Some(t) = (0..p.tested.len()).find(|&t| merging && p.structures[p.tested[t]].dynamic.is_none()) {
+            return Err(FaceError::Input(format!("screen: the shards' results miss task {t} of {}", p.tested.len())));
+        }
     }
-    if let Some(t) =
-        (0..screen.tested.len()).find(|&t| merging && screen.structures[screen.tested[t]].dynamic.is_none())
-    {
-        return Err(FaceError::Input(format!(
-            "screen_pairings: the shards' results miss task {t} of {}",
-            screen.tested.len()
-        )));
+    if let Some((dir, system)) = report {
+        use plantwide_io::report::screen::{shown, write_column_report, write_pairing_report};
+        let dir = std::path::Path::new(dir);
+        match &screened {
+            Screened::Column(c) => write_column_report(dir, &src.name, c).map(|_| ()),
+            Screened::Pairings(p) => {
+                shown(&plant, &request, system).and_then(|s| write_pairing_report(dir, p, &s).map(|_| ()))
+            }
+        }
+        .map_err(io)?;
     }
-    to_json(&screen)
+    let failed = plantwide_studies::request::failed_parts("screen", screened.failed());
+    Ok((plantwide_io::report::json(&screened).map_err(io)?, failed))
 }
-
-/// What `Plant.size` returns: the sizing as `plantwide size --json` prints it, and the message of
-/// its failed parts (none when every part has its answer).
-pub type Sized = (String, Option<String>);
 
 /// `plantwide size --json [--report DIR]`: `request` is a [`SizeRequest`] as JSON (the fields of
 /// `Plant.size`); the report, when asked, is written in `report.1`'s display units, as the CLI's.
@@ -271,7 +241,7 @@ pub fn size(
     sets: &[String],
     request: &str,
     report: Option<(&str, UnitSystem)>,
-) -> Result<Sized, FaceError> {
+) -> Result<Answer, FaceError> {
     let request: SizeRequest =
         serde_json::from_str(request).map_err(|e| FaceError::Input(format!("size: the request: {e}")))?;
     let (plant, ss) = src.at_steady_state(sets)?;
@@ -300,7 +270,7 @@ pub fn tune(
     request: &str,
     report: Option<&str>,
     write: Option<&str>,
-) -> Result<Sized, FaceError> {
+) -> Result<Answer, FaceError> {
     let request: TuneRequest =
         serde_json::from_str(request).map_err(|e| FaceError::Input(format!("tune: the request: {e}")))?;
     let (name, seconds) = request.time_unit()?;
@@ -326,7 +296,7 @@ pub fn tune(
 /// loads it (at its design point). Returns the comparison as the CLI prints it and the message of
 /// its failed parts (none when every part has its answer); the report, when asked, is written in
 /// `report.1`'s display units.
-pub fn compare(schemes: &[Source], request: &str, report: Option<(&str, UnitSystem)>) -> Result<Sized, FaceError> {
+pub fn compare(schemes: &[Source], request: &str, report: Option<(&str, UnitSystem)>) -> Result<Answer, FaceError> {
     let request: CompareRequest =
         serde_json::from_str(request).map_err(|e| FaceError::Input(format!("compare: the request: {e}")))?;
     let plants = schemes
@@ -358,7 +328,7 @@ pub fn identify(
     sets: &[String],
     request: &str,
     report: Option<(&str, bool)>,
-) -> Result<Sized, FaceError> {
+) -> Result<Answer, FaceError> {
     use plantwide_io::report::identify::{StepModel, not_usable, write_report};
     let request: IdentifyRequest =
         serde_json::from_str(request).map_err(|e| FaceError::Input(format!("identify: the request: {e}")))?;

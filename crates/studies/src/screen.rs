@@ -11,9 +11,11 @@
 
 pub mod column;
 pub mod pairings;
+mod request;
 
 pub use column::{ColumnDynamic, ColumnRequest, ColumnScreen, ColumnStructure, screen_column, screen_column_with};
 pub use pairings::{PairingRequest, PairingScreen, screen_pairings};
+pub use request::{ScreenRequest, Screened, study};
 
 /// Why a screening could not be done.
 #[derive(Debug, Clone, thiserror::Error)]
@@ -21,6 +23,14 @@ pub enum ScreenError {
     /// A list of the request names one item twice.
     #[error(transparent)]
     Duplicate(#[from] crate::request::Duplicate),
+    /// A field of the request that does not parse or does not fit.
+    #[error("{field} {why}")]
+    Field {
+        /// The [`ScreenRequest`] field.
+        field: &'static str,
+        /// What is wrong, after the field's name.
+        why: String,
+    },
     /// The unit named is no column (it lacks the reflux, reboiler, distillate and bottoms inputs).
     #[error("no column `{name}` in the flowsheet{hint} (its columns: {columns})")]
     NotAColumn {
@@ -47,9 +57,7 @@ pub enum ScreenError {
         handles: String,
     },
     /// An output path names no variable.
-    #[error(
-        "--outputs: no variable `{path}`{hint}; give the two qualities as variable paths, e.g. distillate.x[light]"
-    )]
+    #[error("outputs: no variable `{path}`{hint}; give the two qualities as variable paths, e.g. distillate.x[light]")]
     NoOutput {
         /// The path.
         path: String,
@@ -57,7 +65,7 @@ pub enum ScreenError {
         hint: String,
     },
     /// An allowed deviation that is not a positive amount.
-    #[error("--allowed-deviation {path}: {value} is no deviation; give a positive amount in the quality's unit")]
+    #[error("allowed_deviation {path}: {value} is no deviation; give a positive amount in the quality's unit")]
     Allowed {
         /// The quality.
         path: String,
@@ -67,7 +75,7 @@ pub enum ScreenError {
     /// No feed of free rate is upstream of the column, so the dynamic check has no default disturbances.
     #[error(
         "column `{column}`: no feed of free rate upstream ({why}), so the dynamic check has no default \
-         disturbances; give them with --disturbances PATH=±x%,… or screen with --steady-only"
+         disturbances; give them with `disturbances` PATH=±x%,… or screen with `steady_only`"
     )]
     NoFeed {
         /// The column.
@@ -84,10 +92,10 @@ pub enum ScreenError {
         why: String,
     },
     /// Not two outputs.
-    #[error("--outputs: a column configuration controls two qualities (top, bottom); got {0}")]
+    #[error("outputs: a column configuration controls two qualities (top, bottom); got {0}")]
     OutputCount(usize),
     /// A CV names no variable.
-    #[error("--cvs: no variable `{path}`{hint}")]
+    #[error("cvs: no variable `{path}`{hint}")]
     NoCv {
         /// The path.
         path: String,
@@ -95,7 +103,7 @@ pub enum ScreenError {
         hint: String,
     },
     /// A watched variable names no variable.
-    #[error("--watch: no variable `{path}`{hint}")]
+    #[error("watch: no variable `{path}`{hint}")]
     NoWatch {
         /// The path.
         path: String,
@@ -103,10 +111,10 @@ pub enum ScreenError {
         hint: String,
     },
     /// Watched variables without disturbances to sweep.
-    #[error("--watch needs --disturbances: the band is tested over ± each disturbance")]
+    #[error("watch needs `disturbances` to sweep: the band is tested over ± each disturbance")]
     WatchWithoutDisturbances,
     /// An MV names no input.
-    #[error("--mvs: `{path}` is no input of the plant{hint}")]
+    #[error("mvs: `{path}` is no input of the plant{hint}")]
     NoMv {
         /// The path.
         path: String,
@@ -115,7 +123,7 @@ pub enum ScreenError {
     },
     /// A throughput candidate that is not an MV.
     #[error(
-        "--throughput {path}: a throughput candidate must be one of the --mvs (it is held while the others are paired)"
+        "throughput {path}: a throughput candidate must be one of the `mvs` (it is held while the others are paired)"
     )]
     ThroughputNotMv {
         /// The path.
@@ -124,9 +132,9 @@ pub enum ScreenError {
     /// A disturbance on an input that a candidate pairs: its controller drives it there, so the
     /// step cannot be applied.
     #[error(
-        "--disturbances {path}: it is also one of the --mvs, and a candidate that pairs it drives it with a \
+        "disturbances {path}: it is also one of the `mvs`, and a candidate that pairs it drives it with a \
          controller, so it cannot be stepped there{held}: disturb an input no candidate pairs, or give it as \
-         the only --throughput candidate (held in every candidate, as a throughput manipulator is)"
+         the only `throughput` candidate (held in every candidate, as a throughput manipulator is)"
     )]
     DisturbedMv {
         /// The disturbance's path.
@@ -137,7 +145,7 @@ pub enum ScreenError {
     },
     /// Not as many free MVs as CVs.
     #[error(
-        "{cvs} CVs and {mvs} MVs{}: pairing needs as many MVs as CVs (one more with --throughput), 1 to 8 of them",
+        "{cvs} CVs and {mvs} MVs{}: pairing needs as many MVs as CVs (one more with a `throughput` candidate), 1 to 8 of them",
         if *throughput { " with a throughput manipulator" } else { "" }
     )]
     NotSquare {
@@ -150,7 +158,7 @@ pub enum ScreenError {
     },
     /// A disturbance that is no free input of the open plant.
     #[error(
-        "--disturbances {path}: not an input of the plant that no controller drives; give a feed flow, composition or temperature"
+        "disturbances {path}: not an input of the plant that no controller drives; give a feed flow, composition or temperature"
     )]
     Disturbance {
         /// The path.
@@ -158,7 +166,7 @@ pub enum ScreenError {
     },
     /// A disturbance that cannot be read, or whose step the plant refuses (no such input, a wrong
     /// unit, a value outside the input's physical range).
-    #[error("--disturbances {0}")]
+    #[error("disturbances {0}")]
     BadDisturbance(Box<crate::disturbance::DisturbanceError>),
     /// The sensitivity test could not be run for a throughput choice.
     #[error("sensitivity test (throughput {throughput}): {why}")]
@@ -248,6 +256,24 @@ impl From<crate::disturbance::DisturbanceError> for ScreenError {
 }
 
 impl ScreenError {
+    /// The [`ScreenRequest`] field a refusal is about, which its message starts with.
+    pub fn field(&self) -> Option<&'static str> {
+        match self {
+            ScreenError::NoOutput { .. } | ScreenError::OutputCount(_) => Some("outputs"),
+            ScreenError::Allowed { .. } => Some("allowed_deviation"),
+            ScreenError::NoCv { .. } => Some("cvs"),
+            ScreenError::NoWatch { .. } | ScreenError::WatchWithoutDisturbances => Some("watch"),
+            ScreenError::NoMv { .. } => Some("mvs"),
+            ScreenError::ThroughputNotMv { .. } => Some("throughput"),
+            ScreenError::DisturbedMv { .. } | ScreenError::Disturbance { .. } | ScreenError::BadDisturbance(_) => {
+                Some("disturbances")
+            }
+            ScreenError::Field { field, .. } => Some(field),
+            ScreenError::Duplicate(d) => ScreenRequest::FIELDS.iter().copied().find(|f| *f == d.list),
+            _ => None,
+        }
+    }
+
     /// True for problems of the request (exit code 1), false for numerical failures (exit code 2).
     pub fn is_user_error(&self) -> bool {
         match self {

@@ -399,6 +399,56 @@ class Plant:
         text, failed = _native.identify(self._text, self._name, assignments(set), json.dumps(request), folder, force)
         return _answer(text, failed)
 
+    def screen(
+        self,
+        column: str | None = None,
+        outputs: Sequence[str] = (),
+        *,
+        cvs: Sequence[str] = (),
+        mvs: Sequence[str] = (),
+        throughput: Sequence[str] = (),
+        disturbances: Sequence[str] = (),
+        watch: Sequence[str] = (),
+        steady_only: bool = False,
+        keep_flowsheets: bool = False,
+        allowed_deviation: Sequence[str | float] = (),
+        candidates: int = 4,
+        measurement_dead_time: str | float = "1 min",
+        duration: str | float | None = None,
+        mpc: Mapping | None = None,
+        set: Mapping[str, Any] | None = None,
+        report: str | os.PathLike | None = None,
+        units: str = "si",
+    ) -> dict:
+        """``plantwide screen FILE … --json``: ``column``'s inventory configurations for its two
+        ``outputs`` (top, bottom), ranked by a dynamic check or (``steady_only``) by their
+        steady-state measures; or the pairings of ``cvs`` to ``mvs`` filtered at steady state and
+        the best ``candidates`` tested on the nonlinear plant for ``disturbances``. Returns the dict
+        the CLI prints; ``report`` writes the CLI's ``--report`` folder in ``units``. Parts without
+        an answer raise ``ConvergenceError``, the result kept as the error's ``result``. For a
+        pairing screen spread over a Dask cluster, see :func:`plantwide.screen_pairings`."""
+        request = {
+            "outputs": list(outputs),
+            "cvs": list(cvs),
+            "mvs": list(mvs),
+            "throughput": list(throughput),
+            "disturbances": list(disturbances),
+            "watch": list(watch),
+            "steady_only": steady_only,
+            "keep_flowsheets": keep_flowsheets,
+            "allowed_deviation": list(allowed_deviation),
+            "candidates": int(candidates),
+            "measurement_dead_time": measurement_dead_time,
+        }
+        for key, value in (("column", column), ("duration", duration), ("mpc", mpc)):
+            if value is not None:
+                request[key] = dict(value) if isinstance(value, Mapping) else value
+        folder = None if report is None else os.fspath(report)
+        text, failed = _native.screen(
+            self._text, self._name, assignments(set), json.dumps(request), None, None, folder, units
+        )
+        return _answer(text, failed)
+
     def __repr__(self) -> str:
         return f"<Plant {self.name} ({self._name}): {len(self.variables)} variables, {len(self.inputs)} free inputs>"
 

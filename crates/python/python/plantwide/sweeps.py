@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from . import _plantwide as _native
-from .plant import Plant, assignments, load
+from .plant import Plant, _answer, assignments, load
 
 
 def _source(flowsheet: str | os.PathLike | Plant) -> tuple[str, str]:
@@ -88,7 +88,8 @@ def sensitivity(
 
 def _screen_task(text: str, name: str, sets: list[str], column: str, outputs: list[str]) -> dict:
     """One operating point's screening (runs on a worker)."""
-    return json.loads(_native.screen(text, name, sets, column, outputs))
+    request = json.dumps({"column": column, "outputs": outputs, "steady_only": True})
+    return _answer(*_native.screen(text, name, sets, request))
 
 
 def screen(
@@ -112,7 +113,7 @@ def screen(
 
 def _pairing_shard_task(text: str, name: str, sets: list[str], args: str, shard: tuple[int, int]) -> dict:
     """One shard of a pairing screen's dynamic tests (runs on a worker)."""
-    return json.loads(_native.screen_pairings(text, name, sets, args, shard))
+    return json.loads(_native.screen(text, name, sets, args, shard)[0])
 
 
 def screen_pairings(
@@ -142,12 +143,12 @@ def screen_pairings(
             "throughput": list(throughput),
             "disturbances": list(disturbances),
             "candidates": int(candidates),
-            "duration": duration,
             "measurement_dead_time": measurement_dead_time,
+            **({} if duration is None else {"duration": duration}),
         }
     )
     if client is None or not disturbances:
-        return json.loads(_native.screen_pairings(text, name, sets, args))
+        return _answer(*_native.screen(text, name, sets, args))
     n = max(1, min(int(candidates), len(client.scheduler_info()["workers"])))
     parts = _gather(client, _pairing_shard_task, [(text, name, sets, args, (i, n)) for i in range(n)])
     merged: dict[str, Any] = {}
@@ -156,4 +157,4 @@ def screen_pairings(
     tasks = parts[0]["tasks"]
     if sorted(int(t) for t in merged) != list(range(tasks)):
         raise RuntimeError(f"screen_pairings: the shards returned tasks {sorted(merged)} of {tasks}")
-    return json.loads(_native.screen_pairings(text, name, sets, args, None, json.dumps(merged)))
+    return _answer(*_native.screen(text, name, sets, args, None, json.dumps(merged)))

@@ -90,19 +90,10 @@ pub struct Identified {
 }
 
 impl IdentifyRequest {
-    /// The fields a message may name, in backticks, for a face to map to its own names.
-    pub const FIELDS: &'static [&'static str] = &[
-        "inputs",
-        "outputs",
-        "design",
-        "noise",
-        "duration",
-        "sample_time",
-        "tau_dom",
-        "amplitude",
-        "high_gain_boost",
-        "closed_loop",
-    ];
+    /// The fields a message names in backticks (`` give a smaller `amplitude` ``), for a face to
+    /// map to its own names.
+    pub const FIELDS: &'static [&'static str] =
+        &["design", "noise", "duration", "sample_time", "tau_dom", "amplitude", "high_gain_boost", "closed_loop"];
 }
 
 /// Identify `request`'s inputs and outputs of `plant` at its steady state `(x, u)`.

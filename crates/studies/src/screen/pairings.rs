@@ -351,8 +351,8 @@ fn check_request(plant: &Plant, r: &PairingRequest) -> Result<(), ScreenError> {
     if !r.watch.is_empty() && r.disturbances.is_empty() {
         return Err(ScreenError::WatchWithoutDisturbances);
     }
-    crate::request::unique("--cvs", &r.cvs, |a, b| plant.var(a) == plant.var(b))?;
-    crate::request::unique("--mvs", &r.mvs, |a, b| plant.input(a) == plant.input(b))?;
+    crate::request::unique("cvs", &r.cvs, |a, b| plant.var(a) == plant.var(b))?;
+    crate::request::unique("mvs", &r.mvs, |a, b| plant.input(a) == plant.input(b))?;
     if let Some(t) = r.throughput.iter().find(|t| !r.mvs.contains(t)) {
         return Err(ScreenError::ThroughputNotMv { path: t.clone() });
     }

@@ -127,22 +127,10 @@ impl TunedLoops {
 }
 
 impl TuneRequest {
-    /// The fields a message may name, in backticks, for a face to map to its own names.
-    pub const FIELDS: &'static [&'static str] = &[
-        "loops",
-        "method",
-        "measurement_dead_time",
-        "measurement_lag",
-        "relay_amplitude",
-        "hysteresis",
-        "scan",
-        "step",
-        "model",
-        "tau_c",
-        "level_band",
-        "flow_change",
-        "time_unit",
-    ];
+    /// The fields a message names in backticks (`` give a longer `scan` ``), for a face to map to
+    /// its own names; a field a message only starts with is [`TuneError::field`]'s.
+    pub const FIELDS: &'static [&'static str] =
+        &["method", "measurement_dead_time", "relay_amplitude", "scan", "step", "model", "tau_c"];
 
     /// The time unit's name and its length in seconds.
     ///

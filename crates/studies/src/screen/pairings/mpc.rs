@@ -138,9 +138,11 @@ pub(crate) fn screen_mpc(
 ) -> Result<MpcAlternative, ScreenError> {
     let bad = |why: String| ScreenError::Mpc { controller: SCREEN_MPC.into(), why };
     let mut spec = description.clone();
-    let Some(obj) = spec.as_object_mut() else { return Err(bad("--mpc: the file must hold one JSON object".into())) };
+    let Some(obj) = spec.as_object_mut() else {
+        return Err(bad("`mpc` must be one JSON object, a controller description".into()));
+    };
     obj.entry("type").or_insert_with(|| "mpc".into());
-    let cvs = obj.get_mut("cvs").and_then(|c| c.as_array_mut()).ok_or_else(|| bad("--mpc: no `cvs` list".into()))?;
+    let cvs = obj.get_mut("cvs").and_then(|c| c.as_array_mut()).ok_or_else(|| bad("`mpc` has no `cvs` list".into()))?;
     let mut paths = Vec::new();
     for cv in cvs.iter_mut().filter_map(|c| c.as_object_mut()) {
         let pv = cv.get("pv").and_then(|p| p.as_str()).unwrap_or_default().to_string();
@@ -154,15 +156,18 @@ pub(crate) fn screen_mpc(
     sorted.1.sort();
     if sorted.0 != sorted.1 {
         return Err(bad(format!(
-            "--mpc: its CVs [{}] must be the screening's --cvs [{}]",
+            "the `mpc` controller's CVs [{}] must be the screening's `cvs` [{}]",
             paths.join(", "),
             r.cvs.join(", ")
         )));
     }
-    let mvs = obj.get("mvs").and_then(|m| m.as_array()).ok_or_else(|| bad("--mpc: no `mvs` list".into()))?;
+    let mvs = obj.get("mvs").and_then(|m| m.as_array()).ok_or_else(|| bad("`mpc` has no `mvs` list".into()))?;
     let outputs: Vec<&str> = mvs.iter().filter_map(|m| m.get("output")?.as_str()).collect();
     if let Some(m) = outputs.iter().find(|m| !r.mvs.iter().any(|x| x == *m)) {
-        return Err(bad(format!("--mpc: MV `{m}` is not one of the screening's --mvs [{}]", r.mvs.join(", "))));
+        return Err(bad(format!(
+            "the `mpc` controller's MV `{m}` is not one of the screening's `mvs` [{}]",
+            r.mvs.join(", ")
+        )));
     }
     let edit = plantwide_flowsheet::StructureEdit::AddController { name: SCREEN_MPC.into(), spec };
     let plant = open.plant.restructure(&[edit]).map_err(|e| bad(e.to_string()))?;
