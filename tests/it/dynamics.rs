@@ -3,6 +3,7 @@
 //! the new steady state, time constant, conservation, step count), event timing, controller
 //! mode switches and failures, sampled controllers and analyzers, and snapshot → resume.
 
+use approx::abs_diff_eq;
 use plantwide::flowsheet::overrides::{set_field, set_input};
 use plantwide::flowsheet::scenario::{parse_scenario, resolve};
 use plantwide::flowsheet::{FlowsheetSpec, Plant, assemble, parse_spec};
@@ -378,8 +379,12 @@ fn a_snapshot_resumed_with_another_scenario_runs_that_scenario_from_its_time() {
     let continuous = run_from(&plant, &with_snapshot, Start::Steady(&x0), &mut |_| {});
     assert!(resumed.times[0] > snap.t && resumed.times[0] <= snap.t + 180.0, "first row at {} s", resumed.times[0]);
     let feed = column(&resumed, "feed_source.F");
-    let near = |a: f64, b: f64| (a - b).abs() <= 1e-12 * b;
-    assert!(near(feed[0], 1.01e3 / 60.0) && near(*feed.last().unwrap(), 0.95e3 / 60.0), "the new step acted: {feed:?}");
+    let (stepped, restored) = (1.01e3 / 60.0, 0.95e3 / 60.0);
+    assert!(
+        abs_diff_eq!(feed[0], stepped, epsilon = 1e-12 * stepped)
+            && abs_diff_eq!(*feed.last().unwrap(), restored, epsilon = 1e-12 * restored),
+        "the new step acted: {feed:?}"
+    );
     let (xb, xb_full) = (column(&resumed, "bottoms.x[light]"), column(&continuous, "bottoms.x[light]"));
     let mut worst: f64 = 0.0;
     for (i, t) in resumed.times.iter().enumerate() {

@@ -2,6 +2,8 @@
 //! feed lost and restored (also one a controller drives: the fault overrides the controller, which
 //! winds up against it), an analyzer frozen and repaired; and the refusals of faults out of order.
 
+use approx::abs_diff_eq;
+
 use crate::harness;
 
 /// A scratch folder of this test process.
@@ -64,8 +66,10 @@ fn a_stuck_pump_and_a_lost_feed_fail_and_are_repaired() {
     let wound = 50.0 + 50.0 * e * 1.5;
     assert!((after[3] - wound).abs() < 1e-6 * wound, "lc.op {} against the wound-up {wound}", after[3]);
     let repaired = stuck_end[1];
-    let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * b.abs();
-    assert!(close(repaired[2], repaired[3]), "the repaired pump takes the controller's output: {repaired:?}");
+    assert!(
+        abs_diff_eq!(repaired[2], repaired[3], epsilon = 1e-12 * repaired[3].abs()),
+        "the repaired pump takes the controller's output: {repaired:?}"
+    );
     let lost = at(&rows, 1000.0)[1];
     assert_eq!(lost[4], 0.0);
     assert!(rows.iter().filter(|r| r[0] > 1000.0 && r[0] < 1100.0).all(|r| r[4] == 0.0));

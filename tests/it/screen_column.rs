@@ -4,6 +4,7 @@
 //! newcomer's own runs; the tuned flowsheets it writes, run again; a configuration that loses the
 //! plant marked, not ranked.
 
+use approx::abs_diff_eq;
 use serde_json::Value;
 
 use crate::harness::{fixture, flowsheet, plantwide};
@@ -43,10 +44,6 @@ fn condition_2x2(g: [[f64; 2]; 2]) -> f64 {
     ((sum + root) / (sum - root)).sqrt()
 }
 
-fn close(a: f64, b: f64, rel: f64) -> bool {
-    (a - b).abs() <= rel * b.abs()
-}
-
 /// The regular configurations (gains measured, not failed).
 fn regular(v: &Value) -> Vec<&Value> {
     v["structures"].as_array().unwrap().iter().filter(|s| !s["gain"].is_null() && s["failure"].is_null()).collect()
@@ -67,20 +64,32 @@ fn scaled_gains_and_one_pairing_on_the_low_reflux_column() {
     assert!(allowed.iter().all(|a| (a - 0.005).abs() < 5e-6), "{allowed:?}");
     let fl = |k: &str| f(&v["flows"][k]);
     let lv = by_name(&v, "LV");
+    let (reflux, duty) = (118.942e3 / 3600.0, 1.61539e6);
     assert!(
-        close(f(&lv["input_scales"][0]), 118.942e3 / 3600.0, 1e-9) && close(f(&lv["input_scales"][1]), 1.61539e6, 1e-9)
+        abs_diff_eq!(f(&lv["input_scales"][0]), reflux, epsilon = 1e-9 * reflux)
+            && abs_diff_eq!(f(&lv["input_scales"][1]), duty, epsilon = 1e-9 * duty),
+        "{lv}"
     );
     let ratios = by_name(&v, "(L/D)(V/B)");
     let (r, s) = (fl("reflux") / fl("distillate"), fl("boilup") / fl("bottoms"));
-    assert!(close(f(&ratios["input_scales"][0]), r, 1e-9) && close(f(&ratios["input_scales"][1]), s, 1e-9), "{ratios}");
+    assert!(
+        abs_diff_eq!(f(&ratios["input_scales"][0]), r, epsilon = 1e-9 * r.abs())
+            && abs_diff_eq!(f(&ratios["input_scales"][1]), s, epsilon = 1e-9 * s.abs()),
+        "{ratios}"
+    );
     for c in regular(&v) {
         let (g, scales) = (m2(&c["gain"]), [f(&c["input_scales"][0]), f(&c["input_scales"][1])]);
         let scaled = [0, 1].map(|i| [0, 1].map(|j| g[i][j] * scales[j] / allowed[i]));
         let shown = m2(&c["scaled_gain"]);
         for (i, j) in [(0, 0), (0, 1), (1, 0), (1, 1)] {
-            assert!(close(shown[i][j], scaled[i][j], 1e-12), "{}: {shown:?} vs {scaled:?}", c["name"]);
+            assert!(
+                abs_diff_eq!(shown[i][j], scaled[i][j], epsilon = 1e-12 * scaled[i][j].abs()),
+                "{}: {shown:?} vs {scaled:?}",
+                c["name"]
+            );
         }
-        assert!(close(f(&c["condition_number"]), condition_2x2(scaled), 1e-9), "{}", c["name"]);
+        let gamma = condition_2x2(scaled);
+        assert!(abs_diff_eq!(f(&c["condition_number"]), gamma, epsilon = 1e-9 * gamma.abs()), "{}", c["name"]);
     }
     // On SI gains LV's γ measured watts against mol/s.
     assert!(condition_2x2(m2(&lv["gain"])) > 1e5 && f(&lv["condition_number"]) < 100.0, "{lv}");
@@ -88,7 +97,8 @@ fn scaled_gains_and_one_pairing_on_the_low_reflux_column() {
     let lb = by_name(&v, "LB");
     let g = m2(&lb["gain"]);
     let l11 = g[0][0] * g[1][1] / (g[0][0] * g[1][1] - g[0][1] * g[1][0]);
-    assert!(l11 < 0.5 && close(f(&lb["relative_gain"]), 1.0 - l11, 1e-9), "{lb}");
+    let lambda = 1.0 - l11;
+    assert!(l11 < 0.5 && abs_diff_eq!(f(&lb["relative_gain"]), lambda, epsilon = 1e-9 * lambda.abs()), "{lb}");
     assert_eq!(lb["pairing"], serde_json::json!(["column.bottoms", "column.reflux"]));
     assert!(lb["verdict"].as_str().unwrap().contains("pair the top quality with column.bottoms"), "{lb}");
     // The steady ranking follows |ln λ| of the recommended pairings (DV first, LV last: the defect's
@@ -110,9 +120,11 @@ fn scaled_gains_and_one_pairing_on_the_low_reflux_column() {
     for (a, b) in regular(&v).into_iter().zip(regular(&w)) {
         let (g, scales) = (m2(&b["gain"]), [f(&b["input_scales"][0]), f(&b["input_scales"][1])]);
         let scaled = [0, 1].map(|i| [0, 1].map(|j| g[i][j] * scales[j] / [0.001, 0.01][i]));
-        assert!(close(f(&b["condition_number"]), condition_2x2(scaled), 1e-9), "{}", b["name"]);
-        assert!(close(f(&b["minimized_condition_number"]), f(&a["minimized_condition_number"]), 1e-9));
-        assert!(close(f(&b["rga"][0][0]), f(&a["rga"][0][0]), 1e-12), "{}", b["name"]);
+        let gamma = condition_2x2(scaled);
+        assert!(abs_diff_eq!(f(&b["condition_number"]), gamma, epsilon = 1e-9 * gamma.abs()), "{}", b["name"]);
+        let (minimized, rga11) = (f(&a["minimized_condition_number"]), f(&a["rga"][0][0]));
+        assert!(abs_diff_eq!(f(&b["minimized_condition_number"]), minimized, epsilon = 1e-9 * minimized.abs()));
+        assert!(abs_diff_eq!(f(&b["rga"][0][0]), rga11, epsilon = 1e-12 * rga11.abs()), "{}", b["name"]);
     }
 }
 
@@ -166,7 +178,7 @@ fn the_dynamic_check_ranks_column_a_and_its_flowsheets_run_as_screened() {
         let runs = d["runs"].as_array().unwrap();
         assert_eq!(runs.len(), 4);
         let sum: f64 = runs.iter().map(|r| (0..2).map(|i| f(&r["cvs"][i]["iae"]) / allowed[i]).sum::<f64>()).sum();
-        assert!(close(f(&c["iae_scaled"]), sum, 1e-12), "{}", c["name"]);
+        assert!(abs_diff_eq!(f(&c["iae_scaled"]), sum, epsilon = 1e-12 * sum.abs()), "{}", c["name"]);
         ranked.push((sum, c["rank"].as_u64().unwrap(), c["name"].as_str().unwrap()));
     }
     assert_eq!(ranked.len(), 6);
@@ -194,7 +206,10 @@ fn the_dynamic_check_ranks_column_a_and_its_flowsheets_run_as_screened() {
     assert_eq!(run["disturbance"], v["disturbances"][2]);
     for (i, q) in ["distillate.x[light]", "bottoms.x[light]"].iter().enumerate() {
         let (mine, screened) = (csv_iae(&csv, q), f(&run["cvs"][i]["iae"]));
-        assert!(close(mine, screened, 0.02), "{best} {q}: {mine} from the written file vs {screened}");
+        assert!(
+            abs_diff_eq!(mine, screened, epsilon = 0.02 * screened.abs()),
+            "{best} {q}: {mine} from the written file vs {screened}"
+        );
     }
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -2,6 +2,7 @@
 //! in `plantwide_studies::size::closed_form`), their nonlinear verification, the optimal design
 //! run by `plantwide run`, the residence-time check, and bad input.
 
+use approx::abs_diff_eq;
 use serde_json::Value;
 
 use crate::harness::{converge, flowsheet, plantwide, value};
@@ -21,10 +22,6 @@ fn num(v: &Value, key: &str) -> f64 {
     v[key].as_f64().unwrap_or_else(|| panic!("no number `{key}` in {v}"))
 }
 
-fn rel(a: f64, b: f64) -> f64 {
-    (a - b).abs() / b.abs()
-}
-
 #[test]
 fn the_three_tank_designs_reproduce_their_closed_forms_and_hold_the_limits() {
     let s = tank_sizing();
@@ -33,34 +30,41 @@ fn the_three_tank_designs_reproduce_their_closed_forms_and_hold_the_limits() {
     let (plant, ss) = converge("surge_tank_pi.json");
     let v_l = value(&plant, &ss.x, "tank.V") / value(&plant, &ss.x, "tank.M");
     let (du, band, r) = (10.0, 0.2, 3.0 / 60.0);
-    assert!(rel(num(&s, "flow_change"), du) < 1e-9, "{}", s["flow_change"]);
-    assert!(rel(num(&s, "liquid_molar_volume"), v_l) < 1e-12);
+    assert!(abs_diff_eq!(num(&s, "flow_change"), du, epsilon = 1e-9 * du), "{}", s["flow_change"]);
+    assert!(abs_diff_eq!(num(&s, "liquid_molar_volume"), v_l, epsilon = 1e-12 * v_l.abs()));
     let designs = s["designs"].as_array().unwrap();
     let by = |c: &str| designs.iter().find(|d| d["controller"] == c).unwrap_or_else(|| panic!("no design {c}"));
     // A = c v_L Δu²/(r Δh): c = 1 (P), 2/e (PI), 1/2 (optimal).
     let area = |c: f64| c * v_l * du * du / (r * band);
     let (p, pi, opt) = (by("p"), by("pi"), by("optimal"));
     for (d, c) in [(p, 1.0), (pi, 2.0 / E), (opt, 0.5)] {
-        assert!(rel(num(d, "area"), area(c)) < 1e-6, "{d}");
-        assert!(rel(num(d, "band_volume"), area(c) * band) < 1e-6, "{d}");
+        assert!(abs_diff_eq!(num(d, "area"), area(c), epsilon = 1e-6 * area(c).abs()), "{d}");
+        let band_volume = area(c) * band;
+        assert!(abs_diff_eq!(num(d, "band_volume"), band_volume, epsilon = 1e-6 * band_volume.abs()), "{d}");
         assert_eq!(d["refinements"], 0, "the closed form holds on a linear tank: {d}");
     }
     // P: |Kc| = Δu/Δh; PI: |Kc| = 2Δu/(eΔh), τ_I = 2eΔh A/(v_L Δu); optimal: C = A/v_L, t* = Δu/r.
-    assert!(rel(num(p, "kc"), du / band) < 1e-6 && p["tau_i"].is_null());
-    assert!(rel(num(pi, "kc"), 2.0 * du / (E * band)) < 1e-6);
-    assert!(rel(num(pi, "tau_i"), 2.0 * E * band * area(2.0 / E) / (v_l * du)) < 1e-6);
-    assert!(rel(num(opt, "capacity"), area(0.5) / v_l) < 1e-6 && rel(num(opt, "ramp_time"), du / r) < 1e-9);
+    let (kc_p, kc_pi, tau_i) = (du / band, 2.0 * du / (E * band), 2.0 * E * band * area(2.0 / E) / (v_l * du));
+    assert!(abs_diff_eq!(num(p, "kc"), kc_p, epsilon = 1e-6 * kc_p.abs()) && p["tau_i"].is_null());
+    assert!(abs_diff_eq!(num(pi, "kc"), kc_pi, epsilon = 1e-6 * kc_pi.abs()));
+    assert!(abs_diff_eq!(num(pi, "tau_i"), tau_i, epsilon = 1e-6 * tau_i.abs()));
+    let (capacity, ramp_time) = (area(0.5) / v_l, du / r);
+    assert!(
+        abs_diff_eq!(num(opt, "capacity"), capacity, epsilon = 1e-6 * capacity.abs())
+            && abs_diff_eq!(num(opt, "ramp_time"), ramp_time, epsilon = 1e-9 * ramp_time.abs())
+    );
     // Each design, run on the nonlinear tank, reaches the band and the rate limit (the three meet
     // them exactly in the linear closed loop) and holds both.
     for d in [p, pi, opt] {
         let v = &d["verified"];
         assert_eq!(v["meets"], true, "{d}");
-        assert!(rel(num(v, "max_level_deviation"), band) < 1e-3, "{v}");
-        assert!(rel(num(v, "max_outflow_rate"), r) < 1e-3, "{v}");
+        assert!(abs_diff_eq!(num(v, "max_level_deviation"), band, epsilon = 1e-3 * band), "{v}");
+        assert!(abs_diff_eq!(num(v, "max_outflow_rate"), r, epsilon = 1e-3 * r), "{v}");
     }
     // The file's own PI (Kc = 50 mol/s/m on 0.1 m²) starts the outflow at Kc v_L Δu/A.
     let c = &s["current"];
-    assert!(rel(num(c, "max_outflow_rate"), 50.0 * v_l * du / 0.1) < 1e-3, "{c}");
+    let initial_rate = 50.0 * v_l * du / 0.1;
+    assert!(abs_diff_eq!(num(c, "max_outflow_rate"), initial_rate, epsilon = 1e-3 * initial_rate.abs()), "{c}");
     assert_eq!(c["meets"], false);
 }
 
@@ -76,10 +80,12 @@ fn the_optimal_design_runs_in_run() {
     let file = crate::harness::fixture("data/surge_tank_averaging.json");
     let sheet: Value = serde_json::from_str(&std::fs::read_to_string(&file).unwrap()).unwrap();
     let area: f64 = sheet["units"]["tank"]["area"].as_str().unwrap().trim_end_matches(" m2").parse().unwrap();
-    assert!(rel(area, num(&opt, "area")) < 1e-6, "{area} vs {}", opt["area"]);
+    let designed = num(&opt, "area");
+    assert!(abs_diff_eq!(area, designed, epsilon = 1e-6 * designed.abs()), "{area} vs {designed}");
     let capacity: f64 =
         sheet["controllers"]["lc"]["capacity"].as_str().unwrap().trim_end_matches(" mol/m").parse().unwrap();
-    assert!(rel(capacity, num(&opt, "capacity")) < 1e-6);
+    let designed = num(&opt, "capacity");
+    assert!(abs_diff_eq!(capacity, designed, epsilon = 1e-6 * designed.abs()), "{capacity} vs {designed}");
     let ramp = num(&opt, "ramp_time");
     let dir = std::env::temp_dir().join(format!("plantwide_size_{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -97,7 +103,7 @@ fn the_optimal_design_runs_in_run() {
         text.lines().skip(1).map(|l| l.split(',').map(|c| c.trim().parse().unwrap()).collect()).collect();
     let peak = rows.iter().map(|row| (row[1] - 1.0).abs()).fold(0.0, f64::max);
     let rate = rows.windows(2).map(|w| (w[1][2] - w[0][2]).abs() / (w[1][0] - w[0][0])).fold(0.0, f64::max);
-    assert!(rel(peak, band) < 1e-3 && peak < band * (1.0 + 1e-3), "peak {peak}");
+    assert!(abs_diff_eq!(peak, band, epsilon = 1e-3 * band) && peak < band * (1.0 + 1e-3), "peak {peak}");
     // The law's rate is capped at r; the record is the integrator's dense output between its steps,
     // whose difference quotients over 0.2 s carry its interpolation error (~1e-5 here).
     assert!(rate <= r * (1.0 + 1e-4) && rate > r * (1.0 - 1e-3), "rate {rate}");
@@ -184,10 +190,11 @@ fn between_the_columns_a_production_step_needs_no_surge_tank() {
         num(&v["values"], "product.F") + num(&v["values"], "heavies.F")
     };
     let du = products(&["--set", "fresh_A.F=110 kmol/h"]) - products(&[]);
-    assert!(rel(num(&s, "flow_change"), du) < 1e-6, "{} vs {du}", s["flow_change"]);
+    assert!(abs_diff_eq!(num(&s, "flow_change"), du, epsilon = 1e-6 * du.abs()), "{} vs {du}", s["flow_change"]);
     let (band, r, v_l) = (0.3, 0.2 / 3.6 / 60.0, num(&s, "liquid_molar_volume"));
     for (d, c) in s["designs"].as_array().unwrap().iter().zip([1.0, 2.0 / E, 0.5]) {
-        assert!(rel(num(d, "closed_form_area"), c * v_l * du * du / (r * band)) < 1e-6, "{d}");
+        let area = c * v_l * du * du / (r * band);
+        assert!(abs_diff_eq!(num(d, "closed_form_area"), area, epsilon = 1e-6 * area.abs()), "{d}");
         let v = &d["verified"];
         assert_eq!(v["meets"], true, "{d}");
         assert!(num(v, "max_level_deviation") <= band * 1.001 && num(v, "max_outflow_rate") <= r * 1.001, "{v}");
@@ -217,7 +224,7 @@ fn candidates_are_ranked_by_the_band_volume_they_need() {
     // for more, and it ranks behind the tank itself. Both exceed the limit today: the file's PI
     // starts the outflow at Kc v_L Δu / A = 0.0906 mol/s² > 0.05.
     let closed = |k: usize| num(&c[k]["designs"][2], "closed_form_area");
-    assert!(rel(closed(0), closed(1)) < 1e-9);
+    assert!(abs_diff_eq!(closed(0), closed(1), epsilon = 1e-9 * closed(1).abs()), "{} vs {}", closed(0), closed(1));
     assert_eq!((c[0]["vessel"].as_str(), c[1]["vessel"].as_str()), (Some("tank"), Some("out")));
     assert!(c[1]["designs"][2]["refinements"].as_u64() > Some(0) && volume(1) > volume(0), "{r}");
     assert!(c.iter().all(|x| x["needs_surge"] == true), "{r}");
@@ -253,8 +260,15 @@ fn ramps_and_sinusoids_verify_against_the_first_order_closed_loop() {
     let tau = num(&p, "area") / (v_l * kc);
     let ramp = 600.0;
     let expected = a / ramp * (1.0 - (-ramp / tau).exp());
-    assert!(rel(num(&p["verified"], "max_outflow_rate"), expected) < 1e-3, "{} vs {expected}", p["verified"]);
-    assert!(rel(num(&p["verified"], "max_level_deviation"), 0.2) < 1e-3, "the level still ends at the band");
+    assert!(
+        abs_diff_eq!(num(&p["verified"], "max_outflow_rate"), expected, epsilon = 1e-3 * expected.abs()),
+        "{} vs {expected}",
+        p["verified"]
+    );
+    assert!(
+        abs_diff_eq!(num(&p["verified"], "max_level_deviation"), 0.2, epsilon = 1e-3 * 0.2),
+        "the level still ends at the band"
+    );
     let p = size("--sine=10 min");
     let w = 2.0 * std::f64::consts::PI / 600.0;
     let duration = num(&p["verified"], "duration");
@@ -266,8 +280,16 @@ fn ramps_and_sinusoids_verify_against_the_first_order_closed_loop() {
         let dh = g * (w * (w * t).cos() + w * w * tau * (w * t).sin() - w * (-t / tau).exp());
         (h_max, rate_max) = (h_max.max(h.abs()), rate_max.max((kc * dh).abs()));
     }
-    assert!(rel(num(&p["verified"], "max_level_deviation"), h_max) < 1e-3, "{} vs {h_max}", p["verified"]);
-    assert!(rel(num(&p["verified"], "max_outflow_rate"), rate_max) < 1e-3, "{} vs {rate_max}", p["verified"]);
+    assert!(
+        abs_diff_eq!(num(&p["verified"], "max_level_deviation"), h_max, epsilon = 1e-3 * h_max.abs()),
+        "{} vs {h_max}",
+        p["verified"]
+    );
+    assert!(
+        abs_diff_eq!(num(&p["verified"], "max_outflow_rate"), rate_max, epsilon = 1e-3 * rate_max.abs()),
+        "{} vs {rate_max}",
+        p["verified"]
+    );
 }
 
 /// `--attenuation 0.3 --period 10min`: P and PI by their attenuation closed forms
@@ -285,10 +307,15 @@ fn attenuation_designs_swing_as_asked_in_the_periodic_steady_state() {
     let v_l = num(&s, "liquid_molar_volume");
     let (dq, a, w, band) = (10.0 * v_l, 0.3, 2.0 * std::f64::consts::PI / 600.0, 0.2);
     let d = s["designs"].as_array().unwrap();
-    assert!(rel(num(&d[0], "area"), dq * (1.0f64 - a * a).sqrt() / (w * band)) < 1e-6, "{}", d[0]);
+    let area = dq * (1.0f64 - a * a).sqrt() / (w * band);
+    assert!(abs_diff_eq!(num(&d[0], "area"), area, epsilon = 1e-6 * area.abs()), "{}", d[0]);
     for x in &d[..2] {
         let v = &x["verified"];
-        assert!(rel(num(v, "attenuation"), a) < 1e-3 && rel(num(v, "level_amplitude"), band) < 1e-3, "{x}");
+        assert!(
+            abs_diff_eq!(num(v, "attenuation"), a, epsilon = 1e-3 * a)
+                && abs_diff_eq!(num(v, "level_amplitude"), band, epsilon = 1e-3 * band),
+            "{x}"
+        );
         assert_eq!(v["meets"], true);
     }
     assert!(num(&d[2]["verified"], "attenuation") <= a * 1.001 && d[2]["verified"]["meets"] == true, "{}", d[2]);
@@ -309,7 +336,8 @@ fn a_scenarios_step_sizes_as_the_same_disturbance() {
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let t: Value = serde_json::from_slice(&out.stdout).unwrap();
     for k in 0..3 {
-        assert!(rel(num(&t["designs"][k], "area"), num(&s["designs"][k], "area")) < 1e-12, "{}", t["designs"][k]);
+        let area = num(&s["designs"][k], "area");
+        assert!(abs_diff_eq!(num(&t["designs"][k], "area"), area, epsilon = 1e-12 * area.abs()), "{}", t["designs"][k]);
     }
     let upsets = flowsheet("scenarios/surge_tank_upsets.json");
     let args = ["size", &file, "--vessel", "tank", "--scenario", &upsets, "--level-band", "0.2 m"];
@@ -348,7 +376,8 @@ fn a_vanishing_ramp_is_sized_as_the_step_in_bounded_time() {
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let t: Value = serde_json::from_slice(&out.stdout).unwrap();
     for k in 0..3 {
-        assert!(rel(num(&t["designs"][k], "area"), num(&s["designs"][k], "area")) < 1e-12);
+        let area = num(&s["designs"][k], "area");
+        assert!(abs_diff_eq!(num(&t["designs"][k], "area"), area, epsilon = 1e-12 * area.abs()), "{}", t["designs"][k]);
         assert_eq!(t["designs"][k]["verified"]["meets"], true, "{}", t["designs"][k]);
     }
 }

@@ -4,6 +4,7 @@
 //! plant). The expected numbers come from conservation and closed forms, their inputs read from
 //! `steady`, never from `size` itself; a part that has no answer must say so and exit 2.
 
+use approx::abs_diff_eq;
 use serde_json::Value;
 
 use crate::harness::{fixture, flowsheet, plantwide};
@@ -30,10 +31,6 @@ fn steady(file: &str, set: &[&str]) -> Value {
 
 fn num(v: &Value, key: &str) -> f64 {
     v[key].as_f64().unwrap_or_else(|| panic!("no number `{key}` in {v}"))
-}
-
-fn rel(a: f64, b: f64) -> f64 {
-    (a - b).abs() / b.abs()
 }
 
 /// 0.5 kmol/h/min in mol/s².
@@ -67,12 +64,13 @@ fn the_newcomers_surge_tank_is_sized_on_the_flow_conservation_gives() {
     let s: Value = serde_json::from_str(&out).unwrap();
     let v = steady(&file, &[]);
     let du = 0.1 * num(&v, "flash_liquid.F");
-    assert!(rel(num(&s, "flow_change"), du) < 1e-6, "{} vs {du}", s["flow_change"]);
+    assert!(abs_diff_eq!(num(&s, "flow_change"), du, epsilon = 1e-6 * du.abs()), "{} vs {du}", s["flow_change"]);
     // The liquid's molar volume from the file's tank: π (1 m)² times its level over its holdup.
     let v_l = std::f64::consts::PI * num(&v, "surge.level") / num(&v, "surge.M");
-    assert!(rel(num(&s, "liquid_molar_volume"), v_l) < 1e-6);
+    assert!(abs_diff_eq!(num(&s, "liquid_molar_volume"), v_l, epsilon = 1e-6 * v_l.abs()));
     for (d, c) in s["designs"].as_array().unwrap().iter().zip([1.0, 2.0 / E, 0.5]) {
-        assert!(rel(num(d, "closed_form_area"), c * v_l * du * du / (RATE * 0.5)) < 1e-6, "{d}");
+        let area = c * v_l * du * du / (RATE * 0.5);
+        assert!(abs_diff_eq!(num(d, "closed_form_area"), area, epsilon = 1e-6 * area.abs()), "{d}");
         let r = &d["verified"];
         assert!(r["meets"] == true && r["failure"].is_null(), "{d}");
         assert!(num(r, "max_level_deviation") <= 0.5 * 1.001 && num(r, "max_outflow_rate") <= RATE * 1.001, "{r}");
@@ -80,7 +78,8 @@ fn the_newcomers_surge_tank_is_sized_on_the_flow_conservation_gives() {
     assert_eq!(s["failed"], Value::Array(vec![]));
     // The file's P loop, 20 kmol/h/m, settles at the offset Δu/Kc: 0.80 m, beyond the band.
     let c = &s["current"];
-    assert!(rel(num(c, "max_deviation"), du / (20_000.0 / 3600.0)) < 1e-3, "{c}");
+    let deviation = du / (20_000.0 / 3600.0);
+    assert!(abs_diff_eq!(num(c, "max_deviation"), deviation, epsilon = 1e-3 * deviation.abs()), "{c}");
     assert_eq!(c["meets"], false);
     assert!(std::fs::metadata(&plot).is_ok_and(|m| m.len() > 1000));
     std::fs::remove_file(&plot).ok();
@@ -128,10 +127,14 @@ fn a_column_drums_holdup_is_not_passed_off_as_a_level() {
     let s: Value = serde_json::from_str(&out).unwrap();
     let d = |set: &[&str]| num(&steady(&file, set), "distillate.F");
     let dd = d(&["--set", "feed_source.F=181.5 kmol/h"]) - d(&[]);
-    assert!(rel(num(&s, "flow_change"), dd) < 1e-6, "{} vs {dd}", s["flow_change"]);
+    assert!(abs_diff_eq!(num(&s, "flow_change"), dd, epsilon = 1e-6 * dd.abs()), "{} vs {dd}", s["flow_change"]);
     let c = &s["current"];
     assert!(c["max_deviation"].is_null() && c["meets"].is_null(), "{c}");
-    assert!(rel(num(c, "max_holdup_deviation"), dd * 120.0) < 2e-3, "{c} vs {}", dd * 120.0);
+    let deviation = dd * 120.0;
+    assert!(
+        abs_diff_eq!(num(c, "max_holdup_deviation"), deviation, epsilon = 2e-3 * deviation.abs()),
+        "{c} vs {deviation}"
+    );
     for d in s["designs"].as_array().unwrap() {
         let r = &d["verified"];
         assert!(r["meets"] == true && num(r, "max_level_deviation") <= 0.5 * 1.001, "{d}");
@@ -202,14 +205,19 @@ fn size_reactor(rate: &str) -> (Option<i32>, Value, String) {
 #[test]
 fn a_reactor_inside_its_recycle_is_verified_to_its_own_steady_state() {
     let p = Recycle::of_file();
-    assert!(rel(p.outflow(p.f0), p.f0 + 32.8253) < 1e-4, "the closed form misses the file's recycle");
+    let outflow = p.f0 + 32.8253;
+    assert!(
+        abs_diff_eq!(p.outflow(p.f0), outflow, epsilon = 1e-4 * outflow.abs()),
+        "the closed form misses the file's recycle"
+    );
     let (code, s, err) = size_reactor("0.2 kmol/h/min");
     assert_eq!(code, Some(0), "{err}");
     let du = p.outflow(1.1 * p.f0) - p.outflow(p.f0);
-    assert!(rel(num(&s, "flow_change"), du) < 1e-5, "{} vs {du}", s["flow_change"]);
+    assert!(abs_diff_eq!(num(&s, "flow_change"), du, epsilon = 1e-5 * du.abs()), "{} vs {du}", s["flow_change"]);
     let r = 0.2 / 3.6 / 60.0;
     for (d, c) in s["designs"].as_array().unwrap().iter().zip([1.0, 2.0 / E, 0.5]) {
-        assert!(rel(num(d, "closed_form_area"), c * p.v_l * du * du / (r * 0.5)) < 1e-5, "{d}");
+        let area = c * p.v_l * du * du / (r * 0.5);
+        assert!(abs_diff_eq!(num(d, "closed_form_area"), area, epsilon = 1e-5 * area.abs()), "{d}");
         let v = &d["verified"];
         assert!(v["failure"].is_null() && v["meets"] == true, "{d}");
         assert!(num(v, "max_level_deviation") <= 0.5 * 1.001 && num(v, "max_outflow_rate") <= r * 1.001, "{v}");
@@ -263,10 +271,19 @@ fn candidates_with_the_same_outflow_are_told_apart_by_their_level() {
     let cells = |name: &str| row(name).split('|').map(|c| c.trim().to_string()).collect::<Vec<_>>();
     let (tank, stream) = (cells("surge"), cells("column_feed"));
     assert_eq!(tank[4], stream[4], "the same outflow change");
-    assert!(rel(tank[5].parse().unwrap(), du / (20_000.0 / 3600.0)) < 1e-3, "{}", row("surge"));
+    let deviation = du / (20_000.0 / 3600.0);
+    assert!(
+        abs_diff_eq!(tank[5].parse::<f64>().unwrap(), deviation, epsilon = 1e-3 * deviation.abs()),
+        "{}",
+        row("surge")
+    );
     assert_eq!(stream[5], "– (no vessel)");
     let rate = |c: &[String]| c[6].parse::<f64>().unwrap();
-    assert!(rel(rate(&tank), rate(&stream)) < 1e-2 && rate(&tank) < RATE * 60.0, "{out}");
+    let (tank_rate, stream_rate) = (rate(&tank), rate(&stream));
+    assert!(
+        abs_diff_eq!(tank_rate, stream_rate, epsilon = 1e-2 * stream_rate.abs()) && tank_rate < RATE * 60.0,
+        "{out}"
+    );
     assert_eq!((tank[7].as_str(), stream[7].as_str()), ("yes", "no"), "{out}");
     let svg = std::fs::read_to_string(&plot).unwrap();
     std::fs::remove_file(&plot).ok();
@@ -337,7 +354,7 @@ fn a_file_vessel_whose_level_would_pass_its_top_is_said_to_overflow() {
     let s: Value = serde_json::from_str(&out).unwrap();
     let top = 2.0 + 0.6 * num(&steady(&file, &[]), "flash_liquid.F") / (20_000.0 / 3600.0);
     let c = &s["current"];
-    assert!(c["meets"] == false && rel(num(c, "max_deviation") + 2.0, top) < 1e-3, "{c}");
+    assert!(c["meets"] == false && abs_diff_eq!(num(c, "max_deviation") + 2.0, top, epsilon = 1e-3 * top.abs()), "{c}");
     let outside = c["outside"].as_str().unwrap();
     assert!(outside.contains(&format!("reaches {top:.2}")) && outside.ends_with("above its top at 4 m"), "{outside}");
 }

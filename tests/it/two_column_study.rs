@@ -13,6 +13,8 @@ use std::path::Path;
 use std::process::Command;
 use std::sync::OnceLock;
 
+use approx::assert_abs_diff_eq;
+
 use crate::harness;
 use plantwide::analysis::faer::{Mat, c64};
 use plantwide::analysis::linear::Linearization;
@@ -30,11 +32,6 @@ fn num(v: &Value, path: &str) -> f64 {
         cur = &cur[key];
     }
     cur.as_f64().unwrap_or_else(|| panic!("{path} is not a number: {cur}"))
-}
-
-fn close(v: &Value, path: &str, expected: f64, rel: f64) {
-    let got = num(v, path);
-    assert!((got - expected).abs() <= rel * expected.abs(), "{path}: {got} vs {expected} (±{rel:e} relative)");
 }
 
 /// The full study (run with `-- --include-ignored`): the script end to end on short horizons,
@@ -92,20 +89,20 @@ fn pin_base_and_structures(r: &Value) {
         assert!(e < 1e-9, "{b}: relative imbalance {e:e}");
     }
     // The base case as designed (flowsheets/README.md).
-    close(r, "base.product_kmol_h", 100.146, 1e-3);
-    close(r, "base.recycle_kmol_h", 197.60, 1e-3);
-    close(r, "base.reactor_T", 350.0, 1e-9);
-    close(r, "base.residence_min", 19.81, 1e-3);
+    assert_abs_diff_eq!(num(r, "base.product_kmol_h"), 100.146, epsilon = 1e-3 * 100.146);
+    assert_abs_diff_eq!(num(r, "base.recycle_kmol_h"), 197.60, epsilon = 1e-3 * 197.60);
+    assert_abs_diff_eq!(num(r, "base.reactor_T"), 350.0, epsilon = 1e-9 * 350.0);
+    assert_abs_diff_eq!(num(r, "base.residence_min"), 19.81, epsilon = 1e-3 * 19.81);
 
     // Column structures: LV interactive on both columns, LB decoupled; the book's perturbation
     // gains re-converge for every structure and agree with the linearization.
-    close(r, "column1.LV.rga11", 5.2216, 1e-3);
-    close(r, "column1.LV.niederlinski", 0.19151, 1e-3);
-    close(r, "column1.DV.rga11", 1.2401, 1e-3);
-    close(r, "column1.LB.rga11", 1.1480, 1e-3);
-    close(r, "column2.LV.rga11", 11.98, 1e-2);
-    close(r, "column2.LB.rga11", 0.9762, 1e-3);
-    close(r, "column2.DV.rga11", 0.02403, 1e-2);
+    assert_abs_diff_eq!(num(r, "column1.LV.rga11"), 5.2216, epsilon = 1e-3 * 5.2216);
+    assert_abs_diff_eq!(num(r, "column1.LV.niederlinski"), 0.19151, epsilon = 1e-3 * 0.19151);
+    assert_abs_diff_eq!(num(r, "column1.DV.rga11"), 1.2401, epsilon = 1e-3 * 1.2401);
+    assert_abs_diff_eq!(num(r, "column1.LB.rga11"), 1.1480, epsilon = 1e-3 * 1.1480);
+    assert_abs_diff_eq!(num(r, "column2.LV.rga11"), 11.98, epsilon = 1e-2 * 11.98);
+    assert_abs_diff_eq!(num(r, "column2.LB.rga11"), 0.9762, epsilon = 1e-3 * 0.9762);
+    assert_abs_diff_eq!(num(r, "column2.DV.rga11"), 0.02403, epsilon = 1e-2 * 0.02403);
     for col in ["column1", "column2"] {
         for st in ["LV", "DV", "LB"] {
             let d = num(r, &format!("{col}.{st}.perturb_vs_linear"));
@@ -135,12 +132,13 @@ fn pin_base_and_structures(r: &Value) {
 fn pin_production_and_sensitivity(r: &Value) {
     // Production rate: the fresh-A flow sets it (all A leaves as R) and snowballs the recycle; the
     // reactor temperature does not move it.
-    close(r, "production.P1.product", 0.99922, 1e-3);
-    close(r, "production.P1.recycle_per_product", 4.615, 1e-3);
+    assert_abs_diff_eq!(num(r, "production.P1.product"), 0.99922, epsilon = 1e-3 * 0.99922);
+    assert_abs_diff_eq!(num(r, "production.P1.recycle_per_product"), 4.615, epsilon = 1e-3 * 4.615);
     assert!(num(r, "production.P2.product").abs() < 0.02);
     // P3 (effluent flow fixed, fresh A on the reactor level) reaches P1's steady states.
-    close(r, "production.P3.product", 0.17814, 1e-3);
-    close(r, "production.P3.recycle_per_product", num(r, "production.P1.recycle_per_product"), 1e-3);
+    assert_abs_diff_eq!(num(r, "production.P3.product"), 0.17814, epsilon = 1e-3 * 0.17814);
+    let per_product = num(r, "production.P1.recycle_per_product");
+    assert_abs_diff_eq!(num(r, "production.P3.recycle_per_product"), per_product, epsilon = 1e-3 * per_product.abs());
 
     // Figure 6-6: the bottoms impurity over ±10 % of each disturbance; the feed rate moves it most.
     let band = |d: &str| -> (f64, f64) {
@@ -161,7 +159,7 @@ fn pin_dynamics_and_safety(r: &Value) {
     let att = num(r, "surge.attenuation");
     let closed = num(r, "surge.first_order_closed_form");
     assert!((att / closed - 1.0).abs() < 0.02, "attenuation {att} vs closed form {closed}");
-    close(r, "surge.first_order_closed_form", 0.3033, 1e-3);
+    assert_abs_diff_eq!(num(r, "surge.first_order_closed_form"), 0.3033, epsilon = 1e-3 * 0.3033);
 
     // Reflux drum: a bigger drum lets less of a column upset into the reactor.
     let through = |m: &str| num(r, &format!("drum.{m}.recycle_max_dev_kmol_h"));
@@ -175,7 +173,7 @@ fn pin_dynamics_and_safety(r: &Value) {
     // unreacted A and B drive the recycle to the distillate valve's limit and column 1's reflux to ~0.
     assert!(num(r, "safety.peak_cooling_only") < 362.0, "{}", r["safety"]);
     assert!(num(r, "safety.min_cooling_only") < 320.0, "{}", r["safety"]);
-    close(r, "safety.cooling_only_recycle_max", 400.0, 1e-6);
+    assert_abs_diff_eq!(num(r, "safety.cooling_only_recycle_max"), 400.0, epsilon = 1e-6 * 400.0);
     assert!(num(r, "safety.cooling_only_reflux_end") < 10.0, "{}", r["safety"]);
     let rec = &r["safety"]["recycle"];
     for k in ["recycle_flow_auto", "recycle_composition_auto"] {

@@ -4,6 +4,7 @@
 
 mod common;
 
+use approx::abs_diff_eq;
 use common::*;
 use plantwide_thermo::flash::rachford_rice;
 use plantwide_thermo::{PhaseState, R_GAS, T_REF, ThermoError, ThermoPackage, VleModel};
@@ -126,7 +127,7 @@ fn round_trips(pkg: &ThermoPackage, p: f64, x: &[f64]) {
     let b = pkg.bubble_t(p, x).unwrap();
     let d = pkg.dew_t(p, &b.incipient).unwrap();
     assert!((d.t - b.t).abs() < 1e-10 * b.t, "{:?}: dew T {} vs bubble T {}", pkg.vle, d.t, b.t);
-    assert!(max_abs_diff(&d.incipient, x) < 1e-10, "dew liquid {:?} vs {x:?}", d.incipient);
+    assert!(abs_diff_eq!(d.incipient[..], x[..], epsilon = 1e-10), "dew liquid {:?} vs {x:?}", d.incipient);
     let f = pkg.flash_tp(b.t, p, x).unwrap();
     assert!(f.beta.abs() < 1e-10, "β at bubble point {}", f.beta);
     let td = pkg.dew_t(p, x).unwrap().t;

@@ -2,9 +2,7 @@
 //! flash converges, is in equilibrium, closes the mass balance, and inverts by the PH flash.
 #![allow(clippy::needless_range_loop)] // index loops over components read like the equations
 
-mod common;
-
-use common::max_abs_diff;
+use approx::abs_diff_eq;
 use plantwide_thermo::{BinaryPair, Library, PhaseState, ThermoPackage, VleModel};
 
 fn package(names: &[&str], vle: &str, extra: &[BinaryPair]) -> ThermoPackage {
@@ -53,7 +51,7 @@ fn sweep(pkg: &ThermoPackage, zs: &[Vec<f64>], pressures: &[f64]) -> (usize, f64
                 let g = pkg.flash_ph(p, f.h, z).unwrap_or_else(|e| panic!("PH {z:?} {p} h={}: {e}", f.h));
                 worst_t = worst_t.max((g.t - t).abs() / t);
                 assert!(
-                    max_abs_diff(&g.x, &f.x) < 1e-8 && max_abs_diff(&g.y, &f.y) < 1e-8,
+                    abs_diff_eq!(g.x[..], f.x[..], epsilon = 1e-8) && abs_diff_eq!(g.y[..], f.y[..], epsilon = 1e-8),
                     "{z:?} {t} {p}: {g:?} vs {f:?}"
                 );
             }

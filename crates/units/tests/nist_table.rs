@@ -7,9 +7,7 @@
 //! inHg (conventional) = 3.386 389 E+03 Pa, inH2O (conventional) = 2.490 889 E+02 Pa,
 //! lbf = 4.448 222 E+00 N, bbl (42 gal) = 1.589 873 E-01 m³).
 
-mod common;
-
-use common::assert_close;
+use approx::abs_diff_eq;
 use plantwide_units::{Dimension as D, UnitKind, parse_quantity, units};
 
 /// (symbol, SI value of 1 unit, SI value of 0 units (offset), dimension, relative tolerance)
@@ -92,9 +90,11 @@ fn one_unit_and_zero_units_in_si() {
     for &(symbol, one, zero, dim, rel) in EXPECTED {
         let q = parse_quantity(&format!("1 {symbol}")).unwrap();
         assert_eq!(q.dim, dim, "{symbol}");
-        assert_close(q.value_si, one, rel, &format!("1 {symbol}"));
+        let got = q.value_si;
+        assert!(abs_diff_eq!(got, one, epsilon = rel * one.abs()), "1 {symbol}: got {got:e}, expected {one:e}");
         let q = parse_quantity(&format!("0 {symbol}")).unwrap();
-        assert_close(q.value_si, zero, rel, &format!("0 {symbol}"));
+        let got = q.value_si;
+        assert!(abs_diff_eq!(got, zero, epsilon = rel * zero.abs()), "0 {symbol}: got {got:e}, expected {zero:e}");
     }
 }
 
@@ -103,8 +103,13 @@ fn table_rows_agree_with_expected() {
     for u in units() {
         let &(_, one, zero, dim, rel) = EXPECTED.iter().find(|e| e.0 == u.symbol).unwrap();
         assert_eq!(u.dim, dim, "{}", u.symbol);
-        assert_close(u.offset, zero, rel, u.symbol);
-        assert_close(u.factor + u.offset, one, rel.max(1e-15), u.symbol);
+        assert!(abs_diff_eq!(u.offset, zero, epsilon = rel * zero.abs()), "{}: offset {:e}", u.symbol, u.offset);
+        let got = u.factor + u.offset;
+        assert!(
+            abs_diff_eq!(got, one, epsilon = rel.max(1e-15) * one.abs()),
+            "{}: got {got:e}, expected {one:e}",
+            u.symbol
+        );
         let affine = !matches!(u.kind, UnitKind::Linear);
         assert_eq!(affine, u.offset != 0.0, "{}", u.symbol);
         assert!(!(affine && u.prefixable), "{}", u.symbol);
@@ -152,7 +157,8 @@ fn si_prefixes() {
     for &(symbol, factor, dim) in cases {
         let q = parse_quantity(&format!("1 {symbol}")).unwrap();
         assert_eq!(q.dim, dim, "{symbol}");
-        assert_close(q.value_si, factor, 1e-15, symbol);
+        let got = q.value_si;
+        assert!(abs_diff_eq!(got, factor, epsilon = 1e-15 * factor), "{symbol}: got {got:e}, expected {factor:e}");
     }
 }
 

@@ -1,8 +1,6 @@
 //! Quantities as flowsheet files write them: compounds, affine temperatures, dimensions.
 
-mod common;
-
-use common::assert_close;
+use approx::{abs_diff_eq, assert_abs_diff_eq};
 use plantwide_units::{
     Dimension as D, Quantity, parse_difference, parse_difference_as, parse_quantity, parse_quantity_as,
 };
@@ -11,8 +9,11 @@ use plantwide_units::{
 fn check(text: &str, expected_si: f64, dim: D) {
     let q = parse_quantity(text).unwrap_or_else(|e| panic!("{text}: {e}"));
     assert_eq!(q.dim, dim, "{text}: dimension {} instead of {}", q.dim, dim);
-    assert_close(q.value_si, expected_si, 1e-12, text);
-    assert_close(parse_quantity_as(text, dim).unwrap(), expected_si, 1e-12, text);
+    // 1e-12 relative, or absolute (SI) where the expected value is 0.
+    let tolerance = 1e-12 * if expected_si == 0.0 { 1.0 } else { expected_si.abs() };
+    for got in [q.value_si, parse_quantity_as(text, dim).unwrap()] {
+        assert!(abs_diff_eq!(got, expected_si, epsilon = tolerance), "{text}: got {got:e}, expected {expected_si:e}");
+    }
 }
 
 #[test]
@@ -84,11 +85,12 @@ fn offset_units_per_degree_in_compounds() {
 fn differences_drop_offsets() {
     let q = parse_difference("10 degC").unwrap();
     assert_eq!(q.dim, D::TEMPERATURE);
-    assert_close(q.value_si, 10.0, 1e-15, "10 degC difference");
-    assert_close(parse_difference_as("18 degF", D::TEMPERATURE).unwrap(), 10.0, 1e-14, "18 degF");
-    assert_close(parse_difference_as("5 psig", D::PRESSURE).unwrap(), 5.0 * 6894.757293168, 1e-13, "5 psig");
-    assert_close(parse_difference_as("10 K", D::TEMPERATURE).unwrap(), 10.0, 0.0, "10 K");
-    assert_close(parse_difference_as("3", D::TEMPERATURE).unwrap(), 3.0, 0.0, "bare");
+    assert_abs_diff_eq!(q.value_si, 10.0, epsilon = 1e-15 * 10.0);
+    assert_abs_diff_eq!(parse_difference_as("18 degF", D::TEMPERATURE).unwrap(), 10.0, epsilon = 1e-14 * 10.0);
+    let psi5 = 5.0 * 6894.757293168;
+    assert_abs_diff_eq!(parse_difference_as("5 psig", D::PRESSURE).unwrap(), psi5, epsilon = 1e-13 * psi5);
+    assert_eq!(parse_difference_as("10 K", D::TEMPERATURE).unwrap(), 10.0, "10 K");
+    assert_eq!(parse_difference_as("3", D::TEMPERATURE).unwrap(), 3.0, "bare");
 }
 
 #[test]
@@ -137,8 +139,8 @@ fn number_spellings() {
 
 #[test]
 fn bare_numbers_are_si_in_the_expected_dimension() {
-    assert_close(parse_quantity_as("12.6", D::MOLAR_FLOW).unwrap(), 12.6, 0.0, "bare flow");
-    assert_close(parse_quantity_as("350", D::TEMPERATURE).unwrap(), 350.0, 0.0, "bare temperature");
+    assert_eq!(parse_quantity_as("12.6", D::MOLAR_FLOW).unwrap(), 12.6, "bare flow");
+    assert_eq!(parse_quantity_as("350", D::TEMPERATURE).unwrap(), 350.0, "bare temperature");
     assert_eq!(parse_quantity("350").unwrap().dim, D::DIMENSIONLESS);
 }
 

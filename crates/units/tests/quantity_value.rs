@@ -1,8 +1,6 @@
 //! The serde type of flowsheet fields.
 
-mod common;
-
-use common::assert_close;
+use approx::assert_abs_diff_eq;
 use plantwide_units::{Dimension as D, QuantityValue, UnitError};
 use serde::Deserialize;
 use serde::de::IntoDeserializer;
@@ -31,11 +29,16 @@ fn is_serialize() {
 
 #[test]
 fn to_si() {
-    assert_close(QuantityValue::Number(12.5).to_si(D::MOLAR_FLOW).unwrap(), 12.5, 0.0, "number is SI");
-    assert_close(QuantityValue::from("1 kmol/min").to_si(D::MOLAR_FLOW).unwrap(), 1000.0 / 60.0, 1e-15, "text");
-    assert_close(QuantityValue::from("80 degC").to_si(D::TEMPERATURE).unwrap(), 353.15, 1e-15, "absolute");
-    assert_close(QuantityValue::from("12.6").to_si(D::MOLAR_FLOW).unwrap(), 12.6, 0.0, "bare text is SI");
-    assert_close(QuantityValue::from(0.25).to_si(D::DIMENSIONLESS).unwrap(), 0.25, 0.0, "fraction");
+    assert_eq!(QuantityValue::Number(12.5).to_si(D::MOLAR_FLOW).unwrap(), 12.5, "number is SI");
+    let text = QuantityValue::from("1 kmol/min").to_si(D::MOLAR_FLOW).unwrap();
+    assert_abs_diff_eq!(text, 1000.0 / 60.0, epsilon = 1e-15 * (1000.0 / 60.0));
+    assert_abs_diff_eq!(
+        QuantityValue::from("80 degC").to_si(D::TEMPERATURE).unwrap(),
+        353.15,
+        epsilon = 1e-15 * 353.15
+    );
+    assert_eq!(QuantityValue::from("12.6").to_si(D::MOLAR_FLOW).unwrap(), 12.6, "bare text is SI");
+    assert_eq!(QuantityValue::from(0.25).to_si(D::DIMENSIONLESS).unwrap(), 0.25, "fraction");
     assert!(matches!(
         QuantityValue::from("5 K").to_si(D::MOLAR_FLOW),
         Err(UnitError::WrongDimension { found: D::TEMPERATURE, expected: D::MOLAR_FLOW, .. })
@@ -47,10 +50,11 @@ fn to_si() {
 #[test]
 fn to_si_difference() {
     let approach = QuantityValue::from("10 degC");
-    assert_close(approach.to_si_difference(D::TEMPERATURE).unwrap(), 10.0, 1e-15, "delta degC");
-    assert_close(approach.to_si(D::TEMPERATURE).unwrap(), 283.15, 1e-15, "absolute degC");
-    assert_close(QuantityValue::from("9 degF").to_si_difference(D::TEMPERATURE).unwrap(), 5.0, 1e-15, "delta degF");
-    assert_close(QuantityValue::Number(3.0).to_si_difference(D::TEMPERATURE).unwrap(), 3.0, 0.0, "number");
+    assert_abs_diff_eq!(approach.to_si_difference(D::TEMPERATURE).unwrap(), 10.0, epsilon = 1e-15 * 10.0);
+    assert_abs_diff_eq!(approach.to_si(D::TEMPERATURE).unwrap(), 283.15, epsilon = 1e-15 * 283.15);
+    let delta_f = QuantityValue::from("9 degF").to_si_difference(D::TEMPERATURE).unwrap();
+    assert_abs_diff_eq!(delta_f, 5.0, epsilon = 1e-15 * 5.0);
+    assert_eq!(QuantityValue::Number(3.0).to_si_difference(D::TEMPERATURE).unwrap(), 3.0, "number");
 }
 
 #[test]

@@ -1,8 +1,6 @@
 //! convert_from_si(parse(x)) = x, and named dimensions display as parseable SI units.
 
-mod common;
-
-use common::assert_close;
+use approx::{abs_diff_eq, assert_abs_diff_eq};
 use plantwide_units::{
     Dimension as D, Quantity, Unit, convert_from_si, convert_to_si, named_dimensions, parse_quantity, prefixes,
     unit_dimension, units,
@@ -18,8 +16,9 @@ fn round_trip(value: f64, unit: &str) {
     // Affine units subtract a large offset, so compare against the scale of the SI value.
     let tolerance = 1e-13 * q.value_si.abs().max(value.abs()).max(1.0);
     assert!((back - value).abs() <= tolerance, "{what}");
-    assert_close(convert_to_si(value, unit).unwrap(), q.value_si, 1e-15, &what);
-    assert_close(q.in_unit(unit).unwrap(), back, 0.0, &what);
+    let si = convert_to_si(value, unit).unwrap();
+    assert!(abs_diff_eq!(si, q.value_si, epsilon = 1e-15 * q.value_si.abs()), "{what}: convert_to_si gives {si:e}");
+    assert_eq!(q.in_unit(unit).unwrap(), back, "{what}");
 }
 
 #[test]
@@ -37,7 +36,12 @@ fn every_prefix_on_every_prefixable_unit() {
         for p in prefixes() {
             let symbol = format!("{}{}", p.symbol, u.symbol);
             let unit = Unit::parse(&symbol).unwrap();
-            assert_close(unit.factor(), p.factor * u.factor, 1e-15, &symbol);
+            let factor = p.factor * u.factor;
+            assert!(
+                abs_diff_eq!(unit.factor(), factor, epsilon = 1e-15 * factor),
+                "{symbol}: {} vs {factor}",
+                unit.factor()
+            );
             round_trip(1.234_567e5, &symbol);
         }
     }
@@ -74,17 +78,18 @@ fn compound_units() {
 
 #[test]
 fn affine_display_conversions() {
-    assert_close(convert_from_si(353.15, "degC").unwrap(), 80.0, 1e-13, "K to degC");
-    assert_close(convert_from_si(353.15, "degF").unwrap(), 176.0, 1e-13, "K to degF");
-    assert_close(convert_from_si(353.15, "degR").unwrap(), 635.67, 1e-13, "K to degR");
-    assert_close(convert_from_si(308_167.718_795_04, "psig").unwrap(), 30.0, 1e-12, "Pa to psig");
-    assert_close(convert_from_si(101_325.0, "barg").unwrap(), 0.0, 1e-12, "Pa to barg");
-    assert_close(convert_from_si(12.599_788_055_555_556, "lbmol/h").unwrap(), 100.0, 1e-14, "lbmol/h");
-    assert_close(convert_from_si(1000.0 / 60.0, "kmol/min").unwrap(), 1.0, 1e-15, "kmol/min");
+    assert_abs_diff_eq!(convert_from_si(353.15, "degC").unwrap(), 80.0, epsilon = 1e-13 * 80.0);
+    assert_abs_diff_eq!(convert_from_si(353.15, "degF").unwrap(), 176.0, epsilon = 1e-13 * 176.0);
+    assert_abs_diff_eq!(convert_from_si(353.15, "degR").unwrap(), 635.67, epsilon = 1e-13 * 635.67);
+    assert_abs_diff_eq!(convert_from_si(308_167.718_795_04, "psig").unwrap(), 30.0, epsilon = 1e-12 * 30.0);
+    // 0 barg: absolute, in bar.
+    assert_abs_diff_eq!(convert_from_si(101_325.0, "barg").unwrap(), 0.0, epsilon = 1e-12);
+    assert_abs_diff_eq!(convert_from_si(12.599_788_055_555_556, "lbmol/h").unwrap(), 100.0, epsilon = 1e-14 * 100.0);
+    assert_abs_diff_eq!(convert_from_si(1000.0 / 60.0, "kmol/min").unwrap(), 1.0, epsilon = 1e-15);
     assert!(convert_from_si(f64::NAN, "K").unwrap().is_nan(), "NaN passes through");
     let u = Unit::parse_difference("degC").unwrap();
     assert!(!u.is_affine());
-    assert_close(u.from_si(10.0), 10.0, 0.0, "difference");
+    assert_eq!(u.from_si(10.0), 10.0, "difference");
 }
 
 #[test]
@@ -93,7 +98,7 @@ fn named_dimensions_display_as_parseable_si_units() {
         assert_eq!(n.dim.to_string(), n.symbol);
         let unit = Unit::parse(n.symbol).unwrap_or_else(|e| panic!("{}: {e}", n.symbol));
         assert_eq!(unit.dimension(), n.dim, "{}", n.symbol);
-        assert_close(unit.factor(), 1.0, 1e-15, n.symbol);
+        assert!(abs_diff_eq!(unit.factor(), 1.0, epsilon = 1e-15), "{}: factor {}", n.symbol, unit.factor());
         assert_eq!(unit_dimension(n.symbol).unwrap(), n.dim);
         assert_eq!(n.dim.name(), n.name);
         assert!(!n.examples.is_empty(), "{}", n.name);
@@ -110,7 +115,7 @@ fn generic_dimensions_display_as_parseable_units() {
         let shown = dim.to_string();
         let unit = Unit::parse(&shown).unwrap_or_else(|e| panic!("{shown}: {e}"));
         assert_eq!(unit.dimension(), dim, "{shown}");
-        assert_close(unit.factor(), 1.0, 1e-15, &shown);
+        assert!(abs_diff_eq!(unit.factor(), 1.0, epsilon = 1e-15), "{shown}: factor {}", unit.factor());
         let q = Quantity::new(2.0, dim);
         assert_eq!(parse_quantity(&q.to_string()).unwrap(), q);
     }

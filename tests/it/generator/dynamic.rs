@@ -2,11 +2,12 @@
 //! the same value end at the same state, every run conserves, and a sweep's points are the
 //! steady states `steady --set` finds at the same inputs.
 
+use approx::relative_eq;
 use serde_json::{Map, Value};
 
 use super::cx::Cx;
 use super::doc::{J, obj};
-use super::relations::{conserved, end_slopes, near, same_end, same_values};
+use super::relations::{conserved, end_slopes, same_end, same_values};
 
 /// The recorded paths of a run: the qualities, the column's holdups, the bottoms flow.
 fn recorded(cx: &Cx<'_>) -> Vec<String> {
@@ -129,7 +130,9 @@ pub fn sensitivity(cx: &mut Cx<'_>) {
         return;
     }
     let rows = sweep_rows(&std::fs::read_to_string(cx.dir.join("sweep.csv")).unwrap_or_default());
-    let pick = |c: f64| rows.iter().find(|(p, _)| near(*p, c, 1e-6, 1e-6)).map(|(_, m)| m.clone());
+    let pick = |c: f64| {
+        rows.iter().find(|(p, _)| relative_eq!(*p, c, epsilon = 1e-6, max_relative = 1e-6)).map(|(_, m)| m.clone())
+    };
     let (Some(base), Some(high)) = (pick(0.0), pick(5.0)) else {
         cx.check(false, "sensitivity: the CSV lacks its base or +5 % row", &[&out], || format!("{} rows", rows.len()));
         return;

@@ -3,6 +3,7 @@
 //! the studies that report the same gains (`identify`'s exact model, `screen --column`'s LV,
 //! `linearize`'s state space).
 
+use approx::relative_eq;
 use serde_json::Value;
 
 use super::cx::Cx;
@@ -63,7 +64,7 @@ pub fn gains_relations(cx: &mut Cx<'_>, perturb: bool) -> Option<Vec<Vec<f64>>> 
             let (a, b) = (v[key].as_f64().unwrap_or(f64::NAN), w[key].as_f64().unwrap_or(f64::NAN));
             let agree = match key {
                 "condition_number" => super::relations::condition_numbers_agree(a, b, 1e-7),
-                _ => super::relations::near(a, b, 1e-7, 0.0),
+                _ => relative_eq!(a, b, epsilon = 0.0, max_relative = 1e-7),
             };
             cx.check(agree, class, &[&base, &out], || format!("{key}: {a:e} against {b:e}"));
         }

@@ -1,6 +1,7 @@
 //! The relations, as pure functions of the commands' JSON: `Ok` when a relation holds, else what
 //! breaks it. Each is tested here on a deliberately broken input, so none of them holds vacuously.
 
+use approx::{abs_diff_eq, relative_eq};
 use serde_json::{Map, Value};
 
 /// Members of `v` matching `pattern` (`a/*/b`: `*` any key or index), with their paths.
@@ -83,11 +84,6 @@ fn clip(s: &str) -> String {
     s.chars().take(400).collect()
 }
 
-/// `a` and `b` agree to `rel` of the larger magnitude, or `abs`.
-pub fn near(a: f64, b: f64, rel: f64, abs: f64) -> bool {
-    (a - b).abs() <= rel * a.abs().max(b.abs()) + abs
-}
-
 /// Two steady states (`values` maps, path → SI number) name the same variables with the same
 /// values.
 pub fn same_values(a: &Map<String, Value>, b: &Map<String, Value>, rel: f64, abs: f64) -> Result<(), String> {
@@ -132,7 +128,8 @@ pub fn permuted(a: &[Vec<f64>], b: &[Vec<f64>], rows: &[usize], cols: &[usize], 
     }
     for (i, &r) in rows.iter().enumerate() {
         for (j, &c) in cols.iter().enumerate() {
-            if !near(a[r][c], b[i][j], rel, rel * natural_size(a, r, c) * 1e-3) {
+            let allowed = rel * a[r][c].abs().max(b[i][j].abs()) + rel * natural_size(a, r, c) * 1e-3;
+            if !abs_diff_eq!(a[r][c], b[i][j], epsilon = allowed) {
                 return Err(format!("entry ({i}, {j}) is {:e}, the permuted entry ({r}, {c}) {:e}", b[i][j], a[r][c]));
             }
         }
@@ -157,7 +154,7 @@ pub fn natural_size(g: &[Vec<f64>], i: usize, j: usize) -> f64 {
 /// smallest singular value by `ε ‖G‖`): two of them agree within that, or `rel` if larger.
 pub fn condition_numbers_agree(a: f64, b: f64, rel: f64) -> bool {
     let rounding = 100.0 * f64::EPSILON * a.abs().max(b.abs());
-    near(a, b, rel.max(rounding), 0.0)
+    relative_eq!(a, b, epsilon = 0.0, max_relative = rel.max(rounding))
 }
 
 /// The rows of a relative gain array sum to 1.
@@ -183,7 +180,8 @@ pub fn gains_agree(a: &[Vec<f64>], b: &[Vec<f64>], rel: f64, floor: f64) -> Resu
     }
     for i in 0..n {
         for &j in &cols {
-            if !near(a[i][j], b[i][j], rel, rel * floor * natural_size(a, i, j)) {
+            let allowed = rel * a[i][j].abs().max(b[i][j].abs()) + rel * floor * natural_size(a, i, j);
+            if !abs_diff_eq!(a[i][j], b[i][j], epsilon = allowed) {
                 return Err(format!("G[{i}][{j}]: {:e} against {:e}", a[i][j], b[i][j]));
             }
         }
@@ -209,7 +207,7 @@ pub fn first_difference(a: &Value, b: &Value, rel: f64, ignore: &[&str], path: &
             .find_map(|(i, (p, q))| first_difference(p, q, rel, ignore, &format!("{path}/{i}"))),
         (Value::Number(p), Value::Number(q)) => {
             let (p, q) = (p.as_f64().unwrap_or(f64::NAN), q.as_f64().unwrap_or(f64::NAN));
-            (!near(p, q, rel, 1e-300)).then(|| format!("{path}: {p:e} against {q:e}"))
+            (!relative_eq!(p, q, epsilon = 1e-300, max_relative = rel)).then(|| format!("{path}: {p:e} against {q:e}"))
         }
         _ => (a != b).then(|| format!("{path}: {} against {}", clip(&a.to_string()), clip(&b.to_string()))),
     }
@@ -332,7 +330,8 @@ pub fn same_end(step: &Value, ramp: &Value, slopes: &[(String, f64)], d: f64, re
         let slope = slopes.iter().find(|(n, _)| n == name).map_or(0.0, |s| s.1);
         let (shift, moved) = (slope * d / 2.0, (x - x0).abs());
         let expected = x - shift;
-        if !near(expected, y, rel * 1e-2, rel * moved + 0.1 * shift.abs() + 1e-12) {
+        let allowed = rel * 1e-2 * expected.abs().max(y.abs()) + rel * moved + 0.1 * shift.abs() + 1e-12;
+        if !abs_diff_eq!(expected, y, epsilon = allowed) {
             return Err(format!(
                 "{name}: the step ends at {x:e} (moving {slope:e}/s, so a {d} s ramp is expected at {expected:e}), the ramp at {y:e} (moved {moved:e})"
             ));

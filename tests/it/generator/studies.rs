@@ -2,12 +2,13 @@
 //! and `compare`, each asked the same question another way (loops, CVs and MVs listed in another
 //! order; a quantity in other units; a scheme compared with itself) and held to its own evidence.
 
+use approx::relative_eq;
 use serde_json::Value;
 
 use super::cx::Cx;
 use super::doc::J;
 use super::exec::Output;
-use super::relations::{first_difference, matrix, near, ranking_follows_evidence, same_pairings, same_values};
+use super::relations::{first_difference, matrix, ranking_follows_evidence, same_pairings, same_values};
 
 fn tune_blt(cx: &mut Cx<'_>, loops: &[String], write: Option<&str>) -> (Output, Option<Value>) {
     let mut args = vec!["tune", "plant.json", "--method", "blt", "--measurement-dead-time", "1 min", "--json"];
@@ -180,7 +181,7 @@ pub fn tune_plant_test(cx: &mut Cx<'_>, pick: usize) {
             let (kc, expected) =
                 (v["loops"][0]["kc"].as_f64().unwrap_or(f64::NAN).abs(), 0.1 * flow.abs() / (0.25 * level_now.abs()));
             cx.check(
-                near(kc, expected, 1e-9, 0.0),
+                relative_eq!(kc, expected, epsilon = 0.0, max_relative = 1e-9),
                 "tune --method averaging: P gain is not 10 % of the flow over a quarter of the level",
                 &[&out],
                 || format!("kc {kc:e}, closed form {expected:e} (op {flow:e}, level {level_now:e})"),

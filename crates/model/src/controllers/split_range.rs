@@ -208,6 +208,7 @@ impl UnitModel for SplitRange {
 
 #[cfg(test)]
 mod tests {
+    use approx::assert_abs_diff_eq;
     use plantwide_units::Dimension;
     use serde_json::json;
 
@@ -251,10 +252,6 @@ mod tests {
         own
     }
 
-    fn close(a: [f64; 2], b: [f64; 2]) -> bool {
-        (a[0] - b[0]).abs() < 1e-12 && (a[1] - b[1]).abs() < 1e-12
-    }
-
     fn jac_err(u: &dyn crate::Unit, s: f64) -> f64 {
         let layout = layout(u);
         let local = [0.3, 0.4, s];
@@ -269,14 +266,14 @@ mod tests {
         let names: Vec<_> = u.internal_vars().iter().map(|v| v.name.clone()).collect();
         assert_eq!(names, ["op", "op2"]);
         assert!(u.inputs().is_empty());
-        assert!(close(at(&u, 0.0), [0.0, 0.0]));
-        assert!(close(at(&u, 0.2), [0.5, 0.0]));
-        assert!(close(at(&u, 0.4), [1.0, 0.0]));
-        assert!(close(at(&u, 0.7), [1.0, 0.5]));
-        assert!(close(at(&u, 1.0), [1.0, 1.0]));
+        assert_abs_diff_eq!(at(&u, 0.0)[..], [0.0, 0.0][..], epsilon = 1e-12);
+        assert_abs_diff_eq!(at(&u, 0.2)[..], [0.5, 0.0][..], epsilon = 1e-12);
+        assert_abs_diff_eq!(at(&u, 0.4)[..], [1.0, 0.0][..], epsilon = 1e-12);
+        assert_abs_diff_eq!(at(&u, 0.7)[..], [1.0, 0.5][..], epsilon = 1e-12);
+        assert_abs_diff_eq!(at(&u, 1.0)[..], [1.0, 1.0][..], epsilon = 1e-12);
         // Outside the signal range the outputs hold.
-        assert!(close(at(&u, -0.5), [0.0, 0.0]));
-        assert!(close(at(&u, 1.5), [1.0, 1.0]));
+        assert_abs_diff_eq!(at(&u, -0.5)[..], [0.0, 0.0][..], epsilon = 1e-12);
+        assert_abs_diff_eq!(at(&u, 1.5)[..], [1.0, 1.0][..], epsilon = 1e-12);
     }
 
     #[test]
@@ -293,11 +290,11 @@ mod tests {
         )
         .unwrap();
         assert_eq!(u.internal_vars()[1].dim, Dimension::MOLAR_FLOW);
-        assert!(close(at(&u, 0.0), [2.0, 0.0]));
-        assert!(close(at(&u, 25.0), [1.0, 0.0]));
-        assert!(close(at(&u, 50.0), [0.0, 0.0]));
-        assert!(close(at(&u, 75.0), [0.0, 2.5]));
-        assert!(close(at(&u, 100.0), [0.0, 5.0]));
+        assert_abs_diff_eq!(at(&u, 0.0)[..], [2.0, 0.0][..], epsilon = 1e-12);
+        assert_abs_diff_eq!(at(&u, 25.0)[..], [1.0, 0.0][..], epsilon = 1e-12);
+        assert_abs_diff_eq!(at(&u, 50.0)[..], [0.0, 0.0][..], epsilon = 1e-12);
+        assert_abs_diff_eq!(at(&u, 75.0)[..], [0.0, 2.5][..], epsilon = 1e-12);
+        assert_abs_diff_eq!(at(&u, 100.0)[..], [0.0, 5.0][..], epsilon = 1e-12);
     }
 
     #[test]
@@ -309,7 +306,7 @@ mod tests {
         )
         .unwrap();
         assert_eq!(u.internal_vars()[1].dim, Dimension::POWER);
-        assert!(close(at(&u, 1.0), [2.0, 2.0e6]));
+        assert_abs_diff_eq!(at(&u, 1.0)[..], [2.0, 2.0e6][..], epsilon = 1e-12);
     }
 
     #[test]

@@ -90,8 +90,3 @@ pub fn central_diff(f: impl Fn(f64) -> f64, x: f64, h: f64) -> f64 {
     let d = |h: f64| (f(x + h) - f(x - h)) / (2.0 * h);
     (4.0 * d(h / 2.0) - d(h)) / 3.0
 }
-
-pub fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
-    assert_eq!(a.len(), b.len());
-    a.iter().zip(b).fold(0.0, |m, (u, v)| m.max((u - v).abs()))
-}
