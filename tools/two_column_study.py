@@ -343,7 +343,7 @@ def screening(s, md):
     mvs = "column1.reflux,column1.bottoms,column2.reflux,column2.bottoms,fresh_A.F"
     p = s.pw("screen", BASE, "--cvs", ",".join(ENDS["column1"] + ENDS["column2"]), "--mvs", mvs,
              "--throughput", "fresh_A.F,column1.reflux,column1.bottoms",
-             "--disturbances", "reactor_B.sp=+10%,feed_cooler.T_out=+1%", "--watch", "bottoms1.x[B]=0:0.0025",
+             "--disturbances", "reactor_B.sp=+10%,feed_cooler.T_out=+3.4 K", "--watch", "bottoms1.x[B]=0:0.0025",
              "--candidates", "6", "--json", parse_json=True)
     rows = []
     for c in sorted(p["structures"], key=lambda c: (c["rank"] is None, c["rank"] or 0)):
@@ -363,7 +363,7 @@ def screening(s, md):
            f"at a non-positive relative gain), {sum(c['passed'] for c in p['structures'])} pass NI > 0, DIC's necessary "
            "conditions and the fig. 6-6 band (column 1 bottoms B within 0 … 0.0025 over ± each disturbance with the CVs "
            "held); the best six by RGA number are tuned by BLT "
-           "(1 min measurement delay) and stepped by the reactor B setpoint +10 % and the feed cooler +1 %. "
+           "(1 min measurement delay) and stepped by the reactor B setpoint +10 % and the feed cooler +3.4 K (1 % of its 340 K). "
            "Dynamic score: mean IAE over the best candidate's, per CV and disturbance.", "",
            table(["rank", "throughput", "pairs (relative gain)", "NI", "RGA number", "dynamic score"], rows), "",
            f"Best: throughput **{best['throughput']}**, "

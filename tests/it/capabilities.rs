@@ -74,3 +74,38 @@ fn every_heat_duty_is_declared() {
         }
     }
 }
+
+/// Every liquid inventory a unit declares (a column's drum and base) is addressable: its stage's
+/// holdup, temperature and composition are variables, and what leaves it is a variable or an
+/// input of the unit. At column A's steady state the drum's and the base's throughputs are those
+/// of the column's balance: reflux + distillate = V[N−1] and bottoms + boilup = L[2].
+#[test]
+fn every_declared_inventory_is_addressable_and_balances() {
+    let mut seen = 0;
+    for (file, plant) in shipped() {
+        for (name, u) in &plant.spec().units {
+            for inv in u.config().inventories() {
+                seen += 1;
+                let var = |f: String| plant.var(&format!("{name}.{f}"));
+                assert!(var(format!("M[{}]", inv.stage)).is_some(), "{file}: {name}.{}", inv.name);
+                assert!(var(format!("T[{}]", inv.stage)).is_some(), "{file}: {name}.{}", inv.name);
+                for p in &inv.leaving {
+                    let found = var(p.clone()).is_some() || plant.input(&format!("{name}.{p}")).is_some();
+                    assert!(
+                        found,
+                        "{file}: `{name}.{p}` leaving {name}.{} is neither a variable nor an input",
+                        inv.name
+                    );
+                }
+            }
+        }
+    }
+    assert!(seen >= 2 * 8, "{seen} inventories on the shipped flowsheets");
+    let (plant, ss) = crate::harness::converge("column_a.json");
+    let residence = plantwide::studies::size::residence::residence_times(&plant, &ss.x);
+    let at = |p: &str| crate::harness::value(&plant, &ss.x, p);
+    let through = |v: &str| residence.iter().find(|r| r.vessel == v).map(|r| r.throughput).unwrap();
+    let n = plant.vars().iter().filter(|v| v.path.starts_with("column.M[")).count();
+    approx::assert_relative_eq!(through("column.drum"), at(&format!("column.V[{}]", n - 1)), max_relative = 1e-9);
+    approx::assert_relative_eq!(through("column.sump"), at("column.L[2]"), max_relative = 1e-9);
+}

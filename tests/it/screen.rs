@@ -375,7 +375,7 @@ fn two_column_screening_with_throughput_choices_reaches_the_studys_conclusions()
         "--throughput",
         "fresh_A.F,column1.reflux,column1.bottoms",
         "--disturbances",
-        "reactor_B.sp=+10%,feed_cooler.T_out=+1%",
+        "reactor_B.sp=+10%,feed_cooler.T_out=+3.4 K",
         "--watch",
         "bottoms1.x[B]=0:0.0025",
         "--candidates",

@@ -26,7 +26,7 @@ pub mod var;
 pub use build::{BuildCx, FieldError};
 pub use capability::{Booking, Boundary, Duty, DutySource, Shape, UtilityFlow};
 pub use error::{Error, InputError, SpecError};
-pub use registry::{ControllerSpec, UnitSpec};
+pub use registry::{ControllerSpec, Inventory, UnitSpec};
 pub use stream::{Stream, StreamLayout};
 pub use unit::{Coloring, InputSpec, LocalLayout, Saturation, SignalSpec, Unit, UnitIo, UnitModel};
 pub use var::{VarKind, VarSpec};

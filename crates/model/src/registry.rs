@@ -21,6 +21,25 @@ pub trait UnitConfig: std::fmt::Debug {
     fn vessel(&self) -> Option<VesselGeometry<'_>> {
         None
     }
+    /// The liquid inventories the unit holds without a geometry (a column's reflux drum and
+    /// base), for sizing and the residence-time check (default: none).
+    fn inventories(&self) -> Vec<Inventory> {
+        Vec::new()
+    }
+}
+
+/// A liquid inventory a unit holds as a holdup without a geometry: sized as a vertical drum of the
+/// area the design needs, and checked for its residence time.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Inventory {
+    /// Its name after the unit's: `drum` is addressed `COL.drum`.
+    pub name: &'static str,
+    /// The stage whose holdup `M[k]`, temperature `T[k]` and composition `x[k][c]` are the
+    /// inventory's.
+    pub stage: usize,
+    /// What leaves it, each a variable or an input of the unit (`L[12]`, `distillate`): their sum
+    /// is its throughput.
+    pub leaving: Vec<String>,
 }
 
 /// A vessel's cross-section (by diameter or area) and height as its description writes them.

@@ -8,7 +8,6 @@
 //! vessel the sum of its outlet streams.
 
 use plantwide_flowsheet::Plant;
-use plantwide_model::UnitSpec;
 use serde::Serialize;
 
 /// The rule's holdup time \[s\].
@@ -34,23 +33,22 @@ pub fn residence_times(plant: &Plant, x: &[f64]) -> Vec<Residence> {
     let at = |p: &str| plant.var(p).map(|i| x[i]);
     let mut out = Vec::new();
     for (name, u) in &plant.spec().units {
-        let ends: Vec<(String, Option<f64>, Option<f64>)> = match u {
-            UnitSpec::Column(c) => {
-                let n = c.stages;
-                let distillate = input_value(plant, x, &format!("{name}.distillate"));
-                let drum = at(&format!("{name}.L[{n}]")).zip(distillate).map(|(l, d)| l + d);
-                let sump = at(&format!("{name}.L[1]")).zip(at(&format!("{name}.V[1]"))).map(|(b, v)| b + v);
-                vec![
-                    (format!("{name}.drum"), at(&format!("{name}.M[{n}]")), drum),
-                    (format!("{name}.sump"), at(&format!("{name}.M[1]")), sump),
-                ]
-            }
-            u if u.config().vessel().is_some() => {
-                let out_flow: f64 = outlet_streams(plant, name).iter().filter_map(|s| at(&format!("{s}.F"))).sum();
-                vec![(name.clone(), at(&format!("{name}.M")), Some(out_flow))]
-            }
-            _ => Vec::new(),
-        };
+        // What leaves an inventory: each a variable of the unit, or an input (its value, or the
+        // output of the controller that drives it).
+        let leaving = |p: &String| at(&format!("{name}.{p}")).or_else(|| input_value(plant, x, &format!("{name}.{p}")));
+        let mut ends: Vec<(String, Option<f64>, Option<f64>)> = u
+            .config()
+            .inventories()
+            .iter()
+            .map(|i| {
+                let throughput = i.leaving.iter().map(leaving).sum::<Option<f64>>();
+                (format!("{name}.{}", i.name), at(&format!("{name}.M[{}]", i.stage)), throughput)
+            })
+            .collect();
+        if u.config().vessel().is_some() {
+            let out_flow: f64 = outlet_streams(plant, name).iter().filter_map(|s| at(&format!("{s}.F"))).sum();
+            ends.push((name.clone(), at(&format!("{name}.M")), Some(out_flow)));
+        }
         for (vessel, m, f) in ends {
             let (Some(holdup), Some(throughput)) = (m, f) else { continue };
             let time = if throughput > 0.0 { holdup / throughput } else { f64::INFINITY };

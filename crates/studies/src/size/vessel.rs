@@ -54,13 +54,19 @@ impl Vessel {
             let kind = Kind::Area { unit: name.to_string(), diameter, area, height, new_on: None };
             return Vessel::with_loop(original, plant.clone(), x.to_vec(), kind, &format!("{name}.level"), r);
         }
-        if let Some((col, end)) = name.rsplit_once('.')
-            && let Some(UnitSpec::Column(c)) = spec.units.get(col)
-            && (end == "drum" || end == "sump")
+        if let Some((unit, end)) = name.rsplit_once('.')
+            && let Some(inv) =
+                spec.units.get(unit).and_then(|u| u.config().inventories().into_iter().find(|i| i.name == end))
         {
-            let stage = if end == "drum" { c.stages } else { 1 };
-            let kind = Kind::Holdup { drum: end == "drum" };
-            return Vessel::with_loop(original, plant.clone(), x.to_vec(), kind, &format!("{col}.M[{stage}]"), r);
+            let kind = Kind::Holdup { drum: inv.name == "drum" };
+            return Vessel::with_loop(
+                original,
+                plant.clone(),
+                x.to_vec(),
+                kind,
+                &format!("{unit}.M[{}]", inv.stage),
+                r,
+            );
         }
         if spec.streams.contains_key(name) {
             let (p, xs, unit) = new_tank(plant, x, name, r)?;
@@ -239,11 +245,10 @@ fn liquid_volume(plant: &Plant, x: &[f64], kind: &Kind, measurement: &str) -> Op
 fn not_a_vessel(plant: &Plant, name: &str, why: &str) -> SizeError {
     let mut known: Vec<String> = Vec::new();
     for (n, u) in &plant.spec().units {
-        match u {
-            UnitSpec::Column(_) => known.extend([format!("{n}.drum"), format!("{n}.sump")]),
-            u if geometry(u).is_some() => known.push(n.clone()),
-            _ => {}
+        if geometry(u).is_some() {
+            known.push(n.clone());
         }
+        known.extend(u.config().inventories().iter().map(|i| format!("{n}.{}", i.name)));
     }
     let streams: Vec<&str> = plant.spec().streams.keys().map(String::as_str).collect();
     SizeError::Vessel {

@@ -230,6 +230,19 @@ impl crate::registry::UnitConfig for ColumnConfig {
     fn ports() -> &'static str {
         "inlets named by `feeds[k].port`; outlets `distillate`, `bottoms` and one named by each `side_draws[k].port`"
     }
+    /// The reflux drum (stage N: reflux `L[N]` and distillate leave it) and the base (stage 1:
+    /// bottoms `L[1]` and boilup `V[1]` leave it).
+    fn inventories(&self) -> Vec<crate::registry::Inventory> {
+        let n = self.stages;
+        vec![
+            crate::registry::Inventory {
+                name: "drum",
+                stage: n,
+                leaving: vec![format!("L[{n}]"), "distillate".into()],
+            },
+            crate::registry::Inventory { name: "sump", stage: 1, leaving: vec!["L[1]".into(), "V[1]".into()] },
+        ]
+    }
 }
 
 impl ColumnConfig {
