@@ -36,8 +36,8 @@ fn boundaries_are_where_material_enters_and_leaves() {
     }
 }
 
-/// Every heat duty a unit carries (an own variable `Q` or `Qc`, an input named `…_duty`) is one
-/// it declares, so that `compare`'s energy use cannot leave it out; a coupled condenser duty is
+/// Every heat duty a unit carries (an own variable `Q` or `Qc`, an input named `duty` or
+/// `…_duty`) is one it declares, so that `compare`'s energy use cannot leave it out; a coupled condenser duty is
 /// declared through its condenser's booking.
 #[test]
 fn every_heat_duty_is_declared() {
@@ -62,7 +62,11 @@ fn every_heat_duty_is_declared() {
             let local = |path: &str| path.strip_prefix(&format!("{}.", b.name)).map(str::to_string);
             let vars = plant.vars().iter().filter(|v| v.block == bi).filter_map(|v| local(&v.path));
             let inputs = plant.inputs().iter().filter(|i| i.block == bi).filter_map(|i| local(&i.path));
-            let duties = vars.filter(|n| n == "Q" || n == "Qc").chain(inputs.filter(|n| n.ends_with("_duty")));
+            // An input `duty` is a heat input unless the unit carries it in a declared `Q` (a
+            // heater or a CSTR in duty mode: `Q` equals it, and booking both would count it twice).
+            let carried = b.unit.duties().iter().any(|d| matches!(d.source, DutySource::Var("Q")));
+            let heat_input = |n: &String| n.ends_with("_duty") || (n == "duty" && !carried);
+            let duties = vars.filter(|n| n == "Q" || n == "Qc").chain(inputs.filter(heat_input));
             for name in duties {
                 assert!(
                     declared.contains(&name.as_str()),
@@ -108,4 +112,26 @@ fn every_declared_inventory_is_addressable_and_balances() {
     let n = plant.vars().iter().filter(|v| v.path.starts_with("column.M[")).count();
     approx::assert_relative_eq!(through("column.drum"), at(&format!("column.V[{}]", n - 1)), max_relative = 1e-9);
     approx::assert_relative_eq!(through("column.sump"), at("column.L[2]"), max_relative = 1e-9);
+}
+
+/// A flash drum's and a tank's heat input `duty` is a utility `compare` books (it was left out
+/// until they declared it): with 50 kW put into the drum of the flash recycle, the booked heating
+/// is the heater's 0.8 MW plus those 50 kW, and the surge tank's 20 kW is its only duty.
+#[test]
+fn a_vessels_heat_input_is_booked_as_heating() {
+    use plantwide::flowsheet::{Override, load_with};
+    use plantwide::solve::{NewtonSettings, steady_state};
+    let booked = |file: &str, sets: &[(&str, &str)]| {
+        let overrides: Vec<Override> = sets.iter().map(|(p, v)| Override::new(*p, *v)).collect();
+        let path = crate::harness::flowsheet(file);
+        let plant = load_with(std::path::Path::new(&path), &overrides).unwrap_or_else(|e| panic!("{e}"));
+        let u = plant.input_values();
+        let ss = steady_state(&plant, &u, None, &NewtonSettings::default()).unwrap_or_else(|e| panic!("{e}"));
+        plantwide::studies::compare::energy(&plant, &ss.x, &u)
+    };
+    let e = booked("flash_recycle.json", &[("drum.duty", "50 kW")]);
+    approx::assert_relative_eq!(e.heating, 0.8e6 + 50e3, max_relative = 1e-12);
+    assert!(e.duties.iter().any(|d| d.path == "drum.duty" && d.duty == 50e3), "{:?}", e.duties);
+    let e = booked("surge_tank.json", &[("tank.duty", "20 kW")]);
+    approx::assert_relative_eq!(e.heating, 20e3, max_relative = 1e-12);
 }

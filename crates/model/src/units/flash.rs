@@ -42,7 +42,7 @@
 //! condition asked for `V < 0` and the run stopped at the bound). The guess puts such a drum at
 //! the feed's bubble point with `V = 0`.
 
-use crate::capability::Shape;
+use crate::capability::{Booking, Duty, DutySource, Shape};
 use plantwide_units::{Dimension, QuantityValue};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -119,6 +119,10 @@ impl UnitModel for Flash {
     }
     fn shape(&self) -> Shape {
         Shape::Vessel
+    }
+    /// The input `duty` \[W\], heat put into the liquid: heating when positive.
+    fn duties(&self) -> &'static [Duty] {
+        &[Duty { source: DutySource::Input("duty"), booking: Booking::Utility }]
     }
     fn inlet_ports(&self) -> Vec<String> {
         vec!["in".into()]
