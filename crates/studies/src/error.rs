@@ -1,6 +1,6 @@
 //! Errors of the studies: [`TuneError`] of tuning, [`crate::screen::ScreenError`] of screening,
-//! [`crate::size::SizeError`] of surge sizing,
-//! joined in the crate-level [`enum@Error`].
+//! [`crate::size::SizeError`] of surge sizing, [`crate::compare::CompareError`] of comparison,
+//! [`crate::identify::IdentifyError`] of identification, joined in the crate-level [`enum@Error`].
 
 use thiserror::Error;
 
@@ -16,6 +16,12 @@ pub enum Error {
     /// Surge sizing.
     #[error(transparent)]
     Size(#[from] crate::size::SizeError),
+    /// Comparison of schemes.
+    #[error(transparent)]
+    Compare(#[from] crate::compare::CompareError),
+    /// Identification.
+    #[error(transparent)]
+    Identify(#[from] crate::identify::IdentifyError),
 }
 
 impl Error {
@@ -25,6 +31,8 @@ impl Error {
             Error::Tune(e) => e.is_user_error(),
             Error::Screen(e) => e.is_user_error(),
             Error::Size(e) => e.is_user_error(),
+            Error::Compare(e) => e.is_user_error(),
+            Error::Identify(e) => e.is_user_error(),
         }
     }
 }
