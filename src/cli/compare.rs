@@ -101,6 +101,6 @@ pub fn run(a: &CompareArgs, system: UnitSystem) -> Result<(), CliError> {
 
 /// A library refusal or failure with the request's fields named as this command's flags.
 fn compare_error(e: CompareError) -> CliError {
-    let message = super::with_flags(e.to_string(), e.field(), &[]);
+    let message = super::with_flags(e.to_string(), e.field(), CompareRequest::FIELDS);
     if e.is_user_error() { CliError::user(message) } else { CliError::numerical(message) }
 }

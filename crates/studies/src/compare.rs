@@ -338,7 +338,7 @@ pub fn compare(plants: &[Plant], request: &CompareSettings) -> Result<Comparison
     {
         return Err(CompareError::Request {
             file: s.file.clone(),
-            what: "give --duration: no scheme has a PI quality loop whose reset time sets the length of the \
+            what: "give a `duration`: no scheme has a PI quality loop whose reset time sets the length of the \
                    closed-loop runs, and a model predictive controller has none"
                 .into(),
         });
@@ -472,7 +472,7 @@ fn quality_loops(plant: &Plant, named: &[String]) -> Result<Vec<QualityLoop>, Co
     if let Some(n) = named.iter().find(|n| !loops.iter().any(|l| &l.controller == *n)) {
         return Err(CompareError::Request {
             file: plant.file().to_string(),
-            what: format!("--loops {n}: no PID controller `{n}` driving an input"),
+            what: format!("`loops` names `{n}`, no PID controller driving an input"),
         });
     }
     Ok(loops)

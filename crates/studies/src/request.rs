@@ -16,7 +16,7 @@ pub fn failed_parts(study: &str, failed: &[String]) -> Option<String> {
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 #[error("{list}: `{item}` is given twice (entries {first} and {second}, counted from 1): give each once")]
 pub struct Duplicate {
-    /// The list (`--cvs`, `--loops`, …).
+    /// The list (the request's field: `cvs`, `loops`, …).
     pub list: String,
     /// The item as given the second time.
     pub item: String,
@@ -51,11 +51,11 @@ mod tests {
 
     #[test]
     fn the_second_of_two_equal_items_is_named_with_both_places() {
-        let e = unique("--cvs", &["a", "b", "c", "b"], |x, y| x == y).unwrap_err();
+        let e = unique("cvs", &["a", "b", "c", "b"], |x, y| x == y).unwrap_err();
         assert_eq!((e.item.as_str(), e.first, e.second), ("b", 2, 4));
         assert!(e.to_string().contains("entries 2 and 4"), "{e}");
-        assert!(unique("--cvs", &["a", "b"], |x, y| x == y).is_ok());
-        let aliases = unique("--cvs", &["s.x[a]", "s.z[a]"], |x, y| x.replace(".z[", ".x[") == y.replace(".z[", ".x["));
+        assert!(unique("cvs", &["a", "b"], |x, y| x == y).is_ok());
+        let aliases = unique("cvs", &["s.x[a]", "s.z[a]"], |x, y| x.replace(".z[", ".x[") == y.replace(".z[", ".x["));
         assert!(aliases.is_err());
     }
 }

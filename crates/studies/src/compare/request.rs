@@ -73,6 +73,10 @@ fn hours() -> f64 {
 }
 
 impl CompareRequest {
+    /// The fields a message names in backticks (`` give a `duration` ``), for a face to map to its
+    /// own names; a field a message only starts with is [`CompareError::field`]'s.
+    pub const FIELDS: &'static [&'static str] = &["duration", "loops"];
+
     /// `outputs` without their display units.
     pub fn output_paths(&self) -> Vec<String> {
         let path = |o: &String| plantwide_analysis::select::split_unit(o).0.to_string();
