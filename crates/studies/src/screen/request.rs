@@ -108,7 +108,7 @@ impl ScreenRequest {
     /// The fields a message names in backticks (`` one of the `mvs` ``), for a face to map to its
     /// own names; a field a message only starts with is [`ScreenError::field`]'s. (Kept to the
     /// fields messages name: a unit called `column` is no field.)
-    pub const FIELDS: &'static [&'static str] = &["cvs", "mvs", "throughput", "disturbances", "steady_only"];
+    pub const FIELDS: &'static [&'static str] = &["cvs", "mvs", "throughput", "disturbances", "steady_only", "mpc"];
 
     /// The column screening asked for, in SI.
     ///
