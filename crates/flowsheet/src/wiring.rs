@@ -220,13 +220,13 @@ impl Plant {
 pub enum StructureEdit {
     /// Set a field of a unit or controller, or an input's value (as [`Plant::variant`] does).
     Set(Override),
-    /// Add a controller, described as in the file's `controllers` section (e.g. a ratio station
-    /// `{"type": "ratio", "wild": "distillate.F", "output": "column.reflux", "ratio": 5.4}`).
+    /// Add a controller, described as the file's `controllers` section holds it (a typed
+    /// description: a ratio station's `RatioConfig`, a PID's `PidConfig`).
     AddController {
         /// Its name (not yet a controller's).
         name: String,
         /// Its description.
-        spec: serde_json::Value,
+        spec: Box<plantwide_model::ControllerSpec>,
     },
     /// Remove a controller: the inputs it drove read their own values again.
     RemoveController(String),
@@ -245,8 +245,8 @@ pub enum StructureEdit {
         stream: String,
         /// The new unit's name (not yet a unit's or controller's).
         unit: String,
-        /// Its description, as in the file's `units` section.
-        spec: serde_json::Value,
+        /// Its description, as the file's `units` section holds it.
+        spec: Box<plantwide_model::UnitSpec>,
         /// The new stream's name (not yet a stream's).
         outlet: String,
     },
@@ -256,7 +256,7 @@ fn insert_on_stream(
     spec: &mut crate::FlowsheetSpec,
     stream: &str,
     unit: &str,
-    u: &serde_json::Value,
+    u: &plantwide_model::UnitSpec,
     outlet: &str,
 ) -> Result<(), OverrideError> {
     let fail = |why: String| OverrideError::Structure { controller: unit.to_string(), why };
@@ -266,25 +266,27 @@ fn insert_on_stream(
     if spec.streams.contains_key(outlet) {
         return Err(fail(format!("the outlet stream's name `{outlet}` is taken")));
     }
-    let parsed = serde_json::from_value(u.clone()).map_err(|e| fail(format!("not a unit description: {e}")))?;
     let Some(cut) = spec.streams.get_mut(stream) else {
         let hint = crate::error::did_you_mean(stream, spec.streams.keys().map(String::as_str));
         return Err(fail(format!("there is no stream `{stream}` to put it on{hint}")));
     };
     let to = std::mem::replace(&mut cut.to, unit.to_string());
     let tear = std::mem::take(&mut cut.tear);
-    spec.units.insert(unit.to_string(), parsed);
+    spec.units.insert(unit.to_string(), u.clone());
     spec.streams.insert(outlet.to_string(), crate::spec::StreamSpec { from: unit.to_string(), to, tear });
     Ok(())
 }
 
-fn add_controller(spec: &mut crate::FlowsheetSpec, name: &str, c: &serde_json::Value) -> Result<(), OverrideError> {
+fn add_controller(
+    spec: &mut crate::FlowsheetSpec,
+    name: &str,
+    c: &plantwide_model::ControllerSpec,
+) -> Result<(), OverrideError> {
     let fail = |why: String| OverrideError::Structure { controller: name.to_string(), why };
     if spec.controllers.contains_key(name) || spec.units.contains_key(name) {
         return Err(fail("the name is taken by a unit or controller of the flowsheet".into()));
     }
-    let parsed = serde_json::from_value(c.clone()).map_err(|e| fail(format!("not a controller description: {e}")))?;
-    spec.controllers.insert(name.to_string(), parsed);
+    spec.controllers.insert(name.to_string(), c.clone());
     Ok(())
 }
 
@@ -361,7 +363,12 @@ mod restructure_tests {
         let open = plant.restructure(&[StructureEdit::RemoveController("lc".into())]).unwrap();
         assert!(open.controller("lc").is_err() && driven(&open, "tank.outflow").is_none());
         // A ratio station on the outflow, then its ratio set: the outflow follows the inflow.
-        let ratio = serde_json::json!({"type": "ratio", "wild": "a.F", "output": "tank.outflow", "ratio": 1.0});
+        let ratio: Box<plantwide_model::ControllerSpec> = Box::new(
+            serde_json::from_value(
+                serde_json::json!({"type": "ratio", "wild": "a.F", "output": "tank.outflow", "ratio": 1.0}),
+            )
+            .unwrap(),
+        );
         let edits = [
             StructureEdit::RemoveController("lc".into()),
             StructureEdit::AddController { name: "rs".into(), spec: ratio.clone() },
@@ -370,13 +377,10 @@ mod restructure_tests {
         let v = plant.restructure(&edits).unwrap();
         assert!(driven(&v, "tank.outflow").is_some());
         assert_eq!(v.inputs()[v.input("rs.ratio").unwrap()].value, 0.9);
-        // Bad edits are named: a taken name, a description that is no controller, an unknown one.
+        // Bad edits are named: a taken name, an unknown controller to remove (a description that
+        // is no controller no longer compiles: the edit is typed).
         let bad = [
             (StructureEdit::AddController { name: "tank".into(), spec: ratio }, "controller `tank`: the name is taken"),
-            (
-                StructureEdit::AddController { name: "x".into(), spec: serde_json::json!({"type": "pdi"}) },
-                "not a controller",
-            ),
             (StructureEdit::RemoveController("lcc".into()), "no such controller to remove"),
         ];
         for (e, msg) in bad {
@@ -391,8 +395,10 @@ mod restructure_tests {
         let plant = load_str_with(super::tests::TANK, "t.json", &[]).unwrap();
         let tank = serde_json::json!({"type": "tank", "area": "1 m2", "height": "2 m",
                                       "outflow": {"type": "flow", "flow": "50 mol/s"}});
+        let tank = Box::new(serde_json::from_value(tank).unwrap());
         let level = serde_json::json!({"type": "pid", "pv": "surge.level", "output": "surge.outflow", "sp": "1 m",
                                        "kc": "50 mol/s/m", "action": "direct"});
+        let level = Box::new(serde_json::from_value(level).unwrap());
         let edits = [
             StructureEdit::InsertOnStream { stream: "b".into(), unit: "surge".into(), spec: tank, outlet: "b2".into() },
             StructureEdit::AddController { name: "surge_level".into(), spec: level },
@@ -405,7 +411,7 @@ mod restructure_tests {
         let again = |stream: &str, unit: &str| StructureEdit::InsertOnStream {
             stream: stream.into(),
             unit: unit.into(),
-            spec: serde_json::json!({"type": "product"}),
+            spec: Box::new(serde_json::from_value(serde_json::json!({"type": "product"})).unwrap()),
             outlet: "c".into(),
         };
         let err = plant.restructure(&[again("bb", "surge")]).unwrap_err().to_string();

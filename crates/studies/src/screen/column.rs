@@ -529,14 +529,24 @@ fn move_level(plant: &Plant, name: &str, to: &str, flows: &[f64; 4], paths: &[St
     }
     c.output = Some(to.to_string());
     (c.bias, c.op_min, c.op_max) = (None, None, None);
-    let spec = serde_json::to_value(ControllerSpec::Pid(c)).unwrap_or_default();
+    // Removed and added again (not set in place): the moved loop comes last among the controllers,
+    // as it always has in a configuration's layout.
+    let spec = Box::new(ControllerSpec::Pid(c));
     vec![StructureEdit::RemoveController(name.into()), StructureEdit::AddController { name: name.into(), spec }]
 }
 
 /// A ratio station `name` driving `output` at `ratio` times the flow `wild`.
 fn ratio_station(name: &str, wild: &str, output: &str, ratio: f64) -> StructureEdit {
-    let spec = serde_json::json!({"type": "ratio", "wild": wild, "output": output, "ratio": ratio});
-    StructureEdit::AddController { name: name.into(), spec }
+    use plantwide_model::controllers::ratio::{RatioConfig, RatioValue};
+    let spec = RatioConfig {
+        wild: wild.into(),
+        output: output.into(),
+        ratio: RatioValue::Value(QuantityValue::Number(ratio)),
+        bias: None,
+        op_min: None,
+        op_max: None,
+    };
+    StructureEdit::AddController { name: name.into(), spec: Box::new(ControllerSpec::Ratio(spec)) }
 }
 
 /// The configuration's starting point: the plant's steady state by variable path; a ratio

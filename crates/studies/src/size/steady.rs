@@ -37,7 +37,7 @@ const LIMIT_NOTE: f64 = 0.05;
 /// [`SizeError::Continuation`] when no steady state is found on the way to the design's.
 pub(super) fn design_steady(
     v: &Vessel,
-    law: &serde_json::Value,
+    law: &plantwide_model::ControllerSpec,
     area: f64,
     normal: Option<f64>,
     what: &str,
@@ -45,7 +45,7 @@ pub(super) fn design_steady(
     let build = |area: f64| -> Result<Plant, SizeError> {
         let mut edits: Vec<StructureEdit> = v.size_edit(area).into_iter().collect();
         edits.push(StructureEdit::RemoveController(v.controller.clone()));
-        edits.push(StructureEdit::AddController { name: v.controller.clone(), spec: law.clone() });
+        edits.push(StructureEdit::AddController { name: v.controller.clone(), spec: Box::new(law.clone()) });
         v.plant.restructure(&edits).map_err(|source| SizeError::Structure { what: what.to_string(), source })
     };
     let plant = build(area)?;

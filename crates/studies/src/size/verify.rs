@@ -16,6 +16,11 @@ use super::steady::{after, design_steady, slowest};
 use super::vessel::{Kind, Vessel};
 use super::{Current, Design, LevelDesign, Shape, SizeCriteria, SizeError, Trace, Verified, verdict};
 use crate::tune::averaging::{AveragingForm, averaging};
+use plantwide_model::ControllerSpec;
+use plantwide_model::controllers::Setpoint;
+use plantwide_model::controllers::averaging_level::{AveragingLaw, AveragingLevelConfig};
+use plantwide_model::controllers::pid::PidConfig;
+use plantwide_units::QuantityValue;
 
 /// Most corrections of a closed-form design that the plant's run showed short.
 pub const MAX_REFINEMENTS: usize = 8;
@@ -101,7 +106,7 @@ struct Scales {
 fn attempt(v: &Vessel, d: LevelDesign, du: f64, s: Scales, area: f64, r: &SizeCriteria) -> Result<Design, SizeError> {
     let (band_y, k_y) = v.measurement_scale(area, r.level_band);
     let normal = matches!(v.kind, Kind::Holdup { .. }).then(|| v.sp.max(2.0 * band_y));
-    let sp = serde_json::json!(normal.unwrap_or(v.sp));
+    let sp = QuantityValue::Number(normal.unwrap_or(v.sp));
     let du_design = s.flow * du.abs();
     // An attenuation design fixes the filter time instead of the band: the band the averaging rule
     // takes to give it (P: τ_F = Δ/(|k| Δu); PI: 1/ω_n = e Δ/(|k| Δu)).
@@ -281,7 +286,7 @@ impl Figures {
 
 /// A design's controller description and settings.
 struct Law {
-    spec: serde_json::Value,
+    spec: ControllerSpec,
     kc: Option<f64>,
     tau_i: Option<f64>,
     capacity: Option<f64>,
@@ -300,7 +305,7 @@ fn law(
     band_y: f64,
     k_y: f64,
     rate: f64,
-    sp: serde_json::Value,
+    sp: QuantityValue,
 ) -> Result<Law, SizeError> {
     let c = &v.config;
     let form = match d {
@@ -308,34 +313,39 @@ fn law(
         LevelDesign::Pi => AveragingForm::Pi,
         LevelDesign::Optimal => {
             let ramp = du / rate;
-            let mut spec = serde_json::json!({
-                "type": "averaging_level", "law": "optimal", "pv": c["pv"], "output": c["output"], "sp": sp,
-                "level_band": band_y, "capacity": 1.0 / k_y, "return_time": 4.0 * ramp, "max_rate": rate,
-                "filter": 1e-4 * ramp, "action": c["action"]});
-            for limit in ["op_min", "op_max"] {
-                if let Some(l) = c.get(limit) {
-                    spec[limit] = l.clone();
-                }
-            }
+            let n = QuantityValue::Number;
+            let spec = ControllerSpec::AveragingLevel(AveragingLevelConfig {
+                pv: c.pv.clone(),
+                output: c.output.clone().unwrap_or_default(),
+                sp,
+                law: AveragingLaw::Optimal,
+                level_band: n(band_y),
+                capacity: Some(n(1.0 / k_y)),
+                return_time: Some(n(4.0 * ramp)),
+                max_rate: Some(n(rate)),
+                filter: Some(n(1e-4 * ramp)),
+                kc: None,
+                tau_i: None,
+                action: c.action,
+                bias: None,
+                op_min: c.op_min.clone(),
+                op_max: c.op_max.clone(),
+            });
             let capacity = Some(1.0 / k_y);
             return Ok(Law { spec, kc: None, tau_i: None, capacity, ramp: Some(ramp), time: ramp, minimum: 25.0 });
         }
     };
     let a = averaging(k_y, du, band_y, form)
         .map_err(|e| SizeError::LevelLoop { vessel: v.measurement.clone(), why: e.to_string() })?;
-    let mut spec = c.clone();
-    spec["type"] = "pid".into();
-    spec["kc"] = a.kc.abs().into();
-    spec["sp"] = sp;
-    spec["bias"] = v.x[v.op].into();
-    if let Some(o) = spec.as_object_mut() {
-        o.remove("tau_d");
-        o.remove("tau_i");
-        o.remove("filter_ratio");
-    }
-    if let Some(ti) = a.tau_i {
-        spec["tau_i"] = ti.into();
-    }
+    let spec = ControllerSpec::Pid(PidConfig {
+        kc: QuantityValue::Number(a.kc.abs()),
+        sp: Setpoint::Value(sp),
+        bias: Some(QuantityValue::Number(v.x[v.op])),
+        tau_i: a.tau_i.map(QuantityValue::Number),
+        tau_d: None,
+        filter_ratio: None,
+        ..c.clone()
+    });
     let minimum = if d == LevelDesign::P { 12.0 } else { 14.0 };
     Ok(Law { spec, kc: Some(a.kc.abs()), tau_i: a.tau_i, capacity: None, ramp: None, time: a.time, minimum })
 }

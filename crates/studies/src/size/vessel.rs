@@ -30,7 +30,7 @@ pub(super) struct Vessel {
     pub kind: Kind,
     /// The level PID's name and its description.
     pub controller: String,
-    pub config: serde_json::Value,
+    pub config: plantwide_model::controllers::pid::PidConfig,
     /// Path and index of the level measurement; index of the controller's output.
     pub measurement: String,
     pub pv: usize,
@@ -113,7 +113,7 @@ impl Vessel {
             _ => return Err(fail(format!("`{controller}` takes its setpoint from a master"))),
         };
         let op = plant.var(&format!("{controller}.op")).ok_or_else(|| fail(format!("`{controller}` has no output")))?;
-        let config = serde_json::to_value(&cfg).map_err(|e| fail(e.to_string()))?;
+        let config = cfg.clone();
         let v_l = liquid_volume(&plant, &x, &kind, measurement).ok_or_else(|| fail("no liquid molar volume".into()))?;
         let v = Vessel {
             plant,
@@ -267,18 +267,39 @@ fn new_tank(plant: &Plant, x: &[f64], stream: &str, r: &SizeCriteria) -> Result<
     };
     let unit = format!("surge_{stream}");
     let band = r.level_band;
-    let tank = serde_json::json!({"type": "tank", "area": 1.0, "height": 4.0 * band, "P": p,
-                                  "outflow": {"type": "flow", "flow": flow}});
-    let level = serde_json::json!({"type": "pid", "pv": format!("{unit}.level"), "output": format!("{unit}.outflow"),
-                                   "sp": 2.0 * band, "kc": (0.1 * flow / band).max(1e-9), "action": "direct", "bias": flow});
+    let n = QuantityValue::Number;
+    let tank = UnitSpec::Tank(plantwide_model::units::tank::TankConfig {
+        diameter: None,
+        area: Some(n(1.0)),
+        height: Some(n(4.0 * band)),
+        pressure: Some(n(p)),
+        duty: None,
+        outflow: plantwide_model::units::outflow::Outflow::Flow { flow: n(flow) },
+        level: None,
+    });
+    let level = ControllerSpec::Pid(plantwide_model::controllers::pid::PidConfig {
+        pv: format!("{unit}.level"),
+        output: Some(format!("{unit}.outflow")),
+        sp: Setpoint::Value(n(2.0 * band)),
+        kc: n((0.1 * flow / band).max(1e-9)),
+        tau_i: None,
+        tau_d: None,
+        filter_ratio: None,
+        action: plantwide_model::controllers::Action::Direct,
+        bias: Some(n(flow)),
+        op_min: None,
+        op_max: None,
+        mode: Default::default(),
+        op_manual: None,
+    });
     let edits = [
         StructureEdit::InsertOnStream {
             stream: stream.into(),
             unit: unit.clone(),
-            spec: tank,
+            spec: Box::new(tank),
             outlet: format!("{stream}_surged"),
         },
-        StructureEdit::AddController { name: format!("{unit}_level"), spec: level },
+        StructureEdit::AddController { name: format!("{unit}_level"), spec: Box::new(level) },
     ];
     let v = plant
         .restructure(&edits)

@@ -12,9 +12,12 @@
 
 use plantwide_analysis::figures::summary;
 use plantwide_flowsheet::{Plant, StructureEdit};
+use plantwide_model::ControllerSpec;
+use plantwide_model::controllers::pid::PidConfig;
+use plantwide_model::controllers::{Action, Setpoint};
 use plantwide_solve::dynamic::{Start, simulate};
 use plantwide_solve::{NewtonSettings, steady_state};
-use plantwide_units::Dimension;
+use plantwide_units::{Dimension, QuantityValue};
 use rayon::prelude::*;
 use serde::{Deserialize, Deserializer, Serialize};
 
@@ -381,7 +384,7 @@ pub(crate) struct Tuned {
 }
 
 /// The controller description of pair `i` with gain `kc` and reset `tau_i` (SI).
-fn loop_spec(open: &OpenPlant, s: &PairingStructure, i: usize, kc: f64, tau_i: f64, action: &str) -> serde_json::Value {
+fn loop_spec(open: &OpenPlant, s: &PairingStructure, i: usize, kc: f64, tau_i: f64, action: Action) -> PidConfig {
     let p = &s.pairs[i];
     let Limited { lo, hi, .. } = pair_outputs(open, s).swap_remove(i);
     let cv = open.plant.var(&p.cv);
@@ -389,15 +392,27 @@ fn loop_spec(open: &OpenPlant, s: &PairingStructure, i: usize, kc: f64, tau_i: f
     let cv_dim = cv.map_or(Dimension::DIMENSIONLESS, |v| open.plant.vars()[v].spec.dim);
     let mv_dim = open.plant.input(&p.mv).map_or(Dimension::DIMENSIONLESS, |i| open.plant.inputs()[i].dim);
     let gain_dim = mv_dim.checked_div(cv_dim).unwrap_or(Dimension::DIMENSIONLESS);
-    serde_json::json!({"type": "pid", "pv": p.cv, "output": p.mv, "sp": si(c, cv_dim), "kc": si(kc, gain_dim),
-                       "tau_i": si(tau_i, Dimension::TIME), "action": action, "op_min": si(lo, mv_dim),
-                       "op_max": si(hi, mv_dim)})
+    PidConfig {
+        pv: p.cv.clone(),
+        output: Some(p.mv.clone()),
+        sp: Setpoint::Value(si(c, cv_dim)),
+        kc: si(kc, gain_dim),
+        tau_i: Some(si(tau_i, Dimension::TIME)),
+        tau_d: None,
+        filter_ratio: None,
+        action,
+        bias: None,
+        op_min: Some(si(lo, mv_dim)),
+        op_max: Some(si(hi, mv_dim)),
+        mode: Default::default(),
+        op_manual: None,
+    }
 }
 
 /// `v` (SI) as a flowsheet quantity: with its SI unit, so that the file a study writes reads
 /// without a note of a bare number (a plain number for a dimensionless one).
-pub(crate) fn si(v: f64, dim: Dimension) -> serde_json::Value {
-    if dim.is_dimensionless() { serde_json::json!(v) } else { format!("{v} {dim}").into() }
+pub(crate) fn si(v: f64, dim: Dimension) -> QuantityValue {
+    if dim.is_dimensionless() { QuantityValue::Number(v) } else { QuantityValue::Text(format!("{v} {dim}")) }
 }
 
 /// The open plant with the candidate's loops, tuned by BLT, and its steady state.
@@ -413,11 +428,12 @@ pub(super) fn closed_plant(
     let mut edits: Vec<StructureEdit> = Vec::new();
     for i in 0..s.pairs.len() {
         let name = format!("pair{}", i + 1);
-        let mut spec = loop_spec(open, s, i, kc[i], ti[i], actions[i]);
+        let action = if actions[i] == "direct" { Action::Direct } else { Action::Reverse };
+        let mut spec = loop_spec(open, s, i, kc[i], ti[i], action);
         if let Some(station) = remote_ratio(open, &s.pairs[i].mv, &name, &mut spec) {
             edits.extend(station);
         }
-        edits.insert(0, StructureEdit::AddController { name, spec });
+        edits.insert(0, StructureEdit::AddController { name, spec: Box::new(ControllerSpec::Pid(spec)) });
     }
     let v = open.plant.restructure(&edits)?;
     let guess = crate::screen::column::mapped_guess(&open.plant, &open.x, &v);
@@ -429,21 +445,19 @@ pub(super) fn closed_plant(
 /// drive): loop `name` becomes the station's master — `spec` loses its output and starts from the
 /// ratio as its bias — and the edits that give the station the remote ratio `{"from": "<name>.op"}`
 /// (Shinskey's ratio trimmed by a composition controller; the `(L/D)` and `(V/B)` configurations).
-fn remote_ratio(open: &OpenPlant, mv: &str, name: &str, spec: &mut serde_json::Value) -> Option<[StructureEdit; 2]> {
+fn remote_ratio(open: &OpenPlant, mv: &str, name: &str, spec: &mut PidConfig) -> Option<[StructureEdit; 2]> {
     let station = mv.strip_suffix(".ratio")?;
-    let Some(plantwide_model::ControllerSpec::Ratio(cfg)) = open.plant.spec().controllers.get(station) else {
+    let Some(ControllerSpec::Ratio(cfg)) = open.plant.spec().controllers.get(station) else {
         return None;
     };
     let (u0, dim) = open.plant.input(mv).map(|i| (open.plant.inputs()[i].value, open.plant.inputs()[i].dim))?;
-    let obj = spec.as_object_mut()?;
-    obj.remove("output");
-    obj.insert("bias".into(), si(u0, dim));
+    spec.output = None;
+    spec.bias = Some(si(u0, dim));
     let mut cfg = cfg.clone();
     cfg.ratio = plantwide_model::controllers::ratio::RatioValue::Remote { from: format!("{name}.op") };
-    let station_spec = serde_json::to_value(plantwide_model::ControllerSpec::Ratio(cfg)).ok()?;
     Some([
         StructureEdit::RemoveController(station.to_string()),
-        StructureEdit::AddController { name: station.to_string(), spec: station_spec },
+        StructureEdit::AddController { name: station.to_string(), spec: Box::new(ControllerSpec::Ratio(cfg)) },
     ])
 }
 

@@ -169,7 +169,10 @@ pub(crate) fn screen_mpc(
             r.mvs.join(", ")
         )));
     }
-    let edit = plantwide_flowsheet::StructureEdit::AddController { name: SCREEN_MPC.into(), spec };
+    // The request's description, filled in above, read as the typed controller it must be.
+    let spec: plantwide_model::ControllerSpec =
+        serde_json::from_value(spec).map_err(|e| bad(format!("not a controller description: {e}")))?;
+    let edit = plantwide_flowsheet::StructureEdit::AddController { name: SCREEN_MPC.into(), spec: Box::new(spec) };
     let plant = open.plant.restructure(&[edit]).map_err(|e| bad(e.to_string()))?;
     let guess = crate::screen::column::mapped_guess(&open.plant, &open.x, &plant);
     let st = steady_state(&plant, &plant.input_values(), Some(&guess), &NewtonSettings::default())
