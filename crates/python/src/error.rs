@@ -66,6 +66,13 @@ impl From<plantwide_studies::screen::ScreenError> for FaceError {
     }
 }
 
+impl From<plantwide_studies::Error> for FaceError {
+    fn from(e: plantwide_studies::Error) -> Self {
+        let user = e.is_user_error();
+        FaceError::classify(e, user)
+    }
+}
+
 impl From<plantwide_studies::TuneError> for FaceError {
     fn from(e: plantwide_studies::TuneError) -> Self {
         let user = e.is_user_error();

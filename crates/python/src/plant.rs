@@ -167,6 +167,11 @@ pub fn sensitivity(
 /// its parts without an answer, the CLI's exit 2 (none when every part has its answer).
 pub type Answer = (String, Option<String>);
 
+/// A study's request from its JSON text (the Python keywords), refused naming the study.
+fn study_request<T: serde::de::DeserializeOwned>(study: &str, text: &str) -> Result<T, FaceError> {
+    serde_json::from_str(text).map_err(|e| FaceError::Input(format!("{study}: the request: {e}")))
+}
+
 /// How much of a pairing screen's dynamic tests this call runs.
 pub enum PairingShare {
     /// All of them.
@@ -189,8 +194,7 @@ pub fn screen(
     share: PairingShare,
     report: Option<(&str, UnitSystem)>,
 ) -> Result<Answer, FaceError> {
-    let request: ScreenRequest =
-        serde_json::from_str(request).map_err(|e| FaceError::Input(format!("screen: the request: {e}")))?;
+    let request: ScreenRequest = study_request("screen", request)?;
     let share = match share {
         PairingShare::All => Share::All,
         PairingShare::Shard(s) => Share::Shard(s),
@@ -242,13 +246,10 @@ pub fn size(
     request: &str,
     report: Option<(&str, UnitSystem)>,
 ) -> Result<Answer, FaceError> {
-    let request: SizeRequest =
-        serde_json::from_str(request).map_err(|e| FaceError::Input(format!("size: the request: {e}")))?;
+    let request: SizeRequest = study_request("size", request)?;
     let (plant, ss) = src.at_steady_state(sets)?;
-    let sizing = plantwide_studies::size::size(&plant, &ss.x, &request, &|_| {}).map_err(|e| {
-        let user = e.is_user_error();
-        FaceError::classify(e, user)
-    })?;
+    let sizing =
+        plantwide_studies::size::size(&plant, &ss.x, &request, &|_| {}).map_err(plantwide_studies::Error::from)?;
     let io = |e: plantwide_io::IoError| {
         let missing = e.is_missing_result();
         FaceError::classify(e, !missing)
@@ -271,8 +272,7 @@ pub fn tune(
     report: Option<&str>,
     write: Option<&str>,
 ) -> Result<Answer, FaceError> {
-    let request: TuneRequest =
-        serde_json::from_str(request).map_err(|e| FaceError::Input(format!("tune: the request: {e}")))?;
+    let request: TuneRequest = study_request("tune", request)?;
     let (name, seconds) = request.time_unit()?;
     let tu = plantwide_io::report::tune::TimeUnit { name, seconds };
     let (plant, ss) = src.at_steady_state(sets)?;
@@ -297,8 +297,7 @@ pub fn tune(
 /// its failed parts (none when every part has its answer); the report, when asked, is written in
 /// `report.1`'s display units.
 pub fn compare(schemes: &[Source], request: &str, report: Option<(&str, UnitSystem)>) -> Result<Answer, FaceError> {
-    let request: CompareRequest =
-        serde_json::from_str(request).map_err(|e| FaceError::Input(format!("compare: the request: {e}")))?;
+    let request: CompareRequest = study_request("compare", request)?;
     let plants = schemes
         .iter()
         .map(|s| {
@@ -307,10 +306,7 @@ pub fn compare(schemes: &[Source], request: &str, report: Option<(&str, UnitSyst
             Ok(p)
         })
         .collect::<Result<Vec<_>, FaceError>>()?;
-    let c = plantwide_studies::compare::study(&plants, &request).map_err(|e| {
-        let user = e.is_user_error();
-        FaceError::classify(e, user)
-    })?;
+    let c = plantwide_studies::compare::study(&plants, &request).map_err(plantwide_studies::Error::from)?;
     let io = |e: plantwide_io::IoError| FaceError::Input(e.to_string());
     if let Some((dir, system)) = report {
         let shown = plantwide_io::report::compare::shown(&plants, &request.outputs, &c, system).map_err(io)?;
@@ -330,13 +326,10 @@ pub fn identify(
     report: Option<(&str, bool)>,
 ) -> Result<Answer, FaceError> {
     use plantwide_io::report::identify::{StepModel, not_usable, write_report};
-    let request: IdentifyRequest =
-        serde_json::from_str(request).map_err(|e| FaceError::Input(format!("identify: the request: {e}")))?;
+    let request: IdentifyRequest = study_request("identify", request)?;
     let (plant, ss) = src.at_steady_state(sets)?;
-    let identified = plantwide_studies::identify::study(&plant, &ss.x, &ss.u, &request).map_err(|e| {
-        let user = e.is_user_error();
-        FaceError::classify(e, user)
-    })?;
+    let identified =
+        plantwide_studies::identify::study(&plant, &ss.x, &ss.u, &request).map_err(plantwide_studies::Error::from)?;
     let id = &identified.identification;
     let step_model = match (report, id.verdict.reliable) {
         (None, _) => StepModel::NoReport,
