@@ -182,7 +182,7 @@ pub(super) fn failed_parts(study: &str, failed: &[String]) -> Result<(), CliErro
 }
 
 /// The `--mpc` file's controller description.
-fn mpc_description(file: &Path) -> Result<serde_json::Value, CliError> {
+fn mpc_description(file: &Path) -> Result<plantwide::studies::screen::pairings::mpc::ScreenMpc, CliError> {
     let text = plantwide::flowsheet::read_text(file).map_err(|e| CliError::user(e.to_string()))?;
     serde_json::from_str(&text).map_err(|e| CliError::user(format!("--mpc {}: {e}", file.display())))
 }

@@ -25,6 +25,7 @@ pub mod schema;
 pub mod spec;
 pub mod tears;
 pub mod wiring;
+pub mod write;
 
 pub use assemble::{assemble, load_file, load_str};
 pub use design::{DesignSpec, SpecEntry, SpecError};

@@ -50,7 +50,7 @@ pub struct ScenarioSpec {
     #[serde(default)]
     pub name: String,
     /// What the scenario studies.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "String::is_empty")]
     pub description: String,
     /// Length of the run (e.g. `"2000 min"`).
     pub duration: QuantityValue,
@@ -72,17 +72,17 @@ pub struct ScenarioSpec {
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub when: Vec<WhenSpec>,
     /// DCS scan interval by controller name: the controller's output is held between scans.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "IndexMap::is_empty")]
     pub sampling: IndexMap<String, QuantityValue>,
     /// Analyzers by controller name: the controller's measurement is sampled every `sample_time`
     /// and each result reaches the controller `dead_time` later, held until the next one.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "IndexMap::is_empty")]
     pub analyzers: IndexMap<String, AnalyzerSpec>,
     /// What to record (default: every controller's measurement and output, every input an event moves).
     #[serde(default)]
     pub record: RecordSpec,
     /// Snapshot files to write during the run.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub snapshots: Vec<SnapshotSpec>,
 }
 
@@ -260,7 +260,7 @@ pub struct RecordSpec {
     pub paths: Vec<RecordPathSpec>,
     /// Streams whose cumulative component amounts `∫ F x_c dt` [mol] are integrated with the
     /// plant (recorded as `<stream>.total[<component>]`).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub totals: Vec<String>,
 }
 

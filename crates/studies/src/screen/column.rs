@@ -210,7 +210,7 @@ pub struct ColumnScreen {
     /// The dynamic check's scenarios, one per step (a file name and its text), kept with the
     /// flowsheets.
     #[serde(skip)]
-    pub scenarios: Vec<(String, serde_json::Value)>,
+    pub scenarios: Vec<(String, plantwide_flowsheet::scenario::ScenarioSpec)>,
 }
 
 /// The column's four flows at the steady state (SI: mol/s; W or kg/s for a duty or steam boilup).

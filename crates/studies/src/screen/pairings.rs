@@ -61,7 +61,7 @@ pub struct PairingRequest {
     pub record: Vec<String>,
     /// A model predictive controller to judge beside the PI candidates: a `"type": "mpc"`
     /// controller description on the CVs and (some of) the MVs ([`mpc::screen_mpc`]).
-    pub mpc: Option<serde_json::Value>,
+    pub mpc: Option<mpc::ScreenMpc>,
     /// Which candidates' dynamic tests this process runs (task `t`: the `t`-th candidate tested):
     /// all, a shard's (then nothing is scored or ranked, and no MPC is run), or none, their
     /// results given by the shards' parts.

@@ -73,7 +73,7 @@ pub struct ScreenRequest {
     /// A model predictive controller to judge beside the PI candidates on the same runs: one
     /// `"type": "mpc"` controller description on the CVs and some of the MVs.
     #[serde(default)]
-    pub mpc: Option<serde_json::Value>,
+    pub mpc: Option<crate::screen::pairings::mpc::ScreenMpc>,
 }
 
 fn four() -> usize {

@@ -15,6 +15,7 @@
 //! and the request, so nothing depends on the thread count.
 
 use plantwide_analysis::shard::Share;
+use plantwide_flowsheet::scenario::ScenarioSpec;
 use plantwide_flowsheet::{Plant, VarPath};
 use rayon::prelude::*;
 
@@ -55,7 +56,7 @@ impl Default for ColumnDynamic {
 pub(super) struct Check {
     pub steps: Vec<String>,
     pub duration: Option<f64>,
-    pub scenarios: Vec<(String, serde_json::Value)>,
+    pub scenarios: Vec<(String, ScenarioSpec)>,
 }
 
 /// The disturbances of the check, each judged against `plant`: those given, or the defaults of
@@ -277,12 +278,7 @@ pub(super) fn check(
 }
 
 /// The scenario of each step, as the check ran it: file name and text.
-fn scenarios(
-    plant: &Plant,
-    outputs: &[String],
-    steps: &[Disturbance],
-    duration: f64,
-) -> Vec<(String, serde_json::Value)> {
+fn scenarios(plant: &Plant, outputs: &[String], steps: &[Disturbance], duration: f64) -> Vec<(String, ScenarioSpec)> {
     let ops = ["pair1.op".to_string(), "pair2.op".to_string()];
     let record: Vec<&String> = outputs.iter().chain(&ops).collect();
     steps
@@ -291,9 +287,9 @@ fn scenarios(
         .map(|(n, s)| {
             let u0 = plantwide_flowsheet::overrides::resolve_input(plant, &s.path)
                 .map_or(f64::NAN, |i| plant.inputs()[i].value);
-            let mut text = scenario(s, s.change(u0), duration, &record);
-            text["name"] = s.label().into();
-            (format!("step{}.scenario.json", n + 1), text)
+            let mut spec = scenario(s, s.change(u0), duration, &record);
+            spec.name = s.label();
+            (format!("step{}.scenario.json", n + 1), spec)
         })
         .collect()
 }

@@ -11,6 +11,9 @@
 //! [`PairingRequest::share`]): each shard runs its own, a merge scores them all.
 
 use plantwide_analysis::figures::summary;
+use plantwide_flowsheet::scenario::{
+    EventSpec, IntegratorSpec, RecordPathSpec, RecordSpec, SCENARIO_FORMAT_VERSION, ScenarioSpec,
+};
 use plantwide_flowsheet::{Plant, StructureEdit};
 use plantwide_model::ControllerSpec;
 use plantwide_model::controllers::pid::PidConfig;
@@ -571,13 +574,30 @@ pub(crate) fn pair_outputs(open: &OpenPlant, s: &PairingStructure) -> Vec<Limite
 
 /// The scenario of a dynamic test's run: `d`'s input stepped by `change` (SI) at [`STEP_AT`] of
 /// `duration` \[s\], `record` recorded at 500 intervals.
-pub(crate) fn scenario(d: &super::Disturbance, change: f64, duration: f64, record: &[&String]) -> serde_json::Value {
-    serde_json::json!({
-        "format_version": 1, "name": format!("{} step", d.path), "duration": format!("{duration} s"),
-        "integrator": {"rtol": 1e-6},
-        "events": [{"type": "step", "at": format!("{} s", STEP_AT * duration), "path": d.path, "by": change}],
-        "record": {"interval": format!("{} s", duration / 500.0), "paths": record}
-    })
+pub(crate) fn scenario(d: &super::Disturbance, change: f64, duration: f64, record: &[&String]) -> ScenarioSpec {
+    let seconds = |t: f64| QuantityValue::Text(format!("{t} s"));
+    ScenarioSpec {
+        format_version: SCENARIO_FORMAT_VERSION,
+        name: format!("{} step", d.path),
+        duration: seconds(duration),
+        integrator: IntegratorSpec { rtol: Some(1e-6), ..IntegratorSpec::default() },
+        events: vec![EventSpec::Step {
+            at: seconds(STEP_AT * duration),
+            path: d.path.clone(),
+            to: None,
+            by: Some(QuantityValue::Number(change)),
+        }],
+        record: RecordSpec {
+            interval: Some(seconds(duration / 500.0)),
+            paths: record.iter().map(|p| RecordPathSpec::Path(p.to_string())).collect(),
+            ..RecordSpec::default()
+        },
+        description: String::new(),
+        when: Vec::new(),
+        sampling: Default::default(),
+        analyzers: Default::default(),
+        snapshots: Vec::new(),
+    }
 }
 
 /// One disturbance step on a controlled plant from its steady state `x`: the figures of `r`'s CVs
@@ -595,8 +615,7 @@ pub(crate) fn run(
         plantwide_flowsheet::overrides::resolve_input(plant, &d.path).map_or(f64::NAN, |i| plant.inputs()[i].value);
     let watched = watched(r);
     let record: Vec<&String> = watched.iter().copied().chain(ops.iter().map(|o| &o.op)).collect();
-    let text = scenario(d, d.change(u0), duration, &record).to_string();
-    let spec = plantwide_flowsheet::scenario::parse_scenario(&text, "screen")?;
+    let spec = scenario(d, d.change(u0), duration, &record);
     let scenario = plantwide_flowsheet::scenario::resolve(&spec, plant, "screen")?;
     let res = simulate(plant, &scenario, Start::Steady(x), "screen", &mut |_| {}).map_err(Box::new)?;
     let figures = summary(&res);

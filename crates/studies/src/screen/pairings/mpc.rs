@@ -19,8 +19,8 @@ use plantwide_flowsheet::Plant;
 use plantwide_model::controllers::mpc::MpcConfig;
 use plantwide_model::registry::ControllerSpec;
 use plantwide_solve::dynamic::{MpcLog, mv_limits};
-use plantwide_units::Dimension;
-use serde::Serialize;
+use plantwide_units::{Dimension, QuantityValue};
+use serde::{Deserialize, Serialize};
 
 use plantwide_solve::{NewtonSettings, SolveError, steady_state};
 
@@ -123,9 +123,62 @@ pub fn assess_mpc(
 /// Name of the controller a screening adds to the open plant.
 pub const SCREEN_MPC: &str = "mpc";
 
+/// The screening's model predictive controller, read at the request's edge: a controller
+/// description whose `"type": "mpc"` and whose CVs' setpoints `sp` may be left out (a left-out
+/// setpoint is the CV's steady value in the open plant, given when the plant is known).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "serde_json::Value", into = "serde_json::Value")]
+pub struct ScreenMpc {
+    /// The description; a left-out setpoint is 0 here until [`screen_mpc`] gives it.
+    pub config: MpcConfig,
+    /// Which CVs' setpoints were left out, by CV.
+    pub steady_sp: Vec<bool>,
+}
+
+/// Why a screening's `mpc` is not a controller description.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{0}")]
+pub struct MpcDescriptionError(String);
+
+impl TryFrom<serde_json::Value> for ScreenMpc {
+    type Error = MpcDescriptionError;
+
+    fn try_from(mut v: serde_json::Value) -> Result<Self, Self::Error> {
+        let bad = |why: &str| MpcDescriptionError(why.to_string());
+        let obj = v.as_object_mut().ok_or_else(|| bad("`mpc` must be one JSON object, a controller description"))?;
+        match obj.remove("type") {
+            None => {}
+            Some(t) if t == "mpc" => {}
+            Some(t) => return Err(MpcDescriptionError(format!("`mpc` must be of `\"type\": \"mpc\"`, not {t}"))),
+        }
+        let cvs = obj.get_mut("cvs").and_then(|c| c.as_array_mut()).ok_or_else(|| bad("`mpc` has no `cvs` list"))?;
+        let mut steady_sp = Vec::with_capacity(cvs.len());
+        for cv in cvs.iter_mut().filter_map(|c| c.as_object_mut()) {
+            steady_sp.push(!cv.contains_key("sp"));
+            cv.entry("sp").or_insert_with(|| 0.0.into());
+        }
+        let config = serde_json::from_value(v)
+            .map_err(|e| MpcDescriptionError(format!("`mpc` is not an MPC controller description: {e}")))?;
+        Ok(ScreenMpc { config, steady_sp })
+    }
+}
+
+impl From<ScreenMpc> for serde_json::Value {
+    /// The description as it was read: a left-out setpoint left out.
+    fn from(m: ScreenMpc) -> Self {
+        let mut v = serde_json::to_value(&m.config).unwrap_or_default();
+        if let Some(cvs) = v.get_mut("cvs").and_then(|c| c.as_array_mut()) {
+            for (cv, _) in cvs.iter_mut().zip(&m.steady_sp).filter(|(_, steady)| **steady) {
+                cv.as_object_mut().map(|o| o.remove("sp"));
+            }
+        }
+        v
+    }
+}
+
 /// The screening's model predictive controller (`r.mpc`) on the open plant, judged on the runs of
 /// the PI candidates (`duration`): its CVs must be the screening's CVs, its MVs among its MVs; a
-/// CV's setpoint defaults to its steady value in the open plant.
+/// CV's setpoint left out is its steady value in the open plant.
 ///
 /// # Errors
 /// [`ScreenError::Mpc`] for a description that does not fit the screening or does not build,
@@ -133,45 +186,36 @@ pub const SCREEN_MPC: &str = "mpc";
 pub(crate) fn screen_mpc(
     open: &OpenPlant,
     r: &PairingRequest,
-    description: &serde_json::Value,
+    description: &ScreenMpc,
     duration: Option<f64>,
 ) -> Result<MpcAlternative, ScreenError> {
     let bad = |why: String| ScreenError::Mpc { controller: SCREEN_MPC.into(), why };
-    let mut spec = description.clone();
-    let Some(obj) = spec.as_object_mut() else {
-        return Err(bad("`mpc` must be one JSON object, a controller description".into()));
-    };
-    obj.entry("type").or_insert_with(|| "mpc".into());
-    let cvs = obj.get_mut("cvs").and_then(|c| c.as_array_mut()).ok_or_else(|| bad("`mpc` has no `cvs` list".into()))?;
-    let mut paths = Vec::new();
-    for cv in cvs.iter_mut().filter_map(|c| c.as_object_mut()) {
-        let pv = cv.get("pv").and_then(|p| p.as_str()).unwrap_or_default().to_string();
-        if let Some(v) = open.plant.var(&pv) {
-            cv.entry("sp").or_insert_with(|| open.x[v].into());
+    let mut config = description.config.clone();
+    for (cv, &steady) in config.cvs.iter_mut().zip(&description.steady_sp) {
+        if let (true, Some(v)) = (steady, open.plant.var(&cv.pv)) {
+            cv.sp = QuantityValue::Number(open.x[v]);
         }
-        paths.push(pv);
     }
-    let mut sorted = (paths.clone(), r.cvs.clone());
-    sorted.0.sort();
-    sorted.1.sort();
-    if sorted.0 != sorted.1 {
+    let mut paths: Vec<String> = config.cvs.iter().map(|c| c.pv.clone()).collect();
+    let mut wanted = r.cvs.clone();
+    paths.sort();
+    wanted.sort();
+    if paths != wanted {
+        let paths: Vec<&str> = config.cvs.iter().map(|c| c.pv.as_str()).collect();
         return Err(bad(format!(
             "the `mpc` controller's CVs [{}] must be the screening's `cvs` [{}]",
             paths.join(", "),
             r.cvs.join(", ")
         )));
     }
-    let mvs = obj.get("mvs").and_then(|m| m.as_array()).ok_or_else(|| bad("`mpc` has no `mvs` list".into()))?;
-    let outputs: Vec<&str> = mvs.iter().filter_map(|m| m.get("output")?.as_str()).collect();
-    if let Some(m) = outputs.iter().find(|m| !r.mvs.iter().any(|x| x == *m)) {
+    if let Some(m) = config.mvs.iter().find(|m| !r.mvs.contains(&m.output)) {
         return Err(bad(format!(
-            "the `mpc` controller's MV `{m}` is not one of the screening's `mvs` [{}]",
+            "the `mpc` controller's MV `{}` is not one of the screening's `mvs` [{}]",
+            m.output,
             r.mvs.join(", ")
         )));
     }
-    // The request's description, filled in above, read as the typed controller it must be.
-    let spec: plantwide_model::ControllerSpec =
-        serde_json::from_value(spec).map_err(|e| bad(format!("not a controller description: {e}")))?;
+    let spec = ControllerSpec::Mpc(config);
     let edit = plantwide_flowsheet::StructureEdit::AddController { name: SCREEN_MPC.into(), spec: Box::new(spec) };
     let plant = open.plant.restructure(&[edit]).map_err(|e| bad(e.to_string()))?;
     let guess = crate::screen::column::mapped_guess(&open.plant, &open.x, &plant);
