@@ -23,7 +23,7 @@ fn main() -> ExitCode {
     match cli::run(args) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {}", e.message);
+            eprintln!("error: {}", cli::library_flags(e.message));
             ExitCode::from(e.code)
         }
     }

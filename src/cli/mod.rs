@@ -37,6 +37,23 @@ pub fn with_flags(message: String, leading: Option<&str>, fields: &[&str]) -> St
     message
 }
 
+/// The request fields that library messages outside the studies name in backticks (`` `step` ``,
+/// `` `method` sm ``), each this command line's flag of the same name; the Python keywords are the
+/// same names.
+const LIBRARY_FIELDS: &[&str] =
+    &["set", "spec", "pairing", "block", "disturb", "points", "shard", "step", "method", "time_unit"];
+
+/// Fields that may lead a library message (`set feed.F: …`, `pairing `1,2`: …`).
+const LEADING_FIELDS: &[&str] = &["set", "spec", "pairing", "block", "disturb", "points", "shard"];
+
+/// `message` from the library with the request fields it names written as this command line's
+/// flags ([`with_flags`] over [`LIBRARY_FIELDS`]).
+pub fn library_flags(message: String) -> String {
+    let leading =
+        LEADING_FIELDS.iter().copied().find(|f| message.strip_prefix(f).is_some_and(|r| r.starts_with([' ', ':'])));
+    with_flags(message, leading, LIBRARY_FIELDS)
+}
+
 /// Write to stdout; a closed pipe ends the process with success (the reader has what it wanted).
 pub fn write_out(args: std::fmt::Arguments<'_>) {
     use std::io::Write;

@@ -34,7 +34,7 @@ pub fn load_plant(file: &Path, sets: &[String]) -> Result<Plant, CliError> {
     let overrides = sets.iter().map(|s| s.parse()).collect::<Result<Vec<_>, _>>().map_err(user)?;
     let plant = plantwide::flowsheet::load_with(file, &overrides).map_err(user)?;
     for note in plant.notes() {
-        eprintln!("note: {}: {note}", file.display());
+        eprintln!("note: {}: {}", file.display(), super::library_flags(note.clone()));
     }
     Ok(plant)
 }
@@ -50,8 +50,10 @@ pub fn add_specs(plant: &mut Plant, specs: &[String], vary: &[String]) -> Result
     }
     let mut entries = Vec::with_capacity(specs.len());
     for (s, v) in specs.iter().zip(vary) {
-        let (path, value) = plantwide::flowsheet::overrides::split_assignment(s)
-            .map_err(|e| CliError::user(format!("--spec {}", e.to_string().replace("--set ", ""))))?;
+        let (path, value) = plantwide::flowsheet::overrides::split_assignment(s).map_err(|e| {
+            let message = e.to_string();
+            CliError::user(format!("--spec {}", message.strip_prefix("set ").unwrap_or(&message)))
+        })?;
         entries.push(SpecEntry { path: path.to_string(), value: value.into(), vary: v.clone() });
     }
     plant.add_specs(&entries).map_err(|e| CliError::user(format!("{}: {e}", plant.file())))

@@ -193,8 +193,9 @@ fn a_bad_explicit_step_is_corrected_or_reported() {
     let e = perturb_gains(&plant, &ss.x, &ss.u, &indices(&inputs), &indices(&outputs), &once).unwrap_err();
     assert!(matches!(e, AnalysisError::PerturbationUnverified(_) | AnalysisError::NotConverged(_)), "{e:?}");
     assert!(!e.is_user_error(), "a numerical failure (exit 2)");
+    // The library names the request's field; the command line names it by its flag (above).
     let text = e.to_string();
-    assert!(text.contains("--step"), "{text}");
+    assert!(text.contains("try `step` ") && !text.contains("--"), "{text}");
     if let AnalysisError::PerturbationUnverified(u) = &e {
         assert!(u.input.starts_with("column.") && u.output.ends_with("x[light]"), "{text}");
         assert!(u.first.is_finite() && u.second.is_finite() && u.first != u.second, "{text}");

@@ -243,7 +243,7 @@ fn gains_on_a_controllers_inputs_name_what_moves_in_its_mode() {
     let e = err(&[&driven[..], &manual[..]].concat());
     assert!(e.contains("`top_composition` is in manual: move its manual output `top_composition.op_manual`"), "{e}");
     assert!(
-        err(&driven).contains("or its manual output `top_composition.op_manual` with `--set top_composition.auto=0`")
+        err(&driven).contains("or its manual output `top_composition.op_manual` with --set `top_composition.auto=0`")
     );
     let sp = ["gains", &file, "--inputs", "top_composition.sp,tray_temperature.sp", "--outputs", outputs];
     let e = err(&[&sp[..], &manual[..]].concat());

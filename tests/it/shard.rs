@@ -158,7 +158,7 @@ fn parts_that_do_not_make_one_job_are_refused_by_name() {
         assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
         assert!(err.contains(needle), "{args:?}: {err}");
     };
-    refused(&["merge", "a0.json"], "shards 1 of 2 are missing; run them (`--shard I/2`)");
+    refused(&["merge", "a0.json"], "shards 1 of 2 are missing; run them (--shard I/2)");
     refused(&["merge", "a0.json", "a0.json", "a1.json"], "a0.json: shard 0/2 is also in a0.json");
     refused(&["merge", "a0.json", "b1.json"], "b1.json: a part of another job (command line differs");
     refused(&["merge", "a0.json", fs], "not a plantwide part file");

@@ -29,7 +29,7 @@ pub enum AnalysisError {
 /// (boxed in [`AnalysisError::PerturbationUnverified`] to keep the error small).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error(
-    "{file}: the perturbation {quantity} of `{output}` to `{input}` did not verify ({check}): {first:.6e} vs {second:.6e} differ by {difference:.1e} relative (tolerance {tolerance:.0e}) at relative step {step:.1e}; try --step {suggestion:.0e} or --method linear"
+    "{file}: the perturbation {quantity} of `{output}` to `{input}` did not verify ({check}): {first:.6e} vs {second:.6e} differ by {difference:.1e} relative (tolerance {tolerance:.0e}) at relative step {step:.1e}; try `step` {suggestion:.0e} or `method` linear"
 )]
 pub struct Unverified {
     /// Flowsheet file.

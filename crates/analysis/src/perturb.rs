@@ -143,7 +143,7 @@ pub struct PerturbGains {
 #[derive(Debug, Clone, thiserror::Error)]
 pub enum PerturbError {
     /// A perturbed plant did not re-converge (at any step tried, the last reason is reported).
-    #[error("{file}: the plant did not re-converge: `{input}` moved by {by:+.3e} (SI): {cause}; try a smaller --step")]
+    #[error("{file}: the plant did not re-converge: `{input}` moved by {by:+.3e} (SI): {cause}; try a smaller `step`")]
     Reconverge {
         /// Flowsheet file.
         file: String,
@@ -156,7 +156,7 @@ pub enum PerturbError {
     },
     /// The re-converged outputs are less accurate than the step moves them by.
     #[error(
-        "{file}: moving `{input}` by ±{step:.3e} (SI) changes the outputs by at most {effect:.3e}, but the re-converged steady states are only accurate to {accuracy:.3e}; increase --step"
+        "{file}: moving `{input}` by ±{step:.3e} (SI) changes the outputs by at most {effect:.3e}, but the re-converged steady states are only accurate to {accuracy:.3e}; increase `step`"
     )]
     Inaccurate {
         /// Flowsheet file.

@@ -120,7 +120,7 @@ pub fn select_input(plant: &Plant, text: &str) -> Result<Signal, AnalysisError> 
             Some(0.0) => format!("`{ctrl}` is in manual: move its manual output `{ctrl}.op_manual` instead"),
             Some(_) => format!(
                 "move its setpoint `{ctrl}.sp` instead (the loop closed), or its manual output \
-                 `{ctrl}.op_manual` with `--set {ctrl}.auto=0` (the loop open)"
+                 `{ctrl}.op_manual` with `set` `{ctrl}.auto=0` (the loop open)"
             ),
             None => format!("move its setpoint `{ctrl}.sp` instead"),
         };
@@ -156,8 +156,7 @@ pub fn select_output(plant: &Plant, text: &str) -> Result<Signal, AnalysisError>
     let Some(index) = plant.var(path).or_else(driven) else {
         let hint = did_you_mean(path, plant.vars().iter().map(|v| v.path.as_str()));
         return Err(request(format!(
-            "{}: no variable `{path}`{hint}; `plantwide steady {} --json` lists every variable path",
-            plant.file(),
+            "{}: no variable `{path}`{hint}; the steady state lists every variable path",
             plant.file()
         )));
     };
@@ -173,7 +172,7 @@ pub fn parse_pairing(text: &str, outputs: &[String], inputs: &[String]) -> Resul
     let n = outputs.len();
     if n != inputs.len() {
         return Err(request(format!(
-            "--pairing needs as many inputs as outputs (got {} inputs, {n} outputs)",
+            "pairing needs as many inputs as outputs (got {} inputs, {n} outputs)",
             inputs.len()
         )));
     }
@@ -181,7 +180,7 @@ pub fn parse_pairing(text: &str, outputs: &[String], inputs: &[String]) -> Resul
     let items: Vec<&str> = text.split(',').map(str::trim).filter(|s| !s.is_empty()).collect();
     if items.len() != n {
         return Err(request(format!(
-            "--pairing `{text}`: expected {n} pairs (one per output), e.g. `1,2` or `OUT=IN,…`"
+            "pairing `{text}`: expected {n} pairs (one per output), e.g. `1,2` or `OUT=IN,…`"
         )));
     }
     for (k, item) in items.iter().enumerate() {
@@ -190,14 +189,14 @@ pub fn parse_pairing(text: &str, outputs: &[String], inputs: &[String]) -> Resul
             None => (k, position(item, inputs, "input")?),
         };
         if pairing[out] != usize::MAX {
-            return Err(request(format!("--pairing `{text}`: output `{}` is paired twice", outputs[out])));
+            return Err(request(format!("pairing `{text}`: output `{}` is paired twice", outputs[out])));
         }
         pairing[out] = inp;
     }
     let mut seen = vec![false; n];
     for &p in &pairing {
         if std::mem::replace(&mut seen[p], true) {
-            return Err(request(format!("--pairing `{text}`: input `{}` is paired twice", inputs[p])));
+            return Err(request(format!("pairing `{text}`: input `{}` is paired twice", inputs[p])));
         }
     }
     Ok(pairing)
@@ -235,13 +234,13 @@ pub struct BlockSpec {
 pub fn parse_block(text: &str, outputs: &[String], inputs: &[String]) -> Result<BlockSpec, AnalysisError> {
     let (o, i) = text
         .split_once('=')
-        .ok_or_else(|| request(format!("--block `{text}`: expected OUTPUTS=INPUTS, e.g. `1=1` or `1,2=2,3`")))?;
+        .ok_or_else(|| request(format!("block `{text}`: expected OUTPUTS=INPUTS, e.g. `1=1` or `1,2=2,3`")))?;
     let list = |s: &str, l: &[String], what: &str| -> Result<Vec<usize>, AnalysisError> {
         s.split(',').map(str::trim).filter(|x| !x.is_empty()).map(|x| position(x, l, what)).collect()
     };
     let block = BlockSpec { outputs: list(o, outputs, "output")?, inputs: list(i, inputs, "input")? };
     if block.outputs.is_empty() || block.outputs.len() != block.inputs.len() {
-        return Err(request(format!("--block `{text}`: a block needs as many inputs as outputs, at least one")));
+        return Err(request(format!("block `{text}`: a block needs as many inputs as outputs, at least one")));
     }
     Ok(block)
 }

@@ -41,33 +41,33 @@ impl Disturbance {
     /// Parse `PATH[@unit]=LOW:HIGH` for `plant` at inputs `u`.
     pub fn parse(plant: &Plant, u: &[f64], text: &str) -> Result<Disturbance, AnalysisError> {
         let (path, range) = text.split_once('=').ok_or_else(|| {
-            request(format!("--disturb `{text}`: expected PATH=LOW:HIGH, e.g. `feed_source.F=-10%:+10%`"))
+            request(format!("disturb `{text}`: expected PATH=LOW:HIGH, e.g. `feed_source.F=-10%:+10%`"))
         })?;
         let signal = select_input(plant, path)?;
         let base = u[signal.index];
         let (lo, hi) = range
             .split_once(':')
-            .ok_or_else(|| request(format!("--disturb `{text}`: the range needs LOW:HIGH, e.g. `-10%:+10%`")))?;
+            .ok_or_else(|| request(format!("disturb `{text}`: the range needs LOW:HIGH, e.g. `-10%:+10%`")))?;
         let dim = plant.inputs()[signal.index].dim;
         let end = |s: &str| -> Result<f64, AnalysisError> {
             let s = s.trim();
             if let Some(p) = s.strip_suffix('%') {
                 let pct: f64 =
-                    p.trim().parse().map_err(|_| request(format!("--disturb `{text}`: `{s}` is not a percentage")))?;
+                    p.trim().parse().map_err(|_| request(format!("disturb `{text}`: `{s}` is not a percentage")))?;
                 if base == 0.0 {
                     return Err(request(format!(
-                        "--disturb `{text}`: `{}` is zero at the base case, so give the range as quantities, not percentages",
+                        "disturb `{text}`: `{}` is zero at the base case, so give the range as quantities, not percentages",
                         signal.path
                     )));
                 }
                 Ok(base + pct / 100.0 * base.abs())
             } else {
-                parse_quantity_as(s, dim).map_err(|e| request(format!("--disturb `{text}`: {e}")))
+                parse_quantity_as(s, dim).map_err(|e| request(format!("disturb `{text}`: {e}")))
             }
         };
         let (low, high) = (end(lo)?, end(hi)?);
         if !(low.is_finite() && high.is_finite() && low < high) {
-            return Err(request(format!("--disturb `{text}`: the range must go from low to high")));
+            return Err(request(format!("disturb `{text}`: the range must go from low to high")));
         }
         Ok(Disturbance { signal, base, low, high })
     }
@@ -236,7 +236,7 @@ pub fn walks(
     share: &Share<Walk>,
 ) -> Result<Vec<Option<Walk>>, AnalysisError> {
     if settings.points < 2 {
-        return Err(request(format!("--points must be at least 2 (got {})", settings.points)));
+        return Err(request(format!("points must be at least 2 (got {})", settings.points)));
     }
     let tasks: Vec<usize> = (0..2 * disturbances.len()).collect();
     Ok(tasks

@@ -22,8 +22,8 @@ pub struct Shard {
 /// Why a `--shard` argument is refused.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 #[error(
-    "--shard `{0}`: expected I/N with 0 ≤ I < N ≤ 100000, the index counting from 0 (e.g. `--shard 0/4` … \
-     `--shard 3/4`; Slurm: `--shard $SLURM_ARRAY_TASK_ID/4` with `--array=0-3`)"
+    "shard `{0}`: expected I/N with 0 ≤ I < N ≤ 100000, the index counting from 0 (e.g. `0/4` … `3/4`; \
+     Slurm: `$SLURM_ARRAY_TASK_ID/4` in an array of tasks 0–3)"
 )]
 pub struct ShardError(pub String);
 

@@ -80,7 +80,7 @@ impl Plant {
     /// [`SpecError`] naming the first entry that does not resolve.
     pub fn add_specs(&mut self, entries: &[SpecEntry]) -> Result<(), SpecError> {
         for e in entries {
-            let origin = format!("--spec {}={} --vary {}", e.path, quantity_text(&e.value), e.vary);
+            let origin = format!("spec {}={} (vary {})", e.path, quantity_text(&e.value), e.vary);
             let spec = resolve(self, e, &origin).map_err(|(_, why)| SpecError { origin: origin.clone(), why })?;
             self.specs.push(spec);
             Arc::make_mut(&mut self.spec).specs.push(e.clone());
@@ -182,7 +182,7 @@ fn resolve_among(
 ) -> Result<DesignSpec, (&'static str, String)> {
     let var = plant.var(&e.path).ok_or_else(|| {
         let hint = did_you_mean(&e.path, plant.vars.iter().map(|v| v.path.as_str()));
-        ("path", format!("no variable `{}`{hint}; `plantwide steady --json` lists every variable's path", e.path))
+        ("path", format!("no variable `{}`{hint}; the steady state lists every variable's path", e.path))
     })?;
     let info = &plant.vars[var].spec;
     let target = e.value.to_si(info.dim).map_err(|err| ("value", format!("{err} (the target of `{}`)", e.path)))?;

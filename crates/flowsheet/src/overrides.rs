@@ -118,7 +118,7 @@ pub(crate) fn apply_inputs(plant: &mut Plant, overrides: &[Override]) -> Result<
         }
         let dim = resolve_input(plant, &o.path).map(|i| plant.inputs[i].dim);
         let note = dim.and_then(|d| plantwide_model::build::bare_note(&o.value.as_str().into(), d));
-        plant.notes.extend(note.map(|n| format!("--set {}: {n}", o.path)));
+        plant.notes.extend(note.map(|n| format!("set {}: {n}", o.path)));
     }
     check_compositions(plant, &u)?;
     if !overrides.is_empty() {
@@ -177,7 +177,7 @@ pub enum OverrideError {
     #[error(transparent)]
     Load(#[from] crate::LoadError),
     /// The assignment is too long.
-    #[error("--set `{text}`: {why}")]
+    #[error("set `{text}`: {why}")]
     TooLong {
         /// The assignment, clipped.
         text: String,
@@ -191,13 +191,13 @@ pub enum OverrideError {
         text: String,
     },
     /// The input is driven by a controller.
-    #[error("--set {path}: this input is driven by a controller; set the controller's setpoint (`<ctrl>.sp`) instead")]
+    #[error("set {path}: this input is driven by a controller; set the controller's setpoint (`<ctrl>.sp`) instead")]
     Driven {
         /// The input path.
         path: String,
     },
     /// The value does not parse as the input's quantity, or is outside its physical range.
-    #[error("--set {path}{}: {why}", value.as_ref().map(|v| format!("={v}")).unwrap_or_default())]
+    #[error("set {path}{}: {why}", value.as_ref().map(|v| format!("={v}")).unwrap_or_default())]
     Value {
         /// The input path.
         path: String,
@@ -207,7 +207,7 @@ pub enum OverrideError {
         why: String,
     },
     /// No input, unit or controller of that name.
-    #[error("--set {path}: no unit, controller, stream or input named `{}`{hint}", path.split('.').next().unwrap_or(path))]
+    #[error("set {path}: no unit, controller, stream or input named `{}`{hint}", path.split('.').next().unwrap_or(path))]
     NoTarget {
         /// The path.
         path: String,
@@ -215,7 +215,7 @@ pub enum OverrideError {
         hint: String,
     },
     /// The path is not `unit.field`, the unit is not an object, or it has no such field.
-    #[error("--set {path}: {why}")]
+    #[error("set {path}: {why}")]
     Field {
         /// The path.
         path: String,
@@ -243,7 +243,7 @@ pub enum OverrideError {
         parts: String,
     },
     /// A unit's own check of its inputs failed ([`plantwide_model::UnitModel::check_inputs`]).
-    #[error("with --set, {path}: {why}")]
+    #[error("with `set`, {path}: {why}")]
     UnitInput {
         /// JSON path of the input.
         path: String,

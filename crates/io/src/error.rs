@@ -18,7 +18,7 @@ pub enum IoError {
     /// for (`Π(τ s + 1)` of many slow lags: τⁿ beyond 1e308).
     #[error(
         "model `{model}`: element {element}: its polynomial coefficients overflow with times in {time_unit} (a \
-         product of {order} lags and leads of up to {slowest:e} {time_unit}): give a larger --time-unit (min, h) \
+         product of {order} lags and leads of up to {slowest:e} {time_unit}): give a larger `time_unit` (min, h) \
          so that the coefficients stay finite"
     )]
     Overflow {

@@ -67,7 +67,7 @@ pub struct Job {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum PartError {
     /// Not a part file, or not one this version reads.
-    #[error("{file}: not a plantwide part file ({why}); give the files that `--shard I/N` wrote")]
+    #[error("{file}: not a plantwide part file ({why}); give the files that a `shard` I/N run wrote")]
     NotAPart {
         /// The file.
         file: String,
@@ -101,7 +101,7 @@ pub enum PartError {
         other: String,
     },
     /// Shards missing.
-    #[error("shards {missing} of {count} are missing; run them (`--shard I/{count}`) and merge all {count} parts")]
+    #[error("shards {missing} of {count} are missing; run them (`shard` I/{count}) and merge all {count} parts")]
     Missing {
         /// The missing indices, comma-separated.
         missing: String,

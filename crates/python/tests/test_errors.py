@@ -29,12 +29,12 @@ def test_an_unknown_field_in_the_file_is_named(cli):
     "path, value",
     [("feed_source.Fx", "1 kmol/min"), ("feed_source.F", "-1 kmol/min"), ("column.reflux", "2 kelvin")],
 )
-def test_a_bad_set_names_the_field_as_the_cli_does(cli, path, value):
+def test_a_bad_set_names_the_keyword_the_cli_names_by_its_flag(cli, path, value):
     plant = pw.load(COLUMN_A)
     with pytest.raises(pw.InputError) as e:
         plant.steady(set={path: value})
-    assert path in str(e.value)
-    assert str(e.value) == cli_message(cli, ["steady", COLUMN_A, "--set", f"{path}={value}"])
+    assert str(e.value).startswith(f"set {path}")
+    assert "--" + str(e.value) == cli_message(cli, ["steady", COLUMN_A, "--set", f"{path}={value}"])
 
 
 def test_a_bad_output_of_gains_is_named(cli):

@@ -459,7 +459,7 @@ fn quality_loops(plant: &Plant, named: &[String]) -> Result<Vec<QualityLoop>, Co
                         "quality loop `{name}` drives no input (its output `{name}.op` sets another controller, \
                          e.g. a ratio station's ratio): compare opens and tunes quality loops at the inputs they \
                          drive, so a scheme of ratio masters or cascade masters cannot be compared yet; compare \
-                         its loops' gains with `plantwide gains --inputs {name}.op_manual,…` instead"
+                         its loops' gains (inputs `{name}.op_manual`, …) instead"
                     ),
                 });
             }

@@ -212,7 +212,7 @@ pub enum ScreenError {
     /// MVs and pairs them, which a controller already there would fight.
     #[error(
         "controller `{controller}` is a model predictive controller: {study} takes no flowsheet with one; screen \
-         the PID structure (remove `{controller}`) and give the controller with --mpc FILE to judge it beside the \
+         the PID structure (remove `{controller}`) and give the controller as the screening's `mpc` to judge it beside the \
          pairings, or compare the two files with `plantwide compare`"
     )]
     ModelPredictive {

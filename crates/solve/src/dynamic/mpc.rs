@@ -371,7 +371,7 @@ enum ModelMismatch {
     /// It lists no inputs or outputs.
     #[error(
         "names no channels: give \"inputs\" (the MVs' driven inputs) and \"outputs\" (the CVs), in the order of the \
-         controller's mvs and cvs, as `plantwide identify --report` writes them"
+         controller's mvs and cvs, as an identification's report writes them"
     )]
     NoChannels,
     /// Its channels are not the controller's: which, against which.

@@ -110,7 +110,7 @@ pub enum SolveError {
     Eo(#[from] SteadyError),
     /// Design specs asked of the sequential-modular method alone.
     #[error(
-        "{file}: design specs ({specs}) are met by the whole-plant Newton, which `--method sm` leaves out: use `--method auto` (a sequential-modular start, then Newton) or `eo`"
+        "{file}: design specs ({specs}) are met by the whole-plant Newton, which `method` sm leaves out: use `method` auto (a sequential-modular start, then Newton) or eo"
     )]
     SpecsNeedNewton {
         /// Flowsheet file.

@@ -64,7 +64,7 @@ pub(super) fn design_steady(
                 (false, _) => String::new(),
                 (true, smaller) => format!(
                     "; a reactor's cross-section is also its volume at the setpoint, so its conversion: no steady \
-                     state was found with a reactor this {} — size surge elsewhere (--candidates) or keep the \
+                     state was found with a reactor this {} — size surge elsewhere (`candidates`) or keep the \
                      reactor's area",
                     if smaller { "small" } else { "large" }
                 ),
