@@ -246,7 +246,9 @@ impl CliError {
 /// Run a parsed command line.
 pub fn run(cli: Cli) -> Result<(), CliError> {
     // A limit set in the environment but not a number is a user error, said before any work.
-    plantwide::model::limits::Limits::from_env().map_err(|e| CliError::user(e.to_string()))?;
+    // The environment is read here, once: the library takes the limits as they are installed.
+    let limits = plantwide::model::limits::Limits::from_env().map_err(|e| CliError::user(e.to_string()))?;
+    plantwide::model::limits::Limits::install(limits);
     match cli.command {
         Command::Check { file } => check::run(&file, cli.units.unwrap_or(UnitsArg::Si).into()),
         Command::Components { json } => components::run(json),

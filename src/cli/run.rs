@@ -63,8 +63,7 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
     plant.set_input_values(&u);
     let scen_name = args.scenario.display().to_string();
     let spec = parse_scenario(&read(&args.scenario)?, &scen_name).map_err(|e| CliError::user(e.to_string()))?;
-    let limits = Limits::from_env().map_err(|e| CliError::user(e.to_string()))?;
-    let sc = resolve_with(&spec, &plant, &scen_name, &limits).map_err(|e| CliError::user(e.to_string()))?;
+    let sc = resolve_with(&spec, &plant, &scen_name, Limits::get()).map_err(|e| CliError::user(e.to_string()))?;
     let snapshot: Option<Snapshot> = match &args.resume {
         Some(p) => Some(
             serde_json::from_str(&read(p)?)

@@ -82,9 +82,9 @@ pub fn run(args: &ServeArgs) -> Result<(), CliError> {
         }
         None => empty_scenario(),
     };
-    let limits = Limits::from_env().map_err(|e| user(&e))?;
+    let limits = Limits::get();
     let scen_name = args.scenario.as_ref().map_or("(no scenario)".to_string(), |p| p.display().to_string());
-    let sc = resolve_with(&spec, &plant, &scen_name, &limits).map_err(|e| user(&e))?;
+    let sc = resolve_with(&spec, &plant, &scen_name, limits).map_err(|e| user(&e))?;
     let x0 = converge(&plant, &u)?.x;
     let live = Live::new(&plant, &x0, &spec, &sc, &fingerprint(&text, &args.set))
         .map_err(|e| CliError::numerical(e.to_string()))?;

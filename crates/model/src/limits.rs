@@ -108,6 +108,9 @@ pub struct LimitsError {
     pub value: String,
 }
 
+/// The limits in force ([`Limits::get`]).
+static LIMITS: OnceLock<Limits> = OnceLock::new();
+
 impl Limits {
     /// Environment variable of [`Limits::max_record_rows`].
     pub const MAX_RECORD_ROWS: &'static str = "PLANTWIDE_MAX_RECORD_ROWS";
@@ -118,11 +121,17 @@ impl Limits {
     /// Environment variable of [`Limits::max_samples`].
     pub const MAX_SAMPLES: &'static str = "PLANTWIDE_MAX_SAMPLES";
 
-    /// The limits in force, read once per process: [`Limits::from_env`], or the defaults where the
-    /// environment holds a bad value (the CLI reports that at its start with [`Limits::from_env`]).
+    /// The limits in force: those a face put in force with [`Limits::install`] (the CLI and the
+    /// Python package read them from the environment once, at their start), else the defaults.
+    /// The library reads no environment.
     pub fn get() -> &'static Limits {
-        static LIMITS: OnceLock<Limits> = OnceLock::new();
-        LIMITS.get_or_init(|| Limits::from_env().unwrap_or_default())
+        LIMITS.get_or_init(Limits::default)
+    }
+
+    /// Put `limits` in force for the process, before any work; false (and nothing changes) when
+    /// limits are already in force — installed, or the defaults taken by a first [`Limits::get`].
+    pub fn install(limits: Limits) -> bool {
+        LIMITS.set(limits).is_ok()
     }
 
     /// The defaults, each replaced by its environment variable when that is set.

@@ -250,6 +250,9 @@ fn identify(
 #[pymodule]
 fn _plantwide(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
+    // The environment is read here, once: a variable that holds no limit is refused at import.
+    let limits = plantwide_flowsheet::scenario::Limits::from_env().map_err(|e| InputError::new_err(e.to_string()))?;
+    plantwide_flowsheet::scenario::Limits::install(limits);
     m.add("PlantwideError", py.get_type::<PlantwideError>())?;
     m.add("InputError", py.get_type::<InputError>())?;
     m.add("ConvergenceError", py.get_type::<ConvergenceError>())?;

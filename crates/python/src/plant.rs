@@ -138,8 +138,7 @@ pub fn linearize(
 pub fn run(src: &Source, sets: &[String], scenario: &Source) -> Result<SimulationResult, FaceError> {
     let (plant, ss) = src.at_steady_state(sets)?;
     let spec = parse_scenario(&scenario.text, &scenario.name).map_err(FaceError::input)?;
-    let limits = Limits::from_env().map_err(FaceError::input)?;
-    let sc = resolve_with(&spec, &plant, &scenario.name, &limits).map_err(FaceError::input)?;
+    let sc = resolve_with(&spec, &plant, &scenario.name, Limits::get()).map_err(FaceError::input)?;
     simulate(&plant, &sc, Start::Steady(&ss.x), "", &mut |_| {}).map_err(|e| {
         let user = e.is_user_error();
         FaceError::classify(e, user)
