@@ -6,10 +6,16 @@
 //!   times.
 //! - [`compare`]: `plantwide compare` and `plantwide.compare`: the schemes side by side, the report
 //!   folder.
+//! - [`gains`]: `plantwide gains`: the gain report of a flowsheet or a transfer-function model, its
+//!   JSON, the RGA heat map.
 //! - [`identify`]: `plantwide identify` and `Plant.identify`: the test, the verdict, the models, the
 //!   report folder with the step model.
+//! - [`linearize`]: `plantwide linearize`: the state-space model's size, modes and steady-state
+//!   gain; a transfer-function model's elements and poles.
 //! - [`screen`]: `plantwide screen` and `Plant.screen`: a column's configurations or the pairings,
 //!   the report folders, a column's tuned flowsheets.
+//! - [`sensitivity`]: `plantwide sensitivity`: the sweeps' tables.
+//! - [`sensors`]: `plantwide sensors`: the stages and the criteria's choices, as text or JSON.
 //! - [`shown`]: the display units of the paths a report shows.
 //! - [`size`]: `plantwide size` and `Plant.size`: the designs' table or the candidates' ranking,
 //!   their figure, the report folder.
@@ -20,8 +26,12 @@
 
 pub mod check;
 pub mod compare;
+pub mod gains;
 pub mod identify;
+pub mod linearize;
 pub mod screen;
+pub mod sensitivity;
+pub mod sensors;
 pub mod shown;
 pub mod size;
 pub mod steady;
@@ -49,4 +59,18 @@ fn write(dir: &Path, name: &str, text: &str) -> Result<String, IoError> {
 /// The first `n` characters of `s` (a name cut to its table column).
 fn truncate(s: &str, n: usize) -> String {
     s.chars().take(n).collect()
+}
+
+/// A number with 6 significant digits: fixed notation for magnitudes in [1e-3, 1e6), else
+/// scientific (the tables of `gains`, `sensors`, `linearize`, `sensitivity`).
+fn sig6(v: f64) -> String {
+    let a = v.abs();
+    if a == 0.0 || !v.is_finite() {
+        format!("{v}")
+    } else if (1e-3..1e6).contains(&a) {
+        let decimals = (5 - a.log10().floor() as i32).max(0) as usize;
+        format!("{v:.decimals$}")
+    } else {
+        format!("{v:.5e}")
+    }
 }
