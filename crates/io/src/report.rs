@@ -12,6 +12,8 @@
 //!   report folder with the step model.
 //! - [`linearize`]: `plantwide linearize`: the state-space model's size, modes and steady-state
 //!   gain; a transfer-function model's elements and poles.
+//! - [`run`]: `plantwide run`: the trends as CSV, the summary as text or JSON; [`run_plot`], the
+//!   trend plot.
 //! - [`screen`]: `plantwide screen` and `Plant.screen`: a column's configurations or the pairings,
 //!   the report folders, a column's tuned flowsheets.
 //! - [`sensitivity`]: `plantwide sensitivity`: the sweeps' tables.
@@ -29,6 +31,8 @@ pub mod compare;
 pub mod gains;
 pub mod identify;
 pub mod linearize;
+pub mod run;
+pub mod run_plot;
 pub mod screen;
 pub mod sensitivity;
 pub mod sensors;
