@@ -7,14 +7,14 @@
 use std::path::PathBuf;
 
 use plantwide::analysis::frequency::{self, FrequencyResults};
-use plantwide::analysis::plant_model::{PlantModel, display_gain};
+use plantwide::analysis::plant_model::PlantModel;
 use plantwide::analysis::select::{in_system, select_inputs, select_outputs};
 use plantwide::io::export::ModelExport;
+use plantwide::io::report;
 use plantwide::units::UnitSystem;
 use plantwide::units::{Dimension, Unit};
 
 use super::CliError;
-use super::gains::sig;
 use super::steady::{converge, load_with_overrides};
 
 /// Arguments of `plantwide linearize`.
@@ -98,41 +98,12 @@ fn run_tf(a: &LinearizeArgs, file: &std::path::Path, tu: &TimeUnit) -> Result<()
     });
     let doc = plantwide::io::tf::export(&model, (&tu.name, tu.seconds), frequency.as_ref())
         .map_err(|e| CliError::numerical(e.to_string()))?;
-    outln!(
-        "transfer-function model `{}`: {} inputs, {} outputs (s in rad/{}, times in {})",
-        model.name,
-        model.inputs.len(),
-        model.outputs.len(),
-        tu.name,
-        tu.name
-    );
-    for (i, o) in model.outputs.iter().enumerate() {
-        for (j, inp) in model.inputs.iter().enumerate() {
-            let e = &doc["elements"][i][j];
-            if e.is_null() {
-                continue;
-            }
-            outln!(
-                "  {} ← {}: num {} / den {} · e^(−{} s)",
-                o.name,
-                inp.name,
-                e["num"],
-                e["den"],
-                sig(e["dead_time"].as_f64().unwrap_or(f64::NAN))
-            );
-        }
-    }
-    let poles: Vec<String> =
-        doc["poles"].as_array().into_iter().flatten().filter_map(|p| p.as_f64()).map(sig).collect();
-    outln!("poles [1/{}]: {}", tu.name, poles.join(", "));
+    out!("{}", report::linearize::tf_text(&model, &doc, &tu.name));
     if let Some(out) = &a.out {
         let text = serde_json::to_string_pretty(&doc).map_err(|e| CliError::user(e.to_string()))?;
         std::fs::write(out, text + "\n")
             .map_err(|e| CliError::user(format!("{}: cannot write: {e}", out.display())))?;
-        outln!(
-            "wrote {} (per element `num`, `den`, `dead_time`: python-control `control.tf(num, den)`)",
-            out.display()
-        );
+        out!("{}", report::linearize::tf_written(out));
     }
     Ok(())
 }
@@ -153,44 +124,13 @@ pub fn run(a: &LinearizeArgs, units: UnitSystem) -> Result<(), CliError> {
     let ss = converge(&plant, &u)?;
     let pm = PlantModel::at(&plant, (&ss.x, &ss.u), (&inputs, &outputs), &omegas).map_err(map)?;
     let (model, direct) = (&pm.model, &pm.direct_gain);
-    outln!(
-        "linear model of `{}` at its steady state: {} states, {} inputs, {} outputs",
-        plant.name(),
-        model.states.len(),
-        inputs.len(),
-        outputs.len()
-    );
-    let slow: Vec<String> = model.time_constants().map_err(map)?.iter().take(5).map(|t| sig(t / tu.seconds)).collect();
-    outln!("slowest time constants [{}]: {}", tu.name, slow.join(", "));
+    out!("{}", report::linearize::heading(plant.name(), &pm, inputs.len(), outputs.len()));
+    let slow = model.time_constants().map_err(map)?;
     let unstable = model.unstable(1e-12).map_err(map)?;
-    if !unstable.is_empty() {
-        let ev: Vec<String> =
-            unstable.iter().map(|l| format!("{:.4e}{:+.4e}j", l.re * tu.seconds, l.im * tu.seconds)).collect();
-        outln!("integrating or unstable modes [1/{}]: {}", tu.name, ev.join(", "));
-    }
+    out!("{}", report::linearize::modes(&slow, &unstable, (&tu.name, tu.seconds)));
     if unstable.is_empty() {
-        let g = display_gain(&model.steady_gain().map_err(map)?, &inputs, &outputs);
-        let gd = display_gain(direct, &inputs, &outputs);
-        // Relative to the largest gain: an output held by integral action has a gain of rounding size,
-        // which no relative difference of its own describes.
-        let cells = || (0..g.nrows()).flat_map(|i| (0..g.ncols()).map(move |j| (i, j)));
-        let largest = cells().map(|(i, j)| gd[(i, j)].abs()).fold(0.0, f64::max);
-        let diff = cells().map(|(i, j)| (g[(i, j)] - gd[(i, j)]).abs()).fold(0.0, f64::max);
-        // Below 1e-10 in display units a gain is zero to rounding: an output held by integral action.
-        let check = if largest > 1e-10 {
-            format!("agrees with −C J⁻¹ B to {:.1e} of its largest entry", diff / largest)
-        } else {
-            format!(
-                "−C J⁻¹ B is 0 to rounding ({largest:.1e}), so the outputs are held at steady state; these are {diff:.1e} off it"
-            )
-        };
-        outln!("steady-state gain D − C A⁻¹ B ({check}), output unit per input unit:");
-        let heads: Vec<String> = inputs.iter().map(|i| format!("{:>14}", format!("{} [{}]", i.path, i.unit))).collect();
-        outln!("  {:<28} {}", "", heads.join(" "));
-        for (i, o) in outputs.iter().enumerate() {
-            let cells: Vec<String> = (0..g.ncols()).map(|j| format!("{:>14}", sig(g[(i, j)]))).collect();
-            outln!("  {:<28} {}", format!("{} [{}]", o.path, o.unit), cells.join(" "));
-        }
+        let gain = model.steady_gain().map_err(map)?;
+        out!("{}", report::linearize::gain(&gain, direct, &inputs, &outputs));
     }
     if let Some(out) = &a.out {
         let export = ModelExport {
@@ -206,15 +146,7 @@ pub fn run(a: &LinearizeArgs, units: UnitSystem) -> Result<(), CliError> {
             false => (export.to_json_string() + "\n").into_bytes(),
         };
         std::fs::write(out, bytes).map_err(|e| CliError::user(format!("{}: cannot write: {e}", out.display())))?;
-        let how = match npz {
-            true => {
-                "numpy `np.load`; `state_names`, `input_names`, `output_names` are python-control-safe, `*_paths` the paths they stand for"
-            }
-            false => {
-                "A, B, C, D; load with python-control `control.ss(A, B, C, D)` or MATLAB `ss(m.A, m.B, m.C, m.D)`; `names` are python-control-safe signal names, `labels` their paths"
-            }
-        };
-        outln!("wrote {} ({how})", out.display());
+        out!("{}", report::linearize::written(out, npz));
     }
     Ok(())
 }

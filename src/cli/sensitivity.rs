@@ -10,10 +10,10 @@ use plantwide::analysis::sensitivity::{Disturbance, SweepSettings, Walk, curves,
 use plantwide::io::IoError;
 use plantwide::io::csv::sensitivity_csv;
 use plantwide::io::plot::write_sensitivity;
+use plantwide::io::report;
 use plantwide::units::UnitSystem;
 
 use super::CliError;
-use super::gains::sig;
 use super::shard::ShardArgs;
 use super::steady::{converge, load_with_overrides};
 
@@ -78,27 +78,7 @@ pub fn run(a: &SensitivityArgs, units: UnitSystem) -> Result<(), CliError> {
     let walks: Vec<Walk> = walks.into_iter().flatten().collect();
     let base: Vec<f64> = idx.iter().map(|&i| ss.x[i]).collect();
     let curves = curves(&disturbances, settings.points, &base, &walks);
-    outln!(
-        "sensitivity of `{}` (control structure as in the flowsheet, each point re-converged from its neighbour)",
-        plant.name()
-    );
-    for c in &curves {
-        let d = &c.disturbance;
-        outln!("\n{} [{}] (base {})", d.signal.path, d.signal.unit, sig(d.signal.display_value(d.base)));
-        out!("{:>12} {:>14}", "change %", "value");
-        for o in &outputs {
-            out!(" {:>24}", format!("{} [{}]", o.path, o.unit));
-        }
-        outln!();
-        for (v, y) in c.values.iter().zip(&c.outputs) {
-            out!("{:>12} {:>14}", sig(d.percent(*v)), sig(d.signal.display_value(*v)));
-            match y {
-                Some(y) => outputs.iter().zip(y).for_each(|(o, yi)| out!(" {:>24}", sig(o.display_value(*yi)))),
-                None => out!(" {:>24}", "not converged"),
-            }
-            outln!();
-        }
-    }
+    out!("{}", report::sensitivity::text(plant.name(), &curves, &outputs));
     if let Some(path) = &a.csv {
         std::fs::write(path, sensitivity_csv(&curves, &outputs))
             .map_err(|e| CliError::user(format!("{}: cannot write: {e}", path.display())))?;

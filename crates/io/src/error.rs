@@ -55,6 +55,13 @@ pub enum IoError {
         /// Why it cannot show the path.
         why: String,
     },
+    /// A trend plot's panel (`"panel"` in a scenario's record) that holds paths shown in two
+    /// units: a panel has one axis.
+    #[error(
+        "record.paths[{}].panel `{}`: `{}` is in {} and `{}` in {}; a panel has one axis: give them one unit",
+        .0.index, .0.panel, .0.first.0, .0.first.1, .0.other.0, .0.other.1
+    )]
+    PanelUnits(Box<MixedPanel>),
     /// A figure with nothing to draw: every part it would show failed, and a plot of what is left
     /// would read as an answer.
     #[error("{file}: not written: {why}")]
@@ -64,6 +71,19 @@ pub enum IoError {
         /// Why there is nothing (which parts failed).
         why: String,
     },
+}
+
+/// The two units of one trend-plot panel ([`IoError::PanelUnits`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct MixedPanel {
+    /// The record entry of the second unit.
+    pub index: usize,
+    /// The panel.
+    pub panel: String,
+    /// The panel's first path and its unit.
+    pub first: (String, String),
+    /// The path in another unit, and that unit.
+    pub other: (String, String),
 }
 
 impl IoError {

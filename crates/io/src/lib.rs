@@ -6,11 +6,12 @@
 //!   signal names and the path each stands for.
 //! - [`npz`]: named arrays as a NumPy `.npz` archive (the state-space export's second format).
 //! - [`csv`]: sensitivity sweeps as CSV.
-//! - [`report`]: each study's report (its table, JSON, figures), the same from every face.
+//! - [`report`]: each command's and study's report (its table, JSON, CSV, figures), the same from
+//!   every face.
 //! - [`plot`]: trend plots of dynamic runs and sensitivity plots, PNG or SVG, with one embedded
 //!   font (DejaVu Sans) registered once, so no system font library is needed.
 //!
-//! **Architecture Invariant:** io sits above the numerical crates (units, analysis, studies)
+//! **Architecture Invariant:** io sits above the numerical crates (units, solve, analysis, studies)
 //! and is never imported by them: they compute typed results, io turns those into text and
 //! pictures. Writing a figure is the only file access here; reading a file's text is the
 //! caller's.
