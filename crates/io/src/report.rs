@@ -28,6 +28,7 @@
 
 pub mod check;
 pub mod compare;
+pub mod components;
 pub mod gains;
 pub mod identify;
 pub mod linearize;
