@@ -31,6 +31,7 @@ mod heat_integration;
 mod hostile;
 mod hostile_commands;
 mod identify;
+mod layers;
 mod mpc;
 mod plots;
 mod pressure;

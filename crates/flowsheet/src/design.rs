@@ -80,7 +80,7 @@ impl Plant {
     /// [`SpecError`] naming the first entry that does not resolve.
     pub fn add_specs(&mut self, entries: &[SpecEntry]) -> Result<(), SpecError> {
         for e in entries {
-            let origin = format!("spec {}={} (vary {})", e.path, quantity_text(&e.value), e.vary);
+            let origin = format!("{}={} varying {}", e.path, quantity_text(&e.value), e.vary);
             let spec = resolve(self, e, &origin).map_err(|(_, why)| SpecError { origin: origin.clone(), why })?;
             self.specs.push(spec);
             Arc::make_mut(&mut self.spec).specs.push(e.clone());

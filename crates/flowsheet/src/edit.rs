@@ -51,12 +51,12 @@ fn edit_one(text: &str, file: &str, e: &FieldEdit) -> Result<String, EditError> 
     let (last, parents) = e.path.split_last().ok_or_else(|| fail("empty path".into()))?;
     let mut span = (0, text.len());
     for key in parents {
-        let members = members(&text[span.0..span.1]).map_err(&fail)?;
+        let members = members(&text[span.0..span.1]).map_err(|e| fail(format!("not an object ({e})")))?;
         let raw = members.get(key.as_str()).ok_or_else(|| fail(format!("no member `{key}`")))?;
         span = offset_of(text, raw);
     }
     let object = &text[span.0..span.1];
-    let members = members(object).map_err(&fail)?;
+    let members = members(object).map_err(|e| fail(format!("not an object ({e})")))?;
     let Some(value) = &e.value else {
         return Ok(match members.get(last.as_str()) {
             Some(raw) => remove_member(text, span.0, offset_of(text, raw)),
@@ -97,8 +97,8 @@ fn remove_member(text: &str, object: usize, (a, b): (usize, usize)) -> String {
 }
 
 /// The members of the JSON object `text`, each value's raw text borrowed from it.
-fn members(text: &str) -> Result<BTreeMap<&str, &RawValue>, String> {
-    serde_json::from_str(text).map_err(|e| format!("not an object ({e})"))
+fn members(text: &str) -> serde_json::Result<BTreeMap<&str, &RawValue>> {
+    serde_json::from_str(text)
 }
 
 /// Byte span of `raw` inside `text` (it borrows from it).

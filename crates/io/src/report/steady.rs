@@ -135,7 +135,7 @@ fn blocks(plant: &Plant, sol: &Solution, units: Option<UnitSystem>) -> String {
         let kind = if b.kind == BlockKind::Controller { "controller" } else { "unit" };
         if internal.len() > 12 {
             t.push_str(&format!(
-                "{kind} {:<14} {:<10} {} … ({} variables; `--json` lists them all)\n",
+                "{kind} {:<14} {:<10} {} … ({} variables; the JSON output lists them all)\n",
                 b.name,
                 b.unit.type_name(),
                 internal[..6].join("  "),
