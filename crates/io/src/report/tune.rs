@@ -183,6 +183,16 @@ fn details(out: &mut String, l: &FlowsheetLoop, u: &str, pv_unit: &str) {
             );
         }
     }
+    if let (Some(from), Some(tc)) = (l.tau_c_raised_from, l.tau_c) {
+        w!(
+            out,
+            "  τc raised from the fitted dead time {} {u} to {} {u} for a {:.0}° phase margin: the plant's exact linear \
+             model showed the default's loop unstable (the fit does not describe the response at that time scale)",
+            significant(from),
+            significant(tc),
+            plantwide_studies::tune::flowsheet::MIN_PHASE_MARGIN
+        );
+    }
     if let Some(c) = &l.linearity {
         w!(out, "{}", linearity_line(c));
     }

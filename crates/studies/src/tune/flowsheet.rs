@@ -76,6 +76,11 @@ pub struct FlowsheetLoop {
     /// SIMC's τc or IMC's λ used \[s or the time unit asked for\].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub tau_c: Option<f64>,
+    /// The default τc (the fitted dead time) when the plant's exact linear model refuted its
+    /// settings and τc was raised from it to keep [`MIN_PHASE_MARGIN`] ([`raise_tau_c`]) \[s or the
+    /// time unit asked for\].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tau_c_raised_from: Option<f64>,
     /// Gain and phase margins of the loop with these settings on the plant's exact linear model
     /// ([`flowsheet_margins`]); frequencies in rad per second or per the time unit asked for.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -133,6 +138,7 @@ impl FlowsheetTuning {
             l.tau_d = l.tau_d.map(|t| t / seconds);
             l.margins = l.margins.map(|m| m.in_time_unit(seconds));
             l.tau_c = l.tau_c.map(|t| t / seconds);
+            l.tau_c_raised_from = l.tau_c_raised_from.map(|t| t / seconds);
             if let Some(r) = &mut l.relay {
                 r.pu /= seconds;
             }
@@ -181,6 +187,7 @@ fn entry(l: &PlantLoop, kc: f64, tau_i: Option<f64>, tau_d: Option<f64>) -> Flow
         linearity: None,
         initial_fit: None,
         tau_c: None,
+        tau_c_raised_from: None,
         failure: None,
         margins: None,
     }
@@ -387,6 +394,56 @@ pub fn flowsheet_margins(
         diagrams.push(b);
     }
     Ok(diagrams)
+}
+
+/// The phase margin \[deg\] a loop tuned by SIMC or IMC with the default τc must keep on the
+/// plant's exact linear model; below it τc is raised ([`raise_tau_c`]). SIMC's τc = θ gives about
+/// 47° on the first-order-plus-dead-time model it assumes (Skogestad 2003, Table 2 with τc = θ);
+/// 30° is the least commonly accepted for a loop that must tolerate model error (Seborg et al.,
+/// *Process Dynamics and Control*, §14: PM 30°–45°).
+pub const MIN_PHASE_MARGIN: f64 = 30.0;
+
+/// Most doublings of τc tried (up to 2¹⁰ θ, past the slowest closed loop anyone would take).
+const MAX_DOUBLINGS: usize = 10;
+
+/// SIMC or IMC loops whose default τc (the fitted dead time) the plant's exact linear model
+/// refutes (a negative phase margin: a fitted model that does not describe the response at the
+/// loop's time scale), retuned from the same fit with τc doubled until each has
+/// [`MIN_PHASE_MARGIN`]: the smallest `θ·2^k` that gives it, with `tau_c_raised_from` recording θ.
+/// Loops the exact model accepts keep SIMC's τc = θ, whatever their margin (shown beside them). A
+/// loop that has no such τc within 2¹⁰ θ keeps its refutation ([`FlowsheetLoop::failure`]). The
+/// margins are those of the final settings, as [`flowsheet_margins`] gives them.
+///
+/// # Errors
+/// [`TuneError`] from the margins' linear model, or [`TuneError::Rule`] for a degenerate model.
+pub fn raise_tau_c(
+    plant: &Plant,
+    x: &[f64],
+    tuning: &mut FlowsheetTuning,
+    (rule, derivative): (ModelRule, bool),
+    measurement: Measurement,
+) -> Result<Vec<Bode>, TuneError> {
+    let mut bode = flowsheet_margins(plant, x, tuning, measurement)?;
+    // Only loops the exact model refutes are retuned; once retuned, until they have the margin.
+    let mut retune: Vec<bool> = tuning.loops.iter().map(|l| l.failure.is_some()).collect();
+    for _ in 0..MAX_DOUBLINGS {
+        let mut raised = false;
+        for (l, retune) in tuning.loops.iter_mut().zip(&mut retune) {
+            let pm = l.margins.and_then(|m| m.phase_margin);
+            *retune &= pm.is_none_or(|pm| pm < MIN_PHASE_MARGIN);
+            let (Some(fit), Some(tc), true) = (&l.fit, l.tau_c, *retune) else { continue };
+            let model = fit.model.measured(measurement.dead_time, measurement.lag);
+            let p = model_rule(rule, &model, Some(2.0 * tc), derivative)?;
+            l.tau_c_raised_from.get_or_insert(tc);
+            (l.kc, l.tau_i, l.tau_d, l.tau_c) = (p.kc, Some(p.tau_i), p.tau_d.filter(|t| *t > 0.0), Some(p.tau_c));
+            raised = true;
+        }
+        if !raised {
+            break;
+        }
+        bode = flowsheet_margins(plant, x, tuning, measurement)?;
+    }
+    Ok(bode)
 }
 
 #[cfg(test)]
