@@ -146,7 +146,7 @@ fn ode_run(
     file: &str,
 ) -> OdeRun {
     let sc = resolve(spec, plant, file).expect("scenario fits the plant");
-    let holdup = |s: usize, c: &str| x0[plant.var(&format!("column.n[{s}][{c}]")).expect("column A holdup")];
+    let holdup = |s: usize, c: &str| x0[plant.var(format!("column.n[{s}][{c}]")).expect("column A holdup")];
     let n0: Vec<f64> = (1..=41).flat_map(|s| [holdup(s, "light"), holdup(s, "heavy")]).collect();
     let sys = column_a_ode::ColumnOde::new(1.01 * 1000.0 / 60.0);
     let worst = column_a_ode::check_jacobian(&sys, &n0);

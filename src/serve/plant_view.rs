@@ -114,16 +114,16 @@ fn controller(plant: &Plant, b: usize) -> Value {
         .collect();
     let pv = plant.measured_var(b).map(|v| plant.vars()[v].path.clone());
     let pv_unit = plant.measured_var(b).map(|v| plant.blocks()[plant.vars()[v].block].name.clone());
-    let input = |suffix: &str| plant.input(&format!("{name}.{suffix}"));
-    let sp = input("sp");
+    let special = [VarPath::setpoint(name), VarPath::auto(name), VarPath::manual_output(name)];
+    let [sp, auto, op_manual] = special.each_ref().map(|p| plant.input(p));
     let cascade = sp.is_some_and(|i| plant.inputs()[i].driven_by.is_some());
-    let special = ["sp", "auto", "op_manual"].map(|s| format!("{name}.{s}"));
     let tuning: Vec<&str> = block
         .input_ids
         .iter()
         .map(|&i| plant.inputs()[i].path.as_str())
         .filter(|p| {
-            !special.iter().any(|s| s == p) && plant.input(p).is_some_and(|i| plant.inputs()[i].driven_by.is_none())
+            !special.iter().any(|s| s.as_str() == *p)
+                && plant.input(p).is_some_and(|i| plant.inputs()[i].driven_by.is_none())
         })
         .collect();
     json!({
@@ -136,8 +136,8 @@ fn controller(plant: &Plant, b: usize) -> Value {
         "cascade": cascade,
         "op": op,
         "drives": drives,
-        "auto": input("auto").map(|i| plant.inputs()[i].path.clone()),
-        "op_manual": input("op_manual").map(|i| plant.inputs()[i].path.clone()),
+        "auto": auto.map(|i| plant.inputs()[i].path.clone()),
+        "op_manual": op_manual.map(|i| plant.inputs()[i].path.clone()),
         "tuning": tuning,
     })
 }
@@ -161,7 +161,7 @@ pub fn default_trend(plant: &Plant) -> Vec<String> {
     for b in (0..plant.blocks().len()).filter(|&b| plant.blocks()[b].kind == BlockKind::Controller) {
         let name = &plant.blocks()[b].name;
         paths.extend(plant.measured_var(b).map(|v| plant.vars()[v].path.clone()));
-        let sp = plant.input(&format!("{name}.sp")).filter(|&i| plant.inputs()[i].driven_by.is_none());
+        let sp = plant.input(VarPath::setpoint(name)).filter(|&i| plant.inputs()[i].driven_by.is_none());
         paths.extend(sp.map(|i| plant.inputs()[i].path.clone()));
     }
     paths

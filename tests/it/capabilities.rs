@@ -90,11 +90,11 @@ fn every_declared_inventory_is_addressable_and_balances() {
         for (name, u) in &plant.spec().units {
             for inv in u.config().inventories() {
                 seen += 1;
-                let var = |f: String| plant.var(&format!("{name}.{f}"));
+                let var = |f: String| plant.var(format!("{name}.{f}"));
                 assert!(var(format!("M[{}]", inv.stage)).is_some(), "{file}: {name}.{}", inv.name);
                 assert!(var(format!("T[{}]", inv.stage)).is_some(), "{file}: {name}.{}", inv.name);
                 for p in &inv.leaving {
-                    let found = var(p.clone()).is_some() || plant.input(&format!("{name}.{p}")).is_some();
+                    let found = var(p.clone()).is_some() || plant.input(format!("{name}.{p}")).is_some();
                     assert!(
                         found,
                         "{file}: `{name}.{p}` leaving {name}.{} is neither a variable nor an input",

@@ -6,9 +6,9 @@
 //! reported in the display units: a gain `dy/du` in SI becomes `dy/du · f_u / f_y`, where `f` is
 //! the SI value of one display unit as a *difference* (so `degC` and `K` give the same gains).
 
-use plantwide_flowsheet::Plant;
 use plantwide_flowsheet::error::did_you_mean;
 use plantwide_flowsheet::overrides::resolve_input;
+use plantwide_flowsheet::{Plant, VarPath};
 use plantwide_units::{Dimension, Unit};
 use serde::Serialize;
 
@@ -114,7 +114,7 @@ pub fn select_input(plant: &Plant, text: &str) -> Result<Signal, AnalysisError> 
     let info = &plant.inputs()[index];
     if let Some(op) = info.driven_by {
         let ctrl = &plant.blocks()[plant.vars()[op].block].name;
-        let auto = plant.input(&format!("{ctrl}.auto")).map(|i| plant.inputs()[i].value);
+        let auto = plant.input(VarPath::auto(ctrl)).map(|i| plant.inputs()[i].value);
         let instead = match auto {
             // In manual its setpoint moves nothing (a zero gain): its manual output is the input.
             Some(0.0) => format!("`{ctrl}` is in manual: move its manual output `{ctrl}.op_manual` instead"),
@@ -130,7 +130,7 @@ pub fn select_input(plant: &Plant, text: &str) -> Result<Signal, AnalysisError> 
         )));
     }
     let block = &plant.blocks()[info.block].name;
-    let manual = plant.input(&format!("{block}.auto")).is_some_and(|i| plant.inputs()[i].value == 0.0);
+    let manual = plant.input(VarPath::auto(block)).is_some_and(|i| plant.inputs()[i].value == 0.0);
     if manual && info.path.strip_prefix(block.as_str()).is_some_and(|rest| rest.starts_with(".sp")) {
         // A gain of zero would be reported, and every measure from it meaningless.
         return Err(request(format!(

@@ -18,7 +18,7 @@
 //!   *Practical Distillation Control*, Van Nostrand Reinhold 1992, ch. 8.
 
 use faer::Mat;
-use plantwide_flowsheet::Plant;
+use plantwide_flowsheet::{Plant, VarPath};
 use plantwide_model::Shape;
 
 use crate::error::{AnalysisError, request};
@@ -58,7 +58,7 @@ pub fn select_temperature_sensors(
     let mut stages = Vec::new();
     let mut vars = Vec::new();
     for stage in 1.. {
-        match plant.var(&format!("{column}.T[{stage}]")) {
+        match plant.var(VarPath::new(column, "T").index(stage)) {
             Some(i) => {
                 stages.push(stage);
                 vars.push(i);

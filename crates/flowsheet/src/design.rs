@@ -18,6 +18,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{Diagnostic, did_you_mean};
 use crate::overrides::resolve_input;
+use crate::path::VarPath;
 use crate::plant::Plant;
 
 /// A design specification as written in a flowsheet file's `specs` or by `--spec PATH=VALUE
@@ -131,7 +132,7 @@ impl Plant {
                 });
             }
             for (k, cv) in cfg.cvs.iter().enumerate() {
-                let sp = format!("{name}.sp{}", k + 1);
+                let sp = VarPath::cv_setpoint(name, k);
                 let sp = self.input(&sp).map(|i| self.inputs[i].value).ok_or_else(|| SpecError {
                     origin: format!("controllers.{name}.cvs[{k}]"),
                     why: format!("no input `{sp}`"),
@@ -139,7 +140,7 @@ impl Plant {
                 entries.push(SpecEntry {
                     path: cv.pv.clone(),
                     value: QuantityValue::Number(sp),
-                    vary: format!("{name}.mv{}", k + 1),
+                    vary: VarPath::mv(name, k).into(),
                 });
             }
         }

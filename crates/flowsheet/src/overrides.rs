@@ -17,7 +17,7 @@ pub fn resolve_input(plant: &Plant, path: &str) -> Option<usize> {
     }
     let path = VarPath::parse(path);
     let s = plant.streams.iter().find(|s| s.name == path.owner())?;
-    plant.input(VarPath::new(&plant.blocks[s.from.0].name, path.field()?).as_str())
+    plant.input(VarPath::new(&plant.blocks[s.from.0].name, path.field()?))
 }
 
 /// One `--set PATH=VALUE` assignment: an input (its value with units) or a field of a unit or

@@ -201,11 +201,12 @@ impl Plant {
         self.blocks.iter().map(|b| b.n_eq).sum()
     }
     /// Global index of the variable at `path` (`stream.x[comp]` and `stream.z[comp]` both work).
-    pub fn var(&self, path: &str) -> Option<usize> {
-        crate::path::VarPath::parse(path).find(&self.var_index)
+    pub fn var(&self, path: impl AsRef<str>) -> Option<usize> {
+        crate::path::VarPath::parse(path.as_ref()).find(&self.var_index)
     }
     /// Index of the input at `path` or named by an alias.
-    pub fn input(&self, path: &str) -> Option<usize> {
+    pub fn input(&self, path: impl AsRef<str>) -> Option<usize> {
+        let path = path.as_ref();
         self.input_index.get(path).or_else(|| self.aliases.get(path)).copied()
     }
     /// Current values of all inputs (SI).

@@ -1132,9 +1132,9 @@ fn event(cx: &mut Cx<'_>, base: &str, e: &EventSpec) -> Vec<Event> {
             let field = format!("{base}.controller");
             let Some(b) = cx.controller(controller, &field) else { return Vec::new() };
             let (auto_input, manual_input) =
-                (cx.plant.input(&format!("{controller}.auto")), cx.plant.input(&format!("{controller}.op_manual")));
+                (cx.plant.input(VarPath::auto(controller)), cx.plant.input(VarPath::manual_output(controller)));
             let (Some(auto_input), Some(manual_input), Some(op)) =
-                (auto_input, manual_input, cx.plant.var(VarPath::controller_output(controller, 0).as_str()))
+                (auto_input, manual_input, cx.plant.var(VarPath::controller_output(controller, 0)))
             else {
                 let kind = cx.plant.blocks[b].unit.type_name();
                 cx.diags.push(Diagnostic::new(
@@ -1178,7 +1178,7 @@ fn event(cx: &mut Cx<'_>, base: &str, e: &EventSpec) -> Vec<Event> {
 
 /// The flow input `F` of feed unit `unit` (refused, naming `base.unit`, if there is none).
 fn feed_flow(cx: &mut Cx<'_>, base: &str, unit: &str) -> Option<usize> {
-    let input = cx.plant.input(&format!("{unit}.F"));
+    let input = cx.plant.input(VarPath::new(unit, "F"));
     if input.is_none() || !cx.plant.blocks.iter().any(|b| b.name == *unit && b.unit.boundary() == Boundary::Source) {
         cx.diags.push(Diagnostic::new(format!("{base}.unit"), format!("no feed unit `{unit}` with an input `F`")));
     }

@@ -10,6 +10,7 @@
 
 use crate::FlowsheetSpec;
 use crate::overrides::{Override, OverrideError};
+use crate::path::VarPath;
 use crate::plant::{BlockKind, InputInfo, Plant, Read};
 
 /// Why a plant cannot be rewired as asked.
@@ -143,7 +144,7 @@ impl Plant {
             .measured_var(b)
             .ok_or_else(|| WiringError::NoMeasurement { file: self.file.clone(), name: self.blocks[b].name.clone() })?;
         let input = self.inputs.len();
-        let path = format!("{}.analyzer", self.blocks[b].name);
+        let path: String = VarPath::new(&self.blocks[b].name, "analyzer").into();
         self.inputs.push(InputInfo {
             path: path.clone(),
             dim: self.vars[v].spec.dim,

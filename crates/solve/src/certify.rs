@@ -13,7 +13,7 @@
 //! A controller in auto whose output rests on a limit while its measurement is off setpoint is a
 //! true steady state but not the one asked for: it is returned as a [`Warning`].
 
-use plantwide_flowsheet::{BlockKind, Plant};
+use plantwide_flowsheet::{BlockKind, Plant, VarPath};
 use plantwide_model::{Boundary, UnitIo, limits::number};
 use serde::Serialize;
 
@@ -187,7 +187,7 @@ fn saturated(plant: &Plant, x: &[f64], u: &[f64]) -> Vec<Warning> {
                 number(s.offset)
             );
             out.push(Warning {
-                path: format!("{}.op", b.name),
+                path: VarPath::controller_output(&b.name, 0).into(),
                 limit: s.limit.into(),
                 value: s.value,
                 offset: s.offset,

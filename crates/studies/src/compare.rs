@@ -32,7 +32,7 @@ pub mod verdict;
 use plantwide_analysis::linear::Linearization;
 use plantwide_analysis::measures::{condition_number, svd};
 use plantwide_analysis::sensitivity::{Disturbance as Sweep, SweepSettings, sweep};
-use plantwide_flowsheet::Plant;
+use plantwide_flowsheet::{Plant, VarPath};
 use plantwide_model::ControllerSpec;
 use plantwide_solve::dynamic::mv_limits;
 use plantwide_solve::{NewtonSettings, StrategySettings, converge, steady_state};
@@ -42,7 +42,7 @@ use serde::Serialize;
 
 use crate::screen::ScreenError;
 use crate::screen::pairings::dynamic::Limited;
-use crate::screen::pairings::mpc::{MpcAlternative, assess_mpc, controllers, output_name};
+use crate::screen::pairings::mpc::{MpcAlternative, assess_mpc, controllers};
 use crate::screen::pairings::{
     Disturbance, DynamicResult, DynamicSettings, PairingRequest, PairingStructure, Tuning, assess_pairing,
 };
@@ -524,10 +524,12 @@ fn stability(
     let as_built = modes(plant, x, u)?;
     let mut manual = plant.clone();
     for l in loops {
-        let input = |name: &str| manual.input(&format!("{}.{name}", l.controller));
-        if let (Some(auto), Some(op_manual), Some(op)) =
-            (input("auto"), input("op_manual"), plant.var(&format!("{}.op", l.controller)))
-        {
+        let ctrl = l.controller.as_str();
+        if let (Some(auto), Some(op_manual), Some(op)) = (
+            manual.input(VarPath::auto(ctrl)),
+            manual.input(VarPath::manual_output(ctrl)),
+            plant.var(VarPath::controller_output(ctrl, 0)),
+        ) {
             manual.set_input_value(auto, 0.0);
             manual.set_input_value(op_manual, x[op]);
         }
@@ -593,7 +595,7 @@ fn held_by_mpc(plant: &Plant, x: &[f64]) -> Result<Option<Held>, CompareError> {
     for (name, cfg) in mpcs {
         let limits = mv_limits(plant, name).map_err(|e| CompareError::Request { file: file(), what: e.to_string() })?;
         for (k, (mv, (lo, hi))) in cfg.mvs.iter().zip(limits).enumerate() {
-            ops.push(Limited { op: output_name(name, k), mv: mv.output.clone(), lo, hi });
+            ops.push(Limited { op: VarPath::controller_output(name, k).into(), mv: mv.output.clone(), lo, hi });
         }
     }
     Ok(Some((held, st.x, ops)))

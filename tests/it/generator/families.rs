@@ -183,7 +183,7 @@ fn meet_design(d: &mut Draft, plant: &Plant, sol: &Solution) -> Option<(Plant, S
     let met = converge(&held_plant, &StrategySettings::default()).ok()?;
     let mut designed = d.doc.clone();
     for (path, ctrl) in [(&reflux, "design_top"), (&heat, "design_bottom")] {
-        let op = met.x[held_plant.var(&format!("{ctrl}.op"))?];
+        let op = met.x[held_plant.var(format!("{ctrl}.op"))?];
         let field = path.rsplit('.').next().unwrap_or_default();
         let at: Vec<&str> = match field {
             "reboiler_duty" => vec!["units", &c.name, "rigorous", field],

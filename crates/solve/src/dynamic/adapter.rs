@@ -7,7 +7,7 @@
 
 use std::ops::Range;
 
-use plantwide_flowsheet::{ExplicitPlan, Plant};
+use plantwide_flowsheet::{ExplicitPlan, Plant, VarPath};
 
 use super::conservation;
 use super::waveform::{Waveform, values_at};
@@ -53,7 +53,7 @@ impl Quadratures {
         for (k, &s) in self.streams.iter().enumerate() {
             let kind = if k < self.n_recorded { "total" } else { "boundary_total" };
             let name = &plant.streams()[s].name;
-            p.extend(plant.components().iter().map(|c| format!("{name}.{kind}[{c}]")));
+            p.extend(plant.components().iter().map(|c| String::from(VarPath::new(name, kind).index(c))));
         }
         p
     }

@@ -14,7 +14,7 @@ use std::borrow::Cow;
 mod conditions;
 
 use plantwide_flowsheet::scenario::{Action, Event, Scenario};
-use plantwide_flowsheet::{Plant, Read};
+use plantwide_flowsheet::{Plant, Read, VarPath};
 
 use super::adapter::{DaeShape, PlantDae, Quadratures};
 use super::instants;
@@ -808,7 +808,7 @@ impl<'p> Driver<'p> {
         for &s in &self.sc.totals {
             for c in self.plant.components() {
                 columns.push(Column {
-                    path: format!("{}.total[{c}]", self.plant.streams()[s].name),
+                    path: VarPath::new(&self.plant.streams()[s].name, "total").index(c).into(),
                     unit: "mol".into(),
                     si_unit: "mol".into(),
                 });
@@ -888,7 +888,7 @@ fn reference_of(plant: &Plant, source: Read) -> Option<usize> {
         let name = &plant.blocks()[b].name;
         let (k, _) = plant.measured_vars(b).into_iter().find(|&(_, m)| m == v)?;
         plant
-            .input(&format!("{name}.sp{}", k + 1))
-            .or_else(|| (k == 0).then(|| plant.input(&format!("{name}.sp"))).flatten())
+            .input(VarPath::cv_setpoint(name, k))
+            .or_else(|| (k == 0).then(|| plant.input(VarPath::setpoint(name))).flatten())
     })
 }

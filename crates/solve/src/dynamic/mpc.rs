@@ -6,7 +6,7 @@
 
 use std::collections::BTreeMap;
 
-use plantwide_flowsheet::Plant;
+use plantwide_flowsheet::{Plant, VarPath};
 use plantwide_model::BuildCx;
 use plantwide_model::controllers::mpc::{Channels, MpcConfig, MpcModelSource, MpcPlan, plan};
 use plantwide_model::registry::ControllerSpec;
@@ -135,11 +135,10 @@ fn resolve(plant: &Plant, name: &str, cfg: &MpcConfig) -> Result<Resolved, MpcEr
         .iter()
         .map(|c| plant.var(&c.pv).ok_or_else(|| fail(name, format!("no variable `{}`", c.pv))))
         .collect::<Result<_, _>>()?;
-    let input = |p: String| plant.input(&p).ok_or_else(|| fail(name, format!("no input `{p}`")));
-    let mv_inputs: Vec<usize> =
-        (1..=cfg.mvs.len()).map(|k| input(format!("{name}.mv{k}"))).collect::<Result<_, _>>()?;
+    let input = |p: VarPath| plant.input(&p).ok_or_else(|| fail(name, format!("no input `{p}`")));
+    let mv_inputs: Vec<usize> = (0..cfg.mvs.len()).map(|k| input(VarPath::mv(name, k))).collect::<Result<_, _>>()?;
     let sp_inputs: Vec<usize> =
-        (1..=cfg.cvs.len()).map(|k| input(format!("{name}.sp{k}"))).collect::<Result<_, _>>()?;
+        (0..cfg.cvs.len()).map(|k| input(VarPath::cv_setpoint(name, k))).collect::<Result<_, _>>()?;
     let cv_dims: Vec<_> = cvs.iter().map(|&v| plant.vars()[v].spec.dim).collect();
     let cv_ranges: Vec<_> = cvs.iter().map(|&v| plant.var_range(v)).collect();
     let mvs: Vec<_> = mv_inputs.iter().map(|&i| (plant.inputs()[i].dim, plant.inputs()[i].value)).collect();

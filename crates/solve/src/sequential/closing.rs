@@ -20,7 +20,7 @@
 //!
 //! The state reached at λ = 1 is the plant's own steady state, certified like any other.
 
-use plantwide_flowsheet::Plant;
+use plantwide_flowsheet::{Plant, VarPath};
 use plantwide_model::ControllerSpec;
 use plantwide_model::controllers::Setpoint;
 
@@ -137,8 +137,8 @@ fn openable(plant: &Plant, u: &[f64]) -> Vec<Opened> {
 /// Loop `name`'s inputs and measurement in the built plant.
 fn opened(plant: &Plant, name: &str) -> Option<Opened> {
     let b = plant.controller(name).ok()?;
-    let input = |field: &str| plant.input(&format!("{name}.{field}"));
-    Some(Opened { name: name.to_string(), auto: input("auto")?, sp: input("sp")?, pv: plant.measured_var(b)? })
+    let (auto, sp) = (plant.input(VarPath::auto(name))?, plant.input(VarPath::setpoint(name))?);
+    Some(Opened { name: name.to_string(), auto, sp, pv: plant.measured_var(b)? })
 }
 
 #[cfg(test)]

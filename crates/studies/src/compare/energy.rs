@@ -14,7 +14,7 @@
 //!   reboiler's heating or the driven condenser's cooling (that condenser's `Qc` less the coupling
 //!   duty is its auxiliary condenser's, cooling).
 
-use plantwide_flowsheet::Plant;
+use plantwide_flowsheet::{Plant, VarPath};
 use serde::Serialize;
 
 /// One duty.
@@ -56,14 +56,14 @@ pub struct Energy {
 
 /// The value of input `path` at the steady state: a free input's value, or the controller output
 /// driving it.
-fn input_value(plant: &Plant, x: &[f64], u: &[f64], path: &str) -> Option<f64> {
+fn input_value(plant: &Plant, x: &[f64], u: &[f64], path: &VarPath) -> Option<f64> {
     let i = plant.input(path)?;
     Some(plant.inputs()[i].driven_by.map_or(u[i], |v| x[v]))
 }
 
 /// Whether input `path` is driven by a unit that moves heat between process streams (a
 /// condenser–reboiler): heat recovered, not a utility.
-fn driven_by_coupling(plant: &Plant, path: &str) -> bool {
+fn driven_by_coupling(plant: &Plant, path: &VarPath) -> bool {
     let driver = plant.input(path).and_then(|i| plant.inputs()[i].driven_by);
     driver.is_some_and(|v| plant.blocks()[plant.vars()[v].block].unit.moves_process_heat())
 }
@@ -80,9 +80,9 @@ pub fn energy(plant: &Plant, x: &[f64], u: &[f64]) -> Energy {
             }
         }
         for f in b.unit.utility_flows() {
-            let path = format!("{}.{}", b.name, f.input);
+            let path = VarPath::new(&b.name, f.input);
             if let Some(value) = input_value(plant, x, u, &path) {
-                other.push(OtherUtility { path, value, unit: f.unit.into() });
+                other.push(OtherUtility { path: path.into(), value, unit: f.unit.into() });
             }
         }
     }
@@ -96,12 +96,12 @@ fn booked(plant: &Plant, x: &[f64], u: &[f64], unit: &str, d: &plantwide_model::
     use plantwide_model::{Booking, DutySource};
     let (path, value) = match d.source {
         DutySource::Var(name) => {
-            let path = format!("{unit}.{name}");
+            let path = VarPath::new(unit, name);
             let value = plant.var(&path).map(|v| x[v]);
             (path, value)
         }
         DutySource::Input(name) => {
-            let path = format!("{unit}.{name}");
+            let path = VarPath::new(unit, name);
             let value = input_value(plant, x, u, &path).filter(|_| !driven_by_coupling(plant, &path));
             (path, value)
         }
@@ -111,7 +111,7 @@ fn booked(plant: &Plant, x: &[f64], u: &[f64], unit: &str, d: &plantwide_model::
         Booking::Utility => (value, "heating", "cooling"),
         Booking::Recovered => (value, "recovered", "recovered"),
         Booking::Removed { coupled } => {
-            let input = format!("{unit}.{coupled}");
+            let input = VarPath::new(unit, coupled);
             let coupled = match driven_by_coupling(plant, &input) {
                 true => input_value(plant, x, u, &input).unwrap_or(0.0),
                 false => 0.0,
@@ -119,7 +119,11 @@ fn booked(plant: &Plant, x: &[f64], u: &[f64], unit: &str, d: &plantwide_model::
             (coupled - value, "heating", "cooling")
         }
     };
-    (value != 0.0).then(|| Duty { path, kind: if value > 0.0 { positive } else { negative }, duty: value.abs() })
+    (value != 0.0).then(|| Duty {
+        path: path.into(),
+        kind: if value > 0.0 { positive } else { negative },
+        duty: value.abs(),
+    })
 }
 
 /// Utility prices and the hours a year the plant runs, to cost the duties of [`Energy`].

@@ -11,7 +11,7 @@
 use faer::Mat;
 use plantwide_analysis::linear::Linearization;
 use plantwide_analysis::select::{Signal, select_outputs};
-use plantwide_flowsheet::Plant;
+use plantwide_flowsheet::{Plant, VarPath};
 
 use super::IdentifyError;
 use crate::tune::loops::{PlantLoop, in_manual, plant_loop};
@@ -65,7 +65,7 @@ pub(super) fn loops(plant: &Plant, x: &[f64], inputs: &[Signal], outputs: &[usiz
                 s.path
             ))
         })?;
-        let sp = plant.input(&format!("{name}.sp")).ok_or_else(|| {
+        let sp = plant.input(VarPath::setpoint(&name)).ok_or_else(|| {
             IdentifyError::Request(format!(
                 "with `closed_loop`, loop `{name}` has a remote setpoint: inject at its master's setpoint instead"
             ))

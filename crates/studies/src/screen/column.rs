@@ -55,7 +55,7 @@ use faer::Mat;
 use plantwide_analysis::linear::Linearization;
 use plantwide_analysis::measures::{SINGULAR_RATIO, condition_number, niederlinski, rga, rows, svd};
 use plantwide_analysis::min_cond::minimized_condition_number;
-use plantwide_flowsheet::{Override, Plant, StructureEdit};
+use plantwide_flowsheet::{Override, Plant, StructureEdit, VarPath};
 use plantwide_model::ControllerSpec;
 use plantwide_solve::{NewtonSettings, StrategySettings, steady_state};
 use plantwide_units::QuantityValue;
@@ -341,9 +341,9 @@ fn failures(c: &ColumnStructure) -> Vec<String> {
 /// The column's flows, level loops and quality loops.
 fn handles(plant: &Plant, column: &str) -> Result<Handles, ScreenError> {
     let boil = ["boilup", "reboiler_duty", "steam_flow"];
-    let find = |c: &str| boil.iter().map(|b| format!("{c}.{b}")).find(|p| plant.input(p).is_some());
+    let find = |c: &str| boil.iter().map(|b| VarPath::new(c, b)).find(|p| plant.input(p).is_some());
     let is_column =
-        |c: &str| ["reflux", "distillate", "bottoms"].iter().all(|f| plant.input(&format!("{c}.{f}")).is_some());
+        |c: &str| ["reflux", "distillate", "bottoms"].iter().all(|f| plant.input(VarPath::new(c, f)).is_some());
     let boilup = find(column).filter(|_| is_column(column));
     let Some(boilup) = boilup else {
         let columns: Vec<&str> =
@@ -351,7 +351,9 @@ fn handles(plant: &Plant, column: &str) -> Result<Handles, ScreenError> {
         let hint = plantwide_flowsheet::error::did_you_mean(column, columns.iter().copied());
         return Err(ScreenError::NotAColumn { name: column.into(), hint, columns: columns.join(", ") });
     };
-    let paths = [format!("{column}.reflux"), boilup, format!("{column}.distillate"), format!("{column}.bottoms")];
+    let paths: [String; 4] =
+        [VarPath::new(column, "reflux"), boilup, VarPath::new(column, "distillate"), VarPath::new(column, "bottoms")]
+            .map(String::from);
     let pids: Vec<(&String, &plantwide_model::controllers::pid::PidConfig)> = plant
         .spec()
         .controllers
@@ -366,10 +368,11 @@ fn handles(plant: &Plant, column: &str) -> Result<Handles, ScreenError> {
             .map(|(n, _)| (*n).clone())
             .ok_or_else(|| ScreenError::NoLevelLoop { column: column.into(), end, pv, handles: paths.join(", ") })
     };
-    let bottom_pv = format!("{column}.M[1]");
-    let reboiler_level = level("reboiler", &|pv| pv == bottom_pv, bottom_pv.clone())?;
-    let top = format!("{column}.M[");
-    let condenser_level = level("condenser", &|pv| pv.starts_with(&top) && pv != bottom_pv, format!("{top}N]"))?;
+    let holdups = VarPath::new(column, "M");
+    let bottom_pv = holdups.clone().index(1);
+    let reboiler_level = level("reboiler", &|pv| pv == bottom_pv.as_str(), bottom_pv.to_string())?;
+    let top = |pv: &str| holdups.has_element(pv) && pv != bottom_pv.as_str();
+    let condenser_level = level("condenser", &top, holdups.clone().index("N").into())?;
     let quality_loops = plant
         .spec()
         .controllers
@@ -377,7 +380,7 @@ fn handles(plant: &Plant, column: &str) -> Result<Handles, ScreenError> {
         .filter(|(n, c)| **n != condenser_level && **n != reboiler_level && drives_any(c, &paths))
         .map(|(n, _)| n.clone())
         .collect();
-    let product = |port: &str| stream_from(plant, &format!("{column}.{port}"));
+    let product = |port: &str| stream_from(plant, VarPath::new(column, port).as_str());
     Ok(Handles {
         column: column.to_string(),
         distillate_flow: product("distillate"),
@@ -402,7 +405,7 @@ fn stream_from(plant: &Plant, port: &str) -> String {
         .streams
         .iter()
         .find(|(_, s)| s.from == port)
-        .map_or_else(|| port.to_string(), |(name, _)| format!("{name}.F"))
+        .map_or_else(|| port.to_string(), |(name, _)| VarPath::new(name, "F").into())
 }
 
 fn output_var(plant: &Plant, path: &str) -> Result<usize, ScreenError> {
@@ -480,12 +483,12 @@ fn edits(plant: &Plant, h: &Handles, flows: &[f64; 4], top: Top, bottom: Bottom)
     let (top_level, top_input) = match top {
         Top::L => (d.clone(), l.clone()),
         Top::D => (l.clone(), d.clone()),
-        Top::Ratio => (d.clone(), format!("{}_reflux_ratio.ratio", h.column)),
+        Top::Ratio => (d.clone(), VarPath::new(&format!("{}_reflux_ratio", h.column), "ratio").into()),
     };
     let (bottom_level, bottom_input) = match bottom {
         Bottom::V => (b.clone(), v.clone()),
         Bottom::B => (v.clone(), b.clone()),
-        Bottom::Ratio => (b.clone(), format!("{}_boilup_ratio.ratio", h.column)),
+        Bottom::Ratio => (b.clone(), VarPath::new(&format!("{}_boilup_ratio", h.column), "ratio").into()),
     };
     e.extend(move_level(plant, &h.condenser_level, &top_level, flows, &h.paths));
     e.extend(move_level(plant, &h.reboiler_level, &bottom_level, flows, &h.paths));
@@ -554,7 +557,7 @@ fn ratio_station(name: &str, wild: &str, output: &str, ratio: f64) -> StructureE
 fn guess(plant: &Plant, x: &[f64], v: &Plant, h: &Handles, flows: &[f64; 4]) -> Vec<f64> {
     let mut g = mapped_guess(plant, x, v);
     for (station, flow) in [("reflux_ratio", flows[0]), ("boilup_ratio", flows[1])] {
-        if let Some(k) = v.var(&format!("{}_{station}.op", h.column)) {
+        if let Some(k) = v.var(VarPath::controller_output(&format!("{}_{station}", h.column), 0)) {
             g[k] = flow;
         }
     }

@@ -7,7 +7,7 @@
 //! column's drum `L_N + D` (reflux and distillate), its base `V_1 + B` (boilup and bottoms), a
 //! vessel the sum of its outlet streams.
 
-use plantwide_flowsheet::Plant;
+use plantwide_flowsheet::{Plant, VarPath};
 use serde::Serialize;
 
 /// The rule's holdup time \[s\].
@@ -30,24 +30,27 @@ pub struct Residence {
 
 /// The residence time of every drum, sump and vessel with a liquid holdup, at the state `x`.
 pub fn residence_times(plant: &Plant, x: &[f64]) -> Vec<Residence> {
-    let at = |p: &str| plant.var(p).map(|i| x[i]);
+    let at = |p: &VarPath| plant.var(p).map(|i| x[i]);
     let mut out = Vec::new();
     for (name, u) in &plant.spec().units {
         // What leaves an inventory: each a variable of the unit, or an input (its value, or the
         // output of the controller that drives it).
-        let leaving = |p: &String| at(&format!("{name}.{p}")).or_else(|| input_value(plant, x, &format!("{name}.{p}")));
+        let leaving = |p: &String| {
+            let path = VarPath::new(name, p);
+            at(&path).or_else(|| input_value(plant, x, &path))
+        };
         let mut ends: Vec<(String, Option<f64>, Option<f64>)> = u
             .config()
             .inventories()
             .iter()
             .map(|i| {
                 let throughput = i.leaving.iter().map(leaving).sum::<Option<f64>>();
-                (format!("{name}.{}", i.name), at(&format!("{name}.M[{}]", i.stage)), throughput)
+                (format!("{name}.{}", i.name), at(&VarPath::new(name, "M").index(i.stage)), throughput)
             })
             .collect();
         if u.config().vessel().is_some() {
-            let out_flow: f64 = outlet_streams(plant, name).iter().filter_map(|s| at(&format!("{s}.F"))).sum();
-            ends.push((name.clone(), at(&format!("{name}.M")), Some(out_flow)));
+            let out_flow: f64 = outlet_streams(plant, name).iter().filter_map(|s| at(&VarPath::new(s, "F"))).sum();
+            ends.push((name.clone(), at(&VarPath::new(name, "M")), Some(out_flow)));
         }
         for (vessel, m, f) in ends {
             let (Some(holdup), Some(throughput)) = (m, f) else { continue };
@@ -59,7 +62,7 @@ pub fn residence_times(plant: &Plant, x: &[f64]) -> Vec<Residence> {
 }
 
 /// The value input `path` has at `x`: the driving controller's output, else its own.
-fn input_value(plant: &Plant, x: &[f64], path: &str) -> Option<f64> {
+fn input_value(plant: &Plant, x: &[f64], path: &VarPath) -> Option<f64> {
     let i = plant.input(path)?;
     let info = &plant.inputs()[i];
     Some(info.driven_by.map_or(info.value, |v| x[v]))

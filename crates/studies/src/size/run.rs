@@ -18,7 +18,7 @@
 //! slowest time constants (a mode `C e^{−t/τ}` is within 10⁻³ after `τ ln(10³ C)`, 12 τ for `C`
 //! up to 160), then it is reported not settled with how far it still was.
 
-use plantwide_flowsheet::Plant;
+use plantwide_flowsheet::{Plant, VarPath};
 use plantwide_solve::dynamic::Session;
 
 use super::{Shape, SizeCriteria, SizeError, Trace};
@@ -179,7 +179,9 @@ pub(super) fn near_limits(plant: &Plant, x: &[f64], within: f64) -> String {
     use plantwide_model::ControllerSpec;
     let mut out = Vec::new();
     for (name, c) in &plant.spec().controllers {
-        let (ControllerSpec::Pid(cfg), Some(op)) = (c, plant.var(&format!("{name}.op"))) else { continue };
+        let (ControllerSpec::Pid(cfg), Some(op)) = (c, plant.var(VarPath::controller_output(name, 0))) else {
+            continue;
+        };
         let dim = plant.vars()[op].spec.dim;
         let si = |l: &Option<plantwide_units::QuantityValue>| l.as_ref().and_then(|l| l.to_si(dim).ok());
         let (lo, hi) = (si(&cfg.op_min), si(&cfg.op_max));

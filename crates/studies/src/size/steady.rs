@@ -14,7 +14,7 @@
 //! on, the design has no steady state near the file's and the error says how far it got.
 
 use plantwide_analysis::linear::Linearization;
-use plantwide_flowsheet::{Plant, StructureEdit};
+use plantwide_flowsheet::{Plant, StructureEdit, VarPath};
 use plantwide_solve::SteadyError;
 
 use super::run::near_limits;
@@ -77,7 +77,7 @@ pub(super) fn design_steady(
             continuation(v, &path, what, first)
         }
         (Kind::Holdup { .. }, Some(n)) => {
-            let Some(sp) = plant.input(&format!("{}.sp", v.controller)) else {
+            let Some(sp) = plant.input(VarPath::setpoint(&v.controller)) else {
                 return Err(SizeError::Steady { what: what.to_string(), source: Box::new(first) });
             };
             let at = |s: f64| -> Result<Plant, SizeError> {
@@ -182,9 +182,9 @@ pub(super) fn slowest(plant: &Plant, x: &[f64]) -> Option<f64> {
 /// a drum or base run at a larger normal holdup starts from its compositions at the new holdup.
 fn scale_holdup(plant: &Plant, guess: &mut [f64], measurement: &str, factor: f64) {
     let Some(stage) = measurement.strip_suffix(']').and_then(|m| m.split_once(".M[")) else { return };
-    let parts = format!("{}.n[{}][", stage.0, stage.1);
+    let parts = VarPath::new(stage.0, "n").index(stage.1);
     for (k, info) in plant.vars().iter().enumerate() {
-        if info.path == measurement || info.path.starts_with(&parts) {
+        if info.path == measurement || parts.has_element(&info.path) {
             guess[k] *= factor;
         }
     }

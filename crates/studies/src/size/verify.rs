@@ -9,7 +9,7 @@
 //! A design whose steady state is not found, whose run stops or does not settle has no figures:
 //! its `failure` says why, and the sizing lists it under `failed`.
 
-use plantwide_flowsheet::Plant;
+use plantwide_flowsheet::{Plant, VarPath};
 
 use super::run::{Ending, Run, peaks, swings};
 use super::steady::{after, design_steady, slowest};
@@ -158,7 +158,7 @@ fn verify(
             .var(p)
             .ok_or_else(|| SizeError::LevelLoop { vessel: v.measurement.clone(), why: format!("{what} has no `{p}`") })
     };
-    let (pv, op) = (index(&v.measurement)?, index(&format!("{}.op", v.controller))?);
+    let (pv, op) = (index(&v.measurement)?, index(VarPath::controller_output(&v.controller, 0).as_str())?);
     let t_min = r.duration.unwrap_or(law.minimum * law.time);
     let after_what = format!("the steady state of {what} after the disturbance");
     let Target { end, scale, t_max } = target(&plant, &xs, (pv, op), r, &after_what, (band_y, du, t_min))?;
@@ -358,8 +358,9 @@ pub(super) fn current(v: &Vessel, r: &SizeCriteria, designs: &[Design], du: f64)
     let fail = |why: String| SizeError::LevelLoop { vessel: v.measurement.clone(), why };
     let (pv, op, area, level, what) = match &v.kind {
         Kind::Area { new_on: Some(stream), .. } => {
-            let f =
-                plant.var(&format!("{stream}.F")).ok_or_else(|| fail(format!("the stream `{stream}` has no flow")))?;
+            let f = plant
+                .var(VarPath::new(stream, "F"))
+                .ok_or_else(|| fail(format!("the stream `{stream}` has no flow")))?;
             (f, f, None, Level::NoVessel, format!("`{stream}` without a tank"))
         }
         Kind::Area { area, .. } => {

@@ -1,7 +1,7 @@
 //! A vessel as the sizing sees it: its level measurement, the PID that holds it by a flow, the
 //! liquid's molar volume, how its size is written, and the flow change a disturbance asks of it.
 
-use plantwide_flowsheet::{Plant, StructureEdit};
+use plantwide_flowsheet::{Plant, StructureEdit, VarPath};
 use plantwide_model::controllers::Setpoint;
 use plantwide_model::{ControllerSpec, UnitSpec};
 use plantwide_units::{Dimension, QuantityValue};
@@ -52,7 +52,7 @@ impl Vessel {
         if let Some(u) = spec.units.get(name) {
             let (diameter, area, height) = geometry(u).ok_or_else(|| not_a_vessel(plant, name, "it holds no level"))?;
             let kind = Kind::Area { unit: name.to_string(), diameter, area, height, new_on: None };
-            return Vessel::with_loop(original, plant.clone(), x.to_vec(), kind, &format!("{name}.level"), r);
+            return Vessel::with_loop(original, plant.clone(), x.to_vec(), kind, &VarPath::new(name, "level"), r);
         }
         if let Some((unit, end)) = name.rsplit_once('.')
             && let Some(inv) =
@@ -64,7 +64,7 @@ impl Vessel {
                 plant.clone(),
                 x.to_vec(),
                 kind,
-                &format!("{unit}.M[{}]", inv.stage),
+                &VarPath::new(unit, "M").index(inv.stage),
                 r,
             );
         }
@@ -72,7 +72,7 @@ impl Vessel {
             let (p, xs, unit) = new_tank(plant, x, name, r)?;
             let kind =
                 Kind::Area { unit: unit.clone(), diameter: false, area: 1.0, height: None, new_on: Some(name.into()) };
-            return Vessel::with_loop(original, p, xs, kind, &format!("{unit}.level"), r);
+            return Vessel::with_loop(original, p, xs, kind, &VarPath::new(&unit, "level"), r);
         }
         Err(not_a_vessel(plant, name, "no unit, column end or stream has this name"))
     }
@@ -82,7 +82,7 @@ impl Vessel {
         plant: Plant,
         x: Vec<f64>,
         kind: Kind,
-        measurement: &str,
+        measurement: &VarPath,
         r: &SizeCriteria,
     ) -> Result<Vessel, SizeError> {
         let fail = |why: String| SizeError::LevelLoop { vessel: measurement.to_string(), why };
@@ -108,13 +108,16 @@ impl Vessel {
             }
         }
         // The local setpoint is an input: its value in the plant (the file's, or a `--set`).
-        let sp = match (&cfg.sp, plant.input(&format!("{controller}.sp"))) {
+        let sp = match (&cfg.sp, plant.input(VarPath::setpoint(&controller))) {
             (Setpoint::Value(_), Some(i)) => plant.inputs()[i].value,
             _ => return Err(fail(format!("`{controller}` takes its setpoint from a master"))),
         };
-        let op = plant.var(&format!("{controller}.op")).ok_or_else(|| fail(format!("`{controller}` has no output")))?;
+        let op = plant
+            .var(VarPath::controller_output(&controller, 0))
+            .ok_or_else(|| fail(format!("`{controller}` has no output")))?;
         let config = cfg.clone();
-        let v_l = liquid_volume(&plant, &x, &kind, measurement).ok_or_else(|| fail("no liquid molar volume".into()))?;
+        let v_l = liquid_volume(&plant, &x, &kind, measurement.as_str())
+            .ok_or_else(|| fail("no liquid molar volume".into()))?;
         let v = Vessel {
             plant,
             x,
@@ -122,7 +125,7 @@ impl Vessel {
             kind,
             controller,
             config,
-            measurement: measurement.into(),
+            measurement: measurement.to_string(),
             pv,
             op,
             outflow,
@@ -178,11 +181,11 @@ impl Vessel {
         let Kind::Area { unit, diameter, .. } = &self.kind else { return None };
         let o = if *diameter {
             plantwide_flowsheet::Override::new(
-                format!("{unit}.diameter"),
+                VarPath::new(unit, "diameter"),
                 (4.0 * area / std::f64::consts::PI).sqrt().to_string(),
             )
         } else {
-            plantwide_flowsheet::Override::new(format!("{unit}.area"), area.to_string())
+            plantwide_flowsheet::Override::new(VarPath::new(unit, "area"), area.to_string())
         };
         Some(StructureEdit::Set(o))
     }
@@ -229,14 +232,14 @@ fn level_pid(plant: &Plant, pv: usize) -> Option<(String, plantwide_model::contr
 
 /// Molar volume of the liquid: `V/M` of a vessel, `v_L(T, x)` of a column's stage.
 fn liquid_volume(plant: &Plant, x: &[f64], kind: &Kind, measurement: &str) -> Option<f64> {
-    let at = |p: &str| plant.var(p).map(|i| x[i]);
+    let at = |p: VarPath| plant.var(p).map(|i| x[i]);
     match kind {
-        Kind::Area { unit, .. } => Some(at(&format!("{unit}.V"))? / at(&format!("{unit}.M"))?),
+        Kind::Area { unit, .. } => Some(at(VarPath::new(unit, "V"))? / at(VarPath::new(unit, "M"))?),
         Kind::Holdup { .. } => {
             let (col, stage) = measurement.strip_suffix(']')?.split_once(".M[")?;
-            let t = at(&format!("{col}.T[{stage}]"))?;
+            let t = at(VarPath::new(col, "T").index(stage))?;
             let comps: Option<Vec<f64>> =
-                plant.components().iter().map(|c| at(&format!("{col}.x[{stage}][{c}]"))).collect();
+                plant.components().iter().map(|c| at(VarPath::new(col, "x").index(stage).index(c))).collect();
             Some(plant.thermo().v_liq(t, &comps?))
         }
     }
@@ -261,7 +264,7 @@ fn not_a_vessel(plant: &Plant, name: &str, why: &str) -> SizeError {
 /// `plant` with a surge tank on `stream` (cross-section 1 m², P-only level loop on its pumped
 /// outflow, setpoint at twice the band in a tank four bands tall), its steady state and its name.
 fn new_tank(plant: &Plant, x: &[f64], stream: &str, r: &SizeCriteria) -> Result<(Plant, Vec<f64>, String), SizeError> {
-    let at = |f: &str| plant.var(&format!("{stream}.{f}")).map(|i| x[i]);
+    let at = |f: &str| plant.var(VarPath::new(stream, f)).map(|i| x[i]);
     let (Some(flow), Some(p)) = (at("F"), at("P")) else {
         return Err(not_a_vessel(plant, stream, "the stream has no flow and pressure"));
     };
@@ -278,8 +281,8 @@ fn new_tank(plant: &Plant, x: &[f64], stream: &str, r: &SizeCriteria) -> Result<
         level: None,
     });
     let level = ControllerSpec::Pid(plantwide_model::controllers::pid::PidConfig {
-        pv: format!("{unit}.level"),
-        output: Some(format!("{unit}.outflow")),
+        pv: VarPath::new(&unit, "level").into(),
+        output: Some(VarPath::new(&unit, "outflow").into()),
         sp: Setpoint::Value(n(2.0 * band)),
         kc: n((0.1 * flow / band).max(1e-9)),
         tau_i: None,

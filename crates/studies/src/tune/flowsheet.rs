@@ -7,8 +7,8 @@
 //! flowsheet text, each in the unit the file wrote the field in, so a reviewer's diff shows only
 //! the new settings.
 
-use plantwide_flowsheet::Plant;
 use plantwide_flowsheet::edit::FieldEdit;
+use plantwide_flowsheet::{Plant, VarPath};
 use plantwide_model::ControllerSpec;
 use plantwide_model::controllers::Action;
 use plantwide_units::{QuantityValue, convert_from_si};
@@ -172,7 +172,7 @@ fn entry(l: &PlantLoop, kc: f64, tau_i: Option<f64>, tau_d: Option<f64>) -> Flow
     FlowsheetLoop {
         controller: l.name.clone(),
         output: l.pv_path.clone(),
-        input: format!("{}.op", l.name),
+        input: VarPath::controller_output(&l.name, 0).into(),
         ku: None,
         pu: None,
         kc,

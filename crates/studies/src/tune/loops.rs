@@ -10,7 +10,7 @@
 use faer::{Mat, c64};
 use plantwide_analysis::linear::{Linearization, StateSpace};
 use plantwide_analysis::response::HessenbergResponse;
-use plantwide_flowsheet::Plant;
+use plantwide_flowsheet::{Plant, VarPath};
 use plantwide_model::ControllerSpec;
 use plantwide_model::controllers::{Action, Setpoint};
 
@@ -48,9 +48,9 @@ pub fn plant_loop(plant: &Plant, name: &str) -> Result<PlantLoop, TuneError> {
     let b = plant.controller(name).map_err(|_| not_a_loop())?;
     let pv = plant.measured_var(b).ok_or_else(not_a_loop)?;
     let (Some(op), Some(op_manual), Some(auto)) = (
-        plant.var(&format!("{name}.op")),
-        plant.input(&format!("{name}.op_manual")),
-        plant.input(&format!("{name}.auto")),
+        plant.var(VarPath::controller_output(name, 0)),
+        plant.input(VarPath::manual_output(name)),
+        plant.input(VarPath::auto(name)),
     ) else {
         return Err(not_a_loop());
     };
@@ -231,7 +231,7 @@ pub fn loop_ultimates(response: &LoopResponse, loops: &[PlantLoop]) -> Result<Ve
         .map(|i| {
             ultimate(|w| response.at(w)[(i, i)], lo, hi).ok_or_else(|| TuneError::NoPhaseCrossover {
                 output: loops[i].pv_path.clone(),
-                input: format!("{}.op", loops[i].name),
+                input: VarPath::controller_output(&loops[i].name, 0).into(),
                 detail: " in the plant's linear model; a measurement dead time of about 1 min on a temperature or \
                          3–5 min on an analyzer (Luyben) gives it one"
                     .into(),
@@ -262,7 +262,7 @@ pub fn plant_blt(
     let system = LoopSystem {
         name: plant.name().to_string(),
         outputs: loops.iter().map(|l| l.pv_path.clone()).collect(),
-        inputs: loops.iter().map(|l| format!("{}.op", l.name)).collect(),
+        inputs: loops.iter().map(|l| VarPath::controller_output(&l.name, 0).to_string()).collect(),
         response: &g,
         gain,
         ultimates,

@@ -94,25 +94,24 @@ fn defaults(plant: &Plant, column: &str, outputs: &[String]) -> Result<Vec<Distu
     let mut list: Vec<Disturbance> = outflows
         .iter()
         .map(|u| Disturbance {
-            path: format!("{u}.outflow"),
+            path: VarPath::new(u, "outflow").into(),
             size: StepSize::Fraction(0.1),
             direction: Direction::Both,
             shown: "10 %".into(),
         })
         .collect();
     for unit in &feeds {
-        let flow = format!("{unit}.F");
         list.push(Disturbance {
-            path: flow,
+            path: VarPath::new(unit, "F").into(),
             size: StepSize::Fraction(0.1),
             direction: Direction::Both,
             shown: "10 %".into(),
         });
         let room = |p: &String| free(p).map_or(0.0, |i| plant.inputs()[i].value.min(1.0 - plant.inputs()[i].value));
-        let prefix = format!("{unit}.z[");
-        let own = component.map(|c| format!("{unit}.z[{c}]")).filter(|p| room(p) > 0.0);
+        let z = VarPath::new(unit, "z");
+        let own = component.map(|c| String::from(z.clone().index(c))).filter(|p| room(p) > 0.0);
         let widest = || {
-            let paths = plant.inputs().iter().map(|i| i.path.clone()).filter(|p| p.starts_with(&prefix));
+            let paths = plant.inputs().iter().map(|i| i.path.clone()).filter(|p| z.has_element(p));
             paths.filter(|p| room(p) > 0.0).max_by(|a, b| room(a).total_cmp(&room(b)))
         };
         if let Some(z) = own.or_else(widest) {
@@ -141,8 +140,8 @@ fn defaults(plant: &Plant, column: &str, outputs: &[String]) -> Result<Vec<Distu
 /// other columns; a recycle is walked once), in the flowsheet's stream order; the units
 /// feeding the column directly; and the units upstream whose `outflow` is a free input.
 fn upstream_feeds<'a>(plant: &'a Plant, column: &'a str) -> (Vec<&'a str>, Vec<&'a str>, Vec<&'a str>) {
-    let free = |path: String| plant.input(&path).is_some_and(|i| plant.inputs()[i].driven_by.is_none());
-    let is_feed = |u: &str| free(format!("{u}.F"));
+    let free = |path: VarPath| plant.input(path).is_some_and(|i| plant.inputs()[i].driven_by.is_none());
+    let is_feed = |u: &str| free(VarPath::new(u, "F"));
     let sources_of = |unit: &str| -> Vec<&'a str> {
         // A stream's ends are `unit.port`, or `unit` alone for a unit of one inlet or outlet.
         let owner = |end: &'a str| end.split('.').next().unwrap_or(end);
@@ -157,7 +156,7 @@ fn upstream_feeds<'a>(plant: &'a Plant, column: &'a str) -> (Vec<&'a str>, Vec<&
             continue;
         }
         seen.push(unit);
-        if free(format!("{unit}.outflow")) {
+        if free(VarPath::new(unit, "outflow")) {
             outflows.push(unit);
         }
         match is_feed(unit) {

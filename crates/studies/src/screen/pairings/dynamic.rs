@@ -14,7 +14,7 @@ use plantwide_analysis::figures::summary;
 use plantwide_flowsheet::scenario::{
     EventSpec, IntegratorSpec, RecordPathSpec, RecordSpec, SCENARIO_FORMAT_VERSION, ScenarioSpec,
 };
-use plantwide_flowsheet::{Plant, StructureEdit};
+use plantwide_flowsheet::{Plant, StructureEdit, VarPath};
 use plantwide_model::ControllerSpec;
 use plantwide_model::controllers::pid::PidConfig;
 use plantwide_model::controllers::{Action, Setpoint};
@@ -457,7 +457,8 @@ fn remote_ratio(open: &OpenPlant, mv: &str, name: &str, spec: &mut PidConfig) ->
     spec.output = None;
     spec.bias = Some(si(u0, dim));
     let mut cfg = cfg.clone();
-    cfg.ratio = plantwide_model::controllers::ratio::RatioValue::Remote { from: format!("{name}.op") };
+    cfg.ratio =
+        plantwide_model::controllers::ratio::RatioValue::Remote { from: VarPath::controller_output(name, 0).into() };
     Some([
         StructureEdit::RemoveController(station.to_string()),
         StructureEdit::AddController { name: station.to_string(), spec: Box::new(ControllerSpec::Ratio(cfg)) },
@@ -567,7 +568,7 @@ pub(crate) fn pair_outputs(open: &OpenPlant, s: &PairingStructure) -> Vec<Limite
             let mv = &s.pairs[i].mv;
             let u0 = open.plant.input(mv).map_or(0.0, |m| open.plant.inputs()[m].value);
             let (lo, hi) = (f64::min(0.0, 2.0 * u0), f64::max(0.0, 2.0 * u0));
-            Limited { op: format!("pair{}.op", i + 1), mv: mv.clone(), lo, hi }
+            Limited { op: VarPath::controller_output(&format!("pair{}", i + 1), 0).into(), mv: mv.clone(), lo, hi }
         })
         .collect()
 }

@@ -15,7 +15,7 @@
 
 use plantwide_analysis::linear::Linearization;
 use plantwide_analysis::measures::{condition_number, rows, svd};
-use plantwide_flowsheet::Plant;
+use plantwide_flowsheet::{Plant, VarPath};
 use plantwide_model::controllers::mpc::MpcConfig;
 use plantwide_model::registry::ControllerSpec;
 use plantwide_solve::dynamic::{MpcLog, mv_limits};
@@ -88,8 +88,9 @@ pub fn assess_mpc(
     let mvs: Vec<String> = cfg.mvs.iter().map(|m| m.output.clone()).collect();
     let cv_vars: Vec<usize> =
         cvs.iter().map(|c| plant.var(c).ok_or_else(|| bad(format!("no variable `{c}`")))).collect::<Result<_, _>>()?;
-    let own: Vec<usize> = (1..=mvs.len())
-        .map(|k| plant.input(&format!("{name}.mv{k}")).ok_or_else(|| bad(format!("no input `{name}.mv{k}`"))))
+    let own: Vec<usize> = (0..mvs.len())
+        .map(|k| VarPath::mv(name, k))
+        .map(|mv| plant.input(&mv).ok_or_else(|| bad(format!("no input `{mv}`"))))
         .collect::<Result<_, _>>()?;
     let analysis = |e| ScreenError::Analysis { structure: format!("controller {name}"), source: Box::new(e) };
     let g = Linearization::new(plant, x, &plant.input_values()).steady_gain(&own, &cv_vars).map_err(analysis)?;
@@ -99,7 +100,7 @@ pub fn assess_mpc(
         .iter()
         .zip(&limits)
         .enumerate()
-        .map(|(k, (mv, &(lo, hi)))| Limited { op: output_name(name, k), mv: mv.clone(), lo, hi })
+        .map(|(k, (mv, &(lo, hi)))| Limited { op: VarPath::controller_output(name, k).into(), mv: mv.clone(), lo, hi })
         .collect();
     let sample_time = cfg.sample_time.to_si(Dimension::TIME).map_err(|e| bad(format!("sample_time: {e}")))?;
     let (dynamic, qp) = match duration {
@@ -222,11 +223,6 @@ pub(crate) fn screen_mpc(
     let st = steady_state(&plant, &plant.input_values(), Some(&guess), &NewtonSettings::default())
         .map_err(|e| ScreenError::Steady { structure: "mpc".into(), source: Box::new(SolveError::from(e).into()) })?;
     assess_mpc(&plant, &st.x, SCREEN_MPC, r, duration.filter(|d| *d > 0.0))
-}
-
-/// Output `k` (0-based) of controller `name`: `name.op`, `name.op2`, ….
-pub(crate) fn output_name(name: &str, k: usize) -> String {
-    if k == 0 { format!("{name}.op") } else { format!("{name}.op{}", k + 1) }
 }
 
 /// Every disturbance run; a run that stops is marked as failed and the others go on.
