@@ -65,14 +65,15 @@ def test_refusals_name_the_request_field(column):
 
 
 def test_settings_their_margins_refute_raise_with_the_result_kept(cli, tmp_path):
-    # The generator's lag-dominant distillate loop (tests/it/tune.rs): SIMC's settings have a
-    # negative phase margin on the plant's linear model; the CLI exits 2 and writes nothing.
+    # The generator's lag-dominant distillate loop (tests/it/tune.rs): SIMC's settings at the τc
+    # asked for have a negative phase margin on the plant's linear model; the CLI exits 2 and
+    # writes nothing.
     plant = str(REPO / "tests" / "data" / "generated" / "rigorous_dc13c1b0.json")
-    args = ["tune", plant, "--loop", "AC101", "--method", "simc", "--set", "AC102.auto=0"]
+    args = ["tune", plant, "--loop", "AC101", "--method", "simc", "--set", "AC102.auto=0", "--tau-c", "1 min"]
     p = cli([*args, "--measurement-dead-time", "1 min", "--json", "--write", str(tmp_path / "cli.json")], check=False)
     assert p.returncode == 2, p.stderr
     with pytest.raises(pw.ConvergenceError) as raised:
-        pw.load(plant).tune("AC101", "simc", measurement_dead_time="1 min", set={"AC102.auto": 0},
+        pw.load(plant).tune("AC101", "simc", measurement_dead_time="1 min", tau_c="1 min", set={"AC102.auto": 0},
                             write=tmp_path / "py.json")
     assert str(raised.value).endswith("nothing written")
     assert str(raised.value) in p.stderr
