@@ -272,6 +272,34 @@ fn screen_refuses_a_flowsheet_with_an_mpc_and_offers_mpc_flag() {
     assert!(err.contains("quality_mpc") && err.contains("--mpc"), "{err}");
 }
 
+/// A screening's `--mpc` description is read into the controller's type before any work: one
+/// of another type, or with a field an MPC does not have, is refused by name (exit 1).
+#[test]
+fn a_bad_screening_mpc_description_is_refused_by_field() {
+    let dir = tempdir("screen_mpc_bad");
+    let lv = flowsheet("column_a_lv.json");
+    let cases = [
+        (r#"{"type": "pid", "cvs": []}"#, r#"must be of `"type": "mpc"`, not "pid""#),
+        (r#"{"mvs": []}"#, "`mpc` has no `cvs` list"),
+        (
+            r#"{"cvs": [{"pv": "distillate.x[light]"}], "mvs": [{"output": "column.reflux"}], "sample_time": "1 min",
+                "prediction_horizon": 10, "control_horizon": 2, "bogus": 1}"#,
+            "unknown field `bogus`",
+        ),
+    ];
+    for (k, (text, needle)) in cases.iter().enumerate() {
+        let file = dir.join(format!("mpc{k}.json"));
+        std::fs::write(&file, text).unwrap();
+        let cvs = "distillate.x[light],bottoms.x[light]";
+        let args = ["screen", &lv, "--cvs", cvs, "--mvs", "column.reflux,column.boilup", "--mpc"];
+        let out = plantwide(&[&args[..], &[file.to_str().unwrap()]].concat());
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{text}: {err}");
+        assert!(err.contains("--mpc") && err.contains(needle), "{text}: {err}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 fn scheme<'a>(c: &'a serde_json::Value, file: &str) -> &'a serde_json::Value {
     c["schemes"].as_array().unwrap().iter().find(|s| s["file"].as_str().unwrap().ends_with(file)).unwrap()
 }
