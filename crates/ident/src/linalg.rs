@@ -17,15 +17,23 @@ pub(crate) struct LsSolution {
 /// Relative threshold on |R_ii| / max|R_jj| below which column i is declared dependent.
 const RANK_TOL: f64 = 1e-10;
 
-/// Solves min ‖Xθ − y‖₂ by Householder QR (faer). Returns `Err(column)` with the first
-/// column whose R diagonal is negligible (numerically rank deficient), or `Err(0)` if X has
-/// fewer rows than columns.
+/// Solves min ‖Xθ − y‖₂ by Householder QR (faer), on the columns of X scaled to unit norm (the
+/// rank test is then on the regression's shape, not on its units: lagged outputs that move by
+/// 10⁻¹² beside an input moved by 10⁴ W are not "dependent"; the column scaling of MATLAB's
+/// `arx`, Ljung, *System Identification*, 2nd ed., §10.1). Returns `Err(column)` with the first
+/// column that is zero or whose scaled R diagonal is negligible (numerically rank deficient), or
+/// `Err(0)` if X has fewer rows than columns.
 pub(crate) fn qr_lstsq(x: &Mat<f64>, y: &[f64]) -> Result<LsSolution, usize> {
     let (m, d) = (x.nrows(), x.ncols());
     if m < d || y.len() != m || d == 0 {
         return Err(0);
     }
-    let qr = x.qr();
+    let norms: Vec<f64> = (0..d).map(|j| (0..m).map(|i| x[(i, j)] * x[(i, j)]).sum::<f64>().sqrt()).collect();
+    if let Some(zero) = norms.iter().position(|n| !(*n > 0.0 && n.is_finite())) {
+        return Err(zero);
+    }
+    let scaled = Mat::<f64>::from_fn(m, d, |i, j| x[(i, j)] / norms[j]);
+    let qr = scaled.qr();
     let r = qr.thin_R();
     let rmax = (0..d).map(|i| r[(i, i)].abs()).fold(0.0, f64::max);
     if let Some(bad) =
@@ -35,8 +43,8 @@ pub(crate) fn qr_lstsq(x: &Mat<f64>, y: &[f64]) -> Result<LsSolution, usize> {
     }
     let rhs = faer::Col::<f64>::from_fn(m, |i| y[i]);
     let sol = qr.solve_lstsq(&rhs);
-    let theta: Vec<f64> = (0..d).map(|i| sol[i]).collect();
-    // R⁻¹ by back substitution, column by column (R X = I).
+    let theta: Vec<f64> = (0..d).map(|i| sol[i] / norms[i]).collect();
+    // R⁻¹ of X = Q R_s N (N the column norms): N⁻¹ R_s⁻¹, by back substitution column by column.
     let mut rinv = Mat::<f64>::zeros(d, d);
     for c in 0..d {
         for i in (0..=c).rev() {
@@ -45,6 +53,11 @@ pub(crate) fn qr_lstsq(x: &Mat<f64>, y: &[f64]) -> Result<LsSolution, usize> {
                 s -= r[(i, k)] * rinv[(k, c)];
             }
             rinv[(i, c)] = s / r[(i, i)];
+        }
+    }
+    for i in 0..d {
+        for c in 0..d {
+            rinv[(i, c)] /= norms[i];
         }
     }
     if theta.iter().any(|v| !v.is_finite()) {
@@ -125,6 +138,31 @@ pub(crate) fn step_bf(b: &[f64], f: &[f64], nk: usize, n: usize) -> Vec<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Columns 10¹⁶ apart in size (a lagged output of 10⁻¹² beside an input of 10⁴ W, plant
+    /// `0x65d44e50b4502fc9` of the generator) are not dependent: θ is recovered, and the
+    /// covariance's diagonal is the unscaled `(XᵀX)⁻¹`'s (closed form for orthogonal columns).
+    #[test]
+    fn a_regression_is_judged_on_its_shape_not_its_units() {
+        let m = 40;
+        let small = |i: usize| 1e-12 * (0.3 * i as f64).sin();
+        let large = |i: usize| 1e4 * (0.7 * i as f64 + 1.0).cos();
+        let x = Mat::<f64>::from_fn(m, 2, |i, j| if j == 0 { small(i) } else { large(i) });
+        let theta = [-2.5e7, 3.0e-5];
+        let y: Vec<f64> = (0..m).map(|i| theta[0] * small(i) + theta[1] * large(i)).collect();
+        let sol = qr_lstsq(&x, &y).expect("two independent columns");
+        for (got, want) in sol.theta.iter().zip(theta) {
+            assert!((got - want).abs() <= 1e-10 * want.abs(), "{got:e} against {want:e}");
+        }
+        let p = covariance(&sol.rinv, 1.0);
+        let gram = |f: &dyn Fn(usize) -> f64| (0..m).map(|i| f(i) * f(i)).sum::<f64>();
+        let cross = (0..m).map(|i| small(i) * large(i)).sum::<f64>();
+        let det = gram(&small) * gram(&large) - cross * cross;
+        assert!((p[0][0] - gram(&large) / det).abs() <= 1e-8 * p[0][0]);
+        assert!((p[1][1] - gram(&small) / det).abs() <= 1e-8 * p[1][1]);
+        let zero = Mat::<f64>::from_fn(m, 2, |i, j| if j == 0 { 0.0 } else { large(i) });
+        assert_eq!(qr_lstsq(&zero, &y).err(), Some(0));
+    }
 
     #[test]
     fn roots_of_known_polynomials() {
