@@ -192,22 +192,52 @@ pub fn gains_agree(a: &[Vec<f64>], b: &[Vec<f64>], rel: f64, floor: f64) -> Resu
 
 /// The first place where `a` and `b` differ beyond `rel`, members named in `ignore` left out.
 pub fn first_difference(a: &Value, b: &Value, rel: f64, ignore: &[&str], path: &str) -> Option<String> {
+    first_difference_beyond(a, b, &[], rel, ignore, path)
+}
+
+/// [`first_difference`], each number allowed to differ by twice as much as `a`'s differs from the
+/// same number of the answers in `jitter` (if more than `rel`): the same question with its inputs
+/// moved by their last bit, so the answer's own conditioning. An answer whose figures move by 1 %
+/// when a limit moves by 10⁻¹⁶ is ill-conditioned, which this does not judge; what it judges is
+/// whether asking in other units moves them more than that.
+pub fn first_difference_beyond(
+    a: &Value,
+    b: &Value,
+    jitter: &[&Value],
+    rel: f64,
+    ignore: &[&str],
+    path: &str,
+) -> Option<String> {
     match (a, b) {
         (Value::Object(x), Value::Object(y)) => {
             let keys: std::collections::BTreeSet<&String> = x.keys().chain(y.keys()).collect();
             keys.into_iter().filter(|k| !ignore.contains(&k.as_str())).find_map(|k| match (x.get(k), y.get(k)) {
-                (Some(p), Some(q)) => first_difference(p, q, rel, ignore, &format!("{path}/{k}")),
+                (Some(p), Some(q)) => {
+                    let j: Vec<&Value> = jitter.iter().filter_map(|j| j.get(k)).collect();
+                    first_difference_beyond(p, q, &j, rel, ignore, &format!("{path}/{k}"))
+                }
                 _ => Some(format!("{path}/{k} is in one only")),
             })
         }
-        (Value::Array(x), Value::Array(y)) if x.len() == y.len() => x
-            .iter()
-            .zip(y)
-            .enumerate()
-            .find_map(|(i, (p, q))| first_difference(p, q, rel, ignore, &format!("{path}/{i}"))),
+        (Value::Array(x), Value::Array(y)) if x.len() == y.len() => {
+            x.iter().zip(y).enumerate().find_map(|(i, (p, q))| {
+                let j: Vec<&Value> = jitter.iter().filter_map(|j| j.get(i)).collect();
+                first_difference_beyond(p, q, &j, rel, ignore, &format!("{path}/{i}"))
+            })
+        }
         (Value::Number(p), Value::Number(q)) => {
             let (p, q) = (p.as_f64().unwrap_or(f64::NAN), q.as_f64().unwrap_or(f64::NAN));
-            (!relative_eq!(p, q, epsilon = 1e-300, max_relative = rel)).then(|| format!("{path}: {p:e} against {q:e}"))
+            let spread = jitter
+                .iter()
+                .filter_map(|j| j.as_f64())
+                .map(|j| (p - j).abs() / p.abs().max(j.abs()).max(1e-300))
+                .fold(0.0, f64::max);
+            let allowed = rel.max(2.0 * spread);
+            (!relative_eq!(p, q, epsilon = 1e-300, max_relative = allowed)).then(|| {
+                let moved =
+                    if spread > 0.0 { format!(" (a last-bit change moves it {spread:.1e})") } else { String::new() };
+                format!("{path}: {p:e} against {q:e}{moved}")
+            })
         }
         _ => (a != b).then(|| format!("{path}: {} against {}", clip(&a.to_string()), clip(&b.to_string()))),
     }
