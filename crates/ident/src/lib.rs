@@ -26,6 +26,7 @@ pub use data::{detrend, detrend_all};
 pub use error::IdentError;
 pub use fir::{FirModel, fir};
 pub use foptd::{Foptd, foptd};
+pub use linalg::stabilized;
 pub use oe::{OeModel, OeOptions, oe, oe_with_options, simulate_oe};
 pub use signals::{DirectionalDesign, PrbsDesign, design_prbs, directional, gbn, prbs, prbs_spectrum, white_noise};
 pub use validate::{Validation, autocorrelation, cross_correlation, fit_percent, validate};

@@ -108,6 +108,43 @@ pub(crate) fn max_root_modulus(c: &[f64]) -> f64 {
     }
 }
 
+/// Roots of the monic polynomial 1 + c₁q⁻¹ + … + c_n q⁻ⁿ (of zⁿ + c₁zⁿ⁻¹ + … + c_n), by the
+/// companion matrix's eigenvalues; none if they cannot be found.
+fn roots(c: &[f64]) -> Option<Vec<faer::c64>> {
+    let n = c.len();
+    if c.iter().any(|v| !v.is_finite()) {
+        return None;
+    }
+    let comp = Mat::<f64>::from_fn(n, n, |i, j| if i == 0 { -c[j] } else { f64::from(u8::from(i == j + 1)) });
+    comp.eigenvalues().ok()
+}
+
+/// The polynomial of [`max_root_modulus`] with each root on or outside the unit circle moved
+/// inside: reflected (`z → 1/z̄`, the same magnitude response up to a gain) and, for a root on the
+/// circle, moved to `RADIUS_AFTER_REFLECTION` of it; the coefficients of the product
+/// `Π (z − r_i)`, their real parts. An initial model of a slow plant sampled coarsely (an ARX
+/// pole at 1.0000128 for τ 4.4e5 s sampled every 2.2e4 s, generated plant 0x199d55bcfab748f3)
+/// is an integrator by a hair; Ljung (*System Identification*, 2nd ed., §10.5) starts a
+/// prediction-error search from the stabilized model. None if the roots cannot be found.
+pub fn stabilized(c: &[f64]) -> Option<Vec<f64>> {
+    let mut poly = vec![faer::c64::new(1.0, 0.0)];
+    for r in roots(c)? {
+        let m2 = r.re * r.re + r.im * r.im;
+        let r = if m2 >= 1.0 { faer::c64::new(r.re, r.im) * (RADIUS_AFTER_REFLECTION / m2) } else { r };
+        // poly ← poly · (z − r), coefficients from the highest power down.
+        poly.push(faer::c64::new(0.0, 0.0));
+        for k in (1..poly.len()).rev() {
+            poly[k] = poly[k] - poly[k - 1] * r;
+        }
+    }
+    let out: Vec<f64> = poly[1..].iter().map(|z| z.re).collect();
+    (max_root_modulus(&out) < 1.0).then_some(out)
+}
+
+/// A reflected root is brought to at most this fraction of the unit circle's radius (a root
+/// exactly on it would stay there).
+const RADIUS_AFTER_REFLECTION: f64 = 0.999;
+
 /// Discrete transfer-function simulation w = q^(−nk) B(q)/F(q) u with zero initial conditions:
 /// w(t) = Σ_{k=1..nb} b_k u(t−nk−k+1) − Σ_{k=1..nf} f_k w(t−k) (Eq 7-27 with A = 1).
 pub(crate) fn filter_bf(b: &[f64], f: &[f64], nk: usize, u: &[f64]) -> Vec<f64> {
@@ -162,6 +199,21 @@ mod tests {
         assert!((p[1][1] - gram(&small) / det).abs() <= 1e-8 * p[1][1]);
         let zero = Mat::<f64>::from_fn(m, 2, |i, j| if j == 0 { 0.0 } else { large(i) });
         assert_eq!(qr_lstsq(&zero, &y).err(), Some(0));
+    }
+
+    /// (1 − 1.25q⁻¹)(1 − 0.5q⁻¹): the root 1.25 reflected to 0.8·0.999 → (1 − 0.7992q⁻¹)(1 −
+    /// 0.5q⁻¹); a complex pair of modulus 1.1 to modulus 0.999/1.1 with the same angle; a stable
+    /// polynomial is returned as it is.
+    #[test]
+    fn unstable_roots_are_reflected_inside_the_unit_circle() {
+        let p = stabilized(&[-1.75, 0.625]).unwrap();
+        let (a, b) = (0.8 * 0.999, 0.5);
+        assert!((p[0] + a + b).abs() < 1e-12 && (p[1] - a * b).abs() < 1e-12, "{p:?}");
+        let q = stabilized(&[0.0, 1.21]).unwrap();
+        let m = 0.999 / 1.1;
+        assert!(q[0].abs() < 1e-12 && (q[1] - m * m).abs() < 1e-12, "{q:?}");
+        let s = stabilized(&[-1.4, 0.45]).unwrap();
+        assert!((s[0] + 1.4).abs() < 1e-12 && (s[1] - 0.45).abs() < 1e-12, "{s:?}");
     }
 
     #[test]

@@ -7,7 +7,7 @@ use crate::StepResponse;
 use crate::arx::{ArxModel, arx};
 use crate::data::{check_len, check_miso, check_nk, check_order, check_rows};
 use crate::error::IdentError;
-use crate::linalg::{covariance, filter_bf, max_root_modulus, qr_lstsq, step_bf};
+use crate::linalg::{covariance, filter_bf, max_root_modulus, qr_lstsq, stabilized, step_bf};
 use faer::Mat;
 use serde::{Deserialize, Serialize};
 
@@ -169,10 +169,17 @@ fn init_theta(sh: &Shape, init: Option<&ArxModel>) -> Result<Vec<f64>, IdentErro
         });
     }
     let modulus = max_root_modulus(&m.a);
+    let mut f = m.a.clone();
     if modulus.is_nan() || modulus >= 1.0 {
-        return Err(IdentError::UnstableInitialModel { input: 0, modulus });
+        // The ARX fit this function made is stabilized (its roots reflected inside the unit
+        // circle); an initial model the caller gave is theirs to fix.
+        f = init
+            .is_none()
+            .then(|| stabilized(&m.a))
+            .flatten()
+            .ok_or(IdentError::UnstableInitialModel { input: 0, modulus })?;
     }
-    Ok(m.b.iter().flat_map(|bj| bj.iter().chain(&m.a).copied()).collect())
+    Ok(m.b.iter().flat_map(|bj| bj.iter().chain(&f).copied()).collect())
 }
 
 /// [`oe_with_options`] with default options (200 iterations, tolerance 1e-10).
@@ -193,8 +200,9 @@ pub fn oe(
 ///   N samples (no measured-output feedback).
 /// * Gradients by filtering (analytic, not finite differences): ψ_b = u(t−nk−i+1)/F,
 ///   ψ_f = −ŵ(t−i)/F, ŵ the simulated contribution of that input.
-/// * Initial θ: B_j and F_j = A of an ARX(na = nf, nb, nk) fit, or `init`; an unstable initial
-///   F is an error.
+/// * Initial θ: B_j and F_j = A of an ARX(na = nf, nb, nk) fit, its unstable roots reflected
+///   inside the unit circle ([`stabilized`](crate::linalg::stabilized)), or `init`; an unstable
+///   `init` is an error.
 /// * LM step: QR solve of [ψ; √μ D]δ = [e; 0], D = column norms of ψ. A step is accepted only if
 ///   every F_j stays stable (companion-matrix roots strictly inside the unit circle) and V
 ///   decreases; otherwise μ ← 10μ (up to 1e12). On acceptance μ ← μ/10.

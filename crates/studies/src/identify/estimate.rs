@@ -162,8 +162,14 @@ fn fit_output(
     };
     let (arx, _) = arx_select((&est.u, ye), (&val.u, yv), MAX_ARX_ORDER, &nk).map_err(fit_error)?;
     let n = arx.na.clamp(1, MAX_OE_ORDER);
-    let init =
+    let mut init =
         if arx.na == n { arx.clone() } else { plantwide_ident::arx(&est.u, ye, n, n, &nk).map_err(fit_error)? };
+    // OE starts from the ARX denominator with its unstable roots reflected inside the unit circle
+    // (a slow plant sampled coarsely gives an ARX pole at 1 by a hair); the ARX model itself is
+    // reported and judged as fitted.
+    if let Some(f) = plantwide_ident::stabilized(&init.a).filter(|f| *f != init.a) {
+        init.a = f;
+    }
     let oe_model = oe(&est.u, ye, n, n, &nk, Some(&init)).map_err(fit_error)?;
     let (fir_model, fir_validation, ridge) = best_fir(est, val, i, n_fir, &judge)?;
     Ok(vec![
