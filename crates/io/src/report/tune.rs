@@ -9,7 +9,7 @@ use std::path::Path;
 use plantwide_analysis::tf::TfModel;
 use plantwide_flowsheet::Plant;
 use plantwide_studies::identify::number as significant;
-use plantwide_studies::tune::flowsheet::{FlowsheetLoop, FlowsheetTuning, kc_text};
+use plantwide_studies::tune::flowsheet::{FlowsheetLoop, FlowsheetTuning, MIN_PHASE_MARGIN, kc_text};
 use plantwide_studies::tune::margins::Bode;
 use plantwide_studies::tune::plant_tests::{Linearity, StepTry};
 use plantwide_studies::tune::request::TunedLoops;
@@ -118,6 +118,13 @@ fn loops_table(out: &mut String, t: &FlowsheetTuning, plant: &Plant, tu: &TimeUn
             raised(t.unstable_at)
         ),
         None => w!(out, "tuning of `{}`: {}\n", plant.name(), t.method),
+    }
+    if let Some(f) = t.detuning_raised_from {
+        w!(
+            out,
+            "detuning raised from F = {f:.4}: the plant's exact linear model showed a loop alone unstable at it; \
+             doubled until each such loop keeps a {MIN_PHASE_MARGIN:.0}° phase margin\n"
+        );
     }
     let u = &tu.name;
     w!(

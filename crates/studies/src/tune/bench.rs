@@ -106,14 +106,17 @@ pub enum RelayError<E: std::error::Error> {
     },
     /// The cycles did not settle.
     #[error(
-        "no sustained cycle after {switches} relay switches (period spread {spread:.2} %): the loop may be \
-         integrating, or saturating at the relay amplitude; try a smaller amplitude or more switches"
+        "no sustained cycle after {switches} relay switches (spread of the last periods {spread:.2} %, of \
+         their amplitudes {amplitude_spread:.2} %): the loop may be integrating, or saturating at the relay \
+         amplitude; try a smaller amplitude or more switches"
     )]
     NotSustained {
         /// Switches taken.
         switches: usize,
         /// Spread of the last periods \[%\].
         spread: f64,
+        /// Spread of the last amplitudes \[%\].
+        amplitude_spread: f64,
     },
 }
 
@@ -157,7 +160,8 @@ pub fn relay<B: Bench>(bench: &mut B, u0: f64, s: &SampledRelay) -> Result<Relay
         }
     }
     let spread = spread_of(&periods(&switches, s.n_cycles)).0 * 100.0;
-    Err(RelayError::NotSustained { switches: switches.len(), spread })
+    let amplitude_spread = spread_of(&amplitudes(&extremes, s.n_cycles)).0 * 100.0;
+    Err(RelayError::NotSustained { switches: switches.len(), spread, amplitude_spread })
 }
 
 /// The periods of the last `n` cycles (a cycle is two switches).
@@ -167,6 +171,21 @@ fn periods(switches: &[f64], n: usize) -> Vec<f64> {
     }
     let t = &switches[switches.len() - 2 * n - 1..];
     (0..n).map(|k| t[2 * k + 2] - t[2 * k]).collect()
+}
+
+/// The amplitudes of the last `n` cycles: half each cycle's peak-to-peak over its two halves
+/// (none before `n` cycles).
+fn amplitudes(extremes: &[(f64, f64)], n: usize) -> Vec<f64> {
+    if extremes.len() < 2 * n {
+        return Vec::new();
+    }
+    let last = &extremes[extremes.len() - 2 * n..];
+    (0..n)
+        .map(|k| {
+            let (a, b) = (last[2 * k], last[2 * k + 1]);
+            0.5 * (a.1.max(b.1) - a.0.min(b.0))
+        })
+        .collect()
 }
 
 /// `(largest relative deviation from the mean, mean)`.
@@ -190,19 +209,17 @@ fn cycle<E: std::error::Error>(
         return Ok(None);
     }
     let (p_spread, pu) = spread_of(&periods(switches, n));
-    let last = &extremes[extremes.len() - 2 * n..];
-    // Each cycle's amplitude: half its peak-to-peak over its two halves.
-    let amps: Vec<f64> = (0..n)
-        .map(|k| {
-            let (a, b) = (last[2 * k], last[2 * k + 1]);
-            0.5 * (a.1.max(b.1) - a.0.min(b.0))
-        })
-        .collect();
-    let (a_spread, a) = spread_of(&amps);
+    let (a_spread, a) = spread_of(&amplitudes(extremes, n));
     if pu < 8.0 * s.scan {
         return Err(RelayError::Chatter { scans: 0.5 * pu / s.scan, period: pu, scan: s.scan });
     }
-    if p_spread > s.tolerance || a_spread > s.tolerance {
+    // Switches fall on the scan's grid, so a sustained cycle's periods jitter by a scan each way
+    // and its amplitudes with them (its half cycles are a scan longer or shorter): a spread of up
+    // to four scans in the period is that quantization, not a cycle still growing (generated
+    // plants 0x25299ef6fed046a2, 0x856e864a5c8f51ba: 0.3–1.2 % at P_u/200, never settling in 200
+    // switches against 1 %).
+    let allowed = s.tolerance.max(4.0 * s.scan / pu);
+    if p_spread > allowed || a_spread > allowed {
         return Ok(None);
     }
     let duty = above[above.len() - 2 * n..].iter().sum::<f64>() / (n as f64 * pu);

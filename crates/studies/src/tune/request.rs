@@ -18,7 +18,8 @@ use super::PiRule;
 use super::averaging::AveragingForm;
 use super::fit::ModelOrder;
 use super::flowsheet::{
-    FlowsheetTuning, averaging_loop, blt_loops, edits, flowsheet_margins, from_relay, from_step, raise_tau_c, written,
+    FlowsheetTuning, averaging_loop, blt_loops, edits, flowsheet_margins, from_relay, from_step, raise_detuning,
+    raise_tau_c, written,
 };
 use super::loops::{Measurement, PlantLoop, inner_first, plant_loop, plant_loops};
 use super::margins::Bode;
@@ -182,6 +183,7 @@ pub fn tune(plant: &Plant, x: &[f64], request: &TuneRequest) -> Result<TunedLoop
     let bode = match (request.method, request.tau_c.is_none()) {
         (Method::Simc, true) => raise_tau_c(plant, x, &mut tuning, (ModelRule::Simc, request.pid), measurement)?,
         (Method::Imc, true) => raise_tau_c(plant, x, &mut tuning, (ModelRule::Imc, request.pid), measurement)?,
+        (Method::Blt, _) => raise_detuning(plant, x, &mut tuning, measurement)?,
         _ => flowsheet_margins(plant, x, &mut tuning, measurement)?,
     };
     Ok(TunedLoops { tuning, bode })
