@@ -417,3 +417,34 @@ fn a_run_cut_short_by_the_length_asked_is_not_judged() {
         assert!((da - db).abs() <= 1e-3 * 0.2, "{da} vs {db}");
     }
 }
+
+/// A reactor in a recycle (generated plant 0x474959d22bbe512d): each design keeps the reactor's
+/// liquid volume at the file's (14 m² × 2.75 m), so its conversion, and every design's steady
+/// state exists and its run holds the limits. Sized at the file's level setpoint, the designs
+/// shrank the reactor to a fifth of its volume and the recycle had no steady state (exit 2).
+#[test]
+fn a_reactor_is_sized_at_its_own_liquid_volume() {
+    let fs = crate::harness::fixture("data/generated/recycle_474959d2.json");
+    let out = plantwide(&[
+        "size",
+        &fs,
+        "--vessel",
+        "reactor",
+        "--disturbance",
+        "fresh.F=+10%",
+        "--level-band",
+        "0.83 m",
+        "--max-outflow-rate",
+        "2.268 kmol/h/min",
+        "--json",
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let designs = v["designs"].as_array().unwrap();
+    assert_eq!(designs.len(), 3, "{v}");
+    for d in designs {
+        let volume = num(d, "area") * num(d, "normal_level");
+        assert!(abs_diff_eq!(volume, 14.0 * 2.75, epsilon = 1e-9 * 38.5), "{d}");
+        assert_eq!(d["verified"]["meets"], true, "{d}");
+    }
+}

@@ -276,6 +276,10 @@ pub struct Design {
     /// Column drum or base: the normal holdup run (mol), at least twice the band's.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub normal_holdup: Option<f64>,
+    /// A reactor: the level setpoint \[m\] that keeps its liquid volume at the file's (its
+    /// conversion depends on it), `setpoint × file's area / area`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub normal_level: Option<f64>,
     /// The design's time \[s\]: P's filter time, PI's `1/ω_n`, the optimal law's ramp time (the
     /// run's sampling and its minimum length are in units of it).
     pub design_time: f64,

@@ -207,6 +207,20 @@ fn table(s: &VesselSizing, plant: &Plant, u: &SizeUnits) -> String {
             ));
         }
     }
+    let kept: Vec<String> = s
+        .designs
+        .iter()
+        .filter_map(|d| {
+            d.normal_level
+                .map(|h| format!("{} {} {}", d.controller.name(), sig(u.length.difference(h)), u.length.unit()))
+        })
+        .collect();
+    if !kept.is_empty() {
+        t.push_str(&format!(
+            "a reactor: each design's level setpoint keeps its liquid volume, and so its conversion, at the file's: {}\n",
+            kept.join(", ")
+        ));
+    }
     t.push_str(&current_line(s, u));
     t
 }

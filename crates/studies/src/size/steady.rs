@@ -62,12 +62,7 @@ pub(super) fn design_steady(
             let reacts = v.plant.block_index(unit).is_some_and(|b| v.plant.blocks()[b].unit.reacts());
             let why = match (reacts, area < *a0) {
                 (false, _) => String::new(),
-                (true, smaller) => format!(
-                    "; a reactor's cross-section is also its volume at the setpoint, so its conversion: no steady \
-                     state was found with a reactor this {} — size surge elsewhere (`candidates`) or keep the \
-                     reactor's area",
-                    if smaller { "small" } else { "large" }
-                ),
+                (true, smaller) => reactor_why(v, *a0, area, normal, smaller),
             };
             let path = Path {
                 at: &|s: f64| build(a0 * (area / a0).powf(s)),
@@ -187,6 +182,25 @@ fn scale_holdup(plant: &Plant, guess: &mut [f64], measurement: &str, factor: f64
         if info.path == measurement || parts.has_element(&info.path) {
             guess[k] *= factor;
         }
+    }
+}
+
+/// Why a reactor's design (cross-section `area`, level setpoint `normal`; the file's `a0`) may
+/// have no steady state: its volume is its conversion.
+fn reactor_why(v: &Vessel, a0: f64, area: f64, normal: Option<f64>, smaller: bool) -> String {
+    let (file, held) = (a0 * v.sp, area * normal.unwrap_or(v.sp));
+    let how = if smaller { "small" } else { "large" };
+    if held > file * (1.0 + 1e-9) {
+        format!(
+            "; a reactor's volume is also its conversion: this design's band needs a level setpoint of twice the \
+             band, so it holds {held:.4} m³ against the file's {file:.4} m³, and no steady state was found with a \
+             reactor this {how} — size surge elsewhere (`candidates`) or allow a narrower band"
+        )
+    } else {
+        format!(
+            "; the reactor's liquid volume was kept at the file's ({file:.4} m³, its level setpoint moved with its \
+             area), yet no steady state was found with a reactor this {how} — size surge elsewhere (`candidates`)"
+        )
     }
 }
 

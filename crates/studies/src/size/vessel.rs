@@ -136,6 +136,12 @@ impl Vessel {
         Ok(v)
     }
 
+    /// Whether the vessel is a unit with reactions (its volume sets its conversion).
+    pub fn reacts(&self) -> bool {
+        let Kind::Area { unit, new_on: None, .. } = &self.kind else { return false };
+        self.plant.block_index(unit).is_some_and(|b| self.plant.blocks()[b].unit.reacts())
+    }
+
     /// The band must fit between the vessel's bottom and top around the setpoint.
     fn check_band(&self, band: f64) -> Result<(), SizeError> {
         let Kind::Area { height, new_on: None, .. } = &self.kind else { return Ok(()) };
