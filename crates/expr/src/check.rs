@@ -231,8 +231,11 @@ impl Checker<'_> {
         for (o, e) in out.iter_mut().zip(base.dim.exponents()) {
             let scaled = f64::from(e) * p;
             let rounded = scaled.round();
-            if (scaled - rounded).abs() > 1e-9 || rounded.abs() > f64::from(i8::MAX) {
+            if (scaled - rounded).abs() > 1e-9 {
                 return self.err(span, ErrorKind::FractionalPower { dim: base.dim, exponent: p });
+            }
+            if rounded.abs() > f64::from(i8::MAX) {
+                return self.err(span, ErrorKind::DimensionOverflow);
             }
             *o = rounded as i8;
         }

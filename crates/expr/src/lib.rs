@@ -55,6 +55,8 @@ mod structure;
 mod symbols;
 mod table;
 mod tape;
+#[doc(hidden)]
+pub mod testing;
 
 pub use compiled::{Equation, Expression, Gradient};
 pub use error::{ErrorKind, ExprError, SymbolError};
