@@ -1,6 +1,5 @@
 //! Checked and compiled equations and expressions: the types a unit model holds.
 
-use num_dual::Dual64;
 use plantwide_thermo::Scalar;
 use plantwide_units::Dimension;
 
@@ -8,7 +7,7 @@ use crate::check::{check_equation, check_expression};
 use crate::error::ExprError;
 use crate::parse::{parse_equation, parse_expression};
 use crate::symbols::SymbolTable;
-use crate::tape::{Tape, compile, compile_residual};
+use crate::tape::{Tape, Workspace, compile, compile_residual};
 
 /// An equation `lhs = rhs`, parsed, checked against a [`SymbolTable`] and compiled; its residual
 /// is `lhs − rhs`, in [`Equation::dimension`].
@@ -54,22 +53,26 @@ impl Equation {
 
     /// The residual and its exact partial derivatives with respect to the variables and the
     /// derivatives it reads (in the order of [`Equation::variables`] and
-    /// [`Equation::derivatives`]), by one `Dual64` pass per dependency.
+    /// [`Equation::derivatives`]), by reverse mode ([`Tape::gradient_in`]). Allocates; use
+    /// [`Equation::gradient_in`] in loops.
     pub fn gradient(&self, x: &[f64], dx: &[f64]) -> Gradient {
-        let mut xd: Vec<Dual64> = x.iter().map(|&v| Dual64::from(v)).collect();
-        let mut dxd: Vec<Dual64> = dx.iter().map(|&v| Dual64::from(v)).collect();
-        let mut res = Gradient { value: self.tape.eval(x, dx), ..Gradient::default() };
-        for &i in self.variables() {
-            xd[i].eps = 1.0;
-            res.d_x.push(self.tape.eval(&xd, &dxd).eps);
-            xd[i].eps = 0.0;
+        let (n_x, n_dx) = self.tape.required_lengths();
+        let (mut d_x, mut d_dx) = (vec![0.0; n_x], vec![0.0; n_dx]);
+        let value = self.tape.gradient_in(x, dx, &mut Workspace::new(), &mut d_x, &mut d_dx);
+        Gradient {
+            value,
+            d_x: self.variables().iter().map(|&i| d_x[i]).collect(),
+            d_dx: self.derivatives().iter().map(|&i| d_dx[i]).collect(),
         }
-        for &i in self.derivatives() {
-            dxd[i].eps = 1.0;
-            res.d_dx.push(self.tape.eval(&xd, &dxd).eps);
-            dxd[i].eps = 0.0;
-        }
-        res
+    }
+
+    /// The residual, with `∂r/∂x[i]` added to `d_x[i]` and `∂r/∂ẋ[i]` to `d_dx[i]` (dense
+    /// slices indexed like `x` and `dx`); see [`Tape::gradient_in`].
+    ///
+    /// # Panics
+    /// If a slice is shorter than [`Tape::required_lengths`].
+    pub fn gradient_in(&self, x: &[f64], dx: &[f64], ws: &mut Workspace, d_x: &mut [f64], d_dx: &mut [f64]) -> f64 {
+        self.tape.gradient_in(x, dx, ws, d_x, d_dx)
     }
 
     /// Evaluates at the guess and refuses what would stop Newton at its first step: a

@@ -65,7 +65,7 @@ pub use span::{Span, render_caret};
 pub use structure::{Matching, StructuralError, StructureMode, check_structure, maximum_matching};
 pub use symbols::{Symbol, SymbolTable, VarKind};
 pub use table::{Interpolation, Table, TableError};
-pub use tape::{INLINE_SLOTS, Tape};
+pub use tape::{INLINE_SLOTS, Tape, Workspace};
 
 /// The longest equation or expression text accepted, in bytes (a long energy balance is a few
 /// hundred).

@@ -203,6 +203,9 @@ fn or_expr(i: &mut Input<'_>, depth: usize) -> PResult<Expr> {
         let rhs = and_expr(i, depth)?;
         let span = lhs.span.join(rhs.span);
         lhs = Expr::new(ExprKind::Or(Box::new(lhs), Box::new(rhs)), span);
+        if lhs.depth > MAX_DEPTH {
+            return Err(too_deep());
+        }
     }
 }
 
@@ -217,6 +220,9 @@ fn and_expr(i: &mut Input<'_>, depth: usize) -> PResult<Expr> {
         let rhs = not_expr(i, depth)?;
         let span = lhs.span.join(rhs.span);
         lhs = Expr::new(ExprKind::And(Box::new(lhs), Box::new(rhs)), span);
+        if lhs.depth > MAX_DEPTH {
+            return Err(too_deep());
+        }
     }
 }
 
@@ -276,6 +282,10 @@ fn chain(
         let rhs = operand(i, depth)?;
         let span = lhs.span.join(rhs.span);
         lhs = Expr::new(ExprKind::Binary(op, Box::new(lhs), Box::new(rhs)), span);
+        // A long flat chain is a deep tree: stop growing it as soon as it is too deep.
+        if lhs.depth > MAX_DEPTH {
+            return Err(too_deep());
+        }
     }
 }
 

@@ -5,11 +5,18 @@
 //! Constant sub-expressions (numbers, parameters and anything computed only from them) are
 //! folded at compile time, and `x + 0`, `x*1`, `x/1` vanish. `if` compiles to a conditional jump
 //! over the branch not taken, so the branch not taken is not evaluated (a `sqrt` of a negative
-//! there is harmless), and both branches count in the sparsity pattern.
+//! there is harmless), and both branches count in the sparsity pattern (a constant condition
+//! keeps only its branch). Variables and derivatives are loaded into their slots once, before
+//! the instructions run.
+//!
+//! Two ways to differentiate: evaluate over `Dual64` with one seeded direction per pass (how
+//! the engine differentiates its built-in units), or [`Tape::gradient_in`], reverse mode, which
+//! gives a whole row of the Jacobian in about three `f64` passes.
 
 use std::collections::BTreeSet;
 use std::convert::Infallible;
 
+use num_dual::Dual64;
 use plantwide_thermo::Scalar;
 
 use crate::ast::{BinOp, CmpOp, Expr, ExprKind, Func};
@@ -24,10 +31,6 @@ type Slot = u32;
 /// One operation; the destination slot is in [`Instr`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) enum Op {
-    /// `x[i]`
-    X(u32),
-    /// `dx[i]`
-    Dx(u32),
     /// A constant materialised in a slot (for operations without an immediate form).
     Const(f64),
     Add(Slot, Slot),
@@ -81,6 +84,25 @@ struct InstrSpans {
     operand: Span,
 }
 
+/// Where a variable slot is loaded from before the instructions run.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Source {
+    /// `x[i]`
+    X(u32),
+    /// `dx[i]`
+    Dx(u32),
+}
+
+/// A slot filled from `x` or `dx` by the prologue (each variable once, however often it is
+/// named), so that the instruction loop only computes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Load {
+    slot: Slot,
+    src: Source,
+    /// The first place the name appears, for a non-finite guess value.
+    span: Span,
+}
+
 /// A value during compilation: a folded constant or a slot.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Val {
@@ -95,6 +117,7 @@ pub const INLINE_SLOTS: usize = 48;
 /// derivative indices it reads (its sparsity).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Tape {
+    loads: Vec<Load>,
     code: Vec<Instr>,
     spans: Vec<InstrSpans>,
     n_slots: usize,
@@ -106,14 +129,20 @@ pub struct Tape {
 }
 
 impl Tape {
-    /// Number of instructions (0 when the expression folded to a constant).
+    /// Number of instructions, not counting the loads of variables and derivatives (each
+    /// loaded once before the instructions run).
     pub fn len(&self) -> usize {
         self.code.len()
     }
 
-    /// Whether the tape has no instructions (a constant).
+    /// Whether the tape has no instructions (a constant, or a lone variable).
     pub fn is_empty(&self) -> bool {
         self.code.is_empty()
+    }
+
+    /// Whether the expression folded to a constant (it reads no variable).
+    pub fn is_constant(&self) -> bool {
+        matches!(self.out, Val::Const(_))
     }
 
     /// Indices into `x` that the expression reads, sorted, each once.
@@ -167,6 +196,14 @@ impl Tape {
     }
 
     fn run<S: Scalar, H: Hook<S>>(&self, x: &[S], dx: &[S], v: &mut [S], hook: &mut H) -> Result<S, H::Err> {
+        for load in &self.loads {
+            let val = match load.src {
+                Source::X(i) => x[i as usize],
+                Source::Dx(i) => dx[i as usize],
+            };
+            hook.load(load, val)?;
+            v[load.slot as usize] = val;
+        }
         let mut pc = 0;
         while let Some(ins) = self.code.get(pc) {
             let k = pc;
@@ -184,7 +221,7 @@ impl Tape {
                 }
                 op => {
                     hook.before(k, &op, v)?;
-                    self.apply(op, x, dx, v)
+                    self.apply(op, v)
                 }
             };
             hook.after(k, val)?;
@@ -197,11 +234,9 @@ impl Tape {
     }
 
     #[inline(always)]
-    fn apply<S: Scalar>(&self, op: Op, x: &[S], dx: &[S], v: &[S]) -> S {
+    fn apply<S: Scalar>(&self, op: Op, v: &[S]) -> S {
         let at = |s: Slot| v[s as usize];
         match op {
-            Op::X(i) => x[i as usize],
-            Op::Dx(i) => dx[i as usize],
             Op::Const(c) => S::from(c),
             Op::Add(a, b) => at(a) + at(b),
             Op::Sub(a, b) => at(a) - at(b),
@@ -227,6 +262,139 @@ impl Tape {
             Op::Mov(a) => at(a),
             Op::JumpIfFalse(..) | Op::Jump(_) => S::from(0.0),
         }
+    }
+}
+
+/// Reusable buffers for [`Tape::gradient_in`], so that repeated gradients do not allocate.
+#[derive(Debug, Clone, Default)]
+pub struct Workspace {
+    values: Vec<f64>,
+    adjoints: Vec<f64>,
+    trace: Vec<u32>,
+}
+
+impl Workspace {
+    /// Empty buffers; they grow to the largest tape used with them.
+    pub fn new() -> Self {
+        Self::default()
+    }
+}
+
+impl Tape {
+    /// The value and its exact gradient by reverse mode (the adjoint of the tape): one `f64`
+    /// pass forward that records the instructions executed, one pass back over them that
+    /// accumulates `∂value/∂slot` (Griewank & Walther, *Evaluating Derivatives*, 2nd ed., SIAM
+    /// 2008, §3.2). Costs a few forward passes however many variables the expression reads,
+    /// where forward-mode duals cost one pass per variable. The partials are **added** to
+    /// `d_x[i]` and `d_dx[i]` at the indices of [`Tape::variables`] and [`Tape::derivatives`]
+    /// (zero them first, or accumulate `∂F/∂x + cj·∂F/∂ẋ` by pre-scaling is up to the caller).
+    ///
+    /// The derivatives are those of the branch taken by `if`, `min` and `max`, and of the
+    /// interval a table lookup falls in, as with dual numbers.
+    ///
+    /// # Panics
+    /// If `x`, `dx`, `d_x` or `d_dx` is shorter than [`Tape::required_lengths`].
+    pub fn gradient_in(&self, x: &[f64], dx: &[f64], ws: &mut Workspace, d_x: &mut [f64], d_dx: &mut [f64]) -> f64 {
+        ws.values.clear();
+        ws.values.resize(self.n_slots, 0.0);
+        ws.trace.clear();
+        let value = match self.run(x, dx, &mut ws.values, &mut Trace(&mut ws.trace)) {
+            Ok(v) => v,
+            Err(never) => match never {},
+        };
+        let Val::Slot(out) = self.out else { return value };
+        ws.adjoints.clear();
+        ws.adjoints.resize(self.n_slots, 0.0);
+        ws.adjoints[out as usize] = 1.0;
+        for &k in ws.trace.iter().rev() {
+            let ins = self.code[k as usize];
+            let g = ws.adjoints[ins.dst as usize];
+            if g != 0.0 {
+                self.adjoint(ins, g, &ws.values, &mut ws.adjoints);
+            }
+        }
+        for load in &self.loads {
+            let g = ws.adjoints[load.slot as usize];
+            match load.src {
+                Source::X(i) => d_x[i as usize] += g,
+                Source::Dx(i) => d_dx[i as usize] += g,
+            }
+        }
+        value
+    }
+
+    /// Adds `g · ∂(ins)/∂(operand)` to each operand's adjoint.
+    fn adjoint(&self, ins: Instr, g: f64, v: &[f64], adj: &mut [f64]) {
+        let at = |s: Slot| v[s as usize];
+        let out = v[ins.dst as usize];
+        let mut add = |s: Slot, d: f64| adj[s as usize] += d;
+        match ins.op {
+            Op::Add(a, b) => {
+                add(a, g);
+                add(b, g);
+            }
+            Op::Sub(a, b) => {
+                add(a, g);
+                add(b, -g);
+            }
+            Op::Mul(a, b) => {
+                add(a, g * at(b));
+                add(b, g * at(a));
+            }
+            Op::Div(a, b) => {
+                add(a, g / at(b));
+                add(b, -g * out / at(b));
+            }
+            Op::AddC(a, _) | Op::Mov(a) => add(a, g),
+            Op::CSub(_, a) | Op::Neg(a) => add(a, -g),
+            Op::MulC(a, c) => add(a, g * c),
+            Op::DivC(a, c) => add(a, g / c),
+            Op::CDiv(_, a) => add(a, -g * out / at(a)),
+            Op::Powi(a, n) => add(a, if n == 0 { 0.0 } else { g * f64::from(n) * at(a).powi(n - 1) }),
+            Op::Powf(a, p) => add(a, g * p * at(a).powf(p - 1.0)),
+            Op::Pow(a, b) => {
+                add(a, g * out * at(b) / at(a));
+                add(b, g * out * at(a).ln());
+            }
+            Op::Func1(f, a) => add(a, g * func1_derivative(f, at(a), out)),
+            Op::Func2(Func::Min | Func::Max, a, b) => {
+                let first = if matches!(ins.op, Op::Func2(Func::Min, ..)) { at(a) <= at(b) } else { at(a) >= at(b) };
+                add(if first { a } else { b }, g);
+            }
+            Op::Func2(_, a, b) => {
+                add(a, g * at(a) / out);
+                add(b, g * at(b) / out);
+            }
+            Op::Func3(f, a, b, e) => {
+                let (d, eps) = (at(a) - at(b), at(e));
+                let root = (d * d + eps * eps).sqrt();
+                let sign = if f == Func::SmoothMax { 1.0 } else { -1.0 };
+                add(a, g * 0.5 * (1.0 + sign * d / root));
+                add(b, g * 0.5 * (1.0 - sign * d / root));
+                add(e, g * 0.5 * sign * eps / root);
+            }
+            Op::Table(t, a) => add(a, g * self.tables[t as usize].eval(Dual64::new(at(a), 1.0)).eps),
+            Op::Const(_) | Op::Cmp(..) | Op::And(..) | Op::Or(..) | Op::Not(_) | Op::JumpIfFalse(..) | Op::Jump(_) => {}
+        }
+    }
+}
+
+/// d f(a)/da for the one-argument built-ins, given `a` and `out = f(a)`.
+fn func1_derivative(f: Func, a: f64, out: f64) -> f64 {
+    match f {
+        Func::Exp => out,
+        Func::Ln => 1.0 / a,
+        Func::Log10 => 1.0 / (a * std::f64::consts::LN_10),
+        Func::Sqrt => 0.5 / out,
+        // As num-dual's `abs`: +1 for +0.0 and positive numbers, −1 otherwise.
+        Func::Abs => {
+            if a.is_sign_positive() {
+                1.0
+            } else {
+                -1.0
+            }
+        }
+        _ => f64::NAN,
     }
 }
 
@@ -286,6 +454,7 @@ pub(crate) fn func3<S: Scalar>(f: Func, a: S, b: S, eps: S) -> S {
 /// Observes evaluation; the unchecked path compiles to nothing.
 trait Hook<S> {
     type Err;
+    fn load(&mut self, load: &Load, val: S) -> Result<(), Self::Err>;
     fn before(&mut self, k: usize, op: &Op, v: &[S]) -> Result<(), Self::Err>;
     fn after(&mut self, k: usize, val: S) -> Result<(), Self::Err>;
 }
@@ -295,11 +464,35 @@ struct Unchecked;
 impl<S> Hook<S> for Unchecked {
     type Err = Infallible;
     #[inline(always)]
+    fn load(&mut self, _: &Load, _: S) -> Result<(), Infallible> {
+        Ok(())
+    }
+    #[inline(always)]
     fn before(&mut self, _: usize, _: &Op, _: &[S]) -> Result<(), Infallible> {
         Ok(())
     }
     #[inline(always)]
     fn after(&mut self, _: usize, _: S) -> Result<(), Infallible> {
+        Ok(())
+    }
+}
+
+/// Records the instructions executed, for the reverse pass.
+struct Trace<'a>(&'a mut Vec<u32>);
+
+impl<S> Hook<S> for Trace<'_> {
+    type Err = Infallible;
+    #[inline(always)]
+    fn load(&mut self, _: &Load, _: S) -> Result<(), Infallible> {
+        Ok(())
+    }
+    #[inline(always)]
+    fn before(&mut self, _: usize, _: &Op, _: &[S]) -> Result<(), Infallible> {
+        Ok(())
+    }
+    #[inline(always)]
+    fn after(&mut self, k: usize, _: S) -> Result<(), Infallible> {
+        self.0.push(k as u32);
         Ok(())
     }
 }
@@ -312,6 +505,14 @@ struct GuessCheck<'a> {
 
 impl Hook<f64> for GuessCheck<'_> {
     type Err = ExprError;
+
+    fn load(&mut self, load: &Load, val: f64) -> Result<(), ExprError> {
+        if val.is_finite() {
+            Ok(())
+        } else {
+            Err(ExprError::new(self.text, load.span, ErrorKind::NonFinite { value: val }))
+        }
+    }
 
     fn before(&mut self, k: usize, op: &Op, v: &[f64]) -> Result<(), ExprError> {
         let at = |s: &Slot| v[*s as usize];
@@ -359,6 +560,7 @@ pub(crate) fn compile_residual(text: &str, symbols: &SymbolTable, lhs: &Expr, rh
 struct Compiler<'a> {
     text: &'a str,
     symbols: &'a SymbolTable,
+    loads: Vec<Load>,
     code: Vec<Instr>,
     spans: Vec<InstrSpans>,
     n_slots: u32,
@@ -373,6 +575,7 @@ impl<'a> Compiler<'a> {
         Compiler {
             text,
             symbols,
+            loads: Vec::new(),
             code: Vec::new(),
             spans: Vec::new(),
             n_slots: 0,
@@ -385,6 +588,7 @@ impl<'a> Compiler<'a> {
 
     fn finish(self, out: Val, out_span: Span) -> Tape {
         Tape {
+            loads: self.loads,
             code: self.code,
             spans: self.spans,
             n_slots: self.n_slots as usize,
@@ -479,7 +683,7 @@ impl<'a> Compiler<'a> {
             Some(Symbol::Parameter { value, .. }) => Val::Const(*value),
             Some(Symbol::Variable { index, .. }) => {
                 self.vars.insert(*index);
-                self.emit(Op::X(*index as u32), span, span)
+                self.load(Source::X(*index as u32), span)
             }
             // The checker has refused unknown names and tables used as values.
             _ => Val::Const(f64::NAN),
@@ -490,10 +694,20 @@ impl<'a> Compiler<'a> {
         match self.symbols.get(name) {
             Some(Symbol::Variable { index, .. }) => {
                 self.ders.insert(*index);
-                self.emit(Op::Dx(*index as u32), span, span)
+                self.load(Source::Dx(*index as u32), span)
             }
             _ => Val::Const(f64::NAN),
         }
+    }
+
+    /// The slot holding `src`, loaded once by the prologue.
+    fn load(&mut self, src: Source, span: Span) -> Val {
+        if let Some(load) = self.loads.iter().find(|l| l.src == src) {
+            return Val::Slot(load.slot);
+        }
+        let slot = self.new_slot();
+        self.loads.push(Load { slot, src, span });
+        Val::Slot(slot)
     }
 
     fn lookup(&mut self, name: &str, arg: &Expr, span: Span) -> Result<Val, ExprError> {
