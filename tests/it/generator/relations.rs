@@ -195,7 +195,11 @@ pub fn first_difference(a: &Value, b: &Value, rel: f64, ignore: &[&str], path: &
     first_difference_beyond(a, b, &[], rel, ignore, path)
 }
 
-/// [`first_difference`], each number allowed to differ by twice as much as `a`'s differs from the
+/// How many times the spread of the answers to the same question with its inputs moved by their
+/// last bit another answer may differ by (a few samples of that spread see less than its largest).
+const JITTER_FACTOR: f64 = 3.0;
+
+/// [`first_difference`], each number allowed to differ by [`JITTER_FACTOR`] times as much as `a`'s differs from the
 /// same number of the answers in `jitter` (if more than `rel`): the same question with its inputs
 /// moved by their last bit, so the answer's own conditioning. An answer whose figures move by 1 %
 /// when a limit moves by 10⁻¹⁶ is ill-conditioned, which this does not judge; what it judges is
@@ -232,7 +236,7 @@ pub fn first_difference_beyond(
                 .filter_map(|j| j.as_f64())
                 .map(|j| (p - j).abs() / p.abs().max(j.abs()).max(1e-300))
                 .fold(0.0, f64::max);
-            let allowed = rel.max(2.0 * spread);
+            let allowed = rel.max(JITTER_FACTOR * spread);
             (!relative_eq!(p, q, epsilon = 1e-300, max_relative = allowed)).then(|| {
                 let moved =
                     if spread > 0.0 { format!(" (a last-bit change moves it {spread:.1e})") } else { String::new() };

@@ -100,22 +100,20 @@ pub fn size_relations(cx: &mut Cx<'_>, pick: usize) {
         // accuracy `size` states for them, the tolerance its verdicts are judged to: a design
         // refined once more on one side of that edge differs by a fraction of it (5e-4 seen), and
         // a check run recorded over another length finds its peak between other samples (1e-4).
-        // Beyond that, by the answer's own conditioning: the same limits moved by one bit either
-        // way in the same units. The optimal law's peak outflow rate, where the level nears its
+        // Beyond that, by the answer's own conditioning: each limit moved by one bit either way
+        // in the same units. The optimal law's peak outflow rate, where the level nears its
         // planned edge, goes as v²/(2 × the room left) and moved by 0.8–1.8 % (plants
         // 0x0eee6541ab4671ef, 0x3f0528ec23b35951), a refinement more or less by 0.2 % of the
-        // planned band (0x25e7509f3d978deb), in SI as much as in other units.
+        // planned band (0x25e7509f3d978deb), in SI as much as in other units; the band in feet came
+        // back one bit above 0.75 m and moved the optimal design's planned band by 6e-6 and its
+        // rate by 3.3e-3 (0xf2c8f3ffd416849e), where both limits nudged together moved it 8e-4.
         let tolerance = plantwide::studies::size::VERIFY_TOLERANCE;
-        let nudged = |x: f64, up: bool| f64::from_bits(if up { x.to_bits() + 1 } else { x.to_bits() - 1 });
-        let jitter: Vec<Value> = [true, false]
+        let nudged = |x: f64, by: i64| f64::from_bits(x.to_bits().wrapping_add_signed(by));
+        let jitter: Vec<Value> = [(1, 0), (-1, 0), (0, 1), (0, -1)]
             .into_iter()
-            .filter_map(|up| {
-                let out = size(
-                    cx,
-                    vessel,
-                    &format!("{} m", nudged(band, up)),
-                    &format!("{} kmol/h/min", nudged(per_min, up)),
-                );
+            .filter_map(|(b, q)| {
+                let out =
+                    size(cx, vessel, &format!("{} m", nudged(band, b)), &format!("{} kmol/h/min", nudged(per_min, q)));
                 out.1
             })
             .collect();
