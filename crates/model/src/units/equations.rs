@@ -1,0 +1,540 @@
+//! A unit written as equations in the flowsheet file (issue 57): parameters with units, its own
+//! differential and algebraic variables, equations as text, inlet and outlet ports and inputs.
+//!
+//! ```json
+//! {"type": "equations",
+//!  "parameters": {"area": "0.5 m2", "rho": "1e4 mol/m3", "k": "2 mol/(s*m)"},
+//!  "variables": {"M": {"kind": "differential", "unit": "mol", "guess": 5000},
+//!                "level": {"kind": "algebraic", "unit": "m", "guess": 1, "lower": 0}},
+//!  "equations": ["der(M) = in.F - out.F", "level*area*rho = M"],
+//!  "ports": {"inlets": ["in"],
+//!            "outlets": {"out": {"F": "k*level", "T": "in.T", "P": "in.P", "x[A]": "in.x[A]", "x[B]": "in.x[B]"}}}}
+//! ```
+//!
+//! # Names in equations
+//! Parameters and inputs by their names, own variables by theirs, and every port's stream
+//! quantities as `<port>.F`, `<port>.T`, `<port>.P`, `<port>.h` and `<port>.x[<component>]`.
+//!
+//! # Layout and the mass matrix
+//! Own variables are the outlet streams (`[F, T, P, h, x…]` each, ports in name order), then the
+//! `variables` in name order. Every name is bound to its slot of the unit's *local vector*, so the
+//! compiled tapes read [`UnitIo::local`] directly (no copy) with an empty `dx`.
+//!
+//! The engine's DAE is semi-explicit, `M x' = f(x)`: the residual of a differential variable is
+//! its time derivative. So each differential variable needs exactly one equation
+//! `der(x) = rhs` with `rhs` free of `der()`; its residual is `rhs` (not `der(x) − rhs`), written
+//! at the variable's own row, where the mass matrix has its 1. Every other equation is algebraic,
+//! residual `lhs − rhs`, placed at the row of the algebraic unknown a perfect matching assigns it
+//! (`check_structure` in dynamic mode): so the unit is square and its rows pair with unknowns.
+//!
+//! # Ports
+//! Inlets are read as known values. Each outlet maps its stream quantities to expressions: `F`,
+//! `T`, `P` and every `x[c]` must be given (each is the equation `out.Q = expr`); `h` may be given,
+//! else it is the liquid enthalpy `h = h_L(T, x)` of the thermodynamic package (the expression
+//! layer has no thermodynamic functions yet).
+//!
+//! # Checks at load
+//! Names, dimensions (both sides, each outlet mapping against its stream quantity), the `der()`
+//! form, a structurally singular set (dynamic mode), and each equation evaluated at the guesses
+//! (variables at their `guess`, inlets at 1 mol/s, 300 K, 1 bar, h = 0, uniform x): a division by
+//! zero or a logarithm of a non-positive number there is refused with its position.
+
+use std::collections::BTreeMap;
+
+use plantwide_expr::{Equation, Expression, StructureMode, SymbolTable, check_structure, parse_equation};
+use plantwide_units::{Dimension, QuantityValue, Unit as UnitOfMeasure, parse_quantity};
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+use crate::stream::{F, H, P, T, Z0};
+use crate::{BuildCx, FieldError, InputSpec, LocalLayout, Scalar, UnitIo, UnitModel, VarSpec};
+
+/// Whether a variable of an equations unit has a time derivative.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum EqVarKind {
+    /// Given by one equation `der(x) = rhs`.
+    Differential,
+    /// Determined by the algebraic equations.
+    Algebraic,
+}
+
+/// One variable of an equations unit; `guess`, `nominal`, `lower` and `upper` are in `unit`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct EqVariableConfig {
+    /// Differential or algebraic.
+    pub kind: EqVarKind,
+    /// Unit of the values below and hence the variable's dimension (`"mol"`, `"K"`,
+    /// `"mol/m3"`; default dimensionless).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub unit: Option<String>,
+    /// Typical magnitude, for scaling (default: |guess|, or 1 if that is 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub nominal: Option<f64>,
+    /// Initial guess (default: the nominal, else 0 … within the bounds).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub guess: Option<f64>,
+    /// Lower bound Newton honours (default none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lower: Option<f64>,
+    /// Upper bound Newton honours (default none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub upper: Option<f64>,
+}
+
+/// The ports of an equations unit.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct EqPortsConfig {
+    /// Inlet port names; their stream quantities (`in.F`, `in.x[A]`, …) are known values.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub inlets: Vec<String>,
+    /// Outlet ports by name, each mapping its stream quantities (`F`, `T`, `P`, `x[<c>]`, and
+    /// optionally `h`) to an expression.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub outlets: BTreeMap<String, BTreeMap<String, String>>,
+}
+
+/// Flowsheet description of a unit written as equations.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct EquationsConfig {
+    /// Constants by name, with units (`"0.5 m3"`, `"80 kJ/mol"`; a bare number is dimensionless).
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub parameters: BTreeMap<String, QuantityValue>,
+    /// Manipulable inputs by name, with units and their value when no controller drives them.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub inputs: BTreeMap<String, QuantityValue>,
+    /// The unit's own variables by name.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub variables: BTreeMap<String, EqVariableConfig>,
+    /// Equations as text (`"der(M) = in.F - out.F"`).
+    pub equations: Vec<String>,
+    /// Inlet and outlet ports.
+    #[serde(default)]
+    pub ports: EqPortsConfig,
+    /// Names of the variables that can be measured (default none listed).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub outputs: Vec<String>,
+}
+
+impl crate::registry::UnitConfig for EquationsConfig {
+    fn ports() -> &'static str {
+        "the inlets and outlets its `ports` name"
+    }
+}
+
+/// How a compiled equation writes its residual.
+#[derive(Debug, Clone, PartialEq)]
+enum Row {
+    /// `der(x) = rhs`: the residual is `rhs` (the time derivative of own variable `row`).
+    Derivative { row: usize, rhs: Expression },
+    /// `lhs = rhs`: the residual is `lhs − rhs`.
+    Algebraic { row: usize, eq: Equation },
+}
+
+/// A unit written as equations.
+#[derive(Debug, Clone)]
+pub struct Equations {
+    inlets: Vec<String>,
+    outlets: Vec<String>,
+    internal: Vec<VarSpec>,
+    guesses: Vec<f64>,
+    inputs: Vec<InputSpec>,
+    rows: Vec<Row>,
+    /// The field each row comes from (`equations[2]`, `ports.outlets.out.F`).
+    fields: Vec<String>,
+    /// The outlets' mappings `out.Q = expr` by the local index of `out.Q`, for the guess.
+    maps: Vec<(usize, Equation)>,
+    /// Own rows of outlet enthalpies closed by the unit as `h = h_L(T, x)`: the outlet's index.
+    default_h: Vec<usize>,
+    /// Names of own rows, for diagnostics.
+    row_names: BTreeMap<usize, String>,
+    outputs: Vec<String>,
+}
+
+/// Stream quantities of a port, with their offsets in a stream block and dimensions.
+fn stream_names(port: &str, components: &[String]) -> Vec<(String, usize, Dimension)> {
+    let mut v = vec![
+        (format!("{port}.F"), F, Dimension::MOLAR_FLOW),
+        (format!("{port}.T"), T, Dimension::TEMPERATURE),
+        (format!("{port}.P"), P, Dimension::PRESSURE),
+        (format!("{port}.h"), H, Dimension::MOLAR_ENERGY),
+    ];
+    v.extend(components.iter().enumerate().map(|(i, c)| (format!("{port}.x[{c}]"), Z0 + i, Dimension::DIMENSIONLESS)));
+    v
+}
+
+impl Equations {
+    /// Build from the flowsheet description.
+    pub fn build(c: &EquationsConfig, mut cx: BuildCx<'_>, _links: ()) -> Result<Equations, Vec<FieldError>> {
+        let comps = cx.components.to_vec();
+        let nc = comps.len();
+        let len = Z0 + nc;
+        let outlets: Vec<String> = c.ports.outlets.keys().cloned().collect();
+        let inlets = c.ports.inlets.clone();
+        let n_out = outlets.len();
+        let n_own = n_out * len + c.variables.len();
+        let inlets_at = n_own;
+        let inputs_at = inlets_at + inlets.len() * len;
+        let mut symbols = SymbolTable::new();
+        let declare = |cx: &mut BuildCx<'_>, field: &str, r: Result<(), plantwide_expr::SymbolError>| {
+            if let Err(e) = r {
+                cx.error(field, e.to_string());
+            }
+        };
+        for (name, q) in &c.parameters {
+            let field = format!("parameters.{name}");
+            let parsed = match q {
+                QuantityValue::Number(x) => Ok(plantwide_units::Quantity::new(*x, Dimension::DIMENSIONLESS)),
+                QuantityValue::Text(s) => parse_quantity(s),
+            };
+            match parsed {
+                Ok(q) => declare(&mut cx, &field, symbols.add_parameter(name, q.value_si, q.dim)),
+                Err(e) => cx.error(&field, e.to_string()),
+            }
+        }
+        let mut inputs = Vec::new();
+        for (k, (name, q)) in c.inputs.iter().enumerate() {
+            let field = format!("inputs.{name}");
+            let parsed = match q {
+                QuantityValue::Number(x) => Ok(plantwide_units::Quantity::new(*x, Dimension::DIMENSIONLESS)),
+                QuantityValue::Text(s) => parse_quantity(s),
+            };
+            match parsed {
+                Ok(q) => {
+                    let r = symbols.add_variable(name, inputs_at + k, q.dim, plantwide_expr::VarKind::Algebraic);
+                    declare(&mut cx, &field, r);
+                    inputs.push(InputSpec { name: name.clone(), dim: q.dim, value: q.value_si });
+                }
+                Err(e) => {
+                    cx.error(&field, e.to_string());
+                    inputs.push(InputSpec { name: name.clone(), dim: Dimension::DIMENSIONLESS, value: f64::NAN });
+                }
+            }
+        }
+        for (k, port) in outlets.iter().enumerate() {
+            for (name, off, dim) in stream_names(port, &comps) {
+                let r = symbols.add_variable(&name, k * len + off, dim, plantwide_expr::VarKind::Algebraic);
+                declare(&mut cx, &format!("ports.outlets.{port}"), r);
+            }
+        }
+        for (k, port) in inlets.iter().enumerate() {
+            if outlets.contains(port) {
+                cx.error(&format!("ports.inlets[{k}]"), format!("`{port}` is also an outlet"));
+                continue;
+            }
+            for (name, off, dim) in stream_names(port, &comps) {
+                let r = symbols.add_variable(&name, inlets_at + k * len + off, dim, plantwide_expr::VarKind::Algebraic);
+                declare(&mut cx, &format!("ports.inlets[{k}]"), r);
+            }
+        }
+        // Own variables, after the outlet streams.
+        let mut internal = Vec::new();
+        let mut guesses = Vec::new();
+        let mut differential = Vec::new();
+        for (i, (name, v)) in c.variables.iter().enumerate() {
+            let field = format!("variables.{name}");
+            let unit = match v.unit.as_deref().map(UnitOfMeasure::parse).transpose() {
+                Ok(u) => u,
+                Err(e) => {
+                    cx.error(&format!("{field}.unit"), e.to_string());
+                    None
+                }
+            };
+            let dim = unit.as_ref().map_or(Dimension::DIMENSIONLESS, UnitOfMeasure::dimension);
+            let si = |x: f64| unit.as_ref().map_or(x, |u| u.to_si(x));
+            let lower = v.lower.map_or(f64::NEG_INFINITY, si);
+            let upper = v.upper.map_or(f64::INFINITY, si);
+            let nominal = match (v.nominal, v.guess) {
+                (Some(n), _) => si(n).abs(),
+                (None, Some(g)) if si(g) != 0.0 => si(g).abs(),
+                _ => 1.0,
+            };
+            if !(nominal.is_finite() && nominal > 0.0) {
+                cx.error(&format!("{field}.nominal"), format!("must be finite and nonzero (got {nominal} {dim})"));
+            }
+            if lower > upper {
+                cx.error(&field, format!("lower bound {lower} {dim} is above the upper bound {upper} {dim}"));
+            }
+            let guess = v.guess.map_or(nominal, si).clamp(lower.min(upper), upper.max(lower));
+            let index = n_out * len + i;
+            let kind = match v.kind {
+                EqVarKind::Differential => {
+                    differential.push(index);
+                    plantwide_expr::VarKind::Differential
+                }
+                EqVarKind::Algebraic => plantwide_expr::VarKind::Algebraic,
+            };
+            declare(&mut cx, &field, symbols.add_variable(name, index, dim, kind));
+            let spec = match v.kind {
+                EqVarKind::Differential => VarSpec::differential(name.clone(), dim, nominal),
+                EqVarKind::Algebraic => VarSpec::algebraic(name.clone(), dim, nominal),
+            };
+            internal.push(spec.bounded(lower, upper));
+            guesses.push(guess);
+        }
+        if !cx.errors.is_empty() {
+            return Err(cx.errors);
+        }
+
+        // Compile the equations: the file's, then the outlets' mappings.
+        let mut compiled: Vec<(String, Equation, Option<Expression>)> = Vec::new();
+        let mut der_of: BTreeMap<usize, String> = BTreeMap::new();
+        for (k, text) in c.equations.iter().enumerate() {
+            let field = format!("equations[{k}]");
+            let eq = match Equation::new(text, &symbols) {
+                Ok(eq) => eq,
+                Err(e) => {
+                    cx.error(&field, e.render());
+                    continue;
+                }
+            };
+            let rhs = match eq.derivatives() {
+                [] => None,
+                &[i] => match der_form(text, &symbols) {
+                    Some(rhs) => {
+                        if let Some(other) = der_of.insert(i, field.clone()) {
+                            let name = symbols.variable_name(i).unwrap_or("?");
+                            cx.error(&field, format!("`der({name})` is already given by {other}: a differential variable has exactly one equation `der({name}) = …`"));
+                        }
+                        Some(rhs)
+                    }
+                    None => {
+                        let name = symbols.variable_name(i).unwrap_or("x");
+                        cx.error(&field, format!("write the equation of a differential variable as `der({name}) = <expression without der()>`: the engine's model is M x' = f(x)\n{text}"));
+                        continue;
+                    }
+                },
+                _ => {
+                    cx.error(&field, format!("an equation may hold one `der()`, as `der(x) = <expression without der()>`\n{text}"));
+                    continue;
+                }
+            };
+            compiled.push((field, eq, rhs));
+        }
+        for &i in &differential {
+            if !der_of.contains_key(&i) {
+                let name = symbols.variable_name(i).unwrap_or("?");
+                cx.error(&format!("variables.{name}"), format!("differential variable `{name}` needs one equation `der({name}) = …`"));
+            }
+        }
+        let mut default_h = Vec::new();
+        let mut maps = Vec::new();
+        for (k, port) in outlets.iter().enumerate() {
+            let map = &c.ports.outlets[port];
+            for (name, _, _) in stream_names(port, &comps) {
+                let q = &name[port.len() + 1..];
+                if q == "h" && !map.contains_key("h") {
+                    default_h.push(k);
+                } else if !map.contains_key(q) {
+                    cx.error(&format!("ports.outlets.{port}"), format!("`{q}` is not given: map each of F, T, P and x[<component>] (and optionally h) to an expression"));
+                }
+            }
+            for (q, expr) in map {
+                let field = format!("ports.outlets.{port}.{q}");
+                if !stream_names(port, &comps).iter().any(|(n, _, _)| n[port.len() + 1..] == **q) {
+                    let known: Vec<String> = stream_names(port, &comps).into_iter().map(|(n, _, _)| n[port.len() + 1..].to_owned()).collect();
+                    cx.error(&field, format!("`{q}` is not a stream quantity (those are {})", known.join(", ")));
+                    continue;
+                }
+                let text = format!("{port}.{q} = {expr}");
+                let Some(&(_, off, _)) = stream_names(port, &comps).iter().find(|(n, _, _)| n[port.len() + 1..] == **q) else { continue };
+                match Equation::new(&text, &symbols) {
+                    Ok(eq) if eq.derivatives().is_empty() => {
+                        maps.push((k * len + off, eq.clone()));
+                        compiled.push((field, eq, None));
+                    }
+                    Ok(_) => cx.error(&field, format!("a port's quantity may not read `der()`\n{text}")),
+                    Err(e) => cx.error(&field, e.render()),
+                }
+            }
+        }
+        let mut outputs = Vec::new();
+        for (k, name) in c.outputs.iter().enumerate() {
+            match symbols.get(name) {
+                Some(plantwide_expr::Symbol::Variable { index, .. }) if *index < n_own => outputs.push(name.clone()),
+                _ => {
+                    let hint = symbols.suggest(name).map(|s| format!("; did you mean `{s}`?")).unwrap_or_default();
+                    cx.error(&format!("outputs[{k}]"), format!("`{name}` is not a variable of the unit{hint}"));
+                }
+            }
+        }
+        if !cx.errors.is_empty() {
+            return Err(cx.errors);
+        }
+
+        // Rows: a perfect matching of equations to the unknowns (derivatives of the differential
+        // variables, the algebraic own variables); the defaulted outlet enthalpies close their own.
+        let h_rows: Vec<usize> = default_h.iter().map(|&k| k * len + H).collect();
+        let unknowns: Vec<usize> = (0..n_own).filter(|i| !h_rows.contains(i)).collect();
+        let eqs: Vec<Equation> = compiled.iter().map(|(_, eq, _)| eq.clone()).collect();
+        let assigned = match check_structure(&eqs, &unknowns, StructureMode::Dynamic, &symbols) {
+            Ok(a) => a,
+            Err(e) => {
+                cx.error("equations", e.to_string());
+                return Err(cx.errors);
+            }
+        };
+        let mut row_names = BTreeMap::new();
+        let mut rows = Vec::new();
+        let mut fields = Vec::new();
+        for ((field, eq, rhs), row) in compiled.into_iter().zip(assigned) {
+            row_names.insert(row, format!("{field}: {}", eq.text()));
+            fields.push(field);
+            rows.push(match rhs {
+                Some(rhs) => Row::Derivative { row, rhs },
+                None => Row::Algebraic { row, eq },
+            });
+        }
+        for &r in &h_rows {
+            row_names.insert(r, format!("{}.h = h_L(T, x)", outlets[r / len]));
+        }
+
+        // Evaluate every equation at the guesses: a zero denominator or a logarithm out of its
+        // domain there would stop Newton at its first step.
+        let layout = LocalLayout {
+            stream: crate::StreamLayout { n_comp: nc },
+            n_outlets: n_out,
+            n_internal: internal.len(),
+            n_inlets: inlets.len(),
+            n_inputs: inputs.len(),
+            n_signals: 0,
+        };
+        let mut local = vec![0.0; layout.len()];
+        for k in 0..inlets.len() {
+            representative_stream(&mut local[inlets_at + k * len..inlets_at + (k + 1) * len]);
+        }
+        inputs.iter().enumerate().for_each(|(k, i)| local[inputs_at + k] = i.value);
+        let unit =
+            Equations { inlets, outlets, internal, guesses, inputs, rows, fields, maps, default_h, row_names, outputs };
+        let mut own = vec![0.0; n_own];
+        unit.guess(&UnitIo { local: &local, layout: &layout, thermo: cx.thermo, time: 0.0 }, &mut own);
+        local[..n_own].copy_from_slice(&own);
+        for (row, field) in unit.rows.iter().zip(&unit.fields) {
+            let result = match row {
+                Row::Derivative { rhs, .. } => rhs.check_at(&local, &[]),
+                Row::Algebraic { eq, .. } => eq.check_at(&local, &[]),
+            };
+            if let Err(e) = result {
+                cx.error(field, format!("at the guess: {}", e.render()));
+            }
+        }
+        cx.finish(unit)
+    }
+
+    /// The names the file declares measurable (`outputs`).
+    pub fn outputs(&self) -> &[String] {
+        &self.outputs
+    }
+
+    /// Structural nonzeros `(row, local column)`: what each row's tape reads.
+    fn row_reads(&self, layout: &LocalLayout) -> Vec<(usize, usize)> {
+        let len = layout.stream.len();
+        let mut p = Vec::new();
+        for row in &self.rows {
+            let (r, vars) = match row {
+                Row::Derivative { row, rhs } => (*row, rhs.variables()),
+                Row::Algebraic { row, eq } => (*row, eq.variables()),
+            };
+            p.extend(vars.iter().map(|&j| (r, j)));
+        }
+        for &k in &self.default_h {
+            let o = k * len;
+            p.extend([(o + H, o + H), (o + H, o + T)]);
+            p.extend((0..layout.stream.n_comp).map(|i| (o + H, o + Z0 + i)));
+        }
+        p
+    }
+}
+
+/// A stream at 1 mol/s, 300 K, 1 bar, h = 0 and uniform composition, for checks at load.
+fn representative_stream(s: &mut [f64]) {
+    let nc = s.len() - Z0;
+    s[F] = 1.0;
+    s[T] = 300.0;
+    s[P] = 1e5;
+    s[H] = 0.0;
+    s[Z0..].iter_mut().for_each(|x| *x = 1.0 / nc as f64);
+}
+
+/// The right-hand side of `text` compiled alone if `text` reads `der(name) = rhs` with `rhs`
+/// free of `der()`.
+fn der_form(text: &str, symbols: &SymbolTable) -> Option<Expression> {
+    let ast = parse_equation(text).ok()?;
+    if !matches!(ast.lhs.kind, plantwide_expr::ast::ExprKind::Der { .. }) {
+        return None;
+    }
+    let rhs = Expression::new(ast.rhs.span.slice(text), symbols).ok()?;
+    rhs.derivatives().is_empty().then_some(rhs)
+}
+
+impl UnitModel for Equations {
+    fn type_name(&self) -> &'static str {
+        "equations"
+    }
+    fn inlet_ports(&self) -> Vec<String> {
+        self.inlets.clone()
+    }
+    fn outlet_ports(&self) -> Vec<String> {
+        self.outlets.clone()
+    }
+    fn internal_vars(&self) -> Vec<VarSpec> {
+        self.internal.clone()
+    }
+    fn inputs(&self) -> Vec<InputSpec> {
+        self.inputs.clone()
+    }
+    fn equation_name(&self, k: usize, own_names: &[String]) -> String {
+        match (self.row_names.get(&k), own_names.get(k)) {
+            (Some(text), Some(own)) => format!("{text} (row of {own})"),
+            (Some(text), None) => text.clone(),
+            (None, _) => format!("equation {k}"),
+        }
+    }
+    fn pattern(&self, layout: &LocalLayout) -> Option<Vec<(usize, usize)>> {
+        Some(self.row_reads(layout))
+    }
+    fn eval<S: Scalar>(&self, io: &UnitIo<'_, S>, r: &mut [S]) {
+        for row in &self.rows {
+            match row {
+                Row::Derivative { row, rhs } => r[*row] = rhs.value(io.local, &[]),
+                Row::Algebraic { row, eq } => r[*row] = eq.residual(io.local, &[]),
+            }
+        }
+        for &k in &self.default_h {
+            let out = io.outlet(k);
+            r[k * io.layout.stream.len() + H] = out.h() - io.thermo.h_liq(out.t(), out.z());
+        }
+    }
+    fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]) {
+        let len = io.layout.stream.len();
+        let n_out = self.outlets.len();
+        own[n_out * len..].copy_from_slice(&self.guesses);
+        // Outlets: a copy of the first inlet (else a representative stream), then each mapping
+        // evaluated at that guess, then the liquid enthalpy where the unit closes it.
+        for k in 0..n_out {
+            let s = &mut own[k * len..(k + 1) * len];
+            if self.inlets.is_empty() {
+                representative_stream(s);
+            } else {
+                s.copy_from_slice(io.inlet(0).v);
+            }
+        }
+        let mut local = io.local.to_vec();
+        local[..own.len()].copy_from_slice(own);
+        for (i, eq) in &self.maps {
+            // `out.Q = expr`: the residual is out.Q − expr, so out.Q − residual is expr.
+            let v = local[*i] - eq.residual(&local, &[]);
+            if v.is_finite() {
+                local[*i] = v;
+            }
+        }
+        for &k in &self.default_h {
+            let o = k * len;
+            local[o + H] = io.thermo.h_liq(local[o + T], &local[o + Z0..o + len]);
+        }
+        own.copy_from_slice(&local[..own.len()]);
+    }
+}
