@@ -538,3 +538,139 @@ impl UnitModel for Equations {
         own.copy_from_slice(&local[..own.len()]);
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::outflow::test_support::{at_guess, build_unit, solve_own};
+    use super::*;
+    use crate::Unit;
+    use crate::testing::{binary_package, jacobian_error};
+
+    /// A surge tank as equations: holdup `M` [mol], level from a constant molar density, outflow
+    /// proportional to the level.
+    const TANK: &str = r#"{
+        "parameters": {"area": "0.5 m2", "rho": "1e4 mol/m3", "k": "2 mol/(s*m)"},
+        "variables": {"M": {"kind": "differential", "unit": "kmol", "guess": 5, "lower": 0},
+                      "level": {"kind": "algebraic", "unit": "m", "guess": 1, "lower": 0}},
+        "equations": ["der(M) = in.F - out.F", "level*area*rho = M"],
+        "ports": {"inlets": ["in"],
+                  "outlets": {"out": {"F": "k*level", "T": "in.T", "P": "in.P",
+                                      "x[light]": "in.x[light]", "x[heavy]": "in.x[heavy]"}}},
+        "outputs": ["level"]
+    }"#;
+
+    fn feed(thermo: &plantwide_thermo::ThermoPackage) -> [f64; 6] {
+        [10.0, 320.0, 2e5, thermo.h_liq(320.0, &[0.4, 0.6]), 0.4, 0.6]
+    }
+
+    #[test]
+    fn tank_residuals_and_exact_jacobian() {
+        let thermo = binary_package();
+        let u = build_unit(TANK, &thermo, Equations::build);
+        let vars: Vec<String> = UnitModel::internal_vars(&u).iter().map(|v| v.name.clone()).collect();
+        assert_eq!(vars, ["M", "level"]);
+        assert_eq!(UnitModel::internal_vars(&u)[0].kind, crate::VarKind::Differential);
+        assert_eq!(UnitModel::internal_vars(&u)[0].nominal, 5000.0);
+        let (lay, mut local) = at_guess(&u, &thermo, &feed(&thermo));
+        // Own: out [F, T, P, h, x_l, x_h] = 0..6, M = 6, level = 7; inlet 8..14.
+        let (m, level, fout) = (4000.0, 1.3, 2.9);
+        local[6] = m;
+        local[7] = level;
+        local[0] = fout;
+        local[1] = 330.0;
+        let n = local.len();
+        let (mut r, mut jac) = (vec![0.0; 8], vec![0.0; 8 * n]);
+        u.jacobian(&UnitIo { local: &local, layout: &lay, thermo: &thermo, time: 0.0 }, &mut r, &mut jac);
+        let (area, rho, k) = (0.5, 1e4, 2.0);
+        assert_eq!(r[6], 10.0 - fout, "der(M) row: the time derivative, in − out");
+        assert_eq!(r[7], level * area * rho - m);
+        assert_eq!(r[0], fout - k * level);
+        assert_eq!(r[1], 330.0 - 320.0);
+        assert_eq!(r[3], local[3] - thermo.h_liq(330.0, &local[4..6]));
+        let mut want = vec![0.0; 8 * n];
+        let mut set = |row: usize, col: usize, v: f64| want[row * n + col] = v;
+        set(6, 8, 1.0); // ∂(in.F − out.F)/∂in.F
+        set(6, 0, -1.0);
+        set(7, 7, area * rho);
+        set(7, 6, -1.0);
+        set(0, 0, 1.0);
+        set(0, 7, -k);
+        for (row, own, inlet) in [(1, 1, 9), (2, 2, 10), (4, 4, 12), (5, 5, 13)] {
+            set(row, own, 1.0);
+            set(row, inlet, -1.0);
+        }
+        for row in [0, 1, 2, 4, 5, 6, 7] {
+            for col in 0..n {
+                assert_eq!(jac[row * n + col], want[row * n + col], "∂r{row}/∂x{col}");
+            }
+        }
+        let err = jacobian_error(&u, &lay, &thermo, &local, 8);
+        assert!(err < 1e-8, "{err}");
+        // The declared pattern holds every nonzero.
+        let pattern = UnitModel::pattern(&u, &lay).unwrap();
+        for row in 0..8 {
+            for col in 0..n {
+                if jac[row * n + col] != 0.0 {
+                    assert!(pattern.contains(&(row, col)), "({row}, {col}) missing from the pattern");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn tank_steady_state() {
+        let thermo = binary_package();
+        let u = build_unit(TANK, &thermo, Equations::build);
+        let (lay, mut local) = at_guess(&u, &thermo, &feed(&thermo));
+        assert_eq!(local[0], 2.0, "outlet flow guessed from its mapping at the guessed level");
+        let norm = solve_own(&u, &lay, &thermo, &mut local);
+        assert!(norm < 1e-12, "{norm}");
+        // F_out = F_in = k·level, M = level·area·rho.
+        assert!((local[7] - 5.0).abs() < 1e-12 && (local[6] - 25_000.0).abs() < 1e-9, "{:?}", &local[..8]);
+        assert!((local[3] - thermo.h_liq(320.0, &[0.4, 0.6])).abs() < 1e-9);
+    }
+
+    fn build_err(json: &str) -> Vec<FieldError> {
+        let thermo = binary_package();
+        let names = ["light".to_string(), "heavy".to_string()];
+        let mut v: serde_json::Value = serde_json::from_str(TANK).unwrap();
+        let patch: serde_json::Value = serde_json::from_str(json).unwrap();
+        for (k, x) in patch.as_object().unwrap() {
+            v[k] = x.clone();
+        }
+        let c: EquationsConfig = serde_json::from_value(v).unwrap();
+        Equations::build(&c, BuildCx::new(&names, &thermo, "units.u"), ()).unwrap_err()
+    }
+
+    #[test]
+    fn errors_name_the_field_and_the_position() {
+        let e = build_err(r#"{"equations": ["der(M) = in.F - out.F", "level*area = M"]}"#);
+        assert_eq!(e[0].path, "units.u.equations[1]");
+        assert!(e[0].message.contains("found m3 and mol\nlevel*area = M\n^^^^^^^^^^^^^^"), "{}", e[0].message);
+        let e = build_err(r#"{"equations": ["der(M) = in.F - out.F", "levl*area*rho = M"]}"#);
+        assert!(e[0].message.contains("did you mean `level`"), "{}", e[0].message);
+        let e = build_err(r#"{"equations": ["2*der(M) = in.F - out.F", "level*area*rho = M"]}"#);
+        assert_eq!(e[0].path, "units.u.equations[0]");
+        assert!(e[0].message.contains("write the equation of a differential variable as `der(M) ="), "{}", e[0].message);
+        let e = build_err(r#"{"equations": ["level*area*rho = M"]}"#);
+        assert_eq!(e[0].path, "units.u.variables.M");
+        let e = build_err(r#"{"equations": ["der(M) = in.F - out.F", "der(M) = in.F", "level*area*rho = M"]}"#);
+        assert!(e[0].message.contains("already given by equations[0]"), "{}", e[0].message);
+        // Structurally singular: level is read by no equation once its equation names only M.
+        let e = build_err(r#"{"equations": ["der(M) = in.F - out.F", "M = area*rho*in.F/k"]}"#);
+        assert_eq!(e[0].path, "units.u.equations");
+        assert!(e[0].message.contains("structurally singular"), "{}", e[0].message);
+        // A zero denominator at the guess (level = 1 m).
+        let e = build_err(
+            r#"{"parameters": {"area": "0.5 m2", "rho": "1e4 mol/m3", "k": "2 mol/(s*m)", "l0": "1 m"},
+                "equations": ["der(M) = in.F - out.F", "area*rho = M/(level - l0)"]}"#,
+        );
+        assert_eq!(e[0].path, "units.u.equations[1]");
+        assert!(e[0].message.starts_with("at the guess:"), "{}", e[0].message);
+        let e = build_err(r#"{"ports": {"inlets": ["in"], "outlets": {"out": {"F": "k*level", "T": "in.T", "P": "in.P"}}}}"#);
+        assert!(e.iter().any(|e| e.path == "units.u.ports.outlets.out" && e.message.contains("`x[light]` is not given")));
+        let e = build_err(r#"{"outputs": ["levle"]}"#);
+        assert!(e[0].message.contains("did you mean `level`"), "{}", e[0].message);
+        assert!(serde_json::from_str::<EquationsConfig>(r#"{"equations": [], "volume": 1}"#).is_err());
+    }
+}
