@@ -25,13 +25,15 @@
 //! `der(x) = rhs` with `rhs` free of `der()`; its residual is `rhs` (not `der(x) − rhs`), written
 //! at the variable's own row, where the mass matrix has its 1. Every other equation is algebraic,
 //! residual `lhs − rhs`, placed at the row of the algebraic unknown a perfect matching assigns it
-//! (`check_structure` in dynamic mode): so the unit is square and its rows pair with unknowns.
+//! (as `check_structure` in dynamic mode, the closed outlet enthalpies included): so the unit is square and its rows pair with unknowns.
 //!
 //! # Ports
-//! Inlets are read as known values. Each outlet maps its stream quantities to expressions: `F`,
-//! `T`, `P` and every `x[c]` must be given (each is the equation `out.Q = expr`); `h` may be given,
-//! else it is the liquid enthalpy `h = h_L(T, x)` of the thermodynamic package (the expression
-//! layer has no thermodynamic functions yet).
+//! Inlets are read as known values. Each outlet maps some of its stream quantities to
+//! expressions, each the equation `out.Q = expr`; a quantity it does not map (`F`, `T`, `P`,
+//! `x[c]`) is an unknown the `equations` must determine (`U = M*out.h` gives `out.T`), else the set
+//! is refused as structurally singular naming it. An unmapped `h` is closed by the unit as the
+//! liquid enthalpy `h = h_L(T, x)` of the thermodynamic package (the expression layer has no
+//! thermodynamic functions yet), so no equation may determine it.
 //!
 //! # Checks at load
 //! Names, dimensions (both sides, each outlet mapping against its stream quantity), the `der()`
@@ -41,7 +43,7 @@
 
 use std::collections::BTreeMap;
 
-use plantwide_expr::{Equation, Expression, StructureMode, SymbolTable, check_structure, parse_equation};
+use plantwide_expr::{Equation, Expression, SymbolTable, parse_equation};
 use plantwide_units::{Dimension, QuantityValue, Unit as UnitOfMeasure, parse_quantity};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -90,8 +92,9 @@ pub struct EqPortsConfig {
     /// Inlet port names; their stream quantities (`in.F`, `in.x[A]`, …) are known values.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub inlets: Vec<String>,
-    /// Outlet ports by name, each mapping its stream quantities (`F`, `T`, `P`, `x[<c>]`, and
-    /// optionally `h`) to an expression.
+    /// Outlet ports by name, each mapping some of its stream quantities (`F`, `T`, `P`, `x[<c>]`,
+    /// `h`) to expressions; the equations determine the others, and an unmapped `h` is the liquid
+    /// enthalpy at the outlet's `T` and `x`.
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub outlets: BTreeMap<String, BTreeMap<String, String>>,
 }
@@ -147,8 +150,9 @@ pub struct Equations {
     fields: Vec<String>,
     /// The outlets' mappings `out.Q = expr` by the local index of `out.Q`, for the guess.
     maps: Vec<(usize, Equation)>,
-    /// Own rows of outlet enthalpies closed by the unit as `h = h_L(T, x)`: the outlet's index.
-    default_h: Vec<usize>,
+    /// Outlet enthalpies closed by the unit as `h = h_L(T, x)`: `(row, outlet)`, the row the
+    /// matching gave the equation (not necessarily `h`'s own: `U = M*out.h` may take that one).
+    default_h: Vec<(usize, usize)>,
     /// Names of own rows, for diagnostics.
     row_names: BTreeMap<usize, String>,
     outputs: Vec<String>,
@@ -328,8 +332,6 @@ impl Equations {
                 let q = &name[port.len() + 1..];
                 if q == "h" && !map.contains_key("h") {
                     default_h.push(k);
-                } else if !map.contains_key(q) {
-                    cx.error(&format!("ports.outlets.{port}"), format!("`{q}` is not given: map each of F, T, P and x[<component>] (and optionally h) to an expression"));
                 }
             }
             for (q, expr) in map {
@@ -365,21 +367,51 @@ impl Equations {
             return Err(cx.errors);
         }
 
-        // Rows: a perfect matching of equations to the unknowns (derivatives of the differential
-        // variables, the algebraic own variables); the defaulted outlet enthalpies close their own.
+        // Rows: a perfect matching of equations to the unknowns in dynamic mode (derivatives of the
+        // differential variables, the algebraic own variables), the closed outlet enthalpies
+        // `h = h_L(T, x)` included as rows of their own that read `h`, `T` and `x`: so `U = M*out.h`
+        // determines `out.T`. (As `check_structure`, with those extra rows.)
         let h_rows: Vec<usize> = default_h.iter().map(|&k| k * len + H).collect();
-        let unknowns: Vec<usize> = (0..n_own).filter(|i| !h_rows.contains(i)).collect();
-        let eqs: Vec<Equation> = compiled.iter().map(|(_, eq, _)| eq.clone()).collect();
-        let assigned = match check_structure(&eqs, &unknowns, StructureMode::Dynamic, &symbols) {
-            Ok(a) => a,
-            Err(e) => {
-                cx.error("equations", e.to_string());
-                return Err(cx.errors);
-            }
-        };
+        let is_differential = |i: usize| symbols.variable_kind(i) == Some(plantwide_expr::VarKind::Differential);
+        let mut incidence: Vec<Vec<usize>> = compiled
+            .iter()
+            .map(|(_, eq, _)| {
+                let alg = eq.variables().iter().copied().filter(|&i| i < n_own && !is_differential(i));
+                alg.chain(eq.derivatives().iter().copied()).collect()
+            })
+            .collect();
+        for &r in &h_rows {
+            incidence.push([r, r - H + T].into_iter().chain((0..nc).map(|i| r - H + Z0 + i)).collect());
+        }
+        let matching = plantwide_expr::maximum_matching(n_own, &incidence);
+        if !matching.is_perfect() {
+            let name = |i: usize| {
+                let base = symbols.variable_name(i).map_or_else(|| format!("x[{i}]"), str::to_owned);
+                if is_differential(i) { format!("der({base})") } else { base }
+            };
+            let text = |e: usize| match compiled.get(e) {
+                Some((_, eq, _)) => eq.text().to_owned(),
+                None => format!("{}.h = h_L(T, x)", outlets[h_rows[e - compiled.len()] / len]),
+            };
+            let list = |v: Vec<String>| {
+                if v.is_empty() { "none".to_owned() } else { v.iter().map(|s| format!("`{s}`")).collect::<Vec<_>>().join(", ") }
+            };
+            cx.error(
+                "equations",
+                format!(
+                    "the equations are structurally singular ({} equations, {n_own} unknowns); left without an unknown: {}; left without an equation: {}",
+                    incidence.len(),
+                    list(matching.unmatched_equations().into_iter().map(text).collect()),
+                    list(matching.unmatched_unknowns().into_iter().map(name).collect()),
+                ),
+            );
+            return Err(cx.errors);
+        }
+        let assigned: Vec<usize> = matching.unknown_of.iter().take(compiled.len()).map(|u| u.unwrap_or_default()).collect();
         let mut row_names = BTreeMap::new();
         let mut rows = Vec::new();
         let mut fields = Vec::new();
+        let n_compiled = assigned.len();
         for ((field, eq, rhs), row) in compiled.into_iter().zip(assigned) {
             row_names.insert(row, format!("{field}: {}", eq.text()));
             fields.push(field);
@@ -388,8 +420,13 @@ impl Equations {
                 None => Row::Algebraic { row, eq },
             });
         }
-        for &r in &h_rows {
-            row_names.insert(r, format!("{}.h = h_L(T, x)", outlets[r / len]));
+        let default_h: Vec<(usize, usize)> = default_h
+            .iter()
+            .enumerate()
+            .map(|(e, &k)| (matching.unknown_of[n_compiled + e].unwrap_or_default(), k))
+            .collect();
+        for &(row, k) in &default_h {
+            row_names.insert(row, format!("{}.h = h_L(T, x)", outlets[k]));
         }
 
         // Evaluate every equation at the guesses: a zero denominator or a logarithm out of its
@@ -440,10 +477,10 @@ impl Equations {
             };
             p.extend(vars.iter().map(|&j| (r, j)));
         }
-        for &k in &self.default_h {
+        for &(row, k) in &self.default_h {
             let o = k * len;
-            p.extend([(o + H, o + H), (o + H, o + T)]);
-            p.extend((0..layout.stream.n_comp).map(|i| (o + H, o + Z0 + i)));
+            p.extend([(row, o + H), (row, o + T)]);
+            p.extend((0..layout.stream.n_comp).map(|i| (row, o + Z0 + i)));
         }
         p
     }
@@ -503,9 +540,9 @@ impl UnitModel for Equations {
                 Row::Algebraic { row, eq } => r[*row] = eq.residual(io.local, &[]),
             }
         }
-        for &k in &self.default_h {
+        for &(row, k) in &self.default_h {
             let out = io.outlet(k);
-            r[k * io.layout.stream.len() + H] = out.h() - io.thermo.h_liq(out.t(), out.z());
+            r[row] = out.h() - io.thermo.h_liq(out.t(), out.z());
         }
     }
     fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]) {
@@ -531,7 +568,7 @@ impl UnitModel for Equations {
                 local[*i] = v;
             }
         }
-        for &k in &self.default_h {
+        for &(_, k) in &self.default_h {
             let o = k * len;
             local[o + H] = io.thermo.h_liq(local[o + T], &local[o + Z0..o + len]);
         }
@@ -668,7 +705,7 @@ mod tests {
         assert_eq!(e[0].path, "units.u.equations[1]");
         assert!(e[0].message.starts_with("at the guess:"), "{}", e[0].message);
         let e = build_err(r#"{"ports": {"inlets": ["in"], "outlets": {"out": {"F": "k*level", "T": "in.T", "P": "in.P"}}}}"#);
-        assert!(e.iter().any(|e| e.path == "units.u.ports.outlets.out" && e.message.contains("`x[light]` is not given")));
+        assert!(e[0].path == "units.u.equations" && e[0].message.contains("`out.x[light]`"), "{}", e[0].message);
         let e = build_err(r#"{"outputs": ["levle"]}"#);
         assert!(e[0].message.contains("did you mean `level`"), "{}", e[0].message);
         assert!(serde_json::from_str::<EquationsConfig>(r#"{"equations": [], "volume": 1}"#).is_err());
