@@ -120,6 +120,10 @@ pub struct EquationsConfig {
     /// Names of the variables that can be measured (default none listed).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub outputs: Vec<String>,
+    /// Whether the equations turn components into one another (default false): the steady-state
+    /// certificate then checks the plant's mass balance, not each component's.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub reacts: bool,
 }
 
 impl crate::registry::UnitConfig for EquationsConfig {
@@ -156,6 +160,7 @@ pub struct Equations {
     /// Names of own rows, for diagnostics.
     row_names: BTreeMap<usize, String>,
     outputs: Vec<String>,
+    reacts: bool,
 }
 
 /// Stream quantities of a port, with their offsets in a stream block and dimensions.
@@ -445,7 +450,7 @@ impl Equations {
         }
         inputs.iter().enumerate().for_each(|(k, i)| local[inputs_at + k] = i.value);
         let unit =
-            Equations { inlets, outlets, internal, guesses, inputs, rows, fields, maps, default_h, row_names, outputs };
+            Equations { inlets, outlets, internal, guesses, inputs, rows, fields, maps, default_h, row_names, outputs, reacts: c.reacts };
         let mut own = vec![0.0; n_own];
         unit.guess(&UnitIo { local: &local, layout: &layout, thermo: cx.thermo, time: 0.0 }, &mut own);
         local[..n_own].copy_from_slice(&own);
@@ -522,6 +527,9 @@ impl UnitModel for Equations {
     }
     fn inputs(&self) -> Vec<InputSpec> {
         self.inputs.clone()
+    }
+    fn reacts(&self) -> bool {
+        self.reacts
     }
     fn equation_name(&self, k: usize, own_names: &[String]) -> String {
         match (self.row_names.get(&k), own_names.get(k)) {
