@@ -317,7 +317,10 @@ impl Equations {
                     }
                 },
                 _ => {
-                    cx.error(&field, format!("an equation may hold one `der()`, as `der(x) = <expression without der()>`\n{text}"));
+                    cx.error(
+                        &field,
+                        format!("an equation may hold one `der()`, as `der(x) = <expression without der()>`\n{text}"),
+                    );
                     continue;
                 }
             };
@@ -326,7 +329,10 @@ impl Equations {
         for &i in &differential {
             if !der_of.contains_key(&i) {
                 let name = symbols.variable_name(i).unwrap_or("?");
-                cx.error(&format!("variables.{name}"), format!("differential variable `{name}` needs one equation `der({name}) = …`"));
+                cx.error(
+                    &format!("variables.{name}"),
+                    format!("differential variable `{name}` needs one equation `der({name}) = …`"),
+                );
             }
         }
         let mut default_h = Vec::new();
@@ -342,12 +348,18 @@ impl Equations {
             for (q, expr) in map {
                 let field = format!("ports.outlets.{port}.{q}");
                 if !stream_names(port, &comps).iter().any(|(n, _, _)| n[port.len() + 1..] == **q) {
-                    let known: Vec<String> = stream_names(port, &comps).into_iter().map(|(n, _, _)| n[port.len() + 1..].to_owned()).collect();
+                    let known: Vec<String> = stream_names(port, &comps)
+                        .into_iter()
+                        .map(|(n, _, _)| n[port.len() + 1..].to_owned())
+                        .collect();
                     cx.error(&field, format!("`{q}` is not a stream quantity (those are {})", known.join(", ")));
                     continue;
                 }
                 let text = format!("{port}.{q} = {expr}");
-                let Some(&(_, off, _)) = stream_names(port, &comps).iter().find(|(n, _, _)| n[port.len() + 1..] == **q) else { continue };
+                let Some(&(_, off, _)) = stream_names(port, &comps).iter().find(|(n, _, _)| n[port.len() + 1..] == **q)
+                else {
+                    continue;
+                };
                 match Equation::new(&text, &symbols) {
                     Ok(eq) if eq.derivatives().is_empty() => {
                         maps.push((k * len + off, eq.clone()));
@@ -399,7 +411,11 @@ impl Equations {
                 None => format!("{}.h = h_L(T, x)", outlets[h_rows[e - compiled.len()] / len]),
             };
             let list = |v: Vec<String>| {
-                if v.is_empty() { "none".to_owned() } else { v.iter().map(|s| format!("`{s}`")).collect::<Vec<_>>().join(", ") }
+                if v.is_empty() {
+                    "none".to_owned()
+                } else {
+                    v.iter().map(|s| format!("`{s}`")).collect::<Vec<_>>().join(", ")
+                }
             };
             cx.error(
                 "equations",
@@ -412,7 +428,8 @@ impl Equations {
             );
             return Err(cx.errors);
         }
-        let assigned: Vec<usize> = matching.unknown_of.iter().take(compiled.len()).map(|u| u.unwrap_or_default()).collect();
+        let assigned: Vec<usize> =
+            matching.unknown_of.iter().take(compiled.len()).map(|u| u.unwrap_or_default()).collect();
         let mut row_names = BTreeMap::new();
         let mut rows = Vec::new();
         let mut fields = Vec::new();
@@ -449,8 +466,20 @@ impl Equations {
             representative_stream(&mut local[inlets_at + k * len..inlets_at + (k + 1) * len]);
         }
         inputs.iter().enumerate().for_each(|(k, i)| local[inputs_at + k] = i.value);
-        let unit =
-            Equations { inlets, outlets, internal, guesses, inputs, rows, fields, maps, default_h, row_names, outputs, reacts: c.reacts };
+        let unit = Equations {
+            inlets,
+            outlets,
+            internal,
+            guesses,
+            inputs,
+            rows,
+            fields,
+            maps,
+            default_h,
+            row_names,
+            outputs,
+            reacts: c.reacts,
+        };
         let mut own = vec![0.0; n_own];
         unit.guess(&UnitIo { local: &local, layout: &layout, thermo: cx.thermo, time: 0.0 }, &mut own);
         local[..n_own].copy_from_slice(&own);
@@ -696,7 +725,11 @@ mod tests {
         assert!(e[0].message.contains("did you mean `level`"), "{}", e[0].message);
         let e = build_err(r#"{"equations": ["2*der(M) = in.F - out.F", "level*area*rho = M"]}"#);
         assert_eq!(e[0].path, "units.u.equations[0]");
-        assert!(e[0].message.contains("write the equation of a differential variable as `der(M) ="), "{}", e[0].message);
+        assert!(
+            e[0].message.contains("write the equation of a differential variable as `der(M) ="),
+            "{}",
+            e[0].message
+        );
         let e = build_err(r#"{"equations": ["level*area*rho = M"]}"#);
         assert_eq!(e[0].path, "units.u.variables.M");
         let e = build_err(r#"{"equations": ["der(M) = in.F - out.F", "der(M) = in.F", "level*area*rho = M"]}"#);
@@ -712,7 +745,9 @@ mod tests {
         );
         assert_eq!(e[0].path, "units.u.equations[1]");
         assert!(e[0].message.starts_with("at the guess:"), "{}", e[0].message);
-        let e = build_err(r#"{"ports": {"inlets": ["in"], "outlets": {"out": {"F": "k*level", "T": "in.T", "P": "in.P"}}}}"#);
+        let e = build_err(
+            r#"{"ports": {"inlets": ["in"], "outlets": {"out": {"F": "k*level", "T": "in.T", "P": "in.P"}}}}"#,
+        );
         assert!(e[0].path == "units.u.equations" && e[0].message.contains("`out.x[light]`"), "{}", e[0].message);
         let e = build_err(r#"{"outputs": ["levle"]}"#);
         assert!(e[0].message.contains("did you mean `level`"), "{}", e[0].message);
