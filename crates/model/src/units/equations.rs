@@ -120,6 +120,11 @@ pub struct EquationsConfig {
     /// Names of the variables that can be measured (default none listed).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub outputs: Vec<String>,
+    /// The amount [mol] of each component the unit holds, as an expression (`{"A": "NA"}`;
+    /// unlisted components hold none); without it the unit holds no material, and a dynamic
+    /// run's conservation check would miss what it accumulates.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub holdup: BTreeMap<String, String>,
     /// Whether the equations turn components into one another (default false): the steady-state
     /// certificate then checks the plant's mass balance, not each component's.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
@@ -161,6 +166,8 @@ pub struct Equations {
     row_names: BTreeMap<usize, String>,
     outputs: Vec<String>,
     reacts: bool,
+    /// Per component, the expression of its holdup [mol] (`None`: none held); empty: no holdup.
+    holdup: Vec<Option<Expression>>,
 }
 
 /// Stream quantities of a port, with their offsets in a stream block and dimensions.
@@ -380,6 +387,24 @@ impl Equations {
                 }
             }
         }
+        let mut holdup = Vec::new();
+        if !c.holdup.is_empty() {
+            holdup = vec![None; nc];
+            for (name, text) in &c.holdup {
+                let field = format!("holdup.{name}");
+                let Some(i) = comps.iter().position(|c| c == name) else {
+                    cx.error(&field, format!("`{name}` is not a component (components: {})", comps.join(", ")));
+                    continue;
+                };
+                match Expression::new(text, &symbols) {
+                    Ok(e) if e.dimension() == Dimension::AMOUNT && e.derivatives().is_empty() => holdup[i] = Some(e),
+                    Ok(e) => {
+                        cx.error(&field, format!("a holdup is an amount (mol) without der(), found {}", e.dimension()))
+                    }
+                    Err(e) => cx.error(&field, e.render()),
+                }
+            }
+        }
         if !cx.errors.is_empty() {
             return Err(cx.errors);
         }
@@ -479,6 +504,7 @@ impl Equations {
             row_names,
             outputs,
             reacts: c.reacts,
+            holdup,
         };
         let mut own = vec![0.0; n_own];
         unit.guess(&UnitIo { local: &local, layout: &layout, thermo: cx.thermo, time: 0.0 }, &mut own);
@@ -560,6 +586,12 @@ impl UnitModel for Equations {
     fn reacts(&self) -> bool {
         self.reacts
     }
+    fn holdup(&self, io: &UnitIo<'_, f64>) -> Option<Vec<f64>> {
+        if self.holdup.is_empty() {
+            return None;
+        }
+        Some(self.holdup.iter().map(|e| e.as_ref().map_or(0.0, |e| e.value(io.local, &[]))).collect())
+    }
     fn equation_name(&self, k: usize, own_names: &[String]) -> String {
         match (self.row_names.get(&k), own_names.get(k)) {
             (Some(text), Some(own)) => format!("{text} (row of {own})"),
@@ -630,7 +662,8 @@ mod tests {
         "ports": {"inlets": ["in"],
                   "outlets": {"out": {"F": "k*level", "T": "in.T", "P": "in.P",
                                       "x[light]": "in.x[light]", "x[heavy]": "in.x[heavy]"}}},
-        "outputs": ["level"]
+        "outputs": ["level"],
+        "holdup": {"light": "M*out.x[light]", "heavy": "M*out.x[heavy]"}
     }"#;
 
     fn feed(thermo: &plantwide_thermo::ThermoPackage) -> [f64; 6] {
@@ -702,6 +735,8 @@ mod tests {
         // F_out = F_in = k·level, M = level·area·rho.
         assert!((local[7] - 5.0).abs() < 1e-12 && (local[6] - 25_000.0).abs() < 1e-9, "{:?}", &local[..8]);
         assert!((local[3] - thermo.h_liq(320.0, &[0.4, 0.6])).abs() < 1e-9);
+        let n = UnitModel::holdup(&u, &UnitIo { local: &local, layout: &lay, thermo: &thermo, time: 0.0 }).unwrap();
+        assert!((n[0] - 10_000.0).abs() < 1e-8 && (n[1] - 15_000.0).abs() < 1e-8, "{n:?}");
     }
 
     fn build_err(json: &str) -> Vec<FieldError> {
@@ -749,6 +784,8 @@ mod tests {
             r#"{"ports": {"inlets": ["in"], "outlets": {"out": {"F": "k*level", "T": "in.T", "P": "in.P"}}}}"#,
         );
         assert!(e[0].path == "units.u.equations" && e[0].message.contains("`out.x[light]`"), "{}", e[0].message);
+        let e = build_err(r#"{"holdup": {"light": "level"}}"#);
+        assert!(e[0].path == "units.u.holdup.light" && e[0].message.contains("found m"), "{}", e[0].message);
         let e = build_err(r#"{"outputs": ["levle"]}"#);
         assert!(e[0].message.contains("did you mean `level`"), "{}", e[0].message);
         assert!(serde_json::from_str::<EquationsConfig>(r#"{"equations": [], "volume": 1}"#).is_err());
