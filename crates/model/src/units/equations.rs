@@ -35,6 +35,12 @@
 //! liquid enthalpy `h = h_L(T, x)` of the thermodynamic package (the expression layer has no
 //! thermodynamic functions yet), so no equation may determine it.
 //!
+//! # Material
+//! `holdup` gives each component's amount [mol] as an expression (for a dynamic run's
+//! conservation check) and `reacts: true` makes the steady-state certificate check mass instead
+//! of each component; without them the unit is taken to hold nothing and to conserve every
+//! component.
+//!
 //! # Checks at load
 //! Names, dimensions (both sides, each outlet mapping against its stream quantity), the `der()`
 //! form, a structurally singular set (dynamic mode), and each equation evaluated at the guesses
@@ -789,5 +795,62 @@ mod tests {
         let e = build_err(r#"{"outputs": ["levle"]}"#);
         assert!(e[0].message.contains("did you mean `level`"), "{}", e[0].message);
         assert!(serde_json::from_str::<EquationsConfig>(r#"{"equations": [], "volume": 1}"#).is_err());
+    }
+}
+
+#[cfg(test)]
+mod timing {
+    use std::time::Instant;
+
+    use super::super::cstr::Cstr;
+    use super::super::outflow::test_support::{at_guess, build_unit};
+    use super::*;
+    use crate::Unit;
+    use crate::testing::binary_package;
+
+    /// The reactor of a flowsheet file, its components renamed to the test package's.
+    fn reactor(rel: &str) -> String {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").join(rel);
+        let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+        let mut r = v["units"]["reactor"].clone();
+        r.as_object_mut().unwrap().remove("type");
+        r.to_string()
+            .replace("[A]", "[light]")
+            .replace("[B]", "[heavy]")
+            .replace("\"A\":", "\"light\":")
+            .replace("\"B\":", "\"heavy\":")
+    }
+
+    fn per_call(u: &dyn Unit, thermo: &plantwide_thermo::ThermoPackage) -> f64 {
+        let feed = [10.0, 300.0, 2e6, thermo.h_liq(300.0, &[1.0, 0.0]), 1.0, 0.0];
+        let (lay, local) = at_guess(u, thermo, &feed);
+        let (n, m) = (local.len(), lay.n_own());
+        let (mut r, mut jac) = (vec![0.0; m], vec![0.0; m * n]);
+        let io = UnitIo { local: &local, layout: &lay, thermo, time: 0.0 };
+        let reps = 20_000;
+        let t0 = Instant::now();
+        for _ in 0..reps {
+            u.residual(&io, &mut r);
+            u.jacobian(&io, &mut r, &mut jac);
+        }
+        t0.elapsed().as_secs_f64() / reps as f64
+    }
+
+    /// Issue 57 asks the equation version's residual + Jacobian within 3× of the built-in's.
+    #[test]
+    #[ignore = "timing: cargo test -p plantwide-model --lib timing -- --ignored --nocapture"]
+    fn cstr_residual_and_jacobian_time() {
+        let mut thermo = binary_package();
+        thermo.components[1] =
+            plantwide_thermo::Component::hypothetical("heavy", 1.0, 0.05, 3.0e4, 350.0, 150.0, 1.0e-4);
+        let builtin = build_unit(&reactor("flowsheets/cstr_multiplicity.json"), &thermo, Cstr::build);
+        let eqs = build_unit(&reactor("tests/data/cstr_equations.json"), &thermo, Equations::build);
+        let (tb, te) = (per_call(&builtin, &thermo), per_call(&eqs, &thermo));
+        eprintln!(
+            "residual + Jacobian: built-in cstr {:.2} µs, equations {:.2} µs, ratio {:.2}",
+            tb * 1e6,
+            te * 1e6,
+            te / tb
+        );
     }
 }
