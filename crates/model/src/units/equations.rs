@@ -25,7 +25,9 @@
 //! `der(x) = rhs` with `rhs` free of `der()`; its residual is `rhs` (not `der(x) − rhs`), written
 //! at the variable's own row, where the mass matrix has its 1. Every other equation is algebraic,
 //! residual `lhs − rhs`, placed at the row of the algebraic unknown a perfect matching assigns it
-//! (as `check_structure` in dynamic mode, the closed outlet enthalpies included): so the unit is square and its rows pair with unknowns.
+//! (as `check_structure` in dynamic mode, the closed outlet enthalpies included): so the unit is
+//! square and its rows pair with unknowns. In dynamic mode a differential variable is a known
+//! state, so `der(x) = rhs` can only take `der(x)`: its row is always `x`'s own.
 //!
 //! # Ports
 //! Inlets are read as known values. Each outlet maps some of its stream quantities to
@@ -33,7 +35,8 @@
 //! `x[c]`) is an unknown the `equations` must determine (`U = M*out.h` gives `out.T`), else the set
 //! is refused as structurally singular naming it. An unmapped `h` is closed by the unit as the
 //! liquid enthalpy `h = h_L(T, x)` of the thermodynamic package (the expression layer has no
-//! thermodynamic functions yet), so no equation may determine it.
+//! thermodynamic functions yet): one more equation of the set, which the matching places like
+//! the others (with `U = M*out.h` it takes `out.T`'s row and the balance `h`'s).
 //!
 //! # Material
 //! `holdup` gives each component's amount [mol] as an expression (for a dynamic run's
