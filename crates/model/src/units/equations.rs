@@ -39,7 +39,7 @@
 //! the others (with `U = M*out.h` it takes `out.T`'s row and the balance `h`'s).
 //!
 //! # Material
-//! `holdup` gives each component's amount [mol] as an expression (for a dynamic run's
+//! `holdup` gives each component's amount \[mol\] as an expression (for a dynamic run's
 //! conservation check) and `reacts: true` makes the steady-state certificate check mass instead
 //! of each component; without them the unit is taken to hold nothing and to conserve every
 //! component.
@@ -129,7 +129,7 @@ pub struct EquationsConfig {
     /// Names of the variables that can be measured (default none listed).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub outputs: Vec<String>,
-    /// The amount [mol] of each component the unit holds, as an expression (`{"A": "NA"}`;
+    /// The amount (mol) of each component the unit holds, as an expression (`{"A": "NA"}`;
     /// unlisted components hold none); without it the unit holds no material, and a dynamic
     /// run's conservation check would miss what it accumulates.
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
@@ -175,7 +175,7 @@ pub struct Equations {
     row_names: BTreeMap<usize, String>,
     outputs: Vec<String>,
     reacts: bool,
-    /// Per component, the expression of its holdup [mol] (`None`: none held); empty: no holdup.
+    /// Per component, the expression of its holdup \[mol\] (`None`: none held); empty: no holdup.
     holdup: Vec<Option<Expression>>,
 }
 
@@ -661,7 +661,7 @@ mod tests {
     use crate::Unit;
     use crate::testing::{binary_package, jacobian_error};
 
-    /// A surge tank as equations: holdup `M` [mol], level from a constant molar density, outflow
+    /// A surge tank as equations: holdup `M` \[mol\], level from a constant molar density, outflow
     /// proportional to the level.
     const TANK: &str = r#"{
         "parameters": {"area": "0.5 m2", "rho": "1e4 mol/m3", "k": "2 mol/(s*m)"},
