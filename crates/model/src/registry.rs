@@ -135,6 +135,7 @@ registry!(
     "tank" => Tank(units::tank::TankConfig, units::tank::Tank),
     "flash" => Flash(units::flash::FlashConfig, units::flash::Flash),
     "cstr" => Cstr(units::cstr::CstrConfig, units::cstr::Cstr),
+    "equations" => Equations(units::equations::EquationsConfig, units::equations::Equations),
 ]);
 
 registry!(

@@ -3,6 +3,7 @@
 
 pub mod column;
 pub mod cstr;
+pub mod equations;
 pub mod feed;
 pub mod flash;
 pub mod heater;
