@@ -35,7 +35,7 @@ F4). Both direct acting, the ISA form of crates/model/src/controllers/pid.rs wit
   F3 = F3_bias + Kc_l (e_l + I_l / tau_l),  dI_l/dt = e_l = L2 - 1
 P100 = 400 kPa is set directly (at its limit); F1 and F200 are inputs.
 
-What the script computes (all written to tests/data/evaporator_scipy.json):
+What the script computes (all written to tests/data/evaporator/scipy.json):
 (a) the economic optimum over (F1, F200) with X2 = 35.5 % and P100 = 400 kPa (the paper reports
     its operating point; we recompute it), then the closed-loop steady state at the nominal
     inputs (the optimum rounded as the flowsheet gives them) by scipy.optimize.root (hybr) on all
@@ -48,7 +48,7 @@ What the script computes (all written to tests/data/evaporator_scipy.json):
     steady solve (relative step 1e-4, so truncation error ~1e-8 relative: the largest
     disagreement is recorded as `central_difference_check`).
 
-Usage: python3 tools/evaporator_scipy.py           (rewrite tests/data/evaporator_scipy.json)
+Usage: python3 tools/evaporator_scipy.py           (rewrite tests/data/evaporator/scipy.json)
        python3 tools/evaporator_scipy.py --check   (recompute; exit 1 unless it matches the file)
 """
 
@@ -61,7 +61,9 @@ import scipy
 from scipy.integrate import solve_ivp
 from scipy.optimize import minimize, root
 
-OUT = Path(__file__).resolve().parent.parent / "tests" / "data" / "evaporator_scipy.json"
+# In a folder of its own: every JSON file directly in tests/data is loaded as a flowsheet by the
+# schema tests (tests/it/flowsheets.rs).
+OUT = Path(__file__).resolve().parent.parent / "tests" / "data" / "evaporator" / "scipy.json"
 
 # Newell & Lee (1989) constants, eqs. (1)-(12) above.
 RHO_A = 20.0  # kg/m, eq. (1)
@@ -335,11 +337,11 @@ def main():
         old = json.loads(OUT.read_text())
         bad = compare(ref, old)
         if bad:
-            print(f"{OUT.name}: {len(bad)} numbers differ from a fresh run:", file=sys.stderr)
+            print(f"{OUT.relative_to(OUT.parents[3])}: {len(bad)} numbers differ from a fresh run:", file=sys.stderr)
             print("\n".join(bad[:20]), file=sys.stderr)
             sys.exit(1)
         o = ref["optimum"]
-        print(f"{OUT.name}: matches a fresh run (optimum F1 {o['F1']:.4f}, F200 {o['F200']:.3f} kg/min, "
+        print(f"{OUT.relative_to(OUT.parents[3])}: matches a fresh run (optimum F1 {o['F1']:.4f}, F200 {o['F200']:.3f} kg/min, "
               f"J {o['cost']:.3f} $/h; gains checked by central differences to "
               f"{ref['gains']['central_difference_check']['max_difference_over_row_max']:.1e})")
         return

@@ -1,6 +1,6 @@
 //! The Newell–Lee evaporator written as one `equations` unit (`flowsheets/evaporator.json`, issue
 //! 57) against an independent SciPy implementation of the paper's equations
-//! (`tools/evaporator_scipy.py`, its numbers in `tests/data/evaporator_scipy.json`, in the paper's
+//! (`tools/evaporator_scipy.py`, its numbers in `tests/data/evaporator/scipy.json`, in the paper's
 //! units: kg/min, %, kPa, °C, kW, m, min, $/h): the steady state at the economic optimum of
 //! Kariwala, Cao & Janardhanan (2008), a +10 % feed step with both PI loops closed, and the
 //! closed-loop steady-state gains. Each comparison is also run against the same file with UA2 moved
@@ -58,7 +58,7 @@ fn si(name: &str, value: f64) -> f64 {
 }
 
 fn reference() -> serde_json::Value {
-    let text = std::fs::read_to_string(fixture("data/evaporator_scipy.json")).unwrap();
+    let text = std::fs::read_to_string(fixture("data/evaporator/scipy.json")).unwrap();
     serde_json::from_str(&text).unwrap()
 }
 
