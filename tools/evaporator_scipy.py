@@ -9,6 +9,14 @@ and constants), with the economic operating region of Kariwala, Cao & Janardhana
 1150-1158 (cost J, the constraints X2 >= 35.5 %, P100 <= 400 kPa, both active at the optimum,
 and u = [F200, F1] the two unconstrained degrees of freedom).
 
+Provenance: neither the book nor the paper was at hand when this was written. The equations and
+constants below were read from several public restatements of the Newell-Lee model (MATLAB and
+Python implementations found by code search), which agree with one another to every digit; the
+cost and constraints are those the brief of issue 57 quotes from Kariwala et al. (2008). The
+optimum this script recomputes (F1 9.469, F2 1.334, F3 24.721, F100 9.434, F200 217.739 kg/min,
+Q100 345.29 kW, T201 45.55 degC, J -582.233 $/h) is to be checked against the paper's printed
+operating point; it agrees with the values we remember from it.
+
 Units are the paper's: flows kg/min, compositions %, pressures kPa, temperatures degC, duties kW,
 time min. The model (Newell & Lee 1989, eqs. numbered as they list them):
   (1)  20 dL2/dt = F1 - F4 - F2                     rho*A = 20 kg/m
