@@ -22,6 +22,7 @@ mod conditions;
 mod core;
 mod display_units;
 mod dynamics;
+mod evaporator;
 mod faults;
 mod fehe;
 mod flowsheets;

@@ -586,6 +586,15 @@ impl UnitModel for Equations {
     fn outlet_ports(&self) -> Vec<String> {
         self.outlets.clone()
     }
+    fn boundary(&self) -> crate::Boundary {
+        // By its ports, as the flowsheet's boundaries go: no inlet (a port-less model too) is a
+        // source, no outlet a sink.
+        match (self.inlets.is_empty(), self.outlets.is_empty()) {
+            (true, _) => crate::Boundary::Source,
+            (false, true) => crate::Boundary::Sink,
+            (false, false) => crate::Boundary::Interior,
+        }
+    }
     fn internal_vars(&self) -> Vec<VarSpec> {
         self.internal.clone()
     }
@@ -731,6 +740,18 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn boundary_follows_the_ports() {
+        let thermo = binary_package();
+        let boundary = |json: &str| UnitModel::boundary(&build_unit(json, &thermo, Equations::build));
+        assert_eq!(boundary(TANK), crate::Boundary::Interior);
+        let sink = r#"{"variables": {"M": {"kind": "differential", "unit": "mol", "guess": 1}},
+                       "equations": ["der(M) = in.F"], "ports": {"inlets": ["in"]}}"#;
+        assert_eq!(boundary(sink), crate::Boundary::Sink);
+        let portless = r#"{"parameters": {"tau": "1 s"}, "variables": {"y": {"kind": "differential", "guess": 1}}, "equations": ["der(y) = -y/tau"]}"#;
+        assert_eq!(boundary(portless), crate::Boundary::Source);
     }
 
     #[test]
