@@ -143,7 +143,7 @@ pub struct UnitInputError {
 pub fn check_unit_inputs(plant: &Plant, u: &[f64]) -> Result<(), UnitInputError> {
     for b in &plant.blocks {
         let values: Vec<f64> = b.input_ids.iter().map(|&i| u[i]).collect();
-        let section = if b.kind == crate::BlockKind::Unit { "units" } else { "controllers" };
+        let section = b.kind.section();
         b.unit
             .check_inputs(&plant.thermo, &values)
             .map_err(|e| UnitInputError { path: format!("{section}.{}.{}", b.name, e.input()), source: Box::new(e) })?;
