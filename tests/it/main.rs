@@ -22,6 +22,7 @@ mod conditions;
 mod core;
 mod display_units;
 mod dynamics;
+mod equation_units_in_studies;
 mod faults;
 mod fehe;
 mod flowsheets;
