@@ -464,3 +464,22 @@ fn serve_keeps_at_most_64_snapshots_and_says_how_to_replace_one() {
     s.ok(json!({"snapshot": "s0"}));
     assert_eq!(s.get("/api/snapshots").as_array().expect("names").len(), 64);
 }
+
+/// A unit written as equations (issue 57) is served as any other: the first state is the steady
+/// state the library converges, and a step in the coolant temperature runs.
+#[test]
+fn serve_runs_a_plant_with_an_equations_unit() {
+    let file = crate::harness::fixture("data/cstr_equations.json");
+    let s = Server::start(&file, &["--paused"]);
+    let plant = load_with(std::path::Path::new(&file), &[]).expect("loads");
+    let settings = StrategySettings { method: Method::Auto, ..StrategySettings::default() };
+    let x0 = converge(&plant, &settings).expect("converges").x;
+    let diff = max_difference(&plant, &s.get("/api/state?at=sync")["values"], &x0);
+    assert!(diff <= 1e-9, "served first state against the steady state: {diff:e}");
+    s.ok(json!({"set": {"reactor.coolant_T": "305 K"}}));
+    for _ in 0..3 {
+        s.ok(json!({"step": true}));
+    }
+    let t0 = s.get("/api/state?at=sync")["values"]["effluent.T"].as_f64().expect("T");
+    assert!(t0 > x0[plant.var("effluent.T").expect("T")], "warmer coolant warms the reactor");
+}

@@ -227,7 +227,7 @@ impl Checker<'_> {
         let Some(p) = exp.value else {
             return self.err(exp_e.span, ErrorKind::NonConstantExponent { dim: base.dim });
         };
-        let mut out = [0i8; 5];
+        let mut out = [0i8; Dimension::BASES];
         for (o, e) in out.iter_mut().zip(base.dim.exponents()) {
             let scaled = f64::from(e) * p;
             let rounded = scaled.round();
@@ -239,7 +239,7 @@ impl Checker<'_> {
             }
             *o = rounded as i8;
         }
-        Ok(Dimension::new(out[0], out[1], out[2], out[3], out[4]))
+        Ok(Dimension::from_exponents(out))
     }
 
     fn call(&self, span: Span, func: Func, args: &[Expr]) -> Checked<Info> {
@@ -277,7 +277,7 @@ impl Checker<'_> {
         if e.iter().any(|x| x % 2 != 0) {
             return self.err(span, ErrorKind::OddRoot { dim });
         }
-        Ok(Dimension::new(e[0] / 2, e[1] / 2, e[2] / 2, e[3] / 2, e[4] / 2))
+        Ok(Dimension::from_exponents(e.map(|x| x / 2)))
     }
 
     /// Two operands that must share a dimension; the literal 0 takes the other's, and a bare

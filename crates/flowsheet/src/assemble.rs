@@ -58,6 +58,7 @@ pub fn assemble(spec: &FlowsheetSpec, file: &str) -> Result<Plant, LoadError> {
     let pending = a.resolve_controllers()?;
     a.push_controllers(&pending)?;
     a.wire_outputs(&pending);
+    a.push_tags()?;
     a.resolve_aliases();
     a.check_plant();
     a.reads_and_offsets()?;
@@ -142,7 +143,8 @@ impl<'s> Assembler<'s> {
     fn check_names(&mut self) -> Result<(), LoadError> {
         let spec = self.spec;
         let name_len = Limits::get().name_len();
-        for name in spec.units.keys().chain(spec.controllers.keys()).chain(spec.streams.keys()) {
+        for name in spec.units.keys().chain(spec.controllers.keys()).chain(spec.streams.keys()).chain(spec.tags.keys())
+        {
             if let Some(msg) = name_len.check(name.chars().count(), "the length of this name") {
                 self.diags.push(Diagnostic::new(plantwide_model::limits::clip(name), msg));
             }
@@ -165,6 +167,16 @@ impl<'s> Assembler<'s> {
                 format!("controllers.{name}"),
                 format!("`{name}` is also a unit name; units and controllers share one name space"),
             ));
+        }
+        for name in spec.tags.keys() {
+            if spec.units.contains_key(name) || spec.controllers.contains_key(name) || spec.streams.contains_key(name) {
+                let msg = format!("`{name}` is also a unit, controller or stream name; tags share their name space");
+                self.diags.push(Diagnostic::new(format!("tags.{name}"), msg));
+            } else if !plantwide_expr::name::is_valid_name(name) || name.contains('.') || name.contains('[') {
+                let msg = "a tag's name is read in expressions (`<tag>.value`): letters, digits and '_', not starting \
+                           with a digit";
+                self.diags.push(Diagnostic::new(format!("tags.{name}"), msg));
+            }
         }
         for name in spec.streams.keys().filter(|n| spec.units.contains_key(*n) || spec.controllers.contains_key(*n)) {
             self.diags.push(Diagnostic::new(
@@ -485,6 +497,106 @@ impl<'s> Assembler<'s> {
         }
     }
 
+    /// Phase 6d: the tags, in file order ([`plantwide_model::tag`]): each expression's names
+    /// resolved to the flowsheet's parameters or to plant variables and inputs laid out so far
+    /// (units, controllers, earlier tags), compiled with their dimensions, checked against a
+    /// declared unit, and pushed as a block with the one variable `<tag>.value`. Stops on any
+    /// problem.
+    fn push_tags(&mut self) -> Result<(), LoadError> {
+        let parameters = self.tag_parameters();
+        for (name, t) in &self.spec.tags {
+            let at = format!("tags.{name}");
+            let text = t.expression();
+            let names = match plantwide_model::tag::names(text) {
+                Ok(n) => n,
+                Err(msg) => {
+                    self.diags.push(Diagnostic::new(at, msg));
+                    continue;
+                }
+            };
+            let (mut reads, mut guess, mut ok) = (Vec::new(), Vec::new(), true);
+            for (n, span) in names.into_iter().filter(|(n, _)| !parameters.iter().any(|p| &p.0 == n)) {
+                match self.tag_read(&n) {
+                    Some((dim, nominal)) => {
+                        reads.push((n, dim));
+                        guess.push(nominal);
+                    }
+                    None => {
+                        ok = false;
+                        let known = self.var_index.keys().chain(self.input_index.keys()).map(String::as_str);
+                        let hint = did_you_mean(&n, known.chain(parameters.iter().map(|p| p.0.as_str())));
+                        let caret = plantwide_expr::render_caret(text, span);
+                        let msg = format!("no variable, input or parameter `{n}`{hint}\n{caret}");
+                        self.diags.push(Diagnostic::new(format!("{at}.expression"), msg));
+                    }
+                }
+            }
+            if !ok {
+                continue;
+            }
+            match plantwide_model::tag::Tag::build(text, &reads, &parameters, &guess) {
+                Ok(tag) => match self.tag_unit_mismatch(t.unit(), tag.dimension()) {
+                    Some(msg) => self.diags.push(Diagnostic::new(format!("{at}.unit"), msg)),
+                    None => self.push_block(name.clone(), BlockKind::Tag, Box::new(tag), &[]),
+                },
+                Err(msg) => self.diags.push(Diagnostic::new(format!("{at}.expression"), msg)),
+            }
+        }
+        self.stop_if_invalid()
+    }
+
+    /// The flowsheet's `parameters` in SI with their dimensions (a bare number is dimensionless);
+    /// a bad one is reported.
+    fn tag_parameters(&mut self) -> Vec<(String, f64, Dimension)> {
+        let mut out = Vec::new();
+        for (name, q) in &self.spec.parameters {
+            let parsed = match q {
+                plantwide_units::QuantityValue::Number(x) => Ok((*x, Dimension::DIMENSIONLESS)),
+                plantwide_units::QuantityValue::Text(t) => {
+                    plantwide_units::parse_quantity(t).map(|q| (q.value_si, q.dim)).map_err(|e| e.to_string())
+                }
+            };
+            match parsed {
+                Ok((v, _)) if !v.is_finite() => {
+                    self.diags.push(Diagnostic::new(format!("parameters.{name}"), "must be a finite number"));
+                }
+                Ok((v, dim)) if plantwide_expr::name::is_valid_name(name) && !name.contains('.') => {
+                    out.push((name.clone(), v, dim));
+                }
+                Ok(_) => self.diags.push(Diagnostic::new(
+                    format!("parameters.{name}"),
+                    "a parameter's name is read in expressions: letters, digits and '_', not starting with a digit",
+                )),
+                Err(e) => self.diags.push(Diagnostic::new(format!("parameters.{name}"), e)),
+            }
+        }
+        out
+    }
+
+    /// The dimension and nominal value of what a tag reads at `path`: a variable laid out so far,
+    /// else an input (its value).
+    fn tag_read(&self, path: &str) -> Option<(Dimension, f64)> {
+        if let Some(i) = VarPath::parse(path).find(&self.var_index) {
+            let v = &self.vars[i].spec;
+            return Some((v.dim, v.nominal));
+        }
+        self.input_index.get(path).map(|&i| (self.inputs[i].dim, self.inputs[i].value))
+    }
+
+    /// Why a tag of dimension `dim` does not have the declared `unit`'s dimension, if it does not.
+    fn tag_unit_mismatch(&self, unit: Option<&str>, dim: Dimension) -> Option<String> {
+        let unit = unit?;
+        match plantwide_units::parse_quantity(&format!("1 {unit}")) {
+            Err(e) => Some(format!("`{unit}` is not a unit: {e}")),
+            Ok(q) if q.dim != dim => Some(format!(
+                "the expression is {} ({dim}) but the unit `{unit}` is {}; fix the expression or the unit",
+                dim.describe(),
+                q.dim.describe()
+            )),
+            Ok(_) => None,
+        }
+    }
+
     /// Phase 7a: input aliases, each naming a declared input.
     fn resolve_aliases(&mut self) {
         for (alias, p) in &self.spec.inputs {
@@ -546,10 +658,14 @@ impl<'s> Assembler<'s> {
                 });
             }
             for s in b.unit.signals() {
-                match VarPath::parse(&s.path).find(&self.var_index) {
-                    Some(v) => reads.push(Read::Var(v)),
+                // A tag may read an input: the controller output driving it, else its value.
+                let input = || {
+                    self.input_index.get(&s.path).map(|&i| self.inputs[i].driven_by.map_or(Read::Input(i), Read::Var))
+                };
+                match VarPath::parse(&s.path).find(&self.var_index).map(Read::Var).or_else(input) {
+                    Some(read) => reads.push(read),
                     None => self.diags.push(Diagnostic::new(
-                        format!("controllers.{}.{}", b.name, s.role),
+                        format!("{}.{}.{}", b.kind.section(), b.name, s.role),
                         format!("no variable `{}`", s.path),
                     )),
                 }
@@ -629,10 +745,7 @@ pub(crate) fn physical_range(spec: &plantwide_model::VarSpec) -> (f64, f64) {
 }
 
 fn section_path(b: &Block) -> String {
-    match b.kind {
-        BlockKind::Unit => format!("units.{}", b.name),
-        BlockKind::Controller => format!("controllers.{}", b.name),
-    }
+    format!("{}.{}", b.kind.section(), b.name)
 }
 
 /// Why block `b`'s Jacobian block is too large to evaluate, if it is: it is held dense, equations ×

@@ -143,7 +143,7 @@ pub struct UnitInputError {
 pub fn check_unit_inputs(plant: &Plant, u: &[f64]) -> Result<(), UnitInputError> {
     for b in &plant.blocks {
         let values: Vec<f64> = b.input_ids.iter().map(|&i| u[i]).collect();
-        let section = if b.kind == crate::BlockKind::Unit { "units" } else { "controllers" };
+        let section = b.kind.section();
         b.unit
             .check_inputs(&plant.thermo, &values)
             .map_err(|e| UnitInputError { path: format!("{section}.{}.{}", b.name, e.input()), source: Box::new(e) })?;
@@ -268,7 +268,12 @@ pub fn set_field(spec: &mut FlowsheetSpec, path: &str, value: &str) -> Result<()
         let names = spec.units.keys().chain(spec.controllers.keys()).map(String::as_str);
         return Err(OverrideError::NoTarget { path: path.to_string(), hint: did_you_mean(head, names) });
     };
-    let obj = doc[section][head].as_object_mut().ok_or_else(|| field_error(format!("`{head}` is not an object")))?;
+    // An `equations` unit's parameters are set by name too (`reactor.k0=…`, a size study's
+    // `tank.area=…`).
+    let unit = &doc[section][head];
+    let in_parameters = unit.get(field).is_none() && unit.get("parameters").and_then(|p| p.get(field)).is_some();
+    let target = if in_parameters { &mut doc[section][head]["parameters"] } else { &mut doc[section][head] };
+    let obj = target.as_object_mut().ok_or_else(|| field_error(format!("`{head}` is not an object")))?;
     if !obj.contains_key(field) {
         let known: Vec<&str> = obj.keys().map(String::as_str).collect();
         return Err(field_error(format!(
@@ -276,8 +281,21 @@ pub fn set_field(spec: &mut FlowsheetSpec, path: &str, value: &str) -> Result<()
             known.join(", ")
         )));
     }
-    let parsed = serde_json::from_str::<Value>(value).unwrap_or_else(|_| Value::String(value.to_string()));
+    let mut parsed = serde_json::from_str::<Value>(value).unwrap_or_else(|_| Value::String(value.to_string()));
+    if in_parameters {
+        parsed = parameter_in_si(&obj[field], parsed);
+    }
     obj.insert(field.to_string(), parsed);
     *spec = serde_json::from_value(doc).map_err(|e| field_error(e.to_string()))?;
     Ok(())
+}
+
+/// A bare number set on an `equations` unit's parameter is in SI units of the parameter's
+/// dimension as the file writes it (`--set reactor.ua=3000` on `"ua": "2 kW/K"` is 3000 W/K), as
+/// bare numbers are everywhere else, rather than dimensionless; anything else stays as written.
+fn parameter_in_si(old: &Value, new: Value) -> Value {
+    let (Some(x), Some(Ok(q))) = (new.as_f64(), old.as_str().map(plantwide_units::parse_quantity)) else {
+        return new;
+    };
+    if q.dim.is_dimensionless() { new } else { Value::String(format!("{x:e} {}", q.dim)) }
 }

@@ -7,6 +7,7 @@ use std::path::Path;
 use indexmap::IndexMap;
 use plantwide_model::limits::{Limits, clip};
 use plantwide_model::{ControllerSpec, UnitSpec};
+use plantwide_units::QuantityValue;
 use serde::de::{DeserializeOwned, DeserializeSeed, MapAccess, SeqAccess, Visitor};
 use serde_json::Value;
 
@@ -24,6 +25,8 @@ const TOP_LEVEL: &[&str] = &[
     "controllers",
     "inputs",
     "specs",
+    "parameters",
+    "tags",
 ];
 
 /// Read a file the engine is given (flowsheet, scenario, model, matrices) as text: at most
@@ -118,8 +121,10 @@ pub fn parse_spec(text: &str, file: &str) -> Result<FlowsheetSpec, LoadError> {
         false,
         &mut diags,
     );
-    let n_blocks = units.len() + controllers.len();
-    if let Some(msg) = Limits::get().units().check(n_blocks, "the number of units and controllers") {
+    let parameters = plain_map::<QuantityValue>(obj.get("parameters"), "parameters", false, &mut diags);
+    let tags = plain_map::<crate::spec::TagSpec>(obj.get("tags"), "tags", false, &mut diags);
+    let n_blocks = units.len() + controllers.len() + tags.len();
+    if let Some(msg) = Limits::get().units().check(n_blocks, "the number of units, controllers and tags") {
         diags.push(Diagnostic::new("units", msg));
     }
     let streams = plain_map::<StreamSpec>(obj.get("streams"), "streams", true, &mut diags);
@@ -137,6 +142,8 @@ pub fn parse_spec(text: &str, file: &str) -> Result<FlowsheetSpec, LoadError> {
             controllers,
             inputs,
             specs,
+            parameters,
+            tags,
         }),
         _ => Err(LoadError::Invalid { file: file.into(), diagnostics: diags }),
     }

@@ -23,13 +23,36 @@ pub enum Read {
     Input(usize),
 }
 
-/// Whether a block is a process unit or a controller.
+/// Whether a block is a process unit, a controller or a tag.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum BlockKind {
     /// A process unit.
     Unit,
     /// A controller.
     Controller,
+    /// A tag: a quantity computed from plant variables by an expression
+    /// ([`plantwide_model::tag`]).
+    Tag,
+}
+
+impl BlockKind {
+    /// The flowsheet file's section of such blocks: `units`, `controllers` or `tags`.
+    pub fn section(self) -> &'static str {
+        match self {
+            BlockKind::Unit => "units",
+            BlockKind::Controller => "controllers",
+            BlockKind::Tag => "tags",
+        }
+    }
+
+    /// The word for one such block in reports: `unit`, `controller` or `tag`.
+    pub fn label(self) -> &'static str {
+        match self {
+            BlockKind::Unit => "unit",
+            BlockKind::Controller => "controller",
+            BlockKind::Tag => "tag",
+        }
+    }
 }
 
 /// One unit or controller in the assembled plant.

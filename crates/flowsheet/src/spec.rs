@@ -47,6 +47,52 @@ pub struct FlowsheetSpec {
     /// free input (`{"path": "distillate.x[light]", "value": 0.995, "vary": "column.reflux"}`).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub specs: Vec<crate::design::SpecEntry>,
+    /// Named constants with units, for the tags' expressions (`"steam_price": "0.03 $/kWh"`); a
+    /// bare number is dimensionless.
+    #[serde(default, skip_serializing_if = "IndexMap::is_empty")]
+    pub parameters: IndexMap<String, QuantityValue>,
+    /// Tags: named quantities computed from the plant's variables and inputs by an expression
+    /// (`"cost": "steam_price*reboiler.duty + feed_price*fresh.F"`), each a variable
+    /// `<tag>.value` of the plant that every analysis sees ([`plantwide_model::tag`]).
+    #[serde(default, skip_serializing_if = "IndexMap::is_empty")]
+    pub tags: IndexMap<String, TagSpec>,
+}
+
+/// A tag: its expression, alone or with the unit its value must have and a description.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(untagged)]
+pub enum TagSpec {
+    /// The expression alone (`"steam_price*reboiler.duty"`).
+    Expression(String),
+    /// The expression with a declared unit and a description.
+    Full {
+        /// The expression, over plant paths (`column.T[5]`, `fresh.F`, `lc.op`, `other_tag.value`)
+        /// and the flowsheet's `parameters`.
+        expression: String,
+        /// A unit whose dimension the expression must have (`"$/h"`): a check, not a conversion.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        unit: Option<String>,
+        /// What the tag measures.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        description: Option<String>,
+    },
+}
+
+impl TagSpec {
+    /// The expression's text.
+    pub fn expression(&self) -> &str {
+        match self {
+            TagSpec::Expression(e) | TagSpec::Full { expression: e, .. } => e,
+        }
+    }
+
+    /// The declared unit, if any.
+    pub fn unit(&self) -> Option<&str> {
+        match self {
+            TagSpec::Expression(_) => None,
+            TagSpec::Full { unit, .. } => unit.as_deref(),
+        }
+    }
 }
 
 /// A component of the flowsheet.

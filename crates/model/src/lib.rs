@@ -18,6 +18,7 @@ pub mod error;
 pub mod limits;
 pub mod registry;
 pub mod stream;
+pub mod tag;
 pub mod testing;
 pub mod unit;
 pub mod units;

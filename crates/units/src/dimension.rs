@@ -7,8 +7,10 @@ use std::ops::{Div, Mul};
 use crate::named;
 
 /// The dimension of a quantity: integer exponents of the SI base dimensions mass (kg), length (m),
-/// time (s), thermodynamic temperature (K) and amount of substance (mol). Electric current and
-/// luminous intensity are not needed by the simulator and are not represented.
+/// time (s), thermodynamic temperature (K) and amount of substance (mol), and one non-SI base,
+/// currency (`$`: the plant's money unit, one currency without exchange rates), so that prices
+/// (`$/kmol`), costs (`$/h`) and economic objectives are checked like any other quantity. Electric
+/// current and luminous intensity are not needed by the simulator and are not represented.
 ///
 /// `Dimension::PRESSURE` is kg·m⁻¹·s⁻², so its fields are `mass: 1, length: -1, time: -2`.
 /// Displays as the SI symbol of a named dimension (`"mol/s"`, `"Pa"`, `"J/(mol*K)"`), otherwise as a
@@ -25,14 +27,19 @@ pub struct Dimension {
     pub temperature: i8,
     /// Exponent of amount of substance (mol).
     pub amount: i8,
+    /// Exponent of currency (`$`).
+    pub currency: i8,
 }
 
 impl Dimension {
     /// A dimension from its exponents of mass (kg), length (m), time (s), temperature (K) and
     /// amount (mol).
     pub const fn new(mass: i8, length: i8, time: i8, temperature: i8, amount: i8) -> Self {
-        Dimension { mass, length, time, temperature, amount }
+        Dimension { mass, length, time, temperature, amount, currency: 0 }
     }
+
+    /// The number of base dimensions: the five SI ones and currency.
+    pub const BASES: usize = 6;
 
     /// Dimensionless (1): fractions, ratios, percentages.
     pub const DIMENSIONLESS: Dimension = Dimension::new(0, 0, 0, 0, 0);
@@ -98,25 +105,35 @@ impl Dimension {
     pub const DENSITY_MASS: Dimension = Dimension::new(1, -3, 0, 0, 0);
     /// Volumetric reaction rate (mol/(m³·s)).
     pub const REACTION_RATE: Dimension = Dimension::new(0, -3, -1, 0, 1);
+    /// Money (`$`).
+    pub const CURRENCY: Dimension = Dimension::from_exponents([0, 0, 0, 0, 0, 1]);
+    /// A cost or revenue rate, an economic objective (`$/s`; shown as `$/h` in plant units).
+    pub const COST_RATE: Dimension = Dimension::from_exponents([0, 0, -1, 0, 0, 1]);
 
     /// Whether all exponents are zero.
     pub const fn is_dimensionless(&self) -> bool {
-        self.mass == 0 && self.length == 0 && self.time == 0 && self.temperature == 0 && self.amount == 0
+        self.mass == 0
+            && self.length == 0
+            && self.time == 0
+            && self.temperature == 0
+            && self.amount == 0
+            && self.currency == 0
     }
 
-    /// The exponents in the order mass, length, time, temperature, amount.
-    pub const fn exponents(&self) -> [i8; 5] {
-        [self.mass, self.length, self.time, self.temperature, self.amount]
+    /// The exponents in the order mass, length, time, temperature, amount, currency.
+    pub const fn exponents(&self) -> [i8; Dimension::BASES] {
+        [self.mass, self.length, self.time, self.temperature, self.amount, self.currency]
     }
 
-    const fn from_exponents(e: [i8; 5]) -> Self {
-        Dimension::new(e[0], e[1], e[2], e[3], e[4])
+    /// The dimension with exponents `e`, in the order of [`Dimension::exponents`].
+    pub const fn from_exponents(e: [i8; Dimension::BASES]) -> Self {
+        Dimension { mass: e[0], length: e[1], time: e[2], temperature: e[3], amount: e[4], currency: e[5] }
     }
 
     fn zip(self, other: Dimension, f: impl Fn(i8, i8) -> Option<i8>) -> Option<Dimension> {
         let (a, b) = (self.exponents(), other.exponents());
-        let mut out = [0i8; 5];
-        for i in 0..5 {
+        let mut out = [0i8; Dimension::BASES];
+        for i in 0..Dimension::BASES {
             out[i] = f(a[i], b[i])?;
         }
         Some(Dimension::from_exponents(out))
@@ -134,7 +151,7 @@ impl Dimension {
 
     /// The dimension raised to an integer power, or `None` if an exponent leaves the `i8` range.
     pub fn checked_pow(self, n: i32) -> Option<Dimension> {
-        let mut out = [0i8; 5];
+        let mut out = [0i8; Dimension::BASES];
         for (o, e) in out.iter_mut().zip(self.exponents()) {
             *o = i8::try_from(i32::from(e).checked_mul(n)?).ok()?;
         }
@@ -210,7 +227,7 @@ impl fmt::Display for Dimension {
         if let Some(n) = named::lookup(*self) {
             return f.write_str(n.symbol);
         }
-        const SYMBOLS: [&str; 5] = ["kg", "m", "s", "K", "mol"];
+        const SYMBOLS: [&str; Dimension::BASES] = ["kg", "m", "s", "K", "mol", "$"];
         let term = |s: &str, e: i8| {
             if e == 1 { s.to_owned() } else { format!("{s}{e}") }
         };

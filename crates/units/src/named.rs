@@ -32,6 +32,8 @@ type D = Dimension;
 static NAMED: &[NamedDimension] = &[
     nd(D::DIMENSIONLESS, "dimensionless", "a dimensionless number", "1", &["0.5", "50 %"]),
     nd(D::MASS, "mass", "a mass", "kg", &["100 kg", "10 lb"]),
+    nd(D::CURRENCY, "money", "an amount of money", "$", &["1000 $", "2 k$"]),
+    nd(D::COST_RATE, "cost rate", "a cost rate", "$/s", &["100 $/h", "2 k$/d"]),
     nd(D::LENGTH, "length", "a length", "m", &["4.5 ft", "2 m"]),
     nd(D::TIME, "time", "a time", "s", &["2 min", "1 h"]),
     nd(D::TEMPERATURE, "temperature", "a temperature", "K", &["350 K", "80 degC"]),

@@ -42,7 +42,7 @@ struct Parser<'a> {
 }
 
 fn is_symbol_char(c: char) -> bool {
-    c.is_alphabetic() || c.is_ascii_digit() || matches!(c, '%' | '°' | '℃' | '℉' | '_')
+    c.is_alphabetic() || c.is_ascii_digit() || matches!(c, '%' | '°' | '℃' | '℉' | '_' | '$')
 }
 
 fn superscript_digit(c: char) -> Option<u32> {

@@ -33,6 +33,7 @@ const TABLE: &[(Dimension, &str, &str)] = &[
     (Dimension::TIME, "min", "min"),
     (Dimension::MOLAR_ENERGY, "kJ/mol", "Btu/lbmol"),
     (Dimension::UA, "kW/K", "Btu/(h*degF)"),
+    (Dimension::COST_RATE, "$/h", "$/h"),
 ];
 
 impl UnitSystem {

@@ -216,3 +216,24 @@ mod tests {
         assert_eq!(format!("{:.1}", Quantity::new(351.26, Dimension::TEMPERATURE)), "351.3 K");
     }
 }
+
+#[cfg(test)]
+mod currency_tests {
+    use super::*;
+
+    #[test]
+    fn prices_and_cost_rates_carry_the_currency_dimension() {
+        // 36 $/h = 0.01 $/s; 2 k$/d = 2000/86400 $/s; 31.8 $/kmol = 0.0318 $/mol.
+        assert!((parse_quantity_as("36 $/h", Dimension::COST_RATE).unwrap() - 0.01).abs() < 1e-15);
+        assert!((parse_quantity_as("2 k$/d", Dimension::COST_RATE).unwrap() - 2000.0 / 86400.0).abs() < 1e-15);
+        let price = parse_quantity("31.8 $/kmol").unwrap();
+        assert_eq!(price.dim, Dimension::CURRENCY / Dimension::AMOUNT);
+        assert!((price.value_si - 0.0318).abs() < 1e-15);
+        assert_eq!(price.dim.to_string(), "$/mol");
+        // Money is not a mass flow: the dimension check sees the difference.
+        assert!(parse_quantity_as("36 $/h", Dimension::MASS_FLOW).is_err());
+        assert_eq!(Dimension::COST_RATE.to_string(), "$/s");
+        assert!(!Dimension::CURRENCY.is_dimensionless());
+        assert_eq!(crate::UnitSystem::Metric.unit_for(Dimension::COST_RATE), "$/h");
+    }
+}

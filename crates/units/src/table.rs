@@ -111,6 +111,8 @@ static UNITS: &[UnitDef] = &[
     lin("%", "percent", 1e-2, D::DIMENSIONLESS),
     lin("ppm", "parts per million", 1e-6, D::DIMENSIONLESS),
     lin("ppb", "parts per billion", 1e-9, D::DIMENSIONLESS),
+    // Currency: one money unit, the plant's (no exchange rates); k$ and M$ by prefix.
+    pre("$", "currency unit", 1.0, D::CURRENCY),
     // Mass.
     pre("g", "gram", 1e-3, D::MASS),
     lin("lb", "pound (avoirdupois)", POUND, D::MASS),

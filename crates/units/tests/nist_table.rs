@@ -16,6 +16,7 @@ const EXPECTED: &[(&str, f64, f64, D, f64)] = &[
     ("%", 0.01, 0.0, D::DIMENSIONLESS, 1e-15),
     ("ppm", 1e-6, 0.0, D::DIMENSIONLESS, 1e-15),
     ("ppb", 1e-9, 0.0, D::DIMENSIONLESS, 1e-15),
+    ("$", 1.0, 0.0, D::CURRENCY, 0.0),
     ("g", 1e-3, 0.0, D::MASS, 1e-15),
     ("lb", 0.45359237, 0.0, D::MASS, 1e-15),
     ("lbm", 0.45359237, 0.0, D::MASS, 1e-15),

@@ -76,6 +76,19 @@ fn controllers_and_specs(plant: &Plant) -> String {
             measured.join(", ")
         ));
     }
+    let tags: Vec<_> = plant.blocks().iter().filter(|b| b.kind == BlockKind::Tag).collect();
+    if !tags.is_empty() {
+        t.push_str(&format!("tags ({}), each the variable `<tag>.value`:\n", tags.len()));
+        for b in &tags {
+            let v = &plant.vars()[b.own_offset];
+            t.push_str(&format!(
+                "  {:<16} [{}] = {}\n",
+                b.name,
+                v.spec.dim,
+                b.unit.equation_name(0, &[]).trim_start_matches("value = ")
+            ));
+        }
+    }
     if !plant.specs().is_empty() {
         t.push_str(&format!(
             "design specs ({}), each with its varied input as one more unknown:\n",

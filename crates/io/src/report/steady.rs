@@ -5,7 +5,7 @@
 
 use std::collections::BTreeMap;
 
-use plantwide_flowsheet::{BlockKind, Plant};
+use plantwide_flowsheet::Plant;
 use plantwide_model::stream::{F, H, P, T, Z0};
 use plantwide_solve::{Method, Solution};
 use plantwide_units::{Dimension, Display, UnitSystem};
@@ -132,7 +132,7 @@ fn blocks(plant: &Plant, sol: &Solution, units: Option<UnitSystem>) -> String {
                 format!("{}={}", v.path.trim_start_matches(&prefix), shown(sol.x[j], v.spec.dim, system))
             })
             .collect();
-        let kind = if b.kind == BlockKind::Controller { "controller" } else { "unit" };
+        let kind = b.kind.label();
         if internal.len() > 12 {
             t.push_str(&format!(
                 "{kind} {:<14} {:<10} {} … ({} variables; the JSON output lists them all)\n",

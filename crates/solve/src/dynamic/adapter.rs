@@ -225,6 +225,10 @@ impl DaeSystem for PlantDae<'_> {
             plantwide_flowsheet::BlockKind::Unit => {
                 "; a vessel running dry or overflowing, or a flow reversing, ends a run this way"
             }
+            plantwide_flowsheet::BlockKind::Tag => {
+                "; a tag's expression leaving its domain (a logarithm or square root of a negative number, a \
+                 division by zero) ends a run this way"
+            }
         })
     }
     fn complete(&self, t: f64, x: &mut [f64]) {
