@@ -40,19 +40,19 @@ const VARIABLES: [(&str, &str); 15] = [
     ("F5", "evaporator.F5"),
     ("F2", "x2_control.op"),
     ("F3", "level_control.op"),
-    ("cost", "evaporator.cost"),
+    ("cost", "cost.value"),
 ];
 
 /// The SI value of the paper-unit `value` of the reference variable `name`.
 fn si(name: &str, value: f64) -> f64 {
     match name.as_bytes()[0] {
-        b'L' => value,                // m
-        b'X' => value / 100.0,        // %
-        b'P' => value * 1e3,          // kPa
-        b'T' => value + 273.15,       // °C
-        b'Q' => value * 1e3,          // kW
-        b'F' => value / 60.0,         // kg/min
-        _ if name == "cost" => value, // $/h as a number
+        b'L' => value,                         // m
+        b'X' => value / 100.0,                 // %
+        b'P' => value * 1e3,                   // kPa
+        b'T' => value + 273.15,                // °C
+        b'Q' => value * 1e3,                   // kW
+        b'F' => value / 60.0,                  // kg/min
+        _ if name == "cost" => value / 3600.0, // $/h
         _ => panic!("no unit for {name}"),
     }
 }
@@ -70,7 +70,10 @@ fn flowsheet_file(perturbed: bool) -> String {
     }
     let text = std::fs::read_to_string(&path).unwrap();
     assert!(text.contains("\"6.84 kW/K\""));
-    let copy = std::env::temp_dir().join(format!("evaporator_ua2_{}.json", std::process::id()));
+    // One copy per call: the tests run in parallel, and a copy being written is not yet JSON.
+    static COPIES: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let k = COPIES.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let copy = std::env::temp_dir().join(format!("evaporator_ua2_{}_{k}.json", std::process::id()));
     std::fs::write(&copy, text.replace("\"6.84 kW/K\"", "\"6.84001 kW/K\"")).unwrap();
     copy.to_string_lossy().into_owned()
 }
@@ -164,6 +167,7 @@ fn gains(file: &str, method: &str) -> Vec<Vec<f64>> {
         b'T' => "degC",
         b'Q' => "kW",
         b'F' => "kg/min",
+        _ if name == "cost" => "$/h",
         _ => "",
     };
     let path =
