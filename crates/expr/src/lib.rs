@@ -48,6 +48,7 @@ pub mod ast;
 mod check;
 mod compiled;
 mod error;
+pub mod external;
 pub mod name;
 pub mod parse;
 mod span;
@@ -60,6 +61,7 @@ pub mod testing;
 
 pub use compiled::{Equation, Expression, Gradient};
 pub use error::{ErrorKind, ExprError, SymbolError};
+pub use external::{BindError, ExternalCall, ExternalEval, ExternalFunction};
 pub use parse::{parse_equation, parse_expression};
 pub use span::{Span, render_caret};
 pub use structure::{Matching, StructuralError, StructureMode, check_structure, maximum_matching};
