@@ -62,6 +62,8 @@ use crate::{InputSpec, LocalLayout, Scalar, UnitIo, UnitModel, VarSpec};
 
 mod build;
 mod thermo;
+#[cfg(test)]
+mod thermo_tests;
 
 /// Whether a variable of an equations unit has a time derivative.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
