@@ -44,6 +44,7 @@ mod size;
 mod size_newcomer;
 mod snowball;
 mod specs;
+mod thermo_functions;
 mod threads;
 mod tune;
 mod tutorial;

@@ -4,11 +4,11 @@ use std::collections::BTreeSet;
 
 use super::{Instr, InstrSpans, Load, Op, Slot, Source, Tape, Val, func1, func2, func3};
 use crate::ast::{BinOp, Expr, ExprKind, Func};
+use crate::check::bind;
 use crate::error::{ErrorKind, ExprError};
+use crate::external::{ExternalNode, FunctionRef};
 use crate::span::Span;
 use crate::symbols::{Symbol, SymbolTable};
-use crate::check::bind;
-use crate::external::{ExternalNode, FunctionRef};
 use crate::table::Table;
 
 /// Compiles a checked expression (the caller has run the dimension check, so every name

@@ -15,7 +15,7 @@
 
 use std::convert::Infallible;
 
-use plantwide_thermo::Scalar;
+use crate::Scalar;
 
 mod compile;
 mod reverse;
@@ -25,8 +25,8 @@ pub use reverse::Workspace;
 
 use crate::ast::{CmpOp, Func};
 use crate::error::{ErrorKind, ExprError};
-use crate::span::Span;
 use crate::external::ExternalNode;
+use crate::span::Span;
 use crate::table::Table;
 
 /// A slot index.

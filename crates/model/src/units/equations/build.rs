@@ -292,7 +292,8 @@ impl Builder<'_, '_> {
                     }
                 },
                 _ => {
-                    let msg = format!("an equation may hold one `der()`, as `der(x) = <expression without der()>`\n{text}");
+                    let msg =
+                        format!("an equation may hold one `der()`, as `der(x) = <expression without der()>`\n{text}");
                     self.cx.error(&field, msg);
                     continue;
                 }

@@ -15,6 +15,42 @@
 //! Parameters and inputs by their names, own variables by theirs, and every port's stream
 //! quantities as `<port>.F`, `<port>.T`, `<port>.P`, `<port>.h` and `<port>.x[<component>]`.
 //!
+//! # Thermodynamic functions of a port's state
+//! The flowsheet's thermodynamic package, called with a port's name (an inlet's or an outlet's):
+//!
+//! | call | value | unit | reads |
+//! |---|---|---|---|
+//! | `h_L(port)` | liquid molar enthalpy `Σ x_i h_L,i(T)` | J/mol | `T`, `x` |
+//! | `h_V(port)` | vapour molar enthalpy `Σ x_i h_ig,i(T)` (the port's `x` as the vapour) | J/mol | `T`, `x` |
+//! | `K(port, c)` | K-value `y_c/x_c` of component `c` at the port's `T`, `P`, `x` | 1 | `T`, `P`, `x` |
+//! | `rho_L(port)` | liquid **molar** density `1/v_L(T, x)` | mol/m³ | `T`, `x` |
+//! | `mw(port)` | mean molar mass `Σ x_i M_i` (so `mw(p)*rho_L(p)` is the mass density) | kg/mol | `x` |
+//! | `T_bubble(port)` | bubble temperature at the port's `P` and `x/Σx` | K | `P`, `x` |
+//!
+//! `K` and `T_bubble` take an optional last argument naming a pressure variable or input of the
+//! unit to use instead of the port's `P`: `K(liquid, benzene, P)` is the K-value of the liquid in
+//! a drum at pressure `P` whose liquid outlet leaves at the valve's downstream pressure.
+//! Components are written as in `x[…]` (`K(out, o-xylene)`). The arguments are names, not
+//! expressions. A parameter, input, variable or table of the file that takes one of these names
+//! hides the function.
+//!
+//! Derivatives are exact: the expression layer asks each call for its value and its partial
+//! derivatives with respect to the port quantities it reads (the package's functions evaluated
+//! over dual numbers, one pass per quantity; the bubble temperature's by the implicit-function
+//! theorem on the bubble-point residual `Σ K_i x_i − 1` at the converged temperature, as
+//! `ThermoPackage::bubble_t` converges it to machine precision). Each call's row of the sparsity
+//! pattern holds exactly the quantities in the table's last column.
+//!
+//! # Tables
+//! `"tables": {"cp": {"x": [300, 350, 400], "y": [1.0, 1.5, 3.0], "x_unit": "K",
+//! "y_unit": "kJ/(kg*K)", "interpolation": "spline"}}` declares `cp(expr)`: `expr` must have the
+//! dimension of `x_unit`, the value has that of `y_unit` (both default dimensionless).
+//! `interpolation` is `linear` (default) or `spline`, the natural cubic spline (zero second
+//! derivative at both ends, as SciPy's `CubicSpline(bc_type="natural")`); beyond the ends the
+//! table continues along its end tangent. At load, fewer than 2 points, `x` and `y` of unequal
+//! lengths, an `x` not strictly increasing, or a value not finite in SI are refused at the
+//! offending point (`units.u.tables.cp.x[2]`).
+
 //! # Layout and the mass matrix
 //! Own variables are the outlet streams (`[F, T, P, h, x…]` each, ports in name order), then the
 //! `variables` in name order. Every name is bound to its slot of the unit's *local vector*, so the
@@ -33,10 +69,10 @@
 //! Inlets are read as known values. Each outlet maps some of its stream quantities to
 //! expressions, each the equation `out.Q = expr`; a quantity it does not map (`F`, `T`, `P`,
 //! `x[c]`) is an unknown the `equations` must determine (`U = M*out.h` gives `out.T`), else the set
-//! is refused as structurally singular naming it. An unmapped `h` is closed by the unit as the
-//! liquid enthalpy `h = h_L(T, x)` of the thermodynamic package (the expression layer has no
-//! thermodynamic functions yet): one more equation of the set, which the matching places like
-//! the others (with `U = M*out.h` it takes `out.T`'s row and the balance `h`'s).
+//! is refused as structurally singular naming it. An unmapped `h` is closed by the unit with the
+//! equation `out.h = h_L(out)`, compiled like the others (the same exact derivatives and the
+//! same sparsity: `h`, `T` and every `x`); the matching places it like the others (with
+//! `U = M*out.h` it takes `out.T`'s row and the balance `h`'s).
 //!
 //! # Material
 //! `holdup` gives each component's amount \[mol\] as an expression (for a dynamic run's
@@ -46,9 +82,13 @@
 //!
 //! # Checks at load
 //! Names, dimensions (both sides, each outlet mapping against its stream quantity), the `der()`
-//! form, a structurally singular set (dynamic mode), and each equation evaluated at the guesses
-//! (variables at their `guess`, inlets at 1 mol/s, 300 K, 1 bar, h = 0, uniform x): a division by
-//! zero or a logarithm of a non-positive number there is refused with its position.
+//! form, a structurally singular set (dynamic mode), bad tables, unknown ports or components in
+//! thermodynamic calls, and each equation evaluated at the guesses: a division by zero, a
+//! logarithm of a non-positive number or a thermodynamic function that cannot be evaluated
+//! there is refused with its position. The guesses are the variables' `guess`es and the outlets
+//! the unit's own guess; the inlets hold the stream the engine starts every stream from before
+//! it guesses the units (1 mol/s, 300 K, 1 atm, uniform `x`, its liquid enthalpy), because a
+//! unit is built before the plant is wired and the upstream guesses are not known then.
 
 use std::collections::BTreeMap;
 
@@ -137,8 +177,8 @@ pub struct EqPortsConfig {
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub inlets: Vec<String>,
     /// Outlet ports by name, each mapping some of its stream quantities (`F`, `T`, `P`, `x[<c>]`,
-    /// `h`) to expressions; the equations determine the others, and an unmapped `h` is the liquid
-    /// enthalpy at the outlet's `T` and `x`.
+    /// `h`) to expressions; the equations determine the others, and an unmapped `h` is closed as
+    /// `h = h_L(out)`, the liquid enthalpy at the outlet's `T` and `x`.
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub outlets: BTreeMap<String, BTreeMap<String, String>>,
 }

@@ -98,7 +98,13 @@ fn thermo_calls_have_exact_jacobians_and_their_port_sparsity() {
             let col = IN + [T, P, Z0, Z0 + 1][j];
             assert_eq!(pattern.contains(&(row, col)), read, "{text}: column {col} in the pattern");
             // The residual is `v − f(in)`: its partial is −∂f.
-            let (fwd, rev) = (jac[row * n + col], grad.d_x.get(eq.variables().iter().position(|&c| c == col).unwrap_or(usize::MAX)).copied().unwrap_or(0.0));
+            let (fwd, rev) = (
+                jac[row * n + col],
+                grad.d_x
+                    .get(eq.variables().iter().position(|&c| c == col).unwrap_or(usize::MAX))
+                    .copied()
+                    .unwrap_or(0.0),
+            );
             for got in [fwd, rev] {
                 let rel = (got + w).abs() / w.abs().max(1e-300);
                 assert!(rel < 1e-12 || (w == 0.0 && got == 0.0), "{text} ∂/∂{col}: {got} vs {}", -w);
@@ -151,7 +157,10 @@ fn bad_thermo_calls_are_located() {
     };
     let cases = [
         ("kl = K(inn, light)", "`K`: `inn` is not a port of the unit (ports: out, in)\nkl = K(inn, light)\n       ^^^"),
-        ("kl = K(in, lite)", "`K`: `lite` is not a component (components: light, heavy)\nkl = K(in, lite)\n           ^^^^"),
+        (
+            "kl = K(in, lite)",
+            "`K`: `lite` is not a component (components: light, heavy)\nkl = K(in, lite)\n           ^^^^",
+        ),
         ("kl = K(in)", "`K`: called with 1 argument(s), as `K(port, component[, P])`\nkl = K(in)\n     ^^^^^"),
         ("kl = K(in, light, T)", "`K`: `T` is not a pressure of the unit (pressures: Pd, in.P, out.P)"),
         ("kl = K_V(in, light)", "unknown name `K_V`"),
@@ -188,10 +197,18 @@ fn tables_in_the_file() {
     assert!(jacobian_error(&u, &lay, &thermo, &local, lay.n_own()) < 1e-7);
     let tables = |t: &str| format!(r#"{{"tables": {{"cp": {t}}}, "equations": ["kl = cp(in.T)"]}}"#);
     let cases = [
-        (r#"{"x": [300, 350, 340], "y": [1, 2, 3], "x_unit": "K"}"#, "units.u.tables.cp.x[2]", "x must be strictly increasing"),
+        (
+            r#"{"x": [300, 350, 340], "y": [1, 2, 3], "x_unit": "K"}"#,
+            "units.u.tables.cp.x[2]",
+            "x must be strictly increasing",
+        ),
         (r#"{"x": [300, 350], "y": [1, 2, 3], "x_unit": "K"}"#, "units.u.tables.cp.y", "2 x values but 3 y values"),
         (r#"{"x": [300], "y": [1], "x_unit": "K"}"#, "units.u.tables.cp.x", "at least 2 points"),
-        (r#"{"x": [300, 350], "y": [1, 1e306], "x_unit": "K", "y_unit": "kJ/mol"}"#, "units.u.tables.cp.y[1]", "not finite"),
+        (
+            r#"{"x": [300, 350], "y": [1, 1e306], "x_unit": "K", "y_unit": "kJ/mol"}"#,
+            "units.u.tables.cp.y[1]",
+            "not finite",
+        ),
         (r#"{"x": [300, 350], "y": [1, 2], "x_unit": "kelvinn"}"#, "units.u.tables.cp.x_unit", ""),
     ];
     for (t, path, want) in cases {
@@ -200,7 +217,13 @@ fn tables_in_the_file() {
         assert!(e[0].message.contains(want) && e[0].message.contains("cp") || want.is_empty(), "{t}: {}", e[0].message);
     }
     // The argument's dimension is checked against the table's x, located in the text.
-    let e = build_err(r#"{"tables": {"cp": {"x": [300, 350], "y": [1, 2], "x_unit": "K"}}, "equations": ["kl = cp(in.P)"]}"#);
-    assert!(e[0].message.contains("the argument of table `cp` and its input must have the same dimension"), "{}", e[0].message);
+    let e = build_err(
+        r#"{"tables": {"cp": {"x": [300, 350], "y": [1, 2], "x_unit": "K"}}, "equations": ["kl = cp(in.P)"]}"#,
+    );
+    assert!(
+        e[0].message.contains("the argument of table `cp` and its input must have the same dimension"),
+        "{}",
+        e[0].message
+    );
     assert!(e[0].message.ends_with("kl = cp(in.P)\n        ^^^^"), "{}", e[0].message);
 }
