@@ -24,6 +24,9 @@ fn in_equation(k: usize, from: &'static str, to: &'static str) -> impl FnOnce(&m
     }
 }
 
+/// An edit of the drum's description.
+type Edit = Box<dyn FnOnce(&mut serde_json::Value)>;
+
 fn check_fails_with(path: &str, fragments: &[&str]) {
     let out = harness::plantwide(&["check", path]);
     let stderr = String::from_utf8_lossy(&out.stderr);
@@ -45,7 +48,7 @@ fn bad_thermo_calls_exit_1_with_the_position() {
     // Equation 3 is `vapour.x[benzene]*(K(liquid, benzene, P)*… ) = …`; the caret lines up under
     // the argument at fault (29 columns in).
     let pad = " ".repeat(29);
-    let cases: [(&str, Box<dyn FnOnce(&mut serde_json::Value)>, Vec<String>); 4] = [
+    let cases: [(&str, Edit, Vec<String>); 4] = [
         (
             "unknown_component",
             Box::new(in_equation(3, "K(liquid, benzene, P)", "K(liquid, benzen, P)")),

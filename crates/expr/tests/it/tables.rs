@@ -141,12 +141,13 @@ fn external_calls_are_exact_in_every_mode_and_read_their_variables() {
     let want = [-(e * 2.0 * a * b + c * c * b), -(e * a * a + c * c * a), -(2.0 * c * b * a), 1.0];
     let grad = eq.gradient(&x, &[]);
     close(grad.value, x[3] - e - c * c * b * a, 1e-13);
-    for j in 0..4 {
-        close(grad.d_x[j], want[j], 1e-14);
-        let xd: Vec<Dual64> = (0..4).map(|i| Dual64::new(x[i], if i == j { 1.0 } else { 0.0 })).collect();
+    for (j, &w) in want.iter().enumerate() {
+        close(grad.d_x[j], w, 1e-14);
+        let xd: Vec<Dual64> =
+            x.iter().enumerate().map(|(i, &v)| Dual64::new(v, if i == j { 1.0 } else { 0.0 })).collect();
         let r = eq.residual(&xd, &[]);
         close(r.re, grad.value, 0.0);
-        close(r.eps, want[j], 1e-14);
+        close(r.eps, w, 1e-14);
     }
     // Refusals are located at the argument, or at the call.
     let err = Equation::new("d = prod(a, q)", &s).unwrap_err();
