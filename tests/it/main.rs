@@ -47,6 +47,7 @@ mod size_newcomer;
 mod snowball;
 mod specs;
 mod tags;
+mod thermo_functions;
 mod threads;
 mod tune;
 mod tutorial;

@@ -10,6 +10,8 @@
 //!   parameters) and every exponent of `x` times `p` an integer;
 //! - `der(x)` has the dimension of `x` per second, for differential variables only;
 //! - `table(x)`: `x` in the table's input dimension, the result in its output dimension;
+//! - `f(args)` of an external function: the arguments are names the function interprets, the
+//!   result in the dimension the function's binding gives;
 //! - numbers are dimensionless, but a bare number (an expression of number literals only) that
 //!   must match a dimensioned quantity is refused, asking for a parameter with units
 //!   (`T + 273.15` hides a unit; `2*F` and `F/2` are fine). The literal `0` matches any
@@ -19,6 +21,7 @@ use plantwide_units::Dimension;
 
 use crate::ast::{BinOp, Equation, Expr, ExprKind, Func};
 use crate::error::{ErrorKind, ExprError};
+use crate::external::{ExternalCall, ExternalFunction};
 use crate::span::Span;
 use crate::symbols::{Symbol, SymbolTable, VarKind};
 
@@ -59,6 +62,22 @@ pub(crate) fn check_equation(text: &str, symbols: &SymbolTable, eq: &Equation) -
 /// Checks an expression and returns its dimension.
 pub(crate) fn check_expression(text: &str, symbols: &SymbolTable, e: &Expr) -> Result<Dimension, ExprError> {
     Checker { text, symbols }.number(e).map(|i| i.dim)
+}
+
+/// Binds a call of external function `name` (see [`crate::external`]), locating a refusal at
+/// the argument at fault or at the call.
+pub(crate) fn bind(
+    text: &str,
+    name: &str,
+    f: &std::sync::Arc<dyn ExternalFunction>,
+    span: Span,
+    args: &[Expr],
+) -> Result<ExternalCall, ExprError> {
+    let texts: Vec<&str> = args.iter().map(|a| a.span.slice(text).trim()).collect();
+    f.bind(&texts).map_err(|e| {
+        let at = e.arg.and_then(|k| args.get(k)).map_or(span, |a| a.span);
+        ExprError::new(text, at, ErrorKind::BadCall { func: name.to_owned(), message: e.message })
+    })
 }
 
 struct Checker<'a> {
@@ -132,12 +151,12 @@ impl Checker<'_> {
             None => self.unknown(span, name),
             Some(Symbol::Parameter { value, dim }) => Ok(Info { value: Some(*value), ..Info::quantity(*dim) }),
             Some(Symbol::Variable { dim, .. }) => Ok(Info::quantity(*dim)),
-            Some(s @ Symbol::Table(_)) => self.err(
+            Some(s @ (Symbol::Table(_) | Symbol::Function(_))) => self.err(
                 span,
                 ErrorKind::WrongKind {
                     name: name.to_owned(),
                     found: s.describe(),
-                    expected: "a value (call a table as `name(x)`)",
+                    expected: "a value (call a table or a function as `name(…)`)",
                 },
             ),
         }
@@ -168,6 +187,9 @@ impl Checker<'_> {
         let table = match self.symbols.get(name) {
             None => return self.unknown(name_span, name),
             Some(Symbol::Table(t)) => t,
+            Some(Symbol::Function(f)) => {
+                return bind(self.text, name, &f.0, span, args).map(|call| Info::quantity(call.dim));
+            }
             Some(s) => {
                 let kind = ErrorKind::WrongKind {
                     name: name.to_owned(),

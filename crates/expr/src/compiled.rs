@@ -1,6 +1,6 @@
 //! Checked and compiled equations and expressions: the types a unit model holds.
 
-use plantwide_thermo::Scalar;
+use crate::Scalar;
 use plantwide_units::Dimension;
 
 use crate::check::{check_equation, check_expression};

@@ -190,6 +190,14 @@ pub enum ErrorKind {
         /// The argument's value.
         value: f64,
     },
+    /// A call of an external function refused by the function (an unknown port or component).
+    #[error("`{func}`: {message}")]
+    BadCall {
+        /// The function's name.
+        func: String,
+        /// What the function says is wrong.
+        message: String,
+    },
     /// A value that is not finite at the guess values.
     #[error("this part evaluates to {value} at the guess values")]
     NonFinite {

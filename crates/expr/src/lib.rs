@@ -30,6 +30,14 @@
 //! [`Equation::check_at`] refuses a guess at which the residual cannot be evaluated, and
 //! [`check_structure`] refuses an equation set that is structurally singular.
 //!
+//! # External functions
+//! A caller declares functions this crate does not know ([`SymbolTable::add_function`]): a call
+//! `f(a, b)` is bound at load to the variables it reads and the dimension of its value, and
+//! compiled into one tape node whose value and exact partial derivatives come from the caller's
+//! [`ExternalEval`], so `f64`, dual-number and reverse-mode evaluation all stay exact. The model
+//! crate binds the thermodynamic package's functions of a port's state this way; this crate
+//! depends on no thermodynamics (see [`external`]).
+//!
 //! # Parser crate
 //! The parser uses [winnow](https://docs.rs/winnow) 1.x: actively maintained (it parses every
 //! `Cargo.toml` through `toml_edit`), no dependencies of its own so it builds in seconds,
@@ -48,6 +56,7 @@ pub mod ast;
 mod check;
 mod compiled;
 mod error;
+pub mod external;
 pub mod name;
 pub mod parse;
 mod span;
@@ -60,12 +69,20 @@ pub mod testing;
 
 pub use compiled::{Equation, Expression, Gradient};
 pub use error::{ErrorKind, ExprError, SymbolError};
+pub use external::{BindError, ExternalCall, ExternalEval, ExternalFunction};
 pub use parse::{parse_equation, parse_expression};
 pub use span::{Span, render_caret};
 pub use structure::{Matching, StructuralError, StructureMode, check_structure, maximum_matching};
 pub use symbols::{Symbol, SymbolTable, VarKind};
 pub use table::{Interpolation, Table, TableError};
 pub use tape::{INLINE_SLOTS, Tape, Workspace};
+
+/// A real scalar the tapes evaluate over: `f64`, or a dual number of `num-dual` for exact
+/// derivatives. The same bounds as the thermodynamics crate's `Scalar`, declared here so that
+/// this crate depends on no thermodynamics: any scalar of the model layer is one of these.
+pub trait Scalar: num_dual::DualNum<Primitive = f64> + Copy + Send + Sync + 'static {}
+
+impl<T: num_dual::DualNum<Primitive = f64> + Copy + Send + Sync + 'static> Scalar for T {}
 
 /// The longest equation or expression text accepted, in bytes (a long energy balance is a few
 /// hundred).

@@ -1,11 +1,13 @@
 //! The caller's names: parameters, variables and tables, each with its dimension.
 
 use std::collections::BTreeMap;
+use std::sync::Arc;
 
 use plantwide_units::Dimension;
 
 use crate::ast::Func;
 use crate::error::SymbolError;
+use crate::external::{ExternalFunction, FunctionRef};
 use crate::name::is_valid_name;
 use crate::table::Table;
 
@@ -40,6 +42,8 @@ pub enum Symbol {
     },
     /// A one-argument table.
     Table(Table),
+    /// A function the caller implements (see [`crate::external`]).
+    Function(FunctionRef),
 }
 
 impl Symbol {
@@ -49,6 +53,7 @@ impl Symbol {
             Symbol::Parameter { .. } => "a parameter",
             Symbol::Variable { .. } => "a variable",
             Symbol::Table(_) => "a table",
+            Symbol::Function(_) => "a function",
         }
     }
 }
@@ -95,6 +100,14 @@ impl SymbolTable {
     /// An invalid, reserved or duplicate name.
     pub fn add_table(&mut self, name: &str, table: Table) -> Result<(), SymbolError> {
         self.insert(name, Symbol::Table(table))
+    }
+
+    /// Declares an external function, called as `name(args)` (see [`crate::external`]).
+    ///
+    /// # Errors
+    /// An invalid, reserved or duplicate name.
+    pub fn add_function(&mut self, name: &str, f: Arc<dyn ExternalFunction>) -> Result<(), SymbolError> {
+        self.insert(name, Symbol::Function(FunctionRef(f)))
     }
 
     fn insert(&mut self, name: &str, symbol: Symbol) -> Result<(), SymbolError> {

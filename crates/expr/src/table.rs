@@ -1,6 +1,6 @@
 //! Tables of `y(x)` with linear or natural cubic-spline interpolation.
 
-use plantwide_thermo::Scalar;
+use crate::Scalar;
 use plantwide_units::Dimension;
 
 /// How a [`Table`] interpolates between its points.

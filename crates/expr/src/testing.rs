@@ -11,7 +11,7 @@
 //! V = 100 L, k0 = 7.2·10¹⁰ min⁻¹, E/R = 8750 K, −ΔH = 5·10⁴ J/mol, ρ = 1000 kg/m³,
 //! cp = 239 J/(kg·K), UA = 5·10⁴ J/(min·K), CAf = 1 mol/L, Tf = 350 K.
 
-use plantwide_thermo::Scalar;
+use crate::Scalar;
 use plantwide_units::Dimension;
 
 use crate::{SymbolTable, VarKind};

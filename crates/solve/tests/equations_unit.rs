@@ -125,3 +125,30 @@ fn surge_tank_as_equations_matches_the_built_in() {
     eprintln!("surge tank inflow step: final {:?}; worst relative difference {worst:.1e}", b.rows.last());
     assert!(worst < 1e-8, "trajectory: worst relative difference {worst:.2e}");
 }
+
+/// The flash drum of `flowsheets/flash_recycle.json` as an equations unit calling the thermo
+/// package (`K(liquid, c, P)`, `h_V(vapour)`, the closure `liquid.h = h_L(liquid)`, `rho_L`, `mw`;
+/// `tests/data/flash_recycle_thermo.json`): the whole recycle plant reaches the built-in's steady
+/// state.
+#[test]
+fn flash_as_equations_with_thermo_functions_has_the_built_in_steady_state() {
+    let (builtin, xb) = solve("flowsheets/flash_recycle.json");
+    let (eqs, xe) = solve("tests/data/flash_recycle_thermo.json");
+    let mut pairs: Vec<(String, String)> = ["vapour", "liquid", "recycle", "bottoms"]
+        .iter()
+        .flat_map(|s| ["F", "T", "P", "h", "x[benzene]", "x[toluene]", "x[o-xylene]"].map(|q| format!("{s}.{q}")))
+        .map(|p| (p.clone(), p))
+        .collect();
+    for v in ["N[benzene]", "N[toluene]", "N[o-xylene]", "M", "level", "V"] {
+        pairs.push((format!("drum.{v}"), format!("drum.{v}")));
+    }
+    let mut worst: f64 = 0.0;
+    for (b, e) in &pairs {
+        let ib = builtin.var(b).unwrap_or_else(|| panic!("built-in has no `{b}`"));
+        let ie = eqs.var(e).unwrap_or_else(|| panic!("equations unit has no `{e}`"));
+        let d = (xb[ib] - xe[ie]).abs() / xb[ib].abs().max(1e-300);
+        eprintln!("{b:>20} {:>22.15e} {:>22.15e}  rel {d:.1e}", xb[ib], xe[ie]);
+        worst = worst.max(d);
+    }
+    assert!(worst < 1e-10, "worst relative difference {worst:.2e}");
+}

@@ -4,7 +4,9 @@ use std::collections::BTreeSet;
 
 use super::{Instr, InstrSpans, Load, Op, Slot, Source, Tape, Val, func1, func2, func3};
 use crate::ast::{BinOp, Expr, ExprKind, Func};
+use crate::check::bind;
 use crate::error::{ErrorKind, ExprError};
+use crate::external::{ExternalNode, FunctionRef};
 use crate::span::Span;
 use crate::symbols::{Symbol, SymbolTable};
 use crate::table::Table;
@@ -35,6 +37,7 @@ struct Compiler<'a> {
     n_slots: u32,
     table_names: Vec<String>,
     tables: Vec<Table>,
+    externals: Vec<ExternalNode>,
     vars: BTreeSet<usize>,
     ders: BTreeSet<usize>,
 }
@@ -50,6 +53,7 @@ impl<'a> Compiler<'a> {
             n_slots: 0,
             table_names: Vec::new(),
             tables: Vec::new(),
+            externals: Vec::new(),
             vars: BTreeSet::new(),
             ders: BTreeSet::new(),
         }
@@ -64,6 +68,7 @@ impl<'a> Compiler<'a> {
             out,
             out_span,
             tables: self.tables,
+            externals: self.externals,
             vars: self.vars.into_iter().collect(),
             ders: self.ders.into_iter().collect(),
         }
@@ -119,7 +124,7 @@ impl<'a> Compiler<'a> {
             }
             ExprKind::Call(func, args) => self.call(*func, args, e.span),
             ExprKind::Der { name, .. } => Ok(self.der(name, e.span)),
-            ExprKind::Lookup { name, args, .. } => self.lookup(name, &args[0], e.span),
+            ExprKind::Lookup { name, args, .. } => self.lookup(name, args, e.span),
             ExprKind::If(cond, yes, no) => self.if_else(cond, yes, no, e.span),
             ExprKind::Compare(op, a, b) => {
                 let (va, vb) = (self.expr(a)?, self.expr(b)?);
@@ -179,8 +184,28 @@ impl<'a> Compiler<'a> {
         Val::Slot(slot)
     }
 
-    fn lookup(&mut self, name: &str, arg: &Expr, span: Span) -> Result<Val, ExprError> {
-        let Some(Symbol::Table(table)) = self.symbols.get(name) else { return Ok(Val::Const(f64::NAN)) };
+    /// A call of external function `f`: its inputs loaded, one node computing it.
+    fn external(&mut self, name: &str, f: &FunctionRef, args: &[Expr], span: Span) -> Result<Val, ExprError> {
+        let call = bind(self.text, name, &f.0, span, args)?;
+        let mut slots = Vec::with_capacity(call.reads.len());
+        for &i in &call.reads {
+            self.vars.insert(i);
+            match self.load(Source::X(i as u32), span) {
+                Val::Slot(s) => slots.push(s),
+                Val::Const(_) => unreachable!("a load is a slot"),
+            }
+        }
+        self.externals.push(ExternalNode { eval: call.eval, args: slots });
+        Ok(self.emit(Op::External(self.externals.len() as u32 - 1), span, span))
+    }
+
+    fn lookup(&mut self, name: &str, args: &[Expr], span: Span) -> Result<Val, ExprError> {
+        let symbols = self.symbols;
+        if let Some(Symbol::Function(f)) = symbols.get(name) {
+            return self.external(name, f, args, span);
+        }
+        let Some(Symbol::Table(table)) = symbols.get(name) else { return Ok(Val::Const(f64::NAN)) };
+        let arg = &args[0];
         let va = self.expr(arg)?;
         if let Val::Const(x) = va {
             return self.constant(table.eval(x), span);

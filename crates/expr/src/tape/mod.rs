@@ -15,7 +15,7 @@
 
 use std::convert::Infallible;
 
-use plantwide_thermo::Scalar;
+use crate::Scalar;
 
 mod compile;
 mod reverse;
@@ -25,6 +25,7 @@ pub use reverse::Workspace;
 
 use crate::ast::{CmpOp, Func};
 use crate::error::{ErrorKind, ExprError};
+use crate::external::ExternalNode;
 use crate::span::Span;
 use crate::table::Table;
 
@@ -59,6 +60,8 @@ pub(crate) enum Op {
     Func3(Func, Slot, Slot, Slot),
     /// `tables[t](a)`
     Table(u32, Slot),
+    /// `externals[e]` of its argument slots.
+    External(u32),
     /// 1 if the comparison holds, else 0.
     Cmp(CmpOp, Slot, Slot),
     And(Slot, Slot),
@@ -127,6 +130,7 @@ pub struct Tape {
     out: Val,
     out_span: Span,
     tables: Vec<Table>,
+    externals: Vec<ExternalNode>,
     vars: Vec<usize>,
     ders: Vec<usize>,
 }
@@ -258,6 +262,7 @@ impl Tape {
             Op::Func2(f, a, b) => func2(f, at(a), at(b)),
             Op::Func3(f, a, b, c) => func3(f, at(a), at(b), at(c)),
             Op::Table(t, a) => self.tables[t as usize].eval(at(a)),
+            Op::External(e) => self.external(e as usize, v),
             Op::Cmp(op, a, b) => truth(op.holds(at(a).re(), at(b).re())),
             Op::And(a, b) => truth(at(a).re() != 0.0 && at(b).re() != 0.0),
             Op::Or(a, b) => truth(at(a).re() != 0.0 || at(b).re() != 0.0),
@@ -265,6 +270,43 @@ impl Tape {
             Op::Mov(a) => at(a),
             Op::JumpIfFalse(..) | Op::Jump(_) => S::from(0.0),
         }
+    }
+}
+
+/// External calls with at most this many inputs gather them on the stack.
+const INLINE_ARGS: usize = 32;
+
+impl Tape {
+    /// External call `e` over the slots `v`: the callback's value over `f64`; over a dual type
+    /// the first-order expansion `f(re) + Σ_k ∂f/∂a_k · (a_k − re(a_k))` from the callback's exact
+    /// partials, which carries every derivative direction the dual type holds.
+    fn external<S: Scalar>(&self, e: usize, v: &[S]) -> S {
+        let node = &self.externals[e];
+        let n = node.args.len();
+        let (mut a_buf, mut d_buf) = ([0.0; INLINE_ARGS], [0.0; INLINE_ARGS]);
+        let (mut a_vec, mut d_vec);
+        let (a, d): (&mut [f64], &mut [f64]) = if n <= INLINE_ARGS {
+            (&mut a_buf[..n], &mut d_buf[..n])
+        } else {
+            a_vec = vec![0.0; n];
+            d_vec = vec![0.0; n];
+            (&mut a_vec, &mut d_vec)
+        };
+        for (ak, &s) in a.iter_mut().zip(&node.args) {
+            *ak = v[s as usize].re();
+        }
+        if std::any::TypeId::of::<S>() == std::any::TypeId::of::<f64>() {
+            return S::from(node.eval.value(a));
+        }
+        let value = node.eval.value_and_partials(a, d);
+        let mut res = S::from(value);
+        for (&dk, &s) in d.iter().zip(&node.args) {
+            if dk != 0.0 {
+                let ak = v[s as usize];
+                res += (ak - S::from(ak.re())) * dk;
+            }
+        }
+        res
     }
 }
 

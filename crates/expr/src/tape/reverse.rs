@@ -116,6 +116,15 @@ impl Tape {
                 add(e, g * 0.5 * sign * eps / root);
             }
             Op::Table(t, a) => add(a, g * self.tables[t as usize].eval(Dual64::new(at(a), 1.0)).eps),
+            Op::External(e) => {
+                let node = &self.externals[e as usize];
+                let inputs: Vec<f64> = node.args.iter().map(|&s| at(s)).collect();
+                let mut d = vec![0.0; inputs.len()];
+                node.eval.value_and_partials(&inputs, &mut d);
+                for (&s, dk) in node.args.iter().zip(d) {
+                    add(s, g * dk);
+                }
+            }
             Op::Const(_) | Op::Cmp(..) | Op::And(..) | Op::Or(..) | Op::Not(_) | Op::JumpIfFalse(..) | Op::Jump(_) => {}
         }
     }

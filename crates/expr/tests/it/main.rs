@@ -5,6 +5,7 @@ mod eval;
 mod guess;
 mod parse;
 mod structure;
+mod tables;
 
 use plantwide_expr::{Expression, SymbolTable, VarKind};
 use plantwide_units::Dimension;

@@ -15,6 +15,42 @@
 //! Parameters and inputs by their names, own variables by theirs, and every port's stream
 //! quantities as `<port>.F`, `<port>.T`, `<port>.P`, `<port>.h` and `<port>.x[<component>]`.
 //!
+//! # Thermodynamic functions of a port's state
+//! The flowsheet's thermodynamic package, called with a port's name (an inlet's or an outlet's):
+//!
+//! | call | value | unit | reads |
+//! |---|---|---|---|
+//! | `h_L(port)` | liquid molar enthalpy `Σ x_i h_L,i(T)` | J/mol | `T`, `x` |
+//! | `h_V(port)` | vapour molar enthalpy `Σ x_i h_ig,i(T)` (the port's `x` as the vapour) | J/mol | `T`, `x` |
+//! | `K(port, c)` | K-value `y_c/x_c` of component `c` at the port's `T`, `P`, `x` | 1 | `T`, `P`, `x` |
+//! | `rho_L(port)` | liquid **molar** density `1/v_L(T, x)` | mol/m³ | `T`, `x` |
+//! | `mw(port)` | mean molar mass `Σ x_i M_i` (so `mw(p)*rho_L(p)` is the mass density) | kg/mol | `x` |
+//! | `T_bubble(port)` | bubble temperature at the port's `P` and `x/Σx` | K | `P`, `x` |
+//!
+//! `K` and `T_bubble` take an optional last argument naming a pressure variable or input of the
+//! unit to use instead of the port's `P`: `K(liquid, benzene, P)` is the K-value of the liquid in
+//! a drum at pressure `P` whose liquid outlet leaves at the valve's downstream pressure.
+//! Components are written as in `x[…]` (`K(out, o-xylene)`). The arguments are names, not
+//! expressions. A parameter, input, variable or table of the file that takes one of these names
+//! hides the function.
+//!
+//! Derivatives are exact: the expression layer asks each call for its value and its partial
+//! derivatives with respect to the port quantities it reads (the package's functions evaluated
+//! over dual numbers, one pass per quantity; the bubble temperature's by the implicit-function
+//! theorem on the bubble-point residual `Σ K_i x_i − 1` at the converged temperature, as
+//! `ThermoPackage::bubble_t` converges it to machine precision). Each call's row of the sparsity
+//! pattern holds exactly the quantities in the table's last column.
+//!
+//! # Tables
+//! `"tables": {"cp": {"x": [300, 350, 400], "y": [1.0, 1.5, 3.0], "x_unit": "K",
+//! "y_unit": "kJ/(kg*K)", "interpolation": "spline"}}` declares `cp(expr)`: `expr` must have the
+//! dimension of `x_unit`, the value has that of `y_unit` (both default dimensionless).
+//! `interpolation` is `linear` (default) or `spline`, the natural cubic spline (zero second
+//! derivative at both ends, as SciPy's `CubicSpline(bc_type="natural")`); beyond the ends the
+//! table continues along its end tangent. At load, fewer than 2 points, `x` and `y` of unequal
+//! lengths, an `x` not strictly increasing, or a value not finite in SI are refused at the
+//! offending point (`units.u.tables.cp.x[2]`).
+
 //! # Layout and the mass matrix
 //! Own variables are the outlet streams (`[F, T, P, h, x…]` each, ports in name order), then the
 //! `variables` in name order. Every name is bound to its slot of the unit's *local vector*, so the
@@ -33,10 +69,10 @@
 //! Inlets are read as known values. Each outlet maps some of its stream quantities to
 //! expressions, each the equation `out.Q = expr`; a quantity it does not map (`F`, `T`, `P`,
 //! `x[c]`) is an unknown the `equations` must determine (`U = M*out.h` gives `out.T`), else the set
-//! is refused as structurally singular naming it. An unmapped `h` is closed by the unit as the
-//! liquid enthalpy `h = h_L(T, x)` of the thermodynamic package (the expression layer has no
-//! thermodynamic functions yet): one more equation of the set, which the matching places like
-//! the others (with `U = M*out.h` it takes `out.T`'s row and the balance `h`'s).
+//! is refused as structurally singular naming it. An unmapped `h` is closed by the unit with the
+//! equation `out.h = h_L(out)`, compiled like the others (the same exact derivatives and the
+//! same sparsity: `h`, `T` and every `x`); the matching places it like the others (with
+//! `U = M*out.h` it takes `out.T`'s row and the balance `h`'s).
 //!
 //! # Material
 //! `holdup` gives each component's amount \[mol\] as an expression (for a dynamic run's
@@ -46,19 +82,28 @@
 //!
 //! # Checks at load
 //! Names, dimensions (both sides, each outlet mapping against its stream quantity), the `der()`
-//! form, a structurally singular set (dynamic mode), and each equation evaluated at the guesses
-//! (variables at their `guess`, inlets at 1 mol/s, 300 K, 1 bar, h = 0, uniform x): a division by
-//! zero or a logarithm of a non-positive number there is refused with its position.
+//! form, a structurally singular set (dynamic mode), bad tables, unknown ports or components in
+//! thermodynamic calls, and each equation evaluated at the guesses: a division by zero, a
+//! logarithm of a non-positive number or a thermodynamic function that cannot be evaluated
+//! there is refused with its position. The guesses are the variables' `guess`es and the outlets
+//! the unit's own guess; the inlets hold the stream the engine starts every stream from before
+//! it guesses the units (1 mol/s, 300 K, 1 atm, uniform `x`, its liquid enthalpy), because a
+//! unit is built before the plant is wired and the upstream guesses are not known then.
 
 use std::collections::BTreeMap;
 
 use plantwide_expr::{Equation, Expression, SymbolTable, parse_equation};
-use plantwide_units::{Dimension, QuantityValue, Unit as UnitOfMeasure, parse_quantity};
+use plantwide_units::{Dimension, QuantityValue};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 use crate::stream::{F, H, P, T, Z0};
-use crate::{BuildCx, FieldError, InputSpec, LocalLayout, Scalar, UnitIo, UnitModel, VarSpec};
+use crate::{InputSpec, LocalLayout, Scalar, UnitIo, UnitModel, VarSpec};
+
+mod build;
+mod thermo;
+#[cfg(test)]
+mod thermo_tests;
 
 /// Whether a variable of an equations unit has a time derivative.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
@@ -94,6 +139,36 @@ pub struct EqVariableConfig {
     pub upper: Option<f64>,
 }
 
+/// How a table of an equations unit interpolates.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum EqInterpolation {
+    /// Straight lines between the points (the default).
+    #[default]
+    Linear,
+    /// The natural cubic spline (second derivative zero at both ends).
+    Spline,
+}
+
+/// A table `y(x)` of an equations unit, called in equations as `name(expr)`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct EqTableConfig {
+    /// The argument's values, strictly increasing, in `x_unit` (at least 2).
+    pub x: Vec<f64>,
+    /// The values at each `x`, in `y_unit` (as many as `x`).
+    pub y: Vec<f64>,
+    /// Unit of `x` and hence the argument's dimension (`"K"`, `"m"`; default dimensionless).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub x_unit: Option<String>,
+    /// Unit of `y` and hence the value's dimension (`"kJ/mol"`, `"m3"`; default dimensionless).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub y_unit: Option<String>,
+    /// `linear` (default) or `spline`.
+    #[serde(default)]
+    pub interpolation: EqInterpolation,
+}
+
 /// The ports of an equations unit.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
@@ -102,8 +177,8 @@ pub struct EqPortsConfig {
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub inlets: Vec<String>,
     /// Outlet ports by name, each mapping some of its stream quantities (`F`, `T`, `P`, `x[<c>]`,
-    /// `h`) to expressions; the equations determine the others, and an unmapped `h` is the liquid
-    /// enthalpy at the outlet's `T` and `x`.
+    /// `h`) to expressions; the equations determine the others, and an unmapped `h` is closed as
+    /// `h = h_L(out)`, the liquid enthalpy at the outlet's `T` and `x`.
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub outlets: BTreeMap<String, BTreeMap<String, String>>,
 }
@@ -121,6 +196,9 @@ pub struct EquationsConfig {
     /// The unit's own variables by name.
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub variables: BTreeMap<String, EqVariableConfig>,
+    /// Tables `y(x)` by name, called in equations as `name(expr)`.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub tables: BTreeMap<String, EqTableConfig>,
     /// Equations as text (`"der(M) = in.F - out.F"`).
     pub equations: Vec<String>,
     /// Inlet and outlet ports.
@@ -168,9 +246,6 @@ pub struct Equations {
     fields: Vec<String>,
     /// The outlets' mappings `out.Q = expr` by the local index of `out.Q`, for the guess.
     maps: Vec<(usize, Equation)>,
-    /// Outlet enthalpies closed by the unit as `h = h_L(T, x)`: `(row, outlet)`, the row the
-    /// matching gave the equation (not necessarily `h`'s own: `U = M*out.h` may take that one).
-    default_h: Vec<(usize, usize)>,
     /// Names of own rows, for diagnostics.
     row_names: BTreeMap<usize, String>,
     outputs: Vec<String>,
@@ -192,352 +267,13 @@ fn stream_names(port: &str, components: &[String]) -> Vec<(String, usize, Dimens
 }
 
 impl Equations {
-    /// Build from the flowsheet description.
-    pub fn build(c: &EquationsConfig, mut cx: BuildCx<'_>, _links: ()) -> Result<Equations, Vec<FieldError>> {
-        let comps = cx.components.to_vec();
-        let nc = comps.len();
-        let len = Z0 + nc;
-        let outlets: Vec<String> = c.ports.outlets.keys().cloned().collect();
-        let inlets = c.ports.inlets.clone();
-        let n_out = outlets.len();
-        let n_own = n_out * len + c.variables.len();
-        let inlets_at = n_own;
-        let inputs_at = inlets_at + inlets.len() * len;
-        let mut symbols = SymbolTable::new();
-        let declare = |cx: &mut BuildCx<'_>, field: &str, r: Result<(), plantwide_expr::SymbolError>| {
-            if let Err(e) = r {
-                cx.error(field, e.to_string());
-            }
-        };
-        for (name, q) in &c.parameters {
-            let field = format!("parameters.{name}");
-            let parsed = match q {
-                QuantityValue::Number(x) => Ok(plantwide_units::Quantity::new(*x, Dimension::DIMENSIONLESS)),
-                QuantityValue::Text(s) => parse_quantity(s),
-            };
-            match parsed {
-                Ok(q) => declare(&mut cx, &field, symbols.add_parameter(name, q.value_si, q.dim)),
-                Err(e) => cx.error(&field, e.to_string()),
-            }
-        }
-        let mut inputs = Vec::new();
-        for (k, (name, q)) in c.inputs.iter().enumerate() {
-            let field = format!("inputs.{name}");
-            let parsed = match q {
-                QuantityValue::Number(x) => Ok(plantwide_units::Quantity::new(*x, Dimension::DIMENSIONLESS)),
-                QuantityValue::Text(s) => parse_quantity(s),
-            };
-            match parsed {
-                Ok(q) => {
-                    let r = symbols.add_variable(name, inputs_at + k, q.dim, plantwide_expr::VarKind::Algebraic);
-                    declare(&mut cx, &field, r);
-                    inputs.push(InputSpec { name: name.clone(), dim: q.dim, value: q.value_si });
-                }
-                Err(e) => {
-                    cx.error(&field, e.to_string());
-                    inputs.push(InputSpec { name: name.clone(), dim: Dimension::DIMENSIONLESS, value: f64::NAN });
-                }
-            }
-        }
-        for (k, port) in outlets.iter().enumerate() {
-            for (name, off, dim) in stream_names(port, &comps) {
-                let r = symbols.add_variable(&name, k * len + off, dim, plantwide_expr::VarKind::Algebraic);
-                declare(&mut cx, &format!("ports.outlets.{port}"), r);
-            }
-        }
-        for (k, port) in inlets.iter().enumerate() {
-            if outlets.contains(port) {
-                cx.error(&format!("ports.inlets[{k}]"), format!("`{port}` is also an outlet"));
-                continue;
-            }
-            for (name, off, dim) in stream_names(port, &comps) {
-                let r = symbols.add_variable(&name, inlets_at + k * len + off, dim, plantwide_expr::VarKind::Algebraic);
-                declare(&mut cx, &format!("ports.inlets[{k}]"), r);
-            }
-        }
-        // Own variables, after the outlet streams.
-        let mut internal = Vec::new();
-        let mut guesses = Vec::new();
-        let mut differential = Vec::new();
-        for (i, (name, v)) in c.variables.iter().enumerate() {
-            let field = format!("variables.{name}");
-            let unit = match v.unit.as_deref().map(UnitOfMeasure::parse).transpose() {
-                Ok(u) => u,
-                Err(e) => {
-                    cx.error(&format!("{field}.unit"), e.to_string());
-                    None
-                }
-            };
-            let dim = unit.as_ref().map_or(Dimension::DIMENSIONLESS, UnitOfMeasure::dimension);
-            let si = |x: f64| unit.as_ref().map_or(x, |u| u.to_si(x));
-            let lower = v.lower.map_or(f64::NEG_INFINITY, si);
-            let upper = v.upper.map_or(f64::INFINITY, si);
-            let nominal = match (v.nominal, v.guess) {
-                (Some(n), _) => si(n).abs(),
-                (None, Some(g)) if si(g) != 0.0 => si(g).abs(),
-                _ => 1.0,
-            };
-            if !(nominal.is_finite() && nominal > 0.0) {
-                cx.error(&format!("{field}.nominal"), format!("must be finite and nonzero (got {nominal} {dim})"));
-            }
-            if lower > upper {
-                cx.error(&field, format!("lower bound {lower} {dim} is above the upper bound {upper} {dim}"));
-            }
-            let guess = v.guess.map_or(nominal, si).clamp(lower.min(upper), upper.max(lower));
-            let index = n_out * len + i;
-            let kind = match v.kind {
-                EqVarKind::Differential => {
-                    differential.push(index);
-                    plantwide_expr::VarKind::Differential
-                }
-                EqVarKind::Algebraic => plantwide_expr::VarKind::Algebraic,
-            };
-            declare(&mut cx, &field, symbols.add_variable(name, index, dim, kind));
-            let spec = match v.kind {
-                EqVarKind::Differential => VarSpec::differential(name.clone(), dim, nominal),
-                EqVarKind::Algebraic => VarSpec::algebraic(name.clone(), dim, nominal),
-            };
-            internal.push(spec.bounded(lower, upper));
-            guesses.push(guess);
-        }
-        if !cx.errors.is_empty() {
-            return Err(cx.errors);
-        }
-
-        // Compile the equations: the file's, then the outlets' mappings.
-        let mut compiled: Vec<(String, Equation, Option<Expression>)> = Vec::new();
-        let mut der_of: BTreeMap<usize, String> = BTreeMap::new();
-        for (k, text) in c.equations.iter().enumerate() {
-            let field = format!("equations[{k}]");
-            let eq = match Equation::new(text, &symbols) {
-                Ok(eq) => eq,
-                Err(e) => {
-                    cx.error(&field, e.render());
-                    continue;
-                }
-            };
-            let rhs = match eq.derivatives() {
-                [] => None,
-                &[i] => match der_form(text, &symbols) {
-                    Some(rhs) => {
-                        if let Some(other) = der_of.insert(i, field.clone()) {
-                            let name = symbols.variable_name(i).unwrap_or("?");
-                            cx.error(&field, format!("`der({name})` is already given by {other}: a differential variable has exactly one equation `der({name}) = …`"));
-                        }
-                        Some(rhs)
-                    }
-                    None => {
-                        let name = symbols.variable_name(i).unwrap_or("x");
-                        cx.error(&field, format!("write the equation of a differential variable as `der({name}) = <expression without der()>`: the engine's model is M x' = f(x)\n{text}"));
-                        continue;
-                    }
-                },
-                _ => {
-                    cx.error(
-                        &field,
-                        format!("an equation may hold one `der()`, as `der(x) = <expression without der()>`\n{text}"),
-                    );
-                    continue;
-                }
-            };
-            compiled.push((field, eq, rhs));
-        }
-        for &i in &differential {
-            if !der_of.contains_key(&i) {
-                let name = symbols.variable_name(i).unwrap_or("?");
-                cx.error(
-                    &format!("variables.{name}"),
-                    format!("differential variable `{name}` needs one equation `der({name}) = …`"),
-                );
-            }
-        }
-        let mut default_h = Vec::new();
-        let mut maps = Vec::new();
-        for (k, port) in outlets.iter().enumerate() {
-            let map = &c.ports.outlets[port];
-            for (name, _, _) in stream_names(port, &comps) {
-                let q = &name[port.len() + 1..];
-                if q == "h" && !map.contains_key("h") {
-                    default_h.push(k);
-                }
-            }
-            for (q, expr) in map {
-                let field = format!("ports.outlets.{port}.{q}");
-                if !stream_names(port, &comps).iter().any(|(n, _, _)| n[port.len() + 1..] == **q) {
-                    let known: Vec<String> = stream_names(port, &comps)
-                        .into_iter()
-                        .map(|(n, _, _)| n[port.len() + 1..].to_owned())
-                        .collect();
-                    cx.error(&field, format!("`{q}` is not a stream quantity (those are {})", known.join(", ")));
-                    continue;
-                }
-                let text = format!("{port}.{q} = {expr}");
-                let Some(&(_, off, _)) = stream_names(port, &comps).iter().find(|(n, _, _)| n[port.len() + 1..] == **q)
-                else {
-                    continue;
-                };
-                match Equation::new(&text, &symbols) {
-                    Ok(eq) if eq.derivatives().is_empty() => {
-                        maps.push((k * len + off, eq.clone()));
-                        compiled.push((field, eq, None));
-                    }
-                    Ok(_) => cx.error(&field, format!("a port's quantity may not read `der()`\n{text}")),
-                    Err(e) => cx.error(&field, e.render()),
-                }
-            }
-        }
-        let mut outputs = Vec::new();
-        for (k, name) in c.outputs.iter().enumerate() {
-            match symbols.get(name) {
-                Some(plantwide_expr::Symbol::Variable { index, .. }) if *index < n_own => outputs.push(name.clone()),
-                _ => {
-                    let hint = symbols.suggest(name).map(|s| format!("; did you mean `{s}`?")).unwrap_or_default();
-                    cx.error(&format!("outputs[{k}]"), format!("`{name}` is not a variable of the unit{hint}"));
-                }
-            }
-        }
-        let mut holdup = Vec::new();
-        if !c.holdup.is_empty() {
-            holdup = vec![None; nc];
-            for (name, text) in &c.holdup {
-                let field = format!("holdup.{name}");
-                let Some(i) = comps.iter().position(|c| c == name) else {
-                    cx.error(&field, format!("`{name}` is not a component (components: {})", comps.join(", ")));
-                    continue;
-                };
-                match Expression::new(text, &symbols) {
-                    Ok(e) if e.dimension() == Dimension::AMOUNT && e.derivatives().is_empty() => holdup[i] = Some(e),
-                    Ok(e) => {
-                        cx.error(&field, format!("a holdup is an amount (mol) without der(), found {}", e.dimension()))
-                    }
-                    Err(e) => cx.error(&field, e.render()),
-                }
-            }
-        }
-        if !cx.errors.is_empty() {
-            return Err(cx.errors);
-        }
-
-        // Rows: a perfect matching of equations to the unknowns in dynamic mode (derivatives of the
-        // differential variables, the algebraic own variables), the closed outlet enthalpies
-        // `h = h_L(T, x)` included as rows of their own that read `h`, `T` and `x`: so `U = M*out.h`
-        // determines `out.T`. (As `check_structure`, with those extra rows.)
-        let h_rows: Vec<usize> = default_h.iter().map(|&k| k * len + H).collect();
-        let is_differential = |i: usize| symbols.variable_kind(i) == Some(plantwide_expr::VarKind::Differential);
-        let mut incidence: Vec<Vec<usize>> = compiled
-            .iter()
-            .map(|(_, eq, _)| {
-                let alg = eq.variables().iter().copied().filter(|&i| i < n_own && !is_differential(i));
-                alg.chain(eq.derivatives().iter().copied()).collect()
-            })
-            .collect();
-        for &r in &h_rows {
-            incidence.push([r, r - H + T].into_iter().chain((0..nc).map(|i| r - H + Z0 + i)).collect());
-        }
-        let matching = plantwide_expr::maximum_matching(n_own, &incidence);
-        if !matching.is_perfect() {
-            let name = |i: usize| {
-                let base = symbols.variable_name(i).map_or_else(|| format!("x[{i}]"), str::to_owned);
-                if is_differential(i) { format!("der({base})") } else { base }
-            };
-            let text = |e: usize| match compiled.get(e) {
-                Some((_, eq, _)) => eq.text().to_owned(),
-                None => format!("{}.h = h_L(T, x)", outlets[h_rows[e - compiled.len()] / len]),
-            };
-            let list = |v: Vec<String>| {
-                if v.is_empty() {
-                    "none".to_owned()
-                } else {
-                    v.iter().map(|s| format!("`{s}`")).collect::<Vec<_>>().join(", ")
-                }
-            };
-            cx.error(
-                "equations",
-                format!(
-                    "the equations are structurally singular ({} equations, {n_own} unknowns); left without an unknown: {}; left without an equation: {}",
-                    incidence.len(),
-                    list(matching.unmatched_equations().into_iter().map(text).collect()),
-                    list(matching.unmatched_unknowns().into_iter().map(name).collect()),
-                ),
-            );
-            return Err(cx.errors);
-        }
-        let assigned: Vec<usize> =
-            matching.unknown_of.iter().take(compiled.len()).map(|u| u.unwrap_or_default()).collect();
-        let mut row_names = BTreeMap::new();
-        let mut rows = Vec::new();
-        let mut fields = Vec::new();
-        let n_compiled = assigned.len();
-        for ((field, eq, rhs), row) in compiled.into_iter().zip(assigned) {
-            row_names.insert(row, format!("{field}: {}", eq.text()));
-            fields.push(field);
-            rows.push(match rhs {
-                Some(rhs) => Row::Derivative { row, rhs },
-                None => Row::Algebraic { row, eq },
-            });
-        }
-        let default_h: Vec<(usize, usize)> = default_h
-            .iter()
-            .enumerate()
-            .map(|(e, &k)| (matching.unknown_of[n_compiled + e].unwrap_or_default(), k))
-            .collect();
-        for &(row, k) in &default_h {
-            row_names.insert(row, format!("{}.h = h_L(T, x)", outlets[k]));
-        }
-
-        // Evaluate every equation at the guesses: a zero denominator or a logarithm out of its
-        // domain there would stop Newton at its first step.
-        let layout = LocalLayout {
-            stream: crate::StreamLayout { n_comp: nc },
-            n_outlets: n_out,
-            n_internal: internal.len(),
-            n_inlets: inlets.len(),
-            n_inputs: inputs.len(),
-            n_signals: 0,
-        };
-        let mut local = vec![0.0; layout.len()];
-        for k in 0..inlets.len() {
-            representative_stream(&mut local[inlets_at + k * len..inlets_at + (k + 1) * len]);
-        }
-        inputs.iter().enumerate().for_each(|(k, i)| local[inputs_at + k] = i.value);
-        let unit = Equations {
-            inlets,
-            outlets,
-            internal,
-            guesses,
-            inputs,
-            rows,
-            fields,
-            maps,
-            default_h,
-            row_names,
-            outputs,
-            reacts: c.reacts,
-            holdup,
-        };
-        let mut own = vec![0.0; n_own];
-        unit.guess(&UnitIo { local: &local, layout: &layout, thermo: cx.thermo, time: 0.0 }, &mut own);
-        local[..n_own].copy_from_slice(&own);
-        for (row, field) in unit.rows.iter().zip(&unit.fields) {
-            let result = match row {
-                Row::Derivative { rhs, .. } => rhs.check_at(&local, &[]),
-                Row::Algebraic { eq, .. } => eq.check_at(&local, &[]),
-            };
-            if let Err(e) = result {
-                cx.error(field, format!("at the guess: {}", e.render()));
-            }
-        }
-        cx.finish(unit)
-    }
-
     /// The names the file declares measurable (`outputs`).
     pub fn outputs(&self) -> &[String] {
         &self.outputs
     }
 
     /// Structural nonzeros `(row, local column)`: what each row's tape reads.
-    fn row_reads(&self, layout: &LocalLayout) -> Vec<(usize, usize)> {
-        let len = layout.stream.len();
+    fn row_reads(&self) -> Vec<(usize, usize)> {
         let mut p = Vec::new();
         for row in &self.rows {
             let (r, vars) = match row {
@@ -546,23 +282,8 @@ impl Equations {
             };
             p.extend(vars.iter().map(|&j| (r, j)));
         }
-        for &(row, k) in &self.default_h {
-            let o = k * len;
-            p.extend([(row, o + H), (row, o + T)]);
-            p.extend((0..layout.stream.n_comp).map(|i| (row, o + Z0 + i)));
-        }
         p
     }
-}
-
-/// A stream at 1 mol/s, 300 K, 1 bar, h = 0 and uniform composition, for checks at load.
-fn representative_stream(s: &mut [f64]) {
-    let nc = s.len() - Z0;
-    s[F] = 1.0;
-    s[T] = 300.0;
-    s[P] = 1e5;
-    s[H] = 0.0;
-    s[Z0..].iter_mut().for_each(|x| *x = 1.0 / nc as f64);
 }
 
 /// The right-hand side of `text` compiled alone if `text` reads `der(name) = rhs` with `rhs`
@@ -617,8 +338,8 @@ impl UnitModel for Equations {
             (None, _) => format!("equation {k}"),
         }
     }
-    fn pattern(&self, layout: &LocalLayout) -> Option<Vec<(usize, usize)>> {
-        Some(self.row_reads(layout))
+    fn pattern(&self, _layout: &LocalLayout) -> Option<Vec<(usize, usize)>> {
+        Some(self.row_reads())
     }
     fn eval<S: Scalar>(&self, io: &UnitIo<'_, S>, r: &mut [S]) {
         for row in &self.rows {
@@ -626,10 +347,6 @@ impl UnitModel for Equations {
                 Row::Derivative { row, rhs } => r[*row] = rhs.value(io.local, &[]),
                 Row::Algebraic { row, eq } => r[*row] = eq.residual(io.local, &[]),
             }
-        }
-        for &(row, k) in &self.default_h {
-            let out = io.outlet(k);
-            r[row] = out.h() - io.thermo.h_liq(out.t(), out.z());
         }
     }
     fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]) {
@@ -641,7 +358,7 @@ impl UnitModel for Equations {
         for k in 0..n_out {
             let s = &mut own[k * len..(k + 1) * len];
             if self.inlets.is_empty() {
-                representative_stream(s);
+                build::cold_start_stream(io.thermo, s);
             } else {
                 s.copy_from_slice(io.inlet(0).v);
             }
@@ -655,10 +372,6 @@ impl UnitModel for Equations {
                 local[*i] = v;
             }
         }
-        for &(_, k) in &self.default_h {
-            let o = k * len;
-            local[o + H] = io.thermo.h_liq(local[o + T], &local[o + Z0..o + len]);
-        }
         own.copy_from_slice(&local[..own.len()]);
     }
 }
@@ -667,8 +380,8 @@ impl UnitModel for Equations {
 mod tests {
     use super::super::outflow::test_support::{at_guess, build_unit, solve_own};
     use super::*;
-    use crate::Unit;
     use crate::testing::{binary_package, jacobian_error};
+    use crate::{BuildCx, FieldError, Unit};
 
     /// A surge tank as equations: holdup `M` \[mol\], level from a constant molar density, outflow
     /// proportional to the level.
