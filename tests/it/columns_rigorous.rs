@@ -421,3 +421,37 @@ fn partial_condenser_and_vapour_side_draw() {
     assert!((v("vapour_draw.F") * 3.6 - 10.0).abs() < 1e-9);
     assert!(comp < 1e-9 && energy.abs() < 1e-9, "{comp} {energy}");
 }
+
+/// A generated methanol/water column (plant 0x2599be5b0ffc3f36, 28 stages) whose bottoms loop
+/// holds a trace of methanol with Kc = 34.4 MW per unit mole fraction. The PI integral's row
+/// read `e + (op − u)/Kc`, in which `e` cancels, so `e = 0` lived only in the `op` row as
+/// `Kc·e` beside the output's size (1e-11 of it at xB = 1e-12); the degrees-of-freedom probe at
+/// the converged point took that for a free direction and `steady` refused a plant that Newton
+/// had converged quadratically ("not determined: top_composition.I, …", exit 1). With the row
+/// written `e + (clamp(u) − u)/Kc` and the probe scaling trace amounts by their own size, the
+/// steady state is accepted, and a second route agrees: the open plant run at the two
+/// controllers' outputs has both measurements on their setpoints.
+#[test]
+fn a_trace_bottoms_setpoint_is_determined() {
+    let path = crate::harness::fixture("data/generated/rigorous_2599be5b.json");
+    let mut d: Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    d["controllers"]["bottom_composition"]["sp"] = json!(1e-12);
+    let (plant, ss) = converge(&d, "trace.json");
+    let v = |p: &str| value(&plant, &ss.x, p);
+    let (reflux, duty) = (v("top_composition.op"), v("bottom_composition.op"));
+    // Second route: no composition loops, their outputs as fixed inputs (bare numbers are SI).
+    let controllers = d["controllers"].as_object_mut().unwrap();
+    controllers.remove("top_composition");
+    controllers.remove("bottom_composition");
+    d["units"]["column"]["reflux"] = json!(reflux);
+    d["units"]["column"]["rigorous"]["reboiler_duty"] = json!(duty);
+    let (open, os) = converge(&d, "open.json");
+    let (xd, xb) = (value(&open, &os.x, "distillate.x[methanol]"), value(&open, &os.x, "bottoms.x[methanol]"));
+    assert!((xd - 0.9117).abs() < 1e-9, "open plant at the outputs: xD {xd}");
+    assert!((xb - 1e-12).abs() < 1e-6 * 1e-12, "open plant at the outputs: xB {xb:e}");
+    // The plant as generated (xB held at 1e-9, which Newton does not reach from the cold start;
+    // the generator's known stall) is not called undetermined.
+    let generated = load_str(&std::fs::read_to_string(&path).unwrap(), "plant.json").unwrap();
+    let e = steady_state(&generated, &generated.input_values(), None, &NewtonSettings::default());
+    assert!(!matches!(e, Err(plantwide::solve::SteadyError::Dof(_))), "{:?}", e.err().map(|e| e.to_string()));
+}

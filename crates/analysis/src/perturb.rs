@@ -310,6 +310,10 @@ impl Problem<'_> {
                     }
                 })
             })
+            .collect::<Vec<Result<Point, PerturbError>>>()
+            // In move order: rayon's own `collect` into a `Result` keeps whichever error a thread
+            // stored first, so with two failed moves the reported one depended on the schedule.
+            .into_iter()
             .collect::<Result<Vec<Point>, PerturbError>>()?;
         let diff = |a: &Point, b: &Point, i: usize| a.y[i] - b.y[i];
         let n = self.outputs.len();

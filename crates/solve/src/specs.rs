@@ -43,6 +43,12 @@ impl<'a> SteadySystem<'a> {
         self
     }
 
+    /// The specification of unknown `j` when it is one of the plant's variables (not a varied
+    /// input).
+    pub(crate) fn plant_var(&self, j: usize) -> Option<&plantwide_model::VarSpec> {
+        self.plant.vars().get(j).map(|v| &v.spec)
+    }
+
     /// The unknowns at plant state `x` and this system's inputs.
     pub fn unknowns(&self, x: &[f64]) -> Vec<f64> {
         let mut z = x.to_vec();

@@ -2,6 +2,7 @@
 
 use plantwide_flowsheet::Plant;
 use plantwide_model::VarKind;
+use plantwide_units::Dimension;
 
 use crate::certify::{CertificateFailure, Warning, certify};
 use crate::rank::{self, Rank};
@@ -190,7 +191,7 @@ fn null_direction(sys: &SteadySystem<'_>, z: &[f64]) -> Option<Vec<usize>> {
     let mut r = vec![0.0; n];
     let mut jac = Vec::new();
     sys.jacobian(z, &mut r, &mut jac);
-    let a = scaled(sys, jac);
+    let a = scaled(sys, z, jac);
     let direction = |v: &[f64]| {
         let null: Vec<f64> = v.iter().map(|a| a.abs()).collect();
         let top = null.iter().cloned().fold(0.0, f64::max);
@@ -205,13 +206,14 @@ fn null_direction(sys: &SteadySystem<'_>, z: &[f64]) -> Option<Vec<usize>> {
     }
 }
 
-/// The Jacobian triplets with duplicates summed, columns scaled by their unknowns' nominal values
-/// and rows by their largest entry.
-fn scaled(sys: &SteadySystem<'_>, mut jx: Vec<(usize, usize, f64)>) -> Vec<(usize, usize, f64)> {
+/// The Jacobian triplets with duplicates summed, columns scaled by their unknowns' sizes
+/// ([`probe_scale`]) and rows by their largest entry.
+fn scaled(sys: &SteadySystem<'_>, z: &[f64], mut jx: Vec<(usize, usize, f64)>) -> Vec<(usize, usize, f64)> {
     jx.sort_unstable_by_key(|t| (t.0, t.1));
+    let scale: Vec<f64> = (0..sys.n()).map(|j| probe_scale(sys, z, j)).collect();
     let mut a: Vec<(usize, usize, f64)> = Vec::with_capacity(jx.len());
     for (i, j, v) in jx {
-        let v = v * sys.nominal(j);
+        let v = v * scale[j];
         match a.last_mut() {
             Some(last) if (last.0, last.1) == (i, j) => last.2 += v,
             _ => a.push((i, j, v)),
@@ -221,6 +223,30 @@ fn scaled(sys: &SteadySystem<'_>, mut jx: Vec<(usize, usize, f64)>) -> Vec<(usiz
     a.iter().for_each(|&(i, _, v)| row_max[i] = row_max[i].max(v.abs()));
     a.iter_mut().filter(|t| row_max[t.0] > 0.0).for_each(|t| t.2 /= row_max[t.0]);
     a
+}
+
+/// Smallest size, relative to its nominal value, that the probe gives a trace amount.
+const TRACE_FLOOR: f64 = 1e-12;
+
+/// The size of unknown `j` at `z` that the probe scales its column by: its nominal value, except
+/// for an amount of one component (a mole fraction, bounded by [0, 1], or a component holdup,
+/// bounded below by 0 and no total inventory), whose size is its own value (between
+/// [`TRACE_FLOOR`] of the nominal value and the nominal value).
+///
+/// A trace component's balances are homogeneous in its own amounts, so what determines them is
+/// relative: a bottoms mole fraction held at 1e-9 by a PI loop moves by a factor when boilup
+/// and reflux move together, which is a change of about 1e-9 on the nominal scale of a mole
+/// fraction. Scaled by nominal values, that loop's row would see every such move as nothing and
+/// the smallest singular value would be about the trace's size (1.5e-12 on a methanol/water
+/// column with xB = 3e-12), below the probe's 1e-12 threshold on a plant whose steady state is
+/// isolated. A positive diagonal column scaling does not change the rank, only what the threshold
+/// measures: on the relative scale of the trace the same direction is a change of order one.
+fn probe_scale(sys: &SteadySystem<'_>, z: &[f64], j: usize) -> f64 {
+    let nominal = sys.nominal(j);
+    let Some(v) = sys.plant_var(j) else { return nominal };
+    let fraction = v.dim == Dimension::DIMENSIONLESS && v.lower == 0.0 && v.upper == 1.0;
+    let component = v.dim == Dimension::AMOUNT && v.lower == 0.0 && !v.inventory;
+    if fraction || component { z[j].abs().clamp(TRACE_FLOOR * nominal, nominal) } else { nominal }
 }
 
 fn explain_loose(plant: &Plant, vars: &[usize], why: &str) -> String {

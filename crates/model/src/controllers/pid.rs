@@ -2,7 +2,7 @@
 //! anti-windup, bias, auto/manual with bumpless transfer, and local or remote (cascade) setpoint.
 //!
 //! Error `e = sp − pv` (reverse action) or `pv − sp` (direct action). Variables, in order:
-//! - `I` (differential, present when `tau_i` is given): `dI/dt = e + (op − u)/Kc` in auto, where
+//! - `I` (differential, present when `tau_i` is given): `dI/dt = e + (clamp(u) − u)/Kc` in auto, where
 //!   `u = bias + Kc (e + I/τ_I + D)` is the unclamped output; the back-calculation term stops windup and
 //!   vanishes while the output is inside its limits. In manual `dI/dt = ((op_man − bias)/Kc − e − I/τ_I)·τ_I/τ_t`
 //!   tracks the manual output, `τ_t = τ_I`.
@@ -243,15 +243,24 @@ impl UnitModel for Pid {
             u += (e - xf) * (td / tf);
         }
         let u = u * self.kc + self.bias;
+        let clamped = clamp(u, self.op_min, self.op_max);
         let mut k = 0;
         if let Some((i, ti)) = integral {
-            r[k] = if auto { e + (op - u) / self.kc } else { (op_manual - self.bias) / self.kc - e - i / ti };
+            // `clamp(u)` for `op`: the two are equal by the `op` row, so the dynamics are the same
+            // (the row is the old one minus the `op` row over Kc, a constant row operation that
+            // leaves Newton's steps unchanged), but inside the limits the back-calculation term is
+            // identically zero and the row reads `e` itself. Written with `op`, `e` cancels in it
+            // (e + (op − bias)/Kc − e − I/τ_I) and the steady state's `e = 0` lives only in the
+            // `op` row as `Kc·e` beside the output's own size: a bottoms loop at 1e-9 with Kc =
+            // 34 MW per unit mole fraction weighs its measurement 1e-11 of that row, which the
+            // degrees-of-freedom probe took for a free direction.
+            r[k] = if auto { e + (clamped - u) / self.kc } else { (op_manual - self.bias) / self.kc - e - i / ti };
             k += 1;
         }
         if let Some((xf, tf, _)) = derivative {
             r[k] = (e - xf) / tf;
         }
-        r[n_diff] = if auto { op - clamp(u, self.op_min, self.op_max) } else { op - op_manual };
+        r[n_diff] = if auto { op - clamped } else { op - op_manual };
     }
     fn without_limits(&self) -> Option<Self> {
         let limited = self.op_min > f64::NEG_INFINITY || self.op_max < f64::INFINITY;
