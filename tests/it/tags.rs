@@ -98,7 +98,7 @@ fn a_run_records_the_tag_as_its_expression_at_every_time() {
     let dir = std::env::temp_dir().join(format!("plantwide-tags-run-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let csv = dir.join("run.csv");
-    let scen = fixture("data/column_a_tags_boilup_step.json");
+    let scen = fixture("data/scenarios/column_a_tags_boilup_step.json");
     let out = plantwide(&["run", &fixture(FILE), "--scenario", &scen, "--csv", csv.to_str().unwrap()]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let text = std::fs::read_to_string(&csv).unwrap();

@@ -509,8 +509,8 @@ impl<'s> Assembler<'s> {
             let text = t.expression();
             let names = match plantwide_model::tag::names(text) {
                 Ok(n) => n,
-                Err(msg) => {
-                    self.diags.push(Diagnostic::new(at, msg));
+                Err(e) => {
+                    self.diags.push(Diagnostic::new(at, e.render()));
                     continue;
                 }
             };
@@ -539,7 +539,7 @@ impl<'s> Assembler<'s> {
                     Some(msg) => self.diags.push(Diagnostic::new(format!("{at}.unit"), msg)),
                     None => self.push_block(name.clone(), BlockKind::Tag, Box::new(tag), &[]),
                 },
-                Err(msg) => self.diags.push(Diagnostic::new(format!("{at}.expression"), msg)),
+                Err(e) => self.diags.push(Diagnostic::new(format!("{at}.expression"), e.to_string())),
             }
         }
         self.stop_if_invalid()

@@ -20,10 +20,33 @@
 //! `|expr|` at the guess and 1 SI unit, so that a cost of 10⁶ $/s and a fraction of 10⁻³ weigh
 //! alike in Newton's stopping test.
 
-use plantwide_expr::{Expression, SymbolTable, VarKind as ExprVarKind};
+use plantwide_expr::{ExprError, Expression, SymbolError, SymbolTable, VarKind as ExprVarKind};
 use plantwide_units::Dimension;
 
 use crate::{Scalar, SignalSpec, UnitIo, UnitModel, VarSpec};
+
+/// Why a tag's expression cannot be compiled.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum TagError {
+    /// The expression's own error (syntax, a dimension mismatch, an unknown name), located in
+    /// its text; `Display` renders the text with a caret under the position.
+    #[error("{}", .0.render())]
+    Expression(#[from] ExprError),
+    /// A parameter or a read path the symbol table refuses.
+    #[error("`{name}`: {source}")]
+    Symbol {
+        /// The parameter's name or the path.
+        name: String,
+        /// Why.
+        source: SymbolError,
+    },
+    /// A `der()` in a tag.
+    #[error("a tag is a function of the plant's variables; `der()` has no place in it: {text}")]
+    Derivative {
+        /// The expression.
+        text: String,
+    },
+}
 
 /// A tag's expression compiled against the plant paths it reads.
 #[derive(Debug, Clone)]
@@ -53,19 +76,20 @@ impl Tag {
         reads: &[(String, Dimension)],
         parameters: &[(String, f64, Dimension)],
         guess: &[f64],
-    ) -> Result<Tag, String> {
+    ) -> Result<Tag, TagError> {
         let mut symbols = SymbolTable::new();
+        let symbol = |name: &str| move |source| TagError::Symbol { name: name.to_string(), source };
         for (name, value, dim) in parameters {
-            symbols.add_parameter(name, *value, *dim).map_err(|e| format!("parameter `{name}`: {e}"))?;
+            symbols.add_parameter(name, *value, *dim).map_err(symbol(name))?;
         }
         for (k, (path, dim)) in reads.iter().enumerate() {
             if symbols.get(path).is_none() {
-                symbols.add_variable(path, slot(k), *dim, ExprVarKind::Algebraic).map_err(|e| e.to_string())?;
+                symbols.add_variable(path, slot(k), *dim, ExprVarKind::Algebraic).map_err(symbol(path))?;
             }
         }
-        let expr = Expression::new(text, &symbols).map_err(|e| e.render())?;
+        let expr = Expression::new(text, &symbols)?;
         if !expr.derivatives().is_empty() {
-            return Err(format!("a tag is a function of the plant's variables; `der()` has no place in it\n{text}"));
+            return Err(TagError::Derivative { text: text.to_string() });
         }
         let mut local = vec![0.0; slot(reads.len())];
         local[1..].copy_from_slice(guess);
@@ -87,10 +111,12 @@ impl Tag {
 }
 
 /// The names an expression's text uses, in order of first appearance, with their byte spans: the
-/// candidates for plant paths (the caller tells paths from parameters). `Err` is the parse
-/// error, rendered.
-pub fn names(text: &str) -> Result<Vec<(String, plantwide_expr::Span)>, String> {
-    let ast = plantwide_expr::parse_expression(text).map_err(|e| e.render())?;
+/// candidates for plant paths (the caller tells paths from parameters).
+///
+/// # Errors
+/// The text's syntax error.
+pub fn names(text: &str) -> Result<Vec<(String, plantwide_expr::Span)>, ExprError> {
+    let ast = plantwide_expr::parse_expression(text)?;
     let mut out: Vec<(String, plantwide_expr::Span)> = Vec::new();
     let mut stack = vec![&ast];
     while let Some(e) = stack.pop() {
@@ -182,7 +208,7 @@ mod tests {
     fn a_dimension_mismatch_is_located_in_the_text() {
         let reads =
             vec![("reboiler.duty".to_string(), Dimension::POWER), ("fresh.F".to_string(), Dimension::MOLAR_FLOW)];
-        let err = Tag::build("reboiler.duty + fresh.F", &reads, &[], &[1.0, 1.0]).unwrap_err();
+        let err = Tag::build("reboiler.duty + fresh.F", &reads, &[], &[1.0, 1.0]).unwrap_err().to_string();
         assert!(err.contains("W and mol/s") && err.contains("^^^"), "{err}");
     }
 

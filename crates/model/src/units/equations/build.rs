@@ -80,10 +80,10 @@ impl Equations {
 }
 
 /// A quantity given as text with a unit, or as a bare (dimensionless) number.
-fn quantity(q: &QuantityValue) -> Result<plantwide_units::Quantity, String> {
+fn quantity(q: &QuantityValue) -> Result<plantwide_units::Quantity, plantwide_units::UnitError> {
     match q {
         QuantityValue::Number(x) => Ok(plantwide_units::Quantity::new(*x, Dimension::DIMENSIONLESS)),
-        QuantityValue::Text(s) => parse_quantity(s).map_err(|e| e.to_string()),
+        QuantityValue::Text(s) => parse_quantity(s),
     }
 }
 
@@ -102,7 +102,7 @@ impl Builder<'_, '_> {
                     let r = self.symbols.add_parameter(name, q.value_si, q.dim);
                     self.declare(&field, r);
                 }
-                Err(e) => self.cx.error(&field, e),
+                Err(e) => self.cx.error(&field, e.to_string()),
             }
         }
     }
@@ -118,7 +118,7 @@ impl Builder<'_, '_> {
                     inputs.push(InputSpec { name: name.clone(), dim: q.dim, value: q.value_si });
                 }
                 Err(e) => {
-                    self.cx.error(&field, e);
+                    self.cx.error(&field, e.to_string());
                     inputs.push(InputSpec { name: name.clone(), dim: Dimension::DIMENSIONLESS, value: f64::NAN });
                 }
             }
