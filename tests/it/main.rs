@@ -22,6 +22,7 @@ mod conditions;
 mod core;
 mod display_units;
 mod dynamics;
+mod equations_bad_input;
 mod faults;
 mod fehe;
 mod flowsheets;
