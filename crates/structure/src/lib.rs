@@ -89,11 +89,25 @@ pub fn maximum_matching(n_rows: usize, n_cols: usize, entries: &[(usize, usize)]
 
 /// Maximum matching of `rows.len()` rows to `n_cols` columns, `rows[i]` listing the columns row
 /// `i` reads (entries `>= n_cols` are ignored, repeats allowed). No diagonal start: the rows and
-/// columns are of different kinds (the equations of a unit and its unknowns).
+/// columns are of different kinds (the equations of a unit and its unknowns). Each row tries its
+/// columns in the order listed (an equation's variables in the order it reads them), so the
+/// result depends on that order as well as on the pattern.
 pub fn maximum_matching_of_rows(n_cols: usize, rows: &[Vec<usize>]) -> Matching {
-    let entries: Vec<(usize, usize)> =
-        rows.iter().enumerate().flat_map(|(i, r)| r.iter().filter(|&&j| j < n_cols).map(move |&j| (i, j))).collect();
-    let adj = Adjacency::from_entries(rows.len(), n_cols, &entries);
+    let mut ptr = Vec::with_capacity(rows.len() + 1);
+    let mut col = Vec::new();
+    // seen[j] == i + 1: column j already listed for row i.
+    let mut seen = vec![0usize; n_cols];
+    ptr.push(0);
+    for (i, r) in rows.iter().enumerate() {
+        for &j in r {
+            if j < n_cols && seen[j] != i + 1 {
+                seen[j] = i + 1;
+                col.push(j);
+            }
+        }
+        ptr.push(col.len());
+    }
+    let adj = Adjacency { ptr, col };
     let mut m = Matching { row_to_col: vec![None; rows.len()], col_to_row: vec![None; n_cols] };
     hopcroft_karp(&adj, &mut m);
     m
@@ -163,12 +177,12 @@ fn hopcroft_karp(adj: &Adjacency, m: &mut Matching) {
         // Layers: unmatched rows at 0; a matched column leads to its row one layer down. `limit`
         // is the layer below the first one that reaches an unmatched column.
         queue.clear();
-        for r in 0..n_rows {
+        for (r, d) in dist.iter_mut().enumerate() {
             if m.row_to_col[r].is_none() {
-                dist[r] = 0;
+                *d = 0;
                 queue.push(r);
             } else {
-                dist[r] = UNREACHED;
+                *d = UNREACHED;
             }
         }
         let mut limit = UNREACHED;
@@ -256,9 +270,12 @@ mod tests {
     }
 
     #[test]
-    fn rows_form_ignores_columns_out_of_range() {
+    fn rows_form_ignores_columns_out_of_range_and_keeps_the_order_given() {
         let m = maximum_matching_of_rows(2, &[vec![0, 1, 7], vec![0]]);
         assert_eq!(m.row_to_col, vec![Some(1), Some(0)]);
+        // Row 2 takes the first of its columns: 2, not 1.
+        let m = maximum_matching_of_rows(3, &[vec![0], vec![0], vec![2, 1, 2]]);
+        assert_eq!((m.unmatched_cols(), m.row_to_col), (vec![1], vec![Some(0), None, Some(2)]));
         let m = maximum_matching_of_rows(3, &[vec![0], vec![0], vec![1]]);
         assert_eq!((m.size(), m.unmatched_rows(), m.unmatched_cols()), (2, vec![1], vec![2]));
     }
