@@ -23,6 +23,7 @@ mod core;
 mod display_units;
 mod dynamics;
 mod equation_units_in_studies;
+mod equations_bad_input;
 mod evaporator;
 mod faults;
 mod fehe;

@@ -4,7 +4,7 @@
 //! unknown `j`) has a perfect matching: then some values of the nonzeros make the Jacobian
 //! invertible; without one, it is singular for every value (Duff, "On algorithms for obtaining
 //! a maximum transversal", ACM TOMS 7 (1981) 315–330; Pantelides, SIAM J. Sci. Stat. Comput. 9
-//! (1988) 213–231, for the index of DAEs).
+//! (1988) 213–231, for the index of DAEs). The matching itself is `plantwide-structure`'s.
 
 use crate::compiled::Equation;
 use crate::symbols::{SymbolTable, VarKind};
@@ -43,47 +43,11 @@ impl Matching {
 /// A maximum bipartite matching of `rows.len()` equations to `n_unknowns` unknowns, where
 /// `rows[i]` lists the unknowns equation `i` reads (entries `>= n_unknowns` are ignored).
 ///
-/// Augmenting paths (Kuhn's algorithm, depth-first with an explicit stack, so no recursion):
-/// **O(n_equations · nnz)** time, O(n_equations + n_unknowns) memory.
+/// Hopcroft–Karp ([`plantwide_structure::maximum_matching_of_rows`], shared with the solvers):
+/// **O(√n · nnz)** time, O(n_equations + n_unknowns + nnz) memory, no recursion.
 pub fn maximum_matching(n_unknowns: usize, rows: &[Vec<usize>]) -> Matching {
-    let mut m = Matching { unknown_of: vec![None; rows.len()], equation_of: vec![None; n_unknowns] };
-    let mut seen = vec![usize::MAX; n_unknowns];
-    for root in 0..rows.len() {
-        augment(root, rows, &mut m, &mut seen);
-    }
-    m
-}
-
-/// Searches an augmenting path from the unmatched equation `root` and flips it if found.
-/// `seen[j] == root` marks unknowns visited in this search.
-fn augment(root: usize, rows: &[Vec<usize>], m: &mut Matching, seen: &mut [usize]) -> bool {
-    // stack[k] = (equation, next edge to try); path[k] = the unknown stack[k] tries to take.
-    let mut stack = vec![(root, 0usize)];
-    let mut path: Vec<usize> = Vec::new();
-    while let Some((eq, pos)) = stack.last_mut() {
-        let Some(&j) = rows[*eq].get(*pos) else {
-            stack.pop();
-            path.pop();
-            continue;
-        };
-        *pos += 1;
-        if j >= seen.len() || seen[j] == root {
-            continue;
-        }
-        seen[j] = root;
-        path.push(j);
-        match m.equation_of[j] {
-            Some(owner) => stack.push((owner, 0)),
-            None => {
-                for (&(e, _), &u) in stack.iter().zip(&path) {
-                    m.unknown_of[e] = Some(u);
-                    m.equation_of[u] = Some(e);
-                }
-                return true;
-            }
-        }
-    }
-    false
+    let m = plantwide_structure::maximum_matching_of_rows(n_unknowns, rows);
+    Matching { unknown_of: m.row_to_col, equation_of: m.col_to_row }
 }
 
 /// Which unknowns the incidence pattern is about.

@@ -78,7 +78,9 @@ impl Tag {
         guess: &[f64],
     ) -> Result<Tag, TagError> {
         let mut symbols = SymbolTable::new();
-        let symbol = |name: &str| move |source| TagError::Symbol { name: name.to_string(), source };
+        fn symbol(name: &str) -> impl FnOnce(SymbolError) -> TagError + '_ {
+            move |source| TagError::Symbol { name: name.to_string(), source }
+        }
         for (name, value, dim) in parameters {
             symbols.add_parameter(name, *value, *dim).map_err(symbol(name))?;
         }
