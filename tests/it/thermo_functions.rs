@@ -127,3 +127,28 @@ fn bad_tables_exit_1_naming_the_table_and_the_point() {
         ],
     );
 }
+
+/// The division-at-the-guess check uses the plant's own guess (issue 57): the inlet the
+/// upstream feed gives, not a made-up stream. With the feed at 350 K, `1/(in.T - 300 K)` is
+/// finite where Newton starts and loads; `1/(in.T - 350 K)` divides by zero there and is refused
+/// with its position.
+#[test]
+fn the_guess_check_sees_the_upstream_units_guess() {
+    let text = std::fs::read_to_string(crate::harness::fixture("data/cstr_equations.json")).unwrap();
+    let mut d: serde_json::Value = serde_json::from_str(&text).unwrap();
+    d["units"]["fresh"]["T"] = "350 K".into();
+    d["units"]["reactor"]["variables"]["w"] = serde_json::json!({"kind": "algebraic", "unit": "1/K", "guess": 0});
+    d["units"]["reactor"]["equations"].as_array_mut().unwrap().push("w = 1/(in.T - T0)".into());
+    let check = |t0: &str| {
+        d["units"]["reactor"]["parameters"]["T0"] = t0.into();
+        let file = std::env::temp_dir().join(format!("guess_check_{}_{}.json", std::process::id(), t0.len()));
+        std::fs::write(&file, d.to_string()).unwrap();
+        crate::harness::plantwide(&["check", file.to_str().unwrap()])
+    };
+    let ok = check("300 K");
+    assert!(ok.status.success(), "{}", String::from_utf8_lossy(&ok.stderr));
+    let bad = check("350.0 K");
+    assert_eq!(bad.status.code(), Some(1));
+    let msg = String::from_utf8_lossy(&bad.stderr);
+    assert!(msg.contains("units.reactor.equations[12]") && msg.contains("at the guess") && msg.contains('^'), "{msg}");
+}

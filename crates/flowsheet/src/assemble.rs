@@ -715,6 +715,7 @@ impl<'s> Assembler<'s> {
             file: plant.file().to_string(),
             diagnostics: vec![Diagnostic::new(e.path, e.source.to_string())],
         })?;
+        check_guess(&plant)?;
         Ok(plant)
     }
 }
@@ -742,6 +743,30 @@ pub(crate) fn physical_range(spec: &plantwide_model::VarSpec) -> (f64, f64) {
     let max = plantwide_model::limits::max_magnitude(spec.dim);
     let lo = if spec.inventory { spec.lower.min(0.0) } else { spec.lower };
     (lo.max(-max), spec.upper.min(max))
+}
+
+/// The units' own checks at the plant's cold-start guess
+/// ([`plantwide_model::UnitModel::check_guess`]: an equations unit's division by zero where
+/// Newton starts), with the upstream units' guesses at their inlets; the guess is computed only
+/// when some unit has such a check.
+fn check_guess(plant: &Plant) -> Result<(), LoadError> {
+    if !plant.blocks.iter().any(|b| b.unit.checks_guess()) {
+        return Ok(());
+    }
+    let u = plant.input_values();
+    let x = plant.initial_guess_at(&u);
+    let (mut local, mut diagnostics) = (Vec::new(), Vec::new());
+    for b in plant.blocks.iter().filter(|b| b.unit.checks_guess()) {
+        plant.gather(b, &x, &u, &mut local);
+        let io = plantwide_model::UnitIo { local: &local, layout: &b.layout, thermo: &plant.thermo, time: 0.0 };
+        let found = b.unit.check_guess(&io);
+        diagnostics.extend(found.into_iter().map(|(f, m)| Diagnostic::new(format!("{}.{f}", section_path(b)), m)));
+    }
+    if diagnostics.is_empty() {
+        Ok(())
+    } else {
+        Err(LoadError::Invalid { file: plant.file().to_string(), diagnostics })
+    }
 }
 
 fn section_path(b: &Block) -> String {

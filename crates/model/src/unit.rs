@@ -201,6 +201,19 @@ pub trait UnitModel: Send + Sync + std::fmt::Debug {
     /// Initial guess of the own variables from the inlets and inputs in `local` (its own block holds
     /// whatever was there before: defaults or a previous solution).
     fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]);
+    /// Problems at the plant's cold-start guess `io` (the unit's own block as it guessed it, its
+    /// inlets the upstream units' guesses, its inputs at their values), each as (field below the
+    /// unit's JSON path, message): what would stop Newton at its first step, such as a division
+    /// by zero (default: none). Called once at load for the units whose
+    /// [`UnitModel::checks_guess`] is true.
+    fn check_guess(&self, _io: &UnitIo<'_, f64>) -> Vec<(String, String)> {
+        Vec::new()
+    }
+    /// Whether the unit has a [`UnitModel::check_guess`] (default false): the load computes the
+    /// plant's guess only if some unit has.
+    fn checks_guess(&self) -> bool {
+        false
+    }
     /// Component amounts `n_c` [mol] held by the unit at the local vector `io.local`, one per
     /// component; `None` (the default) for a unit that holds no material. The dynamic driver
     /// checks the plant's balance with it: `Σ_units Δn_c = ∫ (Σ_feeds F z_c − Σ_products F z_c) dt`.
@@ -309,6 +322,10 @@ pub trait Unit: Send + Sync + std::fmt::Debug {
     fn jacobian_colored(&self, io: &UnitIo<'_, f64>, r: &mut [f64], jac: &mut [f64], coloring: Option<&Coloring>);
     /// See [`UnitModel::guess`].
     fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]);
+    /// See [`UnitModel::check_guess`].
+    fn check_guess(&self, io: &UnitIo<'_, f64>) -> Vec<(String, String)>;
+    /// See [`UnitModel::checks_guess`].
+    fn checks_guess(&self) -> bool;
     /// See [`UnitModel::explicit`].
     fn explicit(&self, layout: &LocalLayout) -> Vec<usize>;
     /// See [`UnitModel::complete`].
@@ -461,6 +478,12 @@ impl<U: UnitModel + 'static> Unit for U {
     }
     fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]) {
         UnitModel::guess(self, io, own);
+    }
+    fn check_guess(&self, io: &UnitIo<'_, f64>) -> Vec<(String, String)> {
+        UnitModel::check_guess(self, io)
+    }
+    fn checks_guess(&self) -> bool {
+        UnitModel::checks_guess(self)
     }
     fn explicit(&self, layout: &LocalLayout) -> Vec<usize> {
         UnitModel::explicit(self, layout)

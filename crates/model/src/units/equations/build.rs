@@ -10,7 +10,7 @@ use plantwide_units::{Dimension, QuantityValue, Unit as UnitOfMeasure, parse_qua
 use super::thermo::PortFunction;
 use super::{EqInterpolation, EqTableConfig, EqVarKind, Equations, EquationsConfig, Row, der_form, stream_names};
 use crate::stream::{F, H, P, T, Z0};
-use crate::{BuildCx, FieldError, InputSpec, LocalLayout, UnitIo, UnitModel, VarSpec};
+use crate::{BuildCx, FieldError, InputSpec, VarSpec};
 
 /// An equation compiled from the file: its field, the equation, and for `der(x) = rhs` the
 /// right-hand side alone.
@@ -74,7 +74,6 @@ impl Equations {
             reacts: c.reacts,
             holdup,
         };
-        b.check_at_guess(&unit);
         b.cx.finish(unit)
     }
 }
@@ -442,40 +441,6 @@ impl Builder<'_, '_> {
             });
         }
         Some((rows, fields, row_names))
-    }
-
-    /// Evaluates every equation at the guess: a zero denominator, a logarithm out of its domain
-    /// or a thermodynamic function that fails there would stop Newton at its first step.
-    ///
-    /// The inlets hold the engine's cold-start stream ([`cold_start_stream`]): a unit is built
-    /// before the plant is wired, so the upstream units' guesses are not known here.
-    fn check_at_guess(&mut self, unit: &Equations) {
-        let layout = LocalLayout {
-            stream: crate::StreamLayout { n_comp: self.comps.len() },
-            n_outlets: self.outlets.len(),
-            n_internal: unit.internal.len(),
-            n_inlets: self.inlets.len(),
-            n_inputs: unit.inputs.len(),
-            n_signals: 0,
-        };
-        let mut local = vec![0.0; layout.len()];
-        for k in 0..self.inlets.len() {
-            let at = self.inlets_at + k * self.len;
-            cold_start_stream(self.cx.thermo, &mut local[at..at + self.len]);
-        }
-        unit.inputs.iter().enumerate().for_each(|(k, i)| local[self.inputs_at + k] = i.value);
-        let mut own = vec![0.0; self.n_own];
-        unit.guess(&UnitIo { local: &local, layout: &layout, thermo: self.cx.thermo, time: 0.0 }, &mut own);
-        local[..self.n_own].copy_from_slice(&own);
-        for (row, field) in unit.rows.iter().zip(&unit.fields) {
-            let result = match row {
-                Row::Derivative { rhs, .. } => rhs.check_at(&local, &[]),
-                Row::Algebraic { eq, .. } => eq.check_at(&local, &[]),
-            };
-            if let Err(e) = result {
-                self.cx.error(field, format!("at the guess: {}", e.render()));
-            }
-        }
     }
 }
 

@@ -374,6 +374,25 @@ impl UnitModel for Equations {
         }
         own.copy_from_slice(&local[..own.len()]);
     }
+    /// Every equation evaluated at the plant's guess, with the inlets the upstream units guessed:
+    /// a zero denominator, a logarithm out of its domain or a thermodynamic function that fails
+    /// there would stop Newton at its first step, and is refused with its position.
+    fn check_guess(&self, io: &UnitIo<'_, f64>) -> Vec<(String, String)> {
+        let mut out = Vec::new();
+        for (row, field) in self.rows.iter().zip(&self.fields) {
+            let result = match row {
+                Row::Derivative { rhs, .. } => rhs.check_at(io.local, &[]),
+                Row::Algebraic { eq, .. } => eq.check_at(io.local, &[]),
+            };
+            if let Err(e) = result {
+                out.push((field.clone(), format!("at the guess: {}", e.render())));
+            }
+        }
+        out
+    }
+    fn checks_guess(&self) -> bool {
+        true
+    }
 }
 
 #[cfg(test)]
@@ -516,13 +535,18 @@ mod tests {
         let e = build_err(r#"{"equations": ["der(M) = in.F - out.F", "M = area*rho*in.F/k"]}"#);
         assert_eq!(e[0].path, "units.u.equations");
         assert!(e[0].message.contains("structurally singular"), "{}", e[0].message);
-        // A zero denominator at the guess (level = 1 m).
-        let e = build_err(
-            r#"{"parameters": {"area": "0.5 m2", "rho": "1e4 mol/m3", "k": "2 mol/(s*m)", "l0": "1 m"},
-                "equations": ["der(M) = in.F - out.F", "area*rho = M/(level - l0)"]}"#,
-        );
-        assert_eq!(e[0].path, "units.u.equations[1]");
-        assert!(e[0].message.starts_with("at the guess:"), "{}", e[0].message);
+        // A zero denominator at the guess (level = 1 m), whatever the inlet.
+        let thermo = binary_package();
+        let names = ["light".to_string(), "heavy".to_string()];
+        let mut v: serde_json::Value = serde_json::from_str(TANK).unwrap();
+        v["parameters"]["l0"] = "1 m".into();
+        v["equations"] = serde_json::json!(["der(M) = in.F - out.F", "area*rho = M/(level - l0)"]);
+        let c: EquationsConfig = serde_json::from_value(v).unwrap();
+        let u = Equations::build(&c, BuildCx::new(&names, &thermo, "units.u"), ()).unwrap();
+        let (lay, local) = at_guess(&u, &thermo, &feed(&thermo));
+        let e = Unit::check_guess(&u, &UnitIo { local: &local, layout: &lay, thermo: &thermo, time: 0.0 });
+        assert_eq!(e[0].0, "equations[1]");
+        assert!(e[0].1.starts_with("at the guess:") && e[0].1.contains("^"), "{}", e[0].1);
         let e = build_err(
             r#"{"ports": {"inlets": ["in"], "outlets": {"out": {"F": "k*level", "T": "in.T", "P": "in.P"}}}}"#,
         );
