@@ -139,7 +139,7 @@ fn the_guess_check_sees_the_upstream_units_guess() {
     d["units"]["fresh"]["T"] = "350 K".into();
     d["units"]["reactor"]["variables"]["w"] = serde_json::json!({"kind": "algebraic", "unit": "1/K", "guess": 0});
     d["units"]["reactor"]["equations"].as_array_mut().unwrap().push("w = 1/(in.T - T0)".into());
-    let check = |t0: &str| {
+    let mut check = |t0: &str| {
         d["units"]["reactor"]["parameters"]["T0"] = t0.into();
         let file = std::env::temp_dir().join(format!("guess_check_{}_{}.json", std::process::id(), t0.len()));
         std::fs::write(&file, d.to_string()).unwrap();
