@@ -62,13 +62,15 @@ const CASES: &[Case] = &[
         // `V = M*vl` twice and no equation for `level`: 12 equations of the file, the outlet's
         // two mappings (`out.F = outflow`, `out.P = P`) and its closed enthalpy, for the outlet's
         // 6 quantities and the 9 variables. Which of the two `V` equations is left over depends
-        // on the matching; `level` is read by no equation. The message names the equation by its
-        // text, with neither its index nor a caret (a structural fault has no one position).
+        // on the matching; `level` is read by no equation. The summary names the equation by its
+        // text; the equation left over is also reported at its own index with its text marked.
         replace: ("level*area = V", "V = vl*M"),
         fragments: &[
             "units.reactor.equations: the equations are structurally singular (15 equations, 15 unknowns)",
             "left without an unknown: `V = ",
             "left without an equation: `level`",
+            "structurally singular: every unknown this equation reads is already determined by the others",
+            "\n^^^^^^^^",
         ],
     },
 ];

@@ -265,12 +265,19 @@ impl Builder<'_, '_> {
     fn compile_equations(&mut self, differential: &[usize]) -> Vec<Compiled> {
         let mut compiled = Vec::new();
         let mut der_of: BTreeMap<usize, String> = BTreeMap::new();
+        let mut failed_der: std::collections::BTreeSet<String> = std::collections::BTreeSet::new();
         for (k, text) in self.c.equations.iter().enumerate() {
             let field = format!("equations[{k}]");
             let eq = match Equation::new(text, &self.symbols) {
                 Ok(eq) => eq,
                 Err(e) => {
                     self.cx.error(&field, e.render());
+                    // Its `der(x)`, if it gives one, is reported there: not again as missing.
+                    if let Ok(ast) = plantwide_expr::parse_equation(text)
+                        && let plantwide_expr::ast::ExprKind::Der { name, .. } = ast.lhs.kind
+                    {
+                        failed_der.insert(name);
+                    }
                     continue;
                 }
             };
@@ -300,8 +307,8 @@ impl Builder<'_, '_> {
             compiled.push((field, eq, rhs));
         }
         for &i in differential {
-            if !der_of.contains_key(&i) {
-                let name = self.symbols.variable_name(i).unwrap_or("?");
+            let name = self.symbols.variable_name(i).unwrap_or("?");
+            if !der_of.contains_key(&i) && !failed_der.contains(name) {
                 let msg = format!("differential variable `{name}` needs one equation `der({name}) = …`");
                 self.cx.error(&format!("variables.{name}"), msg);
             }
@@ -428,6 +435,16 @@ impl Builder<'_, '_> {
                 list(matching.unmatched_unknowns().into_iter().map(name).collect()),
             );
             self.cx.error("equations", msg);
+            // Each equation left over, at its own field with the whole text marked: every unknown it
+            // reads is already determined by the others, so it over-determines them.
+            for e in matching.unmatched_equations() {
+                let (field, eq, _) = &compiled[e];
+                let text = eq.text();
+                let caret = plantwide_expr::render_caret(text, plantwide_expr::Span { start: 0, end: text.len() });
+                let why = "structurally singular: every unknown this equation reads is already determined by the \
+                           others, so it over-determines them (remove it or give it an unknown of its own)";
+                self.cx.error(field, format!("{why}\n{caret}"));
+            }
             return None;
         }
         let (mut rows, mut fields, mut row_names) = (Vec::new(), Vec::new(), BTreeMap::new());
