@@ -222,6 +222,19 @@ impl crate::registry::UnitConfig for EquationsConfig {
     fn ports() -> &'static str {
         "the inlets and outlets its `ports` name"
     }
+    /// A unit that holds a level is a vessel to `size` when its parameters give the geometry by
+    /// the built-in vessels' names: `area` or `diameter`, and `height`; `size` sets the one
+    /// written (`--set tank.area=…` reaches a parameter) and reads the unit's `level`, `M` and
+    /// `V` as it does a tank's.
+    fn vessel(&self) -> Option<crate::registry::VesselGeometry<'_>> {
+        let (diameter, area) = (self.parameters.get("diameter"), self.parameters.get("area"));
+        let holds_level = self.variables.contains_key("level");
+        (holds_level && (diameter.is_some() || area.is_some())).then(|| crate::registry::VesselGeometry {
+            diameter,
+            area,
+            height: self.parameters.get("height"),
+        })
+    }
 }
 
 /// How a compiled equation writes its residual.
