@@ -34,6 +34,24 @@ impl Expr {
     pub fn depth(&self) -> usize {
         self.depth
     }
+
+    /// The names the expression reads, in order of first appearance, each once with the span of
+    /// that first appearance (a table's callee and a `der()` argument are not among them).
+    pub fn names(&self) -> Vec<(String, Span)> {
+        let mut out: Vec<(String, Span)> = Vec::new();
+        let mut stack = vec![self];
+        while let Some(e) = stack.pop() {
+            if let ExprKind::Name(n) = &e.kind
+                && !out.iter().any(|(m, _)| m == n)
+            {
+                out.push((n.clone(), e.span));
+            }
+            // Children pushed in reverse so that they are visited in source order.
+            let children: Vec<&Expr> = e.kind.children().collect();
+            stack.extend(children.into_iter().rev());
+        }
+        out
+    }
 }
 
 /// The kinds of expression node.

@@ -118,20 +118,7 @@ impl Tag {
 /// # Errors
 /// The text's syntax error.
 pub fn names(text: &str) -> Result<Vec<(String, plantwide_expr::Span)>, ExprError> {
-    let ast = plantwide_expr::parse_expression(text)?;
-    let mut out: Vec<(String, plantwide_expr::Span)> = Vec::new();
-    let mut stack = vec![&ast];
-    while let Some(e) = stack.pop() {
-        if let plantwide_expr::ast::ExprKind::Name(n) = &e.kind
-            && !out.iter().any(|(m, _)| m == n)
-        {
-            out.push((n.clone(), e.span));
-        }
-        // Children pushed in reverse so that they are visited in source order.
-        let children: Vec<_> = e.kind.children().collect();
-        stack.extend(children.into_iter().rev());
-    }
-    Ok(out)
+    Ok(plantwide_expr::parse_expression(text)?.names())
 }
 
 impl UnitModel for Tag {
