@@ -22,6 +22,7 @@
 
 #![warn(missing_docs)]
 
+pub(crate) mod balance;
 pub mod error;
 pub mod figures;
 pub mod frequency;

@@ -235,7 +235,10 @@ impl StateSpace {
         if self.a.nrows() == 0 {
             return Ok(Vec::new());
         }
-        let mut ev = self.a.eigenvalues().map_err(|e| AnalysisError::Singular(format!("eigenvalues of A: {e:?}")))?;
+        // Balanced first, as LAPACK's `dgeev` does: on an unbalanced plant matrix the QR
+        // algorithm's `ε‖A‖` moved a CSTR's unstable pair by 1.5e-3 of its real part.
+        let (a, _) = crate::balance::balanced(&self.a);
+        let mut ev = a.eigenvalues().map_err(|e| AnalysisError::Singular(format!("eigenvalues of A: {e:?}")))?;
         ev.sort_by(|x, y| x.re.abs().total_cmp(&y.re.abs()).then(x.im.total_cmp(&y.im)));
         Ok(ev)
     }
@@ -269,6 +272,76 @@ impl StateSpace {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The state matrix of `flowsheets/cstr_multiplicity.json` with two PI loops added (T by the
+    /// coolant, x_A by the feed; `plantwide linearize`, states N_A, N_B, U, T_j, three integrals):
+    /// entries from 9e-8 to 2e4. Its eigenvalues against LAPACK's `dgeev` (NumPy 1.26
+    /// `linalg.eigvals`, which balances) to 1e-9 of each; unbalanced, the QR algorithm moved the
+    /// unstable pair's real part from 9.39125e-4 to 9.37688e-4.
+    #[test]
+    fn the_eigenvalues_of_a_badly_scaled_plant_matrix_agree_with_lapack() {
+        let rows: [[f64; 7]; 7] = [
+            [
+                -0.014694749110733386,
+                0.739080913025507,
+                -8.664420151992543e-08,
+                0.0,
+                -0.009145303882155403,
+                0.0,
+                0.2065697379967852,
+            ],
+            [
+                0.002764723379074954,
+                -0.007359881968738706,
+                8.664420151992543e-08,
+                0.0,
+                -0.00011395537710385524,
+                0.0,
+                0.0,
+            ],
+            [
+                -199.4373875488924,
+                -22308.836190333266,
+                -0.019001123257343436,
+                2000.0,
+                272.63828225433133,
+                0.0,
+                -6139.769037609448,
+            ],
+            [
+                -0.01349070779966024,
+                -0.013490707799660244,
+                -4.581673566716462e-07,
+                -0.0547801147231118,
+                0.0,
+                -2.0418116173194525e-05,
+                0.0,
+            ],
+            [0.001, 0.001, 0.0, 0.0, 0.0, 0.0, 0.0],
+            [0.1962995632231186, 0.19629956322311862, 6.666666666666667e-06, 0.0, 0.0, 0.0, 0.0],
+            [-1.2307180727216425e-05, 0.0009876928192727836, 0.0, 0.0, 0.0, 0.0, 0.0],
+        ];
+        let ss = StateSpace {
+            states: (0..7).collect(),
+            a: Mat::from_fn(7, 7, |i, j| rows[i][j]),
+            b: Mat::zeros(7, 0),
+            c: Mat::zeros(0, 7),
+            d: Mat::zeros(0, 0),
+        };
+        let lapack = [
+            c64::new(-0.000116211212927003, 0.0),
+            c64::new(-0.00016740762908809984, 0.0),
+            c64::new(0.0009391251960509652, -0.002455785034788335),
+            c64::new(0.0009391251960509652, 0.002455785034788335),
+            c64::new(-0.024700011264606435, 0.0),
+            c64::new(-0.036365244672703814, -0.02463285905518843),
+            c64::new(-0.036365244672703814, 0.02463285905518843),
+        ];
+        let ev = ss.eigenvalues().unwrap();
+        for (l, e) in ev.iter().zip(lapack) {
+            assert!((l - e).norm() < 1e-9 * e.norm(), "{l} against LAPACK's {e}: {ev:?}");
+        }
+    }
 
     /// `dx/dt = −x + z`, `0 = −z − x + u` (so `z = u − x`, `dx/dt = −2x + u`), output `z`:
     /// `A = −2`, `B = 1`, `C = −1`, `D = 1`, `G(s) = (s + 1)/(s + 2)`, `G(0) = 1/2`.

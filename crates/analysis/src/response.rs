@@ -10,6 +10,7 @@ use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
 use faer::sparse::{SparseColMat, Triplet};
 use faer::{Mat, c64};
 
+use crate::balance::balanced;
 use crate::error::AnalysisError;
 
 /// `C (jωM − J)⁻¹ B` with the symbolic factorization shared across frequencies.
@@ -80,8 +81,8 @@ fn singular(omega: f64) -> AnalysisError {
 }
 
 /// `G(jω) = D + C (jωI − A)⁻¹ B` of a dense state-space model by Laub's method (Laub 1981, IEEE
-/// Trans. Autom. Control 26, 407): `A = Z H Zᵀ` with `H` upper Hessenberg and `Z` orthogonal
-/// (Householder reflections, faer's `hessenberg_in_place`) once, then for each ω one Gaussian
+/// Trans. Autom. Control 26, 407): `A` balanced ([`balanced`]), then `A = Z H Zᵀ` with `H` upper
+/// Hessenberg and `Z` orthogonal (Householder reflections, faer's `hessenberg_in_place`) once, then for each ω one Gaussian
 /// elimination of the Hessenberg matrix `jωI − H` with partial pivoting — `O(n²)` per input
 /// instead of the `O(n³)` of a dense LU, with the backward stability of orthogonal reduction
 /// (unlike a modal form, which fails on the non-normal state matrices of columns).
@@ -102,8 +103,11 @@ impl HessenbergResponse {
         if n < 2 {
             return HessenbergResponse { h: ss.a.clone(), zb: ss.b.clone(), cz: ss.c.clone(), d: ss.d.clone() };
         }
-        let (h, z) = hessenberg(&ss.a);
-        HessenbergResponse { zb: z.transpose() * &ss.b, cz: &ss.c * &z, h, d: ss.d.clone() }
+        let (a, s) = balanced(&ss.a);
+        let b = Mat::from_fn(n, ss.b.ncols(), |i, k| ss.b[(i, k)] / s[i]);
+        let c = Mat::from_fn(ss.c.nrows(), n, |i, j| ss.c[(i, j)] * s[j]);
+        let (h, z) = hessenberg(&a);
+        HessenbergResponse { zb: z.transpose() * &b, cz: &c * &z, h, d: ss.d.clone() }
     }
 
     /// `G(jω)` at `ω` \[rad/s\] (non-finite entries where `jωI − A` is singular).
@@ -216,6 +220,33 @@ mod tests {
                 for k in 0..2 {
                     let e = (g[(i, k)] - direct[(i, k)]).norm();
                     assert!(e < 1e-12 * direct.norm_l2(), "ω = {w}: {} vs {}", g[(i, k)], direct[(i, k)]);
+                }
+            }
+        }
+    }
+
+    /// The same model with its states rescaled by `T = diag(10^{±k})` (`A' = T⁻¹AT`, `B' = T⁻¹B`,
+    /// `C' = CT`: the same `G` exactly), entries 10¹⁰ apart as in a plant's state matrix: every
+    /// entry of `G(jω)` to 1e-12 of its own size, against the dense solve of the unscaled model.
+    /// Without balancing the orthogonal reduction's `ε‖A'‖` swamps the small entries (1e-6 here).
+    #[test]
+    fn laubs_method_keeps_each_entry_on_a_badly_scaled_model() {
+        let ss = model();
+        let t: Vec<f64> = [1e-5, 3e2, 1.0, 7e4, 2e-3, 1e5, 0.5].to_vec();
+        let scaled = StateSpace {
+            states: ss.states.clone(),
+            a: Mat::from_fn(7, 7, |i, j| ss.a[(i, j)] * t[j] / t[i]),
+            b: Mat::from_fn(7, 2, |i, k| ss.b[(i, k)] / t[i]),
+            c: Mat::from_fn(3, 7, |i, j| ss.c[(i, j)] * t[j]),
+            d: ss.d.clone(),
+        };
+        let fast = HessenbergResponse::new(&scaled);
+        for w in [0.0, 1e-3, 0.5, 3.0, 40.0, 1e4] {
+            let (g, direct) = (fast.at(w), ss.frequency_response(w));
+            for i in 0..3 {
+                for k in 0..2 {
+                    let e = (g[(i, k)] - direct[(i, k)]).norm();
+                    assert!(e < 1e-12 * direct[(i, k)].norm(), "ω = {w}: {} vs {}", g[(i, k)], direct[(i, k)]);
                 }
             }
         }
