@@ -44,13 +44,12 @@ fn every_heat_duty_is_declared() {
     use plantwide::model::Booking;
     for (file, plant) in shipped() {
         for (bi, b) in plant.blocks().iter().enumerate() {
-            let declared: Vec<&str> = b
-                .unit
-                .duties()
+            let duties = b.unit.duties();
+            let declared: Vec<&str> = duties
                 .iter()
                 .flat_map(|d| {
-                    let source = match d.source {
-                        DutySource::Var(n) | DutySource::Input(n) => n,
+                    let source = match &d.source {
+                        DutySource::Var(n) | DutySource::Input(n) => n.as_ref(),
                     };
                     let coupled = match d.booking {
                         Booking::Removed { coupled } => Some(coupled),
@@ -64,7 +63,7 @@ fn every_heat_duty_is_declared() {
             let inputs = plant.inputs().iter().filter(|i| i.block == bi).filter_map(|i| local(&i.path));
             // An input `duty` is a heat input unless the unit carries it in a declared `Q` (a
             // heater or a CSTR in duty mode: `Q` equals it, and booking both would count it twice).
-            let carried = b.unit.duties().iter().any(|d| matches!(d.source, DutySource::Var("Q")));
+            let carried = duties.iter().any(|d| d.source == DutySource::Var("Q".into()));
             let heat_input = |n: &String| n.ends_with("_duty") || (n == "duty" && !carried);
             let duties = vars.filter(|n| n == "Q" || n == "Qc").chain(inputs.filter(heat_input));
             for name in duties {

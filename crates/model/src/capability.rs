@@ -3,6 +3,8 @@
 //! boundary ([`Boundary`]) and how it is drawn ([`Shape`]). Each is a [`crate::UnitModel`] method
 //! with a default; `ARCHITECTURE.md` lists them with what the default means.
 
+use std::borrow::Cow;
+
 use serde::Serialize;
 
 /// Where a unit stands at the plant's boundary. The steady-state certificate balances the
@@ -19,13 +21,14 @@ pub enum Boundary {
 }
 
 /// Where a duty's value is read.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq)]
 pub enum DutySource {
-    /// An own variable of the unit, by local name (`"Q"`).
-    Var(&'static str),
+    /// An own variable of the unit, by local name (`"Q"`; a name from the file for an `equations`
+    /// unit).
+    Var(Cow<'static, str>),
     /// An input of the unit, by local name (`"reboiler_duty"`): its value where it is free, the
     /// output of the controller that drives it otherwise.
-    Input(&'static str),
+    Input(Cow<'static, str>),
 }
 
 /// How a duty \[W\] is booked in an energy balance of utilities.
@@ -47,7 +50,7 @@ pub enum Booking {
 }
 
 /// A duty the unit books in `compare`'s energy use.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Duty {
     /// Where its value is read.
     pub source: DutySource,

@@ -269,8 +269,8 @@ pub trait UnitModel: Send + Sync + std::fmt::Debug {
     }
     /// The duties it books in an energy balance of utilities, in the order reported (default:
     /// none; a unit with a heat duty must declare it, or `compare` leaves it out of the energy use).
-    fn duties(&self) -> &'static [Duty] {
-        &[]
+    fn duties(&self) -> Vec<Duty> {
+        Vec::new()
     }
     /// The utilities it uses that are flows, not duties (default: none).
     fn utility_flows(&self) -> &'static [UtilityFlow] {
@@ -349,7 +349,7 @@ pub trait Unit: Send + Sync + std::fmt::Debug {
     /// See [`UnitModel::boundary`].
     fn boundary(&self) -> Boundary;
     /// See [`UnitModel::duties`].
-    fn duties(&self) -> &'static [Duty];
+    fn duties(&self) -> Vec<Duty>;
     /// See [`UnitModel::utility_flows`].
     fn utility_flows(&self) -> &'static [UtilityFlow];
     /// See [`UnitModel::moves_process_heat`].
@@ -376,7 +376,7 @@ impl<U: UnitModel + 'static> Unit for U {
     fn boundary(&self) -> Boundary {
         UnitModel::boundary(self)
     }
-    fn duties(&self) -> &'static [Duty] {
+    fn duties(&self) -> Vec<Duty> {
         UnitModel::duties(self)
     }
     fn utility_flows(&self) -> &'static [UtilityFlow] {

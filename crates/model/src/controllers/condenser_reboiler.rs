@@ -127,8 +127,8 @@ impl UnitModel for CondenserReboiler {
         "condenser_reboiler"
     }
     /// Its output `op` \[W\], the heat one column's condenser gives the other's reboiler.
-    fn duties(&self) -> &'static [Duty] {
-        &[Duty { source: DutySource::Var("op"), booking: Booking::Recovered }]
+    fn duties(&self) -> Vec<Duty> {
+        vec![Duty { source: DutySource::Var("op".into()), booking: Booking::Recovered }]
     }
     fn moves_process_heat(&self) -> bool {
         true

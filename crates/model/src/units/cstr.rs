@@ -327,8 +327,8 @@ impl UnitModel for Cstr {
         Shape::Vessel
     }
     /// The jacket's `Q` \[W\], heating when positive.
-    fn duties(&self) -> &'static [Duty] {
-        &[Duty { source: DutySource::Var("Q"), booking: Booking::Utility }]
+    fn duties(&self) -> Vec<Duty> {
+        vec![Duty { source: DutySource::Var("Q".into()), booking: Booking::Utility }]
     }
     fn inlet_ports(&self) -> Vec<String> {
         vec!["in".into()]

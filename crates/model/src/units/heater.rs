@@ -79,8 +79,8 @@ impl UnitModel for Heater {
         "heater"
     }
     /// `Q` \[W\], heating when positive.
-    fn duties(&self) -> &'static [Duty] {
-        &[Duty { source: DutySource::Var("Q"), booking: Booking::Utility }]
+    fn duties(&self) -> Vec<Duty> {
+        vec![Duty { source: DutySource::Var("Q".into()), booking: Booking::Utility }]
     }
     fn inlet_ports(&self) -> Vec<String> {
         vec!["in".into()]

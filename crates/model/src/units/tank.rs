@@ -97,8 +97,8 @@ impl UnitModel for Tank {
         Shape::Vessel
     }
     /// The input `duty` \[W\], heat put into the liquid: heating when positive.
-    fn duties(&self) -> &'static [Duty] {
-        &[Duty { source: DutySource::Input("duty"), booking: Booking::Utility }]
+    fn duties(&self) -> Vec<Duty> {
+        vec![Duty { source: DutySource::Input("duty".into()), booking: Booking::Utility }]
     }
     fn inlet_ports(&self) -> Vec<String> {
         vec!["in".into()]

@@ -74,7 +74,7 @@ pub fn energy(plant: &Plant, x: &[f64], u: &[f64]) -> Energy {
     let mut duties = Vec::new();
     let mut other = Vec::new();
     for b in plant.blocks() {
-        for d in b.unit.duties() {
+        for d in &b.unit.duties() {
             if let Some(duty) = booked(plant, x, u, &b.name, d) {
                 duties.push(duty);
             }
@@ -94,7 +94,7 @@ pub fn energy(plant: &Plant, x: &[f64], u: &[f64]) -> Energy {
 /// this unit's configuration does not have, an input driven by a coupling) or zero.
 fn booked(plant: &Plant, x: &[f64], u: &[f64], unit: &str, d: &plantwide_model::Duty) -> Option<Duty> {
     use plantwide_model::{Booking, DutySource};
-    let (path, value) = match d.source {
+    let (path, value) = match &d.source {
         DutySource::Var(name) => {
             let path = VarPath::new(unit, name);
             let value = plant.var(&path).map(|v| x[v]);

@@ -313,11 +313,11 @@ impl UnitModel for Column {
     }
     /// The reboilers' inputs (utilities unless a condenser–reboiler drives them) and the
     /// condenser's `Qc`, cooling less what a coupled `condenser_duty` gives another column.
-    fn duties(&self) -> &'static [Duty] {
-        &[
-            Duty { source: DutySource::Input("reboiler_duty"), booking: Booking::Utility },
-            Duty { source: DutySource::Input("auxiliary_reboiler_duty"), booking: Booking::Utility },
-            Duty { source: DutySource::Var("Qc"), booking: Booking::Removed { coupled: "condenser_duty" } },
+    fn duties(&self) -> Vec<Duty> {
+        vec![
+            Duty { source: DutySource::Input("reboiler_duty".into()), booking: Booking::Utility },
+            Duty { source: DutySource::Input("auxiliary_reboiler_duty".into()), booking: Booking::Utility },
+            Duty { source: DutySource::Var("Qc".into()), booking: Booking::Removed { coupled: "condenser_duty" } },
         ]
     }
     /// A rigorous column's reboiler steam \[kg/s\], a simple column's boilup \[mol/s\].

@@ -55,6 +55,7 @@ impl Equations {
         let mut compiled = b.compile_equations(&differential);
         let maps = b.compile_outlet_maps(&mut compiled);
         let outputs = b.check_outputs();
+        let duties = b.check_duties();
         let holdup = b.compile_holdup();
         if !b.cx.errors.is_empty() {
             return Err(b.cx.errors);
@@ -71,6 +72,7 @@ impl Equations {
             maps,
             row_names,
             outputs,
+            duties,
             reacts: c.reacts,
             holdup,
         };
@@ -373,6 +375,37 @@ impl Builder<'_, '_> {
             }
         }
         outputs
+    }
+
+    /// Each name in `duties`: an own variable or an input, in watts.
+    fn check_duties(&mut self) -> Vec<crate::capability::Duty> {
+        use crate::capability::{Booking, Duty, DutySource};
+        let mut duties = Vec::new();
+        for (k, name) in self.c.duties.iter().enumerate() {
+            let field = format!("duties[{k}]");
+            let (index, dim) = match self.symbols.get(name) {
+                Some(plantwide_expr::Symbol::Variable { index, dim, .. }) => (*index, *dim),
+                _ => {
+                    let hint = self.symbols.suggest(name).map(|s| format!("; did you mean `{s}`?")).unwrap_or_default();
+                    self.cx.error(&field, format!("`{name}` is not a variable or input of the unit{hint}"));
+                    continue;
+                }
+            };
+            let source = match index {
+                _ if dim != Dimension::POWER => {
+                    self.cx.error(&field, format!("`{name}` is in {dim}, not a heat duty (W)"));
+                    continue;
+                }
+                i if i < self.n_own => DutySource::Var(name.clone().into()),
+                i if i >= self.inputs_at => DutySource::Input(name.clone().into()),
+                _ => {
+                    self.cx.error(&field, format!("`{name}` is a port's stream quantity, not a duty of the unit"));
+                    continue;
+                }
+            };
+            duties.push(Duty { source, booking: Booking::Utility });
+        }
+        duties
     }
 
     fn compile_holdup(&mut self) -> Vec<Option<Expression>> {

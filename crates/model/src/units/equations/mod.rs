@@ -212,6 +212,11 @@ pub struct EquationsConfig {
     /// run's conservation check would miss what it accumulates.
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub holdup: BTreeMap<String, String>,
+    /// The heat duties \[W\] it takes from utilities, by name: own variables or inputs, heating
+    /// when positive (as the built-in CSTR's jacket `Q`), so that `compare` books them in the
+    /// plant's energy use and utility cost (default none).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub duties: Vec<String>,
     /// Whether the equations turn components into one another (default false): the steady-state
     /// certificate then checks the plant's mass balance, not each component's.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
@@ -262,6 +267,8 @@ pub struct Equations {
     /// Names of own rows, for diagnostics.
     row_names: BTreeMap<usize, String>,
     outputs: Vec<String>,
+    /// The duties `duties` names.
+    duties: Vec<crate::capability::Duty>,
     reacts: bool,
     /// Per component, the expression of its holdup \[mol\] (`None`: none held); empty: no holdup.
     holdup: Vec<Option<Expression>>,
@@ -319,6 +326,9 @@ impl UnitModel for Equations {
     }
     fn outlet_ports(&self) -> Vec<String> {
         self.outlets.clone()
+    }
+    fn duties(&self) -> Vec<crate::capability::Duty> {
+        self.duties.clone()
     }
     fn boundary(&self) -> crate::Boundary {
         // By its ports, as the flowsheet's boundaries go: no inlet (a port-less model too) is a

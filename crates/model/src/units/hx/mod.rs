@@ -209,8 +209,8 @@ impl UnitModel for HeatExchanger {
         "heat_exchanger"
     }
     /// `Q` \[W\], moved from the hot side to the cold.
-    fn duties(&self) -> &'static [Duty] {
-        &[Duty { source: DutySource::Var("Q"), booking: Booking::Recovered }]
+    fn duties(&self) -> Vec<Duty> {
+        vec![Duty { source: DutySource::Var("Q".into()), booking: Booking::Recovered }]
     }
     fn inlet_ports(&self) -> Vec<String> {
         vec!["hot_in".into(), "cold_in".into()]
