@@ -264,11 +264,21 @@ pub fn identify(
     let test = design::design(plant, u, inputs, &exact, tau_dom, settings)?;
     let noise = per_output_noise(settings, outputs.len());
     let ts = test.design.sample_time;
+    let amplitude: Vec<f64> = test.design.amplitude.iter().zip(inputs).map(|(a, s)| a * s.factor).collect();
+
     let (probe, est_moves, val_moves) = match &closed {
-        None => (plant_test::Probe { set: ii, outputs: oo, measured_inputs: None }, test.estimation, test.validation),
+        None => {
+            let resolve = Some(plant_test::resolve(&exact, &amplitude));
+            (
+                plant_test::Probe { set: ii, outputs: oo, measured_inputs: None, resolve },
+                test.estimation,
+                test.validation,
+            )
+        }
         Some(l) => {
             let ops = l.loops.iter().map(|l| l.op).collect();
-            let probe = plant_test::Probe { set: l.setpoints.clone(), outputs: oo, measured_inputs: Some(ops) };
+            let probe =
+                plant_test::Probe { set: l.setpoints.clone(), outputs: oo, measured_inputs: Some(ops), resolve: None };
             let est = closed_loop::setpoint_moves(&l.gain_pv, &test.estimation);
             (probe, est, closed_loop::setpoint_moves(&l.gain_pv, &test.validation))
         }
@@ -276,7 +286,6 @@ pub fn identify(
     let estimation = plant_test::run(plant, x, &probe, &est_moves, &noise, (ts, settings.seed))?;
     let validation = plant_test::run(plant, x, &probe, &val_moves, &noise, (ts, settings.seed ^ 0x5eed))?;
     let mut fits = estimate::fit_all(&estimation, &validation, &test.design, inputs, outputs)?;
-    let amplitude: Vec<f64> = test.design.amplitude.iter().zip(inputs).map(|(a, s)| a * s.factor).collect();
     let reference = verdict::Reference { exact: &exact, amplitude: &amplitude, inputs, outputs };
     let best = verdict::choose(&reference, &fits);
     let verdict = verdict::judge(&reference, &fits.iter().map(|f| &f[best]).collect::<Vec<_>>());
