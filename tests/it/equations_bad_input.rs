@@ -73,6 +73,17 @@ const CASES: &[Case] = &[
             "\n^^^^^^^^",
         ],
     },
+    Case {
+        file: "cstr_duty_not_power.json",
+        // A duty is a heat flow: `V` is a volume.
+        replace: (r#""duties": ["Q"]"#, r#""duties": ["V"]"#),
+        fragments: &["units.reactor.duties[0]", "`V` is in m3, not a heat duty (W)"],
+    },
+    Case {
+        file: "cstr_duty_unknown.json",
+        replace: (r#""duties": ["Q"]"#, r#""duties": ["Qj"]"#),
+        fragments: &["units.reactor.duties[0]", "`Qj` is not a variable or input of the unit; did you mean `Q`?"],
+    },
 ];
 
 #[test]
