@@ -236,3 +236,47 @@ fn closed_loop_gains_are_scipys() {
     let cost = g.last().unwrap();
     assert!(cost[0].abs() < 1e-3 && cost[1].abs() < 1e-3 && cost[3].abs() > 1e3, "{cost:?}");
 }
+
+/// The model's constants against the paper's own operating point: at Newell & Lee's nominal
+/// inputs (Newell & Lee 1989, *Applied Process Control: A Case Study*, ch. 2; the values as
+/// tabulated again by Kariwala, Cao & Janardhanan 2008) with X2 held at 25 % and L2 at 1 m, every
+/// published steady-state value is reproduced to one unit of its last printed digit, the steam
+/// pressure the level needs (194.7 kPa) included. One unit, not half: the table truncates some
+/// values — its own condenser equation at its own T3 = 80.6 °C gives Q200 = 307.97 kW and
+/// T201 = 46.15 °C, printed 307.9 and 46.1. The SciPy check above shares the equations; this
+/// one checks the equations' constants against the source.
+#[test]
+fn the_evaporator_reproduces_newell_and_lees_nominal_steady_state() {
+    let out = plantwide(&["steady", &fixture("data/evaporator/nominal.json"), "--json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let published: [(&str, &str, f64, f64); 13] = [
+        // (name in the paper's unit system, path, published value, one unit of its last digit)
+        ("F2", "x2_control.op", 2.0, 0.1),
+        ("F4", "evaporator.F4", 8.0, 0.1),
+        ("F5", "evaporator.F5", 8.0, 0.1),
+        ("P2", "evaporator.P2", 50.5, 0.1),
+        ("P100", "level_control.op", 194.7, 0.1),
+        ("T2", "evaporator.T2", 84.6, 0.1),
+        ("T3", "evaporator.T3", 80.6, 0.1),
+        ("T100", "evaporator.T100", 119.9, 0.1),
+        ("T201", "evaporator.T201", 46.1, 0.1),
+        ("F100", "evaporator.F100", 9.3, 0.1),
+        ("Q100", "evaporator.Q100", 339.0, 1.0),
+        ("Q200", "evaporator.Q200", 307.9, 0.1),
+        ("L2", "evaporator.L2", 1.0, 0.01),
+    ];
+    let mut off = Vec::new();
+    for (name, path, value, unit) in published {
+        let x = v["values"][path].as_f64().unwrap_or_else(|| panic!("{path} missing"));
+        let (lo, hi) = if name == "P100" {
+            (si("P", value - unit), si("P", value + unit))
+        } else {
+            (si(name, value - unit), si(name, value + unit))
+        };
+        if !(lo..=hi).contains(&x) {
+            off.push(format!("{name}: {x} SI, published {value} ± {unit}"));
+        }
+    }
+    assert!(off.is_empty(), "{}", off.join("\n"));
+}
