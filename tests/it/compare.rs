@@ -82,7 +82,7 @@ fn the_reactor_with_and_without_its_exchanger() {
 }
 
 /// The verdict's claims against the comparison's own figures, recounted here: each scheme's
-/// count of responses (disturbance × variable) with the least IAE, and the conclusion — one
+/// count of responses (disturbance × variable) with the least IAE (within 1 %), and the conclusion — one
 /// scheme better on both counts when the cheapest also wins the most responses, else a
 /// trade-off. Returns the verdict.
 fn verdict_agrees_with_its_evidence(c: &serde_json::Value) -> String {
@@ -103,7 +103,8 @@ fn verdict_agrees_with_its_evidence(c: &serde_json::Value) -> String {
                 .collect();
             let best = iae.iter().copied().fold(f64::INFINITY, f64::min);
             n += 1;
-            iae.iter().enumerate().filter(|&(_, &e)| e == best).for_each(|(k, _)| wins[k] += 1);
+            // The verdict's rule: an IAE within 1 % of the least is a tie, won by each.
+            iae.iter().enumerate().filter(|&(_, &e)| e <= best * 1.01).for_each(|(k, _)| wins[k] += 1);
         }
     }
     for (k, s) in schemes.iter().enumerate() {
@@ -124,11 +125,12 @@ fn verdict_agrees_with_its_evidence(c: &serde_json::Value) -> String {
     verdict
 }
 
-/// The heat-integrated methanol–water column pair saves steam and rejects the disturbances worse:
-/// the verdict calls it a trade-off and gives both sides; a dearer steam price scales the costs
-/// and wrong prices are refused.
+/// The heat-integrated methanol–water column pair saves steam; its responses are the better ones
+/// in 3 of 4 (one a tie within 1 %) and at worst 1.08× the other scheme's, so the verdict, recounted
+/// from its own figures, calls it better on both counts; a dearer steam price scales the costs and
+/// wrong prices are refused.
 #[test]
-fn a_cheaper_scheme_that_controls_worse_is_called_a_trade_off() {
+fn the_heat_integrated_pair_is_judged_on_its_cost_and_its_own_responses() {
     let files = ["methanol_water_pressure_staged.json", "methanol_water_pressure_staged_without_integration.json"];
     let args = [
         "--disturbances",

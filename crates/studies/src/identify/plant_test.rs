@@ -161,7 +161,7 @@ fn too_small(plant: &Plant, outputs: &[usize], y: &[Vec<f64>], shortfall: f64) -
     format!(
         "the test moves the outputs too little to be told from integration error (largest moves: {}): at the \
          tightest relative tolerance, {TIGHTEST_RTOL:e}, each output must move {ACCURACY_MARGIN:e} times that \
-         tolerance of its size, and one moves {:.1e} of it; raise --amplitude",
+         tolerance of its size, and one moves {:.1e} of it; raise the test's amplitude",
         moves.join(", "),
         shortfall * BdfSettings::default().rtol / TIGHTEST_RTOL
     )
