@@ -98,6 +98,9 @@ pub(super) fn run(
     Ok(TestData { u, y, clean })
 }
 
+/// Samples per signal.
+type Series = Vec<Vec<f64>>;
+
 /// The test's samples `(u, y)`: the measured inputs (closed loop) and the outputs, as deviations,
 /// without noise, integrated at `settings`.
 fn sampled(
@@ -107,7 +110,7 @@ fn sampled(
     moves: &[Vec<f64>],
     ts: f64,
     settings: BdfSettings,
-) -> Result<(Vec<Vec<f64>>, Vec<Vec<f64>>), IdentifyError> {
+) -> Result<(Series, Series), IdentifyError> {
     let (inputs, outputs) = (&probe.set, &probe.outputs);
     let n = moves.first().map_or(0, Vec::len);
     let mut session = Session::with_settings(plant, x, settings).map_err(|e| IdentifyError::Simulation(Box::new(e)))?;
