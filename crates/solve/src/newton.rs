@@ -7,6 +7,16 @@
 //! moves (a vessel draining at a controller's output limit): plain relaxation keeps δ constant there
 //! and marches through the transient at the first step's pace.
 //!
+//! Pseudo-transient continuation hands over to Newton once its scaled residual is below 1e-6.
+//! When that Newton stalls ([`NEWTON_STALL_WINDOW`]), the continuation resumes from where Newton
+//! left the state, at the pseudo time step it had reached, and runs to the tolerance itself: with δ
+//! large it is Newton's method regularized by `M/δ`, as Kelley & Keyes analyse it, down to the root.
+//! This is the case on a high-purity column, whose slowest mode (the composition profile sliding
+//! along the column) leaves the Jacobian nearly singular: a scaled residual of 1e-7 there can be a
+//! Newton step of order one on a tray's mole fractions, along which the line search's merit is so
+//! curved that only steps of 1e-4 to 1e-9 of it are accepted, while the `M/δ` term damps exactly that
+//! mode.
+//!
 //! # References
 //! - C. T. Kelley, D. E. Keyes, *Convergence analysis of pseudo-transient continuation*, SIAM J.
 //!   Numer. Anal. 35 (1998) 508–523.
@@ -24,7 +34,8 @@ use crate::sparse::SparseLu;
 pub struct NewtonSettings {
     /// Maximum Newton iterations (default: 60).
     pub max_iter: usize,
-    /// Tolerance on the scaled residual ‖W·f‖∞ (default: 1e-10).
+    /// Tolerance on the scaled residual ‖W·f‖∞ (default: 1e-10), `W` the row scaling by each
+    /// equation's largest term at the unknowns' own sizes ([`stopping_weights`]).
     pub tol: f64,
     /// Use pseudo-transient continuation when Newton fails (default: true).
     pub pseudo_transient: bool,
@@ -44,7 +55,7 @@ impl Default for NewtonSettings {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum NewtonStatus {
-    /// ‖W·f‖∞ ≤ tol.
+    /// ‖W·f‖∞ ≤ tol ([`stopping_weights`]).
     Converged,
     /// Iteration limit reached.
     MaxIterations,
@@ -55,19 +66,27 @@ pub enum NewtonStatus {
     /// Pseudo-transient continuation made no progress: its best residual did not fall by 1 % over
     /// [`PTC_STALL_WINDOW`] iterations, while its pseudo time step grew ×1.1 per step (ten-thousand-
     /// fold over the window), so neither the transient nor the Newton limit of it is approaching a
-    /// steady state.
+    /// steady state. (Newton's own stall, [`NEWTON_STALL_WINDOW`], hands over to the continuation
+    /// and is not an outcome.)
     Stalled,
 }
 
 /// Iterations without a 1 % improvement after which pseudo-transient continuation gives up.
 pub const PTC_STALL_WINDOW: usize = 100;
 
+/// Newton iterations without a 1 % fall of the scaled residual after which Newton hands over to
+/// pseudo-transient continuation, when that continuation has already been under way: a converging
+/// Newton halves the residual at least every iteration or two, so ten iterations that gain less than
+/// 1 % are line searches accepting a sliver of each step.
+pub const NEWTON_STALL_WINDOW: usize = 10;
+
 /// One iteration of the history.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct IterationRecord {
     /// Iteration number (continuing across the pseudo-transient phase).
     pub iter: usize,
-    /// Scaled residual norm before the step.
+    /// Scaled residual ‖W·f‖∞ of the stopping test before the step (for a pseudo-transient step,
+    /// the continuation's own measure of progress, weighted by nominal sizes).
     pub residual: f64,
     /// Step length accepted by the line search (1 = full Newton step).
     pub step: f64,
@@ -82,7 +101,7 @@ pub struct NewtonReport {
     pub status: NewtonStatus,
     /// Iterations used (Newton plus pseudo-transient).
     pub iterations: usize,
-    /// Final scaled residual ‖W·f‖∞.
+    /// Final scaled residual ‖W·f‖∞ of the stopping test ([`stopping_weights`]).
     pub residual: f64,
     /// Equation with the largest scaled residual, and that residual.
     pub worst: Option<(usize, f64)>,
@@ -109,29 +128,29 @@ struct Work<'a, S: System> {
     jac: Vec<(usize, usize, f64)>,
     r: Vec<f64>,
     w: Vec<f64>,
+    /// The stopping test's row weights ([`stopping_weights`]).
+    ws: Vec<f64>,
     n_res: usize,
     n_jac: usize,
 }
 
 impl<S: System> Work<'_, S> {
-    /// Residual and Jacobian at `x`; refreshes the row scaling (see [`row_weights`]).
+    /// Residual and Jacobian at `x`; refreshes the merit's row scaling ([`row_weights`]) and the
+    /// stopping test's ([`stopping_weights`]).
     fn linearize(&mut self, x: &[f64]) {
         self.sys.jacobian(x, &mut self.r, &mut self.jac);
         self.n_jac += 1;
         row_weights(&self.jac, |j| self.sys.nominal(j), &mut self.w);
+        stopping_weights(&self.jac, |j| self.sys.size(x, j), &mut self.ws);
     }
+    /// The largest residual weighted by nominal sizes (the merit's weights) and its row: the
+    /// measure of progress.
     fn scaled_norm(&self, r: &[f64]) -> (f64, usize) {
-        let mut worst = (0.0, 0);
-        for (i, (ri, wi)) in r.iter().zip(&self.w).enumerate() {
-            let v = (ri * wi).abs();
-            if !v.is_finite() {
-                return (f64::INFINITY, i);
-            }
-            if v > worst.0 {
-                worst = (v, i);
-            }
-        }
-        worst
+        weighted_max(r, &self.w)
+    }
+    /// The largest residual weighted by the stopping test's weights and its row.
+    fn stop_norm(&self, r: &[f64]) -> (f64, usize) {
+        weighted_max(r, &self.ws)
     }
     fn merit(&mut self, x: &[f64], r: &mut [f64]) -> f64 {
         self.sys.residual(x, r);
@@ -158,9 +177,36 @@ impl<S: System> Work<'_, S> {
     }
 }
 
-/// The row scaling of the convergence test, `w_i = 1/max_j |J_ij·nominal_j|` (1 for a row without
-/// a finite nonzero entry), into `w` (its length is the number of rows): a residual is judged
-/// against the largest term of its own equation, whatever that equation's units.
+/// `max_i |r_i·w_i|` and its row `i` (infinite at the first non-finite term).
+fn weighted_max(r: &[f64], w: &[f64]) -> (f64, usize) {
+    let mut worst = (0.0, 0);
+    for (i, (ri, wi)) in r.iter().zip(w).enumerate() {
+        let v = (ri * wi).abs();
+        if !v.is_finite() {
+            return (f64::INFINITY, i);
+        }
+        if v > worst.0 {
+            worst = (v, i);
+        }
+    }
+    worst
+}
+
+/// The row scaling of the stopping test, `w_i = 1/max_j |J_ij·s_j|` with `s_j` the size of unknown
+/// `j` at the iterate ([`System::size`]; 1 for a row without a finite nonzero entry), into `w`:
+/// a residual is judged against the largest term of its own equation at the unknowns' own sizes.
+/// With nominal sizes ([`row_weights`]) a trace component's equations, whose terms are all of
+/// the trace's size, would pass with any relative error: the row `e = sp − pv` of a loop holding a
+/// mole fraction at 1e-9 weighs a miss of 10 % as 1e-10. Where sizes are at most the nominal values
+/// (as [`crate::SteadySystem`]'s are), `w_i` is at least the merit's weight and the test at least
+/// as strict as the nominal one.
+pub fn stopping_weights(jac: &[(usize, usize, f64)], size: impl Fn(usize) -> f64, w: &mut [f64]) {
+    row_weights(jac, size, w);
+}
+
+/// The row scaling of the line search's merit, `w_i = 1/max_j |J_ij·nominal_j|` (1 for a row
+/// without a finite nonzero entry), into `w` (its length is the number of rows): a residual is
+/// judged against the largest term of its own equation, whatever that equation's units.
 pub(crate) fn row_weights(jac: &[(usize, usize, f64)], nominal: impl Fn(usize) -> f64, w: &mut [f64]) {
     w.iter_mut().for_each(|v| *v = 0.0);
     for &(i, j, v) in jac {
@@ -220,15 +266,32 @@ pub fn solve_steady_reusing<S: System>(
     lu: &mut SparseLu,
 ) -> NewtonReport {
     let n = sys.n();
-    let mut wk =
-        Work { sys, n, lu: std::mem::take(lu), jac: Vec::new(), r: vec![0.0; n], w: vec![1.0; n], n_res: 0, n_jac: 0 };
+    let mut wk = Work {
+        sys,
+        n,
+        lu: std::mem::take(lu),
+        jac: Vec::new(),
+        r: vec![0.0; n],
+        w: vec![1.0; n],
+        ws: vec![1.0; n],
+        n_res: 0,
+        n_jac: 0,
+    };
     let mut history = Observed { records: Vec::new(), observer };
-    let mut status = newton_phase(&mut wk, x, settings, &mut history);
+    let mut status = newton_phase(&mut wk, x, settings, &mut history, None);
     if status != NewtonStatus::Converged && settings.pseudo_transient {
-        status = ptc_phase(&mut wk, x, settings, &mut history);
+        let (reached, dt) = ptc_phase(&mut wk, x, settings, &mut history, settings.tol.max(1e-6), settings.ptc_dt0);
+        status = reached;
         if status == NewtonStatus::Converged {
             // PTC reaches the basin; finish with plain Newton to full accuracy.
-            status = newton_phase(&mut wk, x, settings, &mut history);
+            status = newton_phase(&mut wk, x, settings, &mut history, Some(NEWTON_STALL_WINDOW));
+            if matches!(status, NewtonStatus::Stalled | NewtonStatus::MaxIterations) {
+                // Newton stalls near a nearly singular root: the continuation, at the pseudo time
+                // step it had reached, takes the state to the tolerance itself. (Not on a singular
+                // Jacobian: the `M/δ` term would make a plant without an isolated steady state
+                // look solved.)
+                status = ptc_phase(&mut wk, x, settings, &mut history, settings.tol, dt).0;
+            }
         }
     }
     let history = history.records;
@@ -237,7 +300,7 @@ pub fn solve_steady_reusing<S: System>(
     if status != NewtonStatus::Converged {
         wk.linearize(x);
     }
-    let (residual, worst) = wk.scaled_norm(&wk.r.clone());
+    let (residual, worst) = wk.stop_norm(&wk.r);
     *lu = std::mem::take(&mut wk.lu);
     NewtonReport {
         status,
@@ -255,8 +318,17 @@ pub fn solve_steady_reusing<S: System>(
 /// differential variables have moved a little along the plant's own dynamics.
 pub fn pseudo_transient_steps<S: System>(sys: &S, x: &mut [f64], steps: usize, dt: f64) {
     let n = sys.n();
-    let mut wk =
-        Work { sys, n, lu: SparseLu::default(), jac: Vec::new(), r: vec![0.0; n], w: vec![1.0; n], n_res: 0, n_jac: 0 };
+    let mut wk = Work {
+        sys,
+        n,
+        lu: SparseLu::default(),
+        jac: Vec::new(),
+        r: vec![0.0; n],
+        w: vec![1.0; n],
+        ws: vec![1.0; n],
+        n_res: 0,
+        n_jac: 0,
+    };
     let mass = sys.mass();
     for _ in 0..steps {
         wk.linearize(x);
@@ -289,17 +361,26 @@ impl Observed<'_> {
     }
 }
 
+/// Newton's method with the line search from `x`, at most `st.max_iter` iterations. With
+/// `stall_window`, it stops as [`NewtonStatus::Stalled`] once the scaled residual has not fallen by
+/// 1 % over that many iterations.
 fn newton_phase<S: System>(
     wk: &mut Work<'_, S>,
     x: &mut [f64],
     st: &NewtonSettings,
     history: &mut Observed<'_>,
+    stall_window: Option<usize>,
 ) -> NewtonStatus {
+    let mut progress = Vec::new();
     for _ in 0..st.max_iter {
         wk.linearize(x);
-        let (norm, _) = wk.scaled_norm(&wk.r);
+        let (norm, _) = wk.stop_norm(&wk.r);
         if norm <= st.tol {
             return NewtonStatus::Converged;
+        }
+        progress.push(wk.scaled_norm(&wk.r).0);
+        if stall_window.is_some_and(|w| stalled(&progress, w)) {
+            return NewtonStatus::Stalled;
         }
         let mut dx: Vec<f64> = wk.r.iter().map(|v| -v).collect();
         let jac = std::mem::take(&mut wk.jac);
@@ -316,22 +397,34 @@ fn newton_phase<S: System>(
         // Converged at the new point by the row weights of the last Jacobian: no Jacobian is
         // evaluated only to rescale a residual that is already below the tolerance (the weights
         // are row maxima of `|J|`, which the last, quadratically small step hardly moves).
-        if wk.scaled_norm(&wk.r).0 <= st.tol {
+        if wk.stop_norm(&wk.r).0 <= st.tol {
             return NewtonStatus::Converged;
         }
     }
     wk.linearize(x);
-    if wk.scaled_norm(&wk.r).0 <= st.tol { NewtonStatus::Converged } else { NewtonStatus::MaxIterations }
+    if wk.stop_norm(&wk.r).0 <= st.tol { NewtonStatus::Converged } else { NewtonStatus::MaxIterations }
 }
 
+/// Whether the last of the scaled residuals `norms` (one per iteration) is above 99 % of the one
+/// `window` iterations earlier.
+fn stalled(norms: &[f64], window: usize) -> bool {
+    let k = norms.len();
+    k > window && norms[k - 1] > 0.99 * norms[k - 1 - window]
+}
+
+/// Pseudo-transient continuation from `x` with the first pseudo time step `dt0` until the scaled
+/// residual is at most `floor` (then [`NewtonStatus::Converged`]), at most `st.max_ptc_iter`
+/// iterations. Returns the outcome and the pseudo time step reached.
 fn ptc_phase<S: System>(
     wk: &mut Work<'_, S>,
     x: &mut [f64],
     st: &NewtonSettings,
     history: &mut Observed<'_>,
-) -> NewtonStatus {
+    floor: f64,
+    dt0: f64,
+) -> (NewtonStatus, f64) {
     let mass = wk.sys.mass();
-    let mut dt = st.ptc_dt0;
+    let mut dt = dt0;
     let mut prev_norm = f64::NAN;
     let mut failures = 0;
     let (mut best, mut best_at) = (f64::INFINITY, 0);
@@ -339,15 +432,18 @@ fn ptc_phase<S: System>(
         wk.linearize(x);
         let (norm, _) = wk.scaled_norm(&wk.r);
         if !norm.is_finite() {
-            return NewtonStatus::LineSearchFailed;
+            return (NewtonStatus::LineSearchFailed, dt);
         }
-        if norm <= st.tol.max(1e-6) {
-            return NewtonStatus::Converged;
+        // The hand-over to Newton is judged by the continuation's own measure; the tolerance
+        // itself only by the stopping test.
+        let reached = if floor <= st.tol { wk.stop_norm(&wk.r).0 } else { norm };
+        if reached <= floor {
+            return (NewtonStatus::Converged, dt);
         }
         if norm < 0.99 * best {
             (best, best_at) = (norm, k);
         } else if k - best_at >= PTC_STALL_WINDOW {
-            return NewtonStatus::Stalled;
+            return (NewtonStatus::Stalled, dt);
         }
         if prev_norm.is_finite() {
             dt = (PTC_INCREMENT * dt * (prev_norm / norm).clamp(0.2, 10.0)).min(1e12);
@@ -362,7 +458,7 @@ fn ptc_phase<S: System>(
             // stays singular, the algebraic part itself is singular.
             failures += 1;
             if failures > 8 {
-                return NewtonStatus::Singular;
+                return (NewtonStatus::Singular, dt);
             }
             dt *= 0.1;
             continue;
@@ -389,7 +485,7 @@ fn ptc_phase<S: System>(
         x.copy_from_slice(&trial);
         history.push(IterationRecord { iter: history.len(), residual: norm, step: 1.0, pseudo_dt: Some(dt) });
     }
-    NewtonStatus::MaxIterations
+    (NewtonStatus::MaxIterations, dt)
 }
 
 #[cfg(test)]
@@ -492,6 +588,60 @@ mod tests {
         assert_eq!(rep.status, NewtonStatus::Converged, "{rep:?}");
         assert!(rep.iterations <= 3, "{} iterations", rep.iterations);
         assert!((x[0] - 2.0).abs() < 1e-10 && x[1] == 0.0, "{x:?}");
+    }
+
+    /// `f = x − 1e-9` with `x ∈ [0, 1]`, nominal 1: a loop holding a mole fraction at 1e-9. With
+    /// `relative`, the unknown's size is its own value (as [`crate::SteadySystem`] sizes a trace).
+    struct TraceSetpoint {
+        relative: bool,
+    }
+    impl System for TraceSetpoint {
+        fn n(&self) -> usize {
+            1
+        }
+        fn residual(&self, x: &[f64], r: &mut [f64]) {
+            r[0] = x[0] - 1e-9;
+        }
+        fn jacobian(&self, x: &[f64], r: &mut [f64], jac: &mut Vec<(usize, usize, f64)>) {
+            self.residual(x, r);
+            jac.clear();
+            jac.push((0, 0, 1.0));
+        }
+        fn nominal(&self, _i: usize) -> f64 {
+            1.0
+        }
+        fn size(&self, x: &[f64], i: usize) -> f64 {
+            if self.relative { x[i].abs().max(1e-12) } else { self.nominal(i) }
+        }
+        fn bounds(&self, _i: usize) -> (f64, f64) {
+            (0.0, 1.0)
+        }
+        fn mass(&self) -> Vec<(usize, usize)> {
+            vec![(0, 0)]
+        }
+    }
+
+    #[test]
+    fn a_trace_setpoint_is_met_on_its_own_scale() {
+        // 5 % off the setpoint is a residual of 5e-11 on the nominal scale of a fraction: below
+        // the tolerance, so the nominal test stops at once, 5 % off.
+        let mut x = [1.05e-9];
+        let rep = solve_steady(&TraceSetpoint { relative: false }, &mut x, &NewtonSettings::default());
+        assert_eq!((rep.status, rep.iterations), (NewtonStatus::Converged, 0));
+        assert!((x[0] / 1e-9 - 1.0 - 0.05).abs() < 1e-12, "{x:?}");
+        // Weighed at its own size the same miss is 0.05 of the row's largest term: Newton steps.
+        let mut x = [1.05e-9];
+        let rep = solve_steady(&TraceSetpoint { relative: true }, &mut x, &NewtonSettings::default());
+        assert_eq!(rep.status, NewtonStatus::Converged);
+        assert!(rep.iterations >= 1 && rep.residual <= 1e-10, "{rep:?}");
+        assert!((x[0] / 1e-9 - 1.0).abs() < 1e-10, "{x:?}");
+    }
+
+    #[test]
+    fn a_stall_is_no_fall_of_one_percent_over_the_window() {
+        assert!(!stalled(&[1.0, 0.5, 0.4], 2));
+        assert!(stalled(&[1.0, 0.995, 0.991], 2));
+        assert!(!stalled(&[1.0, 0.995], 2), "fewer iterations than the window");
     }
 
     #[test]

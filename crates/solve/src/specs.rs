@@ -118,6 +118,9 @@ impl System for SteadySystem<'_> {
         let v = self.u[self.plant.specs()[i - n].input].abs();
         if v > 0.0 && v.is_finite() { v } else { 1.0 }
     }
+    fn size(&self, z: &[f64], i: usize) -> f64 {
+        crate::steady::own_size(self, z, i, crate::steady::STOP_FLOOR)
+    }
     fn bounds(&self, i: usize) -> (f64, f64) {
         let n = self.plant.n_vars();
         if i < n {

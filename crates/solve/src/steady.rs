@@ -207,10 +207,10 @@ fn null_direction(sys: &SteadySystem<'_>, z: &[f64]) -> Option<Vec<usize>> {
 }
 
 /// The Jacobian triplets with duplicates summed, columns scaled by their unknowns' sizes
-/// ([`probe_scale`]) and rows by their largest entry.
+/// ([`own_size`]) and rows by their largest entry.
 fn scaled(sys: &SteadySystem<'_>, z: &[f64], mut jx: Vec<(usize, usize, f64)>) -> Vec<(usize, usize, f64)> {
     jx.sort_unstable_by_key(|t| (t.0, t.1));
-    let scale: Vec<f64> = (0..sys.n()).map(|j| probe_scale(sys, z, j)).collect();
+    let scale: Vec<f64> = (0..sys.n()).map(|j| own_size(sys, z, j, TRACE_FLOOR)).collect();
     let mut a: Vec<(usize, usize, f64)> = Vec::with_capacity(jx.len());
     for (i, j, v) in jx {
         let v = v * scale[j];
@@ -225,13 +225,21 @@ fn scaled(sys: &SteadySystem<'_>, z: &[f64], mut jx: Vec<(usize, usize, f64)>) -
     a
 }
 
+/// Smallest size, relative to its nominal value, that Newton's stopping test gives a trace
+/// amount: a trace is judged relative to itself down to 1e-4 of its nominal value, below that to
+/// 1e-4 of the nominal value (so to 1e-14 of a mole fraction at the default tolerance). Lower, a
+/// component that is absent (a pure feed's other fraction, 0 by `1 − Σz`) would be held to the
+/// round-off that the LU leaves on it, 2.5e-19 in a CSTR loop, which no iteration removes.
+pub const STOP_FLOOR: f64 = 1e-4;
+
 /// Smallest size, relative to its nominal value, that the probe gives a trace amount.
 const TRACE_FLOOR: f64 = 1e-12;
 
-/// The size of unknown `j` at `z` that the probe scales its column by: its nominal value, except
+/// The size of unknown `j` at `z` that the probe and Newton's stopping test
+/// ([`crate::System::size`]) scale its column by: its nominal value, except
 /// for an amount of one component (a mole fraction, bounded by [0, 1], or a component holdup,
-/// bounded below by 0 and no total inventory), whose size is its own value (between
-/// [`TRACE_FLOOR`] of the nominal value and the nominal value).
+/// bounded below by 0 and no total inventory), whose size is its own value (between `floor` times
+/// the nominal value and the nominal value).
 ///
 /// A trace component's balances are homogeneous in its own amounts, so what determines them is
 /// relative: a bottoms mole fraction held at 1e-9 by a PI loop moves by a factor when boilup
@@ -241,12 +249,17 @@ const TRACE_FLOOR: f64 = 1e-12;
 /// column with xB = 3e-12), below the probe's 1e-12 threshold on a plant whose steady state is
 /// isolated. A positive diagonal column scaling does not change the rank, only what the threshold
 /// measures: on the relative scale of the trace the same direction is a change of order one.
-fn probe_scale(sys: &SteadySystem<'_>, z: &[f64], j: usize) -> f64 {
+///
+/// The stopping test has the same blind spot: the row `e = sp − pv` of a PI loop holding a bottoms
+/// fraction at 7.24e-9 weighs on the nominal scale its error of 1.4e-13, a miss of 2e-5 relative,
+/// as 1.4e-13, far below the tolerance; at the stopping test's floor of sizes ([`STOP_FLOOR`],
+/// higher than the probe's) it weighs 1.4e-9, above it.
+pub(crate) fn own_size(sys: &SteadySystem<'_>, z: &[f64], j: usize, floor: f64) -> f64 {
     let nominal = sys.nominal(j);
     let Some(v) = sys.plant_var(j) else { return nominal };
     let fraction = v.dim == Dimension::DIMENSIONLESS && v.lower == 0.0 && v.upper == 1.0;
     let component = v.dim == Dimension::AMOUNT && v.lower == 0.0 && !v.inventory;
-    if fraction || component { z[j].abs().clamp(TRACE_FLOOR * nominal, nominal) } else { nominal }
+    if fraction || component { z[j].abs().clamp(floor * nominal, nominal) } else { nominal }
 }
 
 fn explain_loose(plant: &Plant, vars: &[usize], why: &str) -> String {

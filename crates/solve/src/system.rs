@@ -12,6 +12,12 @@ pub trait System: Sync {
     fn jacobian(&self, x: &[f64], r: &mut [f64], jac: &mut Vec<(usize, usize, f64)>);
     /// Typical magnitude of unknown `i` (> 0), for scaling.
     fn nominal(&self, i: usize) -> f64;
+    /// Size of unknown `i` at `x` (> 0) that the stopping test scales its Jacobian column by
+    /// (default: its nominal value; [`crate::SteadySystem`] gives an amount of one component its own
+    /// size, so that a trace is judged relatively).
+    fn size(&self, _x: &[f64], i: usize) -> f64 {
+        self.nominal(i)
+    }
     /// Bounds `[lo, hi]` of unknown `i`.
     fn bounds(&self, i: usize) -> (f64, f64);
     /// Entries `(row, col)` of the mass matrix `M` (each 1): the equation that is the time
