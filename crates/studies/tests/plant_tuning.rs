@@ -4,7 +4,7 @@ use faer::{Mat, c64};
 use plantwide_flowsheet::{Plant, load_with};
 use plantwide_studies::TuneError;
 use plantwide_studies::tune::averaging::AveragingForm;
-use plantwide_studies::tune::flowsheet::{averaging_loop, integrating_gain};
+use plantwide_studies::tune::flowsheet::{LevelSwing, averaging_loop, integrating_gain};
 use plantwide_studies::tune::loops::{LoopResponse, Measurement, loop_model, loop_ultimates, plant_blt, plant_loop};
 use plantwide_studies::tune::{BltSettings, max_log_modulus};
 
@@ -108,21 +108,23 @@ fn a_tanks_integrating_gain_is_its_molar_volume_over_its_area() {
     let plant = load_with(std::path::Path::new(path), &[]).unwrap();
     let x = plantwide_solve::converge(&plant, &Default::default()).unwrap().x;
     let l = plant_loop(&plant, "level_control").unwrap();
-    let k = integrating_gain(&plant, &x, &l).unwrap();
+    let du = 10.0 / 3.6;
+    let k = integrating_gain(&plant, &x, &l, LevelSwing { du, band: 0.5 }).unwrap();
     let v_l = x[plant.var("tank.V").unwrap()] / x[plant.var("tank.M").unwrap()];
     let area = std::f64::consts::PI * 1.5f64.powi(2) / 4.0;
     assert!((k + v_l / area).abs() < 1e-6 * v_l / area, "{k} vs {}", -v_l / area);
     // P-only averaging for a 10 kmol/h inflow step in a ±0.5 m band: |Kc| = 10 kmol/h / 0.5 m,
     // direct action (more level, more outflow), filter time Δh/(|k| Δu).
-    let du = 10.0 / 3.6;
     let t = averaging_loop(&plant, &x, &l, Some(du), Some(0.5), AveragingForm::P).unwrap();
     let e = &t.loops[0];
     assert!((e.kc + du / 0.5).abs() < 1e-12 * du && e.action == "direct" && e.file_action.is_none(), "{e:?}");
     let tau = e.averaging.unwrap().time;
     assert!((tau - 0.5 * area / (v_l * du)).abs() < 1e-5 * tau, "{tau}");
-    // A temperature is no level.
-    let two = two_column_plant().0;
-    let x2 = two_column_plant().1;
-    let err = integrating_gain(&two, &x2, &plant_loop(&two, "column1_top_T").unwrap()).unwrap_err();
+    // A temperature is no level: for a swing of a tenth of the reflux it settles inside a band of a
+    // quarter of its value.
+    let (two, x2) = two_column_plant();
+    let l2 = plant_loop(&two, "column1_top_T").unwrap();
+    let swing = LevelSwing { du: 0.1 * x2[l2.op].abs(), band: 0.25 * x2[l2.pv].abs() };
+    let err = integrating_gain(&two, &x2, &l2, swing).unwrap_err();
     assert!(matches!(err, TuneError::NotIntegrating { .. }), "{err}");
 }

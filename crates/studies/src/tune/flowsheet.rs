@@ -15,7 +15,7 @@ use plantwide_units::{QuantityValue, convert_from_si};
 use serde::Serialize;
 
 use super::PiRule;
-use super::averaging::{AveragingForm, AveragingSettings, averaging};
+use super::averaging::{AveragingForm, AveragingSettings, averaging, check_swing};
 use super::bench::RelayCycle;
 use super::blt::BltSettings;
 use super::fit::{ModelFit, ProcessModel};
@@ -222,21 +222,70 @@ pub fn blt_loops(
     })
 }
 
-/// The integrating gain `k = lim_{s→0} s g(s)` of a level loop's element at `x` (level units per
-/// output unit per second), from the linear model with the loop in manual: the real part of
-/// `s g(s) = k (1 − sT + O(s²))` at ω a thousand times below the slowest nonzero eigenvalue, whose
-/// error is `O((ωT)²)` ~ 1e-6 (far lower frequencies lose digits to the integrator's pole).
+/// The design swing of an averaging level: the input change `du` a disturbance needs (input units)
+/// and the level band `band` the measurement may use (measurement units), both positive.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LevelSwing {
+    /// Input change \[input unit\].
+    pub du: f64,
+    /// Level band \[measurement unit\].
+    pub band: f64,
+}
+
+/// Largest `|Im(s g)/Re(s g)|` at the loop's frequency for which the element counts as an
+/// integrator there: a first-order self-regulation `K/(τ s + 1)` gives `1/(ω τ)`, so this accepts
+/// a level whose self-regulation moves the averaging filter time `1/ω` by under 1 %.
+const INTEGRATING_PHASE: f64 = 1e-2;
+
+/// The integrating gain `k` of a level loop's element at `x` (level units per output unit per
+/// second) over the loop's own time scale, with the loop in manual.
+///
+/// The time scale is the frequency `ω*` at which a swing of the output of amplitude `du` moves the
+/// level by `band`: `|g(jω*)| = band/du`, the lowest such on a log grid from a thousandth of the
+/// slowest nonzero eigenvalue up, refined by bisection in `ln ω`. For an integrator `k/s` it is
+/// `ω* = |k| du/band`, the inverse of the P-only averaging filter time `τ_F = band/(|k| du)`
+/// ([`super::averaging`]). There `s g(s) = k` to `O((ω* T)²)` for lags `T ≪ 1/ω*` and to
+/// `O((ω* τ)⁻²)` for a self-regulation `τ ≫ 1/ω*`: `k = Re(jω* g(jω*))`. A level held by another
+/// loop through a trace composition settles at a gain of 1e12 s, an integrator over any time an
+/// averaging loop acts on; a temperature settles within the band or well inside `1/ω*`.
 ///
 /// # Errors
-/// [`TuneError::NotIntegrating`] when the element has a finite steady-state gain.
-pub fn integrating_gain(plant: &Plant, x: &[f64], l: &PlantLoop) -> Result<f64, TuneError> {
-    let (response, w, _) = low_frequency_probe(plant, x, l)?;
-    let g = response.at(w)[(0, 0)];
-    let sg = g * faer::c64::new(0.0, w);
-    if sg.im.abs() > 1e-2 * sg.re.abs() || !sg.re.is_finite() {
-        return Err(TuneError::NotIntegrating { controller: l.name.clone(), measurement: l.pv_path.clone() });
+/// [`TuneError::NotIntegrating`] when the element never leaves the band (`|g| < band/du` at every
+/// frequency), or when `s g(jω*)` is not real within [`INTEGRATING_PHASE`].
+pub fn integrating_gain(plant: &Plant, x: &[f64], l: &PlantLoop, swing: LevelSwing) -> Result<f64, TuneError> {
+    let not = || TuneError::NotIntegrating { controller: l.name.clone(), measurement: l.pv_path.clone() };
+    let (response, lo, _) = low_frequency_probe(plant, x, l)?;
+    let g = |w: f64| response.at(w)[(0, 0)];
+    let w = band_frequency(|w| g(w).norm(), swing.band / swing.du, lo).ok_or_else(not)?;
+    let sg = g(w) * faer::c64::new(0.0, w);
+    if sg.im.abs() > INTEGRATING_PHASE * sg.re.abs() || !sg.re.is_finite() {
+        return Err(not());
     }
     Ok(sg.re)
+}
+
+/// The lowest frequency `ω ≥ lo` at which `magnitude(ω)` falls through `target`: a grid of four
+/// points a decade from `lo` over 40 decades, then 60 bisections in `ln ω` (relative 1e-15 of the
+/// bracket). `None` when `magnitude(lo) < target` (never leaves the band) or it never falls through.
+fn band_frequency(magnitude: impl Fn(f64) -> f64, target: f64, lo: f64) -> Option<f64> {
+    if !(magnitude(lo) >= target) {
+        return None;
+    }
+    let step = 10f64.powf(0.25);
+    let mut a = lo;
+    let b = (1..=160).map(|i| lo * step.powi(i)).find(|&w| {
+        let below = magnitude(w) < target;
+        if !below {
+            a = w;
+        }
+        below
+    })?;
+    let (mut a, mut b) = (a.ln(), b.ln());
+    for _ in 0..60 {
+        let m = 0.5 * (a + b);
+        if magnitude(m.exp()) >= target { a = m } else { b = m }
+    }
+    Some((0.5 * (a + b)).exp())
 }
 
 /// Averaging-level settings of level loop `l`: a disturbance that the output must move by
@@ -253,9 +302,10 @@ pub fn averaging_loop(
     band: Option<f64>,
     form: AveragingForm,
 ) -> Result<FlowsheetTuning, TuneError> {
-    let k = integrating_gain(plant, x, l)?;
     let du = flow_change.unwrap_or(0.1 * x[l.op].abs());
     let band = band.unwrap_or(0.25 * x[l.pv].abs());
+    check_swing(du, band).map_err(TuneError::from)?;
+    let k = integrating_gain(plant, x, l, LevelSwing { du, band })?;
     let a = averaging(k, du, band, form).map_err(TuneError::from)?;
     let mut e = entry(l, a.kc, a.tau_i, None);
     e.averaging = Some(a);
