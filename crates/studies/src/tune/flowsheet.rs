@@ -19,7 +19,7 @@ use super::averaging::{AveragingForm, AveragingSettings, averaging, check_swing}
 use super::bench::RelayCycle;
 use super::blt::BltSettings;
 use super::fit::{ModelFit, ProcessModel};
-use super::loops::{LoopResponse, Measurement, PlantLoop, loop_model, low_frequency_probe, plant_blt};
+use super::loops::{LoopResponse, Measurement, PlantLoop, canonical_order, loop_model, low_frequency_probe, plant_blt};
 use super::margins::{Bode, Margins, bode, pid};
 use super::plant_tests::{Linearity, StepResult};
 use super::rules::{ModelRule, model_rule, tuned_dead_time};
@@ -197,7 +197,8 @@ fn entry(l: &PlantLoop, kc: f64, tau_i: Option<f64>, tau_d: Option<f64>) -> Flow
     }
 }
 
-/// Luyben's BLT of `loops` at the steady state `x` ([`plant_blt`]).
+/// Luyben's BLT of `loops` at the steady state `x` ([`plant_blt`]), computed in the file's order
+/// of the loops ([`canonical_order`]) and reported in the order of `loops`.
 ///
 /// # Errors
 /// As [`plant_blt`].
@@ -207,11 +208,15 @@ pub fn blt_loops(
     loops: &[PlantLoop],
     measurement: Measurement,
 ) -> Result<FlowsheetTuning, TuneError> {
-    let t = plant_blt(plant, x, loops, measurement, &BltSettings::default())?;
+    let order = canonical_order(plant, &loops.iter().map(|l| l.name.as_str()).collect::<Vec<_>>());
+    let computed: Vec<PlantLoop> = order.iter().map(|&k| loops[k].clone()).collect();
+    let t = plant_blt(plant, x, &computed, measurement, &BltSettings::default())?;
+    let mut settings: Vec<_> = order.iter().zip(&t.loops).collect();
+    settings.sort_by_key(|(k, _)| **k);
     let entries = loops
         .iter()
-        .zip(&t.loops)
-        .map(|(l, s)| FlowsheetLoop { ku: Some(s.ku), pu: Some(s.pu), ..entry(l, s.kc, Some(s.tau_i), None) })
+        .zip(settings)
+        .map(|(l, (_, s))| FlowsheetLoop { ku: Some(s.ku), pu: Some(s.pu), ..entry(l, s.kc, Some(s.tau_i), None) })
         .collect();
     Ok(FlowsheetTuning {
         method: "blt",
@@ -432,7 +437,9 @@ fn significant(v: f64) -> String {
 /// seen through `measurement` times its PID, with the tuned loops open (in manual) and every
 /// other loop as in the file — the single-loop margins python-control's `stability_margins`
 /// gives for `g_ii c_i`. Written into each loop's `margins`; returned with each loop's Bode
-/// diagram ([`bode`], SI: ω in rad/s), in the order of `tuning.loops`.
+/// diagram ([`bode`], SI: ω in rad/s), in the order of `tuning.loops`; the loops' model is computed
+/// in the file's order of the loops ([`canonical_order`]), so their order in `tuning` does not move a
+/// margin.
 ///
 /// # Errors
 /// As [`super::loops::loop_model`].
@@ -443,13 +450,16 @@ pub fn flowsheet_margins(
     measurement: Measurement,
 ) -> Result<Vec<Bode>, TuneError> {
     let names: Vec<&str> = tuning.loops.iter().map(|l| l.controller.as_str()).collect();
-    let loops = super::loops::plant_loops(plant, &names)?;
+    let order = canonical_order(plant, &names);
+    let computed: Vec<&str> = order.iter().map(|&k| names[k]).collect();
+    let loops = super::loops::plant_loops(plant, &computed)?;
     let response = LoopResponse::new(loop_model(plant, x, &loops)?, measurement);
     let (lo, hi) = super::loops::frequency_range(&response.model().ss, &loops)?;
     let mut diagrams = Vec::new();
     for (i, l) in tuning.loops.iter_mut().enumerate() {
+        let at = order.iter().position(|&k| k == i).unwrap_or(i);
         let c = |w: f64| pid(l.kc, l.tau_i, l.tau_d, w);
-        let b = bode(|w| response.at(w)[(i, i)] * c(w), lo, hi);
+        let b = bode(|w| response.at(w)[(at, at)] * c(w), lo, hi);
         l.margins = Some(b.margins);
         l.failure = l.refuted();
         diagrams.push(b);
