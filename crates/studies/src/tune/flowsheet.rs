@@ -269,26 +269,21 @@ pub fn integrating_gain(plant: &Plant, x: &[f64], l: &PlantLoop, swing: LevelSwi
     Ok(sg.re)
 }
 
-/// The lowest frequency `ω ≥ lo` at which `magnitude(ω)` falls through `target`: a grid of four
-/// points a decade from `lo` over 40 decades, then 60 bisections in `ln ω` (relative 1e-15 of the
-/// bracket). `None` when `magnitude(lo) < target` (never leaves the band) or it never falls through.
+/// The lowest frequency `ω ≥ lo` at which `magnitude(ω)` falls through `target`: the first step
+/// down through it on a grid of four points a decade from `lo` over 40 decades, refined by 60
+/// bisections in `ln ω` (to rounding). `None` when `magnitude(lo)` is below `target` or not a
+/// number (the level never leaves the band), or it never falls through.
 fn band_frequency(magnitude: impl Fn(f64) -> f64, target: f64, lo: f64) -> Option<f64> {
-    if !(magnitude(lo) >= target) {
+    let above = |w: f64| magnitude(w) >= target;
+    if !above(lo) {
         return None;
     }
     let step = 10f64.powf(0.25);
-    let mut a = lo;
-    let b = (1..=160).map(|i| lo * step.powi(i)).find(|&w| {
-        let below = magnitude(w) < target;
-        if !below {
-            a = w;
-        }
-        below
-    })?;
-    let (mut a, mut b) = (a.ln(), b.ln());
+    let k = (1..=160).find(|&i| !above(lo * step.powi(i)))?;
+    let (mut a, mut b) = ((lo * step.powi(k - 1)).ln(), (lo * step.powi(k)).ln());
     for _ in 0..60 {
         let m = 0.5 * (a + b);
-        if magnitude(m.exp()) >= target { a = m } else { b = m }
+        if above(m.exp()) { a = m } else { b = m }
     }
     Some((0.5 * (a + b)).exp())
 }
