@@ -348,3 +348,60 @@ fn a_generated_high_reflux_column_loses_its_drum_under_lb() {
     ranks.sort_unstable();
     assert_eq!(ranks, [1, 2, 3, 4, 5], "{v}");
 }
+
+/// Generated cyclohexane/n-heptane column 0x9d41ed2c17189e4b (55 stages, xB 2e-4): the dynamic
+/// check's DV plant (the drum on L, PI loops on D and the reboiler duty) was called "not determined"
+/// (LC101.I free) and screen exited 2. The configuration was sound: the PI integral's row read
+/// `e + (op − u)/K_c`, in which `e` cancels, so the bottoms loop's `e = 0` (K_c ≈ 5e12 W per unit
+/// mole fraction) lived only in its output's row and the degrees-of-freedom probe saw the
+/// direction in which reflux and boilup move together as free (fixed in the PI row and the probe's
+/// scaling, commit 70307a7; this plant fails with those two changes reverted). Checked here: every
+/// configuration is judged, and DV's gains equal the LV gains of `gains` carried through the
+/// drum's steady balance (implicit function theorem: with D = D(L, Q) in LV,
+/// `G_DV[:, D] = G_LV[:, L]/(∂D/∂L)` and `G_DV[:, Q] = G_LV[:, Q] − G_LV[:, L] (∂D/∂Q)/(∂D/∂L)`).
+#[test]
+fn a_generated_trace_bottoms_column_screens_dv_with_its_drum_on_reflux() {
+    let file = fixture("data/generated/rigorous_9d41ed2c_open.json");
+    let qualities = "D.x[cyclohexane],B.x[cyclohexane]";
+    let out = plantwide(&["screen", &file, "--column", "column", "--outputs", qualities, "--json"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["failed"], serde_json::json!([]), "{v}");
+    let dv = by_name(&v, "DV");
+    assert!(dv["failure"].is_null() && dv["iae_scaled"].as_f64().is_some(), "{dv}");
+    assert_eq!(dv["inputs"], serde_json::json!(["column.distillate", "column.reboiler_duty"]));
+    let lv = plantwide(&[
+        "gains",
+        &file,
+        "--inputs",
+        "column.reflux,column.reboiler_duty",
+        "--outputs",
+        &format!("{qualities},D.F"),
+        "--json",
+    ]);
+    assert!(lv.status.success(), "{}", String::from_utf8_lossy(&lv.stderr));
+    let g: Value = serde_json::from_slice(&lv.stdout).unwrap();
+    let g = |i: usize, j: usize| g["gain"][i][j].as_f64().unwrap();
+    // DV's gains come from its own Newton solve (its qualities held to 1e-8 of the plant's), which
+    // moves the top purity's gains by about 4e-13 of themselves; the trace bottoms purity's gains
+    // are resolved to about 1e-7 of themselves by either route (1.3e-6 by `ε κ`, see
+    // generator::linear). The duty column is a difference that cancels (by 1e9 for the top purity:
+    // with D fixed it hardly sees the duty; by 36 for the bottoms), so it is held to that
+    // resolution of the terms it is a difference of (measured: 3.9e-13 and 6.5e-15 for the top
+    // purity, 9e-9 and 1.6e-7 for the bottoms).
+    let (dl, dq) = (g(2, 0), g(2, 1));
+    for (i, resolution) in [(0, 1e-11), (1, 1e-6)] {
+        let through_lv = [
+            (g(i, 0) / dl, g(i, 0).abs() / dl.abs()),
+            (g(i, 1) - g(i, 0) * dq / dl, { g(i, 1).abs() + (g(i, 0) * dq / dl).abs() }),
+        ];
+        for (j, (expected, terms)) in through_lv.into_iter().enumerate() {
+            let got = dv["gain"][i][j].as_f64().unwrap();
+            assert!(
+                (got - expected).abs() <= resolution * terms,
+                "DV gain [{i}][{j}] {got:e} against {expected:e} through LV"
+            );
+        }
+    }
+}

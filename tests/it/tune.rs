@@ -809,3 +809,26 @@ fn simc_falls_back_to_a_second_order_fit_the_first_order_one_cannot_explain() {
     assert!(l["fit"]["r2"].as_f64().unwrap() >= 0.9, "{l}");
     assert!(l["failure"].is_null() && l["margins"]["phase_margin"].as_f64().unwrap() > 0.0, "{l}");
 }
+
+/// Generated methanol/water column 0xf3aa41ee5f1a1141: the sump level, with its bottoms flow in
+/// manual, settles at a finite gain of about 5e12 s (the reboiler duty holds a bottoms composition
+/// of 7e-9 and so, after years, the holdup), and averaging tuning refused it as no level. Over the
+/// loop's own time scale (a 10 % bottoms swing filling a quarter of the holdup, about 3 h) it is
+/// an integrator. Checked against the sump's mass balance `dM₁/dt = L₂ − V₁ − B`: `k = −1` (mol
+/// per mol/s per s), which the P-only settings give back as `1/(τ_F |K_c|)` (measured: 1 − 4.6e-10).
+/// The bottoms composition of the same plant still settles within the band: refused.
+#[test]
+fn a_sump_level_held_through_a_trace_composition_integrates_over_its_averaging_time() {
+    let fs = fixture("data/generated/rigorous_f3aa41ee.json");
+    let dir = std::env::temp_dir();
+    let v = json_in(&dir, &["tune", &fs, "--loop", "sump_level", "--method", "averaging", "--json"]);
+    let l = &v["loops"][0];
+    let (kc, tau) = (l["kc"].as_f64().unwrap(), l["averaging"]["time"].as_f64().unwrap());
+    assert!(kc < 0.0 && l["action"] == "direct", "{l}");
+    let k = 1.0 / (tau * kc.abs());
+    assert!((k - 1.0).abs() < 1e-6, "integrating gain {k} against the mass balance's 1");
+    let out = plantwide(&["tune", &fs, "--loop", "xb_control", "--method", "averaging", "--json"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("averaging tuning is for levels"), "{err}");
+}

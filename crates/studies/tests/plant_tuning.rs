@@ -4,7 +4,7 @@ use faer::{Mat, c64};
 use plantwide_flowsheet::{Plant, load_with};
 use plantwide_studies::TuneError;
 use plantwide_studies::tune::averaging::AveragingForm;
-use plantwide_studies::tune::flowsheet::{averaging_loop, integrating_gain};
+use plantwide_studies::tune::flowsheet::{LevelSwing, averaging_loop, integrating_gain};
 use plantwide_studies::tune::loops::{LoopResponse, Measurement, loop_model, loop_ultimates, plant_blt, plant_loop};
 use plantwide_studies::tune::{BltSettings, max_log_modulus};
 
@@ -108,21 +108,61 @@ fn a_tanks_integrating_gain_is_its_molar_volume_over_its_area() {
     let plant = load_with(std::path::Path::new(path), &[]).unwrap();
     let x = plantwide_solve::converge(&plant, &Default::default()).unwrap().x;
     let l = plant_loop(&plant, "level_control").unwrap();
-    let k = integrating_gain(&plant, &x, &l).unwrap();
+    let du = 10.0 / 3.6;
+    let k = integrating_gain(&plant, &x, &l, LevelSwing { du, band: 0.5 }).unwrap();
     let v_l = x[plant.var("tank.V").unwrap()] / x[plant.var("tank.M").unwrap()];
     let area = std::f64::consts::PI * 1.5f64.powi(2) / 4.0;
     assert!((k + v_l / area).abs() < 1e-6 * v_l / area, "{k} vs {}", -v_l / area);
     // P-only averaging for a 10 kmol/h inflow step in a ±0.5 m band: |Kc| = 10 kmol/h / 0.5 m,
     // direct action (more level, more outflow), filter time Δh/(|k| Δu).
-    let du = 10.0 / 3.6;
     let t = averaging_loop(&plant, &x, &l, Some(du), Some(0.5), AveragingForm::P).unwrap();
     let e = &t.loops[0];
     assert!((e.kc + du / 0.5).abs() < 1e-12 * du && e.action == "direct" && e.file_action.is_none(), "{e:?}");
     let tau = e.averaging.unwrap().time;
     assert!((tau - 0.5 * area / (v_l * du)).abs() < 1e-5 * tau, "{tau}");
-    // A temperature is no level.
-    let two = two_column_plant().0;
-    let x2 = two_column_plant().1;
-    let err = integrating_gain(&two, &x2, &plant_loop(&two, "column1_top_T").unwrap()).unwrap_err();
+    // A temperature is no level: for a swing of a tenth of the reflux it settles inside a band of a
+    // quarter of its value.
+    let (two, x2) = two_column_plant();
+    let l2 = plant_loop(&two, "column1_top_T").unwrap();
+    let swing = LevelSwing { du: 0.1 * x2[l2.op].abs(), band: 0.25 * x2[l2.pv].abs() };
+    let err = integrating_gain(&two, &x2, &l2, swing).unwrap_err();
     assert!(matches!(err, TuneError::NotIntegrating { .. }), "{err}");
+}
+
+/// Generated cyclohexane/n-heptane column 0x9d41ed2c17189e4b: BLT of its two quality loops listed
+/// as AC101, AC102 and as AC102, AC101 moved AC102's gain crossover by 1.3e-5 (its element, a
+/// bottoms purity at 2e-4 driven by the reboiler duty, is 1e-13 per W beside flows of order one,
+/// and is resolved to about 1e-6 of its size by arithmetic that the loops' order changed). The
+/// loops are now computed in the file's order, so both listings give the same settings and margins
+/// to the bit. Checked by a second route: at the reported crossover, the loop's element evaluated as
+/// `C (jωM − J)⁻¹ B` on the full sparse Jacobian (not the reduced state space's Hessenberg form the
+/// study uses) times the PI `K_c (1 + 1/(jω τ_I))` and the dead time `e^(−jωθ)` has modulus 1 and
+/// the reported phase margin.
+#[test]
+fn blt_settings_and_margins_do_not_depend_on_the_order_the_loops_are_listed_in() {
+    use plantwide_studies::tune::request::{TuneRequest, tune};
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../tests/data/generated/rigorous_9d41ed2c.json");
+    let plant = load_with(std::path::Path::new(path), &[]).unwrap();
+    let x = plantwide_solve::converge(&plant, &Default::default()).unwrap().x;
+    let request = |loops: &str| -> TuneRequest {
+        serde_json::from_str(&format!(r#"{{"loops": [{loops}], "method": "blt", "measurement_dead_time": "1 min"}}"#))
+            .unwrap()
+    };
+    let a = tune(&plant, &x, &request(r#""AC101", "AC102""#)).unwrap().tuning;
+    let mut b = tune(&plant, &x, &request(r#""AC102", "AC101""#)).unwrap().tuning;
+    assert_eq!(b.loops[0].controller, "AC102");
+    b.loops.reverse();
+    assert_eq!(a, b);
+    let l = &a.loops[1];
+    let m = l.margins.unwrap();
+    let (w, pm) = (m.gain_crossover.unwrap(), m.phase_margin.unwrap());
+    let loops = [plant_loop(&plant, "AC101").unwrap(), plant_loop(&plant, "AC102").unwrap()];
+    let manual = plantwide_studies::tune::loops::in_manual(&plant, &x, &loops);
+    let lin = plantwide_analysis::linear::Linearization::new(&manual, &x, &manual.input_values());
+    let g = lin.response(&[loops[1].op_manual], &[loops[1].pv]).unwrap().at(w).unwrap()[(0, 0)];
+    let c = c64::new(l.kc, 0.0) * (c64::new(1.0, 0.0) + c64::new(0.0, -1.0 / (w * l.tau_i.unwrap())));
+    let lw = g * c * c64::new(0.0, -60.0 * w).exp();
+    let phase_margin = 180.0 + lw.arg().to_degrees();
+    assert!((lw.norm() - 1.0).abs() < 1e-4, "|L(jω_gc)| = {}", lw.norm());
+    assert!((phase_margin - pm).abs() < 1e-3, "phase margin {phase_margin} against {pm}");
 }

@@ -68,12 +68,7 @@ pub fn averaging(k: f64, du: f64, band: f64, form: AveragingForm) -> Result<Aver
     if !(k.is_finite() && k != 0.0) {
         return Err(AveragingError::Bad { what: "the level's integrating gain", value: k, fix: "nonzero and finite" });
     }
-    if !(du.is_finite() && du > 0.0) {
-        return Err(AveragingError::Bad { what: "the input change", value: du, fix: "positive" });
-    }
-    if !(band.is_finite() && band > 0.0) {
-        return Err(AveragingError::Bad { what: "the level band", value: band, fix: "positive" });
-    }
+    check_swing(du, band)?;
     let sign = k.signum();
     Ok(match form {
         AveragingForm::P => {
@@ -85,6 +80,20 @@ pub fn averaging(k: f64, du: f64, band: f64, form: AveragingForm) -> Result<Aver
             AveragingSettings { form, kc: sign * 2.0 * du / (e * band), tau_i: Some(2.0 / wn), time: 1.0 / wn, band }
         }
     })
+}
+
+/// Checks a design swing: the input change `du` and the level band `band` positive and finite.
+///
+/// # Errors
+/// [`AveragingError::Bad`] naming the quantity that is not.
+pub fn check_swing(du: f64, band: f64) -> Result<(), AveragingError> {
+    if !(du.is_finite() && du > 0.0) {
+        return Err(AveragingError::Bad { what: "the input change", value: du, fix: "positive" });
+    }
+    if !(band.is_finite() && band > 0.0) {
+        return Err(AveragingError::Bad { what: "the level band", value: band, fix: "positive" });
+    }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -15,11 +15,11 @@ use plantwide_units::{QuantityValue, convert_from_si};
 use serde::Serialize;
 
 use super::PiRule;
-use super::averaging::{AveragingForm, AveragingSettings, averaging};
+use super::averaging::{AveragingForm, AveragingSettings, averaging, check_swing};
 use super::bench::RelayCycle;
 use super::blt::BltSettings;
 use super::fit::{ModelFit, ProcessModel};
-use super::loops::{LoopResponse, Measurement, PlantLoop, loop_model, low_frequency_probe, plant_blt};
+use super::loops::{LoopResponse, Measurement, PlantLoop, canonical_order, loop_model, low_frequency_probe, plant_blt};
 use super::margins::{Bode, Margins, bode, pid};
 use super::plant_tests::{Linearity, StepResult};
 use super::rules::{ModelRule, model_rule, tuned_dead_time};
@@ -197,7 +197,8 @@ fn entry(l: &PlantLoop, kc: f64, tau_i: Option<f64>, tau_d: Option<f64>) -> Flow
     }
 }
 
-/// Luyben's BLT of `loops` at the steady state `x` ([`plant_blt`]).
+/// Luyben's BLT of `loops` at the steady state `x` ([`plant_blt`]), computed in the file's order
+/// of the loops ([`canonical_order`]) and reported in the order of `loops`.
 ///
 /// # Errors
 /// As [`plant_blt`].
@@ -207,11 +208,15 @@ pub fn blt_loops(
     loops: &[PlantLoop],
     measurement: Measurement,
 ) -> Result<FlowsheetTuning, TuneError> {
-    let t = plant_blt(plant, x, loops, measurement, &BltSettings::default())?;
+    let order = canonical_order(plant, &loops.iter().map(|l| l.name.as_str()).collect::<Vec<_>>());
+    let computed: Vec<PlantLoop> = order.iter().map(|&k| loops[k].clone()).collect();
+    let t = plant_blt(plant, x, &computed, measurement, &BltSettings::default())?;
+    let mut settings: Vec<_> = order.iter().zip(&t.loops).collect();
+    settings.sort_by_key(|(k, _)| **k);
     let entries = loops
         .iter()
-        .zip(&t.loops)
-        .map(|(l, s)| FlowsheetLoop { ku: Some(s.ku), pu: Some(s.pu), ..entry(l, s.kc, Some(s.tau_i), None) })
+        .zip(settings)
+        .map(|(l, (_, s))| FlowsheetLoop { ku: Some(s.ku), pu: Some(s.pu), ..entry(l, s.kc, Some(s.tau_i), None) })
         .collect();
     Ok(FlowsheetTuning {
         method: "blt",
@@ -222,21 +227,65 @@ pub fn blt_loops(
     })
 }
 
-/// The integrating gain `k = lim_{s→0} s g(s)` of a level loop's element at `x` (level units per
-/// output unit per second), from the linear model with the loop in manual: the real part of
-/// `s g(s) = k (1 − sT + O(s²))` at ω a thousand times below the slowest nonzero eigenvalue, whose
-/// error is `O((ωT)²)` ~ 1e-6 (far lower frequencies lose digits to the integrator's pole).
+/// The design swing of an averaging level: the input change `du` a disturbance needs (input units)
+/// and the level band `band` the measurement may use (measurement units), both positive.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LevelSwing {
+    /// Input change \[input unit\].
+    pub du: f64,
+    /// Level band \[measurement unit\].
+    pub band: f64,
+}
+
+/// Largest `|Im(s g)/Re(s g)|` at the loop's frequency for which the element counts as an
+/// integrator there: a first-order self-regulation `K/(τ s + 1)` gives `1/(ω τ)`, so this accepts
+/// a level whose self-regulation moves the averaging filter time `1/ω` by under 1 %.
+const INTEGRATING_PHASE: f64 = 1e-2;
+
+/// The integrating gain `k` of a level loop's element at `x` (level units per output unit per
+/// second) over the loop's own time scale, with the loop in manual.
+///
+/// The time scale is the frequency `ω*` at which a swing of the output of amplitude `du` moves the
+/// level by `band`: `|g(jω*)| = band/du`, the lowest such on a log grid from a thousandth of the
+/// slowest nonzero eigenvalue up, refined by bisection in `ln ω`. For an integrator `k/s` it is
+/// `ω* = |k| du/band`, the inverse of the P-only averaging filter time `τ_F = band/(|k| du)`
+/// ([`super::averaging`]). There `s g(s) = k` to `O((ω* T)²)` for lags `T ≪ 1/ω*` and to
+/// `O((ω* τ)⁻²)` for a self-regulation `τ ≫ 1/ω*`: `k = Re(jω* g(jω*))`. A level held by another
+/// loop through a trace composition settles at a gain of 1e12 s, an integrator over any time an
+/// averaging loop acts on; a temperature settles within the band or well inside `1/ω*`.
 ///
 /// # Errors
-/// [`TuneError::NotIntegrating`] when the element has a finite steady-state gain.
-pub fn integrating_gain(plant: &Plant, x: &[f64], l: &PlantLoop) -> Result<f64, TuneError> {
-    let (response, w, _) = low_frequency_probe(plant, x, l)?;
-    let g = response.at(w)[(0, 0)];
-    let sg = g * faer::c64::new(0.0, w);
-    if sg.im.abs() > 1e-2 * sg.re.abs() || !sg.re.is_finite() {
-        return Err(TuneError::NotIntegrating { controller: l.name.clone(), measurement: l.pv_path.clone() });
+/// [`TuneError::NotIntegrating`] when the element never leaves the band (`|g| < band/du` at every
+/// frequency), or when `s g(jω*)` is not real within [`INTEGRATING_PHASE`].
+pub fn integrating_gain(plant: &Plant, x: &[f64], l: &PlantLoop, swing: LevelSwing) -> Result<f64, TuneError> {
+    let not = || TuneError::NotIntegrating { controller: l.name.clone(), measurement: l.pv_path.clone() };
+    let (response, lo, _) = low_frequency_probe(plant, x, l)?;
+    let g = |w: f64| response.at(w)[(0, 0)];
+    let w = band_frequency(|w| g(w).norm(), swing.band / swing.du, lo).ok_or_else(not)?;
+    let sg = g(w) * faer::c64::new(0.0, w);
+    if sg.im.abs() > INTEGRATING_PHASE * sg.re.abs() || !sg.re.is_finite() {
+        return Err(not());
     }
     Ok(sg.re)
+}
+
+/// The lowest frequency `ω ≥ lo` at which `magnitude(ω)` falls through `target`: the first step
+/// down through it on a grid of four points a decade from `lo` over 40 decades, refined by 60
+/// bisections in `ln ω` (to rounding). `None` when `magnitude(lo)` is below `target` or not a
+/// number (the level never leaves the band), or it never falls through.
+fn band_frequency(magnitude: impl Fn(f64) -> f64, target: f64, lo: f64) -> Option<f64> {
+    let above = |w: f64| magnitude(w) >= target;
+    if !above(lo) {
+        return None;
+    }
+    let step = 10f64.powf(0.25);
+    let k = (1..=160).find(|&i| !above(lo * step.powi(i)))?;
+    let (mut a, mut b) = ((lo * step.powi(k - 1)).ln(), (lo * step.powi(k)).ln());
+    for _ in 0..60 {
+        let m = 0.5 * (a + b);
+        if above(m.exp()) { a = m } else { b = m }
+    }
+    Some((0.5 * (a + b)).exp())
 }
 
 /// Averaging-level settings of level loop `l`: a disturbance that the output must move by
@@ -253,9 +302,10 @@ pub fn averaging_loop(
     band: Option<f64>,
     form: AveragingForm,
 ) -> Result<FlowsheetTuning, TuneError> {
-    let k = integrating_gain(plant, x, l)?;
     let du = flow_change.unwrap_or(0.1 * x[l.op].abs());
     let band = band.unwrap_or(0.25 * x[l.pv].abs());
+    check_swing(du, band).map_err(TuneError::from)?;
+    let k = integrating_gain(plant, x, l, LevelSwing { du, band })?;
     let a = averaging(k, du, band, form).map_err(TuneError::from)?;
     let mut e = entry(l, a.kc, a.tau_i, None);
     e.averaging = Some(a);
@@ -382,7 +432,9 @@ fn significant(v: f64) -> String {
 /// seen through `measurement` times its PID, with the tuned loops open (in manual) and every
 /// other loop as in the file — the single-loop margins python-control's `stability_margins`
 /// gives for `g_ii c_i`. Written into each loop's `margins`; returned with each loop's Bode
-/// diagram ([`bode`], SI: ω in rad/s), in the order of `tuning.loops`.
+/// diagram ([`bode`], SI: ω in rad/s), in the order of `tuning.loops`; the loops' model is computed
+/// in the file's order of the loops ([`canonical_order`]), so their order in `tuning` does not move a
+/// margin.
 ///
 /// # Errors
 /// As [`super::loops::loop_model`].
@@ -393,13 +445,16 @@ pub fn flowsheet_margins(
     measurement: Measurement,
 ) -> Result<Vec<Bode>, TuneError> {
     let names: Vec<&str> = tuning.loops.iter().map(|l| l.controller.as_str()).collect();
-    let loops = super::loops::plant_loops(plant, &names)?;
+    let order = canonical_order(plant, &names);
+    let computed: Vec<&str> = order.iter().map(|&k| names[k]).collect();
+    let loops = super::loops::plant_loops(plant, &computed)?;
     let response = LoopResponse::new(loop_model(plant, x, &loops)?, measurement);
     let (lo, hi) = super::loops::frequency_range(&response.model().ss, &loops)?;
     let mut diagrams = Vec::new();
     for (i, l) in tuning.loops.iter_mut().enumerate() {
+        let at = order.iter().position(|&k| k == i).unwrap_or(i);
         let c = |w: f64| pid(l.kc, l.tau_i, l.tau_d, w);
-        let b = bode(|w| response.at(w)[(i, i)] * c(w), lo, hi);
+        let b = bode(|w| response.at(w)[(at, at)] * c(w), lo, hi);
         l.margins = Some(b.margins);
         l.failure = l.refuted();
         diagrams.push(b);
