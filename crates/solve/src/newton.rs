@@ -134,7 +134,12 @@ struct Work<'a, S: System> {
     n_jac: usize,
 }
 
-impl<S: System> Work<'_, S> {
+impl<'a, S: System> Work<'a, S> {
+    /// Work space for `sys`, reusing `lu`'s symbolic factorization.
+    fn new(sys: &'a S, lu: SparseLu) -> Self {
+        let n = sys.n();
+        Work { sys, n, lu, jac: Vec::new(), r: vec![0.0; n], w: vec![1.0; n], ws: vec![1.0; n], n_res: 0, n_jac: 0 }
+    }
     /// Residual and Jacobian at `x`; refreshes the merit's row scaling ([`row_weights`]) and the
     /// stopping test's ([`stopping_weights`]).
     fn linearize(&mut self, x: &[f64]) {
@@ -266,17 +271,7 @@ pub fn solve_steady_reusing<S: System>(
     lu: &mut SparseLu,
 ) -> NewtonReport {
     let n = sys.n();
-    let mut wk = Work {
-        sys,
-        n,
-        lu: std::mem::take(lu),
-        jac: Vec::new(),
-        r: vec![0.0; n],
-        w: vec![1.0; n],
-        ws: vec![1.0; n],
-        n_res: 0,
-        n_jac: 0,
-    };
+    let mut wk = Work::new(sys, std::mem::take(lu));
     let mut history = Observed { records: Vec::new(), observer };
     let mut status = newton_phase(&mut wk, x, settings, &mut history, None);
     if status != NewtonStatus::Converged && settings.pseudo_transient {
@@ -318,17 +313,7 @@ pub fn solve_steady_reusing<S: System>(
 /// differential variables have moved a little along the plant's own dynamics.
 pub fn pseudo_transient_steps<S: System>(sys: &S, x: &mut [f64], steps: usize, dt: f64) {
     let n = sys.n();
-    let mut wk = Work {
-        sys,
-        n,
-        lu: SparseLu::default(),
-        jac: Vec::new(),
-        r: vec![0.0; n],
-        w: vec![1.0; n],
-        ws: vec![1.0; n],
-        n_res: 0,
-        n_jac: 0,
-    };
+    let mut wk = Work::new(sys, SparseLu::default());
     let mass = sys.mass();
     for _ in 0..steps {
         wk.linearize(x);
