@@ -1,0 +1,247 @@
+//! The local model of a plant's economics at its nominal optimum, the data of every
+//! self-optimizing-control calculation (Halvorsen, Skogestad, Morud & Alstad, "Optimal selection of
+//! controlled variables", Ind. Eng. Chem. Res. 42 (2003) 3273–3284, §3; Alstad, Skogestad & Hori,
+//! "Optimal measurement combinations as controlled variables", J. Process Control 19 (2009)
+//! 138–148, §2).
+//!
+//! For the unconstrained degrees of freedom `u` (`nu`), the disturbances `d` (`nd`) and the
+//! candidate measurements `y` (`ny`), all deviations from the nominal optimum:
+//!
+//! ```text
+//! J(u, d) ≈ J* + ½ Δuᵀ Juu Δu + Δuᵀ Jud Δd + (terms without Δu)
+//! Δy      = Gy Δu + Gyd Δd + n,        d = Wd d',  n = Wn n',  ‖[d'; n']‖₂ ≤ 1
+//! ```
+//!
+//! `Wd` scales the expected disturbances and `Wn` the measurement errors (implementation error
+//! included), each a diagonal of magnitudes or a full matrix. The optimal sensitivity of the
+//! measurements to the disturbances is `F = Gyd − Gy Juu⁻¹ Jud`, and the scaled data of the loss are
+//! `Y = [F Wd, Wn]` (ny × (nd + ny)). Every loss of a subset `s` of the measurements depends on the
+//! data only through `Ys = Y[s, :]` and `G̃ = Gy Juu^{-1/2}`, which [`LocalModel::new`] forms once.
+
+use faer::linalg::solvers::Solve;
+use faer::{Mat, MatRef, Side};
+
+use crate::error::{SocError, field};
+
+/// Most candidate measurements a model may have: the search factors a matrix as large as the
+/// candidate set at each of its nodes, so thousands of candidates would be work without end.
+pub const MAX_MEASUREMENTS: usize = 500;
+
+/// Relative asymmetry of `Juu` accepted as round-off (a Hessian from finite differences); the
+/// symmetric part is used.
+const SYMMETRY_TOLERANCE: f64 = 1e-8;
+
+/// The model's data as given (names and matrices, SI or any consistent units), checked by
+/// [`LocalModel::new`].
+#[derive(Debug, Clone)]
+pub struct Parts {
+    /// Names of the unconstrained degrees of freedom (nu).
+    pub inputs: Vec<String>,
+    /// Names of the disturbances (nd; may be empty).
+    pub disturbances: Vec<String>,
+    /// Names of the candidate measurements (ny).
+    pub measurements: Vec<String>,
+    /// ∂y/∂u at the optimum, ny × nu.
+    pub gy: Mat<f64>,
+    /// ∂y/∂d at the optimum, ny × nd.
+    pub gyd: Mat<f64>,
+    /// ∂²J/∂u², nu × nu: symmetric positive definite at an unconstrained optimum.
+    pub juu: Mat<f64>,
+    /// ∂²J/∂u∂d, nu × nd.
+    pub jud: Mat<f64>,
+    /// Disturbance magnitudes, nd × nd (a diagonal is given as a diagonal matrix).
+    pub wd: Mat<f64>,
+    /// Measurement-error magnitudes, ny × ny.
+    pub wn: Mat<f64>,
+}
+
+/// A checked local model with the quantities every loss uses.
+#[derive(Debug, Clone)]
+pub struct LocalModel {
+    parts: Parts,
+    /// `Juu^{1/2}`, the principal square root.
+    juu_half: Mat<f64>,
+    /// `G̃ = Gy Juu^{-1/2}`, ny × nu.
+    g_tilde: Mat<f64>,
+    /// `Juu⁻¹ Jud`, nu × nd.
+    juu_inv_jud: Mat<f64>,
+    /// `Y = [F Wd, Wn]`, ny × (nd + ny).
+    y: Mat<f64>,
+    /// `Y Yᵀ`, ny × ny, positive definite.
+    y2: Mat<f64>,
+}
+
+impl LocalModel {
+    /// Check the data and form `Juu^{1/2}`, `G̃`, `Y` and `Y Yᵀ`.
+    ///
+    /// # Errors
+    /// [`SocError::Field`] naming the field: a name given twice, a matrix of the wrong shape or
+    /// with a value that is not finite, `Juu` not symmetric or not positive definite, a negative
+    /// magnitude, measurement errors that leave `Y Yᵀ` singular.
+    pub fn new(parts: Parts) -> Result<LocalModel, SocError> {
+        check_names(&parts)?;
+        check_shapes(&parts)?;
+        let (juu_half, juu_inv_half) = square_roots(parts.juu.as_ref())?;
+        let g_tilde = &parts.gy * &juu_inv_half;
+        let juu_inv_jud = parts.juu.llt(Side::Lower).map_err(|_| not_definite(f64::NAN))?.solve(&parts.jud);
+        let f = &parts.gyd - &parts.gy * &juu_inv_jud;
+        let (ny, nd) = (parts.gy.nrows(), parts.gyd.ncols());
+        let mut y = Mat::zeros(ny, nd + ny);
+        y.as_mut().get_mut(.., ..nd).copy_from(&f * &parts.wd);
+        y.as_mut().get_mut(.., nd..).copy_from(&parts.wn);
+        let y2 = &y * y.transpose();
+        y2.llt(Side::Lower).map_err(|_| {
+            field("Wn", "the measurement errors leave the errors of some measurements' combination at zero (Y Yᵀ is singular): give every candidate measurement a nonzero error")
+        })?;
+        Ok(LocalModel { parts, juu_half, g_tilde, juu_inv_jud, y, y2 })
+    }
+
+    /// Number of unconstrained degrees of freedom.
+    pub fn nu(&self) -> usize {
+        self.parts.gy.ncols()
+    }
+
+    /// Number of disturbances.
+    pub fn nd(&self) -> usize {
+        self.parts.gyd.ncols()
+    }
+
+    /// Number of candidate measurements.
+    pub fn ny(&self) -> usize {
+        self.parts.gy.nrows()
+    }
+
+    /// The data as given.
+    pub fn parts(&self) -> &Parts {
+        &self.parts
+    }
+
+    /// `Juu^{1/2}`.
+    pub fn juu_half(&self) -> MatRef<'_, f64> {
+        self.juu_half.as_ref()
+    }
+
+    /// `G̃ = Gy Juu^{-1/2}`.
+    pub fn g_tilde(&self) -> MatRef<'_, f64> {
+        self.g_tilde.as_ref()
+    }
+
+    /// `Juu⁻¹ Jud`.
+    pub fn juu_inv_jud(&self) -> MatRef<'_, f64> {
+        self.juu_inv_jud.as_ref()
+    }
+
+    /// `Y = [F Wd, Wn]`.
+    pub fn y(&self) -> MatRef<'_, f64> {
+        self.y.as_ref()
+    }
+
+    /// `Y Yᵀ`.
+    pub fn y2(&self) -> MatRef<'_, f64> {
+        self.y2.as_ref()
+    }
+}
+
+/// Every list of names non-empty where it must be, each name once.
+fn check_names(p: &Parts) -> Result<(), SocError> {
+    let lists: [(&'static str, &Vec<String>, bool); 3] = [
+        ("inputs", &p.inputs, false),
+        ("disturbances", &p.disturbances, true),
+        ("measurements", &p.measurements, false),
+    ];
+    for (name, list, may_be_empty) in lists {
+        if list.is_empty() && !may_be_empty {
+            return Err(field(name, "is empty: give at least one name"));
+        }
+        for (k, n) in list.iter().enumerate() {
+            if let Some(j) = list[..k].iter().position(|m| m == n) {
+                return Err(field(
+                    name,
+                    format!("`{n}` is given twice (entries {} and {}, counted from 1)", j + 1, k + 1),
+                ));
+            }
+        }
+    }
+    if p.measurements.len() > MAX_MEASUREMENTS {
+        return Err(field(
+            "measurements",
+            format!("{} candidates; at most {MAX_MEASUREMENTS} are searched: preselect them", p.measurements.len()),
+        ));
+    }
+    Ok(())
+}
+
+/// Each matrix of the size its names give, every value finite, magnitudes not negative.
+fn check_shapes(p: &Parts) -> Result<(), SocError> {
+    let (nu, nd, ny) = (p.inputs.len(), p.disturbances.len(), p.measurements.len());
+    let shapes: [(&'static str, &Mat<f64>, usize, usize, &str); 6] = [
+        ("Gy", &p.gy, ny, nu, "measurements × inputs"),
+        ("Gyd", &p.gyd, ny, nd, "measurements × disturbances"),
+        ("Juu", &p.juu, nu, nu, "inputs × inputs"),
+        ("Jud", &p.jud, nu, nd, "inputs × disturbances"),
+        ("Wd", &p.wd, nd, nd, "disturbances × disturbances"),
+        ("Wn", &p.wn, ny, ny, "measurements × measurements"),
+    ];
+    for (name, m, rows, cols, what) in shapes {
+        if (m.nrows(), m.ncols()) != (rows, cols) {
+            return Err(field(
+                name,
+                format!(
+                    "is {} × {}; it must be {rows} × {cols} ({what}, from the lists of names)",
+                    m.nrows(),
+                    m.ncols()
+                ),
+            ));
+        }
+        if let Some((i, j)) =
+            (0..rows).flat_map(|i| (0..cols).map(move |j| (i, j))).find(|&(i, j)| !m[(i, j)].is_finite())
+        {
+            return Err(field(name, format!("entry [{i}][{j}] (counted from 0) is not a finite number")));
+        }
+    }
+    for (name, m) in [("Wd", &p.wd), ("Wn", &p.wn)] {
+        if let Some(k) = (0..m.nrows()).find(|&k| m[(k, k)] < 0.0) {
+            return Err(field(name, format!("diagonal entry {k} (counted from 0) is negative: give magnitudes")));
+        }
+    }
+    Ok(())
+}
+
+/// `Juu^{1/2}` and `Juu^{-1/2}` by the eigen-decomposition of the symmetric part of `Juu`.
+fn square_roots(juu: MatRef<'_, f64>) -> Result<(Mat<f64>, Mat<f64>), SocError> {
+    let n = juu.nrows();
+    let scale = (0..n).flat_map(|i| (0..n).map(move |j| (i, j))).map(|(i, j)| juu[(i, j)].abs()).fold(0.0, f64::max);
+    for i in 0..n {
+        for j in 0..i {
+            if (juu[(i, j)] - juu[(j, i)]).abs() > SYMMETRY_TOLERANCE * scale {
+                return Err(field(
+                    "Juu",
+                    format!(
+                        "is not symmetric: [{i}][{j}] = {:e} but [{j}][{i}] = {:e}; a Hessian is symmetric",
+                        juu[(i, j)],
+                        juu[(j, i)]
+                    ),
+                ));
+            }
+        }
+    }
+    let sym = Mat::from_fn(n, n, |i, j| 0.5 * (juu[(i, j)] + juu[(j, i)]));
+    let eig = sym.self_adjoint_eigen(Side::Lower).map_err(|e| SocError::Numerical(format!("Juu: {e:?}")))?;
+    let lambda: Vec<f64> = eig.S().column_vector().iter().copied().collect();
+    let largest = lambda.iter().copied().fold(0.0, f64::max);
+    if lambda[0] <= largest * f64::EPSILON * n as f64 {
+        return Err(not_definite(lambda[0]));
+    }
+    let v = eig.U();
+    let root = |p: f64| Mat::from_fn(n, n, |i, j| (0..n).map(|k| v[(i, k)] * lambda[k].powf(p) * v[(j, k)]).sum());
+    Ok((root(0.5), root(-0.5)))
+}
+
+fn not_definite(smallest: f64) -> SocError {
+    field(
+        "Juu",
+        format!(
+            "is not positive definite (smallest eigenvalue {smallest:e}): the inputs are not at an unconstrained minimum of the cost; leave out the inputs that a constraint holds, or check the cost's sign"
+        ),
+    )
+}
