@@ -71,6 +71,7 @@ mod linearize;
 mod run;
 mod run_plot;
 mod screen;
+mod select;
 mod sensitivity;
 mod serve;
 mod shard;
@@ -204,6 +205,10 @@ enum Command {
     /// Control-structure screening: a column's inventory configurations (LV, DV, LB, DB, (L/D)V,
     /// L(V/B), (L/D)(V/B)) with their steady-state gains, RGA, Niederlinski index, condition numbers.
     Screen(screen::ScreenArgs),
+    /// Self-optimizing control: the best subsets of candidate measurements to combine into
+    /// controlled variables (exact local method: worst-case and average loss, the optimal
+    /// combination H), found by bidirectional branch and bound, from published linear data.
+    Select(select::SelectArgs),
     /// Surge sizing: the cross-section and level controller (P, critically damped PI, optimal
     /// averaging) that hold a vessel's level band and its outflow's rate limit, each verified by a
     /// nonlinear run; or a ranking of where surge capacity needs the least volume.
@@ -266,6 +271,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Sensors(a) => gains::run_sensors(&a, cli.units.unwrap_or(UnitsArg::Si).into()),
         Command::Tune(a) => tune::run(&a),
         Command::Screen(a) => screen::run(&a, cli.units.unwrap_or(UnitsArg::Si).into()),
+        Command::Select(a) => select::run(&a),
         Command::Size(a) => size::run(&a, cli.units.unwrap_or(UnitsArg::Si).into()),
         Command::Compare(a) => compare::run(&a, cli.units.unwrap_or(UnitsArg::Si).into()),
         Command::Identify(a) => identify::run(&a, cli.units.unwrap_or(UnitsArg::Si).into()),

@@ -41,6 +41,7 @@ mod pressure;
 mod recycle;
 mod screen;
 mod screen_column;
+mod select;
 mod serve;
 mod shard;
 mod size;

@@ -16,6 +16,7 @@
 //!   trend plot.
 //! - [`screen`]: `plantwide screen` and `Plant.screen`: a column's configurations or the pairings,
 //!   the report folders, a column's tuned flowsheets.
+//! - [`select`]: `plantwide select`: the best measurement subsets, their losses and combinations.
 //! - [`sensitivity`]: `plantwide sensitivity`: the sweeps' tables.
 //! - [`sensors`]: `plantwide sensors`: the stages and the criteria's choices, as text or JSON.
 //! - [`shown`]: the display units of the paths a report shows.
@@ -35,6 +36,7 @@ pub mod linearize;
 pub mod run;
 pub mod run_plot;
 pub mod screen;
+pub mod select;
 pub mod sensitivity;
 pub mod sensors;
 pub mod shown;

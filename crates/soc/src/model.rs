@@ -91,7 +91,7 @@ impl LocalModel {
         y.as_mut().get_mut(.., nd..).copy_from(&parts.wn);
         let y2 = &y * y.transpose();
         y2.llt(Side::Lower).map_err(|_| {
-            field("Wn", "the measurement errors leave the errors of some measurements' combination at zero (Y Yᵀ is singular): give every candidate measurement a nonzero error")
+            field("Wn", "the measurement errors, with the disturbances, leave some combination of the measurements without any error (Y Yᵀ is singular): give the measurements nonzero errors")
         })?;
         Ok(LocalModel { parts, juu_half, g_tilde, juu_inv_jud, y, y2 })
     }
