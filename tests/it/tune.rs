@@ -832,3 +832,36 @@ fn a_sump_level_held_through_a_trace_composition_integrates_over_its_averaging_t
     assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(err.contains("averaging tuning is for levels"), "{err}");
 }
+
+/// Generated recycle plant 0x474959d22bbe512d (reactor → column, distillate recycled): with the
+/// drum level in manual the plant has no steady state (the drum's holdup is free: an integrator),
+/// but over the averaging loop's default time scale (a 10 % distillate swing filling a quarter of
+/// the holdup, 1/ω ≈ 30 min) the composition loops, whose closed-loop modes have periods of hours,
+/// move the drum as well: s·g is 13 % imaginary there, and no single integrating gain describes
+/// it. It was refused as "settles at a finite gain", which is false. Now the refusal says it
+/// integrates, why the default band does not work, and a band that does: there the drum is the
+/// integrator of its own mass balance `dM/dt = V − L − D` (k → −1 mol per mol/s per s as the
+/// composition loops fall behind; they still add a few per cent at that band).
+#[test]
+fn a_drum_level_moved_by_the_composition_loops_at_its_time_scale_is_refused_with_a_band_that_works() {
+    let fs = fixture("data/generated/recycle_474959d2.json");
+    let out = plantwide(&["tune", &fs, "--loop", "drum_level", "--method", "averaging"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    for f in ["column.M[16], which integrates", "other loops move it as well", "A --level-band of "] {
+        assert!(err.contains(f), "`{f}` not in {err}");
+    }
+    assert!(!err.contains("finite gain"), "{err}");
+    let band = err.split("A --level-band of ").nth(1).and_then(|r| r.split(" mol").next()).unwrap();
+    let band: f64 = band.parse().unwrap();
+    let dir = std::env::temp_dir();
+    let band_arg = format!("{band} mol");
+    let v = json_in(
+        &dir,
+        &["tune", &fs, "--loop", "drum_level", "--method", "averaging", "--level-band", &band_arg, "--json"],
+    );
+    let l = &v["loops"][0];
+    let (kc, tau) = (l["kc"].as_f64().unwrap(), l["averaging"]["time"].as_f64().unwrap());
+    let k = 1.0 / (tau * kc.abs());
+    assert!((1.0..1.15).contains(&k), "integrating gain {k} against the drum's mass balance 1");
+}

@@ -121,6 +121,32 @@ pub enum TuneError {
         /// Its measurement.
         measurement: String,
     },
+    /// Averaging-level tuning of a level that integrates, but that other loops move as well at
+    /// the averaging loop's own time scale, so that no single integrating gain describes it there.
+    #[error(
+        "`{controller}` measures {measurement}, which integrates (s·g → {slow:.4e} per output unit per second over \
+         the slowest modes) but, at the time scale this `level_band` and `flow_change` give the loop (1/ω = {time:.4e} s), \
+         other loops move it as well: s·g(jω) = {re:.4e} {im:+.4e}j, {off:.0}% off the single integrator averaging tuning \
+         assumes. {suggestion}"
+    )]
+    Interacting {
+        /// Controller.
+        controller: String,
+        /// Its measurement.
+        measurement: String,
+        /// `s g(s)` at the lowest frequency probed.
+        slow: f64,
+        /// `1/ω` at the band's frequency \[s\].
+        time: f64,
+        /// Real part of `s g(jω)`.
+        re: f64,
+        /// Imaginary part of `s g(jω)`.
+        im: f64,
+        /// `|Im/Re|` in per cent.
+        off: f64,
+        /// The level bands at which the loop would see one integrator, and the other methods.
+        suggestion: String,
+    },
     /// The file's action is the opposite of what the process gain needs.
     #[error(
         "`{controller}` has action \"{file}\" in the file, but its process gain needs \"{needed}\" (the loop would \

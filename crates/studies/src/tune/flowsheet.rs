@@ -256,17 +256,62 @@ const INTEGRATING_PHASE: f64 = 1e-2;
 ///
 /// # Errors
 /// [`TuneError::NotIntegrating`] when the element never leaves the band (`|g| < band/du` at every
-/// frequency), or when `s g(jω*)` is not real within [`INTEGRATING_PHASE`].
+/// frequency), or when `s g` is not real within [`INTEGRATING_PHASE`] at `ω*` nor at the lowest
+/// frequency (it settles); [`TuneError::Interacting`] when it integrates at the lowest frequency but
+/// other loops make `s g(jω*)` complex, with the bands at which it would not be.
 pub fn integrating_gain(plant: &Plant, x: &[f64], l: &PlantLoop, swing: LevelSwing) -> Result<f64, TuneError> {
     let not = || TuneError::NotIntegrating { controller: l.name.clone(), measurement: l.pv_path.clone() };
     let (response, lo, _) = low_frequency_probe(plant, x, l)?;
-    let g = |w: f64| response.at(w)[(0, 0)];
-    let w = band_frequency(|w| g(w).norm(), swing.band / swing.du, lo).ok_or_else(not)?;
-    let sg = g(w) * faer::c64::new(0.0, w);
-    if sg.im.abs() > INTEGRATING_PHASE * sg.re.abs() || !sg.re.is_finite() {
+    let sg = |w: f64| response.at(w)[(0, 0)] * faer::c64::new(0.0, w);
+    let w = band_frequency(|w| sg(w).norm() / w, swing.band / swing.du, lo).ok_or_else(not)?;
+    let at = sg(w);
+    if !at.re.is_finite() {
         return Err(not());
     }
-    Ok(sg.re)
+    if one_integrator(at) {
+        return Ok(at.re);
+    }
+    let slow = sg(lo);
+    if !one_integrator(slow) {
+        return Err(not());
+    }
+    // Where on either side of ω* the element is one integrator again, as the band putting the
+    // loop there, |k| du / ω: a band the level has room for (less than its whole value).
+    let clear = |dir: f64| {
+        let grid = (1..=40).map(|k| w * 10f64.powf(dir * k as f64 / 4.0)).take_while(|&v| v >= lo);
+        let points: Vec<f64> = grid.collect();
+        (0..points.len().saturating_sub(2))
+            .find(|&k| points[k..k + 3].iter().all(|&v| one_integrator(sg(v))))
+            .map(|k| sg(points[k]).re.abs() * swing.du / points[k])
+            .filter(|&band| band < x[l.pv].abs())
+    };
+    let unit = plant.vars()[l.pv].spec.dim;
+    let bands: Vec<String> = [(clear(1.0), "a faster loop"), (clear(-1.0), "a slower one")]
+        .into_iter()
+        .filter_map(|(b, what)| b.map(|b| format!("{b:.4e} {unit} ({what})")))
+        .collect();
+    let suggestion = match bands.is_empty() {
+        true => "Use `method` simc or relay.".to_string(),
+        false => {
+            format!("A `level_band` of {} keeps it clear of them; or use `method` simc or relay.", bands.join(" or "))
+        }
+    };
+    Err(TuneError::Interacting {
+        controller: l.name.clone(),
+        measurement: l.pv_path.clone(),
+        slow: slow.re,
+        time: 1.0 / w,
+        re: at.re,
+        im: at.im,
+        off: 100.0 * (at.im / at.re).abs(),
+        suggestion,
+    })
+}
+
+/// Whether `s g(jω)` is a real, nonzero gain within [`INTEGRATING_PHASE`]: the element is one
+/// integrator at that frequency.
+fn one_integrator(sg: faer::c64) -> bool {
+    sg.re.is_finite() && sg.re != 0.0 && sg.im.abs() <= INTEGRATING_PHASE * sg.re.abs()
 }
 
 /// The lowest frequency `ω ≥ lo` at which `magnitude(ω)` falls through `target`: the first step

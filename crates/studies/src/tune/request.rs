@@ -130,8 +130,17 @@ impl TunedLoops {
 impl TuneRequest {
     /// The fields a message names in backticks (`` give a longer `scan` ``), for a face to map to
     /// its own names; a field a message only starts with is [`TuneError::field`]'s.
-    pub const FIELDS: &'static [&'static str] =
-        &["method", "measurement_dead_time", "relay_amplitude", "scan", "step", "model", "tau_c"];
+    pub const FIELDS: &'static [&'static str] = &[
+        "method",
+        "measurement_dead_time",
+        "relay_amplitude",
+        "scan",
+        "step",
+        "model",
+        "tau_c",
+        "level_band",
+        "flow_change",
+    ];
 
     /// The time unit's name and its length in seconds.
     ///
