@@ -684,3 +684,22 @@ fn perturbation_grows_an_automatic_step_the_convergence_noise_swamps() {
         }
     }
 }
+
+/// Generated ppm-purity column 0x8121b93bf5d319a7 with its feed as a third input: the gain matrix
+/// has condition number 3.2e7 and relative gains near 4e4, which magnify the perturbation gains'
+/// remaining error into relative gains 42 % off the exact ones. The refusal said "try --step
+/// 4e-9", a step it had tried and found below what the re-converged steady states resolve (which
+/// then said "increase --step"): advice that went round in a circle. Now it says no step is left.
+#[test]
+fn an_ill_conditioned_plant_whose_relative_gains_perturbation_cannot_verify_is_sent_to_the_linearization() {
+    let fs = harness::fixture("data/generated/simple_8121b93b_open.json");
+    let args = ["gains", &fs, "--inputs", "column.reflux,column.boilup,supply.F"];
+    let outputs = ["--outputs", "distillate.x[light],bottoms.x[light],bottoms.F", "--method", "perturb"];
+    let out = plantwide(&[&args[..], &outputs[..]].concat());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("did not verify") && err.contains("use --method linear"), "{err}");
+    assert!(!err.contains("try --step"), "{err}");
+    let exact = plantwide(&[&args[..], &["--outputs", "distillate.x[light],bottoms.x[light],bottoms.F"][..]].concat());
+    assert!(exact.status.success(), "{}", String::from_utf8_lossy(&exact.stderr));
+}

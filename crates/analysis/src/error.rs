@@ -29,7 +29,7 @@ pub enum AnalysisError {
 /// (boxed in [`AnalysisError::PerturbationUnverified`] to keep the error small).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error(
-    "{file}: the perturbation {quantity} of `{output}` to `{input}` did not verify ({check}): {first:.6e} vs {second:.6e} differ by {difference:.1e} relative (tolerance {tolerance:.0e}) at relative step {step:.1e}; try `step` {suggestion:.0e} or `method` linear"
+    "{file}: the perturbation {quantity} of `{output}` to `{input}` did not verify ({check}): {first:.6e} vs {second:.6e} differ by {difference:.1e} relative (tolerance {tolerance:.0e}) at relative step {step:.1e}; {}", advice(*.suggestion)
 )]
 pub struct Unverified {
     /// Flowsheet file.
@@ -52,8 +52,17 @@ pub struct Unverified {
     pub tolerance: f64,
     /// Largest relative step of the last attempt.
     pub step: f64,
-    /// A smaller relative step to try.
-    pub suggestion: f64,
+    /// A smaller relative step to try; `None` when the smaller step was tried and the re-converged
+    /// steady states were too inaccurate for it.
+    pub suggestion: Option<f64>,
+}
+
+/// What to try after a perturbation that did not verify.
+fn advice(suggestion: Option<f64>) -> String {
+    match suggestion {
+        Some(step) => format!("try `step` {step:.0e} or `method` linear"),
+        None => "a smaller step is below what the re-converged steady states resolve, so perturbation cannot verify these gains: use `method` linear (the exact linearization)".to_string(),
+    }
 }
 
 impl From<PerturbError> for AnalysisError {

@@ -522,9 +522,12 @@ pub fn perturb_gains(
                 last = Some(e);
                 continue;
             }
-            (Err(_), Some(earlier @ AnalysisError::PerturbationUnverified(_))) | (Err(earlier), _) => {
-                return Err(earlier);
+            // The smaller step a failed check asked for is too noisy: no step is left to suggest.
+            (Err(_), Some(AnalysisError::PerturbationUnverified(mut u))) => {
+                u.suggestion = None;
+                return Err(AnalysisError::PerturbationUnverified(u));
             }
+            (Err(earlier), _) => return Err(earlier),
         };
         let mut a = assess(&p, &columns, &rel, exact.as_ref());
         a.check.attempts = attempt;
@@ -606,7 +609,7 @@ fn unverified(p: &Problem, f: &Failure, step: f64, next: f64) -> AnalysisError {
         difference: f.difference,
         tolerance: f.tolerance,
         step,
-        suggestion: next,
+        suggestion: Some(next),
     }
     .into()
 }
