@@ -246,6 +246,36 @@ fn identify(
     Ok(py.detach(|| plant::identify(&src, &sets, &request, report.as_deref().map(|d| (d, force))))?)
 }
 
+/// `plantwide select --matrices FILE --json`: the JSON text of the best measurement subsets of
+/// `size` from published linear data (`criterion` `worst` or `average`).
+#[pyfunction]
+#[pyo3(signature = (matrices, size, best = 5, criterion = "worst", max_nodes = plantwide_soc::DEFAULT_MAX_NODES))]
+fn select(
+    py: Python<'_>,
+    matrices: String,
+    size: usize,
+    best: usize,
+    criterion: &str,
+    max_nodes: u64,
+) -> PyResult<String> {
+    let criterion = match criterion {
+        "worst" => plantwide_soc::Criterion::Worst,
+        "average" => plantwide_soc::Criterion::Average,
+        _ => return Err(InputError::new_err(format!("criterion `{criterion}`: expected `worst` or `average`"))),
+    };
+    let search = plantwide_soc::Search { size, best, criterion, max_nodes };
+    let answer = py.detach(|| -> Result<String, FaceError> {
+        let soc = |e: plantwide_soc::SocError| {
+            let user = e.is_user_error();
+            FaceError::classify(e, user)
+        };
+        let model = plantwide_soc::matrices::read(std::path::Path::new(&matrices)).map_err(soc)?;
+        let ranking = plantwide_soc::branch_and_bound(&model, &search).map_err(soc)?;
+        plantwide_io::report::select::json(&model, size, criterion, &ranking).map_err(FaceError::input)
+    });
+    Ok(answer?)
+}
+
 /// The module `plantwide._plantwide`.
 #[pymodule]
 fn _plantwide(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -269,5 +299,6 @@ fn _plantwide(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(tune, m)?)?;
     m.add_function(wrap_pyfunction!(compare, m)?)?;
     m.add_function(wrap_pyfunction!(identify, m)?)?;
+    m.add_function(wrap_pyfunction!(select, m)?)?;
     Ok(())
 }

@@ -7,6 +7,7 @@
 >>> g.gain, g.rga, g.niederlinski
 >>> plant.tune(["top_composition", "bottom_composition"], "blt")   # as ``plantwide tune --json``
 >>> pw.compare(["a.json", "b.json"], disturbances=["feed.F=±10%"], outputs=["product.F"], report="out")
+>>> pw.select("evaporator.json", size=3)["subsets"][0]["measurements"]   # as ``plantwide select --json``
 >>> pw.sweep("flowsheets/column_a.json", sets=[{"feed_source.F": "1.01 kmol/min"}], outputs=["distillate.x[A]"])
 
 Every call goes through the same library functions as the CLI, so the numbers are the CLI's
@@ -17,6 +18,7 @@ value; an ill-posed plant), :class:`ConvergenceError` where it exits 2, with the
 
 from ._plantwide import ConvergenceError, InputError, PlantwideError
 from .plant import Gains, LinearModel, Plant, SteadyState, compare, load
+from .soc import select
 from .sweeps import screen, screen_pairings, sensitivity, sweep
 
 __all__ = [
@@ -31,6 +33,7 @@ __all__ = [
     "load",
     "screen",
     "screen_pairings",
+    "select",
     "sensitivity",
     "sweep",
 ]
