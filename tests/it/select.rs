@@ -104,6 +104,7 @@ fn bad_data_and_requests_are_refused_by_field_or_flag() {
     );
     refused(&["select", "--matrices", &evaporator, "--size", "11"], 1, &["--size 11", "candidates (10)"]);
     refused(&["select", "--matrices", &evaporator, "--size", "2", "--best", "0"], 1, &["--best 0"]);
+    refused(&["select", "--matrices", &evaporator, "--size", "2", "--max-nodes", "0"], 1, &["--max-nodes 0"]);
     refused(
         &["select", "--matrices", "/no/such/file.json", "--size", "2"],
         1,
@@ -124,8 +125,11 @@ fn bad_data_and_requests_are_refused_by_field_or_flag() {
         (edit(&|v| v["Wd"] = serde_json::json!("big")), vec!["Wd", "a list (the diagonal) or as a list of rows"]),
         (edit(&|v| v["measurements"][3] = serde_json::json!("P2")), vec!["`measurements`", "`P2` is given twice"]),
         (edit(&|v| v["gain"] = serde_json::json!(1)), vec!["unknown field `gain`"]),
+        (edit(&|v| v["measurements"][6] = serde_json::json!("F3, F200")), vec!["`measurements`", "without commas"]),
+        (edit(&|v| v["inputs"][0] = serde_json::json!("")), vec!["`inputs`", "entry 0"]),
+        (format!("{original} {original}"), vec!["more than one JSON value"]),
         // A perfect measurement is allowed while the disturbances still move it; none at all is not.
-        (edit(&|v| v["Wn"] = serde_json::json!(vec![0.0; 10])), vec!["`Wn`", "nonzero error"]),
+        (edit(&|v| v["Wn"] = serde_json::json!(vec![0.0; 10])), vec!["`Wn`", "errors of a size that counts"]),
     ];
     for (k, (text, fragments)) in cases.iter().enumerate() {
         let file = scratch(&format!("bad{k}.json"), text);
@@ -140,4 +144,23 @@ fn a_search_out_of_its_node_budget_exits_2_with_the_best_so_far() {
         2,
         &["stopped after 50 nodes", "--max-nodes", "the best found so far: y"],
     );
+}
+
+#[test]
+fn long_names_are_printed_whole_in_the_combination() {
+    let mut v: Value = serde_json::from_str(&std::fs::read_to_string(data("evaporator.json")).unwrap()).unwrap();
+    v["measurements"][6] = "Temperature_tray_07".into();
+    v["measurements"][8] = "Temperature_tray_08".into();
+    v["inputs"] = serde_json::json!(["Reflux_flow_rate_A", "Reflux_flow_rate_B"]);
+    let file = scratch("long_names.json", &v.to_string());
+    let out = plantwide(&["select", "--matrices", &file, "--size", "2", "--best", "1"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success());
+    for name in ["Temperature_tray_07", "Temperature_tray_08", "c[Reflux_flow_rate_A]", "c[Reflux_flow_rate_B]"] {
+        assert!(text.contains(name), "{name} not in {text}");
+    }
+    // All 45 pairs asked for: every one is listed and none is said to be missing.
+    let out = plantwide(&["select", "--matrices", &data("evaporator.json"), "--size", "2", "--best", "100"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("these are all 45 subsets of 2") && !text.contains("rank-deficient"), "{text}");
 }

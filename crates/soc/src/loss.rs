@@ -42,6 +42,7 @@ use serde::Serialize;
 use crate::dense::{cholesky, lower_solve, lower_transpose_solve, pinv, principal, rank_deficient, rows, thin_svd};
 use crate::error::SocError;
 use crate::model::LocalModel;
+use crate::model::RANK_TOLERANCE;
 
 /// The two losses of a combination.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -78,66 +79,90 @@ pub fn losses_of(model: &LocalModel, subset: &[usize], h: MatRef<'_, f64>) -> Re
             subset.len()
         )));
     }
-    let hg = h * rows(model.parts().gy.as_ref(), subset);
+    let h = model.scale_h(h, subset);
+    Ok(unscaled(model, scaled_losses_of(model, subset, &h)?))
+}
+
+/// The losses of the scaled combination `h` of the scaled measurements, in scaled units.
+fn scaled_losses_of(model: &LocalModel, subset: &[usize], h: &Mat<f64>) -> Result<Losses, SocError> {
+    let hg = h * rows(model.gy(), subset);
     let hy = h * rows(model.y(), subset);
     let m = -(model.juu_half() * singular_checked_solve(hg.as_ref(), hy.as_ref())?);
     from_m(m.as_ref())
 }
 
 /// The exact local method's best combination of the measurements `subset` (ascending indices)
-/// and its losses; `None` when `G̃_s` is rank-deficient to working precision (fewer independent
-/// measurements than inputs: no combination holds the inputs).
+/// and its losses; `None` when `L⁻¹ G̃_s` is rank-deficient to working precision
+/// (`σ_min/σ_max` ≤ 1e-12: fewer independent measurements than inputs, no combination holds the
+/// inputs).
 ///
 /// # Errors
 /// [`SocError::Numerical`] when a factorization fails.
 pub fn exact_local(model: &LocalModel, subset: &[usize]) -> Result<Option<Combination>, SocError> {
     let nu = model.nu();
-    if subset.len() == nu {
-        let gys = rows(model.parts().gy.as_ref(), subset);
-        let sigma = gys.singular_values().map_err(|e| SocError::Numerical(format!("{e:?}")))?;
-        if rank_deficient(&sigma, nu, nu) {
-            return Ok(None);
-        }
-        let lu = gys.partial_piv_lu();
-        let x = lu.solve(rows(model.y(), subset));
-        let m = -(model.juu_half() * &x);
-        let losses = from_m(m.as_ref())?;
-        let h = model.juu_half() * lu.inverse();
-        return Ok(Some(Combination { measurements: subset.to_vec(), h, losses }));
-    }
     let l = cholesky(principal(model.y2(), subset).as_ref(), "Y Yᵀ of the subset")?;
     let w = lower_solve(l.as_ref(), rows(model.g_tilde(), subset).as_ref());
     let svd = thin_svd(w.as_ref())?;
-    if rank_deficient(&svd.sigma, w.nrows(), w.ncols()) {
+    if svd.sigma.last().is_none_or(|&lo| lo.is_nan() || lo <= RANK_TOLERANCE * svd.sigma[0]) {
         return Ok(None);
     }
-    let b = Mat::from_fn(subset.len(), nu, |i, j| (0..nu).map(|r| svd.u[(i, r)] * svd.v[(j, r)] / svd.sigma[r]).sum());
-    let h = lower_transpose_solve(l.as_ref(), b.as_ref()).transpose().to_owned();
-    Ok(Some(Combination { measurements: subset.to_vec(), h, losses: from_sigma(&svd.sigma) }))
+    let (h, losses) = match subset.len() == nu {
+        true => {
+            let lu = rows(model.gy(), subset).partial_piv_lu();
+            let m = -(model.juu_half() * lu.solve(rows(model.y(), subset)));
+            (model.juu_half() * lu.inverse(), from_m(m.as_ref())?)
+        }
+        false => {
+            let b = Mat::from_fn(subset.len(), nu, |i, j| {
+                (0..nu).map(|r| svd.u[(i, r)] * svd.v[(j, r)] / svd.sigma[r]).sum()
+            });
+            (lower_transpose_solve(l.as_ref(), b.as_ref()).transpose().to_owned(), from_sigma(&svd.sigma))
+        }
+    };
+    let losses = unscaled(model, losses);
+    if !(losses.worst_case.is_finite() && losses.average.is_finite()) {
+        return Ok(None);
+    }
+    Ok(Some(Combination { measurements: subset.to_vec(), h: model.unscale_h(&h, subset), losses }))
 }
 
 /// The extended null-space combination of `subset` (Alstad et al. 2009, eq. 41) and its losses.
+///
+/// With at least nu + nd measurements `G̃ʸ` has full column rank, its pseudo-inverse is a left
+/// inverse, and `H` does not change when the disturbance columns of `G̃ʸ` and `J̃` are scaled
+/// alike: they are scaled by `Wd` there, which keeps disturbances of any unit in range. With fewer,
+/// the pseudo-inverse is the minimum-norm one of the unscaled columns, as Alstad et al. and pySOC
+/// compute it.
 ///
 /// # Errors
 /// [`SocError::Request`] when the combination cannot hold the inputs; [`SocError::Numerical`]
 /// when a factorization fails.
 pub fn null_space(model: &LocalModel, subset: &[usize]) -> Result<Combination, SocError> {
     let (nu, nd) = (model.nu(), model.nd());
-    let p = model.parts();
+    let wd = match subset.len() >= nu + nd {
+        true => model.parts().wd.clone(),
+        false => Mat::identity(nd, nd),
+    };
     let mut j_tilde = Mat::zeros(nu, nu + nd);
     j_tilde.as_mut().get_mut(.., ..nu).copy_from(model.juu_half());
-    j_tilde.as_mut().get_mut(.., nu..).copy_from(model.juu_half() * model.juu_inv_jud());
+    j_tilde.as_mut().get_mut(.., nu..).copy_from(model.juu_half() * model.juu_inv_jud() * &wd);
     let mut g = Mat::zeros(subset.len(), nu + nd);
-    g.as_mut().get_mut(.., ..nu).copy_from(rows(p.gy.as_ref(), subset));
-    g.as_mut().get_mut(.., nu..).copy_from(rows(p.gyd.as_ref(), subset));
-    let wn = rows(p.wn.as_ref(), subset);
-    let ln = cholesky((&wn * wn.transpose()).as_ref(), "the noise covariance of the subset")?;
+    g.as_mut().get_mut(.., ..nu).copy_from(rows(model.gy(), subset));
+    g.as_mut().get_mut(.., nu..).copy_from(rows(model.gyd(), subset) * &wd);
+    let wn = rows(model.y(), subset);
+    let wn = wn.as_ref().get(.., nd..);
+    let ln = cholesky((wn * wn.transpose()).as_ref(), "the noise covariance of the subset")?;
     let scaled = pinv(lower_solve(ln.as_ref(), g.as_ref()).as_ref())?;
     // H = J̃ (L⁻¹ G)⁺ L⁻¹, i.e. Hᵀ = L⁻ᵀ ((L⁻¹ G)⁺)ᵀ J̃ᵀ.
     let ht = lower_transpose_solve(ln.as_ref(), (scaled.transpose() * j_tilde.transpose()).as_ref());
     let h = ht.transpose().to_owned();
-    let losses = losses_of(model, subset, h.as_ref())?;
-    Ok(Combination { measurements: subset.to_vec(), h, losses })
+    let losses = unscaled(model, scaled_losses_of(model, subset, &h)?);
+    Ok(Combination { measurements: subset.to_vec(), h: model.unscale_h(&h, subset), losses })
+}
+
+/// Losses of the scaled data in the data's units.
+fn unscaled(model: &LocalModel, l: Losses) -> Losses {
+    Losses { worst_case: model.loss(l.worst_case), average: model.loss(l.average) }
 }
 
 /// Losses from the singular values of `L⁻¹ G̃_s` (the exact local method's closed form).

@@ -79,6 +79,10 @@ pub fn read(path: &Path) -> Result<LocalModel, SocError> {
 /// As [`read`].
 pub fn parse(text: &str, file: &str) -> Result<LocalModel, SocError> {
     let mut de = serde_json::Deserializer::from_str(text);
+    let text_error = |message: String| SocError::Json { file: file.to_string(), path: ".".to_string(), message };
+    if text.starts_with('\u{feff}') {
+        return Err(text_error("starts with a byte-order mark: save it as UTF-8 without one".to_string()));
+    }
     let raw: MatricesFile = serde_path_to_error::deserialize(&mut de).map_err(|e| {
         let message = e.inner().to_string();
         let message = match message.contains("untagged enum Weight") {
@@ -87,6 +91,7 @@ pub fn parse(text: &str, file: &str) -> Result<LocalModel, SocError> {
         };
         SocError::Json { file: file.to_string(), path: e.path().to_string(), message }
     })?;
+    de.end().map_err(|e| text_error(format!("{e}: the file holds more than one JSON value")))?;
     let (nu, nd, ny) = (raw.inputs.len(), raw.disturbances.len(), raw.measurements.len());
     let parts = Parts {
         gy: matrix("Gy", &raw.gy, ny, nu)?,

@@ -33,8 +33,9 @@ fn uniform_average(average: f64, n: usize, nd: usize) -> f64 {
 /// The other 25 rows (3 of size 2, 22 of size 3) hold nearly collinear measurements (P2, T2, T3:
 /// σ_min/σ_max of the scaled data near 1e-12); their losses, 4e21 to 2e25, carry about ε·κ² of
 /// relative error in any double-precision code, and MATLAB's own fixture values are off their
-/// 60-digit values by up to 12 %. They are checked to be those enormous losses, within 3 % of the
-/// 60-digit values: what matters of them is that no one would hold such a subset.
+/// 60-digit values by up to 12 %. No digits of them are there to check: they are checked to be
+/// those enormous losses, within a factor of 2 of the 60-digit values (what matters of them is that
+/// no one would hold such a subset).
 fn check_rows(model: &LocalModel, rows: &Value, of: impl Fn(&[usize]) -> (f64, f64)) {
     let nd = model.nd();
     for row in rows.as_array().unwrap() {
@@ -42,13 +43,15 @@ fn check_rows(model: &LocalModel, rows: &Value, of: impl Fn(&[usize]) -> (f64, f
         let (worst, average) = of(&s);
         let avg = uniform_average(average, s.len(), nd);
         let f = |k: &str| row[k].as_f64().unwrap();
-        let (w, a, tol) = match row["reproducible_1e8"].as_bool().unwrap() {
-            true => (f("worst"), f("avg_uniform"), 1e-8),
-            false => (f("mp60_worst"), f("mp60_avg_uniform"), 3e-2),
-        };
-        assert!(tol < 1e-2 || worst > 1e20, "{s:?}: {worst:e} is not one of the nearly singular subsets");
-        assert!(relative(worst, w) < tol, "{s:?}: worst {worst:e} vs {w:e}");
-        assert!(relative(avg, a) < tol, "{s:?}: average {avg:e} vs {a:e}");
+        if !row["reproducible_1e8"].as_bool().unwrap() {
+            let (w, a) = (f("mp60_worst"), f("mp60_avg_uniform"));
+            assert!(worst > 1e20 && (0.5..2.0).contains(&(worst / w)), "{s:?}: worst {worst:e} vs {w:e}");
+            assert!((0.5..2.0).contains(&(avg / a)), "{s:?}: average {avg:e} vs {a:e}");
+            continue;
+        }
+        let (w, a) = (f("worst"), f("avg_uniform"));
+        assert!(relative(worst, w) < 1e-8, "{s:?}: worst {worst:e} vs {w:e}");
+        assert!(relative(avg, a) < 1e-8, "{s:?}: average {avg:e} vs {a:e}");
     }
 }
 

@@ -34,23 +34,29 @@ pub fn text(model: &LocalModel, size: usize, criterion: Criterion, asked: usize,
             names.join(", ")
         ));
     }
-    if ranking.subsets.len() < asked {
+    if ranking.subsets.len() < asked && ranking.rank_deficient > 0 {
         t.push_str(&format!(
-            "\nonly {} subset(s) of {size} can hold the inputs (the others are rank-deficient to working precision)\n",
-            ranking.subsets.len()
+            "\nonly {} subset(s) of {size} can hold the inputs: {} others evaluated are rank-deficient to working precision\n",
+            ranking.subsets.len(),
+            ranking.rank_deficient
         ));
+    } else if ranking.subsets.len() < asked {
+        t.push_str(&format!("\nthese are all {} subsets of {size}\n", ranking.subsets.len()));
     }
     if let Some(best) = ranking.subsets.first() {
         t.push_str("\nc = H y for the best subset (exact local method; H Gy = Juu^{1/2}):\n");
-        t.push_str(&format!("{:>14}", ""));
-        for &i in &best.measurements {
-            t.push_str(&format!(" {:>12}", super::truncate(&p.measurements[i], 12)));
+        // Whole names, each column as wide as its name: a cut name could read as another.
+        let label = p.inputs.iter().map(|i| i.chars().count() + 3).max().unwrap_or(0);
+        let widths: Vec<usize> = best.measurements.iter().map(|&i| p.measurements[i].chars().count().max(12)).collect();
+        t.push_str(&format!("{:>label$}", ""));
+        for (&i, w) in best.measurements.iter().zip(&widths) {
+            t.push_str(&format!(" {:>w$}", p.measurements[i]));
         }
         t.push('\n');
         for (r, input) in p.inputs.iter().enumerate() {
-            t.push_str(&format!("{:>14}", format!("c[{}]", super::truncate(input, 10))));
-            for j in 0..best.measurements.len() {
-                t.push_str(&format!(" {:>12}", sig(best.h[(r, j)])));
+            t.push_str(&format!("{:>label$}", format!("c[{input}]")));
+            for (j, w) in widths.iter().enumerate() {
+                t.push_str(&format!(" {:>w$}", sig(best.h[(r, j)])));
             }
             t.push('\n');
         }

@@ -14,7 +14,7 @@ def select(
     *,
     best: int = 5,
     criterion: str = "worst",
-    max_nodes: int = 2_000_000,
+    max_nodes: int = 200_000,
 ) -> dict:
     """``plantwide select --matrices FILE --size N --json``: the ``best`` subsets of ``size``
     candidate measurements to combine into controlled variables, by the exact local method
