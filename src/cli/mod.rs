@@ -54,11 +54,16 @@ pub fn library_flags(message: String) -> String {
     with_flags(message, leading, LIBRARY_FIELDS)
 }
 
-/// Write to stdout; a closed pipe ends the process with success (the reader has what it wanted).
+/// Write to stdout; a closed pipe ends the process with success (the reader has what it wanted),
+/// any other failure (a full disk) with exit 1 and the reason, not a silent loss of the output.
 pub fn write_out(args: std::fmt::Arguments<'_>) {
     use std::io::Write;
-    if std::io::stdout().lock().write_fmt(args).is_err() {
-        std::process::exit(0);
+    if let Err(e) = std::io::stdout().lock().write_fmt(args) {
+        if e.kind() == std::io::ErrorKind::BrokenPipe {
+            std::process::exit(0);
+        }
+        eprintln!("error: cannot write the output: {e}");
+        std::process::exit(1);
     }
 }
 

@@ -164,3 +164,18 @@ fn long_names_are_printed_whole_in_the_combination() {
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(text.contains("these are all 45 subsets of 2") && !text.contains("rank-deficient"), "{text}");
 }
+
+/// Output to a full disk is a failure with its reason, not a silent exit 0 (a closed pipe, as
+/// under `head`, still ends quietly).
+#[test]
+fn output_to_a_full_disk_exits_1_with_the_reason() {
+    let Ok(full) = std::fs::OpenOptions::new().write(true).open("/dev/full") else { return };
+    let out = crate::harness::command()
+        .args(["select", "--matrices", &data("evaporator.json"), "--size", "2"])
+        .stdout(full)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("cannot write the output"), "{err}");
+}
