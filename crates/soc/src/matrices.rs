@@ -131,7 +131,10 @@ fn matrix(name: &'static str, given: &[Vec<f64>], rows: usize, cols: usize) -> R
 /// A weight as an `n × n` matrix.
 fn weight(name: &'static str, given: &Weight, n: usize) -> Result<Mat<f64>, SocError> {
     match given {
-        Weight::Diagonal(d) if d.len() == n => Ok(Mat::from_fn(n, n, |i, j| if i == j { d[i] } else { 0.0 })),
+        Weight::Diagonal(d) if d.len() == n => match d.iter().position(|v| *v < 0.0) {
+            Some(k) => Err(field(name, format!("magnitude {k} (counted from 0) is negative: give magnitudes"))),
+            None => Ok(Mat::from_fn(n, n, |i, j| if i == j { d[i] } else { 0.0 })),
+        },
         Weight::Diagonal(d) => {
             Err(field(name, format!("has {} magnitudes; it needs {n} (from the lists of names)", d.len())))
         }

@@ -92,7 +92,7 @@ impl LocalModel {
     /// # Errors
     /// [`SocError::Field`] naming the field: a name empty, given twice or with a comma or control
     /// character, a matrix of the wrong shape or with a value that is not finite, `Juu` not
-    /// symmetric or not positive definite, a negative magnitude, measurement errors that leave
+    /// symmetric or not positive definite, measurement errors that leave
     /// `Y Yᵀ` singular, a `Gy` whose rank is less than the number of inputs, a product that
     /// overflows.
     pub fn new(parts: Parts) -> Result<LocalModel, SocError> {
@@ -292,7 +292,8 @@ fn check_names(p: &Parts) -> Result<(), SocError> {
     Ok(())
 }
 
-/// Each matrix of the size its names give, every value finite, magnitudes not negative.
+/// Each matrix of the size its names give, every value finite (a weight's signs do not matter:
+/// only `W Wᵀ` enters the losses).
 fn check_shapes(p: &Parts) -> Result<(), SocError> {
     let (nu, nd, ny) = (p.inputs.len(), p.disturbances.len(), p.measurements.len());
     let shapes: [(&'static str, &Mat<f64>, usize, usize, &str); 6] = [
@@ -318,11 +319,6 @@ fn check_shapes(p: &Parts) -> Result<(), SocError> {
             (0..rows).flat_map(|i| (0..cols).map(move |j| (i, j))).find(|&(i, j)| !m[(i, j)].is_finite())
         {
             return Err(field(name, format!("entry [{i}][{j}] (counted from 0) is not a finite number")));
-        }
-    }
-    for (name, m) in [("Wd", &p.wd), ("Wn", &p.wn)] {
-        if let Some(k) = (0..m.nrows()).find(|&k| m[(k, k)] < 0.0) {
-            return Err(field(name, format!("diagonal entry {k} (counted from 0) is negative: give magnitudes")));
         }
     }
     Ok(())
