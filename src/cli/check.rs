@@ -34,5 +34,6 @@ pub fn run(file: &Path, system: UnitSystem) -> Result<(), CliError> {
         Err(_) => (x, false),
     };
     out!("{}", report::check::residence(&plant, &x, converged, system));
+    out!("{}", report::inventory::text(&plantwide::flowsheet::inventory::check(&plant)));
     Ok(())
 }

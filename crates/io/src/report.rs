@@ -31,6 +31,7 @@ pub mod compare;
 pub mod components;
 pub mod gains;
 pub mod identify;
+pub mod inventory;
 pub mod linearize;
 pub mod run;
 pub mod run_plot;
