@@ -58,7 +58,8 @@ pub struct InventoryCheck {
     /// `None` when the plant has no inventory loop (nothing to judge).
     pub consistent: Option<bool>,
     /// The feasible TPM locations: inputs (`fresh_A.F`, `fc.sp`) setting a stream's rate that the
-    /// inventory loops radiate from.
+    /// inventory control radiates from (none while some inventory is not held by its own loop or
+    /// its own head).
     pub tpm: Vec<String>,
     /// The inputs that set a stream's rate from outside the inventory control as built: the
     /// throughput manipulators of the plant as it is.
@@ -138,20 +139,21 @@ pub fn check(plant: &Plant) -> InventoryCheck {
     let locals: Vec<Local> = (0..net.inventories.len()).map(|k| local(&net, k)).collect();
     let graph = Reach::new(plant);
     let candidates = candidates(&net);
+    // The inventory control radiates from a TPM only if it holds every inventory.
+    let all_held = locals.iter().all(|l| l.problem.is_none());
     let name = |i: usize| plant.inputs()[i].path.clone();
     let tpm = candidates
         .iter()
-        .filter(|&(&i, streams)| radiation(&net, &graph, i, streams, &locals).is_empty())
+        .filter(|&(&i, streams)| all_held && radiation(&net, &graph, i, streams, &locals).is_empty())
         .map(|(&i, _)| name(i))
         .collect();
-    let mut against: BTreeMap<usize, Vec<String>> = BTreeMap::new();
-    for (&i, streams) in &candidates {
-        for (k, why) in radiation(&net, &graph, i, streams, &locals) {
-            against.entry(k).or_default().push(why);
-        }
-    }
-    let inventories: Vec<InventoryVerdict> =
-        locals.iter().enumerate().map(|(k, l)| verdict(&net, k, l, against.remove(&k).unwrap_or_default())).collect();
+    let given = given_flows(&net, &graph);
+    let single = (candidates.len() == 1).then(|| candidates.keys().next().map(|&i| name(i))).flatten();
+    let inventories: Vec<InventoryVerdict> = locals
+        .iter()
+        .enumerate()
+        .map(|(k, l)| verdict(&net, k, l, objection(&net, k, l, &given, single.as_deref())))
+        .collect();
     let recycles = recycles(&net, &graph, &origins);
     let any_loop = locals.iter().any(|l| l.controller.is_some());
     let note = match (net.inventories.is_empty(), any_loop) {
@@ -352,8 +354,60 @@ fn radiation(net: &Network<'_>, reach: &Reach, tpm: usize, streams: &[usize], lo
     out
 }
 
+/// A flow given to the inventory control: a stream a free input or a loop that controls no
+/// inventory sets, with the units it reaches downstream and those that reach it upstream.
+struct Given {
+    down: HashSet<usize>,
+    up: HashSet<usize>,
+}
+
+/// The given flows of the plant.
+fn given_flows(net: &Network<'_>, reach: &Reach) -> Vec<Given> {
+    let streams = net.plant.streams();
+    let mut out = Vec::new();
+    for (f, s) in &net.setters {
+        let (Flow::Stream(st), Setter::Input(i)) = (f, s) else { continue };
+        if matches!(net.input_origin(*i), Origin::Free(_) | Origin::Controller(_)) {
+            out.push(Given { down: reach.from(streams[*st].to.0, true), up: reach.from(streams[*st].from.0, false) });
+        }
+    }
+    out
+}
+
+/// The radiation rule's objection to inventory `k`'s loop, if any. With several given flows (a
+/// TPM and flows fixed by other loops), each loop must radiate from one of them: a loop acting
+/// with the flow needs a given flow upstream of its inventory, one acting against the flow a
+/// given flow downstream. With a single TPM (`single`) this is Price & Georgakis's rule around
+/// it.
+fn objection(net: &Network<'_>, k: usize, l: &Local, given: &[Given], single: Option<&str>) -> Option<String> {
+    let (Some(_), Some(d)) = (l.controller, l.direction) else { return None };
+    let b = net.inventories[k].block;
+    let path = &net.inventories[k].path;
+    let radiates = match d {
+        Direction::WithFlow => given.iter().any(|g| g.down.contains(&b)),
+        Direction::AgainstFlow => given.iter().any(|g| g.up.contains(&b)),
+    };
+    if radiates {
+        return None;
+    }
+    let (side, other, wanted) = match d {
+        Direction::WithFlow => ("outflow", "upstream", "inflow"),
+        Direction::AgainstFlow => ("inflow", "downstream", "outflow"),
+    };
+    Some(match single {
+        Some(tpm) => format!(
+            "{path} is controlled by its {side}, but the TPM {tpm} is not {other} of it: the radiation rule needs \
+             its {wanted}"
+        ),
+        None => format!(
+            "{path} is controlled by its {side}, but no flow {other} of it is given (a TPM or a flow another loop \
+             sets): the radiation rule needs its {wanted}, or a given flow {other} of it"
+        ),
+    })
+}
+
 /// Inventory `k`'s verdict from its local judgment and the radiation rule's objections.
-fn verdict(net: &Network<'_>, k: usize, l: &Local, radiation: Vec<String>) -> InventoryVerdict {
+fn verdict(net: &Network<'_>, k: usize, l: &Local, radiation: Option<String>) -> InventoryVerdict {
     let plant = net.plant;
     let mut why: Vec<String> = l.problem.iter().cloned().collect();
     why.extend(radiation);
@@ -398,7 +452,8 @@ fn recycle(
     let streams = net.plant.streams();
     let across: Vec<usize> =
         (0..streams.len()).filter(|&s| blocks.contains(&streams[s].from.0) != blocks.contains(&streams[s].to.0)).collect();
-    let name = cycle_name(net, reach, blocks);
+    let entry = across.iter().map(|&s| streams[s].to.0).find(|b| blocks.contains(b));
+    let name = cycle_name(net, reach, blocks, entry);
     let set_inside = |s: &usize| {
         origins.get(&Flow::Stream(*s)).is_some_and(|o| o.iter().any(|o| matches!(o, Origin::Inventory(k) if inside.contains(k))))
     };
@@ -406,30 +461,56 @@ fn recycle(
         return RecycleVerdict { recycle: name, consistent: true, why: None };
     }
     let why = if across.is_empty() {
-        format!("the recycle loop {name} is closed: its total inventory is its initial charge, and its level loops cannot all hold")
-    } else {
-        let list: Vec<String> = across
-            .iter()
-            .map(|&s| {
-                let o = origins.get(&Flow::Stream(s)).map(|o| o.iter().map(|o| origin_name(net, o)).collect::<Vec<_>>());
-                format!("{} by {}", streams[s].name, o.filter(|v| !v.is_empty()).map_or("nothing".into(), |v| v.join(" and ")))
-            })
-            .collect();
         format!(
-            "the recycle loop {name} has no flow into or out of it set by an inventory inside it: its total inventory \
-             is not controlled by inventory control (flows across it: {}); quality loops among those can hold it \
-             only indirectly",
-            list.join(", ")
+            "the recycle loop {name} is closed: no stream enters or leaves it, so its total inventory is its initial \
+             charge and its inventory loops cannot all hold their setpoints"
         )
+    } else {
+        across_why(net, &name, &across, origins)
     };
     RecycleVerdict { recycle: name, consistent: false, why: Some(why) }
 }
 
-/// A cycle through the first unit of a recycle, `a→b→c→a`, with the recycle's other units after it.
-fn cycle_name(net: &Network<'_>, reach: &Reach, blocks: &BTreeSet<usize>) -> String {
+/// Why recycle `name`, whose flows `across` no inventory inside it sets, is not consistent: what
+/// sets each of them, and whether quality loops among those could hold its total inventory
+/// indirectly (consistent at best, not self-consistent).
+fn across_why(net: &Network<'_>, name: &str, across: &[usize], origins: &HashMap<Flow, BTreeSet<Origin>>) -> String {
+    let streams = net.plant.streams();
+    let mut quality = BTreeSet::new();
+    let list: Vec<String> = across
+        .iter()
+        .map(|&s| {
+            let o: Vec<&Origin> = origins.get(&Flow::Stream(s)).map(|o| o.iter().collect()).unwrap_or_default();
+            quality.extend(o.iter().filter_map(|o| match o {
+                Origin::Controller(c) => Some(net.plant.blocks()[*c].name.clone()),
+                _ => None,
+            }));
+            let by: Vec<String> = o.iter().map(|o| origin_name(net, o)).collect();
+            let by = if by.is_empty() { "nothing declared".to_string() } else { by.join(" and ") };
+            format!("{} by {by}", streams[s].name)
+        })
+        .collect();
+    let held = if quality.is_empty() {
+        "nothing holds its total inventory".to_string()
+    } else {
+        format!(
+            "its total inventory is held, if at all, only indirectly by {} (not self-consistent)",
+            quality.into_iter().collect::<Vec<_>>().join(", ")
+        )
+    };
+    format!(
+        "the recycle loop {name} has no flow into or out of it set by an inventory inside it, only flows inside it \
+         (flows across it: {}): {held}",
+        list.join(", ")
+    )
+}
+
+/// A cycle of a recycle through `entry` (where material enters it; else its first unit),
+/// `a→b→c→a`, with the recycle's other units after it.
+fn cycle_name(net: &Network<'_>, reach: &Reach, blocks: &BTreeSet<usize>, entry: Option<usize>) -> String {
     let g = &reach.graph;
     let name = |b: usize| net.plant.blocks()[b].name.clone();
-    let Some(&start) = blocks.first() else { return String::new() };
+    let Some(start) = entry.or_else(|| blocks.first().copied()) else { return String::new() };
     // Breadth-first from the start's successors back to the start, within the recycle.
     let mut parent: HashMap<usize, usize> = HashMap::new();
     let mut queue = std::collections::VecDeque::from([start]);
