@@ -59,7 +59,7 @@ pub struct InventoryCheck {
     pub consistent: Option<bool>,
     /// The feasible TPM locations: inputs (`fresh_A.F`, `fc.sp`) setting a stream's rate that the
     /// inventory control radiates from (none while some inventory is not held by its own loop or
-    /// its own head).
+    /// its own head, or when nothing is judged).
     pub tpm: Vec<String>,
     /// The inputs that set a stream's rate from outside the inventory control as built: the
     /// throughput manipulators of the plant as it is.
@@ -156,23 +156,50 @@ pub fn check(plant: &Plant) -> InventoryCheck {
         .collect();
     let recycles = recycles(&net, &graph, &origins);
     let any_loop = locals.iter().any(|l| l.controller.is_some());
-    let note = match (net.inventories.is_empty(), any_loop) {
-        (true, _) => Some("no unit holds an inventory: nothing to judge".to_string()),
-        (false, false) => Some(
-            "no level or pressure loop measures an inventory: the file does not say how its inventories are \
-             controlled (a steady-state flowsheet), so the inventory control is not judged"
-                .to_string(),
-        ),
-        _ => None,
-    };
+    let (note, judged) = note(&net, any_loop);
     let all_ok = inventories.iter().all(|v| v.consistent) && recycles.iter().all(|r| r.consistent);
     InventoryCheck {
-        consistent: any_loop.then_some(all_ok),
-        tpm,
+        consistent: judged.then_some(all_ok),
+        tpm: if judged { tpm } else { Vec::new() },
         set_from_outside: candidates.keys().map(|&i| name(i)).collect(),
         inventories,
         recycles,
         note,
+    }
+}
+
+/// Why the plant's inventory control is not judged, if it is not, and whether it is: not when no
+/// unit declares an inventory, when no loop measures one (a steady-state flowsheet), or when a
+/// unit holds a level whose flows it does not declare (an equation-written vessel).
+fn note(net: &Network<'_>, any_loop: bool) -> (Option<String>, bool) {
+    let undeclared: Vec<&str> = net
+        .plant
+        .spec()
+        .units
+        .iter()
+        .filter(|(name, u)| {
+            u.config().vessel().is_some() && !net.inventories.iter().any(|i| net.plant.blocks()[i.block].name == **name)
+        })
+        .map(|(name, _)| name.as_str())
+        .collect();
+    if !undeclared.is_empty() {
+        let why = format!(
+            "{} holds a level without declaring the flows that change it, so the inventory control is not judged",
+            undeclared.join(", ")
+        );
+        return (Some(why), false);
+    }
+    match (net.inventories.is_empty(), any_loop) {
+        (true, _) => (Some("no unit holds an inventory: nothing to judge".into()), false),
+        (false, false) => (
+            Some(
+                "no level or pressure loop measures an inventory: the file does not say how its inventories are \
+                 controlled (a steady-state flowsheet), so the inventory control is not judged"
+                    .into(),
+            ),
+            false,
+        ),
+        _ => (None, true),
     }
 }
 
@@ -215,14 +242,23 @@ fn local(net: &Network<'_>, k: usize) -> Local {
 /// Inventory `k` without a loop: held if one of its flows depends on its holdup.
 fn unlooped(net: &Network<'_>, k: usize) -> Local {
     let inv = &net.inventories[k];
-    let regulates = |f: &&Flow| matches!(net.setters.get(*f), Some(Setter::Holdup { inventory, .. }) if *inventory == k);
+    let regulates = |f: &&Flow| match net.setters.get(*f) {
+        Some(Setter::Holdup { inventory, .. }) => *inventory == k,
+        // A unit that moves heat between process streams (a condenser–reboiler) sets the duty from
+        // both sides' temperatures: the condensation rises with the pressure it condenses at.
+        Some(Setter::Input(i)) => net.driver(*i).is_some_and(|c| net.plant.blocks()[c].unit.moves_process_heat()),
+        _ => false,
+    };
     let by_out = inv.outflows.iter().find(regulates);
     let by_in = inv.inflows.iter().find(regulates);
     let base = Local { controller: None, moved: Vec::new(), direction: None, how: None, problem: None };
     match (by_out, by_in) {
         (Some(f), _) | (None, Some(f)) => Local {
             direction: Some(if by_out.is_some() { Direction::WithFlow } else { Direction::AgainstFlow }),
-            how: Some(format!("regulates itself: {} depends on its holdup", flow_name(net, f))),
+            how: Some(match net.setters.get(f) {
+                Some(Setter::Input(_)) => format!("regulates itself: {} ({}) depends on its holdup", flow_name(net, f), set_by(net, f)),
+                _ => format!("regulates itself: {} depends on its holdup", flow_name(net, f)),
+            }),
             ..base
         },
         (None, None) => {

@@ -24,7 +24,9 @@ pub fn text(c: &InventoryCheck) -> String {
         [one] => t.push_str(&format!("  throughput manipulator as built: {one}\n")),
         many => t.push_str(&format!("  flows set from outside the inventory control: {}\n", list(many))),
     }
-    t.push_str(&format!("  feasible TPM locations (the inventory loops radiate from them): {}\n", list(&c.tpm)));
+    if c.consistent.is_some() {
+        t.push_str(&format!("  feasible TPM locations (the inventory control radiates from them): {}\n", list(&c.tpm)));
+    }
     for v in &c.inventories {
         let dash = |s: &Option<String>| s.clone().unwrap_or_else(|| "-".into());
         t.push_str(&format!(
