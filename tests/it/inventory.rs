@@ -110,7 +110,10 @@ fn an_inventory_between_two_fixed_flows_is_not_consistent() {
 fn a_recycle_with_every_flow_on_level_control_is_named() {
     let c = of_fixture("recycle_all_levels");
     assert_eq!(c.consistent, Some(false));
-    assert_eq!(loop_of(on(&c, "drum.level")), (Some("drum_level"), Some("drum.outflow"), Some(Direction::WithFlow), true));
+    assert_eq!(
+        loop_of(on(&c, "drum.level")),
+        (Some("drum_level"), Some("drum.outflow"), Some(Direction::WithFlow), true)
+    );
     assert_eq!(c.recycles.len(), 1);
     let r = &c.recycles[0];
     assert_eq!(r.recycle, "mix→heater→drum→mix");

@@ -256,14 +256,17 @@ fn unlooped(net: &Network<'_>, k: usize) -> Local {
         (Some(f), _) | (None, Some(f)) => Local {
             direction: Some(if by_out.is_some() { Direction::WithFlow } else { Direction::AgainstFlow }),
             how: Some(match net.setters.get(f) {
-                Some(Setter::Input(_)) => format!("regulates itself: {} ({}) depends on its holdup", flow_name(net, f), set_by(net, f)),
+                Some(Setter::Input(_)) => {
+                    format!("regulates itself: {} ({}) depends on its holdup", flow_name(net, f), set_by(net, f))
+                }
                 _ => format!("regulates itself: {} depends on its holdup", flow_name(net, f)),
             }),
             ..base
         },
         (None, None) => {
             let list = |flows: &[Flow]| {
-                let v: Vec<String> = flows.iter().map(|f| format!("{} ({})", flow_name(net, f), set_by(net, f))).collect();
+                let v: Vec<String> =
+                    flows.iter().map(|f| format!("{} ({})", flow_name(net, f), set_by(net, f))).collect();
                 if v.is_empty() { "nothing".to_string() } else { v.join(", ") }
             };
             let problem = format!(
@@ -357,7 +360,13 @@ impl Reach {
 
 /// The inventory loops that break the radiation rule around the TPM `tpm` (an input) that sets
 /// `streams`, each with why.
-fn radiation(net: &Network<'_>, reach: &Reach, tpm: usize, streams: &[usize], locals: &[Local]) -> Vec<(usize, String)> {
+fn radiation(
+    net: &Network<'_>,
+    reach: &Reach,
+    tpm: usize,
+    streams: &[usize],
+    locals: &[Local],
+) -> Vec<(usize, String)> {
     let tpm = &net.plant.inputs()[tpm].path;
     let mut out = Vec::new();
     for &s in streams {
@@ -486,12 +495,15 @@ fn recycle(
     origins: &HashMap<Flow, BTreeSet<Origin>>,
 ) -> RecycleVerdict {
     let streams = net.plant.streams();
-    let across: Vec<usize> =
-        (0..streams.len()).filter(|&s| blocks.contains(&streams[s].from.0) != blocks.contains(&streams[s].to.0)).collect();
+    let across: Vec<usize> = (0..streams.len())
+        .filter(|&s| blocks.contains(&streams[s].from.0) != blocks.contains(&streams[s].to.0))
+        .collect();
     let entry = across.iter().map(|&s| streams[s].to.0).find(|b| blocks.contains(b));
     let name = cycle_name(net, reach, blocks, entry);
     let set_inside = |s: &usize| {
-        origins.get(&Flow::Stream(*s)).is_some_and(|o| o.iter().any(|o| matches!(o, Origin::Inventory(k) if inside.contains(k))))
+        origins
+            .get(&Flow::Stream(*s))
+            .is_some_and(|o| o.iter().any(|o| matches!(o, Origin::Inventory(k) if inside.contains(k))))
     };
     if across.iter().any(set_inside) {
         return RecycleVerdict { recycle: name, consistent: true, why: None };
@@ -580,4 +592,3 @@ fn cycle_name(net: &Network<'_>, reach: &Reach, blocks: &BTreeSet<usize>, entry:
     }
     text
 }
-

@@ -26,7 +26,8 @@ pub mod var;
 
 pub use build::{BuildCx, FieldError};
 pub use capability::{
-    Booking, Boundary, Duty, DutySource, FlowDecl, FlowLaw, FlowVia, InventoryFlows, InventoryPhase, MaterialFlows, Shape, UtilityFlow,
+    Booking, Boundary, Duty, DutySource, FlowDecl, FlowLaw, FlowVia, InventoryFlows, InventoryPhase, MaterialFlows,
+    Shape, UtilityFlow,
 };
 pub use error::{Error, InputError, SpecError};
 pub use registry::{ControllerSpec, Inventory, UnitSpec};

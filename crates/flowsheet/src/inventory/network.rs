@@ -106,9 +106,12 @@ impl<'p> Network<'p> {
             (None, None) => name.clone(),
         };
         let flows = |vias: &[FlowVia]| vias.iter().filter_map(|v| self.flow(b, v)).collect();
-        let controller = self.plant.blocks().iter().enumerate().find_map(|(c, _)| {
-            self.plant.measured_vars(c).iter().any(|(_, v)| measured.contains(v)).then_some(c)
-        });
+        let controller = self
+            .plant
+            .blocks()
+            .iter()
+            .enumerate()
+            .find_map(|(c, _)| self.plant.measured_vars(c).iter().any(|(_, v)| measured.contains(v)).then_some(c));
         Inventory { block: b, path, inflows: flows(&inv.inflows), outflows: flows(&inv.outflows), controller }
     }
 
@@ -184,7 +187,9 @@ impl<'p> Network<'p> {
         match law {
             FlowLaw::Input(name) => self.input_of(b, name).map_or(Setter::Balance(b), Setter::Input),
             FlowLaw::Holdup { input } | FlowLaw::UpstreamHoldup { input } => match self.drained_by(b, flow) {
-                Some(inventory) => Setter::Holdup { inventory, input: input.as_ref().and_then(|i| self.input_of(b, i)) },
+                Some(inventory) => {
+                    Setter::Holdup { inventory, input: input.as_ref().and_then(|i| self.input_of(b, i)) }
+                }
                 None => Setter::Balance(b),
             },
             FlowLaw::Balance => Setter::Balance(b),
@@ -274,7 +279,10 @@ impl<'p> Network<'p> {
             let more: Vec<Flow> = self
                 .setters
                 .iter()
-                .filter(|(f, s)| !out.contains(f) && matches!(s, Setter::Through(b) if self.inlet_streams(*b).any(|t| out.contains(&t))))
+                .filter(|(f, s)| {
+                    !out.contains(f)
+                        && matches!(s, Setter::Through(b) if self.inlet_streams(*b).any(|t| out.contains(&t)))
+                })
                 .map(|(f, _)| f.clone())
                 .collect();
             if more.is_empty() {

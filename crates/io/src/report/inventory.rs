@@ -45,7 +45,8 @@ pub fn text(c: &InventoryCheck) -> String {
         }
     }
     for r in &c.recycles {
-        let state = if r.consistent { "its total inventory is set by an inventory inside it" } else { "NOT consistent" };
+        let state =
+            if r.consistent { "its total inventory is set by an inventory inside it" } else { "NOT consistent" };
         t.push_str(&format!("  recycle {}: {state}\n", r.recycle));
         if let Some(why) = &r.why {
             t.push_str(&format!("      why: {why}\n"));

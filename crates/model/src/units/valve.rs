@@ -44,8 +44,8 @@ use serde::{Deserialize, Serialize};
 
 use super::Phase;
 use super::outflow::Characteristic;
-use crate::stream::{F, H, P, Stream, T, Z0};
 use crate::capability::{FlowLaw, FlowVia, MaterialFlows};
+use crate::stream::{F, H, P, Stream, T, Z0};
 use crate::{BuildCx, FieldError, InputSpec, Scalar, UnitIo, UnitModel};
 
 /// Smoothing pressure of the square root near `ΔP = 0` [Pa].

@@ -21,7 +21,8 @@ pub mod rigorous;
 pub mod simple;
 
 use crate::capability::{
-    Booking, Duty, DutySource, FlowDecl, FlowLaw, FlowVia, InventoryFlows, InventoryPhase, MaterialFlows, Shape, UtilityFlow,
+    Booking, Duty, DutySource, FlowDecl, FlowLaw, FlowVia, InventoryFlows, InventoryPhase, MaterialFlows, Shape,
+    UtilityFlow,
 };
 use plantwide_units::QuantityValue;
 use schemars::JsonSchema;
