@@ -262,3 +262,43 @@ fn honest(c: &InventoryCheck, what: &str) -> bool {
     }
     c.consistent.is_some()
 }
+
+/// What the units declare names real things on every shipped flowsheet: each flow's port is one of
+/// the unit's ports, each inventory is measured by variables the plant has, and each input a law
+/// names is one of the unit's inputs.
+#[test]
+fn declared_flows_name_real_ports_variables_and_inputs() {
+    use plantwide::model::{FlowLaw, FlowVia};
+    let dir = std::path::Path::new(crate::harness::ROOT).join("flowsheets");
+    for e in std::fs::read_dir(dir).expect("flowsheets/").flatten() {
+        let file = e.path().display().to_string();
+        if !file.ends_with(".json") || file.contains("schema") {
+            continue;
+        }
+        let plant = load_file(&e.path()).unwrap_or_else(|e| panic!("{e}"));
+        for b in plant.blocks() {
+            let decl = b.unit.material_flows();
+            let inputs: Vec<String> = b.unit.inputs().into_iter().map(|i| i.name).collect();
+            let port_ok = |v: &FlowVia| match v {
+                FlowVia::Inlet(p) => b.unit.inlet_ports().iter().any(|q| q == p),
+                FlowVia::Outlet(p) => b.unit.outlet_ports().iter().any(|q| q == p),
+                FlowVia::Internal(_) => true,
+            };
+            for d in &decl.flows {
+                assert!(port_ok(&d.via), "{file}: {} declares {:?}", b.name, d.via);
+                let named = match &d.law {
+                    FlowLaw::Input(i) => Some(i),
+                    FlowLaw::Holdup { input } | FlowLaw::UpstreamHoldup { input } => input.as_ref(),
+                    FlowLaw::Balance => None,
+                };
+                assert!(named.is_none_or(|i| inputs.iter().any(|n| n == i)), "{file}: {} law {:?}", b.name, d.law);
+            }
+            for inv in &decl.inventories {
+                assert!(inv.inflows.iter().chain(&inv.outflows).all(port_ok), "{file}: {} {inv:?}", b.name);
+                for m in &inv.measured {
+                    assert!(plant.var(format!("{}.{m}", b.name)).is_some(), "{file}: {}.{m} is no variable", b.name);
+                }
+            }
+        }
+    }
+}
