@@ -339,7 +339,7 @@ impl Reach {
 
     /// The units (block indices) reachable from unit `b` along the streams (`forward`) or against
     /// them, `b` included.
-    fn from(&self, b: usize, forward: bool) -> HashSet<usize> {
+    fn reached(&self, b: usize, forward: bool) -> HashSet<usize> {
         let mut out = HashSet::new();
         let Some(&start) = self.node.get(&b) else { return out };
         if forward {
@@ -371,8 +371,8 @@ fn radiation(
     let mut out = Vec::new();
     for &s in streams {
         let info = &net.plant.streams()[s];
-        let down = reach.from(info.to.0, true);
-        let up = reach.from(info.from.0, false);
+        let down = reach.reached(info.to.0, true);
+        let up = reach.reached(info.from.0, false);
         for (k, l) in locals.iter().enumerate() {
             let (Some(_), Some(d)) = (l.controller, l.direction) else { continue };
             let b = net.inventories[k].block;
@@ -413,7 +413,10 @@ fn given_flows(net: &Network<'_>, reach: &Reach) -> Vec<Given> {
     for (f, s) in &net.setters {
         let (Flow::Stream(st), Setter::Input(i)) = (f, s) else { continue };
         if matches!(net.input_origin(*i), Origin::Free(_) | Origin::Controller(_)) {
-            out.push(Given { down: reach.from(streams[*st].to.0, true), up: reach.from(streams[*st].from.0, false) });
+            out.push(Given {
+                down: reach.reached(streams[*st].to.0, true),
+                up: reach.reached(streams[*st].from.0, false),
+            });
         }
     }
     out

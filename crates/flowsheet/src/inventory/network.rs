@@ -258,8 +258,9 @@ impl<'p> Network<'p> {
         if is_flow { self.input_of(c, "sp") } else { None }
     }
 
-    /// The inputs that set `flow` directly: its own input, or the one that moves its holdup law.
-    fn direct_inputs(setter: &Setter) -> Option<usize> {
+    /// The input that sets a flow with `setter` directly: its own input, or the one that moves its
+    /// holdup law (a valve's opening).
+    fn direct_input(setter: &Setter) -> Option<usize> {
         match *setter {
             Setter::Input(i) | Setter::Holdup { input: Some(i), .. } => Some(i),
             _ => None,
@@ -272,7 +273,7 @@ impl<'p> Network<'p> {
         let mut out: BTreeSet<Flow> = self
             .setters
             .iter()
-            .filter(|(_, s)| Self::direct_inputs(s).is_some_and(|i| inputs.contains(&i)))
+            .filter(|(_, s)| Self::direct_input(s).is_some_and(|i| inputs.contains(&i)))
             .map(|(f, _)| f.clone())
             .collect();
         loop {
