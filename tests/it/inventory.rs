@@ -302,3 +302,28 @@ fn declared_flows_name_real_ports_variables_and_inputs() {
         }
     }
 }
+
+/// The study `docs/two_column_tpm.md` shows the command's output as it is: every line of its two
+/// `check` sections is printed by `check` on the plant and on its column-1 LV variant.
+#[test]
+fn the_two_column_study_shows_the_real_output() {
+    let doc = std::fs::read_to_string(format!("{}/docs/two_column_tpm.md", crate::harness::ROOT)).expect("the study");
+    let sections: Vec<&str> = doc
+        .split("```text\n")
+        .skip(1)
+        .filter_map(|b| b.split("```").next())
+        .filter(|b| b.starts_with("inventory control"))
+        .collect();
+    assert_eq!(sections.len(), 2, "the study's two inventory sections");
+    for (file, shown) in [
+        (flowsheet("two_column_plant.json"), sections[0]),
+        (format!("{}/docs/two_column_tpm/column1_lv.json", crate::harness::ROOT), sections[1]),
+    ] {
+        let out = plantwide(&["check", &file]);
+        let printed = String::from_utf8_lossy(&out.stdout);
+        let got: Vec<&str> = printed.lines().collect();
+        for line in shown.lines() {
+            assert!(got.contains(&line), "{file}: the study shows\n  {line}\nwhich check did not print:\n{printed}");
+        }
+    }
+}
