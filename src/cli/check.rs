@@ -11,6 +11,8 @@ use super::CliError;
 pub fn run(file: &Path, system: UnitSystem) -> Result<(), CliError> {
     let plant = super::steady::load_plant(file, &[])?;
     out!("{}", report::check::summary(&plant, file, system));
+    // Before the degrees of freedom: an inconsistent inventory control is one reason they fail.
+    out!("{}", report::inventory::text(&plantwide::flowsheet::inventory::check(&plant)));
     let u = plant.input_values();
     let x = plant.initial_guess();
     // The numerical probe judges one point: a singular Jacobian at the cold-start guess (a dry tray,

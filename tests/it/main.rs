@@ -34,6 +34,7 @@ mod heat_integration;
 mod hostile;
 mod hostile_commands;
 mod identify;
+mod inventory;
 mod layers;
 mod mpc;
 mod plots;

@@ -13,6 +13,7 @@ pub mod error;
 pub mod explicit;
 pub mod graph;
 pub mod guess;
+pub mod inventory;
 pub mod outputs;
 pub mod overrides;
 pub mod parse;

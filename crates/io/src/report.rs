@@ -32,6 +32,7 @@ pub mod compare;
 pub mod components;
 pub mod gains;
 pub mod identify;
+pub mod inventory;
 pub mod linearize;
 pub mod run;
 pub mod run_plot;

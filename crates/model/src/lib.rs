@@ -25,7 +25,10 @@ pub mod units;
 pub mod var;
 
 pub use build::{BuildCx, FieldError};
-pub use capability::{Booking, Boundary, Duty, DutySource, Shape, UtilityFlow};
+pub use capability::{
+    Booking, Boundary, Duty, DutySource, FlowDecl, FlowLaw, FlowVia, InventoryFlows, InventoryPhase, MaterialFlows,
+    Shape, UtilityFlow,
+};
 pub use error::{Error, InputError, SpecError};
 pub use registry::{ControllerSpec, Inventory, UnitSpec};
 pub use stream::{Stream, StreamLayout};

@@ -18,7 +18,7 @@ use num_dual::Dual64;
 use plantwide_thermo::ThermoPackage;
 use plantwide_units::Dimension;
 
-use crate::capability::{Boundary, Duty, Shape, UtilityFlow};
+use crate::capability::{Boundary, Duty, MaterialFlows, Shape, UtilityFlow};
 use crate::{InputError, Scalar, Stream, StreamLayout, VarSpec};
 
 /// A manipulable input declared by a unit.
@@ -286,6 +286,12 @@ pub trait UnitModel: Send + Sync + std::fmt::Debug {
     fn shape(&self) -> Shape {
         Shape::Block
     }
+    /// The inventories it holds and what sets the flows that fill and drain them, for the
+    /// consistency check of inventory control (default: no holdup, every outlet passes what
+    /// enters).
+    fn material_flows(&self) -> MaterialFlows {
+        MaterialFlows::default()
+    }
 }
 
 /// Object-safe view of a [`UnitModel`], used by assembly and solvers.
@@ -356,6 +362,8 @@ pub trait Unit: Send + Sync + std::fmt::Debug {
     fn moves_process_heat(&self) -> bool;
     /// See [`UnitModel::shape`].
     fn shape(&self) -> Shape;
+    /// See [`UnitModel::material_flows`].
+    fn material_flows(&self) -> MaterialFlows;
 }
 
 /// A controller output held at a limit with the measurement off its setpoint.
@@ -387,6 +395,9 @@ impl<U: UnitModel + 'static> Unit for U {
     }
     fn shape(&self) -> Shape {
         UnitModel::shape(self)
+    }
+    fn material_flows(&self) -> MaterialFlows {
+        UnitModel::material_flows(self)
     }
     fn reacts(&self) -> bool {
         UnitModel::reacts(self)

@@ -28,7 +28,7 @@ mod cx;
 mod doc;
 mod dynamic;
 mod exec;
-mod families;
+pub(crate) mod families;
 mod known;
 mod linear;
 mod relations;

@@ -85,6 +85,8 @@ pub fn column_text(s: &ColumnScreen, file: &str) -> String {
         t.push_str(&row(c));
     }
     t.push_str(&format!("\nverdict: {}\n", s.verdict));
+    t.push('\n');
+    t.push_str(&super::inventory::text(&s.inventory));
     t
 }
 
@@ -354,5 +356,7 @@ pub fn pairing_text(s: &PairingScreen, shown: &Shown) -> String {
         t.push_str(&mpc_row(m));
     }
     t.push_str(&format!("\nverdict: {}\n", s.verdict));
+    t.push('\n');
+    t.push_str(&super::inventory::text(&s.inventory));
     t
 }

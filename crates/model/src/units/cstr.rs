@@ -28,7 +28,7 @@
 //! reaction enthalpy at `T` is `Δh_k + Σ_i ν_ik h_L,i(T)`, which is `Δh_k` when the components share
 //! their enthalpy function (e.g. isomers in a constant-cp model).
 
-use crate::capability::{Booking, Duty, DutySource, Shape};
+use crate::capability::{Booking, Duty, DutySource, MaterialFlows, Shape};
 use std::collections::BTreeMap;
 
 use num_dual::Dual64;
@@ -325,6 +325,10 @@ impl UnitModel for Cstr {
     }
     fn shape(&self) -> Shape {
         Shape::Vessel
+    }
+    /// The liquid, filled by `in` and drained by `out` under the outflow law.
+    fn material_flows(&self) -> MaterialFlows {
+        MaterialFlows::vessel(&["in"], vec![("out", self.law.flow_law())])
     }
     /// The jacket's `Q` \[W\], heating when positive.
     fn duties(&self) -> Vec<Duty> {

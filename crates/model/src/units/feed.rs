@@ -7,7 +7,7 @@
 //! Equations: `F = F_in`, `P = P_in`, `z_i = z_in,i`, and either `T = T_in` or, for a saturated
 //! liquid, the bubble-point condition `Σ K_i(T, P, z) z_i = 1`; `h = h_phase(T, z)`.
 
-use crate::capability::{Boundary, Shape};
+use crate::capability::{Boundary, FlowLaw, FlowVia, MaterialFlows, Shape};
 use std::collections::BTreeMap;
 
 use plantwide_units::{Dimension, QuantityValue};
@@ -113,6 +113,10 @@ impl UnitModel for Feed {
     }
     fn boundary(&self) -> Boundary {
         Boundary::Source
+    }
+    /// The input `F` sets the outflow.
+    fn material_flows(&self) -> MaterialFlows {
+        MaterialFlows::one(FlowVia::Outlet("out".into()), FlowLaw::Input("F".into()))
     }
     fn inlet_ports(&self) -> Vec<String> {
         Vec::new()

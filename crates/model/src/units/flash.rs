@@ -42,7 +42,7 @@
 //! condition asked for `V < 0` and the run stopped at the bound). The guess puts such a drum at
 //! the feed's bubble point with `V = 0`.
 
-use crate::capability::{Booking, Duty, DutySource, Shape};
+use crate::capability::{Booking, Duty, DutySource, FlowLaw, MaterialFlows, Shape};
 use plantwide_units::{Dimension, QuantityValue};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -119,6 +119,11 @@ impl UnitModel for Flash {
     }
     fn shape(&self) -> Shape {
         Shape::Vessel
+    }
+    /// The liquid, filled by `in`, drained by `liquid` under the outflow law and by `vapour`,
+    /// which the energy balance makes (the vapour holdup is neglected: no gas inventory).
+    fn material_flows(&self) -> MaterialFlows {
+        MaterialFlows::vessel(&["in"], vec![("liquid", self.law.flow_law()), ("vapour", Some(FlowLaw::Balance))])
     }
     /// The input `duty` \[W\], heat put into the liquid: heating when positive.
     fn duties(&self) -> Vec<Duty> {

@@ -168,6 +168,18 @@ impl OutflowLaw {
             OutflowLaw::Free => Vec::new(),
         }
     }
+    /// What sets the outflow, for the consistency check of inventory control: the holdup through
+    /// the valve (moved by `opening`: the vessel regulates itself), the input `outflow` (a pumped
+    /// outflow: a pure integrator unless a level loop moves it), or `None` for `free` (the
+    /// downstream unit sets it).
+    pub fn flow_law(&self) -> Option<crate::capability::FlowLaw> {
+        use crate::capability::FlowLaw;
+        match self {
+            OutflowLaw::Valve { .. } => Some(FlowLaw::Holdup { input: Some("opening".into()) }),
+            OutflowLaw::Flow { .. } => Some(FlowLaw::Input("outflow".into())),
+            OutflowLaw::Free => None,
+        }
+    }
     /// Equations relative to own variables: −1 for `free`, else 0.
     pub fn extra_equations(&self) -> isize {
         if matches!(self, OutflowLaw::Free) { -1 } else { 0 }

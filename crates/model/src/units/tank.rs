@@ -17,7 +17,7 @@
 //! With a `flow` outflow the tank is a pure integrator: at steady state its holdup is undetermined
 //! unless a level controller moves `outflow`.
 
-use crate::capability::{Booking, Duty, DutySource, Shape};
+use crate::capability::{Booking, Duty, DutySource, MaterialFlows, Shape};
 use plantwide_units::{Dimension, QuantityValue};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -95,6 +95,10 @@ impl UnitModel for Tank {
     }
     fn shape(&self) -> Shape {
         Shape::Vessel
+    }
+    /// The liquid, filled by `in` and drained by `out` under the outflow law.
+    fn material_flows(&self) -> MaterialFlows {
+        MaterialFlows::vessel(&["in"], vec![("out", self.law.flow_law())])
     }
     /// The input `duty` \[W\], heat put into the liquid: heating when positive.
     fn duties(&self) -> Vec<Duty> {

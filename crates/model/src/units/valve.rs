@@ -44,6 +44,7 @@ use serde::{Deserialize, Serialize};
 
 use super::Phase;
 use super::outflow::Characteristic;
+use crate::capability::{FlowLaw, FlowVia, MaterialFlows};
 use crate::stream::{F, H, P, Stream, T, Z0};
 use crate::{BuildCx, FieldError, InputSpec, Scalar, UnitIo, UnitModel};
 
@@ -185,6 +186,15 @@ impl UnitModel for Valve {
     }
     fn extra_equations(&self) -> isize {
         1
+    }
+    /// The valve sets its inlet flow: to the input `flow` (`flow_set`), or from the pressure of the
+    /// vessel it drains, moved by `opening` (`pressure_drop`: that vessel regulates itself).
+    fn material_flows(&self) -> MaterialFlows {
+        let law = match self.mode {
+            Mode::FlowSet { .. } => FlowLaw::Input("flow".into()),
+            Mode::PressureDrop { .. } => FlowLaw::UpstreamHoldup { input: Some("opening".into()) },
+        };
+        MaterialFlows::one(FlowVia::Inlet("in".into()), law)
     }
     fn equation_name(&self, k: usize, own_names: &[String]) -> String {
         match (own_names.get(k), self.mode) {

@@ -207,6 +207,9 @@ pub struct ColumnScreen {
     /// The recommendation and what it rests on; when the steady-state measures alone would
     /// recommend another configuration, it says so.
     pub verdict: String,
+    /// The plant's inventory control as the file has it: throughput manipulator candidates and
+    /// each inventory's consistency ([`plantwide_flowsheet::inventory`]).
+    pub inventory: plantwide_flowsheet::inventory::InventoryCheck,
     /// The dynamic check's scenarios, one per step (a file name and its text), kept with the
     /// flowsheets.
     #[serde(skip)]
@@ -323,6 +326,7 @@ pub fn screen_column_with(plant: &Plant, r: &ColumnRequest) -> Result<ColumnScre
         structures,
         failed,
         verdict,
+        inventory: plantwide_flowsheet::inventory::check(plant),
         scenarios: check.scenarios,
     })
 }

@@ -151,6 +151,9 @@ pub struct PairingScreen {
     /// measure (RGA number) orders the dynamically tested candidates otherwise than their dynamic
     /// scores do, it says so.
     pub verdict: String,
+    /// The plant's inventory control as the file has it: throughput manipulator candidates and
+    /// each inventory's consistency ([`plantwide_flowsheet::inventory`]).
+    pub inventory: plantwide_flowsheet::inventory::InventoryCheck,
 }
 
 /// The open plant: the loops on the CVs and MVs removed, its steady state and gains.
@@ -232,6 +235,7 @@ pub fn screen_pairings(plant: &Plant, request: &PairingRequest) -> Result<Pairin
         tested,
         failed,
         verdict,
+        inventory: plantwide_flowsheet::inventory::check(plant),
     })
 }
 

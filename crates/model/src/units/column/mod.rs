@@ -20,7 +20,10 @@
 pub mod rigorous;
 pub mod simple;
 
-use crate::capability::{Booking, Duty, DutySource, Shape, UtilityFlow};
+use crate::capability::{
+    Booking, Duty, DutySource, FlowDecl, FlowLaw, FlowVia, InventoryFlows, InventoryPhase, MaterialFlows, Shape,
+    UtilityFlow,
+};
 use plantwide_units::QuantityValue;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -298,6 +301,61 @@ impl Column {
     }
 }
 
+/// A column's inventories and flow laws, from its stage count `n`, ports and input names:
+/// - the drum (`M[n]`) is filled by the vapour the reboiler makes (its input `boilup`,
+///   `reboiler_duty` or `steam_flow`) and drained by the reflux (input `reflux`) and the distillate
+///   (input `distillate`);
+/// - the sump (`M[1]`) is filled by the liquid the trays pass down — the reflux and the feeds, the
+///   trays regulating themselves over their weirs — and drained by the boilup and the bottoms
+///   (input `bottoms`);
+/// - a vapour space (`gas`: the top pressure `P` is a variable) is filled by the boilup and
+///   drained by condensation: the input `condenser_duty` or `coolant_flow`, else the condenser at
+///   the drum's bubble point, which regulates the pressure itself.
+///
+/// Side draws leave trays, which regulate themselves; each is set by its input.
+fn column_flows(n: usize, inlets: &[String], outlets: &[String], inputs: &[String], gas: bool) -> MaterialFlows {
+    let has = |name: &str| inputs.iter().any(|i| i == name);
+    let boilup = ["boilup", "reboiler_duty", "steam_flow"].into_iter().find(|b| has(b)).unwrap_or("boilup");
+    let internal = |name: &'static str| FlowVia::Internal(name.into());
+    let mut flows: Vec<FlowDecl> = outlets
+        .iter()
+        .map(|p| FlowDecl { via: FlowVia::Outlet(p.clone().into()), law: FlowLaw::Input(p.clone().into()) })
+        .collect();
+    flows.push(FlowDecl { via: internal("reflux"), law: FlowLaw::Input("reflux".into()) });
+    flows.push(FlowDecl { via: internal(boilup), law: FlowLaw::Input(boilup.into()) });
+    let mut sump_in = vec![internal("reflux")];
+    sump_in.extend(inlets.iter().map(|p| FlowVia::Inlet(p.clone().into())));
+    let mut inventories = vec![
+        InventoryFlows {
+            name: Some("drum"),
+            phase: InventoryPhase::Liquid,
+            measured: vec![format!("M[{n}]")],
+            inflows: vec![internal(boilup)],
+            outflows: vec![internal("reflux"), FlowVia::Outlet("distillate".into())],
+        },
+        InventoryFlows {
+            name: Some("sump"),
+            phase: InventoryPhase::Liquid,
+            measured: vec!["M[1]".into()],
+            inflows: sump_in,
+            outflows: vec![internal(boilup), FlowVia::Outlet("bottoms".into())],
+        },
+    ];
+    if gas {
+        let condenser = ["condenser_duty", "coolant_flow"].into_iter().find(|c| has(c));
+        let law = condenser.map_or(FlowLaw::Holdup { input: None }, |c| FlowLaw::Input(c.into()));
+        flows.push(FlowDecl { via: internal("condensation"), law });
+        inventories.push(InventoryFlows {
+            name: Some("vapour"),
+            phase: InventoryPhase::Gas,
+            measured: vec!["P".into()],
+            inflows: vec![internal(boilup)],
+            outflows: vec![internal("condensation")],
+        });
+    }
+    MaterialFlows { flows, inventories }
+}
+
 macro_rules! delegate {
     ($self:ident, $m:ident($($a:expr),*)) => {
         match $self {
@@ -326,6 +384,13 @@ impl UnitModel for Column {
     }
     fn shape(&self) -> Shape {
         Shape::Column
+    }
+    /// The reflux drum (stage N) and the sump (stage 1), and the vapour space of a rigorous column
+    /// that has one (its pressure `P`): see [`column_flows`].
+    fn material_flows(&self) -> MaterialFlows {
+        let names: Vec<String> = self.inputs().into_iter().map(|i| i.name).collect();
+        let gas = self.internal_vars().iter().any(|v| v.name == "P");
+        column_flows(delegate!(self, n_stages()), &self.inlet_ports(), &self.outlet_ports(), &names, gas)
     }
     fn inlet_ports(&self) -> Vec<String> {
         delegate!(self, inlet_ports())

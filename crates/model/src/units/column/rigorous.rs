@@ -224,6 +224,10 @@ const IN_BOTTOMS: usize = 3;
 const IN_CONDENSER_DUTY: usize = 4;
 
 impl RigorousColumn {
+    /// Number of stages, condenser and reboiler included.
+    pub(crate) fn n_stages(&self) -> usize {
+        self.n_stages
+    }
     fn nc(&self) -> usize {
         self.comp_names.len()
     }

@@ -81,6 +81,10 @@ const IN_DISTILLATE: usize = 2;
 const IN_BOTTOMS: usize = 3;
 
 impl SimpleColumn {
+    /// Number of stages, condenser and reboiler included.
+    pub(crate) fn n_stages(&self) -> usize {
+        self.n_stages
+    }
     /// Build from the flowsheet description.
     pub fn build(c: &ColumnConfig, mut cx: BuildCx<'_>) -> Result<SimpleColumn, Vec<FieldError>> {
         let n = c.stages;
