@@ -98,10 +98,9 @@ impl LocalModel {
     pub fn new(parts: Parts) -> Result<LocalModel, SocError> {
         check_names(&parts)?;
         check_shapes(&parts)?;
-        let largest = largest_eigenvalue(parts.juu.as_ref())?;
+        let (largest, juu_half, juu_inv_half) = normalized_roots(parts.juu.as_ref())?;
         let cost_scale = 1.0 / largest;
         let juu = &parts.juu * cost_scale;
-        let (juu_half, juu_inv_half) = square_roots(juu.as_ref())?;
         let juu_inv_jud = juu.llt(Side::Lower).map_err(|_| not_definite(f64::NAN))?.solve(&parts.jud * cost_scale);
         let f = &parts.gyd - &parts.gy * &juu_inv_jud;
         finite("Gyd", "F = Gyd − Gy Juu⁻¹ Jud", f.as_ref())?;
@@ -324,27 +323,15 @@ fn check_shapes(p: &Parts) -> Result<(), SocError> {
     Ok(())
 }
 
-/// The largest eigenvalue of the symmetric part of `Juu` (after its symmetry is checked).
-fn largest_eigenvalue(juu: MatRef<'_, f64>) -> Result<f64, SocError> {
+/// The largest eigenvalue `λ_max` of `Juu` (checked symmetric; its symmetric part is used), and
+/// `(Juu/λ_max)^{1/2}`, `(Juu/λ_max)^{-1/2}` from one eigen-decomposition. `Juu` is divided by its
+/// largest entry first, so that entries near 1e300 do not overflow.
+fn normalized_roots(juu: MatRef<'_, f64>) -> Result<(f64, Mat<f64>, Mat<f64>), SocError> {
     let n = juu.nrows();
     let scale = (0..n).flat_map(|i| (0..n).map(move |j| (i, j))).map(|(i, j)| juu[(i, j)].abs()).fold(0.0, f64::max);
     if !(scale > 0.0 && scale.is_finite()) {
         return Err(not_definite(0.0));
     }
-    // Scaled first: the eigenvalues of entries near 1e300 would overflow.
-    let sym = Mat::from_fn(n, n, |i, j| 0.5 * (juu[(i, j)] / scale + juu[(j, i)] / scale));
-    let lambda = sym.self_adjoint_eigenvalues(Side::Lower).map_err(|e| SocError::Numerical(format!("Juu: {e:?}")))?;
-    let largest = lambda.last().copied().unwrap_or(0.0) * scale;
-    match largest > 0.0 && largest.is_finite() {
-        true => Ok(largest),
-        false => Err(not_definite(lambda[0] * scale)),
-    }
-}
-
-/// `Juu^{1/2}` and `Juu^{-1/2}` by the eigen-decomposition of the symmetric part of `Juu`.
-fn square_roots(juu: MatRef<'_, f64>) -> Result<(Mat<f64>, Mat<f64>), SocError> {
-    let n = juu.nrows();
-    let scale = (0..n).flat_map(|i| (0..n).map(move |j| (i, j))).map(|(i, j)| juu[(i, j)].abs()).fold(0.0, f64::max);
     for i in 0..n {
         for j in 0..i {
             if (juu[(i, j)] - juu[(j, i)]).abs() > SYMMETRY_TOLERANCE * scale {
@@ -359,16 +346,17 @@ fn square_roots(juu: MatRef<'_, f64>) -> Result<(Mat<f64>, Mat<f64>), SocError> 
             }
         }
     }
-    let sym = Mat::from_fn(n, n, |i, j| 0.5 * (juu[(i, j)] + juu[(j, i)]));
+    let sym = Mat::from_fn(n, n, |i, j| 0.5 * (juu[(i, j)] / scale + juu[(j, i)] / scale));
     let eig = sym.self_adjoint_eigen(Side::Lower).map_err(|e| SocError::Numerical(format!("Juu: {e:?}")))?;
     let lambda: Vec<f64> = eig.S().column_vector().iter().copied().collect();
     let largest = lambda.iter().copied().fold(0.0, f64::max);
-    if lambda[0] <= largest * f64::EPSILON * n as f64 {
-        return Err(not_definite(lambda[0]));
+    if largest <= 0.0 || lambda[0] <= largest * f64::EPSILON * n as f64 {
+        return Err(not_definite(lambda[0] / largest.max(f64::MIN_POSITIVE)));
     }
     let v = eig.U();
-    let root = |p: f64| Mat::from_fn(n, n, |i, j| (0..n).map(|k| v[(i, k)] * lambda[k].powf(p) * v[(j, k)]).sum());
-    Ok((root(0.5), root(-0.5)))
+    let root =
+        |p: f64| Mat::from_fn(n, n, |i, j| (0..n).map(|k| v[(i, k)] * (lambda[k] / largest).powf(p) * v[(j, k)]).sum());
+    Ok((largest * scale, root(0.5), root(-0.5)))
 }
 
 fn not_definite(smallest: f64) -> SocError {
