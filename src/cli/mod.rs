@@ -73,6 +73,7 @@ mod components;
 mod gains;
 mod identify;
 mod linearize;
+mod optimize;
 mod run;
 mod run_plot;
 mod screen;
@@ -214,6 +215,11 @@ enum Command {
     /// controlled variables (exact local method: worst-case and average loss, the optimal
     /// combination H), found by bidirectional branch and bound, from published linear data.
     Select(select::SelectArgs),
+    /// The economic optimum at steady state: an objective (a tag with prices, or a variable), the
+    /// inputs and setpoints it may move, limits on any variable; SQP on converged steady states
+    /// with exact derivatives, giving the active constraints, their shadow prices, the KKT
+    /// residual and the reduced Hessian.
+    Optimize(optimize::OptimizeArgs),
     /// Surge sizing: the cross-section and level controller (P, critically damped PI, optimal
     /// averaging) that hold a vessel's level band and its outflow's rate limit, each verified by a
     /// nonlinear run; or a ranking of where surge capacity needs the least volume.
@@ -277,6 +283,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Tune(a) => tune::run(&a),
         Command::Screen(a) => screen::run(&a, cli.units.unwrap_or(UnitsArg::Si).into()),
         Command::Select(a) => select::run(&a),
+        Command::Optimize(a) => optimize::run(&a),
         Command::Size(a) => size::run(&a, cli.units.unwrap_or(UnitsArg::Si).into()),
         Command::Compare(a) => compare::run(&a, cli.units.unwrap_or(UnitsArg::Si).into()),
         Command::Identify(a) => identify::run(&a, cli.units.unwrap_or(UnitsArg::Si).into()),

@@ -37,6 +37,7 @@ mod identify;
 mod inventory;
 mod layers;
 mod mpc;
+mod optimize;
 mod plots;
 mod pressure;
 mod recycle;

@@ -14,6 +14,7 @@ pub mod explicit;
 pub mod graph;
 pub mod guess;
 pub mod inventory;
+pub mod optimization;
 pub mod outputs;
 pub mod overrides;
 pub mod parse;

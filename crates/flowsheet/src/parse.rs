@@ -27,6 +27,7 @@ const TOP_LEVEL: &[&str] = &[
     "specs",
     "parameters",
     "tags",
+    "optimization",
 ];
 
 /// Read a file the engine is given (flowsheet, scenario, model, matrices) as text: at most
@@ -130,6 +131,7 @@ pub fn parse_spec(text: &str, file: &str) -> Result<FlowsheetSpec, LoadError> {
     let streams = plain_map::<StreamSpec>(obj.get("streams"), "streams", true, &mut diags);
     let inputs = plain_map::<String>(obj.get("inputs"), "inputs", false, &mut diags);
     let specs: Vec<crate::design::SpecEntry> = field(obj, "specs", &mut diags, false).unwrap_or_default();
+    let optimization: Option<crate::optimization::OptimizationSpec> = field(obj, "optimization", &mut diags, false);
     match thermo {
         Some(thermo) if diags.is_empty() => Ok(FlowsheetSpec {
             format_version,
@@ -144,6 +146,7 @@ pub fn parse_spec(text: &str, file: &str) -> Result<FlowsheetSpec, LoadError> {
             specs,
             parameters,
             tags,
+            optimization,
         }),
         _ => Err(LoadError::Invalid { file: file.into(), diagnostics: diags }),
     }

@@ -56,6 +56,10 @@ pub struct FlowsheetSpec {
     /// `<tag>.value` of the plant that every analysis sees ([`plantwide_model::tag`]).
     #[serde(default, skip_serializing_if = "IndexMap::is_empty")]
     pub tags: IndexMap<String, TagSpec>,
+    /// The economic optimum `plantwide optimize` finds: an objective (a tag or variable), the
+    /// inputs it may move and the limits it must keep ([`crate::optimization`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub optimization: Option<crate::optimization::OptimizationSpec>,
 }
 
 /// A tag: its expression, alone or with the unit its value must have and a description.

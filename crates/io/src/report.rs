@@ -34,6 +34,7 @@ pub mod gains;
 pub mod identify;
 pub mod inventory;
 pub mod linearize;
+pub mod optimize;
 pub mod run;
 pub mod run_plot;
 pub mod screen;

@@ -13,6 +13,7 @@ pub mod disturbance;
 pub mod error;
 pub mod identify;
 mod numeric;
+pub mod optimize;
 pub mod request;
 pub mod screen;
 pub mod size;

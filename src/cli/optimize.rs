@@ -1,0 +1,105 @@
+//! `plantwide optimize FILE [--json] [--report DIR] [--objective PATH[@unit]] [--maximize]
+//! [--vary PATH[=LOW:HIGH]]… [--constraint PATH=LOW:HIGH]… [--set PATH=VALUE]…`: the economic
+//! optimum of the file's `"optimization"` section, the flags replacing or adding to it
+//! ([`plantwide::studies::optimize`]).
+
+use std::path::PathBuf;
+
+use plantwide::flowsheet::optimization::{Limits, OptimizationSpec, Sense};
+use plantwide::io::report::optimize as report;
+use plantwide::studies::optimize::{OptimizeError, State, optimize, parse_limits};
+
+use super::CliError;
+use super::steady::{converge, load_with_overrides};
+
+/// Arguments of `plantwide optimize`.
+#[derive(Debug, clap::Args)]
+pub struct OptimizeArgs {
+    /// Flowsheet file (JSON), with an `"optimization"` section or the flags below.
+    file: PathBuf,
+    /// The objective, replacing the file's: a tag's name or a variable path, `PATH[@unit]`.
+    #[arg(long, value_name = "PATH[@unit]")]
+    objective: Option<String>,
+    /// Maximize the objective (a profit) instead of minimizing it.
+    #[arg(long)]
+    maximize: bool,
+    /// A degree of freedom with optional bounds (`feed.F`, `column.reflux=2 kmol/min:4 kmol/min`,
+    /// `x2_control.sp=35 %:`); repeatable. Given, they replace the file's `vary`.
+    #[arg(long, value_name = "PATH[=LOW:HIGH]")]
+    vary: Vec<String>,
+    /// A limit on a variable, `PATH=LOW:HIGH` with either end empty (`distillate.x[light]=0.99:`);
+    /// repeatable, added to (or replacing the same path of) the file's `constraints`.
+    #[arg(long, value_name = "PATH=LOW:HIGH")]
+    constraint: Vec<String>,
+    /// Print exactly `{"objective", "values", "active", "multipliers", "kkt_residual"}` and more:
+    /// `objective_path`, `objective_unit`, `sense`, `limits`, `reduced_hessian`, `iterations`,
+    /// `plant_solves`.
+    #[arg(long)]
+    json: bool,
+    /// Write `optimum.json`, `optimum.txt` and `optimum.md` into this folder.
+    #[arg(long, value_name = "DIR")]
+    report: Option<PathBuf>,
+    /// Override an input or a unit parameter first, e.g. `--set feed_source.F=1.01kmol/min`.
+    #[arg(long = "set", value_name = "PATH=VALUE")]
+    set: Vec<String>,
+}
+
+/// The file's problem with the flags applied.
+fn request(a: &OptimizeArgs, file: Option<&OptimizationSpec>) -> Result<OptimizationSpec, CliError> {
+    let mut spec = file.cloned().unwrap_or_default();
+    if let Some(o) = &a.objective {
+        spec.objective = o.clone();
+    }
+    if a.maximize {
+        spec.sense = Sense::Maximize;
+    }
+    let user = |flag: &str, e: String| CliError::user(format!("--{flag} {e}"));
+    if !a.vary.is_empty() {
+        spec.vary.clear();
+        for v in &a.vary {
+            let (path, limits) = match v.split_once('=') {
+                Some((p, l)) => (p.trim(), parse_limits(l).map_err(|e| user("vary", e.to_string()))?),
+                None => (v.trim(), Limits::default()),
+            };
+            spec.vary.insert(path.to_string(), limits);
+        }
+    }
+    for c in &a.constraint {
+        let (path, l) =
+            c.split_once('=').ok_or_else(|| user("constraint", format!("`{c}`: expected PATH=LOW:HIGH")))?;
+        spec.constraints
+            .insert(path.trim().to_string(), parse_limits(l).map_err(|e| user("constraint", e.to_string()))?);
+    }
+    if spec.objective.is_empty() {
+        return Err(CliError::user(format!(
+            "{}: no objective: give the file an `optimization` section or --objective (a tag such as `cost`, or a variable path)",
+            a.file.display()
+        )));
+    }
+    Ok(spec)
+}
+
+pub fn run(a: &OptimizeArgs) -> Result<(), CliError> {
+    let (plant, u) = load_with_overrides(&a.file, &a.set)?;
+    let spec = request(a, plant.spec().optimization.as_ref())?;
+    let sol = converge(&plant, &u)?;
+    let start = State { x: sol.x.clone(), u: sol.u.clone() };
+    let optimum = optimize(&plant, &spec, &start).map_err(|e| optimize_error(&a.file, e))?;
+    if let Some(dir) = &a.report {
+        let written = report::write_report(dir, &optimum).map_err(|e| CliError::user(e.to_string()))?;
+        eprintln!("wrote {} in {}", written.join(", "), dir.display());
+    }
+    if a.json {
+        let text = plantwide::io::report::json(&optimum).map_err(|e| CliError::numerical(e.to_string()))?;
+        outln!("{text}");
+    } else {
+        out!("{}", report::text(&optimum));
+    }
+    Ok(())
+}
+
+/// Exit 1 for the request, 2 for the plant or the numbers; the file named.
+fn optimize_error(file: &std::path::Path, e: OptimizeError) -> CliError {
+    let message = format!("{}: {e}", file.display());
+    if e.is_user_error() { CliError::user(message) } else { CliError::numerical(message) }
+}

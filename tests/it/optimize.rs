@@ -1,0 +1,228 @@
+//! `plantwide optimize` (issue 58, item 1): the economic optimum of the Newell–Lee evaporator
+//! against an independent SciPy SLSQP solution (`tools/evaporator_slsqp.py`,
+//! tests/data/evaporator/slsqp.json) from four starts; Skogestad's column A with both purity specs
+//! active against the published operating point and the component balance; shadow prices
+//! against re-optimization with the limit moved; no feasible point, and bad requests, refused
+//! with their exit codes.
+
+use serde_json::Value;
+
+use crate::harness::{ROOT, plantwide};
+
+fn reference() -> Value {
+    let text = std::fs::read_to_string(format!("{ROOT}/tests/data/evaporator/slsqp.json")).unwrap();
+    serde_json::from_str(&text).unwrap()
+}
+
+fn scratch(name: &str, text: &str) -> String {
+    let dir = std::env::temp_dir().join(format!("plantwide-optimize-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path.display().to_string()
+}
+
+/// Run `optimize --json` and return the answer (exit 0 asserted).
+fn optimum(args: &[&str]) -> Value {
+    let mut all = vec!["optimize"];
+    all.extend_from_slice(args);
+    all.push("--json");
+    let out = plantwide(&all);
+    assert!(out.status.success(), "{all:?}: {}", String::from_utf8_lossy(&out.stderr));
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+fn close(a: f64, b: f64, rel: f64) -> bool {
+    (a - b).abs() <= rel * b.abs()
+}
+
+const KG_PER_MIN: f64 = 1.0 / 60.0;
+
+#[test]
+fn the_evaporator_optimum_is_scipys_from_every_start() {
+    let r = reference();
+    let starts: [&[&str]; 4] = [
+        &[],
+        &[
+            "--set",
+            "evaporator.F1=10 kg/min",
+            "--set",
+            "evaporator.F200=200 kg/min",
+            "--set",
+            "evaporator.P100=350 kPa",
+            "--set",
+            "x2_control.sp=40 %",
+        ],
+        &[
+            "--set",
+            "evaporator.F1=15 kg/min",
+            "--set",
+            "evaporator.F200=300 kg/min",
+            "--set",
+            "evaporator.P100=300 kPa",
+            "--set",
+            "x2_control.sp=45 %",
+        ],
+        &[
+            "--set",
+            "evaporator.F1=5 kg/min",
+            "--set",
+            "evaporator.F200=100 kg/min",
+            "--set",
+            "evaporator.P100=150 kPa",
+            "--set",
+            "x2_control.sp=36 %",
+        ],
+    ];
+    let file = format!("{ROOT}/flowsheets/evaporator.json");
+    for start in starts {
+        let mut args = vec![file.as_str()];
+        args.extend_from_slice(start);
+        let o = optimum(&args);
+        let opt = &r["optimum"];
+        let v = &o["values"];
+        assert!(close(o["objective"].as_f64().unwrap(), opt["cost"].as_f64().unwrap(), 1e-6), "{start:?}: {o}");
+        for (path, key) in [("evaporator.F1", "F1"), ("evaporator.F200", "F200")] {
+            let ours = v[path].as_f64().unwrap() / KG_PER_MIN;
+            assert!(close(ours, opt[key].as_f64().unwrap(), 1e-6), "{start:?}: {path} {ours} vs {}", opt[key]);
+        }
+        assert!(close(v["evaporator.P100"].as_f64().unwrap(), 400e3, 1e-6), "{o}");
+        assert!(close(v["evaporator.X2"].as_f64().unwrap(), 0.355, 1e-6), "{o}");
+        let mut active: Vec<&str> = o["active"].as_array().unwrap().iter().map(|a| a.as_str().unwrap()).collect();
+        active.sort_unstable();
+        assert_eq!(active, ["evaporator.P100:max", "evaporator.X2:min"], "{start:?}");
+        // Shadow prices: SciPy's envelope-theorem values (checked there against re-optimization).
+        for name in ["evaporator.X2:min", "evaporator.P100:max"] {
+            let (ours, theirs) =
+                (o["multipliers"][name].as_f64().unwrap(), r["shadow_prices"][name]["envelope"].as_f64().unwrap());
+            assert!(close(ours, theirs, 1e-6), "{start:?}: {name} {ours} vs {theirs}");
+        }
+        assert!(o["kkt_residual"].as_f64().unwrap() < 1e-8, "{o}");
+        // The reduced Hessian along F1, F200 is Juu: central differences of exact gradients here,
+        // of complex-step gradients there, both at a relative step of 1e-4.
+        let h = &o["reduced_hessian"];
+        assert_eq!(h["free"], serde_json::json!(["evaporator.F1@kg/min", "evaporator.F200@kg/min"]));
+        let theirs = &r["reduced_hessian"]["hessian"];
+        for i in 0..2 {
+            for j in 0..2 {
+                let (a, b) = (h["matrix"][i][j].as_f64().unwrap(), theirs[i][j].as_f64().unwrap());
+                assert!(close(a, b, 1e-5), "{start:?}: Juu[{i}][{j}] {a} vs {b}");
+            }
+        }
+    }
+}
+
+/// Column A (flowsheets/column_a.json) with economics under which over-purifying either product
+/// only costs boilup: J = p_V V + p_F F − p_D D − p_B B with p_D = p_B = p_F, so J = p_V V.
+fn column_a_economics(extra: &[(&str, Value)]) -> String {
+    let mut f: Value =
+        serde_json::from_str(&std::fs::read_to_string(format!("{ROOT}/flowsheets/column_a.json")).unwrap()).unwrap();
+    f["parameters"] = serde_json::json!({"p_V": "0.01 $/kmol", "p": "1 $/kmol"});
+    f["tags"] = serde_json::json!({"cost": {
+        "expression": "p_V*column.boilup + p*feed_source.F - p*distillate.F - p*bottoms.F", "unit": "$/min"}});
+    f["optimization"] = serde_json::json!({
+        "objective": "cost",
+        "vary": {"column.reflux": {}, "column.boilup": {}},
+        "constraints": {"distillate.x[light]": {"min": 0.99}, "bottoms.x[light]": {"max": 0.01},
+                        "distillate.F": {"min": "0 kmol/min"}}
+    });
+    for (k, v) in extra {
+        f["optimization"]["constraints"][*k] = v.clone();
+    }
+    scratch(&format!("column_a_economics_{}.json", extra.len()), &serde_json::to_string_pretty(&f).unwrap())
+}
+
+#[test]
+fn column_a_meets_both_purity_specs_exactly_at_its_published_operating_point() {
+    let file = column_a_economics(&[]);
+    let o = optimum(&[&file, "--set", "column.reflux=3 kmol/min", "--set", "column.boilup=3.6 kmol/min"]);
+    let v = &o["values"];
+    let mut active: Vec<&str> = o["active"].as_array().unwrap().iter().map(|a| a.as_str().unwrap()).collect();
+    active.sort_unstable();
+    assert_eq!(active, ["bottoms.x[light]:max", "distillate.x[light]:min"], "{o}");
+    assert!((v["distillate.x[light]"].as_f64().unwrap() - 0.99).abs() < 1e-10, "{o}");
+    assert!((v["bottoms.x[light]"].as_f64().unwrap() - 0.01).abs() < 1e-10, "{o}");
+    // The component balance in closed form: D = F (zF − xB)/(xD − xB) = 0.5 kmol/min.
+    let kmol_per_min = 1000.0 / 60.0;
+    assert!(close(v["distillate.F"].as_f64().unwrap() / kmol_per_min, 0.5, 1e-9), "{o}");
+    // Skogestad & Postlethwaite (2005), section 12.4: L = 2.70629, V = 3.20629 kmol/min.
+    assert!(close(v["column.reflux"].as_f64().unwrap() / kmol_per_min, 2.70629, 2e-6), "{o}");
+    assert!(close(v["column.boilup"].as_f64().unwrap() / kmol_per_min, 3.20629, 2e-6), "{o}");
+    assert!(close(o["objective"].as_f64().unwrap(), 0.01 * v["column.boilup"].as_f64().unwrap() / kmol_per_min, 1e-9));
+    // A vertex: both degrees of freedom fixed by the active specs, nothing left to curve.
+    assert_eq!(o["reduced_hessian"]["free"], serde_json::json!([]));
+    // Purer products cost boilup: the distillate's lower limit has a positive price, the
+    // bottoms' upper limit a negative one.
+    assert!(o["multipliers"]["distillate.x[light]:min"].as_f64().unwrap() > 0.0, "{o}");
+    assert!(o["multipliers"]["bottoms.x[light]:max"].as_f64().unwrap() < 0.0, "{o}");
+}
+
+#[test]
+fn shadow_prices_are_the_change_of_the_optimum_as_the_limit_moves() {
+    let file = column_a_economics(&[]);
+    let base = optimum(&[&file]);
+    let h = 1e-5;
+    for (path, side, at) in [("distillate.x[light]", "min", 0.99), ("bottoms.x[light]", "max", 0.01)] {
+        let moved = |d: f64| {
+            let f = column_a_economics(&[(path, serde_json::json!({side: at + d}))]);
+            optimum(&[&f])["objective"].as_f64().unwrap()
+        };
+        let fd = (moved(h) - moved(-h)) / (2.0 * h);
+        let price = base["multipliers"][format!("{path}:{side}")].as_f64().unwrap();
+        assert!(close(price, fd, 1e-4), "{path}: multiplier {price} vs re-optimized {fd}");
+    }
+}
+
+#[test]
+fn a_plant_that_cannot_meet_its_limits_exits_2_naming_them() {
+    let file = column_a_economics(&[]);
+    let out = plantwide(&["optimize", &file, "--vary", "column.reflux", "--vary", "column.boilup=:2.9 kmol/min"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("no feasible point"), "{err}");
+    assert!(err.contains("`distillate.x[light]` = ") && err.contains("below its min 0.99"), "{err}");
+    assert!(err.contains("`bottoms.x[light]` = ") && err.contains("above its max 0.01"), "{err}");
+    assert!(out.stdout.is_empty(), "no optimum printed: {}", String::from_utf8_lossy(&out.stdout));
+}
+
+#[test]
+fn bad_requests_exit_1_naming_the_field() {
+    let file = column_a_economics(&[]);
+    let cases: [(&[&str], &str); 5] = [
+        (&["--vary", "column.reflx"], "optimization.vary.column.reflx"),
+        (&["--vary", "column.distillate"], "driven by controller"),
+        (&["--objective", "no_such_tag"], "optimization.objective"),
+        (&["--constraint", "distillate.x[light]=0.99 kmol:"], "optimization.constraints.distillate.x[light].min"),
+        (&["--constraint", "distillate.x[light]=0.99"], "--constraint"),
+    ];
+    for (extra, fragment) in cases {
+        let mut args = vec!["optimize", file.as_str()];
+        args.extend_from_slice(extra);
+        let out = plantwide(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{extra:?}: {err}");
+        assert!(err.contains(fragment), "{extra:?}: `{fragment}` not in {err}");
+        assert!(!err.contains("panicked"), "{err}");
+    }
+    let plain = format!("{ROOT}/flowsheets/column_a.json");
+    let out = plantwide(&["optimize", &plain]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no objective"));
+}
+
+#[test]
+fn the_text_report_and_the_report_folder() {
+    let dir = std::env::temp_dir().join(format!("plantwide-optimize-report-{}", std::process::id()));
+    let file = format!("{ROOT}/flowsheets/evaporator.json");
+    let out = plantwide(&["optimize", &file, "--report", dir.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8_lossy(&out.stdout);
+    for fragment in ["economic optimum", "evaporator.X2:min", "211.02", "reduced Hessian", "KKT residual"] {
+        assert!(text.contains(fragment), "`{fragment}` not in {text}");
+    }
+    let json: Value = serde_json::from_str(&std::fs::read_to_string(dir.join("optimum.json")).unwrap()).unwrap();
+    for key in ["objective", "values", "active", "multipliers", "kkt_residual"] {
+        assert!(json.get(key).is_some(), "no `{key}`");
+    }
+    assert!(dir.join("optimum.md").exists());
+}

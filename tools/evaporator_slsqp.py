@@ -1,0 +1,401 @@
+#!/usr/bin/env python3
+"""Newell-Lee evaporator, economic optimum with all its constraints free: an independent SciPy
+SLSQP reference for `plantwide optimize` (written to tests/data/evaporator/slsqp.json).
+
+Written from the published model, not from the flowsheet file nor from tools/evaporator_scipy.py
+(nothing is imported from it): Newell & Lee (1989), "Applied Process Control - A Case Study",
+Prentice Hall, ch. 2 (the evaporator model and its constants), with the economic operating region
+of Kariwala, Cao & Janardhanan (2008), "Local self-optimizing control with average loss
+minimization", Ind. Eng. Chem. Res. 47, 1150-1158 (the cost J, the constraints 40 <= P2 <= 80 kPa,
+F3 <= 100 kg/min, X2 >= 35.5 %, P100 <= 400 kPa, and the bounds F1 <= 20, F200 <= 400 kg/min).
+As in tools/evaporator_scipy.py, the equations and constants were read from public restatements
+of the Newell-Lee model, which agree with one another to every digit.
+
+Units are the paper's: flows kg/min, compositions %, pressures kPa, temperatures degC, duties kW,
+cost $/h. Decision variables v = (F1, F200, P100, X2): four steady-state degrees of freedom (X2 is
+the setpoint of the composition loop; the level L2 has no steady-state effect). With the
+disturbances d = (X1, T1, T200) = (5 %, 40 degC, 25 degC), the steady state is explicit in v:
+  F2   = F1 X1 / X2                                   (eq. 2 at steady state)
+  F4   = F1 - F2,  F5 = F4,  Q200 = 38.5 F5           (eqs. 1, 3, 12)
+  T3   = T200 + Q200 (1 + UA2/(2 Cp F200)) / UA2      (eq. 10; UA2 = 6.84 kW/K, Cp = 0.07)
+  P2   = (T3 - 55) / 0.507                            (eq. 5)
+  T2   = 0.5616 P2 + 0.3126 X2 + 48.43                (eq. 4)
+  T100 = 0.1538 P100 + 90                             (eq. 7)
+  Q100 = 38.5 F4 + 0.07 F1 (T2 - T1)                  (eq. 6)
+  F3   = Q100 / (0.16 (T100 - T2)) - F1               (eq. 8)
+  F100 = Q100 / 36.6                                  (eq. 9)
+  T201 = T200 + Q200 / (F200 Cp)                      (eq. 11)
+  J    = 600 F100 + 0.6 F200 + 1.009 (F2 + F3) + 0.2 F1 - 4800 F2   [$/h], minimised.
+
+What the script computes:
+(a) the optimum by scipy.optimize.minimize(method="SLSQP") from several starting points, with
+    exact (complex-step) gradients of J and of the constraints; the Kariwala constraints on P2, F3,
+    X2 and P100 are general inequality constraints (so SLSQP reports their multipliers), the flow
+    limits are bounds, and X2 <= 50 %, P100 >= 100 kPa are loose bounds of ours that keep SLSQP in
+    the model's domain (asserted inactive);
+(b) the optimum polished on the two unconstrained variables (F1, F200) at the active limits by
+    solving grad J = 0 (complex step) with scipy.optimize.root, exact to rounding; every SLSQP run
+    must agree with it to 1e-6 relative, and with tests/data/evaporator/scipy.json to 1e-7;
+(c) the shadow prices dJ*/d(limit) of the two active constraints, by the envelope theorem
+    (partial derivative of J at the optimum with F1, F200 held, complex step) and by central
+    differences of the polished re-optimum at limit +- h, h = 1e-3 of the limit (truncation error
+    O(h^2): 7e-6 relative for X2, so it is checked to 1e-4) and their Richardson extrapolation
+    with h/2 (checked to 1e-6), plus SLSQP's own KKT multipliers;
+(d) the reduced Hessian Juu of J in (F1, F200) at the active limits (Kariwala et al. 2008), by
+    central differences (relative step 1e-4) of the complex-step gradient, and its eigenvalues.
+
+Usage: python3 tools/evaporator_slsqp.py           (rewrite tests/data/evaporator/slsqp.json)
+       python3 tools/evaporator_slsqp.py --check   (recompute; exit 1 unless it matches the file)
+"""
+
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+import scipy
+from scipy.optimize import minimize, root
+
+ROOT = Path(__file__).resolve().parent.parent
+OUT = ROOT / "tests" / "data" / "evaporator" / "slsqp.json"
+# The reduced reference (optimum over F1, F200 at the active limits): the numbers to agree with.
+REDUCED = ROOT / "tests" / "data" / "evaporator" / "scipy.json"
+
+# Newell & Lee (1989) constants.
+CP = 0.07  # kW/(K kg/min), liquor heat capacity
+LAM = 38.5  # kW/(kg/min), latent heat of the liquor vapour
+LAM_S = 36.6  # kW/(kg/min), latent heat of the steam
+UA1_PER_FLOW = 0.16  # kW/(K kg/min), evaporator UA1 = 0.16 (F1 + F3)
+UA2 = 6.84  # kW/K, condenser
+
+# Nominal disturbances (Newell & Lee 1989; Kariwala et al. 2008).
+D_NOM = {"X1": 5.0, "T1": 40.0, "T200": 25.0}
+
+VARS = ["F1", "F200", "P100", "X2"]
+UNITS = {"F1": "kg/min", "F200": "kg/min", "P100": "kPa", "X2": "%"}
+# Bounds: F1 <= 20, F200 <= 400 are Kariwala et al.'s; the small positive lower bounds on the flows
+# and X2 <= 50, P100 >= 100 are ours (loose, to keep SLSQP where the model is defined).
+BOUNDS = {"F1": (0.1, 20.0), "F200": (0.1, 400.0), "P100": (100.0, None), "X2": (None, 50.0)}
+OURS = ["F1:min", "F200:min", "P100:min", "X2:max"]
+# Kariwala et al. (2008) inequality constraints: (name, variable, kind, limit).
+CONSTRAINTS = [
+    ("evaporator.P2:min", "P2", "min", 40.0),
+    ("evaporator.P2:max", "P2", "max", 80.0),
+    ("evaporator.F3:max", "F3", "max", 100.0),
+    ("evaporator.X2:min", "X2", "min", 35.5),
+    ("evaporator.P100:max", "P100", "max", 400.0),
+]
+ACTIVE = {"evaporator.X2:min": ("X2", 35.5), "evaporator.P100:max": ("P100", 400.0)}
+UNCONSTRAINED = ["F1", "F200"]
+
+STARTS = [[10.0, 200.0, 300.0, 40.0], [15.0, 300.0, 350.0, 45.0], [5.0, 100.0, 150.0, 36.0]]
+SLSQP_OPTIONS = {"ftol": 1e-14, "maxiter": 500}
+# SLSQP works on v / SCALE and COST_SCALE * J (units of 1 kg/min, 50 kg/min, 10 kPa, 0.1 % and
+# 100 $/h). Unscaled, J is ~3000 times stiffer in F1 than in F200 (Juu below) and SLSQP stops
+# from these starts with "Positive directional derivative for linesearch", F200 off by up to 3e-5.
+SCALE = np.array([1.0, 50.0, 10.0, 0.1])
+COST_SCALE = 0.01
+H_CS = 1e-30  # complex step
+
+
+def model(v, d=D_NOM):
+    """The steady state for v = (F1, F200, P100, X2): every variable in closed form (real or
+    complex arithmetic, so that the complex step differentiates it exactly)."""
+    f1, f200, p100, x2 = v
+    f2 = f1 * d["X1"] / x2
+    f4 = f1 - f2
+    q200 = LAM * f4
+    t3 = d["T200"] + q200 * (1.0 + UA2 / (2.0 * CP * f200)) / UA2
+    p2 = (t3 - 55.0) / 0.507
+    t2 = 0.5616 * p2 + 0.3126 * x2 + 48.43
+    t100 = 0.1538 * p100 + 90.0
+    q100 = LAM * f4 + CP * f1 * (t2 - d["T1"])
+    f3 = q100 / (UA1_PER_FLOW * (t100 - t2)) - f1
+    f100 = q100 / LAM_S
+    t201 = d["T200"] + q200 / (f200 * CP)
+    j = 600.0 * f100 + 0.6 * f200 + 1.009 * (f2 + f3) + 0.2 * f1 - 4800.0 * f2
+    return {
+        "F1": f1, "F200": f200, "P100": p100, "X2": x2, "F2": f2, "F3": f3, "F4": f4, "P2": p2,
+        "T2": t2, "T3": t3, "T100": t100, "Q100": q100, "Q200": q200, "F100": f100, "T201": t201,
+        "cost": j,
+    }
+
+
+def cs_grad(fun, v):
+    """Gradient of the real scalar fun at v by the complex step (exact to rounding)."""
+    v = np.asarray(v, dtype=float)
+    g = np.zeros(len(v))
+    for j in range(len(v)):
+        z = v.astype(complex)
+        z[j] += 1j * H_CS
+        g[j] = np.imag(fun(z)) / H_CS
+    return g
+
+
+def cost(v):
+    """J in $/h at v = (F1, F200, P100, X2)."""
+    return model(v)["cost"]
+
+
+def constraint_value(v, var, kind, limit):
+    """Constraint in SLSQP's form c(v) >= 0."""
+    x = model(v)[var]
+    return x - limit if kind == "min" else limit - x
+
+
+def slsqp_constraints():
+    """The five Kariwala constraints as SLSQP inequality dicts in the scaled variables."""
+    cons = []
+    for _, var, kind, limit in CONSTRAINTS:
+        def c(s, var=var, kind=kind, limit=limit):
+            return np.real(constraint_value(s * SCALE, var, kind, limit))
+
+        def jac(s, var=var, kind=kind, limit=limit):
+            return cs_grad(lambda z: constraint_value(z, var, kind, limit), s * SCALE) * SCALE
+
+        cons.append({"type": "ineq", "fun": c, "jac": jac})
+    return cons
+
+
+def run_slsqp(x0):
+    """SLSQP from x0 in the scaled variables v / SCALE with the cost in units of COST_SCALE^-1 $/h;
+    returns the result with x in physical units and the multipliers in $/h per constraint unit."""
+    bounds = [tuple(None if b is None else b / sc for b in BOUNDS[k]) for k, sc in zip(VARS, SCALE)]
+    res = minimize(lambda s: COST_SCALE * np.real(cost(s * SCALE)), np.asarray(x0) / SCALE,
+                   jac=lambda s: COST_SCALE * cs_grad(cost, s * SCALE) * SCALE, method="SLSQP",
+                   bounds=bounds, constraints=slsqp_constraints(), options=SLSQP_OPTIONS)
+    assert res.success, (x0, res.message)
+    res.x = res.x * SCALE
+    res.fun = res.fun / COST_SCALE
+    if getattr(res, "multipliers", None) is not None:
+        res.multipliers = np.asarray(res.multipliers) / COST_SCALE
+    return res
+
+
+def reduced(u, x2, p100):
+    """J as a function of the unconstrained (F1, F200) at fixed X2, P100."""
+    return cost([u[0], u[1], p100, x2])
+
+
+def polish(u0, x2=35.5, p100=400.0):
+    """Solve dJ/d(F1, F200) = 0 at fixed X2, P100 (complex-step gradient): exact to rounding."""
+    def grad(u):
+        return cs_grad(lambda z: reduced(z, x2, p100), u)
+
+    sol = root(grad, u0, method="hybr", options={"xtol": 1e-14})
+    assert np.max(np.abs(grad(sol.x))) < 1e-9, sol
+    return np.array([sol.x[0], sol.x[1], p100, x2])
+
+
+def rel(a, b):
+    """Relative difference of a from b."""
+    return abs(a - b) / abs(b)
+
+
+def is_active(point, var, limit, tol=1e-7):
+    """True when point[var] sits at limit (relative tolerance tol)."""
+    return abs(float(np.real(point[var])) - limit) <= tol * abs(limit)
+
+
+def summarize(point):
+    """The recorded optimum: real floats of the named variables."""
+    keys = ["F1", "F200", "P100", "X2", "F2", "F3", "P2", "F100", "T201", "cost"]
+    return {k: float(np.real(point[k])) for k in keys}
+
+
+def reoptimized_cost(v_opt, var, limit):
+    """J* with one active limit moved to `limit`, F1 and F200 re-optimized (polished)."""
+    lim = {"X2": 35.5, "P100": 400.0, var: limit}
+    return float(np.real(cost(polish(v_opt[:2], x2=lim["X2"], p100=lim["P100"]))))
+
+
+def shadow_prices(v_opt):
+    """dJ*/d(limit) for each active limit: envelope theorem, and central differences of the
+    polished re-optimum at limit +- h (h = 1e-3 of the limit, error O(h^2)) with the Richardson
+    extrapolation of h and h/2 (error O(h^4))."""
+    out = {}
+    grad = cs_grad(cost, v_opt)
+    for name, (var, limit) in ACTIVE.items():
+        envelope = float(grad[VARS.index(var)])
+        h = 1e-3 * limit
+        cd = [(reoptimized_cost(v_opt, var, limit + s) - reoptimized_cost(v_opt, var, limit - s)) / (2.0 * s)
+              for s in (h, h / 2.0)]
+        richardson = (4.0 * cd[1] - cd[0]) / 3.0
+        assert rel(cd[0], envelope) < 1e-4, (name, envelope, cd[0])
+        assert rel(richardson, envelope) < 1e-6, (name, envelope, richardson)
+        unit = "$/h per %" if var == "X2" else "$/h per kPa"
+        out[name] = {"unit": unit, "envelope": envelope, "step": h, "central_difference": cd[0],
+                     "central_difference_half_step": cd[1], "richardson": richardson,
+                     "relative_difference": {"central_difference": rel(cd[0], envelope),
+                                             "richardson": rel(richardson, envelope)}}
+    return out
+
+
+def reduced_hessian(v_opt, rel_step=1e-4):
+    """Juu: central differences of the complex-step gradient in (F1, F200) at the active limits."""
+    u = np.array(v_opt[:2], dtype=float)
+    x2, p100 = v_opt[3], v_opt[2]
+    hess = np.zeros((2, 2))
+    for j in range(2):
+        h = rel_step * abs(u[j])
+        gp = cs_grad(lambda z: reduced(z, x2, p100), u + h * np.eye(2)[j])
+        gm = cs_grad(lambda z: reduced(z, x2, p100), u - h * np.eye(2)[j])
+        hess[:, j] = (gp - gm) / (2.0 * h)
+    asym = abs(hess[0, 1] - hess[1, 0]) / np.max(np.abs(hess))
+    assert asym < 1e-6, asym
+    hess = 0.5 * (hess + hess.T)
+    eig = np.linalg.eigvalsh(hess)
+    assert np.all(eig > 0.0), eig
+    return hess, eig, float(asym)
+
+
+def multipliers(res, prices):
+    """SLSQP's KKT multipliers (if this SciPy returns them) as dJ*/d(limit), against the envelope
+    shadow prices."""
+    if getattr(res, "multipliers", None) is None:
+        return {"available": False, "note": f"SciPy {scipy.__version__} does not return res.multipliers"}
+    lam = np.asarray(res.multipliers, dtype=float)
+    assert len(lam) == len(CONSTRAINTS), lam
+    raw = {name: float(m) for (name, _, _, _), m in zip(CONSTRAINTS, lam)}
+    as_price = {name: (raw[name] if kind == "min" else -raw[name]) + 0.0 for name, _, kind, _ in CONSTRAINTS}
+    diff = {name: rel(as_price[name], prices[name]["envelope"]) for name in ACTIVE}
+    assert max(diff.values()) < 1e-6, diff
+    return {
+        "available": True,
+        "convention": "SciPy SLSQP: L = J - sum(lambda_i c_i) with every constraint written c_i(v) >= 0 "
+        "(c = x - limit for a :min, c = limit - x for a :max) and lambda_i >= 0, so "
+        "dJ*/d(limit) = +lambda for a :min and -lambda for a :max; multipliers of the QP "
+        "subproblem at the last iterate of the first start (bounds get none), unscaled to $/h per unit",
+        "lambda": raw,
+        "as_dJ_dlimit": as_price,
+        "relative_difference": diff,
+    }
+
+
+def start_record(x0, res, opt):
+    """One SLSQP run for the JSON, asserted within 1e-6 relative of the polished optimum."""
+    pt = model(res.x)
+    keys = VARS + ["cost"]
+    worst = max(rel(float(pt[k]), float(opt[k])) for k in keys)
+    assert worst < 1e-6, (x0, worst)
+    return {"x0": dict(zip(VARS, x0)), "iterations": int(res.nit), "function_evaluations": int(res.nfev),
+            "gradient_evaluations": int(res.njev), "message": str(res.message),
+            "x": dict(zip(VARS, map(float, res.x))), "cost": float(res.fun),
+            "max_relative_difference_from_polished": worst}
+
+
+def solve():
+    """Every SLSQP run, checked against each other, the polished optimum and the reduced reference."""
+    runs = [run_slsqp(x0) for x0 in STARTS]
+    v_opt = polish(runs[0].x[:2])
+    opt = model(v_opt)
+    ref = json.loads(REDUCED.read_text())["optimum"]
+    for k in ("F1", "F200", "cost"):
+        assert rel(float(opt[k]), ref[k]) < 1e-7, (k, opt[k], ref[k])
+    for res in runs:
+        for a, b in ((res.x[0], runs[0].x[0]), (res.x[1], runs[0].x[1]), (res.fun, runs[0].fun)):
+            assert rel(a, b) < 1e-7, (a, b)
+        for k, x in (("F1", res.x[0]), ("F200", res.x[1]), ("cost", res.fun)):
+            assert rel(float(x), ref[k]) < 1e-7, (k, x, ref[k])
+    starts = [start_record(x0, res, opt) for x0, res in zip(STARTS, runs)]
+    return runs, v_opt, opt, starts
+
+
+def active_set(opt):
+    """The constraints at their limits (must be exactly ACTIVE); every bound must be inactive."""
+    active = [name for name, var, _, limit in CONSTRAINTS if is_active(opt, var, limit)]
+    assert active == list(ACTIVE), active
+    for var, (lo, hi) in BOUNDS.items():
+        for limit in (lo, hi):
+            assert limit is None or not is_active(opt, var, limit, tol=1e-3), (var, limit)
+    return active
+
+
+def problem():
+    """The problem statement for the JSON: variables, bounds (ours marked), constraints, cost, solver."""
+    return {
+        "variables": [{"name": k, "unit": UNITS[k], "bounds": list(BOUNDS[k])} for k in VARS],
+        "disturbances": D_NOM,
+        "constraints": [{"name": n, "variable": var, "kind": kind, "limit": lim} for n, var, kind, lim in CONSTRAINTS],
+        "ours": {"bounds": [f"evaporator.{b}" for b in OURS],
+                 "note": "F1 >= 0.1, F200 >= 0.1 kg/min (the paper's 0 < F1, F200, made closed), X2 <= 50 % and "
+                 "P100 >= 100 kPa are ours, loose, to keep SLSQP in the model's domain; all inactive at the "
+                 "optimum. F1 <= 20, F200 <= 400 kg/min and the five constraints are Kariwala et al. (2008)'s."},
+        "cost": "J = 600 F100 + 0.6 F200 + 1.009 (F2 + F3) + 0.2 F1 - 4800 F2 [$/h], minimised",
+        "solver": {"method": "scipy.optimize.minimize SLSQP", "options": SLSQP_OPTIONS,
+                   "gradients": "complex step (objective and constraints)",
+                   "scaling": {"variables": dict(zip(VARS, SCALE.tolist())), "cost": COST_SCALE,
+                               "note": "SLSQP iterates on v / scale and cost * J; results are unscaled"}},
+    }
+
+
+def compute():
+    """Everything the JSON holds, recomputed."""
+    runs, v_opt, opt, starts = solve()
+    hess, eig, asym = reduced_hessian(v_opt)
+    prices = shadow_prices(v_opt)
+    return {
+        "description": "Reference economic optimum of the Newell & Lee (1989) evaporator with every constraint "
+        "of Kariwala, Cao & Janardhanan (2008) free, by SciPy SLSQP over (F1, F200, P100, X2), from "
+        "tools/evaporator_slsqp.py; the optimum is polished on (F1, F200) at the active limits. "
+        "Units: flows kg/min, X %, P kPa, T degC, Q kW, cost $/h.",
+        "versions": {"python": sys.version.split()[0], "numpy": np.__version__, "scipy": scipy.__version__},
+        "problem": problem(),
+        "starts": starts,
+        "optimum": summarize(opt),
+        "active": active_set(opt),
+        "shadow_prices": prices,
+        "slsqp_multipliers": multipliers(runs[0], prices),
+        "reduced_hessian": {
+            "variables": UNCONSTRAINED,
+            "unit": "$/h per (kg/min)^2",
+            "at": {"X2": 35.5, "P100": 400.0},
+            "method": "central differences (relative step 1e-4) of the complex-step gradient, symmetrised",
+            "hessian": hess.tolist(),
+            "eigenvalues": eig.tolist(),
+            "asymmetry_over_max": asym,
+        },
+    }
+
+
+def compare(new, old, path="", rtol=1e-9, atol=1e-12):
+    """Numbers within rtol (relative to each number, atol floor); other values equal; versions and
+    rounding-level diagnostics ignored."""
+    if path.endswith(("versions", "asymmetry_over_max", "relative_difference", "max_relative_difference_from_polished")):
+        return []
+    if isinstance(new, dict) and isinstance(old, dict):
+        if set(new) != set(old):
+            return [f"{path}: keys {sorted(set(new) ^ set(old))} differ"]
+        return [b for k in new for b in compare(new[k], old[k], f"{path}.{k}", rtol, atol)]
+    if isinstance(new, list) and isinstance(old, list):
+        if len(new) != len(old):
+            return [f"{path}: length {len(new)} vs {len(old)}"]
+        return [b for i, (a, o) in enumerate(zip(new, old)) for b in compare(a, o, f"{path}[{i}]", rtol, atol)]
+    numbers = (int, float)
+    if isinstance(new, numbers) and isinstance(old, numbers) and not isinstance(new, bool):
+        return [] if abs(new - old) <= rtol * abs(old) + atol else [f"{path}: {new!r} vs committed {old!r}"]
+    return [] if new == old else [f"{path}: {new!r} vs committed {old!r}"]
+
+
+def main():
+    """Write the JSON, or with --check compare a fresh run with it."""
+    ref = compute()
+    name = OUT.relative_to(ROOT)
+    if "--check" in sys.argv[1:]:
+        bad = compare(ref, json.loads(OUT.read_text()))
+        if bad:
+            print(f"{name}: {len(bad)} numbers differ from a fresh run:", file=sys.stderr)
+            print("\n".join(bad[:20]), file=sys.stderr)
+            sys.exit(1)
+        o, s = ref["optimum"], ref["shadow_prices"]
+        print(f"{name}: matches a fresh run (optimum F1 {o['F1']:.4f}, F200 {o['F200']:.3f} kg/min, "
+              f"J {o['cost']:.3f} $/h; shadow prices X2:min {s['evaporator.X2:min']['envelope']:.4f} $/h per %, "
+              f"P100:max {s['evaporator.P100:max']['envelope']:.5f} $/h per kPa; "
+              f"SLSQP iterations {[r['iterations'] for r in ref['starts']]})")
+        return
+    OUT.write_text(json.dumps(ref, indent=1) + "\n")
+    print(f"wrote {name}")
+
+
+if __name__ == "__main__":
+    main()
