@@ -100,6 +100,9 @@ pub fn run(a: &OptimizeArgs) -> Result<(), CliError> {
 
 /// Exit 1 for the request, 2 for the plant or the numbers; the file named.
 fn optimize_error(file: &std::path::Path, e: OptimizeError) -> CliError {
-    let message = format!("{}: {e}", file.display());
+    let text = e.to_string();
+    let name = file.display().to_string();
+    // Messages that name a path of the plant already carry the file.
+    let message = if text.contains(&name) { text } else { format!("{name}: {text}") };
     if e.is_user_error() { CliError::user(message) } else { CliError::numerical(message) }
 }
