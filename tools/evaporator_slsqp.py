@@ -42,7 +42,15 @@ What the script computes:
     O(h^2): 7e-6 relative for X2, so it is checked to 1e-4) and their Richardson extrapolation
     with h/2 (checked to 1e-6), plus SLSQP's own KKT multipliers;
 (d) the reduced Hessian Juu of J in (F1, F200) at the active limits (Kariwala et al. 2008), by
-    central differences (relative step 1e-4) of the complex-step gradient, and its eigenvalues.
+    central differences (relative step 1e-4) of the complex-step gradient, and its eigenvalues;
+(e) the local model of self-optimizing control at the optimum with X2 = 35.5 %, P100 = 400 kPa held
+    (Halvorsen et al. 2003; Kariwala et al. 2008's u = (F1, F200), d = (X1, T1, T200) and ten
+    candidate measurements): Gy, Gyd by complex step, Juu, Jud by central differences of the
+    complex-step gradient checked by Richardson extrapolation, and, for information, the difference
+    from the pySOC matrices in crates/soc/tests/data/evaporator.json;
+(f) the nonlinear loss J_held - J_opt of holding each of the 45 pairs of candidates at its nominal
+    optimal value when one disturbance moves by +- Wd = (0.25 %, 8 degC, 5 degC), J_opt the polished
+    re-optimum at X2 = 35.5 %, P100 = 400 kPa.
 
 Usage: python3 tools/evaporator_slsqp.py           (rewrite tests/data/evaporator/slsqp.json)
        python3 tools/evaporator_slsqp.py --check   (recompute; exit 1 unless it matches the file)
@@ -172,15 +180,15 @@ def run_slsqp(x0):
     return res
 
 
-def reduced(u, x2, p100):
-    """J as a function of the unconstrained (F1, F200) at fixed X2, P100."""
-    return cost([u[0], u[1], p100, x2])
+def reduced(u, x2, p100, d=D_NOM):
+    """J as a function of the unconstrained (F1, F200) at fixed X2, P100 and disturbances d."""
+    return model([u[0], u[1], p100, x2], d)["cost"]
 
 
-def polish(u0, x2=35.5, p100=400.0):
-    """Solve dJ/d(F1, F200) = 0 at fixed X2, P100 (complex-step gradient): exact to rounding."""
+def polish(u0, x2=35.5, p100=400.0, d=D_NOM):
+    """Solve dJ/d(F1, F200) = 0 at fixed X2, P100, d (complex-step gradient): exact to rounding."""
     def grad(u):
-        return cs_grad(lambda z: reduced(z, x2, p100), u)
+        return cs_grad(lambda z: reduced(z, x2, p100, d), u)
 
     sol = root(grad, u0, method="hybr", options={"xtol": 1e-14})
     assert np.max(np.abs(grad(sol.x))) < 1e-9, sol
@@ -355,14 +363,243 @@ def compute():
             "eigenvalues": eig.tolist(),
             "asymmetry_over_max": asym,
         },
+        "local_model": local_model(v_opt, hess),
+        "nonlinear_losses": nonlinear_losses(v_opt),
+    }
+
+
+# --- (e) local model of self-optimizing control, (f) nonlinear losses of measurement pairs -------------
+# Skogestad (2000), "Plantwide control: the search for the self-optimizing control structure",
+# J. Process Control 10, 487-507; Halvorsen, Skogestad, Morud & Alstad (2003), "Optimal selection of
+# controlled variables", IECR 42, 3273-3284 (the local model Gy, Gyd, Juu, Jud); Kariwala, Cao &
+# Janardhanan (2008) (the evaporator's inputs, disturbances, magnitudes Wd and ten candidates).
+
+INPUTS = ["F1", "F200"]  # u, kg/min (F1 first; crates/soc/tests/data/evaporator.json has F200 first)
+DISTURBANCES = ["X1", "T1", "T200"]  # d: %, degC, degC
+WD = [0.25, 8.0, 5.0]  # Kariwala et al. (2008): expected disturbance magnitudes
+CANDIDATES = ["P2", "T2", "T3", "F2", "F100", "T201", "F3", "F5", "F200", "F1"]
+CANDIDATE_UNITS = {"P2": "kPa", "T2": "degC", "T3": "degC", "T201": "degC"}  # the rest kg/min
+HELD = {"X2": 35.5, "P100": 400.0}  # the active constraints, controlled at their limits
+# Kariwala et al.'s other limits, checked at the held points: (variable, kind, limit).
+OTHER_LIMITS = [("P2", "min", 40.0), ("P2", "max", 80.0), ("F3", "max", 100.0), ("F1", "max", 20.0),
+                ("F200", "max", 400.0)]
+KARIWALA = ROOT / "crates" / "soc" / "tests" / "data" / "evaporator.json"  # pySOC matrices, u = (F200, F1)
+HELD_ROOT_OPTIONS = {"xtol": 1e-14}
+# A pair whose 2x2 Gy is singular (P2, T2, T3 are affine in one another at fixed X2; F2, F5, F1 are
+# proportional at fixed X1, X2) does not determine u; its held point counts as not converged.
+SINGULAR_COND = 1e10
+HELD_RESIDUAL = 1e-10  # relative residual of a converged held point
+LOSS_ATOL = 1e-9  # $/h: --check floor for a loss, the difference of two J's of ~600 $/h
+
+
+def d_dict(dv):
+    """The disturbance dict of model() from a vector in DISTURBANCES order."""
+    return dict(zip(DISTURBANCES, dv))
+
+
+def measure(point, name):
+    """Candidate `name` from a model() point; F5 = F4 (Newell & Lee eq. 3 at steady state)."""
+    return point["F4"] if name == "F5" else point[name]
+
+
+def outputs(u, dv, names=CANDIDATES):
+    """The candidates `names` at u = (F1, F200), d = dv, with X2 and P100 held (complex-safe)."""
+    point = model([u[0], u[1], HELD["P100"], HELD["X2"]], d_dict(dv))
+    return np.array([measure(point, n) for n in names])
+
+
+def held_cost(u, dv):
+    """J ($/h) at u = (F1, F200), d = dv, with X2 and P100 held (complex-safe)."""
+    return model([u[0], u[1], HELD["P100"], HELD["X2"]], d_dict(dv))["cost"]
+
+
+def cs_jacobian(fun, x):
+    """Jacobian of the real vector fun at x by the complex step (exact to rounding)."""
+    x = np.asarray(x, dtype=float)
+    cols = []
+    for j in range(len(x)):
+        z = x.astype(complex)
+        z[j] += 1j * H_CS
+        cols.append(np.imag(fun(z)) / H_CS)
+    return np.array(cols).T
+
+
+def u_gradient(u, dv):
+    """dJ/du at (u, dv), complex step."""
+    return cs_grad(lambda z: held_cost(z, dv), u)
+
+
+def second_derivatives(u, dv, h_u, h_d):
+    """Juu and Jud by central differences (steps h_u in u, h_d in d) of the complex-step dJ/du."""
+    juu = np.array([(u_gradient(u + hj * e, dv) - u_gradient(u - hj * e, dv)) / (2.0 * hj)
+                    for hj, e in zip(h_u, np.eye(2))]).T
+    jud = np.array([(u_gradient(u, dv + hk * e) - u_gradient(u, dv - hk * e)) / (2.0 * hk)
+                    for hk, e in zip(h_d, np.eye(3))]).T
+    return 0.5 * (juu + juu.T), jud
+
+
+def max_rel(a, b, floor=1e-8):
+    """Largest elementwise |a - b| / |b| over the entries of b above floor * max|b|."""
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    mask = np.abs(b) > floor * np.max(np.abs(b))
+    return float(np.max(np.abs(a - b)[mask] / np.abs(b)[mask]))
+
+
+def kariwala_matrices(ours):
+    """The pySOC matrices of KARIWALA reordered to u = (F1, F200), and their differences from ours."""
+    ref = json.loads(KARIWALA.read_text())
+    assert ref["disturbances"] == DISTURBANCES and ref["measurements"] == CANDIDATES, ref.keys()
+    perm = [ref["inputs"].index(k) for k in INPUTS]
+    theirs = {"Gy": np.array(ref["Gy"])[:, perm], "Gyd": np.array(ref["Gyd"]),
+              "Juu": np.array(ref["Juu"])[np.ix_(perm, perm)], "Jud": np.array(ref["Jud"])[perm, :]}
+    return {
+        "source": str(KARIWALA.relative_to(ROOT)),
+        "note": "for information only, not asserted: reordered from u = (F200, F1) to (F1, F200); "
+        "max_relative_difference is elementwise over the entries of ours above 1e-8 of the matrix's largest, "
+        "max_difference_over_max is max|theirs - ours| / max|ours|",
+        **{k: v.tolist() for k, v in theirs.items()},
+        "max_relative_difference": {k: max_rel(theirs[k], ours[k]) for k in theirs},
+        "max_difference_over_max": {k: float(np.max(np.abs(theirs[k] - ours[k])) / np.max(np.abs(ours[k])))
+                                    for k in theirs},
+    }
+
+
+def local_model(v_opt, juu_reduced, rel_step=1e-4):
+    """Gy, Gyd (complex step) and Juu, Jud (central differences of the complex-step gradient, checked
+    by Richardson extrapolation with half steps) at the optimum, with X2 and P100 held."""
+    u = np.array(v_opt[:2], dtype=float)
+    dv = np.array([D_NOM[k] for k in DISTURBANCES])
+    gy = cs_jacobian(lambda z: outputs(z, dv), u)
+    gyd = cs_jacobian(lambda z: outputs(u, z), dv)
+    h_u, h_d = rel_step * np.abs(u), rel_step * np.abs(dv)
+    juu, jud = second_derivatives(u, dv, h_u, h_d)
+    juu2, jud2 = second_derivatives(u, dv, h_u / 2.0, h_d / 2.0)
+    rich = {"Juu": (4.0 * juu2 - juu) / 3.0, "Jud": (4.0 * jud2 - jud) / 3.0}
+    check = {"Juu": max_rel(juu, rich["Juu"]), "Jud": max_rel(jud, rich["Jud"])}
+    assert max(check.values()) < 1e-6, check
+    assert max_rel(juu, juu_reduced) < 1e-12, (juu, juu_reduced)
+    ours = {"Gy": gy, "Gyd": gyd, "Juu": juu, "Jud": jud}
+    return {
+        "inputs": INPUTS, "disturbances": DISTURBANCES, "nominal_disturbances": dv.tolist(),
+        "measurements": CANDIDATES,
+        "units": {"inputs": "kg/min", "disturbances": ["%", "degC", "degC"],
+                  "measurements": [CANDIDATE_UNITS.get(m, "kg/min") for m in CANDIDATES], "J": "$/h"},
+        "at": {**HELD, "F1": float(u[0]), "F200": float(u[1])},
+        "method": "Gy = dy/du and Gyd = dy/dd (u held) by complex step; Juu and Jud by central differences "
+        "(step 1e-4 of |u_j| or |d_k|) of the complex-step gradient dJ/du, Juu symmetrised; checked against "
+        "the Richardson extrapolation of steps h and h/2 (second_derivative_check)",
+        **{k: m.tolist() for k, m in ours.items()},
+        "Wd": WD,
+        "second_derivative_check": {"richardson": {k: m.tolist() for k, m in rich.items()},
+                                    "max_relative_difference": check},
+        "kariwala": kariwala_matrices(ours),
+    }
+
+
+def violated(point):
+    """The names ("P2:min", ...) of OTHER_LIMITS that point violates."""
+    out = []
+    for var, kind, limit in OTHER_LIMITS:
+        x = float(np.real(measure(point, var)))
+        if (kind == "min" and x < limit) or (kind == "max" and x > limit):
+            out.append(f"{var}:{kind}")
+    return out
+
+
+def disturbed(k, sign):
+    """The disturbance vector with d_k moved by sign * Wd_k, the others at nominal."""
+    dv = np.array([D_NOM[n] for n in DISTURBANCES])
+    dv[k] += sign * WD[k]
+    return dv
+
+
+def reoptimize(u_opt, dv):
+    """The optimum over (F1, F200) at d = dv with X2, P100 held (polished), and whether the held
+    active set is still optimal there (dJ/dX2 > 0, dJ/dP100 < 0: X2:min and P100:max price positive)."""
+    v = polish(u_opt, x2=HELD["X2"], p100=HELD["P100"], d=d_dict(dv))
+    grad = cs_grad(lambda z: model(z, d_dict(dv))["cost"], v)
+    point = model(v, d_dict(dv))
+    return v, point, bool(grad[VARS.index("X2")] > 0.0 and grad[VARS.index("P100")] < 0.0)
+
+
+def solve_held(pair, y0, dv, u0):
+    """(F1, F200) holding the measurements `pair` at y0 at d = dv (scipy root, hybr, complex-step
+    Jacobian); None unless the residual is at rounding level and the 2x2 Jacobian is nonsingular."""
+    def resid(u):
+        return np.real(outputs(u, dv, pair)) - y0
+
+    def jac(u):
+        return cs_jacobian(lambda z: outputs(z, dv, pair), u)
+
+    with np.errstate(all="ignore"):
+        sol = root(resid, u0, jac=jac, method="hybr", options=HELD_ROOT_OPTIONS)
+        ok = np.all(np.isfinite(sol.x)) and np.all(np.isfinite(resid(sol.x)))
+        if not ok or np.max(np.abs(resid(sol.x)) / np.maximum(np.abs(y0), 1.0)) > HELD_RESIDUAL:
+            return None
+        if np.linalg.cond(jac(sol.x)) > SINGULAR_COND:
+            return None
+    return sol.x
+
+
+def loss_point(pair, y0, u_opt, k, sign, j_opt):
+    """One (pair, disturbance, sign) entry: J with the pair held, J re-optimized, their difference."""
+    dv = disturbed(k, sign)
+    u = solve_held(pair, y0, dv, u_opt)
+    rec = {"disturbance": DISTURBANCES[k], "sign": sign, "loss": None, "J_held": None, "J_opt": j_opt,
+           "converged": u is not None, "violated": None}
+    if u is not None:
+        point = model([u[0], u[1], HELD["P100"], HELD["X2"]], d_dict(dv))
+        j_held = float(point["cost"])
+        assert j_held - j_opt > -1e-9, (pair, rec, j_held)  # J_opt is the minimum
+        rec.update(loss=j_held - j_opt, J_held=j_held, violated=violated(point))
+    return rec
+
+
+def nonlinear_losses(v_opt):
+    """Loss J_held - J_opt ($/h) of holding each pair of candidates at its nominal optimal value, for
+    each disturbance moved by +- Wd; plus the re-optimized points."""
+    u_opt = np.array(v_opt[:2], dtype=float)
+    y_nom = np.real(outputs(u_opt, np.array([D_NOM[n] for n in DISTURBANCES])))
+    cases = [(k, s) for k in range(len(DISTURBANCES)) for s in (1, -1)]
+    reopt = []
+    for k, s in cases:
+        v, point, optimal = reoptimize(u_opt, disturbed(k, s))
+        reopt.append({"disturbance": DISTURBANCES[k], "sign": s, "F1": float(v[0]), "F200": float(v[1]),
+                      "J": float(point["cost"]), "violated": violated(point), "active_set_optimal": optimal})
+    subsets = []
+    for a in range(len(CANDIDATES)):
+        for b in range(a + 1, len(CANDIDATES)):
+            pair = [CANDIDATES[a], CANDIDATES[b]]
+            y0 = y_nom[[a, b]]
+            points = [loss_point(pair, y0, u_opt, k, s, r["J"]) for (k, s), r in zip(cases, reopt)]
+            subsets.append({"measurements": pair, "setpoints": y0.tolist(), "points": points})
+    return {
+        "description": "Kariwala et al. (2008)'s evaporator with X2 = 35.5 % and P100 = 400 kPa held: each pair "
+        "of candidates held at its value at the nominal optimum (setpoints, candidate units) by solving for "
+        "(F1, F200) with scipy.optimize.root (hybr, xtol 1e-14, complex-step Jacobian, from the nominal "
+        "optimum); loss = J_held - J_opt in $/h, J_opt the re-optimum at the same disturbance. converged is "
+        "false (loss null) when no solution is found or the pair's 2x2 Jacobian is singular (u not "
+        "determined). violated lists the other Kariwala limits (P2 in [40, 80] kPa, F3 <= 100, F1 <= 20, "
+        "F200 <= 400 kg/min) broken at the held point. In reoptimized, active_set_optimal says whether "
+        "X2:min and P100:max still have positive shadow prices there.",
+        "disturbances": DISTURBANCES,
+        "magnitudes": WD,
+        "held": HELD,
+        "root_options": HELD_ROOT_OPTIONS,
+        "reoptimized": reopt,
+        "subsets": subsets,
     }
 
 
 def compare(new, old, path="", rtol=1e-9, atol=1e-12):
-    """Numbers within rtol (relative to each number, atol floor); other values equal; versions and
-    rounding-level diagnostics ignored."""
-    if path.endswith(("versions", "asymmetry_over_max", "relative_difference", "max_relative_difference_from_polished")):
+    """Numbers within rtol (relative to each number, atol floor; LOSS_ATOL for a loss, which is the
+    difference of two J's each compared at rtol); other values equal; versions and rounding-level
+    diagnostics ignored."""
+    if path.endswith(("versions", "asymmetry_over_max", "relative_difference", "max_relative_difference_from_polished",
+                      "max_difference_over_max")):
         return []
+    if path.endswith(".loss"):
+        atol = LOSS_ATOL
     if isinstance(new, dict) and isinstance(old, dict):
         if set(new) != set(old):
             return [f"{path}: keys {sorted(set(new) ^ set(old))} differ"]

@@ -15,10 +15,12 @@
 //! minimum, is an error naming what failed.
 
 mod certificate;
+pub mod local;
 mod plant;
 mod polish;
 mod qp;
 pub mod request;
+pub mod select;
 mod sqp;
 
 use indexmap::IndexMap;
@@ -121,6 +123,9 @@ pub enum OptimizeError {
         /// The degrees of freedom.
         dofs: String,
     },
+    /// A request the search refuses (its size or count), named by the search's own field.
+    #[error("{0}")]
+    Request(String),
     /// The SQP ended without a certified minimum.
     #[error("optimize: no optimum certified: {reason} after {iterations} iterations (KKT residual {kkt:.2e})")]
     NotConverged {
@@ -136,7 +141,7 @@ pub enum OptimizeError {
 impl OptimizeError {
     /// Whether the error is in the request (exit 1) rather than the plant or the numbers (exit 2).
     pub fn is_user_error(&self) -> bool {
-        matches!(self, OptimizeError::Field { .. })
+        matches!(self, OptimizeError::Field { .. } | OptimizeError::Request(_))
     }
 }
 
@@ -156,6 +161,20 @@ fn scaled_bounds(problem: &Problem, nlp: &PlantNlp<'_>) -> Bounds {
 /// [`OptimizeError::Field`] for a problem that does not fit the plant; the others when the plant
 /// or the numbers fail (each names what).
 pub fn optimize(plant: &Plant, spec: &OptimizationSpec, start: &State) -> Result<Optimum, OptimizeError> {
+    let problem = Problem::new(plant, spec)?;
+    let mut solved = solve_problem(plant, &problem, start)?;
+    report::optimum(&mut solved.nlp, &problem, &solved.bounds, &solved.sol)
+}
+
+/// A converged SQP with what it ran on.
+pub(crate) struct Solved<'a> {
+    nlp: PlantNlp<'a>,
+    bounds: Bounds,
+    sol: sqp::Solution<State>,
+}
+
+/// Solve `problem` from `start`: the SQP to a KKT point, or the error its end means.
+fn solve_problem<'a>(plant: &'a Plant, problem: &'a Problem, start: &State) -> Result<Solved<'a>, OptimizeError> {
     if !plant.specs().is_empty() {
         return Err(OptimizeError::Field {
             field: "specs".into(),
@@ -164,21 +183,20 @@ pub fn optimize(plant: &Plant, spec: &OptimizationSpec, start: &State) -> Result
                 .into(),
         });
     }
-    let problem = Problem::new(plant, spec)?;
     let start_failure = |e: EvaluationFailure| OptimizeError::Start(e.message);
-    let mut nlp = PlantNlp::new(plant, &problem, start).map_err(start_failure)?;
-    let bounds = scaled_bounds(&problem, &nlp);
+    let mut nlp = PlantNlp::new(plant, problem, start).map_err(start_failure)?;
+    let bounds = scaled_bounds(problem, &nlp);
     let v0 = nlp.variables(&start.u);
     let sol = sqp::solve(&mut nlp, &bounds, &v0, &Settings::default()).map_err(|e| match e {
         SqpError::Start(f) => start_failure(f),
         SqpError::Qp(m) => OptimizeError::NotConverged { reason: m.to_string(), iterations: 0, kkt: f64::NAN },
     })?;
     match sol.outcome {
-        Outcome::Optimal => {}
+        Outcome::Optimal => Ok(Solved { nlp, bounds, sol }),
         Outcome::Infeasible => {
-            let violated = report::violations(&problem, &sol.point.state);
+            let violated = report::violations(problem, &sol.point.state);
             let dofs = problem.dofs.iter().map(|d| format!("`{}`", d.signal.path)).collect::<Vec<_>>().join(", ");
-            return Err(OptimizeError::Infeasible { violated, iterations: sol.iterations, dofs });
+            Err(OptimizeError::Infeasible { violated, iterations: sol.iterations, dofs })
         }
         Outcome::Stalled | Outcome::IterationLimit => {
             let reason = if sol.outcome == Outcome::Stalled {
@@ -186,14 +204,9 @@ pub fn optimize(plant: &Plant, spec: &OptimizationSpec, start: &State) -> Result
             } else {
                 "the iteration limit"
             };
-            return Err(OptimizeError::NotConverged {
-                reason: reason.into(),
-                iterations: sol.iterations,
-                kkt: sol.kkt.max(),
-            });
+            Err(OptimizeError::NotConverged { reason: reason.into(), iterations: sol.iterations, kkt: sol.kkt.max() })
         }
     }
-    report::optimum(&mut nlp, &problem, &bounds, &sol)
 }
 
 mod report;

@@ -5,6 +5,7 @@
 
 use plantwide_analysis::measures::rows;
 use plantwide_soc::{Criterion, LocalModel, Ranking, SocError, null_space};
+use plantwide_studies::optimize::select::PlantSelection;
 use serde::Serialize;
 
 use super::sig6 as sig;
@@ -130,4 +131,85 @@ pub fn json(model: &LocalModel, size: usize, criterion: Criterion, ranking: &Ran
         });
     }
     super::json(&SelectJson { criterion, size, subsets, nodes: ranking.nodes, inputs: &p.inputs })
+}
+
+/// The selection on a plant as JSON: [`json`]'s contract, each subset with its `nonlinear`
+/// verification points, and `optimum` (the [`Optimum`]'s JSON) and `local_model` (the names,
+/// `Gy`, `Gyd`, `Juu`, `Jud`, `Wd`, `Wn` in display units).
+///
+/// # Errors
+/// As [`json`].
+pub fn plant_json(sel: &PlantSelection, size: usize, criterion: Criterion) -> Result<String, IoError> {
+    let text = json(&sel.model, size, criterion, &sel.ranking)?;
+    let mut v: serde_json::Value = serde_json::from_str(&text).map_err(|e| IoError::Draw(e.to_string()))?;
+    let err = |e: serde_json::Error| IoError::Draw(e.to_string());
+    if let Some(subsets) = v.get_mut("subsets").and_then(|s| s.as_array_mut()) {
+        for (s, check) in subsets.iter_mut().zip(&sel.verification) {
+            s["nonlinear"] = serde_json::to_value(&check.points).map_err(err)?;
+        }
+    }
+    let p = sel.model.parts();
+    v["optimum"] = serde_json::to_value(&sel.optimum).map_err(err)?;
+    v["local_model"] = serde_json::json!({
+        "inputs": p.inputs, "disturbances": p.disturbances, "measurements": p.measurements,
+        "Gy": rows(p.gy.as_ref()), "Gyd": rows(p.gyd.as_ref()), "Juu": rows(p.juu.as_ref()),
+        "Jud": rows(p.jud.as_ref()), "Wd": rows(p.wd.as_ref()), "Wn": rows(p.wn.as_ref()),
+    });
+    super::json(&v)
+}
+
+/// The selection on a plant as text: the optimum, then [`text`], then the nonlinear check of each
+/// listed subset (with `every_h`, every subset's `H`, not only the best's).
+pub fn plant_text(sel: &PlantSelection, size: usize, criterion: Criterion, asked: usize, every_h: bool) -> String {
+    let mut t = super::optimize::text(&sel.optimum);
+    t.push('\n');
+    t.push_str(&text(&sel.model, size, criterion, asked, &sel.ranking));
+    if every_h {
+        t.push_str(&all_h(&sel.model, &sel.ranking));
+    }
+    t.push_str(&format!(
+        "\nnonlinear check: c = H y and the active limits held at the nominal optimum, each disturbance moved by ± its magnitude, loss = held − re-optimized ({})\n",
+        sel.optimum.objective_unit
+    ));
+    t.push_str(&format!(
+        "{:>4}  {:<32} {:>5}  {:>13}  {:>13}  notes\n",
+        "rank", "disturbance", "sign", "loss", "local"
+    ));
+    for (k, check) in sel.verification.iter().enumerate() {
+        for pt in &check.points {
+            let loss = pt.loss.map_or_else(|| "failed".to_string(), sig);
+            let mut notes = pt.failure.clone().unwrap_or_default();
+            if !pt.violated.is_empty() {
+                notes = format!("violates: {}", pt.violated.join("; "));
+            }
+            let sign = if pt.sign > 0.0 { "+" } else { "−" };
+            t.push_str(&format!(
+                "{:>4}  {:<32} {:>5}  {:>13}  {:>13}  {notes}\n",
+                k + 1,
+                pt.disturbance,
+                sign,
+                loss,
+                sig(pt.local_loss)
+            ));
+        }
+    }
+    t
+}
+
+fn names(p: &plantwide_soc::Parts, subset: &[usize]) -> String {
+    subset.iter().map(|&i| p.measurements[i].as_str()).collect::<Vec<_>>().join(", ")
+}
+
+/// Every listed subset's `H` after the best's (`--combinations`).
+pub fn all_h(model: &LocalModel, ranking: &Ranking) -> String {
+    let p = model.parts();
+    let mut t = String::new();
+    for (k, c) in ranking.subsets.iter().enumerate().skip(1) {
+        t.push_str(&format!("\nH of subset {} ({}):\n", k + 1, names(p, &c.measurements)));
+        for row in rows(c.h.as_ref()) {
+            let cells: Vec<String> = row.iter().map(|v| format!("{:>13}", sig(*v))).collect();
+            t.push_str(&format!("  {}\n", cells.join(" ")));
+        }
+    }
+    t
 }

@@ -33,6 +33,8 @@ pub(crate) struct Directions {
     pub free: Vec<usize>,
     /// One direction per free input (each of length n).
     pub z: Vec<Vec<f64>>,
+    /// The pivots `(active row, dependent degree of freedom)`: one per independent active row.
+    pub pivots: Vec<(usize, usize)>,
 }
 
 /// Eliminate the active rows with complete pivoting; rows that become zero (dependent active
@@ -80,7 +82,7 @@ pub(crate) fn directions(n: usize, rows: &[Vec<f64>]) -> Directions {
             z
         })
         .collect();
-    Directions { free, z }
+    Directions { free, z, pivots }
 }
 
 /// `∇L = ∇f − Aᵀy` at a point.

@@ -103,6 +103,16 @@ impl<'a> PlantNlp<'a> {
         Ok(nlp)
     }
 
+    /// The inputs besides the degrees of freedom (the disturbances among them).
+    pub fn base(&self) -> &[f64] {
+        &self.u0
+    }
+
+    /// Move the inputs besides the degrees of freedom (a disturbance), keeping the scales.
+    pub fn set_base(&mut self, u: &[f64]) {
+        self.u0 = u.to_vec();
+    }
+
     /// The inputs at scaled variables `v`.
     pub fn inputs(&self, v: &[f64]) -> Vec<f64> {
         let mut u = self.u0.clone();

@@ -6,7 +6,7 @@ use indexmap::IndexMap;
 use plantwide_analysis::select::Signal;
 use plantwide_flowsheet::optimization::Sense;
 
-use super::certificate::{active_rows, directions, eigenvalues, reduced_hessian};
+use super::certificate::{Directions, active_rows, directions, eigenvalues, reduced_hessian};
 use super::plant::{PlantNlp, State};
 use super::request::Problem;
 use super::sqp::{Bounds, Solution};
@@ -44,7 +44,7 @@ pub(super) fn violations(problem: &Problem, state: &State) -> Vec<String> {
 }
 
 /// The sign that makes the objective a cost.
-fn sign(sense: Sense) -> f64 {
+pub(super) fn sign(sense: Sense) -> f64 {
     if sense == Sense::Maximize { -1.0 } else { 1.0 }
 }
 
@@ -97,6 +97,20 @@ fn limits(
         }
     }
     (out, act_c, act_b)
+}
+
+/// The active constraints and bounds of a converged SQP, and the split of the degrees of freedom
+/// into free and dependent ones.
+pub(super) fn active_set(
+    nlp: &PlantNlp<'_>,
+    problem: &Problem,
+    bounds: &Bounds,
+    sol: &Solution<State>,
+) -> (Vec<usize>, Vec<usize>, Directions) {
+    let (_, act_c, act_b) = limits(nlp, problem, bounds, sol);
+    let n = problem.dofs.len();
+    let dirs = directions(n, &active_rows(n, &sol.point.a, &act_c, &act_b));
+    (act_c, act_b, dirs)
 }
 
 /// The optimum of a converged SQP, with its certificate.

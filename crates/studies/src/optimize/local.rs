@@ -1,0 +1,310 @@
+//! The local model of self-optimizing control at a plant's optimum (issue 58, item 2): for the
+//! unconstrained degrees of freedom `u` (the free inputs of the reduced Hessian, the others moving
+//! to hold the active limits), the candidate measurements `y` and the disturbances `d`,
+//!
+//! - `Gy = ∂y/∂u` along the free directions, `Gyd = ∂y/∂d` with `u` held and the active limits
+//!   held (the dependent inputs moving by `−A_D⁻¹ ∂c/∂d`): exact, from one sparse LU of the
+//!   plant Jacobian at the optimum;
+//! - `Juu`: the reduced Hessian of the Lagrangian ([`super::certificate`]);
+//! - `Jud = ∂/∂d (Zᵀ∇L)`: central differences of the exact reduced gradient of the Lagrangian as
+//!   each disturbance moves ± 1e-4 of its magnitude, the dependent inputs following to first
+//!   order (their second-order error is even in the step, so it cancels);
+//! - `Wd`, `Wn`: the disturbances' expected magnitudes and the measurements' errors.
+//!
+//! Everything is in display units: the objective's, the inputs' (of their bounds), each
+//! disturbance's and candidate's (as written), so the losses are in the objective's unit.
+
+use faer::Mat;
+use faer::linalg::solvers::Solve;
+use plantwide_analysis::linear::Linearization;
+use plantwide_analysis::select::{Signal, select_input, select_output, split_unit};
+use plantwide_flowsheet::Plant;
+use plantwide_flowsheet::overrides::resolve_input;
+use plantwide_units::{Unit, parse_difference_as};
+
+use super::certificate::Directions;
+use super::plant::PlantNlp;
+use super::report::sign;
+use super::request::Problem;
+use super::sqp::{Nlp, Solution};
+use super::{OptimizeError, State};
+
+/// What the local model is asked for: `PATH=±Δ` disturbances, candidate `PATH[@unit]`s and
+/// `PATH=±e` implementation errors (one per candidate).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct LocalRequest {
+    /// Disturbances, each `PATH=±Δ` (a free input outside `vary`; Δ a quantity).
+    pub disturbances: Vec<String>,
+    /// Candidate measurements: variables, or degrees of freedom (a measured input).
+    pub candidates: Vec<String>,
+    /// Each candidate's implementation error, `PATH=±e`.
+    pub errors: Vec<String>,
+}
+
+/// A disturbance resolved: the input and its magnitude (SI).
+#[derive(Debug, Clone)]
+pub(crate) struct Dist {
+    pub signal: Signal,
+    pub magnitude: f64,
+}
+
+/// What a candidate is: a plant variable, or a degree of freedom.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Source {
+    Variable(usize),
+    Dof(usize),
+}
+
+/// A candidate resolved, with its error (SI).
+#[derive(Debug, Clone)]
+pub(crate) struct Candidate {
+    pub signal: Signal,
+    pub source: Source,
+    pub error: f64,
+}
+
+fn field(field: &str, message: impl Into<String>) -> OptimizeError {
+    OptimizeError::Field { field: field.to_string(), message: message.into() }
+}
+
+/// `PATH=±X` → (`PATH`, `X`).
+fn plus_minus<'t>(list: &str, text: &'t str) -> Result<(&'t str, &'t str), OptimizeError> {
+    let hint = || field(list, format!("`{text}`: expected PATH=±MAGNITUDE, e.g. `feed.T=±5 K`"));
+    let (path, rest) = text.split_once('=').ok_or_else(hint)?;
+    let rest = rest.trim();
+    let mag = ["±", "+-", "+/-"].iter().find_map(|p| rest.strip_prefix(p)).ok_or_else(hint)?;
+    Ok((path.trim(), mag.trim()))
+}
+
+/// A positive magnitude of dimension `dim` (a difference: `5 degC` is 5 K), and its written unit.
+fn magnitude(list: &str, text: &str, dim: plantwide_units::Dimension) -> Result<(f64, Option<String>), OptimizeError> {
+    let v = parse_difference_as(text, dim).map_err(|e| field(list, format!("`{text}`: {e}")))?;
+    if !(v.is_finite() && v > 0.0) {
+        return Err(field(list, format!("`{text}`: a magnitude must be positive")));
+    }
+    let t = text.trim();
+    let end = t.find(|c: char| !(c.is_ascii_digit() || matches!(c, '.' | '+' | '-' | 'e' | 'E'))).unwrap_or(t.len());
+    let unit = t[end..].trim();
+    Ok((v, (!unit.is_empty()).then(|| unit.to_string())))
+}
+
+/// `signal` shown in `unit`.
+fn shown_in(mut signal: Signal, unit: Option<String>) -> Signal {
+    if let Some((u, f)) = unit.and_then(|u| Unit::parse_difference(&u).ok().map(|p| (u, p.factor()))) {
+        (signal.unit, signal.factor) = (u, f);
+    }
+    signal
+}
+
+impl LocalRequest {
+    /// The disturbances resolved against `plant` (free inputs outside the degrees of freedom).
+    pub(crate) fn disturbances(&self, plant: &Plant, problem: &Problem) -> Result<Vec<Dist>, OptimizeError> {
+        let mut out: Vec<Dist> = Vec::new();
+        for text in &self.disturbances {
+            let (path, mag) = plus_minus("disturbances", text)?;
+            let signal = select_input(plant, path).map_err(|e| field("disturbances", e.to_string()))?;
+            if problem.dofs.iter().any(|d| d.signal.index == signal.index) {
+                return Err(field(
+                    "disturbances",
+                    format!("`{path}` is a degree of freedom (in `vary`), not a disturbance"),
+                ));
+            }
+            if out.iter().any(|d| d.signal.index == signal.index) {
+                return Err(field("disturbances", format!("`{path}` is given twice")));
+            }
+            let (magnitude, unit) = magnitude("disturbances", mag, plant.inputs()[signal.index].dim)?;
+            out.push(Dist { signal: shown_in(signal, unit), magnitude });
+        }
+        if out.is_empty() {
+            return Err(field("disturbances", "is empty: name the disturbances and their expected magnitudes"));
+        }
+        Ok(out)
+    }
+
+    /// The candidates resolved against `plant`, each with its error.
+    pub(crate) fn candidates(&self, plant: &Plant, problem: &Problem) -> Result<Vec<Candidate>, OptimizeError> {
+        let mut out: Vec<Candidate> = Vec::new();
+        for text in &self.candidates {
+            let (path, _) = split_unit(text);
+            let dof = resolve_input(plant, path).and_then(|i| problem.dofs.iter().position(|d| d.signal.index == i));
+            let (signal, source) = match dof {
+                Some(j) => {
+                    let s = select_input(plant, text).map_err(|e| field("candidates", e.to_string()))?;
+                    (s, Source::Dof(j))
+                }
+                None => {
+                    let s = select_output(plant, text).map_err(|e| field("candidates", e.to_string()))?;
+                    let i = s.index;
+                    (s, Source::Variable(i))
+                }
+            };
+            if out.iter().any(|c| c.source == source) {
+                return Err(field("candidates", format!("`{path}` is given twice")));
+            }
+            out.push(Candidate { signal, source, error: f64::NAN });
+        }
+        for text in &self.errors {
+            let (path, mag) = plus_minus("errors", text)?;
+            let c = out.iter_mut().find(|c| c.signal.path == path).ok_or_else(|| {
+                field("errors", format!("`{path}` is no candidate: give errors for the candidates, by the same path"))
+            })?;
+            let dim = match c.source {
+                Source::Variable(i) => plant.vars()[i].spec.dim,
+                Source::Dof(j) => plant.inputs()[problem.dofs[j].signal.index].dim,
+            };
+            c.error = magnitude("errors", mag, dim)?.0;
+        }
+        let missing: Vec<&str> = out.iter().filter(|c| c.error.is_nan()).map(|c| c.signal.path.as_str()).collect();
+        if !missing.is_empty() {
+            return Err(field(
+                "errors",
+                format!("no implementation error for {}: give each candidate one", missing.join(", ")),
+            ));
+        }
+        if out.is_empty() {
+            return Err(field("candidates", "is empty: name the candidate measurements"));
+        }
+        Ok(out)
+    }
+}
+
+/// The exact first derivatives at the optimum: of the candidates and active constraints, with
+/// respect to every degree of freedom and disturbance (SI).
+pub(crate) struct Sensitivities {
+    /// Candidates × (dofs, disturbances).
+    pub y: Mat<f64>,
+    /// Active rows (the pivots' rows, in pivot order) × (dofs, disturbances).
+    pub act: Mat<f64>,
+}
+
+/// The first derivatives of the candidates and active rows at `state`.
+pub(crate) fn sensitivities(
+    plant: &Plant,
+    problem: &Problem,
+    state: &State,
+    (dists, cands): (&[Dist], &[Candidate]),
+    (act_c, act_b, dirs): (&[usize], &[usize], &Directions),
+) -> Result<Sensitivities, OptimizeError> {
+    let n = problem.dofs.len();
+    let inputs: Vec<usize> =
+        problem.dofs.iter().map(|d| d.signal.index).chain(dists.iter().map(|d| d.signal.index)).collect();
+    let vars: Vec<usize> = cands
+        .iter()
+        .filter_map(|c| if let Source::Variable(i) = c.source { Some(i) } else { None })
+        .chain(act_c.iter().map(|&i| problem.constraints[i].signal.index))
+        .collect();
+    let g = Linearization::new(plant, &state.x, &state.u).steady_gain(&inputs, &vars).map_err(|e| {
+        OptimizeError::NotConverged { reason: format!("the gains at the optimum: {e}"), iterations: 0, kkt: f64::NAN }
+    })?;
+    let cols = inputs.len();
+    let mut k = 0;
+    let y = Mat::from_fn(cands.len(), cols, |_, _| 0.0);
+    let mut y = y;
+    for (r, c) in cands.iter().enumerate() {
+        match c.source {
+            Source::Variable(_) => {
+                (0..cols).for_each(|j| y[(r, j)] = g[(k, j)]);
+                k += 1;
+            }
+            Source::Dof(j) => y[(r, j)] = 1.0,
+        }
+    }
+    let n_var = k;
+    let act = Mat::from_fn(dirs.pivots.len(), cols, |p, j| {
+        let row = dirs.pivots[p].0;
+        if row < act_c.len() { g[(n_var + row, j)] } else { f64::from(j < n && j == act_b[row - act_c.len()]) }
+    });
+    Ok(Sensitivities { y, act })
+}
+
+/// `∂u_D/∂d` (dependent × disturbances): the dependent inputs' move that holds the active rows.
+pub(crate) fn dependent_move(s: &Sensitivities, dirs: &Directions, n: usize) -> Result<Mat<f64>, OptimizeError> {
+    let np = dirs.pivots.len();
+    let nd = s.act.ncols() - n;
+    if np == 0 {
+        return Ok(Mat::zeros(0, nd));
+    }
+    let a_d = Mat::from_fn(np, np, |r, c| s.act[(r, dirs.pivots[c].1)]);
+    let rhs = Mat::from_fn(np, nd, |r, k| -s.act[(r, n + k)]);
+    let m = a_d.partial_piv_lu().solve(&rhs);
+    if (0..np).any(|r| (0..nd).any(|k| !m[(r, k)].is_finite())) {
+        return Err(OptimizeError::NotConverged {
+            reason: "the active limits cannot be held as the disturbances move (their gradients are singular)".into(),
+            iterations: 0,
+            kkt: f64::NAN,
+        });
+    }
+    Ok(m)
+}
+
+/// The physical directions (SI per SI of each free input): column `f` over the dofs.
+pub(crate) fn physical_directions(nlp: &PlantNlp<'_>, dirs: &Directions) -> Mat<f64> {
+    let n = nlp.scale_u.len();
+    Mat::from_fn(n, dirs.free.len(), |j, f| dirs.z[f][j] * nlp.scale_u[j] / nlp.scale_u[dirs.free[f]])
+}
+
+/// `Gy` and `Gyd` in display units.
+pub(crate) fn gains(
+    problem: &Problem,
+    s: &Sensitivities,
+    (z, dep, dirs): (&Mat<f64>, &Mat<f64>, &Directions),
+    (dists, cands): (&[Dist], &[Candidate]),
+) -> (Mat<f64>, Mat<f64>) {
+    let n = problem.dofs.len();
+    let gy = Mat::from_fn(cands.len(), dirs.free.len(), |r, f| {
+        let si: f64 = (0..n).map(|j| s.y[(r, j)] * z[(j, f)]).sum();
+        si * problem.dofs[dirs.free[f]].signal.factor / cands[r].signal.factor
+    });
+    let gyd = Mat::from_fn(cands.len(), dists.len(), |r, k| {
+        let follow: f64 = dirs.pivots.iter().enumerate().map(|(p, &(_, j))| s.y[(r, j)] * dep[(p, k)]).sum();
+        (s.y[(r, n + k)] + follow) * dists[k].signal.factor / cands[r].signal.factor
+    });
+    (gy, gyd)
+}
+
+/// `Jud` in display units by central differences of the reduced gradient of the Lagrangian.
+pub(crate) fn jud(
+    nlp: &mut PlantNlp<'_>,
+    problem: &Problem,
+    sol: &Solution<State>,
+    (dep, dirs): (&Mat<f64>, &Directions),
+    dists: &[Dist],
+) -> Result<Mat<f64>, OptimizeError> {
+    let (nf, nd) = (dirs.free.len(), dists.len());
+    let home = nlp.base().to_vec();
+    let mut out = Mat::zeros(nf, nd);
+    let fail = |m: String| OptimizeError::NotConverged {
+        reason: format!("Jud could not be measured: {m}"),
+        iterations: sol.iterations,
+        kkt: sol.kkt.max(),
+    };
+    for (k, d) in dists.iter().enumerate() {
+        let h = 1e-4 * d.magnitude;
+        let mut reduced = Vec::new();
+        for s in [1.0, -1.0] {
+            let mut base = home.clone();
+            base[d.signal.index] += s * h;
+            let mut u = sol.point.state.u.clone();
+            u[d.signal.index] += s * h;
+            for (p, &(_, j)) in dirs.pivots.iter().enumerate() {
+                u[problem.dofs[j].signal.index] += s * h * dep[(p, k)];
+            }
+            nlp.set_base(&base);
+            let v = nlp.variables(&u);
+            let point = nlp.evaluate(&v, Some(&sol.point.state));
+            nlp.set_base(&home);
+            let point = point.map_err(|e| fail(e.message))?;
+            let grad: Vec<f64> = (0..v.len())
+                .map(|j| point.g[j] - (0..sol.y.len()).map(|i| point.a[(i, j)] * sol.y[i]).sum::<f64>())
+                .collect();
+            reduced
+                .push(dirs.z.iter().map(|z| z.iter().zip(&grad).map(|(a, b)| a * b).sum::<f64>()).collect::<Vec<_>>());
+        }
+        let to_objective = sign(problem.sense) * nlp.scale_f / problem.objective.factor;
+        for f in 0..nf {
+            let per_input = problem.dofs[dirs.free[f]].signal.factor / nlp.scale_u[dirs.free[f]];
+            out[(f, k)] = (reduced[0][f] - reduced[1][f]) / (2.0 * h) * to_objective * per_input * d.signal.factor;
+        }
+    }
+    Ok(out)
+}

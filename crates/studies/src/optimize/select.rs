@@ -1,0 +1,302 @@
+//! Self-optimizing control on a plant (issue 58, item 2): the optimum, the local model there
+//! ([`super::local`]), the best measurement subsets by branch and bound (`plantwide_soc`), and each
+//! listed subset verified on the nonlinear plant.
+//!
+//! Verification, for each disturbance moved by ± its magnitude (the others nominal): the
+//! combination `c = H y` is held at its value at the nominal optimum and the active limits at
+//! theirs (Newton on the degrees of freedom with exact gains, every point a certified steady
+//! state): the objective there is `J_held`. The plant is re-optimized at that disturbance with
+//! every limit (`J_opt`, which may rest on other limits than the nominal optimum). The loss is
+//! `J_held − J_opt` (reversed for a maximum), reported beside the local estimate
+//! `½‖Juu^½ (H Gy)⁻¹ H F Wd e_k‖²` of the exact local method.
+
+use faer::Mat;
+use faer::linalg::solvers::Solve;
+use plantwide_flowsheet::Plant;
+use plantwide_flowsheet::optimization::{OptimizationSpec, Sense};
+use plantwide_soc::{LocalModel, Parts, Ranking, Search, branch_and_bound};
+use plantwide_solve::{NewtonSettings, steady_state};
+use serde::Serialize;
+
+use super::local::{
+    Candidate, Dist, LocalRequest, Source, dependent_move, gains, jud, physical_directions, sensitivities,
+};
+use super::report::{active_set, optimum, violations};
+use super::request::Problem;
+use super::{OptimizeError, Optimum, State, solve_problem};
+
+/// One verification point: a disturbance moved by `sign` × its magnitude.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LossPoint {
+    /// The disturbance's path.
+    pub disturbance: String,
+    /// +1 or −1 (times its magnitude).
+    pub sign: f64,
+    /// The exact local method's loss (objective unit).
+    pub local_loss: f64,
+    /// The nonlinear loss `J_held − J_opt` (objective unit); None when a part failed.
+    pub loss: Option<f64>,
+    /// The objective with `H y` and the active limits held.
+    pub held_objective: Option<f64>,
+    /// The objective re-optimized at the disturbance.
+    pub optimal_objective: Option<f64>,
+    /// Limits the held point violates.
+    pub violated: Vec<String>,
+    /// Why a part failed, if one did.
+    pub failure: Option<String>,
+}
+
+/// A listed subset and its verification.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SubsetCheck {
+    /// The measurements.
+    pub measurements: Vec<String>,
+    /// One point per disturbance and sign.
+    pub points: Vec<LossPoint>,
+}
+
+/// The answer of `select` on a plant.
+#[derive(Debug, Clone)]
+pub struct PlantSelection {
+    /// The nominal optimum.
+    pub optimum: Optimum,
+    /// The local model there (display units).
+    pub model: LocalModel,
+    /// The best subsets.
+    pub ranking: Ranking,
+    /// Each listed subset on the nonlinear plant.
+    pub verification: Vec<SubsetCheck>,
+}
+
+fn numerical(reason: String) -> OptimizeError {
+    OptimizeError::NotConverged { reason, iterations: 0, kkt: f64::NAN }
+}
+
+/// Optimize `plant`, form the local model for `request`, search by `search` and verify the
+/// subsets found.
+///
+/// # Errors
+/// As [`super::optimize`]; [`OptimizeError::Field`] for the request's lists (`disturbances`,
+/// `candidates`, `errors`) and the search (`size`, `best`).
+pub fn select_on_plant(
+    plant: &Plant,
+    spec: &OptimizationSpec,
+    start: &State,
+    request: &LocalRequest,
+    search: &Search,
+) -> Result<PlantSelection, OptimizeError> {
+    let problem = Problem::new(plant, spec)?;
+    let dists = request.disturbances(plant, &problem)?;
+    let cands = request.candidates(plant, &problem)?;
+    let mut solved = solve_problem(plant, &problem, start)?;
+    let opt = optimum(&mut solved.nlp, &problem, &solved.bounds, &solved.sol)?;
+    let (act_c, act_b, dirs) = active_set(&solved.nlp, &problem, &solved.bounds, &solved.sol);
+    if dirs.free.is_empty() {
+        return Err(field(
+            "vary",
+            "the active limits fix every degree of freedom at the optimum: nothing is left for self-optimizing control",
+        ));
+    }
+    let state = solved.sol.point.state.clone();
+    let sens = sensitivities(plant, &problem, &state, (&dists, &cands), (&act_c, &act_b, &dirs))?;
+    let n = problem.dofs.len();
+    let dep = dependent_move(&sens, &dirs, n)?;
+    let z = physical_directions(&solved.nlp, &dirs);
+    let (gy, gyd) = gains(&problem, &sens, (&z, &dep, &dirs), (&dists, &cands));
+    let jud = jud(&mut solved.nlp, &problem, &solved.sol, (&dep, &dirs), &dists)?;
+    let juu = Mat::from_fn(dirs.free.len(), dirs.free.len(), |a, b| opt.reduced_hessian.matrix[a][b]);
+    let parts =
+        Parts {
+            inputs: opt.reduced_hessian.free.clone(),
+            disturbances: dists.iter().map(|d| format!("{}@{}", d.signal.path, d.signal.unit)).collect(),
+            measurements: cands.iter().map(|c| format!("{}@{}", c.signal.path, c.signal.unit)).collect(),
+            gy,
+            gyd,
+            juu,
+            jud,
+            wd: Mat::from_fn(dists.len(), dists.len(), |i, j| {
+                if i == j { dists[i].magnitude / dists[i].signal.factor } else { 0.0 }
+            }),
+            wn: Mat::from_fn(cands.len(), cands.len(), |i, j| {
+                if i == j { cands[i].error / cands[i].signal.factor } else { 0.0 }
+            }),
+        };
+    let model = LocalModel::new(parts).map_err(|e| numerical(format!("the local model at the optimum: {e}")))?;
+    let ranking = branch_and_bound(&model, search).map_err(|e| match e.is_user_error() {
+        true => OptimizeError::Request(e.to_string()),
+        false => numerical(e.to_string()),
+    })?;
+    let ctx = Context {
+        plant,
+        spec,
+        problem: &problem,
+        state: &state,
+        dists: &dists,
+        cands: &cands,
+        act: (&act_c, &act_b),
+        dirs: &dirs,
+    };
+    let verification = ranking.subsets.iter().map(|s| ctx.verify(&model, &s.measurements, &s.h, &opt)).collect();
+    Ok(PlantSelection { optimum: opt, model, ranking, verification })
+}
+
+fn field(field: &str, message: &str) -> OptimizeError {
+    OptimizeError::Field { field: field.to_string(), message: message.to_string() }
+}
+
+/// What the verification needs of the nominal optimum.
+struct Context<'a> {
+    plant: &'a Plant,
+    spec: &'a OptimizationSpec,
+    problem: &'a Problem,
+    state: &'a State,
+    dists: &'a [Dist],
+    cands: &'a [Candidate],
+    act: (&'a [usize], &'a [usize]),
+    dirs: &'a super::certificate::Directions,
+}
+
+impl Context<'_> {
+    /// The candidates' values (display units) at a state.
+    fn measured(&self, s: &State) -> Vec<f64> {
+        self.cands
+            .iter()
+            .map(|c| match c.source {
+                Source::Variable(i) => s.x[i] / c.signal.factor,
+                Source::Dof(j) => s.u[self.problem.dofs[j].signal.index] / c.signal.factor,
+            })
+            .collect()
+    }
+
+    /// The active rows' values (SI) at a state, in pivot order.
+    fn held(&self, s: &State) -> Vec<f64> {
+        let (act_c, act_b) = self.act;
+        self.dirs
+            .pivots
+            .iter()
+            .map(|&(row, _)| {
+                if row < act_c.len() {
+                    s.x[self.problem.constraints[act_c[row]].signal.index]
+                } else {
+                    s.u[self.problem.dofs[act_b[row - act_c.len()]].signal.index]
+                }
+            })
+            .collect()
+    }
+
+    /// Every point of one subset.
+    fn verify(&self, model: &LocalModel, subset: &[usize], h: &Mat<f64>, opt: &Optimum) -> SubsetCheck {
+        let names = subset.iter().map(|&i| model.parts().measurements[i].clone()).collect();
+        let mut points = Vec::new();
+        for (k, d) in self.dists.iter().enumerate() {
+            for sign in [1.0, -1.0] {
+                let local_loss = local_loss(model, subset, h, k, sign);
+                let mut p = LossPoint {
+                    disturbance: d.signal.path.clone(),
+                    sign,
+                    local_loss,
+                    loss: None,
+                    held_objective: None,
+                    optimal_objective: None,
+                    violated: Vec::new(),
+                    failure: None,
+                };
+                match self.point(subset, h, d, sign) {
+                    Ok((held, best, violated)) => {
+                        let cost = if opt.sense == Sense::Maximize { best - held } else { held - best };
+                        (p.loss, p.held_objective, p.optimal_objective, p.violated) =
+                            (Some(cost), Some(held), Some(best), violated);
+                    }
+                    Err(e) => p.failure = Some(e),
+                }
+                points.push(p);
+            }
+        }
+        SubsetCheck { measurements: names, points }
+    }
+
+    /// `(J_held, J_opt, violated)` at disturbance `d` moved by `sign` × its magnitude.
+    fn point(&self, subset: &[usize], h: &Mat<f64>, d: &Dist, sign: f64) -> Result<(f64, f64, Vec<String>), String> {
+        let mut u = self.state.u.clone();
+        u[d.signal.index] += sign * d.magnitude;
+        let settings = NewtonSettings::default();
+        let moved = steady_state(self.plant, &u, Some(&self.state.x), &settings).map_err(|e| e.to_string())?;
+        let moved = State { x: moved.x, u: moved.u };
+        let held = self.hold(subset, h, &moved)?;
+        let obj = &self.problem.objective;
+        let j_held = obj.display_value(held.x[obj.index]);
+        let best = super::optimize(self.plant, self.spec, &moved).map_err(|e| format!("re-optimized: {e}"))?;
+        Ok((j_held, best.objective, violations(self.problem, &held)))
+    }
+
+    /// Newton on the degrees of freedom: `H (y − y*) = 0` and the active rows at their values.
+    fn hold(&self, subset: &[usize], h: &Mat<f64>, from: &State) -> Result<State, String> {
+        let (target_y, target_a) = (self.measured(self.state), self.held(self.state));
+        let n = self.problem.dofs.len();
+        let mut s = from.clone();
+        for _ in 0..30 {
+            let y = self.measured(&s);
+            let a = self.held(&s);
+            let nu = h.nrows();
+            let mut r: Vec<f64> = (0..nu)
+                .map(|i| subset.iter().enumerate().map(|(c, &m)| h[(i, c)] * (y[m] - target_y[m])).sum())
+                .collect();
+            r.extend(a.iter().zip(&target_a).map(|(x, t)| x - t));
+            let scale: Vec<f64> = (0..nu).map(|_| 1.0).chain(target_a.iter().map(|t| t.abs().max(1e-12))).collect();
+            if r.iter().zip(&scale).all(|(v, sc)| (v / sc).abs() < 1e-11) {
+                return Ok(s);
+            }
+            let sens =
+                sensitivities(self.plant, self.problem, &s, (&[], self.cands), (self.act.0, self.act.1, self.dirs))
+                    .map_err(|e| e.to_string())?;
+            let jac = Mat::from_fn(n, n, |row, j| {
+                if row < nu {
+                    subset
+                        .iter()
+                        .enumerate()
+                        .map(|(c, &m)| h[(row, c)] * sens.y[(m, j)] / self.cands[m].signal.factor)
+                        .sum()
+                } else {
+                    sens.act[(row - nu, j)]
+                }
+            });
+            let step = jac.partial_piv_lu().solve(Mat::from_fn(n, 1, |i, _| -r[i]));
+            if (0..n).any(|i| !step[(i, 0)].is_finite()) {
+                return Err("the held combination does not fix the degrees of freedom here (singular)".into());
+            }
+            let mut u = s.u.clone();
+            for (j, dof) in self.problem.dofs.iter().enumerate() {
+                u[dof.signal.index] += step[(j, 0)];
+            }
+            let next =
+                steady_state(self.plant, &u, Some(&s.x), &NewtonSettings { tol: 1e-12, ..NewtonSettings::default() })
+                    .or_else(|_| steady_state(self.plant, &u, Some(&s.x), &NewtonSettings::default()))
+                    .map_err(|e| format!("held: {e}"))?;
+            s = State { x: next.x, u: next.u };
+        }
+        Err("holding the combination did not converge in 30 Newton steps".into())
+    }
+}
+
+/// `½‖Juu^½ (H Gy)⁻¹ H F Wd e_k‖²` for the disturbance `k` moved by `sign`: `δu = −(H Gy)⁻¹ H F
+/// Wd e_k`, loss `½ δuᵀ Juu δu`.
+fn local_loss(model: &LocalModel, subset: &[usize], h: &Mat<f64>, k: usize, sign: f64) -> f64 {
+    let p = model.parts();
+    let nu = p.juu.nrows();
+    // F = Gyd − Gy Juu⁻¹ Jud, column k.
+    let juu_inv_jud = p.juu.partial_piv_lu().solve(&p.jud);
+    let f = |m: usize| p.gyd[(m, k)] - (0..nu).map(|i| p.gy[(m, i)] * juu_inv_jud[(i, k)]).sum::<f64>();
+    let hgy =
+        Mat::from_fn(nu, nu, |i, j| subset.iter().enumerate().map(|(c, &m)| h[(i, c)] * p.gy[(m, j)]).sum::<f64>());
+    let hf = Mat::from_fn(nu, 1, |i, _| {
+        subset.iter().enumerate().map(|(c, &m)| h[(i, c)] * f(m)).sum::<f64>() * p.wd[(k, k)] * sign
+    });
+    let du = hgy.partial_piv_lu().solve(&hf);
+    let mut loss = 0.0;
+    for i in 0..nu {
+        for j in 0..nu {
+            loss += 0.5 * du[(i, 0)] * p.juu[(i, j)] * du[(j, 0)];
+        }
+    }
+    loss
+}
