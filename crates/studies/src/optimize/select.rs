@@ -144,6 +144,11 @@ fn field(field: &str, message: &str) -> OptimizeError {
     OptimizeError::Field { field: field.to_string(), message: message.to_string() }
 }
 
+/// Why a verification point has no answer.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{0}")]
+struct PointFailure(String);
+
 /// What the verification needs of the nominal optimum.
 struct Context<'a> {
     plant: &'a Plant,
@@ -207,7 +212,7 @@ impl Context<'_> {
                         (p.loss, p.held_objective, p.optimal_objective, p.violated) =
                             (Some(cost), Some(held), Some(best), violated);
                     }
-                    Err(e) => p.failure = Some(e),
+                    Err(e) => p.failure = Some(e.to_string()),
                 }
                 points.push(p);
             }
@@ -216,21 +221,29 @@ impl Context<'_> {
     }
 
     /// `(J_held, J_opt, violated)` at disturbance `d` moved by `sign` × its magnitude.
-    fn point(&self, subset: &[usize], h: &Mat<f64>, d: &Dist, sign: f64) -> Result<(f64, f64, Vec<String>), String> {
+    fn point(
+        &self,
+        subset: &[usize],
+        h: &Mat<f64>,
+        d: &Dist,
+        sign: f64,
+    ) -> Result<(f64, f64, Vec<String>), PointFailure> {
         let mut u = self.state.u.clone();
         u[d.signal.index] += sign * d.magnitude;
         let settings = NewtonSettings::default();
-        let moved = steady_state(self.plant, &u, Some(&self.state.x), &settings).map_err(|e| e.to_string())?;
+        let moved =
+            steady_state(self.plant, &u, Some(&self.state.x), &settings).map_err(|e| PointFailure(e.to_string()))?;
         let moved = State { x: moved.x, u: moved.u };
         let held = self.hold(subset, h, &moved)?;
         let obj = &self.problem.objective;
         let j_held = obj.display_value(held.x[obj.index]);
-        let best = super::optimize(self.plant, self.spec, &moved).map_err(|e| format!("re-optimized: {e}"))?;
+        let best =
+            super::optimize(self.plant, self.spec, &moved).map_err(|e| PointFailure(format!("re-optimized: {e}")))?;
         Ok((j_held, best.objective, violations(self.problem, &held)))
     }
 
     /// Newton on the degrees of freedom: `H (y − y*) = 0` and the active rows at their values.
-    fn hold(&self, subset: &[usize], h: &Mat<f64>, from: &State) -> Result<State, String> {
+    fn hold(&self, subset: &[usize], h: &Mat<f64>, from: &State) -> Result<State, PointFailure> {
         let (target_y, target_a) = (self.measured(self.state), self.held(self.state));
         let n = self.problem.dofs.len();
         let mut s = from.clone();
@@ -248,7 +261,7 @@ impl Context<'_> {
             }
             let sens =
                 sensitivities(self.plant, self.problem, &s, (&[], self.cands), (self.act.0, self.act.1, self.dirs))
-                    .map_err(|e| e.to_string())?;
+                    .map_err(|e| PointFailure(e.to_string()))?;
             let jac = Mat::from_fn(n, n, |row, j| {
                 if row < nu {
                     subset
@@ -262,7 +275,9 @@ impl Context<'_> {
             });
             let step = jac.partial_piv_lu().solve(Mat::from_fn(n, 1, |i, _| -r[i]));
             if (0..n).any(|i| !step[(i, 0)].is_finite()) {
-                return Err("the held combination does not fix the degrees of freedom here (singular)".into());
+                return Err(PointFailure(
+                    "the held combination does not fix the degrees of freedom here (singular)".into(),
+                ));
             }
             let mut u = s.u.clone();
             for (j, dof) in self.problem.dofs.iter().enumerate() {
@@ -271,10 +286,10 @@ impl Context<'_> {
             let next =
                 steady_state(self.plant, &u, Some(&s.x), &NewtonSettings { tol: 1e-12, ..NewtonSettings::default() })
                     .or_else(|_| steady_state(self.plant, &u, Some(&s.x), &NewtonSettings::default()))
-                    .map_err(|e| format!("held: {e}"))?;
+                    .map_err(|e| PointFailure(format!("held: {e}")))?;
             s = State { x: next.x, u: next.u };
         }
-        Err("holding the combination did not converge in 30 Newton steps".into())
+        Err(PointFailure("holding the combination did not converge in 30 Newton steps".into()))
     }
 }
 
