@@ -228,18 +228,75 @@ impl Context<'_> {
         d: &Dist,
         sign: f64,
     ) -> Result<(f64, f64, Vec<String>), PointFailure> {
-        let mut u = self.state.u.clone();
-        u[d.signal.index] += sign * d.magnitude;
-        let settings = NewtonSettings::default();
-        let moved =
-            steady_state(self.plant, &u, Some(&self.state.x), &settings).map_err(|e| PointFailure(e.to_string()))?;
-        let moved = State { x: moved.x, u: moved.u };
-        let held = self.hold(subset, h, &moved)?;
+        // Continuation in four steps of the disturbance, each predicted by the linearization
+        // (the held combination's and active rows' gains) and corrected by Newton.
+        let mut held = self.state.clone();
+        for quarter in 1..=4 {
+            let delta = sign * d.magnitude / 4.0;
+            let (jac, dcol) = self.newton_matrix(subset, h, &held, Some(d))?;
+            let predictor = jac.partial_piv_lu().solve(Mat::from_fn(jac.nrows(), 1, |i, _| -dcol[i] * delta));
+            let mut start = held.clone();
+            start.u[d.signal.index] = self.state.u[d.signal.index] + f64::from(quarter) * delta;
+            let predicted = self.damped(&start, &predictor)?;
+            held = self.hold(subset, h, &predicted)?;
+        }
+        let moved = held.clone();
         let obj = &self.problem.objective;
         let j_held = obj.display_value(held.x[obj.index]);
         let best =
             super::optimize(self.plant, self.spec, &moved).map_err(|e| PointFailure(format!("re-optimized: {e}")))?;
         Ok((j_held, best.objective, violations(self.problem, &held)))
+    }
+
+    /// The plant after the Newton step `step` on the degrees of freedom, halved (up to 1/64)
+    /// while the plant has no steady state there.
+    fn damped(&self, s: &State, step: &Mat<f64>) -> Result<State, PointFailure> {
+        let tight = NewtonSettings { tol: 1e-12, ..NewtonSettings::default() };
+        let mut last = String::new();
+        for halving in 0..7 {
+            let alpha = 0.5_f64.powi(halving);
+            let mut u = s.u.clone();
+            for (j, dof) in self.problem.dofs.iter().enumerate() {
+                u[dof.signal.index] += alpha * step[(j, 0)];
+            }
+            match steady_state(self.plant, &u, Some(&s.x), &tight)
+                .or_else(|_| steady_state(self.plant, &u, Some(&s.x), &NewtonSettings::default()))
+            {
+                Ok(next) => return Ok(State { x: next.x, u: next.u }),
+                Err(e) => last = brief(&e.to_string()),
+            }
+        }
+        Err(PointFailure(format!("held: no steady state even at 1/64 of the Newton step: {last}")))
+    }
+
+    /// The Jacobian of `[H y; active rows]` with respect to the degrees of freedom (display units
+    /// of the candidates, SI of the rest) at `s`, and its column for disturbance `d`.
+    fn newton_matrix(
+        &self,
+        subset: &[usize],
+        h: &Mat<f64>,
+        s: &State,
+        d: Option<&Dist>,
+    ) -> Result<(Mat<f64>, Vec<f64>), PointFailure> {
+        let dists: Vec<Dist> = d.into_iter().cloned().collect();
+        let sens =
+            sensitivities(self.plant, self.problem, s, (&dists, self.cands), (self.act.0, self.act.1, self.dirs))
+                .map_err(|e| PointFailure(e.to_string()))?;
+        let (n, nu) = (self.problem.dofs.len(), h.nrows());
+        let entry = |row: usize, j: usize| {
+            if row < nu {
+                subset
+                    .iter()
+                    .enumerate()
+                    .map(|(c, &m)| h[(row, c)] * sens.y[(m, j)] / self.cands[m].signal.factor)
+                    .sum()
+            } else {
+                sens.act[(row - nu, j)]
+            }
+        };
+        let jac = Mat::from_fn(n, n, entry);
+        let dcol = if d.is_some() { (0..n).map(|row| entry(row, n)).collect() } else { Vec::new() };
+        Ok((jac, dcol))
     }
 
     /// Newton on the degrees of freedom: `H (y − y*) = 0` and the active rows at their values.
@@ -259,38 +316,22 @@ impl Context<'_> {
             if r.iter().zip(&scale).all(|(v, sc)| (v / sc).abs() < 1e-11) {
                 return Ok(s);
             }
-            let sens =
-                sensitivities(self.plant, self.problem, &s, (&[], self.cands), (self.act.0, self.act.1, self.dirs))
-                    .map_err(|e| PointFailure(e.to_string()))?;
-            let jac = Mat::from_fn(n, n, |row, j| {
-                if row < nu {
-                    subset
-                        .iter()
-                        .enumerate()
-                        .map(|(c, &m)| h[(row, c)] * sens.y[(m, j)] / self.cands[m].signal.factor)
-                        .sum()
-                } else {
-                    sens.act[(row - nu, j)]
-                }
-            });
+            let (jac, _) = self.newton_matrix(subset, h, &s, None)?;
             let step = jac.partial_piv_lu().solve(Mat::from_fn(n, 1, |i, _| -r[i]));
             if (0..n).any(|i| !step[(i, 0)].is_finite()) {
                 return Err(PointFailure(
                     "the held combination does not fix the degrees of freedom here (singular)".into(),
                 ));
             }
-            let mut u = s.u.clone();
-            for (j, dof) in self.problem.dofs.iter().enumerate() {
-                u[dof.signal.index] += step[(j, 0)];
-            }
-            let next =
-                steady_state(self.plant, &u, Some(&s.x), &NewtonSettings { tol: 1e-12, ..NewtonSettings::default() })
-                    .or_else(|_| steady_state(self.plant, &u, Some(&s.x), &NewtonSettings::default()))
-                    .map_err(|e| PointFailure(format!("held: {e}")))?;
-            s = State { x: next.x, u: next.u };
+            s = self.damped(&s, &step)?;
         }
         Err(PointFailure("holding the combination did not converge in 30 Newton steps".into()))
     }
+}
+
+/// A solver's message without its iteration history.
+fn brief(message: &str) -> String {
+    message.split("; history").next().unwrap_or(message).to_string()
 }
 
 /// `½‖Juu^½ (H Gy)⁻¹ H F Wd e_k‖²` for the disturbance `k` moved by `sign`: `δu = −(H Gy)⁻¹ H F
