@@ -80,6 +80,13 @@ impl From<plantwide_studies::TuneError> for FaceError {
     }
 }
 
+impl From<plantwide_studies::optimize::OptimizeError> for FaceError {
+    fn from(e: plantwide_studies::optimize::OptimizeError) -> Self {
+        let user = e.is_user_error();
+        FaceError::classify(e, user)
+    }
+}
+
 impl From<plantwide_flowsheet::OverrideError> for FaceError {
     fn from(e: plantwide_flowsheet::OverrideError) -> Self {
         FaceError::input(e)

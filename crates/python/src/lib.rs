@@ -276,6 +276,43 @@ fn select(
     Ok(answer?)
 }
 
+/// `plantwide optimize FILE --json`: the optimum's JSON text; `request` the `"optimization"`
+/// section as JSON.
+#[pyfunction]
+fn optimize(py: Python<'_>, text: String, name: String, sets: Vec<String>, request: String) -> PyResult<String> {
+    let src = Source { text, name };
+    Ok(py.detach(|| plant::optimize(&src, &sets, &request))?)
+}
+
+/// `plantwide select FILE --json`: the selection's JSON text at the plant's optimum and the
+/// message of the verification points without an answer.
+#[pyfunction]
+#[pyo3(signature = (text, name, sets, disturbances, candidates, errors, size, best = 5, criterion = "worst", max_nodes = plantwide_soc::DEFAULT_MAX_NODES))]
+#[allow(clippy::too_many_arguments)] // one per keyword of the Python method
+fn select_plant(
+    py: Python<'_>,
+    text: String,
+    name: String,
+    sets: Vec<String>,
+    disturbances: Vec<String>,
+    candidates: Vec<String>,
+    errors: Vec<String>,
+    size: usize,
+    best: usize,
+    criterion: &str,
+    max_nodes: u64,
+) -> PyResult<plant::Answer> {
+    let criterion = match criterion {
+        "worst" => plantwide_soc::Criterion::Worst,
+        "average" => plantwide_soc::Criterion::Average,
+        _ => return Err(InputError::new_err(format!("criterion `{criterion}`: expected `worst` or `average`"))),
+    };
+    let search = plantwide_soc::Search { size, best, criterion, max_nodes };
+    let request = plantwide_studies::optimize::local::LocalRequest { disturbances, candidates, errors };
+    let src = Source { text, name };
+    Ok(py.detach(|| plant::select(&src, &sets, request, &search))?)
+}
+
 /// The module `plantwide._plantwide`.
 #[pymodule]
 fn _plantwide(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -298,6 +335,8 @@ fn _plantwide(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(size, m)?)?;
     m.add_function(wrap_pyfunction!(tune, m)?)?;
     m.add_function(wrap_pyfunction!(compare, m)?)?;
+    m.add_function(wrap_pyfunction!(optimize, m)?)?;
+    m.add_function(wrap_pyfunction!(select_plant, m)?)?;
     m.add_function(wrap_pyfunction!(identify, m)?)?;
     m.add_function(wrap_pyfunction!(select, m)?)?;
     Ok(())

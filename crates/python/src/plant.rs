@@ -349,3 +349,45 @@ pub fn identify(
 fn to_json(v: &impl serde::Serialize) -> Result<String, FaceError> {
     serde_json::to_string(v).map_err(|e| FaceError::Input(e.to_string()))
 }
+
+/// `plantwide optimize FILE --json`: `request` is the `"optimization"` section as JSON (the file's
+/// with `Plant.optimize`'s keywords applied, merged by the caller).
+pub fn optimize(src: &Source, sets: &[String], request: &str) -> Result<String, FaceError> {
+    let spec: plantwide_flowsheet::optimization::OptimizationSpec = study_request("optimize", request)?;
+    let (plant, ss) = src.at_steady_state(sets)?;
+    let start = plantwide_studies::optimize::State { x: ss.x, u: ss.u };
+    let optimum = plantwide_studies::optimize::optimize(&plant, &spec, &start)?;
+    plantwide_io::report::json(&optimum).map_err(FaceError::input)
+}
+
+/// `plantwide select FILE --json`: the selection on the plant at the optimum of its
+/// `"optimization"` section, and the message of the verification points without an answer.
+pub fn select(
+    src: &Source,
+    sets: &[String],
+    request: plantwide_studies::optimize::local::LocalRequest,
+    search: &plantwide_soc::Search,
+) -> Result<Answer, FaceError> {
+    let (plant, ss) = src.at_steady_state(sets)?;
+    let Some(spec) = plant.spec().optimization.clone() else {
+        return Err(FaceError::Input(format!(
+            "{}: no `optimization` section: select takes the local model at its optimum",
+            src.name
+        )));
+    };
+    let start = plantwide_studies::optimize::State { x: ss.x, u: ss.u };
+    let sel = plantwide_studies::optimize::select::select_on_plant(&plant, &spec, &start, &request, search)?;
+    let failed: Vec<String> = sel
+        .verification
+        .iter()
+        .flat_map(|c| {
+            c.points.iter().filter_map(move |p| {
+                let sign = if p.sign > 0.0 { "+" } else { "-" };
+                p.failure.as_ref().map(|f| format!("{} ({sign}{}): {f}", c.measurements.join(", "), p.disturbance))
+            })
+        })
+        .collect();
+    let text =
+        plantwide_io::report::select::plant_json(&sel, search.size, search.criterion).map_err(FaceError::input)?;
+    Ok((text, plantwide_studies::request::failed_parts("select", &failed)))
+}

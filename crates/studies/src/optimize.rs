@@ -111,18 +111,16 @@ pub enum OptimizeError {
     #[error("optimize: no steady state at the start point (the file's inputs, moved into the bounds of `vary`): {0}")]
     Start(String),
     /// No point meets every limit.
-    #[error(
-        "optimize: no feasible point: {} (a local minimum of the violation after {iterations} iterations: no move of {dofs} reduces it further)",
-        .violated.join("; ")
-    )]
+    #[error("optimize: no feasible point: {} ({why})", .violated.join("; "))]
     Infeasible {
         /// Each violated limit with its value.
         violated: Vec<String>,
-        /// Iterations.
-        iterations: usize,
-        /// The degrees of freedom.
-        dofs: String,
+        /// How the search ended: at a local minimum of the violation, or short of one.
+        why: String,
     },
+    /// The quadratic subproblem failed.
+    #[error("optimize: the QP solver (clarabel) failed: {0}")]
+    Qp(String),
     /// A request the search refuses (its size or count), named by the search's own field.
     #[error("{0}")]
     Request(String),
@@ -189,14 +187,18 @@ fn solve_problem<'a>(plant: &'a Plant, problem: &'a Problem, start: &State) -> R
     let v0 = nlp.variables(&start.u);
     let sol = sqp::solve(&mut nlp, &bounds, &v0, &Settings::default()).map_err(|e| match e {
         SqpError::Start(f) => start_failure(f),
-        SqpError::Qp(m) => OptimizeError::NotConverged { reason: m.to_string(), iterations: 0, kkt: f64::NAN },
+        SqpError::Qp(m) => OptimizeError::Qp(m.to_string()),
     })?;
     match sol.outcome {
         Outcome::Optimal => Ok(Solved { nlp, bounds, sol }),
         Outcome::Infeasible => {
             let violated = report::violations(problem, &sol.point.state);
             let dofs = problem.dofs.iter().map(|d| format!("`{}`", d.signal.path)).collect::<Vec<_>>().join(", ");
-            Err(OptimizeError::Infeasible { violated, iterations: sol.iterations, dofs })
+            let why = format!(
+                "a local minimum of the violation after {} iterations: no move of {dofs} reduces it further",
+                sol.iterations
+            );
+            Err(OptimizeError::Infeasible { violated, why })
         }
         Outcome::Stalled | Outcome::IterationLimit => {
             let reason = if sol.outcome == Outcome::Stalled {
@@ -204,6 +206,14 @@ fn solve_problem<'a>(plant: &'a Plant, problem: &'a Problem, start: &State) -> R
             } else {
                 "the iteration limit"
             };
+            let violated = report::violations(problem, &sol.point.state);
+            if !violated.is_empty() {
+                let why = format!(
+                    "none found: the search ended at {reason} after {} iterations, these limits still violated",
+                    sol.iterations
+                );
+                return Err(OptimizeError::Infeasible { violated, why });
+            }
             Err(OptimizeError::NotConverged { reason: reason.into(), iterations: sol.iterations, kkt: sol.kkt.max() })
         }
     }

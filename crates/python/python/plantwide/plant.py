@@ -295,6 +295,67 @@ class Plant:
         text, failed = _native.size(self._text, self._name, assignments(set), json.dumps(request), folder, units)
         return _answer(text, failed)
 
+    def optimize(
+        self,
+        objective: str | None = None,
+        *,
+        vary: Mapping[str, Any] | Sequence[str] | None = None,
+        constraints: Mapping[str, Any] | None = None,
+        maximize: bool = False,
+        set: Mapping[str, Any] | None = None,
+    ) -> dict:
+        """``plantwide optimize --json``: the economic optimum of the flowsheet's
+        ``"optimization"`` section, with ``objective`` (a tag or ``PATH[@unit]``), ``vary`` (paths,
+        or ``{path: {"min": …, "max": …}}``, replacing the file's) and ``constraints``
+        (``{path: {"min": …, "max": …}}``, added to the file's) applied as the CLI's flags are.
+        Returns the dict the CLI prints: ``objective``, ``values`` (SI), ``active``,
+        ``multipliers`` (shadow prices ∂J*/∂limit in display units), ``kkt_residual``, and
+        ``limits``, ``reduced_hessian``, …. A request that does not fit the plant raises
+        ``InputError``; no feasible point or no certified optimum raises ``ConvergenceError``."""
+        request = dict(json.loads(self._text).get("optimization") or {})
+        if objective is not None:
+            request["objective"] = objective
+        if maximize:
+            request["sense"] = "maximize"
+        if vary is not None:
+            request["vary"] = dict(vary) if isinstance(vary, Mapping) else {path: {} for path in vary}
+        if constraints is not None:
+            request["constraints"] = {**request.get("constraints", {}), **dict(constraints)}
+        return json.loads(_native.optimize(self._text, self._name, assignments(set), json.dumps(request)))
+
+    def select(
+        self,
+        disturbances: Sequence[str],
+        candidates: Sequence[str],
+        errors: Sequence[str],
+        size: int,
+        *,
+        best: int = 5,
+        criterion: str = "worst",
+        max_nodes: int = 200_000,
+        set: Mapping[str, Any] | None = None,
+    ) -> dict:
+        """``plantwide select FILE --json``: self-optimizing control at the optimum of the
+        flowsheet's ``"optimization"`` section. ``disturbances`` are ``"PATH=±Δ"``, ``candidates``
+        ``"PATH[@unit]"``, ``errors`` ``"PATH=±e"`` (one per candidate). Returns the dict the CLI
+        prints: ``criterion``, ``size``, ``subsets`` (best first, each with ``measurements``,
+        losses, ``H`` and its ``nonlinear`` verification points), ``nodes``, ``optimum`` and
+        ``local_model``. A verification point without an answer raises ``ConvergenceError`` with
+        the result as its ``result``."""
+        text, failed = _native.select_plant(
+            self._text,
+            self._name,
+            assignments(set),
+            list(disturbances),
+            list(candidates),
+            list(errors),
+            size,
+            best,
+            criterion,
+            max_nodes,
+        )
+        return _answer(text, failed)
+
     def tune(
         self,
         loops: str | Sequence[str],

@@ -160,7 +160,16 @@ impl Qp {
         self.solver.update_data(&p.nzval, &q, &a.nzval, &b).map_err(upd)?;
         self.solver.solve();
         let sol = &self.solver.solution;
-        if !matches!(sol.status, SolverStatus::Solved | SolverStatus::AlmostSolved) {
+        // A solve short of its tolerance still gives a usable step when it is finite: the trust
+        // region judges every step on the plant's own merit function.
+        let usable = match sol.status {
+            SolverStatus::Solved | SolverStatus::AlmostSolved => true,
+            SolverStatus::InsufficientProgress | SolverStatus::MaxIterations => {
+                sol.x.iter().chain(&sol.z).chain(&sol.s).all(|v| v.is_finite())
+            }
+            _ => false,
+        };
+        if !usable {
             return Err(QpFailure(format!(
                 "the quadratic subproblem ended {:?} after {} iterations",
                 sol.status, sol.iterations

@@ -132,7 +132,7 @@ impl Kkt {
 }
 
 /// The cap of the penalty.
-const RHO_MAX: f64 = 1e8;
+const RHO_MAX: f64 = 1e6;
 /// The least ratio of actual to predicted decrease that accepts a step.
 const ETA: f64 = 1e-4;
 /// The relative noise of the merit function (the plant's steady solves).
@@ -349,11 +349,11 @@ impl Run {
         if sr <= 0.0 || !sr.is_finite() {
             return;
         }
-        for i in 0..n {
-            for j in 0..n {
-                self.b[(i, j)] += r[i] * r[j] / sr - bs[i] * bs[j] / sbs;
-            }
-        }
+        let updated = Mat::from_fn(n, n, |i, j| self.b[(i, j)] + r[i] * r[j] / sr - bs[i] * bs[j] / sbs);
+        // Damping keeps B positive definite in exact arithmetic; where the plant's derivatives
+        // span many orders, rounding can still break it, and the QP needs it convex: start over.
+        let finite = (0..n).all(|i| (0..n).all(|j| updated[(i, j)].is_finite()));
+        self.b = if finite && updated.llt(faer::Side::Lower).is_ok() { updated } else { Mat::identity(n, n) };
     }
 }
 
