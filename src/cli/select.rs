@@ -124,22 +124,7 @@ fn on_plant(a: &SelectArgs, file: &std::path::Path, search: &Search) -> Result<(
     } else {
         out!("{}", report::plant_text(&sel, a.size, search.criterion, a.best, a.combinations));
     }
-    let failed: Vec<String> = sel
-        .verification
-        .iter()
-        .flat_map(|c| {
-            c.points.iter().filter_map(move |p| {
-                p.failure.as_ref().map(|f| {
-                    format!(
-                        "{} ({}{}): {f}",
-                        c.measurements.join(", "),
-                        if p.sign > 0.0 { "+" } else { "-" },
-                        p.disturbance
-                    )
-                })
-            })
-        })
-        .collect();
+    let failed = sel.failed();
     match plantwide::studies::request::failed_parts("select", &failed) {
         Some(m) => Err(CliError::numerical(m)),
         None => Ok(()),

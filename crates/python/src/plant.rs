@@ -377,16 +377,7 @@ pub fn select(
     };
     let start = plantwide_studies::optimize::State { x: ss.x, u: ss.u };
     let sel = plantwide_studies::optimize::select::select_on_plant(&plant, &spec, &start, &request, search)?;
-    let failed: Vec<String> = sel
-        .verification
-        .iter()
-        .flat_map(|c| {
-            c.points.iter().filter_map(move |p| {
-                let sign = if p.sign > 0.0 { "+" } else { "-" };
-                p.failure.as_ref().map(|f| format!("{} ({sign}{}): {f}", c.measurements.join(", "), p.disturbance))
-            })
-        })
-        .collect();
+    let failed = sel.failed();
     let text =
         plantwide_io::report::select::plant_json(&sel, search.size, search.criterion).map_err(FaceError::input)?;
     Ok((text, plantwide_studies::request::failed_parts("select", &failed)))

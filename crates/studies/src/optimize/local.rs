@@ -20,12 +20,12 @@ use plantwide_analysis::linear::Linearization;
 use plantwide_analysis::select::{Signal, select_input, select_output, split_unit};
 use plantwide_flowsheet::Plant;
 use plantwide_flowsheet::overrides::resolve_input;
-use plantwide_units::{Unit, parse_difference_as};
+use plantwide_units::parse_difference_as;
 
 use super::certificate::Directions;
 use super::plant::PlantNlp;
 use super::report::sign;
-use super::request::Problem;
+use super::request::{Problem, in_unit, unit_of};
 use super::sqp::{Nlp, Solution};
 use super::{OptimizeError, State};
 
@@ -82,18 +82,7 @@ fn magnitude(list: &str, text: &str, dim: plantwide_units::Dimension) -> Result<
     if !(v.is_finite() && v > 0.0) {
         return Err(field(list, format!("`{text}`: a magnitude must be positive")));
     }
-    let t = text.trim();
-    let end = t.find(|c: char| !(c.is_ascii_digit() || matches!(c, '.' | '+' | '-' | 'e' | 'E'))).unwrap_or(t.len());
-    let unit = t[end..].trim();
-    Ok((v, (!unit.is_empty()).then(|| unit.to_string())))
-}
-
-/// `signal` shown in `unit`.
-fn shown_in(mut signal: Signal, unit: Option<String>) -> Signal {
-    if let Some((u, f)) = unit.and_then(|u| Unit::parse_difference(&u).ok().map(|p| (u, p.factor()))) {
-        (signal.unit, signal.factor) = (u, f);
-    }
-    signal
+    Ok((v, unit_of(text)))
 }
 
 impl LocalRequest {
@@ -113,7 +102,7 @@ impl LocalRequest {
                 return Err(field("disturbances", format!("`{path}` is given twice")));
             }
             let (magnitude, unit) = magnitude("disturbances", mag, plant.inputs()[signal.index].dim)?;
-            out.push(Dist { signal: shown_in(signal, unit), magnitude });
+            out.push(Dist { signal: in_unit(signal, unit), magnitude });
         }
         if out.is_empty() {
             return Err(field("disturbances", "is empty: name the disturbances and their expected magnitudes"));

@@ -52,7 +52,12 @@ fn field(field: impl Into<String>, message: impl Into<String>) -> OptimizeError 
 /// The unit written in a limit (`"35.5 %"` → `%`), if any.
 fn written_unit(q: &QuantityValue) -> Option<String> {
     let QuantityValue::Text(t) = q else { return None };
-    let t = t.trim();
+    unit_of(t)
+}
+
+/// The unit after the number of a quantity's text (`"0.25 %"` → `%`), if any.
+pub(super) fn unit_of(text: &str) -> Option<String> {
+    let t = text.trim();
     let end = t.find(|c: char| !(c.is_ascii_digit() || matches!(c, '.' | '+' | '-' | 'e' | 'E'))).unwrap_or(t.len());
     let unit = t[end..].trim();
     (!unit.is_empty()).then(|| unit.to_string())
@@ -73,7 +78,7 @@ fn limits(at: &str, l: &Limits, dim: Dimension) -> Result<(f64, f64, Option<Stri
 }
 
 /// `signal` shown in `unit` when one was written.
-fn in_unit(mut signal: Signal, unit: Option<String>) -> Signal {
+pub(super) fn in_unit(mut signal: Signal, unit: Option<String>) -> Signal {
     if let Some(u) = unit.and_then(|u| Unit::parse_difference(&u).ok().map(|p| (u, p.factor()))) {
         (signal.unit, signal.factor) = u;
     }

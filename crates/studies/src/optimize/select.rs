@@ -68,6 +68,21 @@ pub struct PlantSelection {
     pub verification: Vec<SubsetCheck>,
 }
 
+impl PlantSelection {
+    /// The verification points without an answer, each with its subset, disturbance and reason.
+    pub fn failed(&self) -> Vec<String> {
+        self.verification
+            .iter()
+            .flat_map(|c| {
+                c.points.iter().filter_map(move |p| {
+                    let sign = if p.sign > 0.0 { "+" } else { "-" };
+                    p.failure.as_ref().map(|f| format!("{} ({sign}{}): {f}", c.measurements.join(", "), p.disturbance))
+                })
+            })
+            .collect()
+    }
+}
+
 fn numerical(reason: String) -> OptimizeError {
     OptimizeError::NotConverged { reason, iterations: 0, kkt: f64::NAN }
 }
