@@ -39,9 +39,9 @@ pub struct Problem {
     pub objective: Signal,
     /// Minimize or maximize.
     pub sense: Sense,
-    /// Degrees of freedom, in the order of `vary`.
+    /// Degrees of freedom, in the order of their paths.
     pub dofs: Vec<Dof>,
-    /// Constraints, in the order of `constraints`.
+    /// Constraints, in the order of their paths.
     pub constraints: Vec<Constraint>,
 }
 
@@ -113,7 +113,11 @@ impl Problem {
             return Err(field("optimization.vary", "is empty: name the inputs or setpoints the optimum may move"));
         }
         let mut dofs: Vec<Dof> = Vec::new();
-        for (path, l) in &spec.vary {
+        // In the order of their paths, whatever the face's order: every face then gives the same
+        // problem to the last bit (a file's sections reach here sorted, as JSON objects are read).
+        let mut vary: Vec<_> = spec.vary.iter().collect();
+        vary.sort_by(|a, b| a.0.cmp(b.0));
+        for (path, l) in vary {
             let at = format!("optimization.vary.{path}");
             let signal = select_input(plant, path).map_err(|e| field(&at, e.to_string()))?;
             if let Some(d) = dofs.iter().find(|d| d.signal.index == signal.index) {
@@ -126,7 +130,9 @@ impl Problem {
             dofs.push(Dof { signal: in_unit(signal, unit), lb, ub });
         }
         let mut constraints: Vec<Constraint> = Vec::new();
-        for (path, l) in &spec.constraints {
+        let mut limited: Vec<_> = spec.constraints.iter().collect();
+        limited.sort_by(|a, b| a.0.cmp(b.0));
+        for (path, l) in limited {
             let at = format!("optimization.constraints.{path}");
             if let Some(d) = plantwide_flowsheet::overrides::resolve_input(plant, path)
                 .and_then(|i| dofs.iter_mut().find(|d| d.signal.index == i))

@@ -327,8 +327,13 @@ impl Context<'_> {
                 .map(|i| subset.iter().enumerate().map(|(c, &m)| h[(i, c)] * (y[m] - target_y[m])).sum())
                 .collect();
             r.extend(a.iter().zip(&target_a).map(|(x, t)| x - t));
-            let scale: Vec<f64> = (0..nu).map(|_| 1.0).chain(target_a.iter().map(|t| t.abs().max(1e-12))).collect();
-            if r.iter().zip(&scale).all(|(v, sc)| (v / sc).abs() < 1e-11) {
+            // Each row relative to its own size: |H_i|·|y*| for a combination, the limit for an
+            // active row (the steady states carry ~1e-12 of each).
+            let combination = |i: usize| {
+                subset.iter().enumerate().map(|(c, &m)| (h[(i, c)] * target_y[m]).abs()).sum::<f64>().max(1e-300)
+            };
+            let scale: Vec<f64> = (0..nu).map(combination).chain(target_a.iter().map(|t| t.abs().max(1e-12))).collect();
+            if r.iter().zip(&scale).all(|(v, sc)| (v / sc).abs() < 1e-10) {
                 return Ok(s);
             }
             let (jac, _) = self.newton_matrix(subset, h, &s, None)?;
