@@ -39,6 +39,10 @@ pub struct OptimizeArgs {
     /// Write `optimum.json`, `optimum.txt` and `optimum.md` into this folder.
     #[arg(long, value_name = "DIR")]
     report: Option<PathBuf>,
+    /// Re-optimize along a disturbance, `PATH=LOW:HIGH:N` (N values, ends included), and list
+    /// the active-constraint regions; with `--report`, `sweep.png` draws the optimum along it.
+    #[arg(long, value_name = "PATH=LOW:HIGH:N")]
+    sweep: Option<String>,
     /// Override an input or a unit parameter first, e.g. `--set feed_source.F=1.01kmol/min`.
     #[arg(long = "set", value_name = "PATH=VALUE")]
     set: Vec<String>,
@@ -84,6 +88,9 @@ pub fn run(a: &OptimizeArgs) -> Result<(), CliError> {
     let spec = request(a, plant.spec().optimization.as_ref())?;
     let sol = converge(&plant, &u)?;
     let start = State { x: sol.x.clone(), u: sol.u.clone() };
+    if let Some(text) = &a.sweep {
+        return run_sweep(a, &plant, &spec, &start, text);
+    }
     let optimum = optimize(&plant, &spec, &start).map_err(|e| optimize_error(&a.file, e))?;
     if let Some(dir) = &a.report {
         let written = report::write_report(dir, &optimum).map_err(|e| CliError::user(e.to_string()))?;
@@ -105,4 +112,29 @@ fn optimize_error(file: &std::path::Path, e: OptimizeError) -> CliError {
     // Messages that name a path of the plant already carry the file.
     let message = if text.contains(&name) { text } else { format!("{name}: {text}") };
     if e.is_user_error() { CliError::user(message) } else { CliError::numerical(message) }
+}
+
+/// `--sweep`: the optimum along a disturbance; exit 2 when a value has no optimum.
+fn run_sweep(
+    a: &OptimizeArgs,
+    plant: &plantwide::flowsheet::Plant,
+    spec: &OptimizationSpec,
+    start: &State,
+    text: &str,
+) -> Result<(), CliError> {
+    let sw =
+        plantwide::studies::optimize::sweep::sweep(plant, spec, start, text).map_err(|e| optimize_error(&a.file, e))?;
+    if let Some(dir) = &a.report {
+        let written = report::write_sweep(dir, &sw).map_err(|e| CliError::user(e.to_string()))?;
+        eprintln!("wrote {} in {}", written.join(", "), dir.display());
+    }
+    if a.json {
+        outln!("{}", plantwide::io::report::json(&sw).map_err(|e| CliError::numerical(e.to_string()))?);
+    } else {
+        out!("{}", report::sweep_text(&sw));
+    }
+    match plantwide::studies::request::failed_parts("optimize --sweep", &sw.failed()) {
+        Some(m) => Err(CliError::numerical(m)),
+        None => Ok(()),
+    }
 }

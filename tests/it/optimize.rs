@@ -425,3 +425,45 @@ fn column_a_tray_temperatures_lose_on_the_plant_what_the_local_method_predicts()
         assert!(z.iter().any(|&l| l < local) && z.iter().any(|&l| l > local), "{name}: {z:?} around {local}");
     }
 }
+
+#[test]
+fn the_sweep_finds_the_evaporators_active_constraint_regions() {
+    let dir = std::env::temp_dir().join(format!("plantwide-optimize-sweep-{}", std::process::id()));
+    let file = format!("{ROOT}/flowsheets/evaporator.json");
+    let sw = optimum(&[&file, "--sweep", "evaporator.X1=4.75 %:5.25 %:3", "--report", dir.to_str().unwrap()]);
+    let points = sw["points"].as_array().unwrap();
+    let values: Vec<f64> = points.iter().map(|p| p["value"].as_f64().unwrap()).collect();
+    assert_eq!(values, [4.75, 5.0, 5.25]);
+    let r = reference();
+    let reopt = |sign: f64| {
+        r["nonlinear_losses"]["reoptimized"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|q| q["disturbance"] == "X1" && q["sign"].as_f64().unwrap() == sign)
+            .unwrap()["J"]
+            .as_f64()
+            .unwrap()
+    };
+    let j = |k: usize| points[k]["objective"].as_f64().unwrap();
+    // X1 + 0.25 %: the nominal active set, the optimum SciPy re-finds with it.
+    assert!(close(j(2), reopt(1.0), 1e-9), "{} vs {}", j(2), reopt(1.0));
+    assert!(close(j(1), r["optimum"]["cost"].as_f64().unwrap(), 1e-9));
+    // X1 − 0.25 %: SciPy's re-optimum with X2 and P100 alone breaks P2 ≥ 40 kPa; the sweep finds
+    // P2 at its limit, a dearer but feasible optimum.
+    assert_eq!(
+        points[0]["active"],
+        serde_json::json!(["evaporator.P100:max", "evaporator.P2:min", "evaporator.X2:min"])
+    );
+    assert!(j(0) > reopt(-1.0), "{} vs {}", j(0), reopt(-1.0));
+    let regions = sw["regions"].as_array().unwrap();
+    assert_eq!(regions.len(), 2, "{regions:?}");
+    assert!(dir.join("sweep.png").exists() && dir.join("sweep.json").exists());
+    for (bad, fragment) in [("evaporator.X1=4.5 %:5.5 %:1", "from 2 to"), ("evaporator.F1=1:2:3", "degree of freedom")]
+    {
+        let out = plantwide(&["optimize", &file, "--sweep", bad]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{bad}: {err}");
+        assert!(err.contains(fragment), "{bad}: {err}");
+    }
+}

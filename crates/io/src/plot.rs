@@ -1,7 +1,8 @@
 //! Figures as PNG or SVG files (chosen by the file extension), drawn with plotters: trend plots
 //! of a dynamic run ([`write_trends`], several runs overlaid with [`write_overlays`]), sensitivity
 //! plots ([`write_sensitivity`]), heat maps of small matrices ([`write_matrices`]), rankings as bar
-//! charts ([`write_bars`]) and Bode diagrams of tuned loops ([`write_bode`]). Curves are told
+//! charts ([`write_bars`]), Bode diagrams of tuned loops ([`write_bode`]) and single curves
+//! ([`write_line`]). Curves are told
 //! apart by colour, line pattern and marker, legends stand beside the data, and titles are sized
 //! to fit. Text is
 //! drawn with the embedded DejaVu Sans font under the family `sans-serif`, so no system font
@@ -9,6 +10,7 @@
 
 mod bars;
 mod bode;
+mod line;
 mod matrices;
 mod sensitivity;
 mod style;
@@ -23,6 +25,7 @@ use plotters::style::{FontStyle, register_font};
 
 pub use bars::write_bars;
 pub use bode::{BodeLoop, write_bode};
+pub use line::write_line;
 pub use matrices::{LabelledMatrix, write_matrices};
 pub use sensitivity::write_sensitivity;
 pub use style::{CurveStyle, Marker, curve_style, legend_width, marker_indices, title_font_size};

@@ -22,6 +22,7 @@ mod qp;
 pub mod request;
 pub mod select;
 mod sqp;
+pub mod sweep;
 
 use indexmap::IndexMap;
 use plantwide_flowsheet::Plant;

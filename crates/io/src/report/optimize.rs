@@ -6,6 +6,7 @@
 use std::path::Path;
 
 use plantwide_studies::optimize::Optimum;
+use plantwide_studies::optimize::sweep::Sweep;
 
 use super::sig6 as sig;
 use crate::IoError;
@@ -71,5 +72,46 @@ pub fn write_report(dir: &Path, o: &Optimum) -> Result<Vec<String>, IoError> {
         super::write(dir, "optimum.json", &super::json(o)?)?,
         super::write(dir, "optimum.txt", &text)?,
         super::write(dir, "optimum.md", &md)?,
+    ])
+}
+
+/// The optimum along a disturbance as text: a row per value, then the active-constraint regions.
+pub fn sweep_text(s: &Sweep) -> String {
+    let mut t = format!("the optimum along `{}` [{}]\n\n", s.disturbance, s.unit);
+    t.push_str(&format!("{:>14}  {:>14}  active limits\n", s.unit, s.objective_unit));
+    for p in &s.points {
+        let j = p.objective.map_or_else(|| "failed".to_string(), sig);
+        let what = p.failure.clone().unwrap_or_else(|| p.active.join(", "));
+        t.push_str(&format!("{:>14}  {:>14}  {what}\n", sig(p.value), j));
+    }
+    t.push_str("\nactive-constraint regions:\n");
+    for r in &s.regions {
+        let set = if r.active.is_empty() { "(none active)".to_string() } else { r.active.join(", ") };
+        t.push_str(&format!("  {} … {} {}: {set}\n", sig(r.from), sig(r.to), s.unit));
+    }
+    t
+}
+
+/// Write `sweep.json`, `sweep.txt` and `sweep.png` (the optimal objective along the disturbance,
+/// each region's boundary in the title) into `dir`; the names written.
+///
+/// # Errors
+/// A file that cannot be written or drawn.
+pub fn write_sweep(dir: &Path, s: &Sweep) -> Result<Vec<String>, IoError> {
+    std::fs::create_dir_all(dir).map_err(|e| IoError::Draw(format!("{}: {e}", dir.display())))?;
+    let xs: Vec<f64> = s.points.iter().map(|p| p.value).collect();
+    let ys: Vec<Option<f64>> = s.points.iter().map(|p| p.objective).collect();
+    let title = format!("optimum along {} ({} region(s))", s.disturbance, s.regions.len());
+    crate::plot::write_line(
+        &dir.join("sweep.png"),
+        &title,
+        (&format!("{} [{}]", s.disturbance, s.unit), &format!("objective [{}]", s.objective_unit)),
+        &xs,
+        &ys,
+    )?;
+    Ok(vec![
+        super::write(dir, "sweep.json", &super::json(s)?)?,
+        super::write(dir, "sweep.txt", &sweep_text(s))?,
+        "sweep.png".to_string(),
     ])
 }
