@@ -42,11 +42,13 @@ What the script computes:
     O(h^2): 7e-6 relative for X2, so it is checked to 1e-4) and their Richardson extrapolation
     with h/2 (checked to 1e-6), plus SLSQP's own KKT multipliers;
 (d) the reduced Hessian Juu of J in (F1, F200) at the active limits (Kariwala et al. 2008), by
-    central differences (relative step 1e-4) of the complex-step gradient, and its eigenvalues;
+    central differences (relative steps 1e-3 and 5e-4) of the complex-step gradient, Richardson-
+    extrapolated (error O(h^4), checked against the extrapolation at half the steps to 1e-9), and its
+    eigenvalues;
 (e) the local model of self-optimizing control at the optimum with X2 = 35.5 %, P100 = 400 kPa held
     (Halvorsen et al. 2003; Kariwala et al. 2008's u = (F1, F200), d = (X1, T1, T200) and ten
-    candidate measurements): Gy, Gyd by complex step, Juu, Jud by central differences of the
-    complex-step gradient checked by Richardson extrapolation, and, for information, the difference
+    candidate measurements): Gy, Gyd by complex step, Juu, Jud by Richardson-extrapolated central
+    differences of the complex-step gradient (as in (d)), and, for information, the difference
     from the pySOC matrices in crates/soc/tests/data/evaporator.json;
 (f) the nonlinear loss J_held - J_opt of holding each of the 45 pairs of candidates at its nominal
     optimal value when one disturbance moves by +- Wd = (0.25 %, 8 degC, 5 degC), J_opt the polished
@@ -239,18 +241,33 @@ def shadow_prices(v_opt):
     return out
 
 
-def reduced_hessian(v_opt, rel_step=1e-4):
-    """Juu: central differences of the complex-step gradient in (F1, F200) at the active limits."""
+def richardson(central, h):
+    """Central differences at steps h and h/2 combined to cancel the h^2 term: error O(h^4) (1e-12 of
+    the value at h = 1e-3 of the variable), rounding ~1e-16/h; and the same at h/2 and h/4, whose
+    difference from it estimates its error."""
+    d1, d2, d4 = central(h), central(h / 2.0), central(h / 4.0)
+    return (4.0 * d2 - d1) / 3.0, (4.0 * d4 - d2) / 3.0
+
+
+def reduced_hessian(v_opt, rel_step=1e-3):
+    """Juu: Richardson-extrapolated central differences of the complex-step gradient in (F1, F200)
+    at the active limits."""
     u = np.array(v_opt[:2], dtype=float)
     x2, p100 = v_opt[3], v_opt[2]
-    hess = np.zeros((2, 2))
-    for j in range(2):
-        h = rel_step * abs(u[j])
-        gp = cs_grad(lambda z: reduced(z, x2, p100), u + h * np.eye(2)[j])
-        gm = cs_grad(lambda z: reduced(z, x2, p100), u - h * np.eye(2)[j])
-        hess[:, j] = (gp - gm) / (2.0 * h)
+
+    def central(scale):
+        hess = np.zeros((2, 2))
+        for j in range(2):
+            h = scale * abs(u[j])
+            gp = cs_grad(lambda z: reduced(z, x2, p100), u + h * np.eye(2)[j])
+            gm = cs_grad(lambda z: reduced(z, x2, p100), u - h * np.eye(2)[j])
+            hess[:, j] = (gp - gm) / (2.0 * h)
+        return hess
+
+    hess, finer = richardson(central, rel_step)
+    assert max_rel(hess, finer) < 1e-9, (hess, finer)
     asym = abs(hess[0, 1] - hess[1, 0]) / np.max(np.abs(hess))
-    assert asym < 1e-6, asym
+    assert asym < 1e-9, asym
     hess = 0.5 * (hess + hess.T)
     eig = np.linalg.eigvalsh(hess)
     assert np.all(eig > 0.0), eig
@@ -464,21 +481,21 @@ def kariwala_matrices(ours):
     }
 
 
-def local_model(v_opt, juu_reduced, rel_step=1e-4):
-    """Gy, Gyd (complex step) and Juu, Jud (central differences of the complex-step gradient, checked
-    by Richardson extrapolation with half steps) at the optimum, with X2 and P100 held."""
+def local_model(v_opt, juu_reduced, rel_step=1e-3):
+    """Gy, Gyd (complex step) and Juu, Jud (Richardson-extrapolated central differences of the
+    complex-step gradient, checked against the extrapolation at half the steps) at the optimum, with
+    X2 and P100 held."""
     u = np.array(v_opt[:2], dtype=float)
     dv = np.array([D_NOM[k] for k in DISTURBANCES])
     gy = cs_jacobian(lambda z: outputs(z, dv), u)
     gyd = cs_jacobian(lambda z: outputs(u, z), dv)
-    h_u, h_d = rel_step * np.abs(u), rel_step * np.abs(dv)
-    juu, jud = second_derivatives(u, dv, h_u, h_d)
-    juu2, jud2 = second_derivatives(u, dv, h_u / 2.0, h_d / 2.0)
-    rich = {"Juu": (4.0 * juu2 - juu) / 3.0, "Jud": (4.0 * jud2 - jud) / 3.0}
-    check = {"Juu": max_rel(juu, rich["Juu"]), "Jud": max_rel(jud, rich["Jud"])}
-    assert max(check.values()) < 1e-6, check
-    assert max_rel(juu, juu_reduced) < 1e-12, (juu, juu_reduced)
-    ours = {"Gy": gy, "Gyd": gyd, "Juu": juu, "Jud": jud}
+    both = richardson(lambda s: np.concatenate(second_derivatives(u, dv, s * np.abs(u), s * np.abs(dv)), axis=1),
+                      rel_step)
+    (juu, jud), (juu_fine, jud_fine) = [(m[:, :2], m[:, 2:]) for m in both]
+    check = {"Juu": max_rel(juu_fine, juu), "Jud": max_rel(jud_fine, jud)}
+    assert max(check.values()) < 1e-9, check
+    assert max_rel(juu, juu_reduced) < 1e-9, (juu, juu_reduced)
+    ours = {"Gy": gy, "Gyd": gyd, "Juu": 0.5 * (juu + juu.T), "Jud": jud}
     return {
         "inputs": INPUTS, "disturbances": DISTURBANCES, "nominal_disturbances": dv.tolist(),
         "measurements": CANDIDATES,
@@ -486,11 +503,12 @@ def local_model(v_opt, juu_reduced, rel_step=1e-4):
                   "measurements": [CANDIDATE_UNITS.get(m, "kg/min") for m in CANDIDATES], "J": "$/h"},
         "at": {**HELD, "F1": float(u[0]), "F200": float(u[1])},
         "method": "Gy = dy/du and Gyd = dy/dd (u held) by complex step; Juu and Jud by central differences "
-        "(step 1e-4 of |u_j| or |d_k|) of the complex-step gradient dJ/du, Juu symmetrised; checked against "
-        "the Richardson extrapolation of steps h and h/2 (second_derivative_check)",
+        "of the complex-step gradient dJ/du at steps 1e-3, 5e-4 of |u_j| or |d_k|, Richardson-extrapolated "
+        "(error O(h^4)), Juu symmetrised; checked against the extrapolation at half the steps "
+        "(second_derivative_check)",
         **{k: m.tolist() for k, m in ours.items()},
         "Wd": WD,
-        "second_derivative_check": {"richardson": {k: m.tolist() for k, m in rich.items()},
+        "second_derivative_check": {"half_steps": {"Juu": juu_fine.tolist(), "Jud": jud_fine.tolist()},
                                     "max_relative_difference": check},
         "kariwala": kariwala_matrices(ours),
     }

@@ -12,11 +12,10 @@ use plantwide::studies::optimize::{OptimizeError, State, optimize, parse_limits}
 use super::CliError;
 use super::steady::{converge, load_with_overrides};
 
-/// Arguments of `plantwide optimize`.
+/// The problem's flags, shared by `optimize` and `select FILE`: they replace or add to the
+/// file's `"optimization"` section.
 #[derive(Debug, clap::Args)]
-pub struct OptimizeArgs {
-    /// Flowsheet file (JSON), with an `"optimization"` section or the flags below.
-    file: PathBuf,
+pub struct ProblemArgs {
     /// The objective, replacing the file's: a tag's name or a variable path, `PATH[@unit]`.
     #[arg(long, value_name = "PATH[@unit]")]
     objective: Option<String>,
@@ -31,6 +30,15 @@ pub struct OptimizeArgs {
     /// repeatable, added to (or replacing the same path of) the file's `constraints`.
     #[arg(long, value_name = "PATH=LOW:HIGH")]
     constraint: Vec<String>,
+}
+
+/// Arguments of `plantwide optimize`.
+#[derive(Debug, clap::Args)]
+pub struct OptimizeArgs {
+    /// Flowsheet file (JSON), with an `"optimization"` section or the problem's flags.
+    file: PathBuf,
+    #[command(flatten)]
+    problem: ProblemArgs,
     /// Print exactly `{"objective", "values", "active", "multipliers", "kkt_residual"}` and more:
     /// `objective_path`, `objective_unit`, `sense`, `limits`, `reduced_hessian`, `iterations`,
     /// `plant_solves`.
@@ -48,9 +56,20 @@ pub struct OptimizeArgs {
     set: Vec<String>,
 }
 
-/// The file's problem with the flags applied.
-fn request(a: &OptimizeArgs, file: Option<&OptimizationSpec>) -> Result<OptimizationSpec, CliError> {
-    let mut spec = file.cloned().unwrap_or_default();
+impl ProblemArgs {
+    /// No flag given.
+    pub(super) fn is_empty(&self) -> bool {
+        self.objective.is_none() && !self.maximize && self.vary.is_empty() && self.constraint.is_empty()
+    }
+}
+
+/// The problem of `file`'s `"optimization"` section (`section`) with the flags applied.
+pub(super) fn request(
+    a: &ProblemArgs,
+    file: &std::path::Path,
+    section: Option<&OptimizationSpec>,
+) -> Result<OptimizationSpec, CliError> {
+    let mut spec = section.cloned().unwrap_or_default();
     if let Some(o) = &a.objective {
         spec.objective = o.clone();
     }
@@ -77,7 +96,7 @@ fn request(a: &OptimizeArgs, file: Option<&OptimizationSpec>) -> Result<Optimiza
     if spec.objective.is_empty() {
         return Err(CliError::user(format!(
             "{}: no objective: give the file an `optimization` section or --objective (a tag such as `cost`, or a variable path)",
-            a.file.display()
+            file.display()
         )));
     }
     Ok(spec)
@@ -85,7 +104,7 @@ fn request(a: &OptimizeArgs, file: Option<&OptimizationSpec>) -> Result<Optimiza
 
 pub fn run(a: &OptimizeArgs) -> Result<(), CliError> {
     let (plant, u) = load_with_overrides(&a.file, &a.set)?;
-    let spec = request(a, plant.spec().optimization.as_ref())?;
+    let spec = request(&a.problem, &a.file, plant.spec().optimization.as_ref())?;
     let sol = converge(&plant, &u)?;
     let start = State { x: sol.x.clone(), u: sol.u.clone() };
     if let Some(text) = &a.sweep {

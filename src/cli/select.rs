@@ -3,8 +3,9 @@
 //! controlled variables (exact local method, bidirectional branch and bound) from published
 //! linear data ([`plantwide::soc::matrices`]); and `plantwide select FILE --disturbances d=±Δ,…
 //! --candidates y1,y2,… --errors y=±e,… --size N [--best K] [--criterion worst|average]
-//! [--combinations] [--json]`, the same on a plant at its economic optimum, each subset verified
-//! on the nonlinear plant ([`plantwide::studies::optimize::select`]).
+//! [--combinations] [--json]` (and `optimize`'s `--objective`, `--maximize`, `--vary`,
+//! `--constraint`), the same on a plant at its economic optimum, each subset verified on the
+//! nonlinear plant ([`plantwide::studies::optimize::select`]).
 
 use std::path::PathBuf;
 
@@ -16,6 +17,7 @@ use plantwide::studies::optimize::local::LocalRequest;
 use plantwide::studies::optimize::select::select_on_plant;
 
 use super::CliError;
+use super::optimize::{ProblemArgs, request};
 use super::steady::{converge, load_with_overrides};
 
 /// The loss that ranks the subsets.
@@ -30,9 +32,12 @@ pub enum CriterionArg {
 /// Arguments of `plantwide select`.
 #[derive(Debug, clap::Args)]
 pub struct SelectArgs {
-    /// A flowsheet with an `"optimization"` section: the local model is taken at its optimum.
+    /// A flowsheet with an `"optimization"` section or the problem's flags: the local model is
+    /// taken at its optimum.
     #[arg(required_unless_present = "matrices", conflicts_with = "matrices")]
     file: Option<PathBuf>,
+    #[command(flatten)]
+    problem: ProblemArgs,
     /// Linear data in place of a plant (JSON): `inputs`, `disturbances`, `measurements` (names),
     /// `Gy`, `Gyd`, `Juu`, `Jud` (lists of rows), `Wd`, `Wn` (a diagonal as a list, or a full matrix).
     #[arg(long, value_name = "FILE.json")]
@@ -79,6 +84,11 @@ pub fn run(a: &SelectArgs) -> Result<(), CliError> {
         return on_plant(a, file, &search);
     }
     let Some(matrices) = &a.matrices else { return Err(CliError::user("give a flowsheet FILE or --matrices")) };
+    if !a.problem.is_empty() {
+        return Err(CliError::user(
+            "--objective, --maximize, --vary and --constraint pose the problem on a flowsheet FILE; --matrices already holds its local model",
+        ));
+    }
     let model = matrices::read(matrices).map_err(select_error)?;
     let ranking = branch_and_bound(&model, &search).map_err(select_error)?;
     if a.json {
@@ -96,12 +106,7 @@ pub fn run(a: &SelectArgs) -> Result<(), CliError> {
 /// `select FILE …`: optimize, form the local model, search, verify.
 fn on_plant(a: &SelectArgs, file: &std::path::Path, search: &Search) -> Result<(), CliError> {
     let (plant, u) = load_with_overrides(file, &a.set)?;
-    let Some(spec) = plant.spec().optimization.clone() else {
-        return Err(CliError::user(format!(
-            "{}: no `optimization` section: select on a plant takes the local model at the optimum `plantwide optimize` finds",
-            file.display()
-        )));
-    };
+    let spec = request(&a.problem, file, plant.spec().optimization.as_ref())?;
     let sol = converge(&plant, &u)?;
     let start = State { x: sol.x.clone(), u: sol.u.clone() };
     let request = LocalRequest {
@@ -109,14 +114,9 @@ fn on_plant(a: &SelectArgs, file: &std::path::Path, search: &Search) -> Result<(
         candidates: a.candidates.clone(),
         errors: a.errors.clone(),
     };
-    let sel = select_on_plant(&plant, &spec, &start, &request, search).map_err(|e| {
-        let fields = ["disturbances", "candidates", "errors", "size", "best", "max_nodes"];
-        let text = e.to_string();
-        let leading =
-            fields.iter().copied().find(|f| text.starts_with(&format!("{f}:")) || text.starts_with(&format!("{f} ")));
-        let message = super::with_flags(text, leading, &fields);
-        if e.is_user_error() { CliError::user(message) } else { CliError::numerical(message) }
-    })?;
+    let fields = ["disturbances", "candidates", "errors", "size", "best", "max_nodes"];
+    let sel = select_on_plant(&plant, &spec, &start, &request, search)
+        .map_err(|e| flagged(e.to_string(), e.is_user_error(), &fields))?;
     if a.json {
         let text =
             report::plant_json(&sel, a.size, search.criterion).map_err(|e| CliError::numerical(e.to_string()))?;
@@ -134,11 +134,14 @@ fn on_plant(a: &SelectArgs, file: &std::path::Path, search: &Search) -> Result<(
 /// The library's message with the request's fields as this command line's flags; exit 1 for the
 /// data or the request, 2 for a search that did not finish.
 fn select_error(e: SocError) -> CliError {
-    let fields = ["size", "best", "max_nodes"];
-    let leading = fields.iter().copied().find(|f| e.to_string().starts_with(&format!("{f} ")));
-    let message = super::with_flags(e.to_string(), leading, &fields);
-    match e.is_user_error() {
-        true => CliError::user(message),
-        false => CliError::numerical(message),
-    }
+    flagged(e.to_string(), e.is_user_error(), &["size", "best", "max_nodes"])
+}
+
+/// A library message (`text`) whose leading request field (`fields`) becomes this command
+/// line's flag; exit 1 for a user's error, 2 otherwise.
+fn flagged(text: String, user: bool, fields: &[&str]) -> CliError {
+    let leading =
+        fields.iter().copied().find(|f| text.starts_with(&format!("{f}:")) || text.starts_with(&format!("{f} ")));
+    let message = super::with_flags(text, leading, fields);
+    if user { CliError::user(message) } else { CliError::numerical(message) }
 }

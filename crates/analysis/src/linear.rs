@@ -124,6 +124,31 @@ impl Linearization {
         Ok(Mat::from_fn(outputs.len(), inputs.len(), |i, k| -x[(outputs[i], k)]))
     }
 
+    /// The steady state's response to moves of the inputs: `δx = −J⁻¹ B δu` for each column of
+    /// `du` (rows: every input of the plant, SI), as the columns of the result (`n × du.ncols()`).
+    pub fn state_moves(&self, du: &Mat<f64>) -> Result<Mat<f64>, AnalysisError> {
+        let mut x = Mat::<f64>::zeros(self.n, du.ncols());
+        for &(i, j, v) in &self.ju {
+            for k in 0..du.ncols() {
+                x[(i, k)] -= v * du[(j, k)];
+            }
+        }
+        solve_sparse(self.n, &self.jx, &mut x, "the plant Jacobian ∂f/∂x")?;
+        check_finite(&x, "the plant Jacobian ∂f/∂x")?;
+        Ok(x)
+    }
+
+    /// The adjoint `λ` of `J` for weights `w` on the variables: `Jᵀ λ = w` (one sparse LU of
+    /// `Jᵀ`). For a function `φ = wᵀx` of the steady state, `−λ` weighs the equations' residuals
+    /// in `dφ` and `∂²φ/∂u∂u = −λᵀ f''[δw, δw']` along input moves and their state responses.
+    pub fn adjoint(&self, w: &[f64]) -> Result<Vec<f64>, AnalysisError> {
+        let jt: Vec<(usize, usize, f64)> = self.jx.iter().map(|&(i, j, v)| (j, i, v)).collect();
+        let mut lambda = Mat::from_fn(self.n, 1, |i, _| w[i]);
+        solve_sparse(self.n, &jt, &mut lambda, "the transposed plant Jacobian ∂f/∂xᵀ")?;
+        check_finite(&lambda, "the transposed plant Jacobian ∂f/∂xᵀ")?;
+        Ok(lambda.col(0).iter().copied().collect())
+    }
+
     /// Frequency response `G(jω) = C (jωM − J)⁻¹ B` at each `ω` [rad/s], in parallel.
     pub fn frequency_response(
         &self,

@@ -290,6 +290,23 @@ impl Plant {
         });
     }
 
+    /// The second derivative of the residuals along two directions `a = (a_x, a_u)` and
+    /// `b = (b_x, b_u)` of the variables and inputs, `f''[a, b] = Σ ∂²f/∂w_i∂w_j a_i b_j`
+    /// (`w = (x, u)`), exact by hyper-dual numbers: one pass of every block ([`Unit::curvature`]),
+    /// into `out` (length `n_eqs`). With the adjoint `λ` of a function of the steady state, the
+    /// implicit-function theorem turns it into that function's exact second derivative along
+    /// the inputs (`plantwide_studies::optimize`).
+    pub fn curvature(&self, (x, u): (&[f64], &[f64]), a: (&[f64], &[f64]), b: (&[f64], &[f64]), out: &mut [f64]) {
+        let (mut local, mut la, mut lb) = (Vec::new(), Vec::new(), Vec::new());
+        for blk in &self.blocks {
+            self.gather(blk, x, u, &mut local);
+            self.gather(blk, a.0, a.1, &mut la);
+            self.gather(blk, b.0, b.1, &mut lb);
+            let io = UnitIo { local: &local, layout: &blk.layout, thermo: &self.thermo, time: 0.0 };
+            blk.unit.curvature(&io, &la, &lb, &mut out[blk.eq_offset..blk.eq_offset + blk.n_eq]);
+        }
+    }
+
     /// Residuals and Jacobians: `∂f/∂x` as triplets `(row, col, value)` into `jx`, and `∂f/∂u`
     /// (free inputs only) into `ju`. Structural entries are kept even when their value is zero, so
     /// the pattern is the same at every point. Blocks are evaluated in parallel (rayon) when the

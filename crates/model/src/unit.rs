@@ -14,7 +14,7 @@
 //! whose outflow a downstream valve sets) may own more variables than equations or the reverse; the
 //! plant as a whole is square.
 
-use num_dual::Dual64;
+use num_dual::{Dual64, HyperDual64};
 use plantwide_thermo::ThermoPackage;
 use plantwide_units::Dimension;
 
@@ -326,6 +326,11 @@ pub trait Unit: Send + Sync + std::fmt::Debug {
     /// [`Unit::jacobian`] with the colouring of the unit's pattern computed once by the caller
     /// (`None` for a dense unit); assembly caches it per block.
     fn jacobian_colored(&self, io: &UnitIo<'_, f64>, r: &mut [f64], jac: &mut [f64], coloring: Option<&Coloring>);
+    /// The second derivative of the residuals along two directions of the local vector,
+    /// `out_k = Σ_ij ∂²r_k/∂local_i ∂local_j · a_i · b_j`, exact by one pass of hyper-dual numbers
+    /// (`local + ε₁a + ε₂b`, the `ε₁ε₂` part). The curvature the optimizer's reduced Hessian and
+    /// the self-optimizing `Juu`, `Jud` are made of.
+    fn curvature(&self, io: &UnitIo<'_, f64>, a: &[f64], b: &[f64], out: &mut [f64]);
     /// See [`UnitModel::guess`].
     fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]);
     /// See [`UnitModel::check_guess`].
@@ -486,6 +491,13 @@ impl<U: UnitModel + 'static> Unit for U {
                 r[k] = rd[k].re;
             }
         }
+    }
+    fn curvature(&self, io: &UnitIo<'_, f64>, a: &[f64], b: &[f64], out: &mut [f64]) {
+        let local: Vec<HyperDual64> =
+            io.local.iter().zip(a).zip(b).map(|((&v, &da), &db)| HyperDual64::new(v, da, db, 0.0)).collect();
+        let mut r = vec![HyperDual64::from_re(0.0); out.len()];
+        self.eval(&UnitIo { local: &local, layout: io.layout, thermo: io.thermo, time: io.time }, &mut r);
+        out.iter_mut().zip(&r).for_each(|(o, v)| *o = v.eps1eps2);
     }
     fn guess(&self, io: &UnitIo<'_, f64>, own: &mut [f64]) {
         UnitModel::guess(self, io, own);

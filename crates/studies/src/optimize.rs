@@ -10,11 +10,12 @@
 //! clarabel solves with the KKT structure built once ([`qp`]).
 //!
 //! The answer ([`Optimum`]): the optimum, its active set, the shadow prices `∂J*/∂limit` of the
-//! active limits in display units, the KKT residual, and the reduced Hessian of the Lagrangian
-//! measured at the optimum ([`certificate`]). No feasible point, or a KKT point that is no
+//! active limits in display units, the KKT residual, and the exact reduced Hessian of the
+//! Lagrangian at the optimum ([`certificate`], [`curvature`]). No feasible point, or a KKT point that is no
 //! minimum, is an error naming what failed.
 
 mod certificate;
+mod curvature;
 pub mod local;
 mod plant;
 mod polish;

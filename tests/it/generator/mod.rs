@@ -31,6 +31,7 @@ mod exec;
 pub(crate) mod families;
 mod known;
 mod linear;
+mod optimize;
 mod relations;
 mod schemes;
 mod shortcut;
@@ -110,6 +111,10 @@ fn check(cx: &mut Cx<'_>, full: bool) {
         && (full || s.is_multiple_of(3))
     {
         linear::linearize(cx, g);
+    }
+    // Apart from the rotation, so that adding it moved no plant's other studies.
+    if full || (s / 19).is_multiple_of(3) {
+        optimize::optimize_and_select(cx);
     }
 }
 

@@ -6,18 +6,14 @@
 //! per independent active constraint, the pivots) and free ones; moving free input `j` by one
 //! unit while the dependent inputs keep the active constraints at their limits (to first order)
 //! is the direction `z_j = e_j − D⁻¹ a_j`. The Hessian of the Lagrangian along the directions,
-//! `Zᵀ ∇²L Z`, comes from central differences of the exact gradient of the Lagrangian
-//! `∇L = ∇f − Aᵀy` (two plant solves per free input, step `h` = 1e-4 of the input's scale:
-//! truncation ~h², rounding ~1e-12/h, so ~1e-8 relative). In the free inputs' own units it is the
-//! `Juu` of self-optimizing control when the active set is that of the nominal optimum.
+//! `Zᵀ ∇²L Z`, is exact: the adjoint of the Lagrangian and the plant's second derivatives by
+//! hyper-dual numbers ([`super::curvature`]), no plant solve. In the free inputs' own units it is
+//! the `Juu` of self-optimizing control when the active set is that of the nominal optimum.
 
 use faer::Mat;
 
+use super::curvature::Curvature;
 use super::plant::{EvaluationFailure, PlantNlp};
-use super::sqp::{Nlp, Point};
-
-/// The relative step of the central differences.
-const STEP: f64 = 1e-4;
 
 /// Active rows: the constraint gradients and bound rows (scaled), as dense rows over `n`.
 pub(crate) fn active_rows(n: usize, a: &Mat<f64>, constraints: &[usize], bounds: &[usize]) -> Vec<Vec<f64>> {
@@ -85,33 +81,20 @@ pub(crate) fn directions(n: usize, rows: &[Vec<f64>]) -> Directions {
     Directions { free, z, pivots }
 }
 
-/// `∇L = ∇f − Aᵀy` at a point.
-fn lagrangian_gradient<S>(p: &Point<S>, y: &[f64]) -> Vec<f64> {
-    (0..p.g.len()).map(|j| p.g[j] - (0..y.len()).map(|i| p.a[(i, j)] * y[i]).sum::<f64>()).collect()
-}
-
-/// `Zᵀ ∇²L Z` (scaled, symmetrized) at `v` by central differences of `∇L` along each direction.
+/// `Zᵀ ∇²L Z` (scaled) at the steady state `state` with multipliers `y`: exact, along the
+/// physical moves of the directions ([`super::curvature`]).
 ///
 /// # Errors
-/// The plant could not be solved at a displaced point.
+/// The plant Jacobian is singular there.
 pub(crate) fn reduced_hessian(
-    nlp: &mut PlantNlp<'_>,
-    v: &[f64],
-    near: &super::plant::State,
+    nlp: &PlantNlp<'_>,
+    state: &super::plant::State,
     y: &[f64],
     dirs: &Directions,
 ) -> Result<Mat<f64>, EvaluationFailure> {
-    let k = dirs.z.len();
-    let mut hz: Vec<Vec<f64>> = Vec::with_capacity(k);
-    for z in &dirs.z {
-        let at = |s: f64| -> Vec<f64> { v.iter().zip(z).map(|(vi, zi)| vi + s * STEP * zi).collect() };
-        let plus = nlp.evaluate(&at(1.0), Some(near))?;
-        let minus = nlp.evaluate(&at(-1.0), Some(near))?;
-        let (gp, gm) = (lagrangian_gradient(&plus, y), lagrangian_gradient(&minus, y));
-        hz.push(gp.iter().zip(&gm).map(|(a, b)| (a - b) / (2.0 * STEP)).collect());
-    }
-    let raw = Mat::from_fn(k, k, |a, b| dirs.z[a].iter().zip(&hz[b]).map(|(x, y)| x * y).sum::<f64>());
-    Ok(Mat::from_fn(k, k, |a, b| 0.5 * (raw[(a, b)] + raw[(b, a)])))
+    let curvature = Curvature::new(nlp.plant(), state, &nlp.lagrangian_weights(y))?;
+    let moves = curvature.moves(&dirs.z.iter().map(|z| nlp.input_move(z)).collect::<Vec<_>>())?;
+    Ok(curvature.matrix(&moves))
 }
 
 /// Eigenvalues of a small symmetric matrix, ascending.

@@ -5,10 +5,10 @@
 //! - `Gy = ∂y/∂u` along the free directions, `Gyd = ∂y/∂d` with `u` held and the active limits
 //!   held (the dependent inputs moving by `−A_D⁻¹ ∂c/∂d`): exact, from one sparse LU of the
 //!   plant Jacobian at the optimum;
-//! - `Juu`: the reduced Hessian of the Lagrangian ([`super::certificate`]);
-//! - `Jud = ∂/∂d (Zᵀ∇L)`: central differences of the exact reduced gradient of the Lagrangian as
-//!   each disturbance moves ± 1e-4 of its magnitude, the dependent inputs following to first
-//!   order (their second-order error is even in the step, so it cancels);
+//! - `Juu`: the reduced Hessian of the Lagrangian ([`super::certificate`]), exact;
+//! - `Jud = ∂/∂d (Zᵀ∇L)`: the Lagrangian's mixed second derivatives along the free directions
+//!   and each disturbance's move, the dependent inputs following it to hold the active limits:
+//!   exact, by the adjoint and hyper-dual numbers ([`super::curvature`]);
 //! - `Wd`, `Wn`: the disturbances' expected magnitudes and the measurements' errors.
 //!
 //! Everything is in display units: the objective's, the inputs' (of their bounds), each
@@ -23,10 +23,11 @@ use plantwide_flowsheet::overrides::resolve_input;
 use plantwide_units::parse_difference_as;
 
 use super::certificate::Directions;
-use super::plant::PlantNlp;
+use super::curvature::Curvature;
+use super::plant::{EvaluationFailure, PlantNlp};
 use super::report::sign;
 use super::request::{Problem, in_unit, unit_of};
-use super::sqp::{Nlp, Solution};
+use super::sqp::Solution;
 use super::{OptimizeError, State};
 
 /// What the local model is asked for: `PATH=±Δ` disturbances, candidate `PATH[@unit]`s and
@@ -251,49 +252,36 @@ pub(crate) fn gains(
     (gy, gyd)
 }
 
-/// `Jud` in display units by central differences of the reduced gradient of the Lagrangian.
+/// `Jud` in display units, exact: `∂(Zᵀ∇L)/∂d = Zᵀ ∇²L δ_d` along each disturbance's move with
+/// the dependent inputs following it ([`super::curvature`]).
 pub(crate) fn jud(
-    nlp: &mut PlantNlp<'_>,
+    nlp: &PlantNlp<'_>,
     problem: &Problem,
     sol: &Solution<State>,
     (dep, dirs): (&Mat<f64>, &Directions),
     dists: &[Dist],
 ) -> Result<Mat<f64>, OptimizeError> {
-    let (nf, nd) = (dirs.free.len(), dists.len());
-    let home = nlp.base().to_vec();
-    let mut out = Mat::zeros(nf, nd);
-    let fail = |m: String| OptimizeError::NotConverged {
-        reason: format!("Jud could not be measured: {m}"),
+    let fail = |e: EvaluationFailure| OptimizeError::NotConverged {
+        reason: format!("Jud at the optimum: {}", e.message),
         iterations: sol.iterations,
         kkt: sol.kkt.max(),
     };
+    let state = &sol.point.state;
+    let curvature = Curvature::new(nlp.plant(), state, &nlp.lagrangian_weights(&sol.y)).map_err(fail)?;
+    let mut du: Vec<Vec<f64>> = dirs.z.iter().map(|z| nlp.input_move(z)).collect();
     for (k, d) in dists.iter().enumerate() {
-        let h = 1e-4 * d.magnitude;
-        let mut reduced = Vec::new();
-        for s in [1.0, -1.0] {
-            let mut base = home.clone();
-            base[d.signal.index] += s * h;
-            let mut u = sol.point.state.u.clone();
-            u[d.signal.index] += s * h;
-            for (p, &(_, j)) in dirs.pivots.iter().enumerate() {
-                u[problem.dofs[j].signal.index] += s * h * dep[(p, k)];
-            }
-            nlp.set_base(&base);
-            let v = nlp.variables(&u);
-            let point = nlp.evaluate(&v, Some(&sol.point.state));
-            nlp.set_base(&home);
-            let point = point.map_err(|e| fail(e.message))?;
-            let grad: Vec<f64> = (0..v.len())
-                .map(|j| point.g[j] - (0..sol.y.len()).map(|i| point.a[(i, j)] * sol.y[i]).sum::<f64>())
-                .collect();
-            reduced
-                .push(dirs.z.iter().map(|z| z.iter().zip(&grad).map(|(a, b)| a * b).sum::<f64>()).collect::<Vec<_>>());
+        let mut m = vec![0.0; state.u.len()];
+        m[d.signal.index] = 1.0;
+        for (p, &(_, j)) in dirs.pivots.iter().enumerate() {
+            m[problem.dofs[j].signal.index] += dep[(p, k)];
         }
-        let to_objective = sign(problem.sense) * nlp.scale_f / problem.objective.factor;
-        for f in 0..nf {
-            let per_input = problem.dofs[dirs.free[f]].signal.factor / nlp.scale_u[dirs.free[f]];
-            out[(f, k)] = (reduced[0][f] - reduced[1][f]) / (2.0 * h) * to_objective * per_input * d.signal.factor;
-        }
+        du.push(m);
     }
-    Ok(out)
+    let moves = curvature.moves(&du).map_err(fail)?;
+    let nf = dirs.free.len();
+    let to_objective = sign(problem.sense) * nlp.scale_f / problem.objective.factor;
+    Ok(Mat::from_fn(nf, dists.len(), |f, k| {
+        let per_input = problem.dofs[dirs.free[f]].signal.factor / nlp.scale_u[dirs.free[f]];
+        curvature.second(&moves[f], &moves[nf + k]) * to_objective * per_input * dists[k].signal.factor
+    }))
 }

@@ -6,13 +6,16 @@
 //!
 //! Scaling, fixed at the start point: each degree of freedom by the width of its bounds (by its
 //! magnitude when a bound is missing), the objective by its largest change over one such width
-//! (so the scaled gradient starts at unit size), each constraint by the same measure of its own.
+//! to second order (so the scaled gradient starts at unit size unless the curvature dominates;
+//! at a stationary start, the curvature alone), each constraint by its largest first-order
+//! change.
 
 use plantwide_analysis::linear::Linearization;
 use plantwide_flowsheet::Plant;
 use plantwide_flowsheet::optimization::Sense;
 use plantwide_solve::{NewtonSettings, SteadyError, steady_state};
 
+use super::curvature::Curvature;
 use super::request::Problem;
 use super::sqp::{Nlp, Point};
 
@@ -95,22 +98,13 @@ impl<'a> PlantNlp<'a> {
             raw.gradients[k].iter().zip(&nlp.scale_u).fold(0.0_f64, |m, (g, s)| m.max((g * s).abs()))
         };
         let fallback = |v: f64| if v.abs() > 0.0 { v.abs() } else { 1.0 };
-        nlp.scale_f = if size(0) > 0.0 { size(0) } else { fallback(raw.values[0]) };
+        let change = nlp.objective_change(start, &raw.gradients[0])?;
+        nlp.scale_f = if change > 0.0 { change } else { fallback(raw.values[0]) };
         for (i, c) in problem.constraints.iter().enumerate() {
             let limit = if c.lo.is_finite() { c.lo } else { c.hi };
             nlp.scale_c[i] = if size(i + 1) > 0.0 { size(i + 1) } else { fallback(limit.abs().max(raw.values[i + 1])) };
         }
         Ok(nlp)
-    }
-
-    /// The inputs besides the degrees of freedom (the disturbances among them).
-    pub fn base(&self) -> &[f64] {
-        &self.u0
-    }
-
-    /// Move the inputs besides the degrees of freedom (a disturbance), keeping the scales.
-    pub fn set_base(&mut self, u: &[f64]) {
-        self.u0 = u.to_vec();
     }
 
     /// The inputs at scaled variables `v`.
@@ -125,6 +119,49 @@ impl<'a> PlantNlp<'a> {
     /// The scaled variables of the inputs `u`.
     pub fn variables(&self, u: &[f64]) -> Vec<f64> {
         self.problem.dofs.iter().enumerate().map(|(j, d)| u[d.signal.index] / self.scale_u[j]).collect()
+    }
+
+    /// The objective's largest change over one width of a degree of freedom, to second order:
+    /// `max_j |g_j| w_j + ½ |H_jj| w_j²` (`H_jj` exact, [`Curvature`]). The curvature matters
+    /// where the start is stationary: at an optimum whose disturbance the caller moves (a
+    /// re-optimization from the held point), the gradient is rounding, and a scale taken from it
+    /// alone would magnify that rounding into the SQP's steps.
+    fn objective_change(&self, start: &State, gradient: &[f64]) -> Result<f64, EvaluationFailure> {
+        let mut w = vec![0.0; self.plant.n_vars()];
+        w[self.problem.objective.index] = 1.0;
+        let curvature = Curvature::new(self.plant, start, &w)?;
+        let unit = |j: usize| (0..self.scale_u.len()).map(|k| f64::from(u8::from(k == j))).collect::<Vec<_>>();
+        let moves = curvature.moves(&(0..self.scale_u.len()).map(|j| self.input_move(&unit(j))).collect::<Vec<_>>())?;
+        Ok(moves
+            .iter()
+            .enumerate()
+            .map(|(j, m)| (gradient[j] * self.scale_u[j]).abs() + 0.5 * curvature.second(m, m).abs())
+            .fold(0.0_f64, f64::max))
+    }
+
+    /// The plant.
+    pub fn plant(&self) -> &Plant {
+        self.plant
+    }
+
+    /// The SQP's Lagrangian `f − Σ yᵢ cᵢ` (scaled objective and constraints) as weights on the
+    /// plant's variables: `L = wᵀx` up to the bounds' terms, which are linear in the inputs.
+    pub fn lagrangian_weights(&self, y: &[f64]) -> Vec<f64> {
+        let mut w = vec![0.0; self.plant.n_vars()];
+        w[self.problem.objective.index] += self.sign() / self.scale_f;
+        for (i, c) in self.problem.constraints.iter().enumerate() {
+            w[c.signal.index] -= y[i] / self.scale_c[i];
+        }
+        w
+    }
+
+    /// The move of every input (SI) along the scaled direction `z` of the degrees of freedom.
+    pub fn input_move(&self, z: &[f64]) -> Vec<f64> {
+        let mut du = vec![0.0; self.u0.len()];
+        for (j, d) in self.problem.dofs.iter().enumerate() {
+            du[d.signal.index] += z[j] * self.scale_u[j];
+        }
+        du
     }
 
     /// The sign that makes the objective a cost.

@@ -128,8 +128,7 @@ pub(super) fn optimum(
         iterations: sol.iterations,
         kkt: sol.kkt.max(),
     };
-    let h =
-        reduced_hessian(nlp, &sol.v, &sol.point.state, &sol.y, &dirs).map_err(|e| certificate_failure(e.message))?;
+    let h = reduced_hessian(nlp, &sol.point.state, &sol.y, &dirs).map_err(|e| certificate_failure(e.message))?;
     let scaled_eigenvalues = eigenvalues(&h);
     let largest = scaled_eigenvalues.iter().fold(1.0_f64, |m, e| m.max(e.abs()));
     if let Some(&least) = scaled_eigenvalues.first().filter(|&&e| e < -1e-6 * largest) {

@@ -118,7 +118,7 @@ pub fn select_on_plant(
     let dep = dependent_move(&sens, &dirs, n)?;
     let z = physical_directions(&solved.nlp, &dirs);
     let (gy, gyd) = gains(&problem, &sens, (&z, &dep, &dirs), (&dists, &cands));
-    let jud = jud(&mut solved.nlp, &problem, &solved.sol, (&dep, &dirs), &dists)?;
+    let jud = jud(&solved.nlp, &problem, &solved.sol, (&dep, &dirs), &dists)?;
     let juu = Mat::from_fn(dirs.free.len(), dirs.free.len(), |a, b| opt.reduced_hessian.matrix[a][b]);
     let parts =
         Parts {
