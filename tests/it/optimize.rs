@@ -468,3 +468,24 @@ fn the_sweep_finds_the_evaporators_active_constraint_regions() {
         assert!(err.contains(fragment), "{bad}: {err}");
     }
 }
+
+#[test]
+fn a_combination_held_only_part_of_the_way_says_how_far() {
+    // Size 5 on the evaporator: at X1 − 0.25 % the best combination is held only about a third of
+    // the way (the sweep shows another active-constraint region beyond); the point fails, says
+    // how far it got, and the command exits 2 with the other points' answers in the JSON.
+    let args = evaporator_select(&["--size", "5", "--best", "1", "--json"]);
+    let refs: Vec<&str> = args.iter().map(String::as_str).collect();
+    let out = plantwide(&refs);
+    assert_eq!(out.status.code(), Some(2), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("1 part failed"));
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let points = v["subsets"][0]["nonlinear"].as_array().unwrap();
+    let failed: Vec<&Value> = points.iter().filter(|p| !p["failure"].is_null()).collect();
+    assert_eq!(failed.len(), 1, "{points:?}");
+    assert_eq!((failed[0]["disturbance"].as_str(), failed[0]["sign"].as_f64()), (Some("evaporator.X1"), Some(-1.0)));
+    let why = failed[0]["failure"].as_str().unwrap();
+    let share: f64 = why.split("held only to ").nth(1).and_then(|r| r.split(' ').next()).unwrap().parse().unwrap();
+    assert!((0.0..100.0).contains(&share), "{why}");
+    assert!(points.iter().filter(|p| p["failure"].is_null()).all(|p| p["loss"].as_f64().is_some_and(f64::is_finite)));
+}

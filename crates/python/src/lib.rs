@@ -284,16 +284,18 @@ fn optimize(py: Python<'_>, text: String, name: String, sets: Vec<String>, reque
     Ok(py.detach(|| plant::optimize(&src, &sets, &request))?)
 }
 
-/// `plantwide select FILE --json`: the selection's JSON text at the plant's optimum and the
-/// message of the verification points without an answer.
+/// `plantwide select FILE --json`: the selection's JSON text at the optimum of `problem` (the
+/// `"optimization"` section as JSON) and the message of the verification points without an
+/// answer.
 #[pyfunction]
-#[pyo3(signature = (text, name, sets, disturbances, candidates, errors, size, best = 5, criterion = "worst", max_nodes = plantwide_soc::DEFAULT_MAX_NODES))]
+#[pyo3(signature = (text, name, sets, problem, disturbances, candidates, errors, size, best = 5, criterion = "worst", max_nodes = plantwide_soc::DEFAULT_MAX_NODES))]
 #[allow(clippy::too_many_arguments)] // one per keyword of the Python method
 fn select_plant(
     py: Python<'_>,
     text: String,
     name: String,
     sets: Vec<String>,
+    problem: String,
     disturbances: Vec<String>,
     candidates: Vec<String>,
     errors: Vec<String>,
@@ -310,7 +312,7 @@ fn select_plant(
     let search = plantwide_soc::Search { size, best, criterion, max_nodes };
     let request = plantwide_studies::optimize::local::LocalRequest { disturbances, candidates, errors };
     let src = Source { text, name };
-    Ok(py.detach(|| plant::select(&src, &sets, request, &search))?)
+    Ok(py.detach(|| plant::select(&src, &sets, &problem, request, &search))?)
 }
 
 /// The module `plantwide._plantwide`.

@@ -360,21 +360,18 @@ pub fn optimize(src: &Source, sets: &[String], request: &str) -> Result<String, 
     plantwide_io::report::json(&optimum).map_err(FaceError::input)
 }
 
-/// `plantwide select FILE --json`: the selection on the plant at the optimum of its
-/// `"optimization"` section, and the message of the verification points without an answer.
+/// `plantwide select FILE --json`: the selection on the plant at the optimum of `problem` (an
+/// `"optimization"` section as JSON), and the message of the verification points without an
+/// answer.
 pub fn select(
     src: &Source,
     sets: &[String],
+    problem: &str,
     request: plantwide_studies::optimize::local::LocalRequest,
     search: &plantwide_soc::Search,
 ) -> Result<Answer, FaceError> {
+    let spec: plantwide_flowsheet::optimization::OptimizationSpec = study_request("select", problem)?;
     let (plant, ss) = src.at_steady_state(sets)?;
-    let Some(spec) = plant.spec().optimization.clone() else {
-        return Err(FaceError::Input(format!(
-            "{}: no `optimization` section: select takes the local model at its optimum",
-            src.name
-        )));
-    };
     let start = plantwide_studies::optimize::State { x: ss.x, u: ss.u };
     let sel = plantwide_studies::optimize::select::select_on_plant(&plant, &spec, &start, &request, search)?;
     let failed = sel.failed();

@@ -42,3 +42,26 @@ def test_select_on_the_plant_returns_what_the_cli_prints(cli):
     assert got == printed
     assert got["subsets"][0]["measurements"] == ["evaporator.F3@kg/min", "evaporator.F200@kg/min"]
     assert all(p["loss"] is not None for s in got["subsets"] for p in s["nonlinear"])
+
+
+def test_select_keywords_pose_the_problem_as_the_cli_flags_do(cli, tmp_path):
+    # The evaporator without its "optimization" section: the keywords (and the CLI's flags) give
+    # the section back, and the answer is the file's.
+    doc = json.loads((REPO / "flowsheets" / "evaporator.json").read_text())
+    section = doc.pop("optimization")
+    bare = tmp_path / "evaporator_bare.json"
+    bare.write_text(json.dumps(doc))
+    lists = ["--disturbances", ",".join(DISTURBANCES), "--candidates", ",".join(CANDIDATES),
+             "--errors", ",".join(ERRORS), "--size", "2", "--best", "2", "--json"]
+    with_file = json.loads(cli(["select", EVAPORATOR, *lists]).stdout)
+    flags = ["--objective", section["objective"]]
+    for path, limits in section["vary"].items():
+        flags += ["--vary", f"{path}={limits.get('min', '')}:{limits.get('max', '')}" if limits else path]
+    for path, limits in section["constraints"].items():
+        flags += ["--constraint", f"{path}={limits.get('min', '')}:{limits.get('max', '')}"]
+    with_flags = json.loads(cli(["select", str(bare), *flags, *lists]).stdout)
+    got = pw.load(str(bare)).select(DISTURBANCES, CANDIDATES, ERRORS, 2, best=2, objective=section["objective"],
+                                    vary=section["vary"], constraints=section["constraints"])
+    assert got == with_flags == with_file
+    with pytest.raises(pw.InputError, match="objective"):
+        pw.load(str(bare)).select(DISTURBANCES, CANDIDATES, ERRORS, 2)

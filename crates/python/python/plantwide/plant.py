@@ -312,6 +312,11 @@ class Plant:
         ``multipliers`` (shadow prices ∂J*/∂limit in display units), ``kkt_residual``, and
         ``limits``, ``reduced_hessian``, …. A request that does not fit the plant raises
         ``InputError``; no feasible point or no certified optimum raises ``ConvergenceError``."""
+        request = self._problem(objective, vary, constraints, maximize)
+        return json.loads(_native.optimize(self._text, self._name, assignments(set), request))
+
+    def _problem(self, objective, vary, constraints, maximize) -> str:
+        """The file's ``"optimization"`` section with the keywords applied as the CLI's flags are."""
         request = dict(json.loads(self._text).get("optimization") or {})
         if objective is not None:
             request["objective"] = objective
@@ -321,7 +326,7 @@ class Plant:
             request["vary"] = dict(vary) if isinstance(vary, Mapping) else {path: {} for path in vary}
         if constraints is not None:
             request["constraints"] = {**request.get("constraints", {}), **dict(constraints)}
-        return json.loads(_native.optimize(self._text, self._name, assignments(set), json.dumps(request)))
+        return json.dumps(request)
 
     def select(
         self,
@@ -333,10 +338,15 @@ class Plant:
         best: int = 5,
         criterion: str = "worst",
         max_nodes: int = 200_000,
+        objective: str | None = None,
+        vary: Mapping[str, Any] | Sequence[str] | None = None,
+        constraints: Mapping[str, Any] | None = None,
+        maximize: bool = False,
         set: Mapping[str, Any] | None = None,
     ) -> dict:
         """``plantwide select FILE --json``: self-optimizing control at the optimum of the
-        flowsheet's ``"optimization"`` section. ``disturbances`` are ``"PATH=±Δ"``, ``candidates``
+        flowsheet's ``"optimization"`` section, with ``objective``, ``vary``, ``constraints`` and
+        ``maximize`` applied as in :meth:`optimize`. ``disturbances`` are ``"PATH=±Δ"``, ``candidates``
         ``"PATH[@unit]"``, ``errors`` ``"PATH=±e"`` (one per candidate). Returns the dict the CLI
         prints: ``criterion``, ``size``, ``subsets`` (best first, each with ``measurements``,
         losses, ``H`` and its ``nonlinear`` verification points), ``nodes``, ``optimum`` and
@@ -346,6 +356,7 @@ class Plant:
             self._text,
             self._name,
             assignments(set),
+            self._problem(objective, vary, constraints, maximize),
             list(disturbances),
             list(candidates),
             list(errors),

@@ -243,24 +243,51 @@ impl Context<'_> {
         d: &Dist,
         sign: f64,
     ) -> Result<(f64, f64, Vec<String>), PointFailure> {
-        // Continuation in four steps of the disturbance, each predicted by the linearization
+        // Continuation along the disturbance: steps of a quarter of it, halved (down to 1/64)
+        // where one fails and doubled back after a success, each predicted by the linearization
         // (the held combination's and active rows' gains) and corrected by Newton.
-        let mut held = self.state.clone();
-        for quarter in 1..=4 {
-            let delta = sign * d.magnitude / 4.0;
-            let (jac, dcol) = self.newton_matrix(subset, h, &held, Some(d))?;
-            let predictor = jac.partial_piv_lu().solve(Mat::from_fn(jac.nrows(), 1, |i, _| -dcol[i] * delta));
-            let mut start = held.clone();
-            start.u[d.signal.index] = self.state.u[d.signal.index] + f64::from(quarter) * delta;
-            let predicted = self.damped(&start, &predictor)?;
-            held = self.hold(subset, h, &predicted)?;
+        let (mut held, mut reached, mut step) = (self.state.clone(), 0.0_f64, 0.25_f64);
+        while reached < 1.0 {
+            let next = (reached + step).min(1.0);
+            match self.advance(subset, h, (d, sign), &held, (reached, next)) {
+                Ok(s) => (held, reached, step) = (s, next, (2.0 * step).min(0.25)),
+                Err(_) if step > 1.0 / 64.0 => step /= 2.0,
+                Err(e) => {
+                    let at = self.state.u[d.signal.index] + sign * d.magnitude * reached;
+                    return Err(PointFailure(format!(
+                        "the combination is held only to {:.0} % of the disturbance ({} = {:.6} {}), not beyond: {e}",
+                        100.0 * reached,
+                        d.signal.path,
+                        d.signal.display_value(at),
+                        d.signal.unit,
+                    )));
+                }
+            }
         }
-        let moved = held.clone();
         let obj = &self.problem.objective;
         let j_held = obj.display_value(held.x[obj.index]);
         let best =
-            super::optimize(self.plant, self.spec, &moved).map_err(|e| PointFailure(format!("re-optimized: {e}")))?;
+            super::optimize(self.plant, self.spec, &held).map_err(|e| PointFailure(format!("re-optimized: {e}")))?;
         Ok((j_held, best.objective, violations(self.problem, &held)))
+    }
+
+    /// The held point with the disturbance moved from the fraction `from` of its move to `to`,
+    /// starting at the held point `s` of `from`.
+    fn advance(
+        &self,
+        subset: &[usize],
+        h: &Mat<f64>,
+        (d, sign): (&Dist, f64),
+        s: &State,
+        (from, to): (f64, f64),
+    ) -> Result<State, PointFailure> {
+        let delta = sign * d.magnitude * (to - from);
+        let (jac, dcol) = self.newton_matrix(subset, h, s, Some(d))?;
+        let predictor = jac.partial_piv_lu().solve(Mat::from_fn(jac.nrows(), 1, |i, _| -dcol[i] * delta));
+        let mut start = s.clone();
+        start.u[d.signal.index] = self.state.u[d.signal.index] + sign * d.magnitude * to;
+        let predicted = self.damped(&start, &predictor)?;
+        self.hold(subset, h, &predicted)
     }
 
     /// The plant after the Newton step `step` on the degrees of freedom, halved (up to 1/64)
@@ -314,26 +341,33 @@ impl Context<'_> {
         Ok((jac, dcol))
     }
 
-    /// Newton on the degrees of freedom: `H (y − y*) = 0` and the active rows at their values.
-    fn hold(&self, subset: &[usize], h: &Mat<f64>, from: &State) -> Result<State, PointFailure> {
+    /// The residuals of holding: `H (y − y*)` and the active rows minus their values, each
+    /// relative to its own size (`|H_i|·|y*|` for a combination, the limit for an active row:
+    /// the steady states carry ~1e-12 of each).
+    fn hold_residual(&self, subset: &[usize], h: &Mat<f64>, s: &State) -> (Vec<f64>, Vec<f64>) {
         let (target_y, target_a) = (self.measured(self.state), self.held(self.state));
+        let (y, a) = (self.measured(s), self.held(s));
+        let nu = h.nrows();
+        let mut r: Vec<f64> =
+            (0..nu).map(|i| subset.iter().enumerate().map(|(c, &m)| h[(i, c)] * (y[m] - target_y[m])).sum()).collect();
+        r.extend(a.iter().zip(&target_a).map(|(x, t)| x - t));
+        let combination = |i: usize| {
+            subset.iter().enumerate().map(|(c, &m)| (h[(i, c)] * target_y[m]).abs()).sum::<f64>().max(1e-300)
+        };
+        let scale = (0..nu).map(combination).chain(target_a.iter().map(|t| t.abs().max(1e-12))).collect();
+        (r, scale)
+    }
+
+    /// Newton on the degrees of freedom: `H (y − y*) = 0` and the active rows at their values,
+    /// each step backtracked (down to 1/64) until the scaled residual falls.
+    fn hold(&self, subset: &[usize], h: &Mat<f64>, from: &State) -> Result<State, PointFailure> {
         let n = self.problem.dofs.len();
+        let size = |r: &[f64], scale: &[f64]| r.iter().zip(scale).fold(0.0_f64, |m, (v, sc)| m.max((v / sc).abs()));
         let mut s = from.clone();
+        let (mut r, scale) = self.hold_residual(subset, h, &s);
         for _ in 0..30 {
-            let y = self.measured(&s);
-            let a = self.held(&s);
-            let nu = h.nrows();
-            let mut r: Vec<f64> = (0..nu)
-                .map(|i| subset.iter().enumerate().map(|(c, &m)| h[(i, c)] * (y[m] - target_y[m])).sum())
-                .collect();
-            r.extend(a.iter().zip(&target_a).map(|(x, t)| x - t));
-            // Each row relative to its own size: |H_i|·|y*| for a combination, the limit for an
-            // active row (the steady states carry ~1e-12 of each).
-            let combination = |i: usize| {
-                subset.iter().enumerate().map(|(c, &m)| (h[(i, c)] * target_y[m]).abs()).sum::<f64>().max(1e-300)
-            };
-            let scale: Vec<f64> = (0..nu).map(combination).chain(target_a.iter().map(|t| t.abs().max(1e-12))).collect();
-            if r.iter().zip(&scale).all(|(v, sc)| (v / sc).abs() < 1e-10) {
+            let now = size(&r, &scale);
+            if now < 1e-10 {
                 return Ok(s);
             }
             let (jac, _) = self.newton_matrix(subset, h, &s, None)?;
@@ -343,9 +377,40 @@ impl Context<'_> {
                     "the held combination does not fix the degrees of freedom here (singular)".into(),
                 ));
             }
-            s = self.damped(&s, &step)?;
+            let (mut accepted, mut unsolved) = (None, None);
+            for halving in 0..7 {
+                let alpha = 0.5_f64.powi(halving);
+                let next = match self.damped(&s, &Mat::from_fn(n, 1, |i, _| alpha * step[(i, 0)])) {
+                    Ok(next) => next,
+                    Err(e) => {
+                        unsolved = Some(e);
+                        continue;
+                    }
+                };
+                let (r_next, _) = self.hold_residual(subset, h, &next);
+                if size(&r_next, &scale) < (1.0 - 1e-4 * alpha) * now {
+                    accepted = Some((next, r_next));
+                    break;
+                }
+            }
+            let Some((next, r_next)) = accepted else {
+                let why = unsolved.map_or(String::new(), |e| format!("; a step's plant: {e}"));
+                return Err(PointFailure(format!(
+                    "no Newton step reduces the held combination's residual ({now:.2e}, scaled; its Jacobian's condition number {:.1e} there){why}",
+                    condition(&jac)
+                )));
+            };
+            (s, r) = (next, r_next);
         }
         Err(PointFailure("holding the combination did not converge in 30 Newton steps".into()))
+    }
+}
+
+/// The 2-norm condition number of a small square matrix (∞ when singular).
+fn condition(m: &Mat<f64>) -> f64 {
+    match m.singular_values() {
+        Ok(s) if s.last().is_some_and(|&least| least > 0.0) => s[0] / s[s.len() - 1],
+        _ => f64::INFINITY,
     }
 }
 

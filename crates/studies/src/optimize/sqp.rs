@@ -12,10 +12,11 @@
 //! before rejecting a step (against the Maratos effect), and updates the Hessian of the
 //! Lagrangian by damped BFGS (Powell 1978).
 //!
-//! Why BFGS and not exact second derivatives: the unit models give exact first derivatives (dual
-//! numbers) but no second ones, and finite differences of the reduced gradient would cost one
-//! plant solve per degree of freedom per iteration; BFGS costs none and converges
-//! superlinearly. The exact curvature is measured once, at the optimum, for the certificate.
+//! Why BFGS and not the exact Hessian the plant can give ([`super::curvature`]): clarabel's
+//! subproblems need a convex objective, and away from the optimum, or across active limits, the
+//! exact Hessian of the Lagrangian is often indefinite; convexifying it discards the Newton
+//! property it would bring. Damped BFGS is positive definite by construction and converges
+//! superlinearly; the exact curvature certifies the answer at the optimum.
 //!
 //! The penalty `ρ` only grows: tenfold while the QP needs slacks (its linearization cannot be
 //! met inside the region) or while a multiplier comes near it. With `ρ` at its cap and the
