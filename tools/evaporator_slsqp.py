@@ -52,7 +52,10 @@ What the script computes:
     from the pySOC matrices in crates/soc/tests/data/evaporator.json;
 (f) the nonlinear loss J_held - J_opt of holding each of the 45 pairs of candidates at its nominal
     optimal value when one disturbance moves by +- Wd = (0.25 %, 8 degC, 5 degC), J_opt the polished
-    re-optimum at X2 = 35.5 %, P100 = 400 kPa.
+    re-optimum at X2 = 35.5 %, P100 = 400 kPa;
+(g) the optimum under a hostile extra limit, F3 <= 0.01 kg/min: the vertex of F3, P2, X2 and P100
+    at their limits, by a root solve of the closed form (SLSQP stops there: "Inequality constraints
+    incompatible").
 
 Usage: python3 tools/evaporator_slsqp.py           (rewrite tests/data/evaporator/slsqp.json)
        python3 tools/evaporator_slsqp.py --check   (recompute; exit 1 unless it matches the file)
@@ -375,14 +378,32 @@ def compute():
             "variables": UNCONSTRAINED,
             "unit": "$/h per (kg/min)^2",
             "at": {"X2": 35.5, "P100": 400.0},
-            "method": "central differences (relative step 1e-4) of the complex-step gradient, symmetrised",
+            "method": "central differences (relative steps 1e-3, 5e-4) of the complex-step gradient, "
+            "Richardson-extrapolated, symmetrised",
             "hessian": hess.tolist(),
             "eigenvalues": eig.tolist(),
             "asymmetry_over_max": asym,
         },
         "local_model": local_model(v_opt, hess),
         "nonlinear_losses": nonlinear_losses(v_opt),
+        "hostile_limit": hostile_vertex(),
     }
+
+
+def hostile_vertex(f3_max=0.01):
+    """The optimum under the extra limit F3 <= 0.01 kg/min (a plant squeezed 10^4-fold): the vertex
+    where F3 = 0.01 kg/min and P2 = 40 kPa with X2 = 35.5 % and P100 = 400 kPa, by a root solve of the
+    closed form; SLSQP itself stops there with "Inequality constraints incompatible"."""
+    def vertex(u):
+        m = model([u[0], u[1], 400.0, 35.5])
+        return [m["F3"] - f3_max, m["P2"] - 40.0]
+
+    sol = root(vertex, [0.005, 0.02], method="hybr", options={"xtol": 1e-14})
+    assert sol.success and max(abs(r) for r in vertex(sol.x)) < 1e-10, sol
+    m = model([sol.x[0], sol.x[1], 400.0, 35.5])
+    return {"limit": "evaporator.F3 <= 0.01 kg/min", "active": ["F3:max", "P2:min", "X2:min", "P100:max"],
+            "method": "root of F3 = 0.01 kg/min, P2 = 40 kPa at X2 = 35.5 %, P100 = 400 kPa on the closed form",
+            "F1": float(sol.x[0]), "F200": float(sol.x[1]), "cost": float(np.real(m["cost"]))}
 
 
 # --- (e) local model of self-optimizing control, (f) nonlinear losses of measurement pairs -------------

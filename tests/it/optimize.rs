@@ -489,3 +489,25 @@ fn a_combination_held_only_part_of_the_way_says_how_far() {
     assert!((0.0..100.0).contains(&share), "{why}");
     assert!(points.iter().filter(|p| p["failure"].is_null()).all(|p| p["loss"].as_f64().is_some_and(f64::is_finite)));
 }
+
+#[test]
+fn a_hostile_limit_leads_to_the_closed_forms_vertex() {
+    // F3 ≤ 0.01 kg/min squeezes the evaporator 10⁴-fold: the optimum is the vertex where F3, P2,
+    // X2 and P100 rest on their limits, which the script solves on the closed form (SciPy's SLSQP
+    // stops there, "Inequality constraints incompatible").
+    let file = format!("{ROOT}/flowsheets/evaporator.json");
+    let out = plantwide(&["optimize", &file, "--constraint", "evaporator.F3=:0.01 kg/min", "--json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let o: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let r = &reference()["hostile_limit"];
+    for (path, key) in [("evaporator.F1", "F1"), ("evaporator.F200", "F200")] {
+        let (ours, theirs) = (o["values"][path].as_f64().unwrap(), r[key].as_f64().unwrap() * KG_PER_MIN);
+        assert!(close(ours, theirs, 1e-6), "{path}: {ours} vs {theirs}");
+    }
+    let (j, j_ref) = (o["objective"].as_f64().unwrap(), r["cost"].as_f64().unwrap());
+    assert!(close(j, j_ref, 1e-6), "J {j} vs {j_ref}");
+    let mut active: Vec<&str> = o["active"].as_array().unwrap().iter().map(|a| a.as_str().unwrap()).collect();
+    active.sort_unstable();
+    assert_eq!(active, ["evaporator.F3:max", "evaporator.P100:max", "evaporator.P2:min", "evaporator.X2:min"]);
+    assert!(o["kkt_residual"].as_f64().unwrap() < 1e-8, "{o}");
+}
