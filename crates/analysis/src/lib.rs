@@ -23,6 +23,7 @@
 #![warn(missing_docs)]
 
 pub(crate) mod balance;
+pub mod continuation;
 pub mod error;
 pub mod figures;
 pub mod frequency;

@@ -20,6 +20,7 @@ use plantwide_solve::{NewtonSettings, NewtonStatus, SteadySystem, solve_steady};
 use plantwide_units::parse_quantity_as;
 use rayon::prelude::*;
 
+use crate::continuation::{Steps, reach};
 use crate::error::{AnalysisError, request};
 use crate::select::{Signal, select_input};
 use crate::shard::Share;
@@ -152,45 +153,39 @@ fn walk(
     outputs: &[usize],
     settings: &NewtonSettings,
 ) -> Walk {
-    let mut x = x0.to_vec();
     // The inputs a design spec varies are unknowns: each point starts from the last one's values.
-    let mut u = u0.to_vec();
+    let mut state = (x0.to_vec(), u0.to_vec());
     let mut at = d.base;
     let mut res = Vec::with_capacity(targets.len());
-    let solve = |x: &mut Vec<f64>, u: &mut Vec<f64>, value: f64| -> Result<(), NewtonFailure> {
+    let solve = |(x, u): &(Vec<f64>, Vec<f64>), _: f64, value: f64| -> Result<(Vec<f64>, Vec<f64>), NewtonFailure> {
         let mut trial_u = u.clone();
         trial_u[d.signal.index] = value;
         let sys = SteadySystem::new(plant, &trial_u);
         let mut z = sys.unknowns(x);
         let report = solve_steady(&sys, &mut z, settings);
         if report.status == NewtonStatus::Converged {
-            (*x, *u) = sys.split(&z);
-            Ok(())
+            Ok(sys.split(&z))
         } else {
             let (eq, residual) = report.worst.unwrap_or((0, f64::NAN));
             Err(NewtonFailure { status: report.status, equation: equation_name(plant, eq), residual })
         }
     };
     for (k, &target) in targets.iter().enumerate() {
-        // Try the full step, then halve it until a sub-step converges; repeat until at the target.
-        let mut step = target - at;
-        let mut halvings = 0;
-        while at != target {
-            let next = if (target - at).abs() <= step.abs() { target } else { at + step };
-            match solve(&mut x, &mut u, next) {
-                Ok(()) => at = next,
-                Err(newton) if halvings >= 6 => {
-                    res.extend(std::iter::repeat_n(None, targets.len() - k));
-                    let why = SweepFailure { path: d.signal.path.clone(), value: next, from: at, newton };
-                    return Walk { outputs: res, failure: Some(why) };
-                }
-                Err(_) => {
-                    step /= 2.0;
-                    halvings += 1;
-                }
+        // The full step, halved (down to 1/64) where a sub-step does not converge.
+        match reach(state, (at, target), Steps::halving(target - at, 6), &solve) {
+            Ok(s) => (state, at) = (s, target),
+            Err(stalled) => {
+                res.extend(std::iter::repeat_n(None, targets.len() - k));
+                let why = SweepFailure {
+                    path: d.signal.path.clone(),
+                    value: stalled.tried,
+                    from: stalled.reached,
+                    newton: stalled.error,
+                };
+                return Walk { outputs: res, failure: Some(why) };
             }
         }
-        res.push(Some(outputs.iter().map(|&i| x[i]).collect()));
+        res.push(Some(outputs.iter().map(|&i| state.0[i]).collect()));
     }
     Walk { outputs: res, failure: None }
 }

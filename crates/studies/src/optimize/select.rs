@@ -12,6 +12,7 @@
 
 use faer::Mat;
 use faer::linalg::solvers::Solve;
+use plantwide_analysis::continuation::{Steps, reach};
 use plantwide_flowsheet::Plant;
 use plantwide_flowsheet::optimization::{OptimizationSpec, Sense};
 use plantwide_soc::{LocalModel, Parts, Ranking, Search, branch_and_bound};
@@ -243,27 +244,21 @@ impl Context<'_> {
         d: &Dist,
         sign: f64,
     ) -> Result<(f64, f64, Vec<String>), PointFailure> {
-        // Continuation along the disturbance: steps of a quarter of it, halved (down to 1/64)
-        // where one fails and doubled back after a success, each predicted by the linearization
-        // (the held combination's and active rows' gains) and corrected by Newton.
-        let (mut held, mut reached, mut step) = (self.state.clone(), 0.0_f64, 0.25_f64);
-        while reached < 1.0 {
-            let next = (reached + step).min(1.0);
-            match self.advance(subset, h, (d, sign), &held, (reached, next)) {
-                Ok(s) => (held, reached, step) = (s, next, (2.0 * step).min(0.25)),
-                Err(_) if step > 1.0 / 64.0 => step /= 2.0,
-                Err(e) => {
-                    let at = self.state.u[d.signal.index] + sign * d.magnitude * reached;
-                    return Err(PointFailure(format!(
-                        "the combination is held only to {:.0} % of the disturbance ({} = {:.6} {}), not beyond: {e}",
-                        100.0 * reached,
-                        d.signal.path,
-                        d.signal.display_value(at),
-                        d.signal.unit,
-                    )));
-                }
-            }
-        }
+        // Continuation along the disturbance ([`reach`]): steps of a quarter of it, halved (down
+        // to 1/64) where one fails and doubled back after a success, each predicted by the
+        // linearization (the held combination's and active rows' gains) and corrected by Newton.
+        let advance = |s: &State, from: f64, to: f64| self.advance(subset, h, (d, sign), s, (from, to));
+        let held = reach(self.state.clone(), (0.0, 1.0), Steps::halving(0.25, 4), advance).map_err(|stalled| {
+            let at = self.state.u[d.signal.index] + sign * d.magnitude * stalled.reached;
+            PointFailure(format!(
+                "the combination is held only to {:.0} % of the disturbance ({} = {:.6} {}), not beyond: {}",
+                100.0 * stalled.reached,
+                d.signal.path,
+                d.signal.display_value(at),
+                d.signal.unit,
+                stalled.error,
+            ))
+        })?;
         let obj = &self.problem.objective;
         let j_held = obj.display_value(held.x[obj.index]);
         let best =

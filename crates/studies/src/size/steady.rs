@@ -13,6 +13,7 @@
 //! steady state, a step halved where Newton fails, down to 1/512 of the way. Where no step goes
 //! on, the design has no steady state near the file's and the error says how far it got.
 
+use plantwide_analysis::continuation::{Steps, reach};
 use plantwide_analysis::linear::Linearization;
 use plantwide_flowsheet::{Plant, StructureEdit, VarPath};
 use plantwide_solve::SteadyError;
@@ -102,39 +103,44 @@ struct Path<'a> {
 /// a step halved where Newton fails (`first`: the direct attempt's failure, reported when the
 /// design's controller has no steady state even at the file's size).
 fn continuation(v: &Vessel, path: &Path<'_>, what: &str, first: SteadyError) -> Result<(Plant, Vec<f64>), SizeError> {
-    let mut here = (path.at)(0.0)?;
-    let mut x = newton(&here, &mapped_guess(&v.plant, &v.x, &here))
+    let here = (path.at)(0.0)?;
+    let x = newton(&here, &mapped_guess(&v.plant, &v.x, &here))
         .map_err(|_| SizeError::Steady { what: what.to_string(), source: Box::new(first) })?;
-    let (mut s, mut h) = (0.0f64, 0.25f64);
-    while s < 1.0 {
-        let next = (s + h).min(1.0);
-        let p = (path.at)(next)?;
-        match newton(&p, &mapped_guess(&here, &x, &p)) {
-            Ok(xn) => {
-                (here, x, s) = (p, xn, next);
-                h = (2.0 * h).min(0.5);
-            }
-            Err(source) if h <= MIN_STEP => {
-                let near = near_limits(&here, &x, LIMIT_NOTE);
-                let stall = Stall {
-                    from: (path.size)(0.0),
-                    to: (path.size)(1.0),
-                    reached: (path.size)(s),
-                    next: (path.size)(next),
-                    reason: short(&source),
-                    limits: if near.is_empty() { String::new() } else { format!("; at {}: {near}", (path.size)(s)) },
-                    why: path.why.to_string(),
-                };
-                return Err(SizeError::Continuation {
-                    what: what.to_string(),
-                    stall: Box::new(stall),
-                    source: Box::new(source),
-                });
-            }
-            Err(_) => h /= 2.0,
-        }
-    }
-    Ok((here, x))
+    let advance = |(here, x): &(Plant, Vec<f64>), _: f64, next: f64| -> Result<(Plant, Vec<f64>), Step> {
+        let p = (path.at)(next).map_err(Step::Unbuilt)?;
+        let xn = newton(&p, &mapped_guess(here, x, &p)).map_err(Step::Newton)?;
+        Ok((p, xn))
+    };
+    let steps = Steps { first: 0.25, largest: 0.5, smallest: MIN_STEP };
+    reach((here, x), (0.0, 1.0), steps, advance).map_err(|stalled| {
+        let source = match stalled.error {
+            Step::Unbuilt(e) => return e,
+            Step::Newton(e) => e,
+        };
+        let (here, x) = &stalled.state;
+        let near = near_limits(here, x, LIMIT_NOTE);
+        let stall = Stall {
+            from: (path.size)(0.0),
+            to: (path.size)(1.0),
+            reached: (path.size)(stalled.reached),
+            next: (path.size)(stalled.tried),
+            reason: short(&source),
+            limits: if near.is_empty() {
+                String::new()
+            } else {
+                format!("; at {}: {near}", (path.size)(stalled.reached))
+            },
+            why: path.why.to_string(),
+        };
+        SizeError::Continuation { what: what.to_string(), stall: Box::new(stall), source: Box::new(source) }
+    })
+}
+
+/// Why a step of the size continuation failed: the plant could not be built at the size, or
+/// Newton found no steady state there.
+enum Step {
+    Unbuilt(SizeError),
+    Newton(SteadyError),
 }
 
 /// The steady state of `plant` (at `x`) after the disturbance's full change, by Newton from `x`;
@@ -148,22 +154,12 @@ pub(super) fn after(plant: &Plant, x: &[f64], r: &SizeCriteria, what: &str) -> R
         .ok_or_else(|| SizeError::Disturbance { path: d.path.clone(), why: "no such input".into() })?;
     let u0 = plant.inputs()[i].value;
     let mut p = plant.clone();
-    let (mut x, mut done, mut h) = (x.to_vec(), 0.0f64, 1.0f64);
-    while done < 1.0 {
-        let next = (done + h).min(1.0);
+    let advance = |x: &Vec<f64>, _: f64, next: f64| {
         p.set_input_value(i, u0 + next * d.change);
-        match newton(&p, &x) {
-            Ok(xn) => {
-                (x, done) = (xn, next);
-                h = (2.0 * h).min(1.0);
-            }
-            Err(source) if h <= 1.0 / 64.0 => {
-                return Err(SizeError::Steady { what: what.to_string(), source: Box::new(source) });
-            }
-            Err(_) => h /= 2.0,
-        }
-    }
-    Ok(x)
+        newton(&p, x)
+    };
+    reach(x.to_vec(), (0.0, 1.0), Steps::halving(1.0, 6), advance)
+        .map_err(|stalled| SizeError::Steady { what: what.to_string(), source: Box::new(stalled.error) })
 }
 
 /// The slowest time constant \[s\] of `plant` at its steady state `x`, from its exact
