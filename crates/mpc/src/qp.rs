@@ -85,19 +85,24 @@ impl std::fmt::Debug for Qp {
     }
 }
 
-/// Clarabel settings: tight tolerances so that an inactive-constraint QP reproduces the closed
-/// form to ~1e-10, and presolve off so that in-place data updates are allowed.
-fn solver_settings() -> Result<DefaultSettings<f64>, MpcError> {
-    DefaultSettingsBuilder::default()
-        .verbose(false)
+/// The clarabel settings of a QP built once and re-solved with its data updated in place (this
+/// controller's, and the steady-state optimizer's subproblems): tight tolerances, so that an
+/// inactive-constraint QP reproduces its closed form to ~1e-10; presolve off, which in-place data
+/// updates require; explicit zeros kept, so the pattern stays the one built. A caller adds its own.
+pub fn in_place_settings() -> DefaultSettingsBuilder<f64> {
+    let mut b = DefaultSettingsBuilder::default();
+    b.verbose(false)
         .max_iter(200)
         .tol_gap_abs(1e-12)
         .tol_gap_rel(1e-12)
         .tol_feas(1e-12)
         .presolve_enable(false)
-        .input_sparse_dropzeros(false)
-        .build()
-        .map_err(|e| MpcError::Setup(e.to_string()))
+        .input_sparse_dropzeros(false);
+    b
+}
+
+fn solver_settings() -> Result<DefaultSettings<f64>, MpcError> {
+    in_place_settings().build().map_err(|e| MpcError::Setup(e.to_string()))
 }
 
 impl Qp {

@@ -17,8 +17,9 @@
 //! is kept); presolve, equilibration and the dropping of structural zeros are off to allow it.
 
 use clarabel::algebra::CscMatrix;
-use clarabel::solver::{DefaultSettingsBuilder, DefaultSolver, IPSolver, NonnegativeConeT, SolverStatus};
+use clarabel::solver::{DefaultSolver, IPSolver, NonnegativeConeT, SolverStatus};
 use faer::Mat;
+use plantwide_mpc::qp::in_place_settings;
 
 use super::polish::{Held, polish};
 
@@ -120,17 +121,7 @@ impl Qp {
         let p = p_matrix(n, sides.len(), &Mat::identity(n, n));
         let a = a_matrix(n, &sides, &Mat::zeros(m, n));
         let rows = a.m;
-        let settings = DefaultSettingsBuilder::default()
-            .verbose(false)
-            .max_iter(200)
-            .tol_gap_abs(1e-12)
-            .tol_gap_rel(1e-12)
-            .tol_feas(1e-12)
-            .presolve_enable(false)
-            .equilibrate_enable(false)
-            .input_sparse_dropzeros(false)
-            .build()
-            .map_err(|e| QpFailure(e.to_string()))?;
+        let settings = in_place_settings().equilibrate_enable(false).build().map_err(|e| QpFailure(e.to_string()))?;
         let q = vec![0.0; n + sides.len()];
         let b = vec![1.0; rows];
         let solver = DefaultSolver::new(&p, &q, &a, &b, &[NonnegativeConeT(rows)], settings)
