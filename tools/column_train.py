@@ -19,6 +19,14 @@ copies' inputs stay reachable by path, e.g. `column_3.reflux`).
     python3 tools/column_train.py 16 --out /tmp/train16.json --scenario /tmp/train16_sc.json
     python3 tools/column_train.py 4 > /tmp/train4.json
 
+`--coupled` couples the copies into a train (issue 61): the bottoms of column k (0.5 kmol/min at
+x_light 0.01) and a fresh make-up feed `makeup_k+1` (0.5 kmol/min at z_light 0.99) meet in a
+liquid mixer `mix_k+1` ahead of column k + 1, so every column sees column A's feed (1 kmol/min at
+z 0.5) and stays near its steady state; a disturbance of column 1 travels down the train.
+`--ring` also recycles the last column's distillate to the first: column 1 is then fed by
+`mix_1` from the recycle and a fresh feed of 0.5 kmol/min at z_light 0.01 (the train holds one
+tear stream, `distillate_N`).
+
 `--scenario FILE` also writes a 60-min scenario: feed_1.F 1 -> 1.01 kmol/min at t = 0,
 recording bottoms_1.x[light] and distillate_1.x[light] every 1 min (a small recording, so
 that a run measures the integrator rather than CSV writing).
@@ -77,6 +85,49 @@ def train(n, base_path=BASE):
     }
 
 
+def _feed(base, flow, light):
+    """A feed like column A's with flow `flow` (kmol/min) and light mole fraction `light`."""
+    f = copy.deepcopy(base["units"]["feed_source"])
+    f["F"] = "%g kmol/min" % flow
+    f["z"] = {"light": light, "heavy": round(1.0 - light, 12)}
+    return f
+
+
+def coupled(n, ring=False, base_path=BASE):
+    """The train with column k's bottoms and a make-up feed mixed into column k + 1 (and, with
+    `ring`, the last distillate recycled to the first column)."""
+    if ring and n < 2:
+        raise ValueError("a ring needs N >= 2")
+    plant = train(n, base_path)
+    with open(base_path) as f:
+        base = json.load(f)
+    units, streams = plant["units"], plant["streams"]
+    for k in range(2, n + 1):
+        units["makeup_%d" % k] = _feed(base, 0.5, 0.99)
+        units["mix_%d" % k] = {"type": "mixer", "phase": "liquid"}
+        del units["feed_%d" % k]
+        del units["bottom_%d" % (k - 1)]
+        del streams["feed_stream_%d" % k]
+        streams["bottoms_%d" % (k - 1)] = {"from": "column_%d.bottoms" % (k - 1), "to": "mix_%d.in1" % k}
+        streams["makeup_stream_%d" % k] = {"from": "makeup_%d" % k, "to": "mix_%d.in2" % k}
+        streams["feed_stream_%d" % k] = {"from": "mix_%d" % k, "to": "column_%d.feed" % k}
+    kind = "coupled"
+    if ring:
+        kind = "ring"
+        units["feed_1"] = _feed(base, 0.5, 0.01)
+        units["mix_1"] = {"type": "mixer", "phase": "liquid"}
+        del units["top_%d" % n]
+        streams["feed_stream_1"] = {"from": "feed_1", "to": "mix_1.in1"}
+        streams["distillate_%d" % n] = {"from": "column_%d.distillate" % n, "to": "mix_1.in2", "tear": True}
+        streams["mixed_1"] = {"from": "mix_1", "to": "column_1.feed"}
+    plant["name"] = "column_a_%s_%d" % (kind, n)
+    plant["description"] = (
+        "%d copies of Skogestad's column A in a %s train (tools/column_train.py --%s): column k's bottoms "
+        "and a make-up feed of 0.5 kmol/min at z_light 0.99 feed column k + 1%s." % (
+            n, kind, kind, "; the last distillate is recycled to the first column" if ring else ""))
+    return plant
+
+
 def scenario(duration_min=60, interval_min=1):
     return {
         "format_version": 1,
@@ -109,10 +160,14 @@ def main(argv=None):
     ap.add_argument("--out", help="flowsheet file to write (default: stdout)")
     ap.add_argument("--scenario", help="also write the 60-min feed-step scenario here")
     ap.add_argument("--duration", type=float, default=60, help="scenario duration, min (default 60)")
+    shape = ap.add_mutually_exclusive_group()
+    shape.add_argument("--coupled", action="store_true", help="bottoms of column k + a make-up feed into column k+1")
+    shape.add_argument("--ring", action="store_true", help="--coupled, and the last distillate back to column 1")
     args = ap.parse_args(argv)
-    if args.n < 1:
-        ap.error("N must be >= 1")
-    _write(train(args.n), args.out)
+    if args.n < 1 or (args.ring and args.n < 2):
+        ap.error("N must be >= 1 (>= 2 for --ring)")
+    plant = coupled(args.n, ring=args.ring) if args.coupled or args.ring else train(args.n)
+    _write(plant, args.out)
     if args.scenario:
         _write(scenario(args.duration), args.scenario)
 
