@@ -82,11 +82,11 @@ pub fn optimize_and_select(cx: &mut Cx<'_>) {
         &[&opt, &gout],
         || format!("{juu:e} against 2 g² = {:e}", 2.0 * g[0] * g[0]),
     );
-    select_bottoms(cx, (&file, &vary), &top_sp, &g);
+    select_bottoms(cx, (&file, &vary), &top_sp, (&g, target));
 }
 
 /// `select` of the bottoms flow against the distillate flow, the top setpoint disturbed.
-fn select_bottoms(cx: &mut Cx<'_>, (file, vary): (&str, &str), top_sp: &str, g: &[f64]) {
+fn select_bottoms(cx: &mut Cx<'_>, (file, vary): (&str, &str), top_sp: &str, (g, target): (&[f64], f64)) {
     let r = cx.case.roles.clone();
     let (b, d) = (bottoms(cx), format!("{}.F", r.products[0]));
     let xd = cx.value(&format!("{}.x[{}]", r.products[0], r.light)).unwrap_or(0.99);
@@ -118,9 +118,11 @@ fn select_bottoms(cx: &mut Cx<'_>, (file, vary): (&str, &str), top_sp: &str, g: 
     let m = &v["local_model"];
     let (juu, jud) = (m["Juu"][0][0].as_f64().unwrap_or(f64::NAN), m["Jud"][0][0].as_f64().unwrap_or(f64::NAN));
     let (want_uu, want_ud) = (2.0 * g[0] * g[0], 2.0 * g[0] * g[1]);
-    let scale = want_ud.abs().max(1e-9 * want_uu.abs().sqrt());
+    // Where the setpoint barely moves B (g_d at rounding), Jud is rounding too: judged against
+    // 2|g|·B/xD, what a gain of B's own size per unit of the setpoint would give, to 1e-9.
+    let rounding = 1e-9 * 2.0 * g[0].abs() * target.abs() / xd.abs().max(1e-12);
     cx.check(
-        near(juu, want_uu, 1e-6, 0.0) && near(jud, want_ud, 1e-6, 1e-6 * scale),
+        near(juu, want_uu, 1e-6, 0.0) && near(jud, want_ud, 1e-6, rounding),
         "select: Juu, Jud are not 2g², 2g·g_d",
         &[&out],
         || format!("Juu {juu:e} against {want_uu:e}, Jud {jud:e} against {want_ud:e}"),

@@ -432,7 +432,7 @@ pub fn open_plant(plant: &Plant, cvs: &[String], mvs: &[String]) -> Result<OpenP
     let cv_ids: Vec<usize> = cvs.iter().filter_map(|c| v.var(c)).collect();
     let cv_values: Vec<f64> = cvs.iter().filter_map(|c| plant.var(c)).map(|i| base.x[i]).collect();
     for ((&i, &b), c) in cv_ids.iter().zip(&cv_values).zip(cvs) {
-        if (s.x[i] - b).abs() > 1e-8 * b.abs().max(1e-8) {
+        if super::column::moved(s.x[i], b) {
             return Err(ScreenError::Moved { structure: label, output: c.clone(), value: s.x[i], base: b });
         }
     }
