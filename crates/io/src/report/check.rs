@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use plantwide_flowsheet::{Block, BlockKind, Plant};
+use plantwide_flowsheet::{BlockKind, Plant};
 use plantwide_solve::DofError;
 use plantwide_studies::size::residence::{RULE_OF_THUMB, residence_times};
 use plantwide_units::{Dimension, UnitSystem};
@@ -52,16 +52,19 @@ pub fn summary(plant: &Plant, file: &Path, system: UnitSystem) -> String {
 
 /// The controllers (what each reads and drives) and the design specs.
 fn controllers_and_specs(plant: &Plant) -> String {
-    let ctrls: Vec<_> = plant.blocks().iter().filter(|b| b.kind == BlockKind::Controller).collect();
+    // The inputs each block drives, in one pass (per controller, a scan of every input and of
+    // every block was cubic in the plant's size: 15 % of `check` on 512 columns).
+    let mut driven_by_block: Vec<Vec<&str>> = vec![Vec::new(); plant.blocks().len()];
+    for i in plant.inputs() {
+        if let Some(v) = i.driven_by {
+            driven_by_block[plant.vars()[v].block].push(i.path.as_str());
+        }
+    }
+    let ctrls: Vec<_> = plant.blocks().iter().enumerate().filter(|(_, b)| b.kind == BlockKind::Controller).collect();
     let mut t = format!("controllers ({}):\n", ctrls.len());
-    for b in &ctrls {
+    for &(k, b) in &ctrls {
         let measured: Vec<String> = b.unit.signals().iter().map(|s| format!("{}={}", s.role, s.path)).collect();
-        let driven: Vec<&str> = plant
-            .inputs()
-            .iter()
-            .filter(|i| i.driven_by.is_some_and(|v| plant.vars()[v].block == index(plant, b)))
-            .map(|i| i.path.as_str())
-            .collect();
+        let driven = &driven_by_block[k];
         // A controller with no input of its own (a PID whose output a ratio station or a
         // cascade slave reads as its setpoint) is read by other blocks instead.
         let drives = if driven.is_empty() {
@@ -99,11 +102,6 @@ fn controllers_and_specs(plant: &Plant) -> String {
         }
     }
     t
-}
-
-/// The position of `block` among the plant's blocks.
-fn index(plant: &Plant, block: &Block) -> usize {
-    plant.blocks().iter().position(|x| std::ptr::eq(x, block)).unwrap_or(usize::MAX)
 }
 
 /// The counts of variables, equations and inputs (design specs add a varied input to the unknowns
