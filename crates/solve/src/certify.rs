@@ -96,13 +96,17 @@ pub fn certify_to(plant: &Plant, x: &[f64], u: &[f64], tol: f64) -> Result<Vec<W
     }
     let reacting = plant.blocks().iter().any(|b| b.unit.reacts());
     let scale = (0..plant.streams().len()).map(|s| x[plant.stream_flow_var(s)]).fold(0.0, f64::max).max(1e-12);
+    let (mut ins, mut outs) = (vec![Vec::new(); plant.blocks().len()], vec![Vec::new(); plant.blocks().len()]);
+    for (s, st) in plant.streams().iter().enumerate() {
+        ins[st.to.0].push(s);
+        outs[st.from.0].push(s);
+    }
     for (bi, b) in plant.blocks().iter().enumerate() {
         if b.kind != BlockKind::Unit || b.unit.boundary() != Boundary::Interior {
             continue;
         }
-        let ins = (0..plant.streams().len()).filter(|&s| plant.streams()[s].to.0 == bi);
-        let outs = (0..plant.streams().len()).filter(|&s| plant.streams()[s].from.0 == bi);
-        if let Some((equation, rel)) = imbalance(plant, x, (ins, outs), b.unit.reacts(), 1e-6 * scale, tol) {
+        let streams = (ins[bi].iter().copied(), outs[bi].iter().copied());
+        if let Some((equation, rel)) = imbalance(plant, x, streams, b.unit.reacts(), 1e-6 * scale, tol) {
             return Err(fail(&b.name, equation, rel, floors(plant, x, bi)));
         }
         if let Some(path) = floors(plant, x, bi).into_iter().next() {
@@ -160,10 +164,11 @@ pub fn floors_anywhere(plant: &Plant, x: &[f64]) -> Vec<String> {
 
 /// Total holdups of block `bi` resting on their lower bound.
 fn floors(plant: &Plant, x: &[f64], bi: usize) -> Vec<String> {
-    plant
-        .vars()
+    let b = &plant.blocks()[bi];
+    let own = b.own_offset..b.own_offset + b.layout.n_own();
+    plant.vars()[own.clone()]
         .iter()
-        .zip(x)
+        .zip(&x[own])
         .filter(|&(v, &xv)| {
             v.block == bi && v.spec.inventory && xv <= v.spec.lower + 1e-9 * v.spec.nominal.abs().max(1e-300)
         })

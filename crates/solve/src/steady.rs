@@ -385,15 +385,10 @@ pub fn steady_state_observed(
     let sys = SteadySystem::new(plant, u);
     let mut z = sys.unknowns(&x_start);
     let report = solve_steady_observed(&sys, &mut z, settings, observer);
-    let (x, u_end) = sys.split(&z);
     if report.status == NewtonStatus::Converged {
-        let warnings = certify(plant, &x, &u_end).map_err(|e| SteadyError::Certificate(Box::new(e)))?;
-        // An isolated steady state only: a Newton step on a singular Jacobian can still land on
-        // one of infinitely many solutions (a free inventory) when round-off leaves a tiny pivot
-        // rather than a zero one; the sparse probe at the solution refuses it.
-        dof_check(plant, &u_end, &x, DofProbe::Numerical)?;
-        return Ok(SteadyState { x, u: u_end, report, warnings });
+        return checked(plant, &sys, &z, report);
     }
+    let (x, _) = sys.split(&z);
     if let Err(mut e) = dof_check(plant, u, &x_start, DofProbe::Numerical) {
         if let DofError::Underdetermined { newton, .. } = &mut e {
             *newton = Some(format!(
@@ -425,4 +420,36 @@ pub fn steady_state_observed(
         report,
         x,
     })))
+}
+
+/// [`steady_state_observed`] within `settings.max_iter` Newton iterations (and the continuation if
+/// `settings` asks for it), for a caller with another way to go on: `None` when Newton did not
+/// converge, without the numerical probe that explains a failure; a converged point is checked as
+/// [`steady_state_observed`] checks it. The iterates are those of [`steady_state_observed`] from
+/// the same start, so a solve that converges within the budget is the same solve.
+pub(crate) fn steady_state_within(
+    plant: &Plant,
+    u: &[f64],
+    x0: &[f64],
+    settings: &NewtonSettings,
+    observer: &mut dyn FnMut(&crate::IterationRecord),
+) -> Option<Result<SteadyState, SteadyError>> {
+    if let Err(e) = dof_check(plant, u, x0, DofProbe::Structural) {
+        return Some(Err(e.into()));
+    }
+    let sys = SteadySystem::new(plant, u);
+    let mut z = sys.unknowns(x0);
+    let report = solve_steady_observed(&sys, &mut z, settings, observer);
+    (report.status == NewtonStatus::Converged).then(|| checked(plant, &sys, &z, report))
+}
+
+/// A converged Newton solve `z` certified ([`certify`]) and probed for a singular Jacobian at the
+/// solution: an isolated steady state only, since a Newton step on a singular Jacobian can still
+/// land on one of infinitely many solutions (a free inventory) when round-off leaves a tiny pivot
+/// rather than a zero one; the sparse probe at the solution refuses it.
+fn checked(plant: &Plant, sys: &SteadySystem<'_>, z: &[f64], report: NewtonReport) -> Result<SteadyState, SteadyError> {
+    let (x, u) = sys.split(z);
+    let warnings = certify(plant, &x, &u).map_err(|e| SteadyError::Certificate(Box::new(e)))?;
+    dof_check(plant, &u, &x, DofProbe::Numerical)?;
+    Ok(SteadyState { x, u, report, warnings })
 }

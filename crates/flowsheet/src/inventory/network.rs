@@ -70,6 +70,17 @@ pub(super) struct Network<'p> {
     pub inventories: Vec<Inventory>,
     /// What sets every stream and internal flow.
     pub setters: HashMap<Flow, Setter>,
+    /// The stream at each (block, inlet port) and each (block, outlet port).
+    stream_into: HashMap<(usize, usize), usize>,
+    stream_out_of: HashMap<(usize, usize), usize>,
+    /// The streams entering each block.
+    inlets: Vec<Vec<usize>>,
+    /// The flows each block passes on from its inlets ([`Setter::Through`]), by block.
+    through: HashMap<usize, Vec<Flow>>,
+    /// The inputs each block's output drives (for controllers), in input order.
+    drives: Vec<Vec<usize>>,
+    /// The first block (in file order) that measures each measured variable.
+    measurer: HashMap<usize, usize>,
 }
 
 impl<'p> Network<'p> {
@@ -80,9 +91,38 @@ impl<'p> Network<'p> {
             .iter()
             .map(|b| if b.kind == BlockKind::Unit { b.unit.material_flows() } else { MaterialFlows::default() })
             .collect();
-        let mut net = Network { plant, decls, inventories: Vec::new(), setters: HashMap::new() };
+        let streams = plant.streams();
+        let mut inlets = vec![Vec::new(); plant.blocks().len()];
+        streams.iter().enumerate().for_each(|(k, s)| inlets[s.to.0].push(k));
+        let mut drives = vec![Vec::new(); plant.blocks().len()];
+        for (i, info) in plant.inputs().iter().enumerate() {
+            if let Some(v) = info.driven_by {
+                drives[plant.vars()[v].block].push(i);
+            }
+        }
+        let mut net = Network {
+            plant,
+            decls,
+            inventories: Vec::new(),
+            setters: HashMap::new(),
+            stream_into: streams.iter().enumerate().rev().map(|(k, s)| (s.to, k)).collect(),
+            stream_out_of: streams.iter().enumerate().rev().map(|(k, s)| (s.from, k)).collect(),
+            inlets,
+            through: HashMap::new(),
+            drives,
+            measurer: HashMap::new(),
+        };
+        for c in (0..plant.blocks().len()).rev() {
+            net.measurer.extend(plant.measured_vars(c).into_iter().map(|(_, v)| (v, c)));
+        }
         net.inventories = net.collect_inventories();
         net.setters = net.collect_setters();
+        for (f, s) in &net.setters {
+            if let Setter::Through(b) = *s {
+                net.through.entry(b).or_default().push(f.clone());
+            }
+        }
+        net.through.values_mut().for_each(|v| v.sort());
         net
     }
 
@@ -106,27 +146,21 @@ impl<'p> Network<'p> {
             (None, None) => name.clone(),
         };
         let flows = |vias: &[FlowVia]| vias.iter().filter_map(|v| self.flow(b, v)).collect();
-        let controller = self
-            .plant
-            .blocks()
-            .iter()
-            .enumerate()
-            .find_map(|(c, _)| self.plant.measured_vars(c).iter().any(|(_, v)| measured.contains(v)).then_some(c));
+        let controller = measured.iter().filter_map(|v| self.measurer.get(v).copied()).min();
         Inventory { block: b, path, inflows: flows(&inv.inflows), outflows: flows(&inv.outflows), controller }
     }
 
     /// The flow `via` of unit `b`: the stream at one of its ports, or a flow inside it.
     fn flow(&self, b: usize, via: &FlowVia) -> Option<Flow> {
         let unit = &self.plant.blocks()[b].unit;
-        let streams = self.plant.streams();
         match via {
             FlowVia::Inlet(p) => {
                 let k = unit.inlet_ports().iter().position(|q| q == p)?;
-                streams.iter().position(|s| s.to == (b, k)).map(Flow::Stream)
+                self.stream_into.get(&(b, k)).copied().map(Flow::Stream)
             }
             FlowVia::Outlet(p) => {
                 let k = unit.outlet_ports().iter().position(|q| q == p)?;
-                streams.iter().position(|s| s.from == (b, k)).map(Flow::Stream)
+                self.stream_out_of.get(&(b, k)).copied().map(Flow::Stream)
             }
             FlowVia::Internal(n) => Some(Flow::Internal(b, n.to_string())),
         }
@@ -211,13 +245,10 @@ impl<'p> Network<'p> {
             if !seen.insert(c) {
                 continue;
             }
-            for (i, info) in self.plant.inputs().iter().enumerate() {
-                if self.driver(i) != Some(c) {
-                    continue;
-                }
-                match self.plant.blocks()[info.block].kind {
+            for &i in &self.drives[c] {
+                match self.plant.blocks()[self.plant.inputs()[i].block].kind {
                     BlockKind::Unit => out.push(i),
-                    _ => todo.push(info.block),
+                    _ => todo.push(self.plant.inputs()[i].block),
                 }
             }
         }
@@ -268,7 +299,8 @@ impl<'p> Network<'p> {
     }
 
     /// The flows moving `inputs` changes: those they set, and what passes them on through units
-    /// that hold nothing (a mixer's outlet when one of its inlets changes).
+    /// that hold nothing (a mixer's outlet when one of its inlets changes), found by a search from
+    /// the flows set directly along the streams into such units.
     pub fn affected(&self, inputs: &[usize]) -> BTreeSet<Flow> {
         let mut out: BTreeSet<Flow> = self
             .setters
@@ -276,26 +308,22 @@ impl<'p> Network<'p> {
             .filter(|(_, s)| Self::direct_input(s).is_some_and(|i| inputs.contains(&i)))
             .map(|(f, _)| f.clone())
             .collect();
-        loop {
-            let more: Vec<Flow> = self
-                .setters
-                .iter()
-                .filter(|(f, s)| {
-                    !out.contains(f)
-                        && matches!(s, Setter::Through(b) if self.inlet_streams(*b).any(|t| out.contains(&t)))
-                })
-                .map(|(f, _)| f.clone())
-                .collect();
-            if more.is_empty() {
-                return out;
+        let mut todo: Vec<Flow> = out.iter().cloned().collect();
+        while let Some(f) = todo.pop() {
+            let Flow::Stream(k) = f else { continue };
+            let into = self.plant.streams()[k].to.0;
+            for g in self.through.get(&into).into_iter().flatten() {
+                if out.insert(g.clone()) {
+                    todo.push(g.clone());
+                }
             }
-            out.extend(more);
         }
+        out
     }
 
     /// The streams entering unit `b`.
     fn inlet_streams(&self, b: usize) -> impl Iterator<Item = Flow> + '_ {
-        self.plant.streams().iter().enumerate().filter(move |(_, s)| s.to.0 == b).map(|(k, _)| Flow::Stream(k))
+        self.inlets[b].iter().map(|&k| Flow::Stream(k))
     }
 
     /// The origins of every flow: a flow that passes what enters a unit has the origins of that
