@@ -73,7 +73,8 @@ pub enum MethodArg {
     /// Sequential modular: unit by unit in flow order, recycles converged on tear streams.
     Sm,
     /// Sequential modular to a loose tolerance, then whole-plant Newton (plants with recycles);
-    /// whole-plant Newton alone otherwise.
+    /// otherwise whole-plant Newton, started from a sequential-modular pass if it has not converged
+    /// from the cold start within 20 iterations.
     Auto,
 }
 

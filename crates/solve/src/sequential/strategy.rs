@@ -20,7 +20,8 @@ pub enum Method {
     /// Sequential modular alone, to [`SmSettings::tol`].
     Sm,
     /// Plants with recycles: sequential modular to [`StrategySettings::auto_tol`], then whole-plant
-    /// Newton from there (from the cold start if the pass fails). Plants without: Newton.
+    /// Newton from there (from the cold start if the pass fails). Plants without: Newton from the
+    /// cold start, from a pass after 20 iterations without convergence.
     Auto,
 }
 
