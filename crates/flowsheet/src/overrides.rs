@@ -154,13 +154,14 @@ pub fn check_unit_inputs(plant: &Plant, u: &[f64]) -> Result<(), UnitInputError>
 /// The mole-fraction inputs `z[c]` of each unit (a feed's composition but its last component,
 /// which makes up the balance) must not sum above 1: the last fraction would be negative.
 pub fn check_compositions(plant: &Plant, u: &[f64]) -> Result<(), OverrideError> {
-    for (bi, b) in plant.blocks.iter().enumerate() {
-        let z: Vec<usize> = (0..plant.inputs.len())
-            .filter(|&i| {
-                let path = VarPath::parse(&plant.inputs[i].path);
-                plant.inputs[i].block == bi && path.owner() == b.name && path.is_composition()
-            })
-            .collect();
+    let mut by_block = vec![Vec::new(); plant.blocks.len()];
+    for (i, input) in plant.inputs.iter().enumerate() {
+        let path = VarPath::parse(&input.path);
+        if path.owner() == plant.blocks[input.block].name && path.is_composition() {
+            by_block[input.block].push(i);
+        }
+    }
+    for (b, z) in plant.blocks.iter().zip(by_block) {
         let sum: f64 = z.iter().map(|&i| u[i]).sum();
         if sum > 1.0 + 1e-9 {
             let parts: Vec<String> = z.iter().map(|&i| format!("{} = {}", plant.inputs[i].path, u[i])).collect();

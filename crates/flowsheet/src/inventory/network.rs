@@ -3,7 +3,7 @@
 //! setting comes from ([`Origin`]: a free input, an inventory, another controller), and the
 //! inventories with the loops that measure them.
 
-use std::collections::{BTreeSet, HashMap};
+use std::collections::{BTreeSet, HashMap, HashSet};
 
 use plantwide_model::{FlowLaw, FlowVia, InventoryFlows, MaterialFlows};
 
@@ -81,6 +81,10 @@ pub(super) struct Network<'p> {
     drives: Vec<Vec<usize>>,
     /// The first block (in file order) that measures each measured variable.
     measurer: HashMap<usize, usize>,
+    /// The first inventory each controller measures, by controller block.
+    loops: HashMap<usize, usize>,
+    /// The names of the streams.
+    stream_names: HashSet<String>,
 }
 
 impl<'p> Network<'p> {
@@ -111,11 +115,18 @@ impl<'p> Network<'p> {
             through: HashMap::new(),
             drives,
             measurer: HashMap::new(),
+            loops: HashMap::new(),
+            stream_names: streams.iter().map(|s| s.name.clone()).collect(),
         };
         for c in (0..plant.blocks().len()).rev() {
             net.measurer.extend(plant.measured_vars(c).into_iter().map(|(_, v)| (v, c)));
         }
         net.inventories = net.collect_inventories();
+        for (k, inv) in net.inventories.iter().enumerate().rev() {
+            if let Some(c) = inv.controller {
+                net.loops.insert(c, k);
+            }
+        }
         net.setters = net.collect_setters();
         for (f, s) in &net.setters {
             if let Setter::Through(b) = *s {
@@ -257,7 +268,7 @@ impl<'p> Network<'p> {
 
     /// The inventory controller `c` measures, if any.
     pub fn loop_of(&self, c: usize) -> Option<usize> {
-        self.inventories.iter().position(|i| i.controller == Some(c))
+        self.loops.get(&c).copied()
     }
 
     /// Where the value of input `i` comes from: free, or the first controller up its chain that
@@ -285,7 +296,7 @@ impl<'p> Network<'p> {
         let signals = block.unit.signals();
         let pv = self.plant.measured_vars(c).into_iter().find(|(k, _)| signals.get(*k).is_some_and(|s| s.role == "pv"));
         let path = &self.plant.vars()[pv?.1].path;
-        let is_flow = self.plant.streams().iter().any(|s| *path == format!("{}.F", s.name));
+        let is_flow = path.strip_suffix(".F").is_some_and(|stream| self.stream_names.contains(stream));
         if is_flow { self.input_of(c, "sp") } else { None }
     }
 
