@@ -868,3 +868,44 @@ fn a_flash_drum_runs_all_liquid_while_its_feed_is_subcooled_and_comes_back() {
     );
     assert!(res.conservation.worst() < 1e-9, "{}", res.conservation.worst());
 }
+
+/// A flash drum whose vapour vanishes in the middle of a smooth trajectory, not at a step (issue
+/// 53: generated plant 0xd22d4145c7789247, the LV configuration `screen --column` tuned, stepped by
+/// −0.038 in the feed's methanol). The preheater holds 364.89 K, and 370 s after the step the
+/// drum's liquid, turning heavier, reaches its bubble point there: the vapour stops. The drum's
+/// phase condition was smoothed by 1e-10, far below what the corrector resolves, so Newton cycled
+/// across the corner and the step size fell to 7e-12 s. Independent checks: the run ends on the
+/// steady state of the stepped plant converged on its own from the cold start (with vapour
+/// again, once the drum's composition has followed its feed's); moles are conserved.
+#[test]
+fn a_flash_drum_whose_vapour_vanishes_mid_run_integrates_through() {
+    let path = harness::fixture("data/generated/train_d22d4145_lv.json");
+    let plant = plantwide::flowsheet::load_file(std::path::Path::new(&path)).unwrap_or_else(|e| panic!("{e}"));
+    let ss = steady_state(&plant, &plant.input_values(), None, &NewtonSettings::default()).unwrap();
+    let scenario = r#"{"format_version": 1, "duration": "254976.766 s", "integrator": {"rtol": 1e-6},
+        "events": [{"type": "step", "at": "5099.535 s", "path": "feed_source.z[methanol]", "by": -0.038}],
+        "record": {"interval": "60 s", "paths": ["flash_vapour.F", "flash_liquid.T"]}}"#;
+    let res = run_from(&plant, scenario, Start::Steady(&ss.x), &mut |_| {});
+    let v = column(&res, "flash_vapour.F");
+    assert!(v[0] > 0.4, "two-phase at the start: {} mol/s", v[0]);
+    assert!(res.conservation.worst() < 1e-9, "{:?}", res.conservation);
+    let mut moved = plant.clone();
+    let z = plant.input("feed_source.z[methanol]").unwrap();
+    moved.set_input_value(z, plant.input_values()[z] - 0.038);
+    let cold = steady_state(&moved, &moved.input_values(), None, &NewtonSettings::default()).unwrap();
+    let worst = (0..plant.n_vars())
+        .map(|i| (res.x[i] - cold.x[i]).abs() / plant.vars()[i].spec.nominal.max(cold.x[i].abs()))
+        .fold(0.0, f64::max);
+    assert!(worst < 1e-4, "the run's end against the stepped plant's steady state: {worst:.2e}");
+    // The vapour vanished for a while (the drum's liquid lagging its feed) and came back.
+    let t = column(&res, "flash_liquid.T");
+    let gone: Vec<usize> = (0..v.len()).filter(|&k| v[k].abs() < 1e-6 * v[0]).collect();
+    assert!(!gone.is_empty(), "the vapour never vanished: least {:e} mol/s", v.iter().fold(f64::MAX, |a, b| a.min(*b)));
+    let back = cold.x[moved.var("flash_vapour.F").unwrap()];
+    assert!(back > 0.1 && (v[v.len() - 1] - back).abs() < 1e-4 * back, "end {} mol/s against {back}", v[v.len() - 1]);
+    // While it is gone, the liquid sits below the preheater's 364.89 K bubble point no more: it
+    // leaves at the preheated feed's temperature (within the drum's lag).
+    for &k in &gone {
+        assert!(t[k] <= 364.9, "all liquid at {} s, yet {} K", res.times[k], t[k]);
+    }
+}
