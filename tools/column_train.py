@@ -128,24 +128,28 @@ def coupled(n, ring=False, base_path=BASE):
     return plant
 
 
-def scenario(duration_min=60, interval_min=1):
+def step_scenario(name, description, path, to, paths, duration_min=60, interval_min=1):
+    """A scenario of one step of `path` to `to` at t = 0, recording `paths` (the benchmarks')."""
     return {
         "format_version": 1,
-        "name": "train feed step +1 %",
-        "description": "Column A train: copy 1's feed 1 -> 1.01 kmol/min at t = 0, %g min; records copy 1's "
-        "product compositions only (benchmark of the integrator, not of CSV writing)." % duration_min,
+        "name": name,
+        "description": description,
         "duration": "%g min" % duration_min,
         "integrator": {"rtol": 1e-6, "atol": 1e-8},
-        "events": [{"type": "step", "at": "0 min", "path": "feed_1.F", "to": "1.01 kmol/min"}],
-        "record": {
-            "interval": "%g min" % interval_min,
-            "time_unit": "min",
-            "paths": ["bottoms_1.x[light]", "distillate_1.x[light]"],
-        },
+        "events": [{"type": "step", "at": "0 min", "path": path, "to": to}],
+        "record": {"interval": "%g min" % interval_min, "time_unit": "min", "paths": paths},
     }
 
 
-def _write(obj, path):
+def scenario(duration_min=60, interval_min=1):
+    return step_scenario(
+        "train feed step +1 %",
+        "Column A train: copy 1's feed 1 -> 1.01 kmol/min at t = 0, %g min; records copy 1's "
+        "product compositions only (benchmark of the integrator, not of CSV writing)." % duration_min,
+        "feed_1.F", "1.01 kmol/min", ["bottoms_1.x[light]", "distillate_1.x[light]"], duration_min, interval_min)
+
+
+def write(obj, path):
     text = json.dumps(obj, indent=1) + "\n"
     if path in (None, "-"):
         sys.stdout.write(text)
@@ -167,9 +171,9 @@ def main(argv=None):
     if args.n < 1 or (args.ring and args.n < 2):
         ap.error("N must be >= 1 (>= 2 for --ring)")
     plant = coupled(args.n, ring=args.ring) if args.coupled or args.ring else train(args.n)
-    _write(plant, args.out)
+    write(plant, args.out)
     if args.scenario:
-        _write(scenario(args.duration), args.scenario)
+        write(scenario(args.duration), args.scenario)
 
 
 if __name__ == "__main__":

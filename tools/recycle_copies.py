@@ -19,6 +19,9 @@ import json
 import os
 import sys
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import column_train  # noqa: E402
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 BASE = os.path.join(ROOT, "flowsheets", "reactor_column_recycle.json")
 
@@ -69,29 +72,11 @@ def copies(n, base_path=BASE):
 
 
 def scenario(duration_min=60, interval_min=1):
-    return {
-        "format_version": 1,
-        "name": "snowball copies: fresh feed step +1 %",
-        "description": "Copy 1's fresh feed 239.5 -> 241.895 lbmol/h at t = 0, %g min; records copy 1's "
+    return column_train.step_scenario(
+        "snowball copies: fresh feed step +1 %",
+        "Copy 1's fresh feed 239.5 -> 241.895 lbmol/h at t = 0, %g min; records copy 1's "
         "recycle flow and bottoms composition only." % duration_min,
-        "duration": "%g min" % duration_min,
-        "integrator": {"rtol": 1e-6, "atol": 1e-8},
-        "events": [{"type": "step", "at": "0 min", "path": "fresh_1.F", "to": "241.895 lbmol/h"}],
-        "record": {
-            "interval": "%g min" % interval_min,
-            "time_unit": "min",
-            "paths": ["recycle_1.F", "bottoms_1.x[A]"],
-        },
-    }
-
-
-def _write(obj, path):
-    text = json.dumps(obj, indent=1) + "\n"
-    if path in (None, "-"):
-        sys.stdout.write(text)
-    else:
-        with open(path, "w") as f:
-            f.write(text)
+        "fresh_1.F", "241.895 lbmol/h", ["recycle_1.F", "bottoms_1.x[A]"], duration_min, interval_min)
 
 
 def main(argv=None):
@@ -101,9 +86,9 @@ def main(argv=None):
     ap.add_argument("--scenario", help="also write the 60-min fresh-feed-step scenario here")
     ap.add_argument("--duration", type=float, default=60, help="scenario duration, min (default 60)")
     args = ap.parse_args(argv)
-    _write(copies(args.n), args.out)
+    column_train.write(copies(args.n), args.out)
     if args.scenario:
-        _write(scenario(args.duration), args.scenario)
+        column_train.write(scenario(args.duration), args.scenario)
 
 
 if __name__ == "__main__":
