@@ -91,7 +91,8 @@ pub struct TuneArgs {
     /// PID instead of PI (SIMC on a SOPTD fit, IMC).
     #[arg(long)]
     pub(super) pid: bool,
-    /// Averaging: the largest allowed level deviation (default: a quarter of the level).
+    /// Averaging: the largest allowed level deviation (default: a quarter of the level, narrowed, with a
+    /// note, where other loops move the level at that band's time scale).
     #[arg(long, value_name = "LEVEL")]
     pub(super) level_band: Option<String>,
     /// Averaging: the output change that balances the design disturbance (default: 10 % of the output).

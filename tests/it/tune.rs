@@ -865,3 +865,33 @@ fn a_drum_level_moved_by_the_composition_loops_at_its_time_scale_is_refused_with
     let k = 1.0 / (tau * kc.abs());
     assert!((1.0..1.15).contains(&k), "integrating gain {k} against the drum's mass balance 1");
 }
+
+/// Averaging tuning with the default band where other loops move the level at that band's time
+/// scale (issue 53: generated reactor–column recycle 0x7e767b5c29b20118, its condenser level, was
+/// refused with exit 1 though the refusal itself named a band that works). The default band, a
+/// quarter of the holdup, is narrowed to the faster loop's band and the output says so; that band
+/// given with `--level-band` gives the same settings; the default band given explicitly is still
+/// refused (a band the user chose is not changed behind their back).
+#[test]
+fn averaging_narrows_a_default_band_that_other_loops_interfere_with() {
+    let dir = std::env::temp_dir();
+    let fs = fixture("data/generated/recycle_7e767b5c.json");
+    let tune = ["tune", &fs, "--loop", "condenser_level", "--method", "averaging", "--json"];
+    let v = json_in(&dir, &tune);
+    let av = &v["loops"][0]["averaging"];
+    let (band, from) = (av["band"].as_f64().unwrap(), av["band_narrowed_from"].as_f64().unwrap());
+    let ss = json_in(&dir, &["steady", &fs, "--json"]);
+    let holdup = ss["values"]["column.M[19]"].as_f64().unwrap();
+    assert!((from - 0.25 * holdup).abs() < 1e-9 * holdup, "narrowed from {from}, a quarter of {holdup}");
+    assert!(band > 0.0 && band < from, "band {band} mol");
+    let given = format!("{band:.17e} mol");
+    let again = json_in(&dir, &[&tune[..], &["--level-band", &given]].concat());
+    let kc = |v: &serde_json::Value| v["loops"][0]["kc"].as_f64().unwrap();
+    assert!((kc(&again) - kc(&v)).abs() < 1e-12 * kc(&v).abs(), "{} against {}", kc(&again), kc(&v));
+    assert!(again["loops"][0]["averaging"].get("band_narrowed_from").is_none(), "{again}");
+    let default = format!("{from:.17e} mol");
+    let out = plantwide(&[&tune[..], &["--level-band", &default]].concat());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("other loops move it as well") && err.contains("keeps it clear"), "{err}");
+}

@@ -126,8 +126,8 @@ pub enum TuneError {
     #[error(
         "`{controller}` measures {measurement}, which integrates (s·g → {slow:.4e} per output unit per second over \
          the slowest modes) but, at the time scale this `level_band` and `flow_change` give the loop (1/ω = {time:.4e} s), \
-         other loops move it as well: s·g(jω) = {re:.4e} {im:+.4e}j, {off:.0}% off the single integrator averaging tuning \
-         assumes. {suggestion}"
+         other loops move it as well: s·g(jω) = {re:.4e} {im:+.4e}j, {:.0}% off the single integrator averaging tuning \
+         assumes. {suggestion}", 100.0 * (.im / .re).abs()
     )]
     Interacting {
         /// Controller.
@@ -142,10 +142,10 @@ pub enum TuneError {
         re: f64,
         /// Imaginary part of `s g(jω)`.
         im: f64,
-        /// `|Im/Re|` in per cent.
-        off: f64,
         /// The level bands at which the loop would see one integrator, and the other methods.
         suggestion: String,
+        /// The band of a faster loop that sees one integrator, if there is one (measurement units).
+        faster_band: Option<f64>,
     },
     /// The file's action is the opposite of what the process gain needs.
     #[error(

@@ -205,6 +205,14 @@ fn details(out: &mut String, l: &FlowsheetLoop, u: &str, pv_unit: &str) {
     }
     if let Some(av) = &l.averaging {
         w!(out, "  averaging {:?}: largest level deviation {} {pv_unit} at {:.4} {u}", av.form, av.band, av.time);
+        if let Some(from) = av.band_narrowed_from {
+            w!(
+                out,
+                "  band narrowed from the default {} {pv_unit} (a quarter of the holdup): at that band's time scale other \
+                 loops move the level as well; this one keeps it a single integrator (give --level-band to choose)",
+                significant(from)
+            );
+        }
     }
     if let Some(m) = &l.margins {
         w!(out, "  {}", margins_line(m, u, "on the plant's linear model, the tuned loops open"));

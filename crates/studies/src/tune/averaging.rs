@@ -42,6 +42,10 @@ pub struct AveragingSettings {
     pub time: f64,
     /// The largest level deviation after the design disturbance (= the band asked for).
     pub band: f64,
+    /// The default band (a quarter of the holdup) this one replaced, where other loops move the
+    /// level at the default's time scale ([`crate::tune::flowsheet::averaging_loop`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub band_narrowed_from: Option<f64>,
 }
 
 /// Why averaging settings cannot be computed.
@@ -71,13 +75,25 @@ pub fn averaging(k: f64, du: f64, band: f64, form: AveragingForm) -> Result<Aver
     check_swing(du, band)?;
     let sign = k.signum();
     Ok(match form {
-        AveragingForm::P => {
-            AveragingSettings { form, kc: sign * du / band, tau_i: None, time: band / (k.abs() * du), band }
-        }
+        AveragingForm::P => AveragingSettings {
+            form,
+            kc: sign * du / band,
+            tau_i: None,
+            time: band / (k.abs() * du),
+            band,
+            band_narrowed_from: None,
+        },
         AveragingForm::Pi => {
             let e = std::f64::consts::E;
             let wn = k.abs() * du / (e * band);
-            AveragingSettings { form, kc: sign * 2.0 * du / (e * band), tau_i: Some(2.0 / wn), time: 1.0 / wn, band }
+            AveragingSettings {
+                form,
+                kc: sign * 2.0 * du / (e * band),
+                tau_i: Some(2.0 / wn),
+                time: 1.0 / wn,
+                band,
+                band_narrowed_from: None,
+            }
         }
     })
 }

@@ -286,7 +286,8 @@ pub fn integrating_gain(plant: &Plant, x: &[f64], l: &PlantLoop, swing: LevelSwi
             .filter(|&band| band < x[l.pv].abs())
     };
     let unit = plant.vars()[l.pv].spec.dim;
-    let bands: Vec<String> = [(clear(1.0), "a faster loop"), (clear(-1.0), "a slower one")]
+    let faster_band = clear(1.0);
+    let bands: Vec<String> = [(faster_band, "a faster loop"), (clear(-1.0), "a slower one")]
         .into_iter()
         .filter_map(|(b, what)| b.map(|b| format!("{b:.4e} {unit} ({what})")))
         .collect();
@@ -303,8 +304,8 @@ pub fn integrating_gain(plant: &Plant, x: &[f64], l: &PlantLoop, swing: LevelSwi
         time: 1.0 / w,
         re: at.re,
         im: at.im,
-        off: 100.0 * (at.im / at.re).abs(),
         suggestion,
+        faster_band,
     })
 }
 
@@ -335,10 +336,14 @@ fn band_frequency(magnitude: impl Fn(f64) -> f64, target: f64, lo: f64) -> Optio
 
 /// Averaging-level settings of level loop `l`: a disturbance that the output must move by
 /// `flow_change` to balance (default: 10 % of the output's steady value) within a level band
-/// (default: a quarter of the measurement's steady value).
+/// (default: a quarter of the measurement's steady value). Where the default band would put the
+/// loop at a time scale at which other loops move the level too ([`TuneError::Interacting`]), the
+/// band of a faster loop that sees one integrator is used instead, and the settings say so
+/// ([`AveragingSettings::band_narrowed_from`]); a band the user gave is kept or refused.
 ///
 /// # Errors
-/// [`TuneError::NotIntegrating`] for a loop whose measurement does not integrate; bad bands.
+/// [`TuneError::NotIntegrating`] for a loop whose measurement does not integrate; bad bands;
+/// [`TuneError::Interacting`] for a band given, or a default with no faster band that works.
 pub fn averaging_loop(
     plant: &Plant,
     x: &[f64],
@@ -348,10 +353,18 @@ pub fn averaging_loop(
     form: AveragingForm,
 ) -> Result<FlowsheetTuning, TuneError> {
     let du = flow_change.unwrap_or(0.1 * x[l.op].abs());
-    let band = band.unwrap_or(0.25 * x[l.pv].abs());
+    let default = 0.25 * x[l.pv].abs();
+    let given = band.is_some();
+    let band = band.unwrap_or(default);
     check_swing(du, band).map_err(TuneError::from)?;
-    let k = integrating_gain(plant, x, l, LevelSwing { du, band })?;
-    let a = averaging(k, du, band, form).map_err(TuneError::from)?;
+    let (k, band, narrowed) = match integrating_gain(plant, x, l, LevelSwing { du, band }) {
+        Err(TuneError::Interacting { faster_band: Some(b), .. }) if !given => {
+            (integrating_gain(plant, x, l, LevelSwing { du, band: b })?, b, Some(default))
+        }
+        k => (k?, band, None),
+    };
+    let mut a = averaging(k, du, band, form).map_err(TuneError::from)?;
+    a.band_narrowed_from = narrowed;
     let mut e = entry(l, a.kc, a.tau_i, None);
     e.averaging = Some(a);
     Ok(FlowsheetTuning {
