@@ -841,11 +841,14 @@ fn a_sump_level_held_through_a_trace_composition_integrates_over_its_averaging_t
 /// it. It was refused as "settles at a finite gain", which is false. Now the refusal says it
 /// integrates, why the default band does not work, and a band that does: there the drum is the
 /// integrator of its own mass balance `dM/dt = V − L − D` (k → −1 mol per mol/s per s as the
-/// composition loops fall behind; they still add a few per cent at that band).
+/// composition loops fall behind; they still add a few per cent at that band). The default band
+/// given explicitly is refused so; left to its default, it is narrowed to that band.
 #[test]
 fn a_drum_level_moved_by_the_composition_loops_at_its_time_scale_is_refused_with_a_band_that_works() {
     let fs = fixture("data/generated/recycle_474959d2.json");
-    let out = plantwide(&["tune", &fs, "--loop", "drum_level", "--method", "averaging"]);
+    let ss = json_in(&std::env::temp_dir(), &["steady", &fs, "--json"]);
+    let default = format!("{:.17e} mol", 0.25 * ss["values"]["column.M[16]"].as_f64().unwrap());
+    let out = plantwide(&["tune", &fs, "--loop", "drum_level", "--method", "averaging", "--level-band", &default]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{err}");
     for f in ["column.M[16], which integrates", "other loops move it as well", "A --level-band of "] {
@@ -864,6 +867,10 @@ fn a_drum_level_moved_by_the_composition_loops_at_its_time_scale_is_refused_with
     let (kc, tau) = (l["kc"].as_f64().unwrap(), l["averaging"]["time"].as_f64().unwrap());
     let k = 1.0 / (tau * kc.abs());
     assert!((1.0..1.15).contains(&k), "integrating gain {k} against the drum's mass balance 1");
+    let narrowed = json_in(&dir, &["tune", &fs, "--loop", "drum_level", "--method", "averaging", "--json"]);
+    let n = &narrowed["loops"][0];
+    assert!(n["averaging"]["band_narrowed_from"].is_number(), "{n}");
+    assert!((n["averaging"]["band"].as_f64().unwrap() - band).abs() < 1e-4 * band, "{n} against {band} mol");
 }
 
 /// Averaging tuning with the default band where other loops move the level at that band's time

@@ -209,7 +209,7 @@ fn details(out: &mut String, l: &FlowsheetLoop, u: &str, pv_unit: &str) {
             w!(
                 out,
                 "  band narrowed from the default {} {pv_unit} (a quarter of the holdup): at that band's time scale other \
-                 loops move the level as well; this one keeps it a single integrator (give --level-band to choose)",
+                 loops move the level as well; this one keeps it a single integrator (a band given explicitly is kept)",
                 significant(from)
             );
         }
