@@ -342,7 +342,7 @@ mod tests {
         assert_eq!(unit("kJ/(kmol*degC)").offset(), 0.0);
         assert_eq!(unit("1/degF").offset(), 0.0);
         assert!((unit("1/degF").factor() - 1.8).abs() < 1e-12);
-        for s in ["degC/min", "degC^2", "degC*s", "psig/s", "1/psig", "1/(1/degC)"] {
+        for s in ["degC/min", "degC^2", "degC*s", "psig/s", "kPag/h", "1/psig", "1/(1/degC)"] {
             assert!(matches!(err(s), UnitError::AffineInCompound { .. }), "{s}");
         }
     }

@@ -82,6 +82,14 @@ pub const POUND_MOLE: f64 = 1000.0 * POUND;
 pub const MM_HG: f64 = 13595.1 * STANDARD_GRAVITY * 1e-3;
 /// Size of the Rankine and Fahrenheit degree in K: 5/9 K.
 pub const RANKINE: f64 = 5.0 / 9.0;
+/// Molar gas constant in J/(mol·K): N_A·k = 8.31446261815324, exact since the 2019 SI.
+pub const GAS_CONSTANT: f64 = 8.314_462_618_153_24;
+/// Normal cubic metre in mol: the ideal gas in 1 m³ at 0 °C and 1 atm (DIN 1343), `ATM / (R · 273.15 K)`
+/// ≈ 44.6150 mol. The volume of `kscmh` (10³ m³/h at 0 °C and 1 atm).
+pub const NORMAL_CUBIC_METRE: f64 = ATM / (GAS_CONSTANT * 273.15);
+/// Standard cubic foot in mol: the ideal gas in 1 ft³ at 60 °F and 14.696 psia (the US gas-industry
+/// standard conditions of GPA 2172 / API MPMS 14.5), ≈ 1.19530 mol. The volume of `MMSCFD`.
+pub const STANDARD_CUBIC_FOOT: f64 = 14.696 * PSI * FOOT * FOOT * FOOT / (GAS_CONSTANT * 519.67 * RANKINE);
 
 type D = Dimension;
 
@@ -153,11 +161,35 @@ static UNITS: &[UnitDef] = &[
     lin("gal", "US gallon", US_GALLON, D::VOLUME),
     lin("bbl", "barrel (petroleum, 42 US gal)", 42.0 * US_GALLON, D::VOLUME),
     lin("gpm", "US gallon per minute", US_GALLON / 60.0, D::VOLUMETRIC_FLOW),
+    // Gas quantities as ideal-gas volumes at standard conditions: amounts and molar flows.
+    lin("Nm3", "normal cubic metre (0 degC, 1 atm)", NORMAL_CUBIC_METRE, D::AMOUNT),
+    lin("scmh", "standard cubic metre per hour (0 degC, 1 atm)", NORMAL_CUBIC_METRE / 3600.0, D::MOLAR_FLOW),
+    lin(
+        "kscmh",
+        "10^3 standard cubic metres per hour (0 degC, 1 atm)",
+        1e3 * NORMAL_CUBIC_METRE / 3600.0,
+        D::MOLAR_FLOW,
+    ),
+    lin("scf", "standard cubic foot (60 degF, 14.696 psia)", STANDARD_CUBIC_FOOT, D::AMOUNT),
+    lin(
+        "MSCFD",
+        "10^3 standard cubic feet per day (60 degF, 14.696 psia)",
+        1e3 * STANDARD_CUBIC_FOOT / 86400.0,
+        D::MOLAR_FLOW,
+    ),
+    lin(
+        "MMSCFD",
+        "10^6 standard cubic feet per day (60 degF, 14.696 psia)",
+        1e6 * STANDARD_CUBIC_FOOT / 86400.0,
+        D::MOLAR_FLOW,
+    ),
     // Pressure.
     pre("Pa", "pascal", 1.0, D::PRESSURE),
     pre("bar", "bar", 1e5, D::PRESSURE),
     lin("bara", "bar absolute", 1e5, D::PRESSURE),
     gauge("barg", "bar gauge", 1e5, "bar"),
+    gauge("kPag", "kilopascal gauge", 1e3, "kPa"),
+    gauge("MPag", "megapascal gauge", 1e6, "MPa"),
     lin("atm", "standard atmosphere", ATM, D::PRESSURE),
     lin("psi", "pound-force per square inch", PSI, D::PRESSURE),
     lin("psia", "pound-force per square inch absolute", PSI, D::PRESSURE),
@@ -273,5 +305,17 @@ mod tests {
         assert!(lookup("kft").is_none());
         assert!(lookup("kdegC").is_none());
         assert!(lookup("MBtu").is_none());
+    }
+
+    /// Standard gas volumes against independent figures: 1 Nm³ = 44.615 mol (the ideal-gas molar
+    /// volume at 0 °C and 1 atm is 22.41397 L/mol, CODATA 2018); 1 scf = 1.19530 mol (379.48 scf per
+    /// lb-mol at 60 °F and 14.696 psia, GPSA Engineering Data Book, section 1).
+    #[test]
+    fn standard_gas_volumes() {
+        assert!((1.0 / NORMAL_CUBIC_METRE - 22.413_969_54e-3).abs() < 1e-11);
+        let scf_per_lbmol = POUND_MOLE / STANDARD_CUBIC_FOOT;
+        assert!((scf_per_lbmol - 379.48).abs() < 0.01, "{scf_per_lbmol}");
+        assert_eq!(lookup("kscmh").unwrap().factor(), 1e3 * lookup("scmh").unwrap().factor());
+        assert_eq!(lookup("MMSCFD").unwrap().def.dim, D::MOLAR_FLOW);
     }
 }

@@ -5,7 +5,9 @@
 //! NIST SP 811 (2008) Appendix B.8/B.9 for derived ones (psi = 6.894 757 293 168 E+03 Pa,
 //! hp = 7.456 998 716 E+02 W, torr = 1.333 224 E+02 Pa, mmHg = 1.333 224 E+02 Pa,
 //! inHg (conventional) = 3.386 389 E+03 Pa, inH2O (conventional) = 2.490 889 E+02 Pa,
-//! lbf = 4.448 222 E+00 N, bbl (42 gal) = 1.589 873 E-01 m³).
+//! lbf = 4.448 222 E+00 N, bbl (42 gal) = 1.589 873 E-01 m³). Standard gas volumes: the ideal-gas
+//! molar volume at 0 °C and 101.325 kPa, 22.413 969 54 L/mol (CODATA 2018), and 379.482 scf per
+//! lb-mol at 60 °F and 14.696 psia (GPA 2172).
 
 use approx::abs_diff_eq;
 use plantwide_units::{Dimension as D, UnitKind, parse_quantity, units};
@@ -52,6 +54,12 @@ const EXPECTED: &[(&str, f64, f64, D, f64)] = &[
     ("gal", 3.785411784e-3, 0.0, D::VOLUME, 1e-15),
     ("bbl", 0.158987294928, 0.0, D::VOLUME, 1e-15),
     ("gpm", 3.785411784e-3 / 60.0, 0.0, D::VOLUMETRIC_FLOW, 1e-15),
+    ("Nm3", 1.0 / 22.413_969_54e-3, 0.0, D::AMOUNT, 1e-9),
+    ("scmh", 1.0 / 22.413_969_54e-3 / 3600.0, 0.0, D::MOLAR_FLOW, 1e-9),
+    ("kscmh", 1e3 / 22.413_969_54e-3 / 3600.0, 0.0, D::MOLAR_FLOW, 1e-9),
+    ("scf", 453.59237 / 379.482, 0.0, D::AMOUNT, 1e-5),
+    ("MSCFD", 1e3 * 453.59237 / 379.482 / 86400.0, 0.0, D::MOLAR_FLOW, 1e-5),
+    ("MMSCFD", 1e6 * 453.59237 / 379.482 / 86400.0, 0.0, D::MOLAR_FLOW, 1e-5),
     ("Pa", 1.0, 0.0, D::PRESSURE, 0.0),
     ("bar", 1e5, 0.0, D::PRESSURE, 0.0),
     ("bara", 1e5, 0.0, D::PRESSURE, 0.0),
@@ -60,6 +68,8 @@ const EXPECTED: &[(&str, f64, f64, D, f64)] = &[
     ("psi", 6894.757293168, 0.0, D::PRESSURE, 1e-13),
     ("psia", 6894.757293168, 0.0, D::PRESSURE, 1e-13),
     ("psig", 6894.757293168 + 101325.0, 101325.0, D::PRESSURE, 1e-13),
+    ("kPag", 1e3 + 101325.0, 101325.0, D::PRESSURE, 1e-15),
+    ("MPag", 1e6 + 101325.0, 101325.0, D::PRESSURE, 1e-15),
     ("torr", 133.3224, 0.0, D::PRESSURE, 1e-6),
     ("Torr", 133.3224, 0.0, D::PRESSURE, 1e-6),
     ("mmHg", 133.3224, 0.0, D::PRESSURE, 1e-6),

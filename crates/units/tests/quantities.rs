@@ -89,6 +89,7 @@ fn differences_drop_offsets() {
     assert_abs_diff_eq!(parse_difference_as("18 degF", D::TEMPERATURE).unwrap(), 10.0, epsilon = 1e-14 * 10.0);
     let psi5 = 5.0 * 6894.757293168;
     assert_abs_diff_eq!(parse_difference_as("5 psig", D::PRESSURE).unwrap(), psi5, epsilon = 1e-13 * psi5);
+    assert_abs_diff_eq!(parse_difference_as("5 kPag", D::PRESSURE).unwrap(), 5e3, epsilon = 1e-12 * 5e3);
     assert_eq!(parse_difference_as("10 K", D::TEMPERATURE).unwrap(), 10.0, "10 K");
     assert_eq!(parse_difference_as("3", D::TEMPERATURE).unwrap(), 3.0, "bare");
 }

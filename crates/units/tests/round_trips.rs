@@ -84,6 +84,17 @@ fn affine_display_conversions() {
     assert_abs_diff_eq!(convert_from_si(308_167.718_795_04, "psig").unwrap(), 30.0, epsilon = 1e-12 * 30.0);
     // 0 barg: absolute, in bar.
     assert_abs_diff_eq!(convert_from_si(101_325.0, "barg").unwrap(), 0.0, epsilon = 1e-12);
+    // 250 kPag is 351.325 kPa absolute; 2.5 MPag is 2.601325 MPa absolute.
+    assert_abs_diff_eq!(convert_from_si(351_325.0, "kPag").unwrap(), 250.0, epsilon = 1e-12 * 250.0);
+    assert_abs_diff_eq!(convert_from_si(2_601_325.0, "MPag").unwrap(), 2.5, epsilon = 1e-12 * 2.5);
+    // Standard gas flows: 1 kscmh is 10^3 m3/h of ideal gas at 0 degC and 1 atm, 22.41396954 L/mol
+    // (CODATA 2018), so 12.393 mol/s; 1 MMSCFD is 10^6 scf/d at 379.48 scf per lb-mol (GPSA), so
+    // 13.834 mol/s.
+    let kscmh = 1e6 / 22.413_969_54 / 3600.0;
+    assert_abs_diff_eq!(convert_from_si(kscmh, "kscmh").unwrap(), 1.0, epsilon = 1e-9);
+    assert_abs_diff_eq!(convert_from_si(kscmh, "Nm3/h").unwrap(), 1e3, epsilon = 1e-6);
+    let mmscfd = 1e6 / 379.48 * 453.592_37 / 86_400.0;
+    assert_abs_diff_eq!(convert_from_si(mmscfd, "MMSCFD").unwrap(), 1.0, epsilon = 3e-5);
     assert_abs_diff_eq!(convert_from_si(12.599_788_055_555_556, "lbmol/h").unwrap(), 100.0, epsilon = 1e-14 * 100.0);
     assert_abs_diff_eq!(convert_from_si(1000.0 / 60.0, "kmol/min").unwrap(), 1.0, epsilon = 1e-15);
     assert!(convert_from_si(f64::NAN, "K").unwrap().is_nan(), "NaN passes through");
