@@ -73,7 +73,13 @@ fn token_everywhere(bind: IpAddr) -> bool {
 pub fn serve(live: Live, opts: &Options) -> Result<(), ServeError> {
     let token = guard::new_token()?;
     let paths = live.paths();
-    let index: HashMap<String, usize> = paths.iter().enumerate().map(|(k, p)| (p.clone(), k)).collect();
+    let mut index: HashMap<String, usize> = paths.iter().enumerate().map(|(k, p)| (p.clone(), k)).collect();
+    // A tag's name is its value's path too (`XMEAS(7)` for `XMEAS(7).value`).
+    for (name, t) in live.plant().tags() {
+        if let Some(&k) = index.get(&live.plant().vars()[t.var].path) {
+            index.insert(name.clone(), k);
+        }
+    }
     let plant = plant_view::describe(live.plant(), &paths);
     let default_trend = plant_view::default_trend(live.plant());
     let first = Published {

@@ -1,6 +1,7 @@
 //! What the page draws, from the plant's unit graph: units placed in columns by their distance
 //! from the feeds, streams between them, controllers with their measurement, setpoint, output,
-//! mode and tuning inputs (a faceplate each), the free inputs, and every path's SI unit.
+//! mode and tuning inputs (a faceplate each), the free inputs, the tags (each a name for a value
+//! path, with its unit and the input it names), and every path's SI unit.
 
 use std::collections::VecDeque;
 
@@ -38,6 +39,15 @@ pub fn describe(plant: &Plant, paths: &[String]) -> Value {
         .filter(|i| i.driven_by.is_none())
         .map(|i| json!({ "path": i.path, "unit": i.dim.to_string(), "value": i.value }))
         .collect();
+    let mut tags: Vec<Value> = plant
+        .tags()
+        .iter()
+        .map(|(name, t)| {
+            let (var, input) = (&plant.vars()[t.var], t.input.map(|i| &plant.inputs()[i].path));
+            json!({ "name": name, "path": var.path, "unit": t.unit, "si_unit": var.spec.dim.to_string(), "input": input })
+        })
+        .collect();
+    tags.sort_by(|a, b| a["name"].as_str().cmp(&b["name"].as_str()));
     let mut si: Vec<String> = plant.vars().iter().map(|v| v.spec.dim.to_string()).collect();
     si.extend(plant.inputs().iter().filter(|i| i.driven_by.is_none()).map(|i| i.dim.to_string()));
     json!({
@@ -46,6 +56,7 @@ pub fn describe(plant: &Plant, paths: &[String]) -> Value {
         "streams": streams,
         "controllers": controllers,
         "inputs": inputs,
+        "tags": tags,
         "paths": paths,
         "si_units": si,
         "trend": default_trend(plant),

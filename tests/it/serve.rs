@@ -483,3 +483,22 @@ fn serve_runs_a_plant_with_an_equations_unit() {
     let t0 = s.get("/api/state?at=sync")["values"]["effluent.T"].as_f64().expect("T");
     assert!(t0 > x0[plant.var("effluent.T").expect("T")], "warmer coolant warms the reactor");
 }
+
+/// A tag's name is a trend path of the page (issue 56, item 5): `/api/plant` lists the tags with
+/// the value path each names and its unit, and a pen on the name streams that path's values.
+#[test]
+fn serve_trends_a_tag_by_its_name() {
+    let s = Server::start(&crate::harness::fixture("data/column_a_tags.json"), &["--paused"]);
+    let plant = s.get("/api/plant");
+    let tags = plant["tags"].as_array().expect("tags");
+    let cost = tags.iter().find(|t| t["name"] == "cost").expect("the cost tag");
+    assert_eq!(cost["path"], "cost.value");
+    assert_eq!(cost["unit"], "$/h");
+    assert!(tags.iter().any(|t| t["name"] == "impurity" && t["unit"].is_null()), "{tags:?}");
+    let (head, samples) = stream_samples(&s, "cost,cost.value", 2);
+    assert_eq!(head, json!(["cost", "cost.value"]));
+    for v in &samples {
+        let v = v["v"].as_array().expect("values");
+        assert!(v[0].as_f64().is_some() && v[0] == v[1], "{v:?}");
+    }
+}

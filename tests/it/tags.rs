@@ -141,3 +141,117 @@ fn bad_tags_are_refused_with_the_field_the_position_and_a_suggestion() {
     let msg = refused(&with_tags(serde_json::json!({"c": "der(column.boilup)"}), None));
     assert!(msg.contains("tags.c.expression"), "{msg}");
 }
+
+/// btx_column_pressure.json (its top pressure a state) with the tags a plant's own instrument list
+/// would give (issue 56, item 5): a measurement in gauge pressure, a manipulated input in kW and a
+/// gas flow in kscmh, under names that are not identifiers. Written to a temporary folder.
+fn instrument_tagged() -> (std::path::PathBuf, std::path::PathBuf) {
+    let text = std::fs::read_to_string(crate::harness::flowsheet("btx_column_pressure.json")).unwrap();
+    let mut d: serde_json::Value = serde_json::from_str(&text).unwrap();
+    d["tags"] = serde_json::json!({
+        "XMEAS(7)": "column.P@kPag",
+        "XMV(10)": "column.reboiler_duty @ kW",
+        "FI-101": {"expression": "feed_source.F", "unit": "kscmh", "description": "feed, as gas at 0 degC and 1 atm"}
+    });
+    let dir = std::env::temp_dir().join(format!("plantwide-named-tags-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("btx_tagged.json");
+    std::fs::write(&file, d.to_string()).unwrap();
+    (dir, file)
+}
+
+/// `steady --json` prints each tag in its unit, checked against the variables it names and the
+/// units' definitions written out here: kPag = (P − 101325 Pa)/1000; 1 kscmh = 10³ m³/h of ideal
+/// gas at 0 °C and 1 atm, 22.41396954 L/mol (CODATA 2018), so 100 kmol/h is 2.241396954 kscmh.
+/// A `--set` through a tag naming an input is the same edit as through the input's path.
+#[test]
+fn named_tags_print_in_their_units_and_stand_for_their_paths_in_set() {
+    let (_dir, file) = instrument_tagged();
+    let f = file.to_str().unwrap();
+    let s = json(&["steady", f, "--set", "pressure_control.auto=0", "--json"]);
+    let p = s["values"]["column.P"].as_f64().unwrap();
+    let kpag = s["tags"]["XMEAS(7)"].as_f64().unwrap();
+    assert!((kpag - (p - 101_325.0) / 1e3).abs() < 1e-9, "{kpag} kPag against P = {p} Pa");
+    assert!((s["tags"]["XMV(10)"].as_f64().unwrap() - 1100.0).abs() < 1e-9, "{}", s["tags"]);
+    assert!((s["tags"]["FI-101"].as_f64().unwrap() - 2.241_396_954).abs() < 1e-8, "{}", s["tags"]);
+
+    let by_tag = json(&["steady", f, "--set", "pressure_control.auto=0", "--set", "XMV(10)=1.2 MW", "--json"]);
+    let by_path =
+        json(&["steady", f, "--set", "pressure_control.auto=0", "--set", "column.reboiler_duty=1.2 MW", "--json"]);
+    assert_eq!(by_tag["values"], by_path["values"]);
+    assert!((by_tag["tags"]["XMV(10)"].as_f64().unwrap() - 1200.0).abs() < 1e-9);
+    assert!(by_tag["values"]["column.P"].as_f64().unwrap() > p + 1e3, "more boil-up raises the floating pressure");
+}
+
+/// `gains` named by tags equals `gains` named by the paths in the tags' units, and reports the
+/// tags' units.
+#[test]
+fn gains_between_tags_are_the_gains_between_their_paths_in_their_units() {
+    let (_dir, file) = instrument_tagged();
+    let f = file.to_str().unwrap();
+    let open = ["--set", "pressure_control.auto=0", "--json"];
+    let by_tag = json(&[&["gains", f, "--inputs", "XMV(10),FI-101", "--outputs", "XMEAS(7)"][..], &open].concat());
+    let by_path = json(
+        &[
+            &["gains", f, "--inputs", "column.reboiler_duty@kW,feed_source.F@kscmh", "--outputs", "column.P@kPa"][..],
+            &open,
+        ]
+        .concat(),
+    );
+    let (gt, gp) = (&by_tag["gain"][0], &by_path["gain"][0]);
+    for j in 0..2 {
+        let (a, b) = (gt[j].as_f64().unwrap(), gp[j].as_f64().unwrap());
+        assert!(b.abs() > 1e-6 && (a - b).abs() <= 1e-12 * b.abs(), "gain {j}: {a} against {b}");
+    }
+    let units = by_tag.to_string();
+    assert!(units.contains("\"kPag\"") && units.contains("\"kscmh\"") && units.contains("\"kW\""), "{units}");
+}
+
+/// A run records a tag under its name in its unit, and an event may move an input by its tag: the
+/// trend equals the path's, recorded beside it in SI, converted by kPag's definition.
+#[test]
+fn a_run_records_tags_in_their_units_and_steps_an_input_by_its_tag() {
+    let (dir, file) = instrument_tagged();
+    let scenario = serde_json::json!({
+        "format_version": 1,
+        "duration": "20 min",
+        "events": [{"type": "step", "at": "2 min", "path": "XMV(10)", "to": "1155 kW"}],
+        "record": {"interval": "1 min", "time_unit": "min", "paths": ["XMEAS(7)", "column.P", "XMV(10)"]}
+    });
+    let scen = dir.join("duty_step.json");
+    std::fs::write(&scen, scenario.to_string()).unwrap();
+    let csv = dir.join("run.csv");
+    let args = ["run", file.to_str().unwrap(), "--scenario", scen.to_str().unwrap(), "--csv", csv.to_str().unwrap()];
+    let out = plantwide(&[&args[..], &["--set", "pressure_control.auto=0", "--units", "metric"]].concat());
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let header = text.lines().next().unwrap();
+    assert!(header.contains("XMEAS(7) [kPag]") && header.contains("XMV(10) [kW]"), "{header}");
+    assert!(header.contains("column.P [kPa]"), "--units metric shows the path in kPa: {header}");
+    let rows: Vec<Vec<f64>> =
+        text.lines().skip(1).map(|l| l.split(',').map(|x| x.parse().unwrap()).collect()).collect();
+    for r in &rows {
+        assert!((r[1] - (r[2] - 101.325)).abs() < 1e-9, "t = {} min: {} kPag against {} kPa", r[0], r[1], r[2]);
+    }
+    let (first, last) = (&rows[0], &rows[rows.len() - 1]);
+    assert!((first[3] - 1100.0).abs() < 1e-9 && (last[3] - 1155.0).abs() < 1e-9, "{first:?} … {last:?}");
+    assert!(last[1] > first[1] + 0.1, "the step raises the floating pressure: {} → {} kPag", first[1], last[1]);
+}
+
+#[test]
+fn bad_named_tags_are_refused_with_the_fix() {
+    let base = |tags: serde_json::Value| {
+        let text = std::fs::read_to_string(crate::harness::flowsheet("btx_column_pressure.json")).unwrap();
+        let mut d: serde_json::Value = serde_json::from_str(&text).unwrap();
+        d["tags"] = tags;
+        d.to_string()
+    };
+    let msg = refused(&base(serde_json::json!({"PI.101": "column.P@kPag"})));
+    assert!(msg.contains("tags.PI.101") && msg.contains("without '.'"), "{msg}");
+    let msg = refused(&base(serde_json::json!({"PI-101": {"expression": "column.P@kPag", "unit": "bar"}})));
+    assert!(msg.contains("tags.PI-101.unit") && msg.contains("given twice"), "{msg}");
+    let msg = refused(&base(serde_json::json!({"PI-101": "column.P@kscmh"})));
+    assert!(msg.contains("tags.PI-101.unit") && msg.contains("a pressure") && msg.contains("a molar flow"), "{msg}");
+    let msg = refused(&base(serde_json::json!({"PI-101": "column.P@furlong"})));
+    assert!(msg.contains("tags.PI-101.unit") && msg.contains("furlong"), "{msg}");
+}

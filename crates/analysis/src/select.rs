@@ -1,8 +1,9 @@
 //! Inputs and outputs chosen for an analysis, written as paths with an optional display unit after
 //! `@`: `column.reflux@kmol/min`, `distillate.x[light]`, `column.T[21]@degC`.
 //!
-//! An input is any free (not controller-driven) declared input, an alias, or `stream.X` for input
-//! `X` of the unit producing `stream`; an output is any variable path. Gains are computed in SI and
+//! An input is any free (not controller-driven) declared input, an alias, a tag naming an input, or
+//! `stream.X` for input `X` of the unit producing `stream`; an output is any variable path or tag
+//! name. A tag named without a unit is shown in its own (`"XMEAS(7)": "reactor.P@kPag"`). Gains are computed in SI and
 //! reported in the display units: a gain `dy/du` in SI becomes `dy/du · f_u / f_y`, where `f` is
 //! the SI value of one display unit as a *difference* (so `degC` and `K` give the same gains).
 
@@ -76,7 +77,8 @@ fn display_unit(what: &str, unit: Option<&str>, dim: Dimension) -> Result<(Strin
 
 /// `texts` (`path[@unit]`) with each path that names no unit given `system`'s unit of its
 /// dimension (`--units metric`: `column.reflux` → `column.reflux@kmol/h`); a path that names one,
-/// or that resolves to nothing (reported later), is kept as written.
+/// a tag with a unit of its own, or a path that resolves to nothing (reported later), is kept as
+/// written.
 pub fn in_system(plant: &Plant, texts: &[String], system: plantwide_units::UnitSystem) -> Vec<String> {
     texts
         .iter()
@@ -85,6 +87,7 @@ pub fn in_system(plant: &Plant, texts: &[String], system: plantwide_units::UnitS
             let var = || plant.var(path).map(|v| plant.vars()[v].spec.dim);
             let dim = var().or_else(|| resolve_input(plant, path).map(|i| plant.inputs()[i].dim));
             match (unit, dim) {
+                (None, _) if plant.tag_unit(path).is_some() => t.clone(),
                 (None, Some(d)) if system.unit_for(d) != d.to_string() => format!("{path}@{}", system.unit_for(d)),
                 _ => t.clone(),
             }
@@ -100,6 +103,7 @@ pub fn select_inputs(plant: &Plant, texts: &[String]) -> Result<Vec<Signal>, Ana
 /// Resolve one free input written as `path[@unit]`.
 pub fn select_input(plant: &Plant, text: &str) -> Result<Signal, AnalysisError> {
     let (path, unit) = split_unit(text);
+    let unit = unit.or_else(|| plant.tag_unit(path));
     let Some(index) = resolve_input(plant, path) else {
         let free: Vec<&str> =
             plant.inputs().iter().filter(|i| i.driven_by.is_none()).map(|i| i.path.as_str()).collect();
@@ -152,6 +156,7 @@ pub fn select_outputs(plant: &Plant, texts: &[String]) -> Result<Vec<Signal>, An
 /// drives (`column.reboiler_duty`), read as the controller output that drives it.
 pub fn select_output(plant: &Plant, text: &str) -> Result<Signal, AnalysisError> {
     let (path, unit) = split_unit(text);
+    let unit = unit.or_else(|| plant.tag_unit(path));
     let driven = || resolve_input(plant, path).and_then(|i| plant.inputs()[i].driven_by);
     let Some(index) = plant.var(path).or_else(driven) else {
         let hint = did_you_mean(path, plant.vars().iter().map(|v| v.path.as_str()));

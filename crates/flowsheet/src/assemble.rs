@@ -33,7 +33,7 @@ use crate::components::thermo_package;
 use crate::error::{Diagnostic, LoadError, did_you_mean};
 use crate::parse::parse_spec;
 use crate::path::VarPath;
-use crate::plant::{Block, BlockKind, InputInfo, Plant, Read, StreamInfo, VarInfo};
+use crate::plant::{Block, BlockKind, InputInfo, Plant, Read, StreamInfo, TagRef, VarInfo};
 use crate::spec::FlowsheetSpec;
 
 /// Read, validate and assemble the flowsheet file at `path`.
@@ -88,6 +88,7 @@ struct Assembler<'s> {
     inputs: Vec<InputInfo>,
     streams: Vec<StreamInfo>,
     aliases: HashMap<String, usize>,
+    tags: HashMap<String, TagRef>,
     var_index: HashMap<String, usize>,
     input_index: HashMap<String, usize>,
 }
@@ -124,6 +125,7 @@ impl<'s> Assembler<'s> {
             inputs: Vec::new(),
             streams: Vec::new(),
             aliases: HashMap::new(),
+            tags: HashMap::new(),
             var_index: HashMap::new(),
             input_index: HashMap::new(),
         })
@@ -172,9 +174,10 @@ impl<'s> Assembler<'s> {
             if spec.units.contains_key(name) || spec.controllers.contains_key(name) || spec.streams.contains_key(name) {
                 let msg = format!("`{name}` is also a unit, controller or stream name; tags share their name space");
                 self.diags.push(Diagnostic::new(format!("tags.{name}"), msg));
-            } else if !plantwide_expr::name::is_valid_name(name) || name.contains('.') || name.contains('[') {
-                let msg = "a tag's name is read in expressions (`<tag>.value`): letters, digits and '_', not starting \
-                           with a digit";
+            } else if name.is_empty() || name.contains(['.', '[', ']', '@', ',', '=', ' ']) {
+                let msg = "a tag's name is used as a path: not empty, without '.', '[', ']', '@', ',', '=' or spaces \
+                           (`XMEAS(7)`, `reactor_cost`); to be read in other tags' expressions (`<tag>.value`) it \
+                           must be letters, digits and '_'";
                 self.diags.push(Diagnostic::new(format!("tags.{name}"), msg));
             }
         }
@@ -534,15 +537,32 @@ impl<'s> Assembler<'s> {
             if !ok {
                 continue;
             }
+            if let Some((field, after)) = t.unit_given_twice() {
+                let msg =
+                    format!("the unit is given twice (`unit`: `{field}`, and `@{after}` in the expression): keep one");
+                self.diags.push(Diagnostic::new(format!("{at}.unit"), msg));
+                continue;
+            }
             match plantwide_model::tag::Tag::build(text, &reads, &parameters, &guess) {
                 Ok(tag) => match self.tag_unit_mismatch(t.unit(), tag.dimension()) {
                     Some(msg) => self.diags.push(Diagnostic::new(format!("{at}.unit"), msg)),
-                    None => self.push_block(name.clone(), BlockKind::Tag, Box::new(tag), &[]),
+                    None => {
+                        self.push_block(name.clone(), BlockKind::Tag, Box::new(tag), &[]);
+                        self.name_tag(name, t);
+                    }
                 },
                 Err(e) => self.diags.push(Diagnostic::new(format!("{at}.expression"), e.to_string())),
             }
         }
         self.stop_if_invalid()
+    }
+
+    /// Tag `name`, just pushed, by name: its value variable, its unit and the input its expression
+    /// is, if it is one input's path.
+    fn name_tag(&mut self, name: &str, t: &crate::spec::TagSpec) {
+        let Some(&var) = self.var_index.get(&format!("{name}.value")) else { return };
+        let input = self.input_index.get(t.expression().trim()).copied();
+        self.tags.insert(name.to_string(), TagRef { var, unit: t.unit().map(str::to_string), input });
     }
 
     /// The flowsheet's `parameters` in SI with their dimensions (a bare number is dimensionless);
@@ -697,6 +717,7 @@ impl<'s> Assembler<'s> {
             inputs: self.inputs,
             streams: self.streams,
             aliases: Arc::new(self.aliases),
+            tags: Arc::new(self.tags),
             var_index: Arc::new(self.var_index),
             input_index: self.input_index,
             spec: Arc::new(self.spec.clone()),

@@ -36,6 +36,8 @@ pub use explicit::ExplicitPlan;
 pub use overrides::{Override, OverrideError, load_str_with, load_with};
 pub use parse::{parse_spec, read_text};
 pub use path::VarPath;
-pub use plant::{Block, BlockKind, InputInfo, Parallelism, Plant, Read, StreamInfo, VarInfo, with_dense_jacobian};
+pub use plant::{
+    Block, BlockKind, InputInfo, Parallelism, Plant, Read, StreamInfo, TagRef, VarInfo, with_dense_jacobian,
+};
 pub use spec::FlowsheetSpec;
 pub use wiring::{StructureEdit, WiringError};

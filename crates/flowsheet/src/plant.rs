@@ -123,6 +123,17 @@ pub struct StreamInfo {
     pub tear: bool,
 }
 
+/// A tag named as a path: what its name reads and moves.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct TagRef {
+    /// Global index of its value variable `<tag>.value`.
+    pub var: usize,
+    /// Its unit (`"reactor.P@kPag"`, or the `unit` field), in which its value is shown.
+    pub unit: Option<String>,
+    /// The input its expression is, when the expression is one input's path.
+    pub input: Option<usize>,
+}
+
 /// The assembled plant.
 #[derive(Debug, Clone)]
 pub struct Plant {
@@ -147,6 +158,8 @@ pub struct Plant {
     pub(crate) streams: Vec<StreamInfo>,
     /// Named inputs (`alias → input index`).
     pub(crate) aliases: Arc<HashMap<String, usize>>,
+    /// Tags by name.
+    pub(crate) tags: Arc<HashMap<String, TagRef>>,
     pub(crate) var_index: Arc<HashMap<String, usize>>,
     pub(crate) input_index: HashMap<String, usize>,
     /// The description the plant was assembled from (after field overrides): structure variants
@@ -223,14 +236,25 @@ impl Plant {
     pub fn n_eqs(&self) -> usize {
         self.blocks.iter().map(|b| b.n_eq).sum()
     }
-    /// Global index of the variable at `path` (`stream.x[comp]` and `stream.z[comp]` both work).
+    /// Global index of the variable at `path` (`stream.x[comp]` and `stream.z[comp]` both work), or
+    /// of a tag's value named by the tag's name.
     pub fn var(&self, path: impl AsRef<str>) -> Option<usize> {
-        crate::path::VarPath::parse(path.as_ref()).find(&self.var_index)
+        let path = path.as_ref();
+        self.tags.get(path).map(|t| t.var).or_else(|| crate::path::VarPath::parse(path).find(&self.var_index))
     }
-    /// Index of the input at `path` or named by an alias.
+    /// Index of the input at `path`, named by an alias, or by a tag whose expression is its path.
     pub fn input(&self, path: impl AsRef<str>) -> Option<usize> {
         let path = path.as_ref();
-        self.input_index.get(path).or_else(|| self.aliases.get(path)).copied()
+        let tagged = || self.tags.get(path).and_then(|t| t.input);
+        self.input_index.get(path).or_else(|| self.aliases.get(path)).copied().or_else(tagged)
+    }
+    /// Tags by name: the variable each reads, its unit, the input it names.
+    pub fn tags(&self) -> &HashMap<String, TagRef> {
+        &self.tags
+    }
+    /// The unit of tag `name`, if it is a tag with one: the unit a path named by it is shown in.
+    pub fn tag_unit(&self, name: &str) -> Option<&str> {
+        self.tags.get(name)?.unit.as_deref()
     }
     /// Current values of all inputs (SI).
     pub fn input_values(&self) -> Vec<f64> {

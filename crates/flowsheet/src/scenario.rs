@@ -830,7 +830,7 @@ fn recorded(cx: &mut Cx<'_>, rec: &RecordSpec, events: &[Event], conditions: &[C
                 ));
                 continue;
             }
-            None => dim.to_string(),
+            None => cx.plant.tag_unit(path).map_or_else(|| dim.to_string(), str::to_string),
         };
         if let Some(first) = seen.get(&(source, unit.clone())) {
             cx.diags.push(Diagnostic::new(

@@ -63,17 +63,24 @@ pub struct FlowsheetSpec {
 }
 
 /// A tag: its expression, alone or with the unit its value must have and a description.
+///
+/// A display unit may follow the expression after `@` (`"XMEAS(7)": "reactor.P@kPag"`): the tag's
+/// value is shown in it wherever the tag is named without a unit (`run` records, `gains`,
+/// `steady --json`'s `tags`). A tag is named like a path: by its name alone (`XMEAS(7)`), which
+/// reads its value, or, when its expression is one input's path, moves that input (`--set`,
+/// scenario events, `gains` inputs).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(untagged)]
 pub enum TagSpec {
-    /// The expression alone (`"steam_price*reboiler.duty"`).
+    /// The expression alone (`"steam_price*reboiler.duty"`), or with a unit (`"reactor.P@kPag"`).
     Expression(String),
     /// The expression with a declared unit and a description.
     Full {
         /// The expression, over plant paths (`column.T[5]`, `fresh.F`, `lc.op`, `other_tag.value`)
         /// and the flowsheet's `parameters`.
         expression: String,
-        /// A unit whose dimension the expression must have (`"$/h"`): a check, not a conversion.
+        /// A unit whose dimension the expression must have (`"$/h"`), in which the tag's value is
+        /// shown.
         #[serde(default, skip_serializing_if = "Option::is_none")]
         unit: Option<String>,
         /// What the tag measures.
@@ -83,18 +90,37 @@ pub enum TagSpec {
 }
 
 impl TagSpec {
-    /// The expression's text.
-    pub fn expression(&self) -> &str {
+    /// The text as written: expression and a unit after `@`, if any.
+    fn written(&self) -> &str {
         match self {
             TagSpec::Expression(e) | TagSpec::Full { expression: e, .. } => e,
         }
     }
 
-    /// The declared unit, if any.
+    /// The unit written after `@` in the expression's text, if any.
+    fn unit_after_at(&self) -> Option<&str> {
+        self.written().rsplit_once('@').map(|(_, u)| u.trim())
+    }
+
+    /// The expression's text, without the unit written after `@`.
+    pub fn expression(&self) -> &str {
+        let w = self.written();
+        w.rsplit_once('@').map_or(w, |(e, _)| e.trim_end())
+    }
+
+    /// The declared unit: the `unit` field, else the one written after `@`.
     pub fn unit(&self) -> Option<&str> {
         match self {
-            TagSpec::Expression(_) => None,
-            TagSpec::Full { unit, .. } => unit.as_deref(),
+            TagSpec::Full { unit: Some(u), .. } => Some(u),
+            _ => self.unit_after_at(),
+        }
+    }
+
+    /// Both spellings of the unit when the tag gives the `unit` field and a unit after `@`.
+    pub fn unit_given_twice(&self) -> Option<(&str, &str)> {
+        match self {
+            TagSpec::Full { unit: Some(u), .. } => self.unit_after_at().map(|a| (u.as_str(), a)),
+            _ => None,
         }
     }
 }

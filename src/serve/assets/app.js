@@ -336,7 +336,9 @@ async function main() {
   plant.paths.forEach((p, k) => { live.units[p] = plant.si_units[k]; });
   $('plant-name').textContent = 'plantwide — ' + plant.name;
   document.title = 'plantwide — ' + plant.name;
-  $('all-paths').innerHTML = plant.paths.map((p) => `<option value="${p}">`).join('');
+  // A tag's name trends its value (in SI, as every pen).
+  plant.tags.forEach((t) => { live.units[t.name] = t.si_unit; });
+  $('all-paths').innerHTML = plant.tags.map((t) => t.name).concat(plant.paths).map((p) => `<option value="${p}">`).join('');
   $('input-path').innerHTML = plant.inputs.map((i) => `<option>${i.path}</option>`).join('');
   drawFlowsheet(plant);
   const fps = $('faceplates');

@@ -14,10 +14,12 @@ use serde::Serialize;
 use crate::IoError;
 
 /// Every column whose scenario entry names no unit shown in `units`' unit of its dimension; a unit
-/// the scenario names (SI ones too) is kept.
+/// the scenario names (SI ones too), and a tag's own unit, are kept.
 pub fn display_units(res: &mut SimulationResult, units: UnitSystem, spec: &ScenarioSpec) {
     let asked = |k: usize| matches!(spec.record.paths.get(k), Some(RecordPathSpec::WithUnit { unit: Some(_), .. }));
-    for (_, c) in res.columns.iter_mut().enumerate().filter(|(k, _)| !asked(*k)) {
+    // A column already in a unit other than SI without being asked for one is a tag in its own unit.
+    let own = |c: &plantwide_solve::dynamic::Column| c.unit != c.si_unit;
+    for (_, c) in res.columns.iter_mut().enumerate().filter(|(k, c)| !asked(*k) && !own(c)) {
         if let Ok(dim) = unit_dimension(&c.si_unit) {
             c.unit = units.unit_for(dim);
         }

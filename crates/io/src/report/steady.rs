@@ -8,7 +8,7 @@ use std::collections::BTreeMap;
 use plantwide_flowsheet::Plant;
 use plantwide_model::stream::{F, H, P, T, Z0};
 use plantwide_solve::{Method, Solution};
-use plantwide_units::{Dimension, Display, UnitSystem};
+use plantwide_units::{Dimension, Display, UnitSystem, convert_from_si};
 use serde::Serialize;
 
 use crate::IoError;
@@ -182,6 +182,7 @@ struct SteadyJson<'a> {
     residual: f64,
     sequential_modular: serde_json::Value,
     specs: Vec<SpecJson<'a>>,
+    tags: BTreeMap<&'a str, f64>,
     values: BTreeMap<String, f64>,
     warnings: serde_json::Value,
 }
@@ -198,7 +199,8 @@ struct SpecJson<'a> {
 }
 
 /// The steady state found by `method` as JSON: every variable and free input under its path
-/// (SI), the specs met, the sequential-modular report and the warnings.
+/// (SI), each tag's value under its name in the tag's unit (SI without one), the specs met, the
+/// sequential-modular report and the warnings.
 ///
 /// # Errors
 /// [`IoError::Draw`] if serde cannot write it.
@@ -224,6 +226,14 @@ pub fn json(plant: &Plant, sol: &Solution, method: Method) -> Result<String, IoE
         residual,
         sequential_modular: value(serde_json::to_value(&sol.sm))?,
         specs,
+        tags: plant
+            .tags()
+            .iter()
+            .map(|(name, t)| {
+                let si = sol.x[t.var];
+                (name.as_str(), t.unit.as_deref().map_or(si, |u| convert_from_si(si, u).unwrap_or(si)))
+            })
+            .collect(),
         values: sol.values(plant).into_iter().collect(),
         warnings: value(serde_json::to_value(&sol.warnings))?,
     })
