@@ -902,3 +902,54 @@ fn averaging_narrows_a_default_band_that_other_loops_interfere_with() {
     assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(err.contains("other loops move it as well") && err.contains("keeps it clear"), "{err}");
 }
+
+/// On a column refluxed at L/D = 58 (generated 0x000000005eed0061: reflux 153 mol/s, distillate
+/// 2.6 mol/s) the default relay amplitude, 5 % of the reflux (7.6 mol/s), is three times the
+/// distillate: with the boil-up held, the drum's level loop drives D = V − L negative on the first
+/// half cycle, and the run stopped at the switch ("consistent initialization failed … AC101.op",
+/// exit 1). The default amplitude is now half the move that reverses a flow at steady state, from
+/// the exact steady gains: here the mass balance gives ∂D/∂L = −1 exactly, so half the
+/// distillate. An amplitude asked beyond that room is refused naming the flow; the cycle found
+/// gives the exact linear model's ultimates to the describing function's approximation.
+#[test]
+fn the_default_relay_amplitude_keeps_the_distillate_flowing() {
+    let fs = fixture("data/generated/column_5eed0061.json");
+    let common = ["--loop", "AC101", "--method", "relay", "--set", "AC102.auto=0", "--measurement-dead-time", "1 min"];
+    let out = crate::harness::plantwide(&[&["tune", &fs][..], &common[..], &["--json"]].concat());
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let relay: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let steady = crate::harness::plantwide(&["steady", &fs, "--set", "AC102.auto=0", "--json"]);
+    let steady: serde_json::Value = serde_json::from_slice(&steady.stdout).unwrap();
+    let d = steady["values"]["D.F"].as_f64().unwrap();
+    let r = &relay["loops"][0]["relay"];
+    assert_eq!(r["limited_by"], "D.F", "{r}");
+    let h = r["relay_amplitude"].as_f64().unwrap();
+    assert!((h - 0.5 * d).abs() < 1e-6 * d, "relay amplitude {h} mol/s against half the distillate {d}");
+
+    let exact = crate::harness::plantwide(&[
+        "tune",
+        &fs,
+        "--loops",
+        "AC101",
+        "--method",
+        "blt",
+        "--set",
+        "AC102.auto=0",
+        "--measurement-dead-time",
+        "1 min",
+        "--json",
+    ]);
+    assert!(exact.status.success(), "{}", String::from_utf8_lossy(&exact.stderr));
+    let exact: serde_json::Value = serde_json::from_slice(&exact.stdout).unwrap();
+    let e = &exact["loops"][0];
+    let (ku, pu) = (r["ku"].as_f64().unwrap(), r["pu"].as_f64().unwrap());
+    let (ku0, pu0) = (e["ku"].as_f64().unwrap(), e["pu"].as_f64().unwrap());
+    assert!((ku / ku0 - 1.0).abs() < 0.25, "relay Ku {ku} against the exact {ku0}");
+    assert!((pu / pu0 - 1.0).abs() < 0.10, "relay Pu {pu} against the exact {pu0}");
+
+    let asked =
+        crate::harness::plantwide(&[&["tune", &fs][..], &common[..], &["--relay-amplitude", "7 mol/s"]].concat());
+    assert_eq!(asked.status.code(), Some(1));
+    let msg = String::from_utf8_lossy(&asked.stderr);
+    assert!(msg.contains("`D.F` past its bound") && msg.contains("--relay-amplitude"), "{msg}");
+}

@@ -265,6 +265,25 @@ pub enum TuneError {
         /// Why that value is out of range.
         why: String,
     },
+    /// A test's move asked for would take a flow past its bound at the new steady state.
+    #[error(
+        "`{controller}`: a move of {} {unit} either way takes `{path}` past its bound at the new steady state (the \
+         exact steady gains allow at most {} {unit}); give a smaller `relay_amplitude` or `step`",
+        plantwide_model::limits::number(*.amplitude),
+        plantwide_model::limits::number(*.limit)
+    )]
+    BeyondRoom {
+        /// Controller.
+        controller: String,
+        /// The output's SI unit.
+        unit: String,
+        /// The move asked for (output units, SI).
+        amplitude: f64,
+        /// The variable it would take past its bound.
+        path: String,
+        /// The largest move that keeps it within (output units, SI).
+        limit: f64,
+    },
     /// The loop's output has no lasting effect on its measurement (a washout: the response returns
     /// to where it started), so no model with a steady-state gain or an integrator describes it.
     #[error(

@@ -22,6 +22,7 @@ pub mod margins;
 pub mod plant_tests;
 pub mod relay;
 pub mod request;
+pub mod room;
 pub mod rules;
 pub mod ultimate;
 

@@ -173,6 +173,14 @@ fn details(out: &mut String, l: &FlowsheetLoop, u: &str, pv_unit: &str) {
             100.0 * r.amplitude_spread,
             100.0 * r.duty
         );
+        if let Some(path) = &r.limited_by {
+            w!(
+                out,
+                "  relay amplitude {:.5e} (the output's SI unit), half the move that would take `{path}` past its \
+                 bound at steady state: less than the default 5 % of the output",
+                r.relay_amplitude
+            );
+        }
     }
     if let Some(f) = &l.fit {
         let model = serde_json::to_string(&f.model).unwrap_or_default();

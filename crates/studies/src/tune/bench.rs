@@ -71,6 +71,11 @@ pub struct RelayCycle {
     pub duty: f64,
     /// Relay switches taken.
     pub switches: usize,
+    /// The relay's amplitude `h` (output units).
+    pub relay_amplitude: f64,
+    /// The flow whose room shrank the default amplitude, if one did.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub limited_by: Option<String>,
 }
 
 /// Why a relay test found no usable cycle.
@@ -232,6 +237,8 @@ fn cycle<E: std::error::Error>(
         amplitude_spread: a_spread,
         duty,
         switches: switches.len(),
+        relay_amplitude: s.amplitude,
+        limited_by: None,
     }))
 }
 

@@ -16,6 +16,7 @@ use serde::Serialize;
 use super::bench::{Bench, RelayCycle, SampledRelay, StepTest, relay, step};
 use super::fit::{ModelFit, ModelOrder, ProcessModel, StepResponse, assess, fit_step};
 use super::loops::{LoopResponse, Measurement, PlantLoop, in_manual, loop_model, loop_ultimates, low_frequency_probe};
+use super::room::{DEFAULT_ROOM_FRACTION, Room, room};
 use crate::TuneError;
 
 /// The plant with one loop in manual, run by a [`Session`], its measurement seen through the
@@ -78,7 +79,8 @@ fn bench<'a>(
 /// Options of a relay test; `None` takes the default.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct RelayOptions {
-    /// Relay amplitude (output units; default 5 % of the output's steady value).
+    /// Relay amplitude (output units; default 5 % of the output's steady value, or less where that
+    /// would take a flow past half its room: [`super::room`]).
     pub amplitude: Option<f64>,
     /// Hysteresis (measurement units; default 0).
     pub hysteresis: Option<f64>,
@@ -99,8 +101,15 @@ pub fn relay_loop(plant: &Plant, x: &[f64], l: &PlantLoop, o: RelayOptions) -> R
     let response = LoopResponse::new(model, o.measurement);
     let linear = loop_ultimates(&response, std::slice::from_ref(l))?[0];
     let u0 = x[l.op];
+    if let Some(a) = o.amplitude {
+        // The output's own range first: the plainer reason.
+        within_range(plant, l, u0 + a)?;
+        within_range(plant, l, u0 - a)?;
+    }
+    let room = room(plant, x, l);
+    let (amplitude, limited_by) = move_within_room(plant, l, o.amplitude, 0.05 * u0.abs(), room.as_ref())?;
     let settings = SampledRelay {
-        amplitude: o.amplitude.unwrap_or(0.05 * u0.abs()),
+        amplitude,
         hysteresis: o.hysteresis.unwrap_or(0.0),
         scan: o.scan.unwrap_or(linear.pu / 200.0),
         sign: if linear.ku.is_finite() { linear.ku.signum() } else { gain_sign },
@@ -117,7 +126,36 @@ pub fn relay_loop(plant: &Plant, x: &[f64], l: &PlantLoop, o: RelayOptions) -> R
     within_range(plant, l, u0 + settings.amplitude)?;
     within_range(plant, l, u0 - settings.amplitude)?;
     let mut b = bench(plant, x, l, o.measurement, settings.scan)?;
-    relay(&mut b, u0, &settings).map_err(|e| TuneError::Relay { controller: l.name.clone(), source: Box::new(e) })
+    let mut cycle = relay(&mut b, u0, &settings)
+        .map_err(|e| TuneError::Relay { controller: l.name.clone(), source: Box::new(e) })?;
+    cycle.limited_by = limited_by;
+    Ok(cycle)
+}
+
+/// The move a test makes of loop `l`'s output: the one asked for, refused when it takes a flow past its
+/// bound at the new steady state ([`TuneError::BeyondRoom`]); else `default`,
+/// shrunk to [`DEFAULT_ROOM_FRACTION`] of the room, with the path that shrank it.
+fn move_within_room(
+    plant: &Plant,
+    l: &PlantLoop,
+    asked: Option<f64>,
+    default: f64,
+    room: Option<&Room>,
+) -> Result<(f64, Option<String>), TuneError> {
+    match (asked, room) {
+        (Some(a), Some(r)) if a.abs() > r.limit => Err(TuneError::BeyondRoom {
+            controller: l.name.clone(),
+            unit: plant.vars()[l.op].spec.dim.to_string(),
+            amplitude: a.abs(),
+            path: r.path.clone(),
+            limit: r.limit,
+        }),
+        (Some(a), _) => Ok((a, None)),
+        (None, Some(r)) if default > DEFAULT_ROOM_FRACTION * r.limit => {
+            Ok((DEFAULT_ROOM_FRACTION * r.limit, Some(r.path.clone())))
+        }
+        (None, _) => Ok((default, None)),
+    }
 }
 
 /// The least fraction of a step response's variance a fitted model must explain for settings to
@@ -128,7 +166,8 @@ pub const MIN_R2: f64 = 0.9;
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct StepOptions {
     /// Output step (output units), the first one tried; default 5 % of its steady value, or less
-    /// where the linear response would take over a tenth of the measurement's room to its bound.
+    /// where the linear response would take over a tenth of the measurement's room to its bound, or
+    /// a flow past half its room ([`super::room`]).
     pub step: Option<f64>,
     /// Sampling interval \[s\].
     pub scan: Option<f64>,
@@ -242,7 +281,11 @@ fn step_loop_of(plant: &Plant, x: &[f64], l: &PlantLoop, o: StepOptions) -> Resu
         }
         _ => None,
     };
-    let first = o.step.unwrap_or_else(|| default_step(plant, x, l, &element));
+    if let Some(step) = o.step {
+        within_range(plant, l, u0 + step)?;
+    }
+    let room = room(plant, x, l);
+    let (first, _) = move_within_room(plant, l, o.step, default_step(plant, x, l, &element), room.as_ref())?;
     if !(first != 0.0 && first.is_finite()) {
         return Err(TuneError::RelayAmplitude { controller: l.name.clone(), amplitude: first });
     }
