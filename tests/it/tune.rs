@@ -953,3 +953,20 @@ fn the_default_relay_amplitude_keeps_the_distillate_flowing() {
     let msg = String::from_utf8_lossy(&asked.stderr);
     assert!(msg.contains("`D.F` past its bound") && msg.contains("--relay-amplitude"), "{msg}");
 }
+
+/// A recycle whose reflux step rings (generated 0x7716be46eec488a2: the reactor-level loop and the
+/// recycle; an open-loop +5 % reflux step takes the recycle's composition 0.946 → 0.970 at 2 h,
+/// then down through 0.962 to 0.965) fits no first- or second-order lag (R² 0.49 and 0.44):
+/// SIMC refuses with exit 1, and says why — the overshoot, which the record shows — and what
+/// works instead; the relay test it names tunes the loop.
+#[test]
+fn simc_names_an_overshooting_response_as_its_reason_and_the_relay_tunes_it() {
+    let fs = fixture("data/generated/recycle_7716be46.json");
+    let common = ["--loop", "xd_control", "--set", "xb_control.auto=0", "--measurement-dead-time", "1 min"];
+    let simc = crate::harness::plantwide(&[&["tune", &fs][..], &common[..], &["--method", "simc"]].concat());
+    assert_eq!(simc.status.code(), Some(1));
+    let msg = String::from_utf8_lossy(&simc.stderr);
+    assert!(msg.contains("overshoots its final value by") && msg.contains("relay test"), "{msg}");
+    let relay = crate::harness::plantwide(&[&["tune", &fs][..], &common[..], &["--method", "relay"]].concat());
+    assert!(relay.status.success(), "{}", String::from_utf8_lossy(&relay.stderr));
+}

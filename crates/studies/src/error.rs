@@ -297,8 +297,14 @@ pub enum TuneError {
     },
     /// The fitted model does not describe the step response: settings from it would be arbitrary.
     #[error(
-        "`{controller}`: the {model} model explains R² = {r2:.3} of the step response (at least {min_r2} needed); \
-         choose another `model`, a smaller `step`, or a relay test"
+        "`{controller}`: the {model} model explains R² = {r2:.3} of the step response (at least {min_r2} needed); {}",
+        shape.as_ref().map_or_else(
+            || "choose another `model`, a smaller `step`, or a relay test".to_string(),
+            |s| format!(
+                "the response {s}, which no first- or second-order lag describes: tune the loop by a relay test, or by \
+                 `blt` on the exact linear model"
+            )
+        )
     )]
     PoorFit {
         /// Controller.
@@ -309,6 +315,8 @@ pub enum TuneError {
         r2: f64,
         /// The least accepted.
         min_r2: f64,
+        /// What the response does that a lag cannot ([`crate::tune::fit::lagless_shape`]).
+        shape: Option<String>,
     },
     /// No step tried gives a fitted gain within [`crate::tune::plant_tests::MAX_GAIN_ERROR`] of the
     /// element's linearized gain: the settings would rest on the secant of a curved response, or on

@@ -28,6 +28,32 @@ pub struct StepResponse {
     pub du: f64,
 }
 
+/// Least overshoot or inverse response, as a fraction of the final change, that
+/// [`lagless_shape`] reports: an overdamped second-order lag has neither, and a sampled response
+/// that has settled within 2e-3 of its end does not reach this by noise.
+pub const SHAPE_THRESHOLD: f64 = 0.05;
+
+/// What a settled step response does that no overdamped lag (first or second order, with a dead
+/// time) can: overshoot its final value (an underdamped element: a loop or a recycle that rings)
+/// or first move the other way (an inverse response), by more than [`SHAPE_THRESHOLD`] of its
+/// final change; `None` otherwise or when it has no final change.
+pub fn lagless_shape(r: &StepResponse) -> Option<String> {
+    let last = *r.y.last()?;
+    if !(last != 0.0 && last.is_finite()) {
+        return None;
+    }
+    let along = |y: f64| y / last;
+    let peak = r.y.iter().copied().map(along).fold(f64::MIN, f64::max);
+    let dip = r.y.iter().copied().map(along).fold(f64::MAX, f64::min);
+    if peak - 1.0 > SHAPE_THRESHOLD {
+        Some(format!("overshoots its final value by {:.0} % (an underdamped element)", 100.0 * (peak - 1.0)))
+    } else if -dip > SHAPE_THRESHOLD {
+        Some(format!("first moves the other way, by {:.0} % of its final change (an inverse response)", -100.0 * dip))
+    } else {
+        None
+    }
+}
+
 /// Which model to fit.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -398,5 +424,32 @@ mod tests {
         assert_eq!(fit_step(&no_step, ModelOrder::Foptd), Err(FitError::NoStep));
         let short = StepResponse { t: vec![0.0, 1.0], y: vec![0.0, 1.0], du: 1.0 };
         assert!(matches!(fit_step(&short, ModelOrder::Foptd), Err(FitError::Data(_))));
+    }
+
+    /// The shapes against closed forms: a second-order lag with ζ = 0.3 overshoots by
+    /// `exp(−πζ/√(1 − ζ²))` = 37.2 %; `(1 − 3s)/(1 + s)²` dips to `1 − 4e^(−3/4)` = −0.8895 at
+    /// t = 3/4; an overdamped lag (ζ = 1.5) and a first-order one have neither.
+    #[test]
+    fn lagless_shapes_against_closed_forms() {
+        let t: Vec<f64> = (0..=8000).map(|k| f64::from(k) * 0.005).collect();
+        let record =
+            |f: &dyn Fn(f64) -> f64| StepResponse { t: t.clone(), y: t.iter().map(|&t| f(t)).collect(), du: 1.0 };
+        let z: f64 = 0.3;
+        let wd = (1.0 - z * z).sqrt();
+        let under = record(&|t| 1.0 - (-z * t).exp() * ((wd * t).cos() + z / wd * (wd * t).sin()));
+        let expected = (-std::f64::consts::PI * z / wd).exp();
+        assert!((expected - 0.372).abs() < 1e-3);
+        assert_eq!(
+            lagless_shape(&under).unwrap(),
+            format!("overshoots its final value by {:.0} % (an underdamped element)", 100.0 * expected)
+        );
+        let inverse = record(&|t| 1.0 - (-t).exp() * (1.0 + 4.0 * t));
+        assert_eq!(
+            lagless_shape(&inverse).unwrap(),
+            "first moves the other way, by 89 % of its final change (an inverse response)"
+        );
+        let over = record(&|t| 1.0 - ((-0.38 * t).exp() * 2.618 - (-2.62 * t).exp() * 0.382) / 2.236);
+        assert_eq!(lagless_shape(&over), None);
+        assert_eq!(lagless_shape(&record(&|t| 1.0 - (-t).exp())), None);
     }
 }

@@ -310,6 +310,7 @@ fn step_loop_of(plant: &Plant, x: &[f64], l: &PlantLoop, o: StepOptions) -> Resu
                     model: order.name(),
                     r2: fit.r2,
                     min_r2: MIN_R2,
+                    shape: settled.then(|| super::fit::lagless_shape(&record)).flatten(),
                 });
             }
             let linearity = comparable.then_some(Linearity { linear_gain: element.gain, tests });
