@@ -29,6 +29,7 @@ mod faults;
 mod fehe;
 mod flowsheets;
 mod fuzz;
+mod gas_vessel;
 mod generator;
 mod heat_integration;
 mod hostile;

@@ -133,6 +133,7 @@ registry!(
     "pump" => Pump(units::pump::PumpConfig, units::pump::Pump),
     "heat_exchanger" => HeatExchanger(units::hx::HeatExchangerConfig, units::hx::HeatExchanger),
     "tank" => Tank(units::tank::TankConfig, units::tank::Tank),
+    "gas_vessel" => GasVessel(units::gas_vessel::GasVesselConfig, units::gas_vessel::GasVessel),
     "flash" => Flash(units::flash::FlashConfig, units::flash::Flash),
     "cstr" => Cstr(units::cstr::CstrConfig, units::cstr::Cstr),
     "equations" => Equations(units::equations::EquationsConfig, units::equations::Equations),

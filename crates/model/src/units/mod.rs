@@ -6,6 +6,7 @@ pub mod cstr;
 pub mod equations;
 pub mod feed;
 pub mod flash;
+pub mod gas_vessel;
 pub mod heater;
 pub mod hx;
 pub mod mixer;
