@@ -73,7 +73,7 @@ fn rows(plant: &Plant, units: &[usize], depth: &[usize]) -> Vec<usize> {
     for d in 0..=deepest {
         let mut here: Vec<usize> = units.iter().copied().filter(|&b| depth[b] == d).collect();
         let key = |b: usize| {
-            let upstream = plant.streams().iter().filter(|s| s.to.0 == b && depth[s.from.0] < d);
+            let upstream = plant.streams_into(b).iter().map(|&k| &plant.streams()[k]).filter(|s| depth[s.from.0] < d);
             upstream.map(|s| (row[s.from.0], s.from.1)).min().unwrap_or((0, 0))
         };
         here.sort_by_key(|&b| key(b));
@@ -90,13 +90,13 @@ fn depths(plant: &Plant) -> Vec<usize> {
     let mut depth = vec![usize::MAX; n];
     let mut queue = VecDeque::new();
     for (b, d) in depth.iter_mut().enumerate() {
-        if plant.blocks()[b].kind == BlockKind::Unit && !plant.streams().iter().any(|s| s.to.0 == b) {
+        if plant.blocks()[b].kind == BlockKind::Unit && plant.streams_into(b).is_empty() {
             *d = 0;
             queue.push_back(b);
         }
     }
     while let Some(b) = queue.pop_front() {
-        for s in plant.streams().iter().filter(|s| s.from.0 == b) {
+        for s in plant.streams_out_of(b).iter().map(|&k| &plant.streams()[k]) {
             if depth[s.to.0] == usize::MAX {
                 depth[s.to.0] = depth[b] + 1;
                 queue.push_back(s.to.0);

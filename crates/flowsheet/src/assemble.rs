@@ -706,6 +706,7 @@ impl<'s> Assembler<'s> {
 
     /// The plant, after each unit's own check of its input values.
     fn finish(self) -> Result<Plant, LoadError> {
+        let stream_ends = Arc::new(crate::plant::StreamEnds::new(self.blocks.len(), &self.streams));
         let plant = Plant {
             file: self.file.to_string(),
             name: self.spec.name.clone(),
@@ -715,6 +716,7 @@ impl<'s> Assembler<'s> {
             blocks: self.blocks,
             vars: Arc::new(self.vars),
             inputs: self.inputs,
+            stream_ends,
             streams: self.streams,
             aliases: Arc::new(self.aliases),
             tags: Arc::new(self.tags),

@@ -23,9 +23,10 @@ impl Plant {
                     continue;
                 }
                 order.push(b);
-                for s in self.streams.iter().filter(|s| s.from.0 == b) {
-                    if !seen[s.to.0] {
-                        queue.push_back(s.to.0);
+                for &k in self.streams_out_of(b) {
+                    let to = self.streams[k].to.0;
+                    if !seen[to] {
+                        queue.push_back(to);
                     }
                 }
             }

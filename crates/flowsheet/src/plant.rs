@@ -123,6 +123,26 @@ pub struct StreamInfo {
     pub tear: bool,
 }
 
+/// The streams entering and leaving each block: `into[b]`, `out_of[b]` (stream indices in file
+/// order).
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct StreamEnds {
+    into: Vec<Vec<usize>>,
+    out_of: Vec<Vec<usize>>,
+}
+
+impl StreamEnds {
+    /// The index of `streams` over `n_blocks` blocks.
+    pub(crate) fn new(n_blocks: usize, streams: &[StreamInfo]) -> StreamEnds {
+        let mut ends = StreamEnds { into: vec![Vec::new(); n_blocks], out_of: vec![Vec::new(); n_blocks] };
+        for (k, s) in streams.iter().enumerate() {
+            ends.into[s.to.0].push(k);
+            ends.out_of[s.from.0].push(k);
+        }
+        ends
+    }
+}
+
 /// A tag named as a path: what its name reads and moves.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct TagRef {
@@ -156,6 +176,8 @@ pub struct Plant {
     pub(crate) inputs: Vec<InputInfo>,
     /// Streams.
     pub(crate) streams: Vec<StreamInfo>,
+    /// The streams entering and leaving each block, in file order (indexed once at assembly).
+    pub(crate) stream_ends: Arc<StreamEnds>,
     /// Named inputs (`alias → input index`).
     pub(crate) aliases: Arc<HashMap<String, usize>>,
     /// Tags by name.
@@ -215,6 +237,14 @@ impl Plant {
     /// Material streams.
     pub fn streams(&self) -> &[StreamInfo] {
         &self.streams
+    }
+    /// The streams entering block `b` (indices into [`Plant::streams`], in file order).
+    pub fn streams_into(&self, b: usize) -> &[usize] {
+        &self.stream_ends.into[b]
+    }
+    /// The streams leaving block `b` (indices into [`Plant::streams`], in file order).
+    pub fn streams_out_of(&self, b: usize) -> &[usize] {
+        &self.stream_ends.out_of[b]
     }
     /// Named inputs (`alias → input index`).
     pub fn aliases(&self) -> &HashMap<String, usize> {

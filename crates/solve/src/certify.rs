@@ -96,16 +96,11 @@ pub fn certify_to(plant: &Plant, x: &[f64], u: &[f64], tol: f64) -> Result<Vec<W
     }
     let reacting = plant.blocks().iter().any(|b| b.unit.reacts());
     let scale = (0..plant.streams().len()).map(|s| x[plant.stream_flow_var(s)]).fold(0.0, f64::max).max(1e-12);
-    let (mut ins, mut outs) = (vec![Vec::new(); plant.blocks().len()], vec![Vec::new(); plant.blocks().len()]);
-    for (s, st) in plant.streams().iter().enumerate() {
-        ins[st.to.0].push(s);
-        outs[st.from.0].push(s);
-    }
     for (bi, b) in plant.blocks().iter().enumerate() {
         if b.kind != BlockKind::Unit || b.unit.boundary() != Boundary::Interior {
             continue;
         }
-        let streams = (ins[bi].iter().copied(), outs[bi].iter().copied());
+        let streams = (plant.streams_into(bi).iter().copied(), plant.streams_out_of(bi).iter().copied());
         if let Some((equation, rel)) = imbalance(plant, x, streams, b.unit.reacts(), 1e-6 * scale, tol) {
             return Err(fail(&b.name, equation, rel, floors(plant, x, bi)));
         }

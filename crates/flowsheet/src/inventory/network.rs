@@ -73,8 +73,6 @@ pub(super) struct Network<'p> {
     /// The stream at each (block, inlet port) and each (block, outlet port).
     stream_into: HashMap<(usize, usize), usize>,
     stream_out_of: HashMap<(usize, usize), usize>,
-    /// The streams entering each block.
-    inlets: Vec<Vec<usize>>,
     /// The flows each block passes on from its inlets ([`Setter::Through`]), by block.
     through: HashMap<usize, Vec<Flow>>,
     /// The inputs each block's output drives (for controllers), in input order.
@@ -96,8 +94,6 @@ impl<'p> Network<'p> {
             .map(|b| if b.kind == BlockKind::Unit { b.unit.material_flows() } else { MaterialFlows::default() })
             .collect();
         let streams = plant.streams();
-        let mut inlets = vec![Vec::new(); plant.blocks().len()];
-        streams.iter().enumerate().for_each(|(k, s)| inlets[s.to.0].push(k));
         let mut drives = vec![Vec::new(); plant.blocks().len()];
         for (i, info) in plant.inputs().iter().enumerate() {
             if let Some(v) = info.driven_by {
@@ -111,7 +107,6 @@ impl<'p> Network<'p> {
             setters: HashMap::new(),
             stream_into: streams.iter().enumerate().rev().map(|(k, s)| (s.to, k)).collect(),
             stream_out_of: streams.iter().enumerate().rev().map(|(k, s)| (s.from, k)).collect(),
-            inlets,
             through: HashMap::new(),
             drives,
             measurer: HashMap::new(),
@@ -334,7 +329,7 @@ impl<'p> Network<'p> {
 
     /// The streams entering unit `b`.
     fn inlet_streams(&self, b: usize) -> impl Iterator<Item = Flow> + '_ {
-        self.inlets[b].iter().map(|&k| Flow::Stream(k))
+        self.plant.streams_into(b).iter().map(|&k| Flow::Stream(k))
     }
 
     /// The origins of every flow: a flow that passes what enters a unit has the origins of that

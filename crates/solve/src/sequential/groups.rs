@@ -153,9 +153,10 @@ pub fn solve_groups(plant: &Plant) -> Vec<SolveGroup> {
     for (bi, b) in plant.blocks().iter().enumerate() {
         let n_own = b.layout.n_own();
         if b.n_eq > n_own {
-            for s in plant.streams().iter().filter(|s| s.to.0 == bi) {
-                let why = format!("`{}` writes the equation for the outflow of `{}`", name(bi), name(s.from.0));
-                part.join(&[s.from.0, bi], why);
+            for &k in plant.streams_into(bi) {
+                let from = plant.streams()[k].from.0;
+                let why = format!("`{}` writes the equation for the outflow of `{}`", name(bi), name(from));
+                part.join(&[from, bi], why);
             }
         }
     }

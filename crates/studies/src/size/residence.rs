@@ -71,5 +71,5 @@ fn input_value(plant: &Plant, x: &[f64], path: &VarPath) -> Option<f64> {
 /// Names of the streams leaving unit `name`.
 fn outlet_streams(plant: &Plant, name: &str) -> Vec<String> {
     let Some(b) = plant.block_index(name) else { return Vec::new() };
-    plant.streams().iter().filter(|s| s.from.0 == b).map(|s| s.name.clone()).collect()
+    plant.streams_out_of(b).iter().map(|&k| plant.streams()[k].name.clone()).collect()
 }
