@@ -72,7 +72,7 @@ pub use error::{ErrorKind, ExprError, SymbolError};
 pub use external::{BindError, ExternalCall, ExternalEval, ExternalFunction};
 pub use parse::{parse_equation, parse_expression};
 pub use span::{Span, render_caret};
-pub use structure::{Matching, StructuralError, StructureMode, check_structure, maximum_matching};
+pub use structure::{Matching, StructuralError, StructureMode, check_structure, maximum_matching, name_list};
 pub use symbols::{Symbol, SymbolTable, VarKind};
 pub use table::{Interpolation, Table, TableError};
 pub use tape::{INLINE_SLOTS, Tape, Workspace};

@@ -66,7 +66,7 @@ pub enum StructureMode {
 #[error(
     "the equations are structurally singular ({n_equations} equations, {n_unknowns} unknowns); \
      left without an unknown: {}; left without an equation: {}",
-    list(.unmatched_equations), list(.unmatched_unknowns)
+    name_list(.unmatched_equations), name_list(.unmatched_unknowns)
 )]
 pub struct StructuralError {
     /// Number of equations.
@@ -79,11 +79,20 @@ pub struct StructuralError {
     pub unmatched_unknowns: Vec<String>,
 }
 
-fn list(items: &[String]) -> String {
+/// Most names [`name_list`] writes out: an equation set flooded with copies (a file with 10 000
+/// repeated equations) is named by its first few and a count, not by a message of megabytes.
+pub const MAX_LISTED: usize = 10;
+
+/// Names for a message: each quoted, comma-separated, at most [`MAX_LISTED`] of them and then how
+/// many more; `none` for none.
+pub fn name_list<S: AsRef<str>>(items: &[S]) -> String {
     if items.is_empty() {
-        "none".to_owned()
-    } else {
-        items.iter().map(|s| format!("`{s}`")).collect::<Vec<_>>().join(", ")
+        return "none".to_owned();
+    }
+    let shown: Vec<String> = items.iter().take(MAX_LISTED).map(|s| format!("`{}`", s.as_ref())).collect();
+    match items.len().saturating_sub(MAX_LISTED) {
+        0 => shown.join(", "),
+        more => format!("{}, … and {more} more", shown.join(", ")),
     }
 }
 

@@ -49,3 +49,14 @@ fn singular_sets_name_what_is_left_over() {
     assert_eq!(err.unmatched_unknowns, vec!["der(T)".to_owned()]);
     assert!(err.unmatched_equations.is_empty());
 }
+
+/// A flooded equation set (10 000 copies of one equation, a fuzz mutant of the evaporator) is
+/// named by its first ten and a count: the message stays a few kB, not 300 kB.
+#[test]
+fn a_flood_of_unmatched_equations_is_named_by_the_first_ten_and_a_count() {
+    let many: Vec<String> = (0..10_000).map(|k| format!("x{k} = 1")).collect();
+    let text = plantwide_expr::name_list(&many);
+    assert!(text.starts_with("`x0 = 1`, `x1 = 1`") && text.ends_with("`x9 = 1`, … and 9990 more"), "{text}");
+    assert_eq!(plantwide_expr::name_list(&["a", "b"]), "`a`, `b`");
+    assert_eq!(plantwide_expr::name_list::<&str>(&[]), "none");
+}

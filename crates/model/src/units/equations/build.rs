@@ -453,19 +453,14 @@ impl Builder<'_, '_> {
                 let base = symbols.variable_name(i).map_or_else(|| format!("x[{i}]"), str::to_owned);
                 if is_differential(i) { format!("der({base})") } else { base }
             };
-            let list = |v: Vec<String>| {
-                if v.is_empty() {
-                    "none".to_owned()
-                } else {
-                    v.iter().map(|s| format!("`{s}`")).collect::<Vec<_>>().join(", ")
-                }
-            };
-            let unmatched_eqs = matching.unmatched_equations().into_iter().map(|e| compiled[e].1.text().to_owned());
+            let unmatched_eqs: Vec<&str> =
+                matching.unmatched_equations().into_iter().map(|e| compiled[e].1.text()).collect();
+            let unmatched: Vec<String> = matching.unmatched_unknowns().into_iter().map(name).collect();
             let msg = format!(
                 "the equations are structurally singular ({} equations, {n_own} unknowns); left without an unknown: {}; left without an equation: {}",
                 incidence.len(),
-                list(unmatched_eqs.collect()),
-                list(matching.unmatched_unknowns().into_iter().map(name).collect()),
+                plantwide_expr::name_list(&unmatched_eqs),
+                plantwide_expr::name_list(&unmatched),
             );
             self.cx.error("equations", msg);
             // Each equation left over, at its own field with the whole text marked: every unknown it
