@@ -58,3 +58,38 @@ fn blowdown_through_a_gas_valve_matches_scipy_choked_and_subcritical() {
         eprintln!("{case}: largest relative difference from SciPy {worst:.1e}");
     }
 }
+
+/// The shipped `flowsheets/gas_receiver.json`: held at 12 barg by its vent valve, the valve's
+/// opening is SciPy's root of the same valve equation (to 1e-9), and its tags read in their units
+/// (12 barg; 40 mol/s is 3.2276 kscmh at 22.41396954 L/mol, CODATA). After the supply's +20 %
+/// step the pressure is back at 12 barg and the opening at SciPy's for 48 mol/s (to 1e-6), with
+/// moles conserved.
+#[test]
+fn the_shipped_receiver_holds_its_pressure_on_the_valve_scipy_predicts() {
+    let reference: Value =
+        serde_json::from_str(&std::fs::read_to_string(fixture("data/gas/blowdown_reference.json")).unwrap()).unwrap();
+    let opening = |f: &str| reference["receiver_openings"][f].as_f64().unwrap();
+    let sheet = crate::harness::flowsheet("gas_receiver.json");
+    let out = plantwide(&["steady", &sheet, "--json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let s: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let op = s["values"]["PC101.op"].as_f64().unwrap();
+    assert!((op - opening("40")).abs() < 1e-9, "opening {op} against SciPy's {}", opening("40"));
+    assert!((s["tags"]["PI-101"].as_f64().unwrap() - 12.0).abs() < 1e-9, "{}", s["tags"]);
+    let kscmh = 40.0 * 22.413_969_54e-3 * 3.6;
+    assert!((s["tags"]["FI-101"].as_f64().unwrap() - kscmh).abs() < 1e-8, "{}", s["tags"]);
+
+    let dir = std::env::temp_dir().join(format!("plantwide-gas-receiver-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let csv = dir.join("run.csv");
+    let scen = crate::harness::flowsheet("scenarios/gas_receiver_supply_step.json");
+    let out = plantwide(&["run", &sheet, "--scenario", &scen, "--csv", csv.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("conservation (moles): largest relative error"));
+    let text = std::fs::read_to_string(&csv).unwrap();
+    assert!(text.starts_with("time [min],PI-101 [barg],FI-101 [kscmh],PC101.op [1],vent.T [K]"), "{text:.80}");
+    let last: Vec<f64> = text.lines().last().unwrap().split(',').map(|x| x.parse().unwrap()).collect();
+    assert!((last[1] - 12.0).abs() < 1e-6 && (last[3] - opening("48")).abs() < 1e-6, "{last:?}");
+    let peak = text.lines().skip(1).filter_map(|l| l.split(',').nth(1)?.parse::<f64>().ok()).fold(0.0, f64::max);
+    assert!(peak > 12.01, "the step lifts the pressure before the loop answers: {peak} barg");
+}

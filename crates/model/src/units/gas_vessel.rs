@@ -33,7 +33,7 @@ use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 use super::outflow::{ATM, Characteristic, signed_sqrt};
-use crate::capability::{Booking, Duty, DutySource, FlowLaw, MaterialFlows, Shape};
+use crate::capability::{Booking, Duty, DutySource, FlowLaw, InventoryPhase, MaterialFlows, Shape};
 use crate::stream::{F, H, P, T, Z0};
 use crate::{BuildCx, FieldError, InputSpec, Scalar, UnitIo, UnitModel, VarSpec};
 
@@ -161,13 +161,18 @@ impl UnitModel for GasVessel {
         Shape::Vessel
     }
     /// The gas, filled by `in` and drained by `out`: by its valve under the vessel's pressure, or
-    /// by a downstream unit.
+    /// by a downstream unit; measured by the pressure `P`.
     fn material_flows(&self) -> MaterialFlows {
         let law = match self.law {
             GasLaw::Valve { .. } => Some(FlowLaw::Holdup { input: Some("opening".into()) }),
             GasLaw::Free => None,
         };
-        MaterialFlows::vessel(&["in"], vec![("out", law)])
+        let mut flows = MaterialFlows::vessel(&["in"], vec![("out", law)]);
+        for inventory in &mut flows.inventories {
+            inventory.phase = InventoryPhase::Gas;
+            inventory.measured = vec!["P".into()];
+        }
+        flows
     }
     /// The input `duty` \[W\], heat put into the gas.
     fn duties(&self) -> Vec<Duty> {
