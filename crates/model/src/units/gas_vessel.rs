@@ -277,9 +277,9 @@ impl GasVessel {
 
 #[cfg(test)]
 mod tests {
-    use super::super::outflow::test_support::{Lcg, at_guess, build_unit, solve_own};
+    use super::super::outflow::test_support::{Lcg, at_guess, build_unit, solve_own, worst_jacobian_error};
     use super::*;
-    use crate::testing::{binary_package, jacobian_error};
+    use crate::testing::binary_package;
 
     const SUBCRITICAL: &str = r#"{"volume": "2 m3", "duty": "5 kW",
         "outflow": {"type": "valve", "cv": "2e-4 m2", "opening": 0.6, "p_out": "4 bar"}}"#;
@@ -298,13 +298,7 @@ mod tests {
         let mut rng = Lcg(3);
         for json in [SUBCRITICAL, CHOKED, FREE] {
             let u = build_unit(json, &thermo, GasVessel::build);
-            let (lay, base) = at_guess(&u, &thermo, &feed(&thermo));
-            let n_eq = (lay.n_own() as isize + UnitModel::extra_equations(&u)) as usize;
-            let mut worst: f64 = 0.0;
-            for _ in 0..5 {
-                let local: Vec<f64> = base.iter().map(|v| v * rng.range(0.9, 1.1)).collect();
-                worst = worst.max(jacobian_error(&u, &lay, &thermo, &local, n_eq));
-            }
+            let worst = worst_jacobian_error(&u, &thermo, &feed(&thermo), &mut rng, 0.1);
             assert!(worst < 1e-6, "{json}: {worst}");
         }
     }

@@ -436,6 +436,29 @@ pub(crate) mod test_support {
     /// A seeded linear congruential generator.
     pub struct Lcg(pub u64);
 
+    /// The largest [`crate::testing::jacobian_error`] of `unit` over five points around its guess
+    /// from `inlet`: each local value scaled by a factor in `[1 − spread, 1 + spread)`, a zero
+    /// replaced by a number in `[0.01, 0.1)`.
+    pub fn worst_jacobian_error(
+        unit: &dyn Unit,
+        thermo: &ThermoPackage,
+        inlet: &[f64],
+        rng: &mut Lcg,
+        spread: f64,
+    ) -> f64 {
+        let (lay, base) = at_guess(unit, thermo, inlet);
+        let n_eq = (lay.n_own() as isize + unit.extra_equations()) as usize;
+        let mut worst: f64 = 0.0;
+        for _ in 0..5 {
+            let local: Vec<f64> = base
+                .iter()
+                .map(|&v| if v == 0.0 { rng.range(0.01, 0.1) } else { v * rng.range(1.0 - spread, 1.0 + spread) })
+                .collect();
+            worst = worst.max(crate::testing::jacobian_error(unit, &lay, thermo, &local, n_eq));
+        }
+        worst
+    }
+
     impl Lcg {
         /// Next number in [lo, hi).
         pub fn range(&mut self, lo: f64, hi: f64) -> f64 {

@@ -169,7 +169,7 @@ impl UnitModel for Tank {
 
 #[cfg(test)]
 mod tests {
-    use super::super::outflow::test_support::{Lcg, at_guess, build_unit, solve_own};
+    use super::super::outflow::test_support::{Lcg, at_guess, build_unit, solve_own, worst_jacobian_error};
     use super::super::outflow::{Characteristic, GRAVITY};
     use super::*;
     use crate::testing::{binary_package, jacobian_error};
@@ -191,13 +191,7 @@ mod tests {
         let mut rng = Lcg(7);
         for json in [VALVE, VALVE_EQP, FLOW, FREE] {
             let u = build_unit(json, &thermo, Tank::build);
-            let (lay, base) = at_guess(&u, &thermo, &feed(&thermo));
-            let n_eq = (lay.n_own() as isize + UnitModel::extra_equations(&u)) as usize;
-            let mut worst: f64 = 0.0;
-            for _ in 0..5 {
-                let local: Vec<f64> = base.iter().map(|v| v * rng.range(0.8, 1.2)).collect();
-                worst = worst.max(jacobian_error(&u, &lay, &thermo, &local, n_eq));
-            }
+            let worst = worst_jacobian_error(&u, &thermo, &feed(&thermo), &mut rng, 0.2);
             eprintln!("tank jacobian_error {worst:.1e}: {json}");
             assert!(worst < 1e-6, "{json}: {worst}");
         }
