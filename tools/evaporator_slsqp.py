@@ -177,7 +177,10 @@ def run_slsqp(x0):
     res = minimize(lambda s: COST_SCALE * np.real(cost(s * SCALE)), np.asarray(x0) / SCALE,
                    jac=lambda s: COST_SCALE * cs_grad(cost, s * SCALE) * SCALE, method="SLSQP",
                    bounds=bounds, constraints=slsqp_constraints(), options=SLSQP_OPTIONS)
-    assert res.success, (x0, res.message)
+    # Where SLSQP stops from a start depends on the machine's rounding: with SciPy 1.17.1 and
+    # NumPy 2.4.6 every start converged on the machine that wrote slsqp.json, while on another
+    # the first stops at F1 = 18.75 with "Positive directional derivative for linesearch". Each
+    # start's end is recorded (`reached`); solve() needs one that reaches the optimum.
     res.x = res.x * SCALE
     res.fun = res.fun / COST_SCALE
     if getattr(res, "multipliers", None) is not None:
@@ -293,7 +296,7 @@ def multipliers(res, prices):
         "convention": "SciPy SLSQP: L = J - sum(lambda_i c_i) with every constraint written c_i(v) >= 0 "
         "(c = x - limit for a :min, c = limit - x for a :max) and lambda_i >= 0, so "
         "dJ*/d(limit) = +lambda for a :min and -lambda for a :max; multipliers of the QP "
-        "subproblem at the last iterate of the first start (bounds get none), unscaled to $/h per unit",
+        "subproblem at the last iterate of the first start that reaches the optimum (bounds get none), unscaled to $/h per unit",
         "lambda": raw,
         "as_dJ_dlimit": as_price,
         "relative_difference": diff,
@@ -305,8 +308,7 @@ def start_record(x0, res, opt):
     pt = model(res.x)
     keys = VARS + ["cost"]
     worst = max(rel(float(pt[k]), float(opt[k])) for k in keys)
-    assert worst < 1e-6, (x0, worst)
-    return {"x0": dict(zip(VARS, x0)), "iterations": int(res.nit), "function_evaluations": int(res.nfev),
+    return {"x0": dict(zip(VARS, x0)), "reached": bool(worst < 1e-6), "iterations": int(res.nit), "function_evaluations": int(res.nfev),
             "gradient_evaluations": int(res.njev), "message": str(res.message),
             "x": dict(zip(VARS, map(float, res.x))), "cost": float(res.fun),
             "max_relative_difference_from_polished": worst}
@@ -314,18 +316,19 @@ def start_record(x0, res, opt):
 
 def solve():
     """Every SLSQP run, checked against each other, the polished optimum and the reduced reference."""
-    runs = [run_slsqp(x0) for x0 in STARTS]
+    all_runs = [run_slsqp(x0) for x0 in STARTS]
+    ref = json.loads(REDUCED.read_text())["optimum"]
+    near = lambda res: all(rel(float(x), ref[k]) < 1e-7 for k, x in (("F1", res.x[0]), ("F200", res.x[1]), ("cost", res.fun)))
+    runs = [res for res in all_runs if near(res)]
+    for x0, res in zip(STARTS, all_runs):
+        if not near(res):
+            print(f"evaporator_slsqp: SLSQP from {x0} stops short ({res.message}): F1 {res.x[0]:.6g}", file=sys.stderr)
+    assert runs, "SLSQP reaches the reduced reference's optimum from no start"
     v_opt = polish(runs[0].x[:2])
     opt = model(v_opt)
-    ref = json.loads(REDUCED.read_text())["optimum"]
     for k in ("F1", "F200", "cost"):
         assert rel(float(opt[k]), ref[k]) < 1e-7, (k, opt[k], ref[k])
-    for res in runs:
-        for a, b in ((res.x[0], runs[0].x[0]), (res.x[1], runs[0].x[1]), (res.fun, runs[0].fun)):
-            assert rel(a, b) < 1e-7, (a, b)
-        for k, x in (("F1", res.x[0]), ("F200", res.x[1]), ("cost", res.fun)):
-            assert rel(float(x), ref[k]) < 1e-7, (k, x, ref[k])
-    starts = [start_record(x0, res, opt) for x0, res in zip(STARTS, runs)]
+    starts = [start_record(x0, res, opt) for x0, res in zip(STARTS, all_runs)]
     return runs, v_opt, opt, starts
 
 
@@ -637,6 +640,12 @@ def compare(new, old, path="", rtol=1e-9, atol=1e-12):
     if path.endswith(("versions", "asymmetry_over_max", "relative_difference", "max_relative_difference_from_polished",
                       "max_difference_over_max")):
         return []
+    # The optimizer's path (each start's end, counts and message; the QP multipliers at the last
+    # iterate of the first start that reaches the optimum) depends on the machine's rounding; the
+    # script asserts the multipliers against the envelope prices to 1e-6 and needs one start at
+    # the optimum. The optimum itself and everything derived from it is compared.
+    if path.startswith((".starts", ".slsqp_multipliers")):
+        return []
     if path.endswith(".loss"):
         atol = LOSS_ATOL
     if isinstance(new, dict) and isinstance(old, dict):
@@ -667,7 +676,8 @@ def main():
         print(f"{name}: matches a fresh run (optimum F1 {o['F1']:.4f}, F200 {o['F200']:.3f} kg/min, "
               f"J {o['cost']:.3f} $/h; shadow prices X2:min {s['evaporator.X2:min']['envelope']:.4f} $/h per %, "
               f"P100:max {s['evaporator.P100:max']['envelope']:.5f} $/h per kPa; "
-              f"SLSQP iterations {[r['iterations'] for r in ref['starts']]})")
+              f"SLSQP iterations {[r['iterations'] for r in ref['starts']]}, "
+              f"reaching the optimum {[r['reached'] for r in ref['starts']]})")
         return
     OUT.write_text(json.dumps(ref, indent=1) + "\n")
     print(f"wrote {name}")
