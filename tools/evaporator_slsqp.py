@@ -178,9 +178,10 @@ def run_slsqp(x0):
                    jac=lambda s: COST_SCALE * cs_grad(cost, s * SCALE) * SCALE, method="SLSQP",
                    bounds=bounds, constraints=slsqp_constraints(), options=SLSQP_OPTIONS)
     # Where SLSQP stops from a start depends on the machine's rounding: with SciPy 1.17.1 and
-    # NumPy 2.4.6 every start converged on the machine that wrote slsqp.json, while on another
-    # the first stops at F1 = 18.75 with "Positive directional derivative for linesearch". Each
-    # start's end is recorded (`reached`); solve() needs one that reaches the optimum.
+    # NumPy 2.4.6 every start converged on the machine that first wrote slsqp.json (2026-12-07),
+    # while on the one that rewrote it (2026-12-08) the first stops at F1 = 18.75 with "Positive
+    # directional derivative for linesearch". Each start's end is recorded (`reached`); solve()
+    # needs one that reaches the optimum.
     res.x = res.x * SCALE
     res.fun = res.fun / COST_SCALE
     if getattr(res, "multipliers", None) is not None:
